@@ -1,0 +1,22 @@
+//! # flexstar-model
+//!
+//! The data every other flexstar crate shares: the robot's parameters (paper, section 8), the
+//! base geometry (Eqs. 1-3), the actuator trajectories `s_i(t)`, the TOML experiment files and
+//! the [`Response`] that every solver returns. No solver code lives here.
+//!
+//! Conventions (frames, signs, units) are written once, in `docs/conventions.md`; the items here
+//! follow them. All quantities are SI: metres, seconds, kilograms, newtons, radians.
+
+pub mod config;
+pub mod error;
+pub mod geometry;
+pub mod output;
+pub mod params;
+pub mod response;
+pub mod trajectory;
+
+pub use config::{AmmSettings, Experiment, FemSettings, ModeFamily, TimeSpan};
+pub use error::ModelError;
+pub use params::RobotParams;
+pub use response::{BeamShape, Column, Response, StarShape};
+pub use trajectory::{Pose, Trajectory};

@@ -1,0 +1,154 @@
+//! Robot parameters (paper, section 8; MODEL-NOTES section 1).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::ModelError;
+
+/// Physical parameters of the star-triangle robot. All three beams are identical.
+///
+/// TOML keys keep the paper's symbols (`E`, `I`, `rho`, `L`, `d`, `Lp`, `mpp_mpa`, `Jp`); every
+/// key is optional and defaults to the paper's value (section 8).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RobotParams {
+    /// Young's modulus E [Pa].
+    #[serde(rename = "E")]
+    pub e: f64,
+    /// Second moment of area I of the beam section [m^4].
+    #[serde(rename = "I")]
+    pub i: f64,
+    /// Mass per unit length rho of each beam [kg/m].
+    pub rho: f64,
+    /// Beam length L, junction G to free tip [m].
+    #[serde(rename = "L")]
+    pub l: f64,
+    /// In-radius d of the base triangle [m] (Eqs. 1-3).
+    pub d: f64,
+    /// Sleeve (passive prismatic joint) length Lp [m].
+    #[serde(rename = "Lp")]
+    pub lp: f64,
+    /// Mass of passive + active prismatic joint, mpp + mpa [kg] (Eq. 33).
+    pub mpp_mpa: f64,
+    /// Rotational inertia Jp of a sleeve about its pin [kg m^2] (Eq. 31).
+    #[serde(rename = "Jp")]
+    pub jp: f64,
+    /// Axial stiffness EA [N] used by models with axially flexible beams (FEM).
+    /// Default `E * rho / 7800` (steel density), MODEL-NOTES section 1: 6e6 N.
+    #[serde(rename = "EA")]
+    pub ea: Option<f64>,
+}
+
+impl Default for RobotParams {
+    fn default() -> Self {
+        Self::paper()
+    }
+}
+
+impl RobotParams {
+    /// The paper's parameters (section 8).
+    pub fn paper() -> Self {
+        RobotParams {
+            e: 200e9,
+            i: 2.5e-12,
+            rho: 0.234,
+            l: 0.5,
+            d: 0.18,
+            lp: 0.03,
+            mpp_mpa: 0.2,
+            jp: 2e-4,
+            ea: None,
+        }
+    }
+
+    /// Bending stiffness EI [N m^2].
+    pub fn ei(&self) -> f64 {
+        self.e * self.i
+    }
+
+    /// Axial stiffness EA [N]: the given value or `E * rho / 7800`.
+    pub fn ea(&self) -> f64 {
+        self.ea.unwrap_or(self.e * self.rho / 7800.0)
+    }
+
+    /// Half a side of the base triangle, `sqrt(3) d` [m]: a slider stays within `|s_i| < sqrt(3) d`.
+    pub fn half_side(&self) -> f64 {
+        3f64.sqrt() * self.d
+    }
+
+    /// Mass of the rigid star, `3 rho L` [kg].
+    pub fn star_mass(&self) -> f64 {
+        3.0 * self.rho * self.l
+    }
+
+    /// Rotational inertia of the rigid star about G, `3 rho L^3 / 3 = rho L^3` [kg m^2].
+    pub fn star_inertia(&self) -> f64 {
+        self.rho * self.l.powi(3)
+    }
+
+    /// Check every parameter; the error names the key and the reason.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        let positive = [
+            ("robot.E", self.e),
+            ("robot.I", self.i),
+            ("robot.rho", self.rho),
+            ("robot.L", self.l),
+            ("robot.d", self.d),
+            ("robot.Lp", self.lp),
+        ];
+        for (key, v) in positive {
+            if !v.is_finite() || v <= 0.0 {
+                return Err(ModelError::invalid(key, format!("must be a positive finite number, got {v}")));
+            }
+        }
+        for (key, v) in [("robot.mpp_mpa", self.mpp_mpa), ("robot.Jp", self.jp)] {
+            if !v.is_finite() || v < 0.0 {
+                return Err(ModelError::invalid(key, format!("must be a finite number >= 0, got {v}")));
+            }
+        }
+        if let Some(ea) = self.ea {
+            if !ea.is_finite() || ea <= 0.0 {
+                return Err(ModelError::invalid("robot.EA", format!("must be a positive finite number, got {ea}")));
+            }
+        }
+        if self.lp >= self.l {
+            return Err(ModelError::invalid(
+                "robot.Lp",
+                format!("the sleeve must be shorter than the beam: 0 < Lp < L = {}, got {}", self.l, self.lp),
+            ));
+        }
+        if self.d + self.lp / 2.0 >= self.l {
+            return Err(ModelError::invalid(
+                "robot.L",
+                format!(
+                    "the beams must pass through the sleeves at the start: need d + Lp/2 < L, got d = {}, Lp = {}, L = {}",
+                    self.d, self.lp, self.l
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_values_give_ei_half() {
+        // MODEL-NOTES section 1: EI = 0.5 N m^2, EA = 6e6 N.
+        let p = RobotParams::paper();
+        assert!((p.ei() - 0.5).abs() < 1e-12);
+        assert!((p.ea() - 6e6).abs() < 1e-6);
+        p.validate().unwrap();
+    }
+
+    #[test]
+    fn rejects_nan_and_negative() {
+        let mut p = RobotParams::paper();
+        p.rho = f64::NAN;
+        assert!(p.validate().unwrap_err().to_string().contains("robot.rho"));
+        let mut p = RobotParams::paper();
+        p.l = -1.0;
+        assert!(p.validate().unwrap_err().to_string().contains("robot.L"));
+    }
+}

@@ -1,0 +1,155 @@
+//! The result every solver returns, and its CSV form.
+//!
+//! Elastic outputs follow MODEL-NOTES section 2: `w_iG` is the elastic displacement of G projected
+//! on `e_wi`; the tip value `w_i(L)` is `(tip - (G_rigid + L e_xi)) . e_wi` [m]; `Fa_i` is the force
+//! the actuator applies to slider i along its +s direction [N] (Eq. 33).
+
+use std::path::Path;
+
+use crate::error::ModelError;
+use crate::output::write_atomically;
+
+/// Fixed leading CSV columns of every solver result (issue contract).
+pub const RESPONSE_HEADER: [&str; 10] = [
+    "t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3",
+];
+
+/// A named extra output column (multipliers, sleeve rotations, ...), one value per output time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Column {
+    pub name: String,
+    pub values: Vec<f64>,
+}
+
+/// Shape of one beam at one instant, sampled along the material coordinate.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BeamShape {
+    /// Material coordinate from G [m], 0..L.
+    pub x: Vec<f64>,
+    /// Elastic transverse displacement in the rigid frame of the beam, `w_i(x)` [m].
+    pub w: Vec<f64>,
+    /// Absolute position of the beam point in the fixed frame [m].
+    pub pos: Vec<[f64; 2]>,
+}
+
+/// The deformed star at one instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StarShape {
+    pub t: f64,
+    pub beams: [BeamShape; 3],
+}
+
+/// Time histories produced by a solver at the output times.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Response {
+    /// Solver label, e.g. `amm-free-free` or `fem`.
+    pub label: String,
+    /// Output times [s].
+    pub t: Vec<f64>,
+    /// `w_iG` [m], i = 1..3.
+    pub w_g: [Vec<f64>; 3],
+    /// Tip `w_i(L)` [m], i = 1..3 (points A, B, C).
+    pub w_tip: [Vec<f64>; 3],
+    /// Driving forces `Fa_i` [N] (Eq. 33).
+    pub fa: [Vec<f64>; 3],
+    /// Further columns written after the fixed ones.
+    pub extra: Vec<Column>,
+    /// Deformed star at the requested instants.
+    pub shapes: Vec<StarShape>,
+}
+
+impl Response {
+    /// An empty response with room for `n` output times.
+    pub fn with_capacity(label: impl Into<String>, n: usize) -> Self {
+        let v = || Vec::with_capacity(n);
+        Response {
+            label: label.into(),
+            t: v(),
+            w_g: [v(), v(), v()],
+            w_tip: [v(), v(), v()],
+            fa: [v(), v(), v()],
+            extra: Vec::new(),
+            shapes: Vec::new(),
+        }
+    }
+
+    /// Append one output row of the fixed columns.
+    pub fn push(&mut self, t: f64, w_g: [f64; 3], w_tip: [f64; 3], fa: [f64; 3]) {
+        self.t.push(t);
+        for i in 0..3 {
+            self.w_g[i].push(w_g[i]);
+            self.w_tip[i].push(w_tip[i]);
+            self.fa[i].push(fa[i]);
+        }
+    }
+
+    /// Number of output rows.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// Column header: [`RESPONSE_HEADER`] then the extra columns.
+    pub fn header(&self) -> Vec<String> {
+        RESPONSE_HEADER
+            .iter()
+            .map(|s| s.to_string())
+            .chain(self.extra.iter().map(|c| c.name.clone()))
+            .collect()
+    }
+
+    /// Write the response as CSV, whole or not at all.
+    pub fn write_csv(&self, path: &Path) -> Result<(), ModelError> {
+        for c in &self.extra {
+            if c.values.len() != self.len() {
+                return Err(ModelError::Write {
+                    file: path.to_path_buf(),
+                    reason: format!("column {} has {} rows, expected {}", c.name, c.values.len(), self.len()),
+                });
+            }
+        }
+        write_atomically(path, |w| {
+            let mut out = csv::Writer::from_writer(w);
+            out.write_record(self.header())?;
+            let mut row = Vec::with_capacity(10 + self.extra.len());
+            for k in 0..self.len() {
+                row.clear();
+                row.push(self.t[k]);
+                for group in [&self.w_g, &self.w_tip, &self.fa] {
+                    row.extend(group.iter().map(|c| c[k]));
+                }
+                row.extend(self.extra.iter().map(|c| c.values[k]));
+                out.write_record(row.iter().map(|v| format!("{v:e}")))?;
+            }
+            out.flush()?;
+            Ok(())
+        })
+    }
+
+    /// Write the deformed-star snapshots as CSV (`t,beam,x,w,X,Y`), whole or not at all.
+    pub fn write_shapes_csv(&self, path: &Path) -> Result<(), ModelError> {
+        write_atomically(path, |w| {
+            let mut out = csv::Writer::from_writer(w);
+            out.write_record(["t", "beam", "x", "w", "X", "Y"])?;
+            for s in &self.shapes {
+                for (i, b) in s.beams.iter().enumerate() {
+                    for k in 0..b.x.len() {
+                        out.write_record([
+                            format!("{:e}", s.t),
+                            format!("{}", i + 1),
+                            format!("{:e}", b.x[k]),
+                            format!("{:e}", b.w[k]),
+                            format!("{:e}", b.pos[k][0]),
+                            format!("{:e}", b.pos[k][1]),
+                        ])?;
+                    }
+                }
+            }
+            out.flush()?;
+            Ok(())
+        })
+    }
+}

@@ -1,0 +1,123 @@
+//! Where a trajectory leaves the feasible range (MODEL-NOTES section 6).
+//!
+//! A motion is physically possible while, for every beam and slider,
+//! `Lp/2 < xp_i` (the sleeve does not reach the junction G), `xp_i + Lp/2 < L` (it does not slide
+//! off the tip), `|s_i| < sqrt(3) d` (the slider stays on its side of the base) and every angle of
+//! IJK is below 120 degrees (the Fermat point exists).
+
+use flexstar_model::geometry::revolute_point;
+use flexstar_model::{RobotParams, Trajectory};
+
+
+use crate::direct::{direct_kinematics, largest_angle};
+
+/// Which limit is violated.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Violation {
+    /// Sleeve i reaches the junction G: `xp_i <= Lp/2`.
+    SleeveAtJunction { beam: usize, xp: f64 },
+    /// Sleeve i slides off the tip: `xp_i + Lp/2 >= L`.
+    SleeveOffTip { beam: usize, xp: f64 },
+    /// Slider i leaves its side of the base: `|s_i| >= sqrt(3) d`.
+    SliderOffBase { slider: usize, s: f64 },
+    /// An angle of IJK reaches 120 degrees: no Fermat point.
+    NoFermatPoint { vertex: usize, angle_deg: f64 },
+    /// The trajectory could not be evaluated (e.g. inverse kinematics of a task-space pose).
+    Trajectory(String),
+}
+
+impl std::fmt::Display for Violation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Violation::SleeveAtJunction { beam, xp } => {
+                write!(f, "sleeve {beam} reaches the junction G (xp{beam} = {xp:.5} m, limit Lp/2)")
+            }
+            Violation::SleeveOffTip { beam, xp } => {
+                write!(f, "sleeve {beam} slides off the tip of beam {beam} (xp{beam} = {xp:.5} m, limit L - Lp/2)")
+            }
+            Violation::SliderOffBase { slider, s } => {
+                write!(f, "slider {slider} leaves its side of the base (s{slider} = {s:.5} m, limit sqrt(3) d)")
+            }
+            Violation::NoFermatPoint { vertex, angle_deg } => write!(
+                f,
+                "triangle IJK has an angle of {angle_deg:.2} degrees at {} (no Fermat point beyond 120)",
+                ["I", "J", "K"][*vertex]
+            ),
+            Violation::Trajectory(msg) => write!(f, "{msg}"),
+        }
+    }
+}
+
+/// The trajectory leaves the feasible range at time `t`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("trajectory infeasible at t = {t:.4} s: {violation}")]
+pub struct Infeasible {
+    /// First time at which a limit is reached [s] (to 1e-9 s).
+    pub t: f64,
+    pub violation: Violation,
+}
+
+/// Smallest feasibility margin at time t and the limit it belongs to; negative means violated.
+fn margin(params: &RobotParams, traj: &Trajectory, t: f64) -> (f64, Violation) {
+    let s = match traj.s(params, t) {
+        Ok(s) => s,
+        Err(e) => return (-1.0, Violation::Trajectory(e.to_string())),
+    };
+    let mut worst = (f64::INFINITY, Violation::Trajectory(String::new()));
+    let mut take = |m: f64, v: Violation| {
+        if m < worst.0 {
+            worst = (m, v);
+        }
+    };
+    for (i, si) in s.iter().enumerate() {
+        take(params.half_side() - si.abs(), Violation::SliderOffBase { slider: i + 1, s: *si });
+    }
+    let pts = [0, 1, 2].map(|i| revolute_point(i, params.d, s[i]));
+    let (ang, k) = largest_angle(&pts);
+    // angle margin scaled to a length so that the margins are comparable
+    take((2.0 * std::f64::consts::FRAC_PI_3 - ang) * params.lp, Violation::NoFermatPoint { vertex: k, angle_deg: ang.to_degrees() });
+    if let Some(pose) = direct_kinematics(params.d, s) {
+        for (i, xp) in pose.xp.iter().enumerate() {
+            take(xp - params.lp / 2.0, Violation::SleeveAtJunction { beam: i + 1, xp: *xp });
+            take(params.l - params.lp / 2.0 - xp, Violation::SleeveOffTip { beam: i + 1, xp: *xp });
+        }
+    }
+    worst
+}
+
+/// Check `[0, t_end]`: `Ok` if the motion stays feasible, otherwise the first time a limit is
+/// reached (scanned at steps of at most `scan_step` and refined by bisection) and the reason.
+pub fn check_trajectory(params: &RobotParams, traj: &Trajectory, t_end: f64, scan_step: f64) -> Result<(), Infeasible> {
+    let n = ((t_end / scan_step.min(t_end / 200.0)).ceil() as usize).max(1);
+    let (m0, v0) = margin(params, traj, 0.0);
+    if m0 <= 0.0 {
+        return Err(Infeasible { t: 0.0, violation: v0 });
+    }
+    let mut t_ok = 0.0;
+    for k in 1..=n {
+        let t = t_end * k as f64 / n as f64;
+        let (m, _) = margin(params, traj, t);
+        if m <= 0.0 {
+            let (mut lo, mut hi) = (t_ok, t);
+            while hi - lo > 1e-10 {
+                let mid = 0.5 * (lo + hi);
+                if margin(params, traj, mid).0 <= 0.0 {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            let (_, violation) = margin(params, traj, hi);
+            return Err(Infeasible { t: hi, violation });
+        }
+        t_ok = t;
+    }
+    Ok(())
+}
+
+/// Is `s` (at rest) inside the feasible range? Used by property tests and samplers.
+pub fn is_feasible_configuration(params: &RobotParams, s: [f64; 3]) -> bool {
+    let traj = Trajectory::Polynomial { s1: vec![s[0]], s2: vec![s[1]], s3: vec![s[2]] };
+    margin(params, &traj, 0.0).0 > 0.0
+}
+

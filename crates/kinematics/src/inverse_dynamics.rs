@@ -1,0 +1,56 @@
+//! Rigid-body inverse dynamics of star + sleeves + sliders: the driving forces the robot needs if
+//! the star were rigid. The flexible models must reach it in the stiff limit.
+//!
+//! Unknowns: the normal force `f_i e_wi` that sleeve i exerts on the star (frictionless, so no
+//! component along the beam; it passes through the pin, which lies on the beam). Each sleeve
+//! turns with the star (theta_pi = 0), so the moment it exerts on the star is `-Jp theta''`.
+//! Newton-Euler for the star about its centre of mass G (sum of e_xi is zero):
+//!
+//! ```text
+//! 3 rho L a_G                      = sum_i f_i e_wi
+//! (rho L^3 + 3 Jp) theta''         = sum_i xp_i f_i
+//! ```
+//! and for slider i (mass mpp + mpa along u_i), Eq. 33 with `e_wi . u_i = cos(theta)`:
+//! `Fa_i = (mpp + mpa) s_i'' + f_i e_wi . u_i`.
+
+use flexstar_model::geometry::slider_direction;
+use flexstar_model::RobotParams;
+
+use crate::state::{dot, RigidState};
+
+/// Forces of the rigid robot at one instant [N].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidForces {
+    /// Driving force of actuator i along +s_i (Eq. 33).
+    pub fa: [f64; 3],
+    /// Normal force of sleeve i on the star along e_wi (`Fp + FL + FR` of Eq. 33).
+    pub normal: [f64; 3],
+}
+
+/// Driving forces of the rigid robot (Eq. 33 with a rigid star and `theta_pi = 0`).
+pub fn rigid_inverse_dynamics(params: &RobotParams, state: &RigidState) -> RigidForces {
+    let ew = [0, 1, 2].map(|i| state.e_w(i));
+    let a = state.a_g();
+    let m = params.star_mass();
+    let j = params.star_inertia() + 3.0 * params.jp;
+    let rows = [
+        [ew[0][0], ew[1][0], ew[2][0], m * a[0]],
+        [ew[0][1], ew[1][1], ew[2][1], m * a[1]],
+        [state.xp[0].v, state.xp[1].v, state.xp[2].v, j * state.theta.d2],
+    ];
+    let normal = solve3(rows);
+    let fa = [0, 1, 2].map(|i| params.mpp_mpa * state.s[i].d2 + normal[i] * dot(ew[i], slider_direction(i)));
+    RigidForces { fa, normal }
+}
+
+/// Cramer's rule for a 3x3 system given as augmented rows (the matrix is well conditioned
+/// whenever the Fermat point exists: the e_wi are 120 degrees apart).
+fn solve3(r: [[f64; 4]; 3]) -> [f64; 3] {
+    let det = |c: [usize; 3]| {
+        r[0][c[0]] * (r[1][c[1]] * r[2][c[2]] - r[1][c[2]] * r[2][c[1]])
+            - r[0][c[1]] * (r[1][c[0]] * r[2][c[2]] - r[1][c[2]] * r[2][c[0]])
+            + r[0][c[2]] * (r[1][c[0]] * r[2][c[1]] - r[1][c[1]] * r[2][c[0]])
+    };
+    let d = det([0, 1, 2]);
+    [det([3, 1, 2]) / d, det([0, 3, 2]) / d, det([0, 1, 3]) / d]
+}

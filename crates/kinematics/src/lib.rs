@@ -1,0 +1,47 @@
+//! # flexstar-kinematics
+//!
+//! Rigid kinematics of the star-triangle robot (paper, section 3; MODEL-NOTES sections 2 and 6):
+//!
+//! - [`direct`]: G as the Fermat point of the revolute points I, J, K (Eqs. 4-7), the orientation
+//!   theta (Eq. 9) and the sleeve positions xp_i (Eq. 10), generic over dual numbers so that
+//!   [`RigidState`] carries first and second time derivatives exact to round-off (Eq. 8);
+//! - [`RigidState::a_x`], [`RigidState::a_w`]: rigid accelerations of any beam point (Eqs. 11-12);
+//! - [`feasibility`]: the first time a trajectory leaves the feasible range, with the reason;
+//! - [`inverse_dynamics`]: driving forces of the rigid robot (Eq. 33 with a rigid star);
+//! - [`table`]: the `kinematics.csv` table.
+//!
+//! The closed-form inverse kinematics lives in `flexstar_model::geometry` (trajectories need it)
+//! and is re-exported here.
+
+pub mod direct;
+pub mod feasibility;
+pub mod inverse_dynamics;
+pub mod state;
+pub mod table;
+
+pub use direct::{direct_kinematics, RigidPose};
+pub use feasibility::{check_trajectory, Infeasible, Violation};
+pub use flexstar_model::geometry::inverse_kinematics;
+pub use inverse_dynamics::{rigid_inverse_dynamics, RigidForces};
+pub use state::RigidState;
+
+/// Errors of the rigid kinematics.
+#[derive(Debug, thiserror::Error)]
+pub enum KinematicsError {
+    /// The revolute points do not admit a Fermat point inside the triangle.
+    #[error("t = {t:.6} s: no rigid configuration: {reason}")]
+    NoSolution { t: f64, reason: String },
+    /// The trajectory itself failed (e.g. inverse kinematics of a task-space pose).
+    #[error("t = {t:.6} s: trajectory: {source}")]
+    Trajectory {
+        t: f64,
+        #[source]
+        source: flexstar_model::ModelError,
+    },
+    /// The trajectory leaves the feasible range.
+    #[error(transparent)]
+    Infeasible(#[from] Infeasible),
+    /// Writing a result file failed.
+    #[error(transparent)]
+    Write(flexstar_model::ModelError),
+}

@@ -1,0 +1,35 @@
+//! `flexstar`: reproduce, verify and extend the vibration analysis of the flexible 3-PRP
+//! star-triangle robot. A thin command line over the library crates: it parses arguments, calls
+//! one library function per subcommand, prints progress and summaries to stderr and writes data
+//! files. Exit code 0 on success, 1 on any error (with the reason on stderr).
+
+mod commands;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "flexstar", version, about = "Vibration of the 3-PRP star-triangle robot with a flexible star: rigid kinematics, assumed modes (AMM), finite elements (FEM), Table I")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Rigid kinematics of an experiment: writes DIR/<name>/kinematics.csv
+    Kinematics(commands::kinematics::Args),
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Kinematics(args) => commands::kinematics::run(args),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,22 @@
+# flexstar recipes (https://github.com/casey/just); each is one cargo command.
+
+# Reproduce the paper's Table I and figures and check the thresholds (the main job).
+verify out="out/verify":
+    cargo run --release --bin flexstar -- verify --out {{out}}
+
+# The whole test suite (what CI runs).
+test:
+    cargo test --workspace
+
+# Criterion benchmarks of the solvers.
+bench:
+    cargo bench --workspace
+
+# Rigid kinematics of the four paper cases.
+kinematics:
+    for c in configs/case1.toml configs/case2.toml configs/case3.toml configs/case4.toml; do cargo run --release --bin flexstar -- kinematics $c; done
+
+# Formatting and lints.
+lint:
+    cargo fmt --all -- --check
+    cargo clippy --workspace --all-targets

@@ -8,7 +8,11 @@ mod commands;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "flexstar", version, about = "Vibration of the 3-PRP star-triangle robot with a flexible star: rigid kinematics, assumed modes (AMM), finite elements (FEM), Table I")]
+#[command(
+    name = "flexstar",
+    version,
+    about = "Vibration of the 3-PRP star-triangle robot with a flexible star: rigid kinematics, assumed modes (AMM), finite elements (FEM), Table I"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

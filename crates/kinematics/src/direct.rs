@@ -61,7 +61,11 @@ fn outward_apex<D: Scalar>(a: [D; 2], b: [D; 2], ccw: bool) -> [D; 2] {
 /// Returns `None` when IJK is degenerate or has an angle of 120 degrees or more (no point sees
 /// the vertices at 120 degrees).
 pub fn direct_kinematics<D: Scalar>(d: f64, s: [D; 3]) -> Option<RigidPose<D>> {
-    let p = [revolute_point(0, d, s[0]), revolute_point(1, d, s[1]), revolute_point(2, d, s[2])];
+    let p = [
+        revolute_point(0, d, s[0]),
+        revolute_point(1, d, s[1]),
+        revolute_point(2, d, s[2]),
+    ];
     let re = p.map(|q| [q[0].re(), q[1].re()]);
     let area2 = cross(sub(re[1], re[0]), sub(re[2], re[0]));
     if area2.abs() < 1e-14 || largest_angle(&re).0 >= 2.0 * std::f64::consts::FRAC_PI_3 {

@@ -8,7 +8,6 @@
 use flexstar_model::geometry::revolute_point;
 use flexstar_model::{RobotParams, Trajectory};
 
-
 use crate::direct::{direct_kinematics, largest_angle};
 
 /// Which limit is violated.
@@ -30,13 +29,22 @@ impl std::fmt::Display for Violation {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Violation::SleeveAtJunction { beam, xp } => {
-                write!(f, "sleeve {beam} reaches the junction G (xp{beam} = {xp:.5} m, limit Lp/2)")
+                write!(
+                    f,
+                    "sleeve {beam} reaches the junction G (xp{beam} = {xp:.5} m, limit Lp/2)"
+                )
             }
             Violation::SleeveOffTip { beam, xp } => {
-                write!(f, "sleeve {beam} slides off the tip of beam {beam} (xp{beam} = {xp:.5} m, limit L - Lp/2)")
+                write!(
+                    f,
+                    "sleeve {beam} slides off the tip of beam {beam} (xp{beam} = {xp:.5} m, limit L - Lp/2)"
+                )
             }
             Violation::SliderOffBase { slider, s } => {
-                write!(f, "slider {slider} leaves its side of the base (s{slider} = {s:.5} m, limit sqrt(3) d)")
+                write!(
+                    f,
+                    "slider {slider} leaves its side of the base (s{slider} = {s:.5} m, limit sqrt(3) d)"
+                )
             }
             Violation::NoFermatPoint { vertex, angle_deg } => write!(
                 f,
@@ -70,16 +78,31 @@ fn margin(params: &RobotParams, traj: &Trajectory, t: f64) -> (f64, Violation) {
         }
     };
     for (i, si) in s.iter().enumerate() {
-        take(params.half_side() - si.abs(), Violation::SliderOffBase { slider: i + 1, s: *si });
+        take(
+            params.half_side() - si.abs(),
+            Violation::SliderOffBase { slider: i + 1, s: *si },
+        );
     }
     let pts = [0, 1, 2].map(|i| revolute_point(i, params.d, s[i]));
     let (ang, k) = largest_angle(&pts);
     // angle margin scaled to a length so that the margins are comparable
-    take((2.0 * std::f64::consts::FRAC_PI_3 - ang) * params.lp, Violation::NoFermatPoint { vertex: k, angle_deg: ang.to_degrees() });
+    take(
+        (2.0 * std::f64::consts::FRAC_PI_3 - ang) * params.lp,
+        Violation::NoFermatPoint {
+            vertex: k,
+            angle_deg: ang.to_degrees(),
+        },
+    );
     if let Some(pose) = direct_kinematics(params.d, s) {
         for (i, xp) in pose.xp.iter().enumerate() {
-            take(xp - params.lp / 2.0, Violation::SleeveAtJunction { beam: i + 1, xp: *xp });
-            take(params.l - params.lp / 2.0 - xp, Violation::SleeveOffTip { beam: i + 1, xp: *xp });
+            take(
+                xp - params.lp / 2.0,
+                Violation::SleeveAtJunction { beam: i + 1, xp: *xp },
+            );
+            take(
+                params.l - params.lp / 2.0 - xp,
+                Violation::SleeveOffTip { beam: i + 1, xp: *xp },
+            );
         }
     }
     worst
@@ -117,7 +140,10 @@ pub fn check_trajectory(params: &RobotParams, traj: &Trajectory, t_end: f64, sca
 
 /// Is `s` (at rest) inside the feasible range? Used by property tests and samplers.
 pub fn is_feasible_configuration(params: &RobotParams, s: [f64; 3]) -> bool {
-    let traj = Trajectory::Polynomial { s1: vec![s[0]], s2: vec![s[1]], s3: vec![s[2]] };
+    let traj = Trajectory::Polynomial {
+        s1: vec![s[0]],
+        s2: vec![s[1]],
+        s3: vec![s[2]],
+    };
     margin(params, &traj, 0.0).0 > 0.0
 }
-

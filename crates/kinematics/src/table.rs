@@ -11,7 +11,20 @@ use crate::KinematicsError;
 
 /// Column header of `kinematics.csv` (issue contract).
 pub const KINEMATICS_HEADER: [&str; 14] = [
-    "t", "s1", "s2", "s3", "Gx", "Gy", "theta", "xp1", "xp2", "xp3", "aGx", "aGy", "thetadot", "thetaddot",
+    "t",
+    "s1",
+    "s2",
+    "s3",
+    "Gx",
+    "Gy",
+    "theta",
+    "xp1",
+    "xp2",
+    "xp3",
+    "aGx",
+    "aGy",
+    "thetadot",
+    "thetaddot",
 ];
 
 /// Rigid states at the experiment's output times, after checking feasibility over the span.
@@ -27,8 +40,20 @@ pub fn kinematics_table(exp: &Experiment) -> Result<Vec<RigidState>, KinematicsE
 /// One CSV row in the order of [`KINEMATICS_HEADER`].
 pub fn row(st: &RigidState) -> [f64; 14] {
     [
-        st.t, st.s[0].v, st.s[1].v, st.s[2].v, st.g[0].v, st.g[1].v, st.theta.v, st.xp[0].v, st.xp[1].v, st.xp[2].v,
-        st.g[0].d2, st.g[1].d2, st.theta.d1, st.theta.d2,
+        st.t,
+        st.s[0].v,
+        st.s[1].v,
+        st.s[2].v,
+        st.g[0].v,
+        st.g[1].v,
+        st.theta.v,
+        st.xp[0].v,
+        st.xp[1].v,
+        st.xp[2].v,
+        st.g[0].d2,
+        st.g[1].d2,
+        st.theta.d1,
+        st.theta.d2,
     ]
 }
 

@@ -124,7 +124,11 @@ fn derivatives_agree_with_finite_differences() {
         Trajectory::quadratic([1.0, -0.5, -0.5]),
         Trajectory::quadratic([1.0, 0.0, 0.5]),
         Trajectory::quadratic([1.0, -1.0, 0.0]),
-        Trajectory::Polynomial { s1: vec![0.0, 0.02, 0.3, -0.4], s2: vec![0.0, -0.05, 0.1], s3: vec![0.0, 0.0, 0.0, 0.7] },
+        Trajectory::Polynomial {
+            s1: vec![0.0, 0.02, 0.3, -0.4],
+            s2: vec![0.0, -0.05, 0.1],
+            s3: vec![0.0, 0.0, 0.0, 0.7],
+        },
     ];
     for tr in &cases {
         for t in [0.1, 0.2, 0.3] {
@@ -140,8 +144,16 @@ fn derivatives_agree_with_finite_differences() {
             ];
             for (k, (f, ad)) in checks.iter().enumerate() {
                 let (d1, d2) = fd8(*f, t, 1e-3);
-                assert!((d1 - ad[0]).abs() < 1e-8 * (1.0 + ad[0].abs()), "{tr:?} t={t} quantity {k}: fd {d1} ad {}", ad[0]);
-                assert!((d2 - ad[1]).abs() < 1e-6 * (1.0 + ad[1].abs()), "{tr:?} t={t} quantity {k}: fd {d2} ad {}", ad[1]);
+                assert!(
+                    (d1 - ad[0]).abs() < 1e-8 * (1.0 + ad[0].abs()),
+                    "{tr:?} t={t} quantity {k}: fd {d1} ad {}",
+                    ad[0]
+                );
+                assert!(
+                    (d2 - ad[1]).abs() < 1e-6 * (1.0 + ad[1].abs()),
+                    "{tr:?} t={t} quantity {k}: fd {d2} ad {}",
+                    ad[1]
+                );
             }
         }
     }
@@ -171,7 +183,10 @@ fn case2_leaves_the_feasible_range_when_sleeve_j_reaches_g() {
     let p = paper();
     let err = check_trajectory(&p, &Trajectory::quadratic([1.0, -0.5, -0.5]), 0.5, 1e-3).unwrap_err();
     assert!(err.t > 0.40 && err.t < 0.44, "t = {}", err.t);
-    assert!(matches!(err.violation, Violation::SleeveAtJunction { beam: 2, .. }), "{err}");
+    assert!(
+        matches!(err.violation, Violation::SleeveAtJunction { beam: 2, .. }),
+        "{err}"
+    );
     // and the paper's span up to 0.4 s is fine
     check_trajectory(&p, &Trajectory::quadratic([1.0, -0.5, -0.5]), 0.4, 1e-3).unwrap();
 }
@@ -187,10 +202,17 @@ fn paper_cases_are_feasible_over_their_spans() {
 #[test]
 fn infeasible_from_the_start_is_reported_at_zero() {
     let p = paper();
-    let tr = Trajectory::Polynomial { s1: vec![0.4], s2: vec![0.0], s3: vec![0.0] };
+    let tr = Trajectory::Polynomial {
+        s1: vec![0.4],
+        s2: vec![0.0],
+        s3: vec![0.0],
+    };
     let err = check_trajectory(&p, &tr, 0.1, 1e-3).unwrap_err();
     assert_eq!(err.t, 0.0);
-    assert!(matches!(err.violation, Violation::SliderOffBase { slider: 1, .. }), "{err}");
+    assert!(
+        matches!(err.violation, Violation::SliderOffBase { slider: 1, .. }),
+        "{err}"
+    );
 }
 
 #[test]
@@ -201,8 +223,16 @@ fn rigid_inverse_dynamics_balances_power() {
     let trs = [
         Trajectory::quadratic([1.0, 0.0, 0.5]),
         Trajectory::Quintic {
-            from: Pose { gx: 0.0, gy: 0.0, theta: 0.0 },
-            to: Pose { gx: 0.03, gy: -0.02, theta: 0.3 },
+            from: Pose {
+                gx: 0.0,
+                gy: 0.0,
+                theta: 0.0,
+            },
+            to: Pose {
+                gx: 0.03,
+                gy: -0.02,
+                theta: 0.3,
+            },
             t0: 0.0,
             t1: 0.5,
         },
@@ -215,7 +245,10 @@ fn rigid_inverse_dynamics_balances_power() {
             let dtdt = p.star_mass() * (st.g[0].d1 * st.g[0].d2 + st.g[1].d1 * st.g[1].d2)
                 + (p.star_inertia() + 3.0 * p.jp) * st.theta.d1 * st.theta.d2
                 + p.mpp_mpa * (0..3).map(|i| st.s[i].d1 * st.s[i].d2).sum::<f64>();
-            assert!((power - dtdt).abs() < 1e-10 * (1.0 + dtdt.abs()), "{tr:?} t={t}: {power} vs {dtdt}");
+            assert!(
+                (power - dtdt).abs() < 1e-10 * (1.0 + dtdt.abs()),
+                "{tr:?} t={t}: {power} vs {dtdt}"
+            );
         }
     }
 }

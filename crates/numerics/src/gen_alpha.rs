@@ -28,7 +28,13 @@ impl GenAlpha {
         let alpha_f = r / (r + 1.0);
         let gamma = 0.5 + alpha_f - alpha_m;
         let beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
-        GenAlpha { rho_inf: r, alpha_m, alpha_f, gamma, beta }
+        GenAlpha {
+            rho_inf: r,
+            alpha_m,
+            alpha_f,
+            gamma,
+            beta,
+        }
     }
 
     /// `d a_{n+1} / d qdd_{n+1}` = (1 - alpha_f) / (1 - alpha_m).

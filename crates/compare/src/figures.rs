@@ -1,0 +1,408 @@
+//! The paper's figures for one case, AMM families against the FEM (plotters, SVG and PNG):
+//! elastic displacement of G in the three rigid frames (Figs. 8, 12, 16, 20), tip displacements
+//! (Figs. 9, 13, 17, 21), the deformed star at t_end (Figs. 10, 14, 18, 22) and the driving
+//! forces with the rigid-body limit (Figs. 11, 15, 19, 23).
+
+use std::path::Path;
+use std::sync::Once;
+
+use flexstar_kinematics::RigidState;
+use flexstar_model::Response;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// A figure could not be drawn or written.
+#[derive(Debug, thiserror::Error)]
+#[error("figure {name}: {reason}")]
+pub struct FigureError {
+    pub name: String,
+    pub reason: String,
+}
+
+/// One curve.
+#[derive(Debug, Clone)]
+pub struct Series {
+    pub label: String,
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub style: Style,
+}
+
+/// Line style of a curve: colour index and dash.
+#[derive(Debug, Clone, Copy)]
+pub struct Style {
+    pub color: RGBColor,
+    pub width: u32,
+    pub dashed: bool,
+}
+
+/// One panel: title, axis labels, curves; `equal_axes` keeps the aspect ratio (star shapes).
+#[derive(Debug, Clone)]
+pub struct Panel {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+    pub equal_axes: bool,
+}
+
+/// A figure: panels side by side, a caption on top.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    pub name: String,
+    pub caption: String,
+    pub panels: Vec<Panel>,
+}
+
+/// Colours: FEM black, then one per AMM family, rigid grey.
+pub const FEM_STYLE: Style = Style {
+    color: RGBColor(0, 0, 0),
+    width: 3,
+    dashed: false,
+};
+pub const RIGID_STYLE: Style = Style {
+    color: RGBColor(140, 140, 140),
+    width: 1,
+    dashed: true,
+};
+pub const FAMILY_COLORS: [RGBColor; 4] = [
+    RGBColor(214, 39, 40),
+    RGBColor(31, 119, 180),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+];
+
+static FONT: Once = Once::new();
+
+/// Register the bundled DejaVu Sans (see assets/DejaVuSans-LICENSE.txt) so that text renders
+/// without system fonts.
+fn register_font() {
+    FONT.call_once(|| {
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            include_bytes!("../assets/DejaVuSans.ttf"),
+        );
+    });
+}
+
+const PANEL_W: u32 = 520;
+const PANEL_H: u32 = 400;
+const CAPTION_H: u32 = 40;
+
+impl Figure {
+    pub fn size(&self) -> (u32, u32) {
+        (PANEL_W * self.panels.len().max(1) as u32, PANEL_H + CAPTION_H)
+    }
+
+    /// Draw on any plotters backend.
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let (top, body) = root.split_vertically(CAPTION_H);
+        top.titled(&self.caption, ("sans-serif", 18))
+            .map_err(|e| e.to_string())?;
+        let areas = body.split_evenly((1, self.panels.len().max(1)));
+        for (panel, area) in self.panels.iter().zip(areas) {
+            draw_panel(panel, &area)?;
+        }
+        root.present().map_err(|e| e.to_string())
+    }
+
+    /// The figure as an SVG document.
+    pub fn to_svg_string(&self) -> Result<String, FigureError> {
+        register_font();
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, self.size()).into_drawing_area();
+            self.draw(root).map_err(|reason| FigureError {
+                name: self.name.clone(),
+                reason,
+            })?;
+        }
+        Ok(svg)
+    }
+
+    /// Write `<dir>/<name>.svg` and `<dir>/<name>.png`, each whole or not at all.
+    pub fn write(&self, dir: &Path) -> Result<(), FigureError> {
+        register_font();
+        let err = |reason: String| FigureError {
+            name: self.name.clone(),
+            reason,
+        };
+        let svg = self.to_svg_string()?;
+        flexstar_model::output::write_string_atomically(&dir.join(format!("{}.svg", self.name)), &svg)
+            .map_err(|e| err(e.to_string()))?;
+        // PNG: drawn into a temporary file beside the target, renamed when complete
+        let png = dir.join(format!("{}.png", self.name));
+        let tmp = tempfile::Builder::new()
+            .suffix(".png")
+            .tempfile_in(dir)
+            .map_err(|e| err(e.to_string()))?;
+        {
+            let root = BitMapBackend::new(tmp.path(), self.size()).into_drawing_area();
+            self.draw(root).map_err(err)?;
+        }
+        tmp.persist(&png).map_err(|e| err(e.to_string()))?;
+        Ok(())
+    }
+}
+
+fn bounds(panel: &Panel) -> ((f64, f64), (f64, f64)) {
+    let mut x = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut y = (f64::INFINITY, f64::NEG_INFINITY);
+    for s in &panel.series {
+        for (&a, &b) in s.x.iter().zip(&s.y) {
+            if a.is_finite() && b.is_finite() {
+                x = (x.0.min(a), x.1.max(a));
+                y = (y.0.min(b), y.1.max(b));
+            }
+        }
+    }
+    if !x.0.is_finite() {
+        return ((0.0, 1.0), (-1.0, 1.0));
+    }
+    let pad = |r: (f64, f64)| {
+        let span = (r.1 - r.0).abs().max(1e-12 * (1.0 + r.0.abs()));
+        (r.0 - 0.05 * span, r.1 + 0.05 * span)
+    };
+    let (mut x, mut y) = (pad(x), pad(y));
+    if panel.equal_axes {
+        let (w, h) = (x.1 - x.0, y.1 - y.0);
+        let aspect = (PANEL_W as f64 - 80.0) / (PANEL_H as f64 - 80.0);
+        if w / h < aspect {
+            let extra = (h * aspect - w) / 2.0;
+            x = (x.0 - extra, x.1 + extra);
+        } else {
+            let extra = (w / aspect - h) / 2.0;
+            y = (y.0 - extra, y.1 + extra);
+        }
+    }
+    (x, y)
+}
+
+/// Tick labels: plain decimals for moderate magnitudes, exponents otherwise.
+fn tick(v: &f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || (1e-2..1e4).contains(&a) {
+        let s = format!("{v:.3}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        if s == "-0" {
+            "0".into()
+        } else {
+            s.to_string()
+        }
+    } else {
+        format!("{v:.1e}")
+    }
+}
+
+fn draw_panel<DB: DrawingBackend>(panel: &Panel, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    let (xr, yr) = bounds(panel);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, ("sans-serif", 15))
+        .margin(8)
+        .x_label_area_size(36)
+        .y_label_area_size(64)
+        .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc(panel.x_label.as_str())
+        .y_desc(panel.y_label.as_str())
+        .label_style(("sans-serif", 12))
+        .y_label_formatter(&tick)
+        .x_label_formatter(&tick)
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    for s in &panel.series {
+        let color = s.style.color;
+        let style = ShapeStyle {
+            color: color.to_rgba(),
+            filled: false,
+            stroke_width: s.style.width,
+        };
+        let pts: Vec<(f64, f64)> =
+            s.x.iter()
+                .zip(&s.y)
+                .map(|(a, b)| (*a, *b))
+                .filter(|(a, b)| a.is_finite() && b.is_finite())
+                .collect();
+        let anno = if s.style.dashed {
+            chart
+                .draw_series(DashedLineSeries::new(pts, 6, 4, style))
+                .map_err(|e| e.to_string())?
+        } else {
+            chart
+                .draw_series(LineSeries::new(pts, style))
+                .map_err(|e| e.to_string())?
+        };
+        if !s.label.is_empty() {
+            anno.label(s.label.as_str()).legend(move |(x, y)| {
+                PathElement::new(
+                    vec![(x, y), (x + 18, y)],
+                    ShapeStyle {
+                        color: color.to_rgba(),
+                        filled: false,
+                        stroke_width: 2,
+                    },
+                )
+            });
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(180, 180, 180))
+        .label_font(("sans-serif", 12))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// A labelled response with its drawing style.
+pub struct Run<'a> {
+    pub label: String,
+    pub response: &'a Response,
+    pub style: Style,
+}
+
+fn scaled(v: &[f64], k: f64) -> Vec<f64> {
+    v.iter().map(|x| x * k).collect()
+}
+
+/// Three panels of one quantity (per beam), every run overlaid; values in mm.
+fn per_beam(runs: &[Run], title: &str, y_label: &str, pick: impl Fn(&Response, usize) -> Vec<f64>) -> Vec<Panel> {
+    (0..3)
+        .map(|i| Panel {
+            title: format!("{title} {}", i + 1),
+            x_label: "t [s]".into(),
+            y_label: y_label.into(),
+            series: runs
+                .iter()
+                .map(|r| Series {
+                    label: r.label.clone(),
+                    x: r.response.t.clone(),
+                    y: pick(r.response, i),
+                    style: r.style,
+                })
+                .collect(),
+            equal_axes: false,
+        })
+        .collect()
+}
+
+/// Elastic displacement of G in the three rigid frames, w_iG [mm].
+pub fn figure_w_g(case: &str, runs: &[Run]) -> Figure {
+    Figure {
+        name: format!("{case}-wG"),
+        caption: format!("{case}: elastic displacement of G in the rigid frames x_i w_i"),
+        panels: per_beam(runs, "w_G in frame", "w_iG [mm]", |r, i| scaled(&r.w_g[i], 1e3)),
+    }
+}
+
+/// Elastic tip displacements w_i(L) [mm] (points A, B, C).
+pub fn figure_tips(case: &str, runs: &[Run]) -> Figure {
+    let mut f = Figure {
+        name: format!("{case}-tips"),
+        caption: format!("{case}: elastic tip displacements w_i(L) (A, B, C)"),
+        panels: per_beam(runs, "tip of beam", "w_i(L) [mm]", |r, i| scaled(&r.w_tip[i], 1e3)),
+    };
+    for (p, name) in f.panels.iter_mut().zip(["A", "B", "C"]) {
+        p.title = format!("tip {name} (beam {})", &p.title[p.title.len() - 1..]);
+    }
+    f
+}
+
+/// Driving forces Fa_i [N] (Eq. 33), with the rigid-body inverse dynamics as a dashed line.
+pub fn figure_forces(case: &str, runs: &[Run], rigid: Option<(&[f64], &[[f64; 3]])>) -> Figure {
+    let mut panels = per_beam(runs, "driving force Fa", "Fa_i [N]", |r, i| r.fa[i].clone());
+    if let Some((t, fa)) = rigid {
+        for (i, p) in panels.iter_mut().enumerate() {
+            p.series.push(Series {
+                label: "rigid".into(),
+                x: t.to_vec(),
+                y: fa.iter().map(|f| f[i]).collect(),
+                style: RIGID_STYLE,
+            });
+        }
+    }
+    Figure {
+        name: format!("{case}-forces"),
+        caption: format!("{case}: driving forces Fa_i (Eq. 33)"),
+        panels,
+    }
+}
+
+/// The deformed star at its last snapshot: (a) elastic deflection w_i(x) of each beam [mm];
+/// (b) absolute shape with the elastic part magnified by `magnify`, over the rigid star
+/// (`rigid`: the rigid kinematics at the snapshot time, post-processing only).
+pub fn figure_star(case: &str, runs: &[Run], rigid: &RigidState, magnify: f64) -> Option<Figure> {
+    let mut deflection = Panel {
+        title: "(a) elastic deflection w_i(x)".into(),
+        x_label: "x [m]".into(),
+        y_label: "w [mm]".into(),
+        series: vec![],
+        equal_axes: false,
+    };
+    let mut absolute = Panel {
+        title: format!("(b) star, elastic part x{magnify:.0}"),
+        x_label: "X [m]".into(),
+        y_label: "Y [m]".into(),
+        series: vec![],
+        equal_axes: true,
+    };
+    let mut t_snap = None;
+    for r in runs {
+        let Some(shape) = r.response.shapes.last() else {
+            continue;
+        };
+        t_snap = Some(shape.t);
+        for (i, b) in shape.beams.iter().enumerate() {
+            let label = if i == 0 { r.label.clone() } else { String::new() };
+            deflection.series.push(Series {
+                label: label.clone(),
+                x: b.x.clone(),
+                y: scaled(&b.w, 1e3),
+                style: r.style,
+            });
+            let (xs, ys): (Vec<f64>, Vec<f64>) =
+                b.x.iter()
+                    .zip(&b.pos)
+                    .map(|(x, p)| {
+                        let q = rigid.point(i, *x);
+                        (q[0] + magnify * (p[0] - q[0]), q[1] + magnify * (p[1] - q[1]))
+                    })
+                    .unzip();
+            absolute.series.push(Series {
+                label,
+                x: xs,
+                y: ys,
+                style: r.style,
+            });
+        }
+    }
+    let t = t_snap?;
+    for i in 0..3 {
+        let (a, b) = (rigid.point(i, 0.0), rigid.point(i, rigid_length(runs, i)));
+        absolute.series.push(Series {
+            label: if i == 0 { "rigid".into() } else { String::new() },
+            x: vec![a[0], b[0]],
+            y: vec![a[1], b[1]],
+            style: RIGID_STYLE,
+        });
+    }
+    Some(Figure {
+        name: format!("{case}-star"),
+        caption: format!("{case}: beam shapes at t = {t:.3} s"),
+        panels: vec![deflection, absolute],
+    })
+}
+
+/// Length of beam i as sampled by the runs' last snapshots.
+fn rigid_length(runs: &[Run], i: usize) -> f64 {
+    runs.iter()
+        .filter_map(|r| r.response.shapes.last().and_then(|s| s.beams[i].x.last().copied()))
+        .fold(0.0, f64::max)
+}

@@ -1,0 +1,29 @@
+//! Speed of the AMM (issue 4 item 8): one paper case, N = 25, 0.5 s of motion at the default
+//! step, target at most 20 ms on one core. The four paper cases share the catalogue of the tests.
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use flexstar_amm::solve;
+use flexstar_model::ModeFamily;
+
+fn paper_cases(c: &mut Criterion) {
+    let mut group = c.benchmark_group("amm_n25_default_step");
+    group.sample_size(20);
+    for case in [3, 1, 2, 4] {
+        for fam in ModeFamily::PAPER {
+            if case != 3 && fam != ModeFamily::FreeFree {
+                continue;
+            }
+            let exp = common::paper_case(case);
+            let settings = common::settings(fam, 25, None);
+            group.bench_function(format!("case{case}_{fam}"), |b| {
+                b.iter(|| solve(&exp, &settings).unwrap())
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, paper_cases);
+criterion_main!(benches);

@@ -1,0 +1,26 @@
+//! # flexstar-amm
+//!
+//! The paper's constrained assumed-modes method (sections 6-7, Eqs. 30-44) for the vibration of
+//! the 3-PRP star-triangle robot whose moving platform is a star of three flexible
+//! Euler-Bernoulli beams sliding through sleeves.
+//!
+//! - [`modes`]: the mode families of Eq. 34-1 (pinned-free, slide-free, free-free, clamped-free),
+//!   evaluated stably to hundreds of modes;
+//! - `system` (private): the constrained linear time-varying equations (Eqs. 37, 44, 31 with the
+//!   constraints of Eqs. 38-43) and their per-step linear solve;
+//! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]).
+//!
+//! Frames and signs follow MODEL-NOTES sections 2-3; the derivation, the departures from the
+//! printed paper and the convergence study are in `docs/amm.md`. SI units throughout.
+
+// Units are written in brackets after a quantity ([m], [Hz]) as in the other flexstar crates.
+#![allow(rustdoc::broken_intra_doc_links)]
+
+pub mod error;
+pub mod modes;
+pub mod solver;
+mod system;
+
+pub use error::AmmError;
+pub use modes::{ModeSet, MAX_MODES};
+pub use solver::{parse_family, solve, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS};

@@ -1,0 +1,628 @@
+//! Assumed-mode families of one beam (Eq. 34-1; MODEL-NOTES section 4), G at x = 0, free tip at
+//! x = L.
+//!
+//! Each elastic mode solves `(EI/rho) phi'''' = lambda phi` with `lambda = (EI/rho) beta^4`. It is
+//! written in the numerically stable basis
+//!
+//! ```text
+//! Phi(xi) = c1 cos(b xi) + c2 sin(b xi) + c3 exp(-b xi) + c4 exp(-b (1 - xi)),   xi = x/L, b = beta L
+//! ```
+//! (the textbook `cosh - cos - sigma (sinh - sin)` loses every digit above b ~ 20; here no term
+//! exceeds 1, so phi and its first three derivatives keep full relative precision for any N).
+//! `phi(x) = Phi(x/L) / sqrt(L)`, normalised so that `int_0^L phi_j phi_m dx = delta_jm` [1/sqrt(m)].
+//!
+//! | family | BC at G | characteristic equation (stable form) | asymptote of b_n | rigid modes |
+//! |---|---|---|---|---|
+//! | clamped-free | w = w' = 0 | cos b + sech b = 0 | (2n-1) pi/2 | none |
+//! | pinned-free | w = w'' = 0 | sin b - cos b tanh b = 0 | (4n+1) pi/4 | sqrt(3) xi |
+//! | slide-free | w' = w''' = 0 | sin b + cos b tanh b = 0 | (4n-1) pi/4 | 1 |
+//! | free-free | w'' = w''' = 0 | cos b - sech b = 0 | (2n+1) pi/2 | 1, sqrt(3)(2 xi - 1) |
+//!
+//! N counts every mode, rigid ones first.
+
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+use flexstar_model::{ModeFamily, RobotParams};
+
+use crate::error::AmmError;
+
+/// Largest number of modes per beam accepted (issue 4: "absurdly large" beyond this).
+pub const MAX_MODES: usize = 400;
+
+/// Shape of one mode on the unit interval, `Phi(xi)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Shape {
+    /// Rigid mode `Phi = a + b xi` (lambda = 0).
+    Rigid { a: f64, b: f64 },
+    /// Elastic mode in the stable basis; `bl` = beta L, `e` = exp(-beta L).
+    Elastic { bl: f64, c: [f64; 4], e: f64 },
+}
+
+/// The first N modes of one family for beams of the robot (Eq. 34-1), with the integrals and
+/// point values the motion equations need (Eqs. 37, 44).
+#[derive(Debug, Clone)]
+pub struct ModeSet {
+    family: ModeFamily,
+    l: f64,
+    ei_over_rho: f64,
+    shapes: Vec<Shape>,
+    /// Number of leading rigid modes.
+    rigid: usize,
+    lambda: Vec<f64>,
+    phi_int: Vec<f64>,
+    psi_int: Vec<f64>,
+    /// Modes after this index have roots exactly pi apart (see `triplet_at`).
+    recur_from: usize,
+}
+
+/// Boundary conditions at G as derivative orders (Eq. 34-1).
+fn orders_at_g(family: ModeFamily) -> [usize; 2] {
+    match family {
+        ModeFamily::ClampedFree => [0, 1],
+        ModeFamily::PinnedFree => [0, 2],
+        ModeFamily::SlideFree => [1, 3],
+        ModeFamily::FreeFree => [2, 3],
+    }
+}
+
+/// Rigid modes of a family on the unit interval, orthonormal: `(a, b)` of `Phi = a + b xi`.
+fn rigid_modes(family: ModeFamily) -> &'static [(f64, f64)] {
+    const S3: f64 = 1.732_050_807_568_877_2;
+    match family {
+        ModeFamily::ClampedFree => &[],
+        ModeFamily::PinnedFree => &[(0.0, S3)],
+        ModeFamily::SlideFree => &[(1.0, 0.0)],
+        ModeFamily::FreeFree => &[(1.0, 0.0), (-S3, 2.0 * S3)],
+    }
+}
+
+fn sech(b: f64) -> f64 {
+    if b > 700.0 {
+        0.0
+    } else {
+        2.0 * (-b).exp() / (1.0 + (-2.0 * b).exp())
+    }
+}
+
+/// Characteristic function of the family in a form with O(1) terms (no cancellation).
+fn characteristic(family: ModeFamily, b: f64) -> f64 {
+    let (s, c) = b.sin_cos();
+    match family {
+        ModeFamily::ClampedFree => c + sech(b),
+        ModeFamily::FreeFree => c - sech(b),
+        ModeFamily::PinnedFree => s - c * b.tanh(),
+        ModeFamily::SlideFree => s + c * b.tanh(),
+    }
+}
+
+/// Asymptotic estimate of the n-th elastic root b_n (n = 1, 2, ...).
+fn asymptote(family: ModeFamily, n: usize) -> f64 {
+    let n = n as f64;
+    match family {
+        ModeFamily::ClampedFree => (2.0 * n - 1.0) * FRAC_PI_2,
+        ModeFamily::FreeFree => (2.0 * n + 1.0) * FRAC_PI_2,
+        ModeFamily::PinnedFree => (4.0 * n + 1.0) * FRAC_PI_4,
+        ModeFamily::SlideFree => (4.0 * n - 1.0) * FRAC_PI_4,
+    }
+}
+
+/// n-th elastic root beta_n L to full precision: bisection on the stable characteristic function
+/// in `[asymptote - 0.6, asymptote + 0.6]` (roots are ~pi apart; the first lies within 0.31 of
+/// its asymptote) until the bracket cannot shrink.
+fn elastic_root(family: ModeFamily, n: usize) -> Result<f64, AmmError> {
+    let a = asymptote(family, n);
+    let (mut lo, mut hi) = (a - 0.6, a + 0.6);
+    let (flo, fhi) = (characteristic(family, lo), characteristic(family, hi));
+    if flo * fhi > 0.0 {
+        return Err(AmmError::RootNotFound {
+            family: family.name(),
+            index: n,
+            lo,
+            hi,
+        });
+    }
+    let lo_negative = flo < 0.0;
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        let f = characteristic(family, mid);
+        if f == 0.0 {
+            return Ok(mid);
+        }
+        if (f < 0.0) == lo_negative {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    // the endpoint with the smaller residual
+    if characteristic(family, lo).abs() <= characteristic(family, hi).abs() {
+        Ok(lo)
+    } else {
+        Ok(hi)
+    }
+}
+
+/// Row of the stable basis for the k-th derivative divided by b^k, at xi:
+/// `[cos(b xi + k pi/2), sin(b xi + k pi/2), (-1)^k exp(-b xi), exp(-b (1 - xi))]`.
+fn basis_row(bl: f64, xi: f64, k: usize) -> [f64; 4] {
+    let (s, c) = (bl * xi).sin_cos();
+    let (cs, sn) = match k % 4 {
+        0 => (c, s),
+        1 => (-s, c),
+        2 => (-c, -s),
+        _ => (s, -c),
+    };
+    let sign = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
+    [cs, sn, sign * (-bl * xi).exp(), (-bl * (1.0 - xi)).exp()]
+}
+
+fn det3(m: [[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+/// Null vector of a 4x4 matrix of rank 3: the generalized cross product of the three rows whose
+/// product is largest (cofactor expansion; the rows are O(1), so this is accurate to round-off).
+fn null_vector(a: [[f64; 4]; 4]) -> [f64; 4] {
+    let mut best = [0.0; 4];
+    let mut best_norm = -1.0;
+    for skip in 0..4 {
+        let rows: Vec<[f64; 4]> = (0..4).filter(|&r| r != skip).map(|r| a[r]).collect();
+        let mut n = [0.0; 4];
+        for (col, nc) in n.iter_mut().enumerate() {
+            let mut m = [[0.0; 3]; 3];
+            for (ri, row) in rows.iter().enumerate() {
+                let mut cj = 0;
+                for (j, v) in row.iter().enumerate() {
+                    if j != col {
+                        m[ri][cj] = *v;
+                        cj += 1;
+                    }
+                }
+            }
+            let sign = if col % 2 == 0 { 1.0 } else { -1.0 };
+            *nc = sign * det3(m);
+        }
+        let norm = n.iter().map(|v| v * v).sum::<f64>();
+        if norm > best_norm {
+            best_norm = norm;
+            best = n;
+        }
+    }
+    best
+}
+
+/// Gram matrix `int_0^1 f_a f_b dxi` of the stable basis (closed form).
+fn gram(bl: f64) -> [[f64; 4]; 4] {
+    let (s, c) = bl.sin_cos();
+    let e = (-bl).exp();
+    let tb = 2.0 * bl;
+    let g11 = 0.5 + s * c / tb;
+    let g22 = 0.5 - s * c / tb;
+    let g12 = s * s / tb;
+    let g33 = (1.0 - e * e) / tb;
+    let g34 = e;
+    let g13 = (1.0 + e * (s - c)) / tb;
+    let g23 = (1.0 - e * (s + c)) / tb;
+    let g14 = (c + s - e) / tb;
+    let g24 = (s - c + e) / tb;
+    [
+        [g11, g12, g13, g14],
+        [g12, g22, g23, g24],
+        [g13, g23, g33, g34],
+        [g14, g24, g34, g33],
+    ]
+}
+
+impl Shape {
+    /// `Phi^(k)(xi)` for k = 0..=3 on the unit interval.
+    #[inline]
+    fn eval(&self, xi: f64) -> [f64; 4] {
+        match *self {
+            Shape::Rigid { a, b } => [a + b * xi, b, 0.0, 0.0],
+            Shape::Elastic { bl, c, .. } => {
+                let mut out = [0.0; 4];
+                let mut bk = 1.0;
+                for (k, o) in out.iter_mut().enumerate() {
+                    let r = basis_row(bl, xi, k);
+                    *o = bk * (c[0] * r[0] + c[1] * r[1] + c[2] * r[2] + c[3] * r[3]);
+                    bk *= bl;
+                }
+                out
+            }
+        }
+    }
+}
+
+impl ModeSet {
+    /// The first `n` modes of `family` (rigid ones included) for the beams of `params`.
+    ///
+    /// Errors: `n = 0` or `n > MAX_MODES`, non-positive EI, rho or L.
+    pub fn new(family: ModeFamily, n: usize, params: &RobotParams) -> Result<Self, AmmError> {
+        if n == 0 || n > MAX_MODES {
+            return Err(AmmError::invalid(
+                "amm.modes",
+                format!("need 1 <= modes <= {MAX_MODES}, got {n}"),
+            ));
+        }
+        for (key, v) in [
+            ("robot.E * robot.I", params.ei()),
+            ("robot.rho", params.rho),
+            ("robot.L", params.l),
+        ] {
+            if !v.is_finite() || v <= 0.0 {
+                return Err(AmmError::invalid(
+                    key,
+                    format!("must be a positive finite number, got {v}"),
+                ));
+            }
+        }
+        let l = params.l;
+        let rigid = rigid_modes(family);
+        let mut shapes = Vec::with_capacity(n);
+        for &(a, b) in rigid.iter().take(n) {
+            shapes.push(Shape::Rigid { a, b });
+        }
+        let orders = orders_at_g(family);
+        let mut k = 1;
+        while shapes.len() < n {
+            let bl = elastic_root(family, k)?;
+            let a = [
+                basis_row(bl, 0.0, orders[0]),
+                basis_row(bl, 0.0, orders[1]),
+                basis_row(bl, 1.0, 2),
+                basis_row(bl, 1.0, 3),
+            ];
+            let mut c = null_vector(a);
+            let g = gram(bl);
+            let mut norm2 = 0.0;
+            for p in 0..4 {
+                for q in 0..4 {
+                    norm2 += c[p] * g[p][q] * c[q];
+                }
+            }
+            let e = (-bl).exp();
+            let tip = c[0] * bl.cos() + c[1] * bl.sin() + c[2] * e + c[3];
+            let scale = tip.signum() / norm2.sqrt();
+            for v in &mut c {
+                *v *= scale;
+            }
+            shapes.push(Shape::Elastic { bl, c, e });
+            k += 1;
+        }
+        let ei_over_rho = params.ei() / params.rho;
+        let sqrt_l = l.sqrt();
+        let mut lambda = Vec::with_capacity(n);
+        let mut phi_int = Vec::with_capacity(n);
+        let mut psi_int = Vec::with_capacity(n);
+        for s in &shapes {
+            // int_0^1 Phi dxi and int_0^1 xi Phi dxi; for elastic modes from the ODE and the free
+            // tip: int Phi = -Phi'''(0)/b^4, int xi Phi = Phi''(0)/b^4.
+            let (bl, i0, i1) = match *s {
+                Shape::Rigid { a, b } => (0.0, a + 0.5 * b, 0.5 * a + b / 3.0),
+                Shape::Elastic { bl, .. } => {
+                    let v = s.eval(0.0);
+                    let b4 = bl.powi(4);
+                    (bl, -v[3] / b4, v[2] / b4)
+                }
+            };
+            lambda.push(ei_over_rho * (bl / l).powi(4));
+            phi_int.push(sqrt_l * i0);
+            psi_int.push(sqrt_l * l * i1);
+        }
+        // first mode from which every root is >= 40 and pi after the previous one
+        let bls: Vec<f64> = shapes
+            .iter()
+            .map(|s| if let Shape::Elastic { bl, .. } = s { *bl } else { 0.0 })
+            .collect();
+        let mut recur_from = n;
+        for m in (1..n).rev() {
+            if bls[m - 1] >= 40.0 && (bls[m] - bls[m - 1] - PI).abs() < 1e-12 * bls[m] {
+                recur_from = m - 1;
+            } else {
+                break;
+            }
+        }
+        Ok(ModeSet {
+            family,
+            l,
+            ei_over_rho,
+            shapes,
+            rigid: rigid.len().min(n),
+            lambda,
+            phi_int,
+            psi_int,
+            recur_from,
+        })
+    }
+
+    /// The family of these modes.
+    pub fn family(&self) -> ModeFamily {
+        self.family
+    }
+
+    /// Number of modes N (rigid ones included).
+    pub fn len(&self) -> usize {
+        self.shapes.len()
+    }
+
+    /// Always false: a mode set holds at least one mode.
+    pub fn is_empty(&self) -> bool {
+        self.shapes.is_empty()
+    }
+
+    /// Number of rigid modes (lambda = 0) among the N.
+    pub fn rigid_count(&self) -> usize {
+        self.rigid
+    }
+
+    /// Beam length L [m].
+    pub fn length(&self) -> f64 {
+        self.l
+    }
+
+    /// Eq. 34-1: dimensionless roots beta_m L, 0 for rigid modes.
+    pub fn beta_l(&self) -> Vec<f64> {
+        self.shapes
+            .iter()
+            .map(|s| match s {
+                Shape::Rigid { .. } => 0.0,
+                Shape::Elastic { bl, .. } => *bl,
+            })
+            .collect()
+    }
+
+    /// Eq. 34-1: `lambda_m = omega_m^2 = (EI/rho) beta_m^4` [1/s^2] (0 for rigid modes).
+    pub fn lambda(&self) -> &[f64] {
+        &self.lambda
+    }
+
+    /// Natural frequencies `f_m = (beta_m L)^2 / (2 pi L^2) sqrt(EI/rho)` [Hz] (0 for rigid modes).
+    pub fn frequencies_hz(&self) -> Vec<f64> {
+        self.lambda.iter().map(|l| l.sqrt() / (2.0 * PI)).collect()
+    }
+
+    /// Eqs. 37, 44: `Phi_m = int_0^L phi_m dx` [sqrt(m)].
+    pub fn phi_integral(&self) -> &[f64] {
+        &self.phi_int
+    }
+
+    /// Eq. 37: `Psi_m = int_0^L x phi_m dx` [m^1.5].
+    pub fn x_phi_integral(&self) -> &[f64] {
+        &self.psi_int
+    }
+
+    /// `EI / rho` [m^4/s^2].
+    pub fn ei_over_rho(&self) -> f64 {
+        self.ei_over_rho
+    }
+
+    /// Mode m (0-based) and its first three x-derivatives at material coordinate x [m] (0 = G):
+    /// `[phi, phi', phi'', phi''']` in `[m^-1/2, m^-3/2, m^-5/2, m^-7/2]`.
+    pub fn eval(&self, m: usize, x: f64) -> [f64; 4] {
+        let xi = x / self.l;
+        let v = self.shapes[m].eval(xi);
+        let s = 1.0 / self.l.sqrt();
+        [
+            v[0] * s,
+            v[1] * s / self.l,
+            v[2] * s / (self.l * self.l),
+            v[3] * s / (self.l * self.l * self.l),
+        ]
+    }
+
+    /// All modes at x [m]: `val[m] = phi_m(x)` and, if given, `slope[m] = phi_m'(x)`.
+    /// The per-step kernel of the constraint matrix (Eqs. 41-43): one sin/cos pair and one
+    /// exponential per elastic mode, no allocation.
+    pub fn values_at(&self, x: f64, val: &mut [f64], mut slope: Option<&mut [f64]>) {
+        let xi = x / self.l;
+        let s = 1.0 / self.l.sqrt();
+        let sd = s / self.l;
+        for (m, sh) in self.shapes.iter().enumerate() {
+            match *sh {
+                Shape::Rigid { a, b } => {
+                    val[m] = (a + b * xi) * s;
+                    if let Some(d) = slope.as_deref_mut() {
+                        d[m] = b * sd;
+                    }
+                }
+                Shape::Elastic { bl, c, e } => {
+                    let (sn, cs) = (bl * xi).sin_cos();
+                    let e1 = (-bl * xi).exp();
+                    // exp(-b(1 - xi)) = exp(-b) / exp(-b xi) while both are representable
+                    let e2 = if bl < 600.0 { e / e1 } else { (-bl * (1.0 - xi)).exp() };
+                    val[m] = (c[0] * cs + c[1] * sn + c[2] * e1 + c[3] * e2) * s;
+                    if let Some(d) = slope.as_deref_mut() {
+                        d[m] = bl * (-c[0] * sn + c[1] * cs - c[2] * e1 + c[3] * e2) * sd;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Precomputed per-mode factors for evaluating the modes at `x - h`, `x`, `x + h` together
+/// (the sleeve points of Eqs. 41-43, `h = Lp/2` fixed): `[cos(beta h), sin(beta h), exp(-beta h), exp(beta h)]`.
+#[derive(Debug, Clone)]
+pub(crate) struct Triplet {
+    h: f64,
+    f: Vec<[f64; 4]>,
+}
+
+impl ModeSet {
+    /// Factors for [`ModeSet::triplet_at`] with half-width `h` [m].
+    pub(crate) fn triplet(&self, h: f64) -> Triplet {
+        let eta = h / self.l;
+        let f = self
+            .shapes
+            .iter()
+            .map(|s| match *s {
+                Shape::Rigid { .. } => [1.0, 0.0, 1.0, 1.0],
+                Shape::Elastic { bl, .. } => {
+                    let (sn, cs) = (bl * eta).sin_cos();
+                    [cs, sn, (-bl * eta).exp(), (bl * eta).exp()]
+                }
+            })
+            .collect();
+        Triplet { h, f }
+    }
+
+    /// `phi_m(x - h)`, `phi_m(x)`, `phi_m(x + h)` and `phi_m'(x)` for every mode, by angle
+    /// addition with the factors of `tri`: one sin/cos pair and one exponential per elastic mode
+    /// below beta L = 40. Above, consecutive roots are pi apart to round-off (the distance to the
+    /// asymptote is below 2 exp(-40)), so sin, cos and the exponentials of mode m + 1 follow from
+    /// those of mode m by one rotation by pi x / L and two products. Needs `0 <= x - h`, `x + h <= L`.
+    pub(crate) fn triplet_at(
+        &self,
+        tri: &Triplet,
+        x: f64,
+        left: &mut [f64],
+        mid: &mut [f64],
+        right: &mut [f64],
+        slope: &mut [f64],
+    ) {
+        let xi = x / self.l;
+        let eta = tri.h / self.l;
+        let s = 1.0 / self.l.sqrt();
+        let sd = s / self.l;
+        let (rs, rc) = (PI * xi).sin_cos();
+        let (q1, q2) = ((-PI * xi).exp(), (-PI * (1.0 - xi)).exp());
+        let (mut sn, mut cs, mut e1, mut e2) = (0.0, 0.0, 0.0, 0.0);
+        for (m, (sh, f)) in self.shapes.iter().zip(&tri.f).enumerate() {
+            match *sh {
+                Shape::Rigid { a, b } => {
+                    mid[m] = (a + b * xi) * s;
+                    left[m] = (a + b * (xi - eta)) * s;
+                    right[m] = (a + b * (xi + eta)) * s;
+                    slope[m] = b * sd;
+                }
+                Shape::Elastic { bl, c, e } => {
+                    if m > self.recur_from {
+                        (sn, cs) = (sn * rc + cs * rs, cs * rc - sn * rs);
+                        e1 *= q1;
+                        e2 = if e2 > 1e-290 { e2 * q2 } else { 0.0 };
+                    } else {
+                        (sn, cs) = (bl * xi).sin_cos();
+                        e1 = (-bl * xi).exp();
+                        e2 = if bl < 600.0 { e / e1 } else { (-bl * (1.0 - xi)).exp() };
+                    }
+                    let p = c[0] * cs + c[1] * sn;
+                    let q = c[1] * cs - c[0] * sn;
+                    let (g1, g2) = (c[2] * e1, c[3] * e2);
+                    mid[m] = (p + g1 + g2) * s;
+                    slope[m] = bl * (q - g1 + g2) * sd;
+                    let (pc, qs) = (p * f[0], q * f[1]);
+                    right[m] = (pc + qs + g1 * f[2] + g2 * f[3]) * s;
+                    left[m] = (pc - qs + g1 * f[3] + g2 * f[2]) * s;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::needless_range_loop)]
+mod tests {
+    use super::*;
+    use flexstar_numerics::quadrature::integrate;
+
+    fn composite(f: impl Fn(f64) -> f64, panels: usize) -> f64 {
+        (0..panels)
+            .map(|k| integrate(&f, k as f64 / panels as f64, (k + 1) as f64 / panels as f64, 5))
+            .sum()
+    }
+
+    #[test]
+    fn gram_matrix_matches_quadrature() {
+        for bl in [1.875, 4.73, 23.6, 80.1] {
+            let g = gram(bl);
+            for p in 0..4 {
+                for q in 0..4 {
+                    let num = composite(|x| basis_row(bl, x, 0)[p] * basis_row(bl, x, 0)[q], 400);
+                    assert!(
+                        (num - g[p][q]).abs() < 1e-13,
+                        "b = {bl}, ({p},{q}): {num} vs {}",
+                        g[p][q]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn boundary_conditions_hold_to_round_off() {
+        let p = RobotParams::paper();
+        for fam in [
+            ModeFamily::ClampedFree,
+            ModeFamily::PinnedFree,
+            ModeFamily::SlideFree,
+            ModeFamily::FreeFree,
+        ] {
+            let ms = ModeSet::new(fam, 100, &p).unwrap();
+            let o = orders_at_g(fam);
+            for m in ms.rigid_count()..ms.len() {
+                let bl = ms.beta_l()[m];
+                let v0 = ms.shapes[m].eval(0.0);
+                let v1 = ms.shapes[m].eval(1.0);
+                // relative to the size of the k-th derivative, b^k
+                for k in o {
+                    assert!(v0[k].abs() < 1e-12 * bl.powi(k as i32), "{fam} m={m} k={k}: {}", v0[k]);
+                }
+                for k in [2, 3] {
+                    assert!(
+                        v1[k].abs() < 1e-12 * bl.powi(k as i32),
+                        "{fam} m={m} tip k={k}: {}",
+                        v1[k]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn triplet_kernel_matches_eval() {
+        let p = RobotParams::paper();
+        for fam in [ModeFamily::PinnedFree, ModeFamily::FreeFree] {
+            let n = 400;
+            let ms = ModeSet::new(fam, n, &p).unwrap();
+            assert!(ms.recur_from < 15, "{fam}: recurrence from mode {}", ms.recur_from);
+            let tri = ms.triplet(0.015);
+            let mut b = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+            for x in [0.015, 0.18, 0.3, 0.485] {
+                let [l, m, r, d] = &mut b;
+                ms.triplet_at(&tri, x, l, m, r, d);
+                for k in 0..n {
+                    let want = [
+                        ms.eval(k, x - 0.015)[0],
+                        ms.eval(k, x)[0],
+                        ms.eval(k, x + 0.015)[0],
+                        ms.eval(k, x)[1],
+                    ];
+                    // values are O(1/sqrt L), slopes O(beta/sqrt L)
+                    let scale = [1.0, 1.0, 1.0, ms.beta_l()[k].max(1.0) / p.l];
+                    for ((got, w), sc) in [l[k], m[k], r[k], d[k]].iter().zip(want).zip(scale) {
+                        assert!((got - w).abs() < 1e-11 * sc, "{fam} k={k} x={x}: {got} vs {w}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fast_kernel_matches_eval() {
+        let p = RobotParams::paper();
+        let ms = ModeSet::new(ModeFamily::FreeFree, 60, &p).unwrap();
+        let (mut v, mut d) = (vec![0.0; 60], vec![0.0; 60]);
+        for x in [0.0, 0.013, 0.2, 0.4999, 0.5] {
+            ms.values_at(x, &mut v, Some(&mut d));
+            for m in 0..60 {
+                let e = ms.eval(m, x);
+                assert!((e[0] - v[m]).abs() < 1e-12 * (1.0 + e[0].abs()), "m={m} x={x}");
+                assert!((e[1] - d[m]).abs() < 1e-12 * (1.0 + e[1].abs()), "m={m} x={x}");
+            }
+        }
+    }
+}

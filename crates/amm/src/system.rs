@@ -1,0 +1,576 @@
+//! The constrained linear time-varying system of the AMM (Eqs. 30-32, 37, 44 with the constraints
+//! of Eqs. 38-43) and its per-step linear solve.
+//!
+//! Unknowns of beam i (block of N + 2): modal coordinates `alpha_i` (N), axial displacement
+//! `u_i = x_iG` and sleeve rotation `thp_i`. With orthonormal modes,
+//!
+//! ```text
+//! M q'' + D(t) q' + K(t) q = f(t) + C(t)^T lambda,      C(t) q = 0
+//! ```
+//! per beam (alpha rows j, u row, thp row; Phi_j = int phi_j, Psi_j = int x phi_j):
+//!
+//! ```text
+//! rho [alpha_j'' + (lambda_j - th'^2) alpha_j + (u th'' + 2 u' th') Phi_j] = -rho (a_G.e_w Phi_j + th'' Psi_j) + (C^T lambda)_j   (Eq. 37)
+//! rho [L u'' - L th'^2 u - 2 th' Phi.alpha' - th'' Phi.alpha]     = -rho (L a_G.e_x - th'^2 L^2/2) + (C^T lambda)_u      (Eqs. 30, 44)
+//! Jp thp''                                                        = -Jp th''                        + (C^T lambda)_thp    (Eq. 31)
+//! ```
+//! The step matrix `S = M + gamma' D + beta' K` of one beam is an arrowhead: diagonal in alpha,
+//! `d_j = rho (1 + beta' (lambda_j - th'^2))`, bordered by the u row and column (`-p Phi_m`,
+//! `+p Phi_j`, `p = rho (2 gamma' th' + beta' th'')`), and `Jp` for thp. It is the same for the
+//! three beams (it depends on th only) and is solved in O(N). The constraints (at most 18 rows)
+//! are eliminated by the Schur complement `A = C S^-1 C^T`, a small dense LU per step.
+
+use flexstar_kinematics::RigidState;
+use flexstar_model::RobotParams;
+
+use crate::error::AmmError;
+use crate::modes::{ModeSet, Triplet};
+
+const SQRT3: f64 = 1.732_050_807_568_877_2;
+
+/// One constraint row and its multiplier (MODEL-NOTES section 3; Eqs. 24-29, 38-43). Beams are
+/// 0-based here. The multiplier is the generalized force on the beam for the row as written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Row {
+    /// Eq. 38: `u_i - (w_{i+2,G} - w_{i+1,G}) / sqrt3 = 0`; multiplier `F_ix` (axial force at G).
+    Fix(usize),
+    /// Eq. 40: `w_1G + w_2G + w_3G = 0`; multiplier `Fw`.
+    Fw,
+    /// Eq. 39: `w_1'(0) - w_2'(0) = 0`; multiplier `M1G`.
+    M1G,
+    /// Eq. 39: `w_3'(0) - w_2'(0) = 0`; multiplier `M3G`.
+    M3G,
+    /// Eq. 41: `w_i(xp_i) = 0`; multiplier `Fp_i`.
+    Fp(usize),
+    /// Eq. 42: `w_i(xp_i + Lp/2) - Lp/2 thp_i = 0`; multiplier `FR_pi`.
+    FR(usize),
+    /// Eq. 42: `w_i(xp_i - Lp/2) + Lp/2 thp_i = 0`; multiplier `FL_pi`.
+    FL(usize),
+    /// Eq. 43: `thp_i - w_i'(xp_i) = 0`; multiplier `Mp_i`.
+    Mp(usize),
+}
+
+/// Basis vectors of the alpha parts of the constraint rows of one beam: every row's alpha part is
+/// one of them times a scalar.
+const B_PHI0: usize = 0; // phi_j(0)          (Fix, Fw)
+const B_DPHI0: usize = 1; // phi_j'(0)        (MiG)
+const B_MID: usize = 2; // phi_j(xp)          (Fp)
+const B_RIGHT: usize = 3; // phi_j(xp + Lp/2) (FR)
+const B_LEFT: usize = 4; // phi_j(xp - Lp/2)  (FL)
+const B_MSLOPE: usize = 5; // -phi_j'(xp)     (Mp)
+const NB: usize = 6;
+/// "This row has no alpha part."
+const NONE: usize = usize::MAX;
+
+/// The rows of C that touch one beam: row k is `sc[k] * B[basis[k]]` on alpha, `cu[k]` on u_i and
+/// `ct[k]` on thp_i.
+#[derive(Debug, Clone, Default)]
+struct BeamRows {
+    /// Global row index of each local row.
+    ids: Vec<usize>,
+    basis: Vec<usize>,
+    sc: Vec<f64>,
+    cu: Vec<f64>,
+    ct: Vec<f64>,
+    /// The sleeve basis vectors B_MID..B_MSLOPE of this beam (refreshed per step), N each.
+    sleeve: [Vec<f64>; 4],
+    // per-step workspace
+    /// `D^-1 B_a` for the sleeve vectors.
+    scaled: [Vec<f64>; 4],
+    /// Gram matrix `B_a . D^-1 B_b` of the six basis vectors.
+    gram: [[f64; NB]; NB],
+    /// `B_a . D^-1 Phi`.
+    g: [f64; NB],
+}
+
+/// Workspace of the constrained system: everything sized once, nothing allocated per step.
+#[derive(Debug, Clone)]
+pub(crate) struct System {
+    pub(crate) modes: ModeSet,
+    pub(crate) nm: usize,
+    pub(crate) nb: usize,
+    rho: f64,
+    l: f64,
+    jp: f64,
+    tri: Triplet,
+    lambda_m: Vec<f64>,
+    phi: Vec<f64>,
+    psi: Vec<f64>,
+    pub(crate) phi0: Vec<f64>,
+    dphi0: Vec<f64>,
+    pub(crate) phil: Vec<f64>,
+    pub(crate) rows: Vec<Row>,
+    beams: [BeamRows; 3],
+    // arrowhead data of S (the same for the three beams)
+    inv_d: Vec<f64>,
+    w: Vec<f64>,
+    p: f64,
+    inv_sigma: f64,
+    // per-step buffers
+    scaled0: [Vec<f64>; 2],
+    dinv_r: Vec<f64>,
+    resid: Vec<f64>,
+    a: Vec<f64>,
+    rhs: Vec<f64>,
+    piv: Vec<usize>,
+    /// Multipliers of the last solve, in the order of `rows`.
+    pub(crate) lam: Vec<f64>,
+}
+
+/// Is a vector of mode values zero to round-off? `scale[m]` is the size a non-zero entry would have.
+fn negligible(v: &[f64], scale: &[f64]) -> bool {
+    v.iter().zip(scale).all(|(x, s)| x.abs() <= 1e-9 * s)
+}
+
+impl System {
+    /// Build the system for `modes`, keeping the constraint rows that do not vanish identically
+    /// for the family (pinned-free: no `Fw`; slide-free: no slope equalities; clamped-free: neither).
+    pub(crate) fn new(modes: ModeSet, params: &RobotParams) -> Self {
+        let nm = modes.len();
+        let nb = nm + 2;
+        let l = params.l;
+        let sl = 1.0 / l.sqrt();
+        let bl = modes.beta_l();
+        let mut phi0 = vec![0.0; nm];
+        let mut dphi0 = vec![0.0; nm];
+        let mut phil = vec![0.0; nm];
+        for m in 0..nm {
+            let e0 = modes.eval(m, 0.0);
+            phi0[m] = e0[0];
+            dphi0[m] = e0[1];
+            phil[m] = modes.eval(m, l)[0];
+        }
+        // a non-zero value is O(1/sqrt L), a non-zero slope O(max(1, beta L) / L^1.5)
+        let val_scale = vec![sl; nm];
+        let slope_scale: Vec<f64> = bl.iter().map(|b| b.max(1.0) * sl / l).collect();
+        let has_w0 = !negligible(&phi0, &val_scale);
+        let has_slope0 = !negligible(&dphi0, &slope_scale);
+
+        let mut rows = vec![Row::Fix(0), Row::Fix(1), Row::Fix(2)];
+        if has_w0 {
+            rows.push(Row::Fw);
+        }
+        if has_slope0 {
+            rows.push(Row::M1G);
+            rows.push(Row::M3G);
+        }
+        for i in 0..3 {
+            rows.extend([Row::Fp(i), Row::FR(i), Row::FL(i), Row::Mp(i)]);
+        }
+        let hp = 0.5 * params.lp;
+        let mut beams: [BeamRows; 3] = std::array::from_fn(|_| BeamRows {
+            ids: Vec::new(),
+            basis: Vec::new(),
+            sc: Vec::new(),
+            cu: Vec::new(),
+            ct: Vec::new(),
+            sleeve: std::array::from_fn(|_| vec![0.0; nm]),
+            scaled: std::array::from_fn(|_| vec![0.0; nm]),
+            gram: [[0.0; NB]; NB],
+            g: [0.0; NB],
+        });
+        for (k, row) in rows.iter().enumerate() {
+            for (b, beam) in beams.iter_mut().enumerate() {
+                // (basis vector, its factor, u coefficient, thp coefficient); None: block is zero
+                let entry = match *row {
+                    Row::Fix(i) if b == i => Some((NONE, 0.0, 1.0, 0.0)),
+                    Row::Fix(i) if has_w0 => Some((
+                        B_PHI0,
+                        if b == (i + 1) % 3 { 1.0 / SQRT3 } else { -1.0 / SQRT3 },
+                        0.0,
+                        0.0,
+                    )),
+                    Row::Fix(_) => None,
+                    Row::Fw => Some((B_PHI0, 1.0, 0.0, 0.0)),
+                    Row::M1G | Row::M3G => {
+                        let first = if *row == Row::M1G { 0 } else { 2 };
+                        match b {
+                            1 => Some((B_DPHI0, -1.0, 0.0, 0.0)),
+                            _ if b == first => Some((B_DPHI0, 1.0, 0.0, 0.0)),
+                            _ => None,
+                        }
+                    }
+                    Row::Fp(i) if b == i => Some((B_MID, 1.0, 0.0, 0.0)),
+                    Row::FR(i) if b == i => Some((B_RIGHT, 1.0, 0.0, -hp)),
+                    Row::FL(i) if b == i => Some((B_LEFT, 1.0, 0.0, hp)),
+                    Row::Mp(i) if b == i => Some((B_MSLOPE, 1.0, 0.0, 1.0)),
+                    Row::Fp(_) | Row::FR(_) | Row::FL(_) | Row::Mp(_) => None,
+                };
+                if let Some((basis, sc, cu, ct)) = entry {
+                    beam.ids.push(k);
+                    beam.basis.push(basis);
+                    beam.sc.push(sc);
+                    beam.cu.push(cu);
+                    beam.ct.push(ct);
+                }
+            }
+        }
+        let m = rows.len();
+        let n = 3 * nb;
+        System {
+            nm,
+            nb,
+            rho: params.rho,
+            l,
+            jp: params.jp,
+            tri: modes.triplet(hp),
+            lambda_m: modes.lambda().to_vec(),
+            phi: modes.phi_integral().to_vec(),
+            psi: modes.x_phi_integral().to_vec(),
+            phi0,
+            dphi0,
+            phil,
+            rows,
+            beams,
+            inv_d: vec![0.0; nm],
+            w: vec![0.0; nm],
+            p: 0.0,
+            inv_sigma: 0.0,
+            scaled0: [vec![0.0; nm], vec![0.0; nm]],
+            dinv_r: vec![0.0; nm],
+            resid: vec![0.0; n],
+            a: vec![0.0; m * m],
+            rhs: vec![0.0; m],
+            piv: vec![0; m],
+            lam: vec![0.0; m],
+            modes,
+        }
+    }
+
+    /// Number of unknowns, 3 (N + 2).
+    pub(crate) fn dim(&self) -> usize {
+        3 * self.nb
+    }
+
+    /// Basis vector `a` of beam `beam`.
+    fn basis<'s>(&'s self, beam: &'s BeamRows, a: usize) -> &'s [f64] {
+        match a {
+            B_PHI0 => &self.phi0,
+            B_DPHI0 => &self.dphi0,
+            _ => &beam.sleeve[a - B_MID],
+        }
+    }
+
+    /// Eqs. 41-43: refresh the sleeve basis vectors for the sleeve positions xp_i(t).
+    fn update_sleeve_rows(&mut self, xp: [f64; 3]) {
+        for (beam, &x) in self.beams.iter_mut().zip(&xp) {
+            let [mid, right, left, mslope] = &mut beam.sleeve;
+            self.modes.triplet_at(&self.tri, x, left, mid, right, mslope);
+            mslope.iter_mut().for_each(|v| *v = -*v);
+        }
+    }
+
+    /// Arrowhead data of `S = M + gamma' D + beta' K` for the angular rate th' and acceleration th''.
+    fn factor_s(&mut self, bp: f64, gp: f64, thd: f64, thdd: f64) {
+        let rho = self.rho;
+        self.p = rho * (2.0 * gp * thd + bp * thdd);
+        let mut sigma = rho * self.l * (1.0 - bp * thd * thd);
+        for j in 0..self.nm {
+            let d = rho * (1.0 + bp * (self.lambda_m[j] - thd * thd));
+            self.inv_d[j] = 1.0 / d;
+            self.w[j] = self.phi[j] / d;
+            sigma += self.p * self.p * self.phi[j] * self.w[j];
+        }
+        self.inv_sigma = 1.0 / sigma;
+    }
+
+    /// Solve `S x = r` for one beam block (O(N)), in place.
+    #[inline]
+    fn arrow_solve(&self, x: &mut [f64]) {
+        let nm = self.nm;
+        let y = (x[nm] + self.p * dot(&self.w, &x[..nm])) * self.inv_sigma;
+        for ((xj, pj), dj) in x[..nm].iter_mut().zip(&self.phi).zip(&self.inv_d) {
+            *xj = (*xj - self.p * pj * y) * dj;
+        }
+        x[nm] = y;
+        x[nm + 1] /= self.jp;
+    }
+
+    /// One linear solve of the index-3 generalized-alpha step (or of the consistent initial
+    /// accelerations when `bp = gp = 0`): with `q = qhat + bp qdd`, `q' = vhat + gp qdd`,
+    ///
+    /// ```text
+    /// S qdd - C^T lambda = f - D vhat - K qhat,     C qdd = -C qhat / bp   (0 when bp = 0)
+    /// ```
+    /// at the rigid state `st`. Writes `qdd` and `self.lam`.
+    ///
+    /// `A = C S^-1 C^T` is assembled without forming `S^-1 C^T`. Block elimination of the u row
+    /// of the arrowhead gives, for rows k and s of one beam (alpha part `ca`, u and thp
+    /// coefficients `cu`, `ct`),
+    /// `A_ks = ca_k D^-1 ca_s + (cu_k - p g_k)(cu_s + p g_s) / sigma + ct_k ct_s / Jp`, with
+    /// `g_k = ca_k . D^-1 Phi` and `sigma = s_uu + p^2 Phi D^-1 Phi`; and every alpha part is a
+    /// multiple of one of six vectors (phi(0), phi'(0), phi at the three sleeve points, phi'(xp)),
+    /// so only their 6x6 Gram matrix `B D^-1 B^T` is computed (21 dot products of length N).
+    pub(crate) fn solve(
+        &mut self,
+        st: &RigidState,
+        bp: f64,
+        gp: f64,
+        qhat: &[f64],
+        vhat: &[f64],
+        qdd: &mut [f64],
+    ) -> Result<(), AmmError> {
+        let (nm, nb, rho, l) = (self.nm, self.nb, self.rho, self.l);
+        let thd = st.theta.d1;
+        let thdd = st.theta.d2;
+        let ag = st.a_g();
+        self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v]);
+        self.factor_s(bp, gp, thd, thdd);
+
+        // residual r = f - D vhat - K qhat, per beam
+        for i in 0..3 {
+            let ew = st.e_w(i);
+            let ex = st.e_x(i);
+            let aw = ag[0] * ew[0] + ag[1] * ew[1];
+            let ax = ag[0] * ex[0] + ag[1] * ex[1];
+            let o = i * nb;
+            let (qa, qu) = (&qhat[o..o + nm], qhat[o + nm]);
+            let (va, vu) = (&vhat[o..o + nm], vhat[o + nm]);
+            let r = &mut self.resid[o..o + nb];
+            let mut phi_q = 0.0;
+            let mut phi_v = 0.0;
+            for j in 0..nm {
+                let pj = self.phi[j];
+                r[j] = -rho * (aw * pj + thdd * self.psi[j])
+                    - 2.0 * rho * thd * pj * vu
+                    - rho * (self.lambda_m[j] - thd * thd) * qa[j]
+                    - rho * thdd * pj * qu;
+                phi_q += pj * qa[j];
+                phi_v += pj * va[j];
+            }
+            r[nm] = -rho * (l * ax - thd * thd * l * l / 2.0)
+                + 2.0 * rho * thd * phi_v
+                + rho * thdd * phi_q
+                + rho * l * thd * thd * qu;
+            r[nm + 1] = -self.jp * thdd;
+        }
+
+        // Gram data of the junction vectors (shared by the beams)
+        for (sv, v) in self.scaled0.iter_mut().zip([&self.phi0, &self.dphi0]) {
+            for ((s, x), d) in sv.iter_mut().zip(v.iter()).zip(&self.inv_d) {
+                *s = x * d;
+            }
+        }
+        let g00 = dot(&self.scaled0[0], &self.phi0);
+        let g01 = dot(&self.scaled0[0], &self.dphi0);
+        let g11 = dot(&self.scaled0[1], &self.dphi0);
+        let w0 = dot(&self.scaled0[0], &self.phi);
+        let w1 = dot(&self.scaled0[1], &self.phi);
+
+        let m = self.rows.len();
+        let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp);
+        self.a.iter_mut().for_each(|v| *v = 0.0);
+        self.rhs.iter_mut().for_each(|v| *v = 0.0);
+        let mut beams = std::mem::take(&mut self.beams);
+        for (i, beam) in beams.iter_mut().enumerate() {
+            let o = i * nb;
+            // sleeve vectors scaled by D^-1, the Gram matrix and g = B D^-1 Phi
+            for (sv, v) in beam.scaled.iter_mut().zip(&beam.sleeve) {
+                for ((s, x), d) in sv.iter_mut().zip(v).zip(&self.inv_d) {
+                    *s = x * d;
+                }
+            }
+            let gram = &mut beam.gram;
+            gram[B_PHI0][B_PHI0] = g00;
+            gram[B_PHI0][B_DPHI0] = g01;
+            gram[B_DPHI0][B_PHI0] = g01;
+            gram[B_DPHI0][B_DPHI0] = g11;
+            for a in 0..4 {
+                let sa = &beam.scaled[a];
+                gram[B_MID + a][B_PHI0] = dot(sa, &self.phi0);
+                gram[B_MID + a][B_DPHI0] = dot(sa, &self.dphi0);
+                gram[B_PHI0][B_MID + a] = gram[B_MID + a][B_PHI0];
+                gram[B_DPHI0][B_MID + a] = gram[B_MID + a][B_DPHI0];
+                for b in a..4 {
+                    let v = dot(sa, &beam.sleeve[b]);
+                    gram[B_MID + a][B_MID + b] = v;
+                    gram[B_MID + b][B_MID + a] = v;
+                }
+                beam.g[B_MID + a] = dot(sa, &self.phi);
+            }
+            beam.g[B_PHI0] = w0;
+            beam.g[B_DPHI0] = w1;
+
+            // c_k . S^-1 r = ca_k D^-1 r_a + (cu_k - p g_k) y_r + ct_k r_thp / Jp, and c_k . qhat
+            let r = &self.resid[o..o + nb];
+            let y_r = (r[nm] + p * dot(&self.w, &r[..nm])) * inv_sigma;
+            for ((d, x), di) in self.dinv_r.iter_mut().zip(&r[..nm]).zip(&self.inv_d) {
+                *d = x * di;
+            }
+            let mut bdr = [0.0; NB];
+            let mut bq = [0.0; NB];
+            let used = |a: usize| beam.basis.contains(&a);
+            for a in 0..NB {
+                if used(a) {
+                    let v = match a {
+                        B_PHI0 => &self.phi0,
+                        B_DPHI0 => &self.dphi0,
+                        _ => &beam.sleeve[a - B_MID],
+                    };
+                    bdr[a] = dot(v, &self.dinv_r);
+                    bq[a] = dot(v, &qhat[o..o + nm]);
+                }
+            }
+            let mb = beam.ids.len();
+            for k in 0..mb {
+                let (bk, sk) = (beam.basis[k], beam.sc[k]);
+                let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };
+                let mut cz = (beam.cu[k] - p * gk) * y_r + beam.ct[k] * r[nm + 1] * inv_jp;
+                let mut cq = beam.cu[k] * qhat[o + nm] + beam.ct[k] * qhat[o + nm + 1];
+                if bk != NONE {
+                    cz += sk * bdr[bk];
+                    cq += sk * bq[bk];
+                }
+                let cq = if bp > 0.0 { cq / bp } else { 0.0 };
+                self.rhs[beam.ids[k]] -= cz + cq;
+            }
+            for k in 0..mb {
+                let (bk, sk) = (beam.basis[k], beam.sc[k]);
+                let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };
+                let left = (beam.cu[k] - p * gk) * inv_sigma;
+                let row = beam.ids[k] * m;
+                for s in 0..mb {
+                    let (bs, ss) = (beam.basis[s], beam.sc[s]);
+                    let gs = if bs == NONE { 0.0 } else { ss * beam.g[bs] };
+                    let mut v = left * (beam.cu[s] + p * gs) + beam.ct[k] * beam.ct[s] * inv_jp;
+                    if bk != NONE && bs != NONE {
+                        v += sk * ss * beam.gram[bk][bs];
+                    }
+                    self.a[row + beam.ids[s]] += v;
+                }
+            }
+        }
+        self.beams = beams;
+        lu_solve(&mut self.a, &mut self.piv, &mut self.rhs, m)
+            .map_err(|reason| AmmError::SingularConstraints { t: st.t, reason })?;
+        self.lam.copy_from_slice(&self.rhs);
+
+        // qdd = S^-1 (r + C^T lambda): collect the multipliers per basis vector, then one axpy each
+        qdd.copy_from_slice(&self.resid);
+        for (i, beam) in self.beams.iter().enumerate() {
+            let o = i * nb;
+            let mut coef = [0.0; NB];
+            for (k, &g) in beam.ids.iter().enumerate() {
+                let lam = self.lam[g];
+                if beam.basis[k] != NONE {
+                    coef[beam.basis[k]] += lam * beam.sc[k];
+                }
+                qdd[o + nm] += lam * beam.cu[k];
+                qdd[o + nm + 1] += lam * beam.ct[k];
+            }
+            for (a, &c) in coef.iter().enumerate() {
+                if c != 0.0 {
+                    for (q, v) in qdd[o..o + nm].iter_mut().zip(self.basis(beam, a)) {
+                        *q += c * v;
+                    }
+                }
+            }
+        }
+        for i in 0..3 {
+            self.arrow_solve(&mut qdd[i * nb..(i + 1) * nb]);
+        }
+        Ok(())
+    }
+
+    /// Largest |C q| over the rows (constraint residual, for tests).
+    #[cfg(test)]
+    pub(crate) fn constraint_residual(&self, q: &[f64]) -> f64 {
+        let (nm, nb) = (self.nm, self.nb);
+        let mut r = vec![0.0; self.rows.len()];
+        for (i, beam) in self.beams.iter().enumerate() {
+            let o = i * nb;
+            for (k, &g) in beam.ids.iter().enumerate() {
+                let mut v = beam.cu[k] * q[o + nm] + beam.ct[k] * q[o + nm + 1];
+                if beam.basis[k] != NONE {
+                    v += beam.sc[k] * dot(self.basis(beam, beam.basis[k]), &q[o..o + nm]);
+                }
+                r[g] += v;
+            }
+        }
+        r.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+    }
+}
+
+/// Dot product with four independent accumulators (breaks the add latency chain; the order of
+/// summation is fixed, so results are reproducible).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let ca = a.chunks_exact(4);
+    let cb = b.chunks_exact(4);
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        acc[0] += x[0] * y[0];
+        acc[1] += x[1] * y[1];
+        acc[2] += x[2] * y[2];
+        acc[3] += x[3] * y[3];
+    }
+    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
+}
+
+/// In-place LU with partial pivoting of the dense m x m matrix `a` (row-major) and solve for `b`.
+/// Fails when a pivot is below 1e-13 of the largest entry of its row before elimination.
+fn lu_solve(a: &mut [f64], piv: &mut [usize], b: &mut [f64], m: usize) -> Result<(), String> {
+    // row scales for the singularity test
+    for (r, p) in piv.iter_mut().enumerate() {
+        *p = r;
+    }
+    // m <= 18 by construction (6 junction + 12 sleeve rows)
+    let mut scale = [0.0f64; 32];
+    for r in 0..m {
+        scale[r] = a[r * m..(r + 1) * m].iter().fold(0.0f64, |s, v| s.max(v.abs()));
+        if scale[r] == 0.0 || !scale[r].is_finite() {
+            return Err(format!("constraint row {r} has no coupling"));
+        }
+    }
+    for k in 0..m {
+        let (mut best, mut arg) = (0.0, k);
+        for r in k..m {
+            let v = a[r * m + k].abs() / scale[r];
+            if v > best {
+                best = v;
+                arg = r;
+            }
+        }
+        if best.is_nan() || best <= 1e-13 {
+            return Err(format!(
+                "rank-deficient at elimination step {k} of {m} (pivot ratio {best:e})"
+            ));
+        }
+        if arg != k {
+            let (top, bottom) = a.split_at_mut(arg * m);
+            top[k * m..(k + 1) * m].swap_with_slice(&mut bottom[..m]);
+            b.swap(k, arg);
+            scale.swap(k, arg);
+            piv.swap(k, arg);
+        }
+        let (top, bottom) = a.split_at_mut((k + 1) * m);
+        let pivot_row = &top[k * m..(k + 1) * m];
+        let inv = 1.0 / pivot_row[k];
+        let bk = b[k];
+        for (r, row) in bottom.chunks_exact_mut(m).enumerate() {
+            let f = row[k] * inv;
+            if f != 0.0 {
+                row[k] = f;
+                for (x, p) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
+                    *x -= f * p;
+                }
+                b[k + 1 + r] -= f * bk;
+            }
+        }
+    }
+    for k in (0..m).rev() {
+        let mut s = b[k];
+        for c in k + 1..m {
+            s -= a[k * m + c] * b[c];
+        }
+        b[k] = s / a[k * m + k];
+    }
+    Ok(())
+}

@@ -1,0 +1,465 @@
+//! The co-rotational two-node planar Euler-Bernoulli beam element in absolute coordinates
+//! (Crisfield 1991, vol. 1, ch. 7; Battini's notation), with the consistent inertia of its own
+//! cubic interpolation (Le, Battini & Hjiaj 2011, Comput. Mech. 48:153).
+//!
+//! Element DOFs `q_e = [xa, ya, phia, xb, yb, phib]`: absolute node positions [m] in the fixed XY
+//! frame and rotation increments of the cross-sections [rad] from the initial (straight, stress
+//! free) configuration. With the current chord `d = xb - xa`, `l_n = |d|`, chord angle `beta`
+//! (initial `beta0`), the local deformations are
+//!
+//! ```text
+//! u = l_n - l0,   th1 = phia - (beta - beta0),   th2 = phib - (beta - beta0)   (wrapped to (-pi, pi])
+//! ```
+//!
+//! and the local (linear) Euler-Bernoulli law gives `N = EA u / l0`,
+//! `M1 = EI/l0 (4 th1 + 2 th2)`, `M2 = EI/l0 (2 th1 + 4 th2)`.
+//!
+//! The material point at `zeta = x / l0` in [0, 1] sits at (shallow local interpolation, cubic
+//! Hermite for the local transverse displacement, linear for the axial one)
+//!
+//! ```text
+//! r(zeta) = xa + zeta d + w(zeta) e2,   w = l0 (H1 th1 + H2 th2),
+//! H1 = zeta (1 - zeta)^2,   H2 = -zeta^2 (1 - zeta),   e2 = [-sin beta, cos beta]
+//! ```
+//!
+//! and its cross-section angle is `beta + H1' th1 + H2' th2`. The same `r(zeta)` defines the
+//! kinetic energy `T = 1/2 int rho |r_dot|^2 dx`, evaluated by 4-point Gauss quadrature (exact
+//! for the linearised element, where it reduces to the textbook consistent mass matrix). Its
+//! Lagrange equations give the inertia force `int rho J^T (J q_dd + r_conv) dx` with
+//! `J = dr/dq_e` and the convective acceleration `r_conv` (terms quadratic in `q_dot`).
+
+use flexstar_numerics::quadrature::gauss_legendre;
+
+/// 6x6 element matrix, row-major.
+pub type Mat6 = [[f64; 6]; 6];
+
+/// Wrap an angle to (-pi, pi].
+fn wrap(a: f64) -> f64 {
+    use std::f64::consts::PI;
+    let w = (a + PI).rem_euclid(2.0 * PI) - PI;
+    if w <= -PI {
+        w + 2.0 * PI
+    } else {
+        w
+    }
+}
+
+/// Cubic Hermite rotation shape functions (per unit l0) and their first two derivatives in zeta.
+#[inline]
+fn hermite(z: f64) -> [f64; 6] {
+    let h1 = z * (1.0 - z) * (1.0 - z);
+    let h2 = -z * z * (1.0 - z);
+    let d1 = (1.0 - z) * (1.0 - 3.0 * z);
+    let d2 = 3.0 * z * z - 2.0 * z;
+    let dd1 = 6.0 * z - 4.0;
+    let dd2 = 6.0 * z - 2.0;
+    [h1, h2, d1, d2, dd1, dd2]
+}
+
+/// Reference data of one element: its two nodes, initial length and chord angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Element {
+    /// Global node indices (a at material coordinate `x`, b at `x + l0`).
+    pub nodes: [usize; 2],
+    /// Initial (stress-free) length [m].
+    pub l0: f64,
+    /// cos and sin of the initial chord angle beta0.
+    pub c0: f64,
+    pub s0: f64,
+}
+
+/// Current kinematic state of one element (everything a force or interpolation needs).
+#[derive(Debug, Clone, Copy)]
+pub struct ElementState {
+    pub l0: f64,
+    /// Current chord length l_n [m].
+    pub ln: f64,
+    /// cos and sin of the current chord angle beta.
+    pub c: f64,
+    pub s: f64,
+    /// Axial elongation u = l_n - l0 [m].
+    pub u: f64,
+    /// Local end rotations th1, th2 [rad] (small in a fine mesh).
+    pub th1: f64,
+    pub th2: f64,
+    /// Rigid chord rotation beta - beta0, unwrapped consistently with node a's rotation [rad].
+    pub delta: f64,
+    /// Chord vector d = xb - xa [m].
+    pub d: [f64; 2],
+}
+
+impl ElementState {
+    /// Local deformations of element `el` at element DOFs `q` (`[xa, ya, phia, xb, yb, phib]`).
+    #[inline]
+    pub fn new(el: &Element, q: &[f64; 6]) -> Self {
+        let d = [q[3] - q[0], q[4] - q[1]];
+        let ln = (d[0] * d[0] + d[1] * d[1]).sqrt();
+        let (c, s) = (d[0] / ln, d[1] / ln);
+        let sd = el.c0 * s - el.s0 * c;
+        let cd = el.c0 * c + el.s0 * s;
+        let dp = sd.atan2(cd);
+        let th1 = wrap(q[2] - dp);
+        let delta = q[2] - th1;
+        let th2 = wrap(q[5] - delta);
+        ElementState {
+            l0: el.l0,
+            ln,
+            c,
+            s,
+            u: ln - el.l0,
+            th1,
+            th2,
+            delta,
+            d,
+        }
+    }
+
+    /// `d beta / d q_e` = z / l_n with z = [s, -c, 0, -s, c, 0].
+    #[inline]
+    pub fn jbeta(&self) -> [f64; 6] {
+        let (s, c) = (self.s / self.ln, self.c / self.ln);
+        [s, -c, 0.0, -s, c, 0.0]
+    }
+
+    /// Local forces `[N, M1, M2]` (axial force [N], end moments [N m]).
+    #[inline]
+    pub fn local_forces(&self, ea: f64, ei: f64) -> [f64; 3] {
+        let k = ei / self.l0;
+        [
+            ea * self.u / self.l0,
+            k * (4.0 * self.th1 + 2.0 * self.th2),
+            k * (2.0 * self.th1 + 4.0 * self.th2),
+        ]
+    }
+
+    /// Strain energy [J]: `EA u^2 / (2 l0) + EI/l0 (2 th1^2 + 2 th1 th2 + 2 th2^2)`.
+    pub fn strain_energy(&self, ea: f64, ei: f64) -> f64 {
+        0.5 * ea * self.u * self.u / self.l0
+            + ei / self.l0 * 2.0 * (self.th1 * self.th1 + self.th1 * self.th2 + self.th2 * self.th2)
+    }
+
+    /// Internal force vector f = B^T [N, M1, M2] and tangent stiffness
+    /// `K = B^T Kl B + N z z^T / l_n + (M1 + M2)(r z^T + z r^T) / l_n^2`.
+    pub fn internal(&self, ea: f64, ei: f64) -> ([f64; 6], Mat6) {
+        let (c, s, ln) = (self.c, self.s, self.ln);
+        let [n, m1, m2] = self.local_forces(ea, ei);
+        let r = [-c, -s, 0.0, c, s, 0.0];
+        let z = [s, -c, 0.0, -s, c, 0.0];
+        let b1 = [-s / ln, c / ln, 1.0, s / ln, -c / ln, 0.0];
+        let b2 = [-s / ln, c / ln, 0.0, s / ln, -c / ln, 1.0];
+        let mut f = [0.0; 6];
+        for j in 0..6 {
+            f[j] = n * r[j] + m1 * b1[j] + m2 * b2[j];
+        }
+        let ka = ea / self.l0;
+        let k4 = 4.0 * ei / self.l0;
+        let k2 = 2.0 * ei / self.l0;
+        let gz = n / ln;
+        let gm = (m1 + m2) / (ln * ln);
+        let mut k = [[0.0; 6]; 6];
+        for i in 0..6 {
+            for j in 0..6 {
+                k[i][j] = ka * r[i] * r[j]
+                    + k4 * (b1[i] * b1[j] + b2[i] * b2[j])
+                    + k2 * (b1[i] * b2[j] + b2[i] * b1[j])
+                    + gz * z[i] * z[j]
+                    + gm * (r[i] * z[j] + z[i] * r[j]);
+            }
+        }
+        (f, k)
+    }
+
+    /// Interpolated position `r(zeta)` [m] of the material point at `zeta` in [0, 1].
+    #[inline]
+    pub fn position(&self, el_a: [f64; 2], zeta: f64) -> [f64; 2] {
+        let h = hermite(zeta);
+        let w = self.l0 * (h[0] * self.th1 + h[1] * self.th2);
+        [
+            el_a[0] + zeta * self.d[0] - w * self.s,
+            el_a[1] + zeta * self.d[1] + w * self.c,
+        ]
+    }
+
+    /// Jacobian `J = d r(zeta) / d q_e` (2 x 6).
+    #[inline]
+    pub fn jacobian(&self, zeta: f64) -> [[f64; 6]; 2] {
+        let h = hermite(zeta);
+        let l0 = self.l0;
+        let w = l0 * (h[0] * self.th1 + h[1] * self.th2);
+        let jb = self.jbeta();
+        let e1 = [self.c, self.s];
+        let e2 = [-self.s, self.c];
+        // dw/dq = l0 (H1 (e3 - jb) + H2 (e6 - jb))
+        let hs = l0 * (h[0] + h[1]);
+        let mut dw = [0.0; 6];
+        for j in 0..6 {
+            dw[j] = -hs * jb[j];
+        }
+        dw[2] += l0 * h[0];
+        dw[5] += l0 * h[1];
+        let mut jac = [[0.0; 6]; 2];
+        for k in 0..2 {
+            for j in 0..6 {
+                jac[k][j] = e2[k] * dw[j] - w * e1[k] * jb[j];
+            }
+            jac[k][k] += 1.0 - zeta;
+            jac[k][3 + k] += zeta;
+        }
+        jac
+    }
+
+    /// `d r / d zeta` [m] (not per unit length: divide by l0 for `d r / d x`).
+    #[inline]
+    pub fn dr_dzeta(&self, zeta: f64) -> [f64; 2] {
+        let h = hermite(zeta);
+        let wz = self.l0 * (h[2] * self.th1 + h[3] * self.th2);
+        [self.d[0] - wz * self.s, self.d[1] + wz * self.c]
+    }
+
+    /// Cross-section angle at `zeta` relative to the initial element angle, `alpha - beta0` [rad],
+    /// with its gradient with respect to `q_e` and its derivative in `zeta`.
+    #[inline]
+    pub fn angle(&self, zeta: f64) -> (f64, [f64; 6], f64) {
+        let h = hermite(zeta);
+        let v = self.delta + h[2] * self.th1 + h[3] * self.th2;
+        let jb = self.jbeta();
+        let kb = 1.0 - h[2] - h[3];
+        let mut g = [0.0; 6];
+        for j in 0..6 {
+            g[j] = kb * jb[j];
+        }
+        g[2] += h[2];
+        g[5] += h[3];
+        (v, g, h[4] * self.th1 + h[5] * self.th2)
+    }
+
+    /// Convective acceleration of the material point at `zeta`: the part of `r_dd` that does not
+    /// involve `q_dd` (quadratic in the element velocities `qd`).
+    #[inline]
+    pub fn convective(&self, zeta: f64, qd: &[f64; 6]) -> [f64; 2] {
+        let h = hermite(zeta);
+        let l0 = self.l0;
+        let ln2 = self.ln * self.ln;
+        let dd = [qd[3] - qd[0], qd[4] - qd[1]];
+        let bd = (self.d[0] * dd[1] - self.d[1] * dd[0]) / ln2;
+        let bdd_c = -2.0 * bd * (self.d[0] * dd[0] + self.d[1] * dd[1]) / ln2;
+        let w = l0 * (h[0] * self.th1 + h[1] * self.th2);
+        let wd = l0 * (h[0] * (qd[2] - bd) + h[1] * (qd[5] - bd));
+        let wdd_c = -l0 * (h[0] + h[1]) * bdd_c;
+        let e1 = [self.c, self.s];
+        let e2 = [-self.s, self.c];
+        let a1 = -2.0 * wd * bd - w * bdd_c;
+        let a2 = wdd_c - w * bd * bd;
+        [a1 * e1[0] + a2 * e2[0], a1 * e1[1] + a2 * e2[1]]
+    }
+
+    /// Inertia of the element (Lagrange equations of `T = 1/2 int rho |r_dot|^2 dx`):
+    /// returns the convective inertia force `int rho J^T r_conv dx` [N, N m] and the consistent
+    /// mass matrix `M(q) = int rho J^T J dx`, both by 4-point Gauss quadrature. The full inertia
+    /// force is `M q_dd + f_conv`.
+    pub fn inertia(&self, rho: f64, qd: &[f64; 6]) -> ([f64; 6], Mat6) {
+        let (pts, wts) = gauss_legendre(4);
+        let mut f = [0.0; 6];
+        let mut m = [[0.0; 6]; 6];
+        for (p, wg) in pts.iter().zip(wts) {
+            let z = 0.5 * (p + 1.0);
+            let wq = 0.5 * wg * rho * self.l0;
+            let jac = self.jacobian(z);
+            let rc = self.convective(z, qd);
+            for i in 0..6 {
+                f[i] += wq * (jac[0][i] * rc[0] + jac[1][i] * rc[1]);
+                for j in i..6 {
+                    m[i][j] += wq * (jac[0][i] * jac[0][j] + jac[1][i] * jac[1][j]);
+                }
+            }
+        }
+        for i in 0..6 {
+            for j in 0..i {
+                m[i][j] = m[j][i];
+            }
+        }
+        (f, m)
+    }
+
+    /// Kinetic energy [J] of the element moving with velocities `qd`.
+    pub fn kinetic_energy(&self, rho: f64, qd: &[f64; 6]) -> f64 {
+        let (pts, wts) = gauss_legendre(4);
+        let mut t = 0.0;
+        for (p, wg) in pts.iter().zip(wts) {
+            let z = 0.5 * (p + 1.0);
+            let jac = self.jacobian(z);
+            let v0: f64 = (0..6).map(|j| jac[0][j] * qd[j]).sum();
+            let v1: f64 = (0..6).map(|j| jac[1][j] * qd[j]).sum();
+            t += 0.5 * wg * (v0 * v0 + v1 * v1);
+        }
+        0.5 * rho * self.l0 * t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn el() -> Element {
+        let b0: f64 = 0.7;
+        Element {
+            nodes: [0, 1],
+            l0: 0.05,
+            c0: b0.cos(),
+            s0: b0.sin(),
+        }
+    }
+
+    fn q0() -> [f64; 6] {
+        // a deformed, rotated state: chord turned by ~2 rad, stretched, bent
+        let b: f64 = 0.7 + 2.0;
+        let l = 0.05 * (1.0 + 1e-3);
+        [0.1, -0.2, 2.0 + 0.03, 0.1 + l * b.cos(), -0.2 + l * b.sin(), 2.0 - 0.02]
+    }
+
+    fn pert(q: &[f64; 6], j: usize, h: f64) -> [f64; 6] {
+        let mut p = *q;
+        p[j] += h;
+        p
+    }
+
+    #[test]
+    fn local_deformations_of_rigid_motion_vanish() {
+        let e = el();
+        let b: f64 = 0.7 + 5.0; // more than pi of rigid rotation
+        let q = [0.3, 0.1, 5.0, 0.3 + 0.05 * b.cos(), 0.1 + 0.05 * b.sin(), 5.0];
+        let st = ElementState::new(&e, &q);
+        assert!(st.u.abs() < 1e-15 && st.th1.abs() < 1e-12 && st.th2.abs() < 1e-12);
+        assert!((st.delta - 5.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn force_is_gradient_of_energy_and_stiffness_is_gradient_of_force() {
+        // Finite differences, central, step 1e-7 (fenris style: every analytic derivative checked).
+        let e = el();
+        let (ea, ei) = (6e6, 0.5);
+        let q = q0();
+        let st = ElementState::new(&e, &q);
+        let (f, k) = st.internal(ea, ei);
+        let h = 1e-7;
+        for j in 0..6 {
+            let ep = ElementState::new(&e, &pert(&q, j, h)).strain_energy(ea, ei);
+            let em = ElementState::new(&e, &pert(&q, j, -h)).strain_energy(ea, ei);
+            let fd = (ep - em) / (2.0 * h);
+            assert!(
+                (fd - f[j]).abs() < 1e-6 * (1.0 + f[j].abs()),
+                "f[{j}]: {fd} vs {}",
+                f[j]
+            );
+            let (fp, _) = ElementState::new(&e, &pert(&q, j, h)).internal(ea, ei);
+            let (fm, _) = ElementState::new(&e, &pert(&q, j, -h)).internal(ea, ei);
+            for i in 0..6 {
+                let kd = (fp[i] - fm[i]) / (2.0 * h);
+                assert!(
+                    (kd - k[i][j]).abs() < 1e-5 * (1.0 + k[i][j].abs()),
+                    "K[{i}][{j}]: {kd} vs {}",
+                    k[i][j]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn jacobian_angle_and_zeta_derivatives_match_finite_differences() {
+        let e = el();
+        let q = q0();
+        let a = [q[0], q[1]];
+        let h = 1e-7;
+        for z in [0.0, 0.3, 0.77, 1.0] {
+            let st = ElementState::new(&e, &q);
+            let jac = st.jacobian(z);
+            let (_, ga, az) = st.angle(z);
+            for j in 0..6 {
+                let (qp, qm) = (pert(&q, j, h), pert(&q, j, -h));
+                let (sp, sm) = (ElementState::new(&e, &qp), ElementState::new(&e, &qm));
+                let rp = sp.position([qp[0], qp[1]], z);
+                let rm = sm.position([qm[0], qm[1]], z);
+                for k in 0..2 {
+                    let fd = (rp[k] - rm[k]) / (2.0 * h);
+                    assert!(
+                        (fd - jac[k][j]).abs() < 1e-8,
+                        "J[{k}][{j}] at {z}: {fd} vs {}",
+                        jac[k][j]
+                    );
+                }
+                let fd = (sp.angle(z).0 - sm.angle(z).0) / (2.0 * h);
+                assert!((fd - ga[j]).abs() < 1e-6, "dalpha/dq[{j}] at {z}: {fd} vs {}", ga[j]);
+            }
+            let rz = st.dr_dzeta(z);
+            let hz = 1e-6;
+            let (rp, rm) = (st.position(a, z + hz), st.position(a, z - hz));
+            for k in 0..2 {
+                assert!(((rp[k] - rm[k]) / (2.0 * hz) - rz[k]).abs() < 1e-8);
+            }
+            let fd = (st.angle(z + hz).0 - st.angle(z - hz).0) / (2.0 * hz);
+            assert!((fd - az).abs() < 1e-7);
+        }
+    }
+
+    #[test]
+    fn convective_acceleration_is_second_time_derivative() {
+        // r(q(t)) along q(t) = q0 + t qd: r_dd at t = 0 is exactly the convective term.
+        let e = el();
+        let q = q0();
+        let qd = [0.3, -1.1, 4.0, -0.7, 0.9, -3.0];
+        // (the chord stretches at 40/s here, so the step must be small for O(h^2) truncation)
+        let h = 1e-5;
+        for z in [0.2, 0.5, 0.9] {
+            let r = |t: f64| {
+                let qt: [f64; 6] = std::array::from_fn(|j| q[j] + t * qd[j]);
+                ElementState::new(&e, &qt).position([qt[0], qt[1]], z)
+            };
+            let (rp, r0, rm) = (r(h), r(0.0), r(-h));
+            let conv = ElementState::new(&e, &q).convective(z, &qd);
+            for k in 0..2 {
+                let fd = (rp[k] - 2.0 * r0[k] + rm[k]) / (h * h);
+                assert!(
+                    (fd - conv[k]).abs() < 1e-5 * (1.0 + conv[k].abs()),
+                    "{z}: {fd} vs {}",
+                    conv[k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn linearised_mass_is_textbook_consistent_mass() {
+        // Element along X: axial rho l/6 [2 1; 1 2], transverse rho l/420 [156 22l 54 -13l; ...]
+        // (Przemieniecki 1968, Theory of Matrix Structural Analysis, section 11.3).
+        let e = Element {
+            nodes: [0, 1],
+            l0: 0.1,
+            c0: 1.0,
+            s0: 0.0,
+        };
+        let st = ElementState::new(&e, &[0.0, 0.0, 0.0, 0.1, 0.0, 0.0]);
+        let (_, m) = st.inertia(2.0, &[0.0; 6]);
+        let (l, rl) = (0.1, 2.0 * 0.1);
+        let ax = [[2.0, 1.0], [1.0, 2.0]];
+        let tr = [
+            [156.0, 22.0 * l, 54.0, -13.0 * l],
+            [22.0 * l, 4.0 * l * l, 13.0 * l, -3.0 * l * l],
+            [54.0, 13.0 * l, 156.0, -22.0 * l],
+            [-13.0 * l, -3.0 * l * l, -22.0 * l, 4.0 * l * l],
+        ];
+        let (ia, it) = ([0, 3], [1, 2, 4, 5]);
+        for a in 0..2 {
+            for b in 0..2 {
+                assert!((m[ia[a]][ia[b]] - rl / 6.0 * ax[a][b]).abs() < 1e-14);
+            }
+            for b in 0..4 {
+                assert!(m[ia[a]][it[b]].abs() < 1e-14);
+            }
+        }
+        for a in 0..4 {
+            for b in 0..4 {
+                assert!((m[it[a]][it[b]] - rl / 420.0 * tr[a][b]).abs() < 1e-14, "{a}{b}");
+            }
+        }
+    }
+}

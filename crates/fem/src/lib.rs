@@ -1,0 +1,26 @@
+//! # flexstar-fem
+//!
+//! The independent finite-element reference model of the flexible star-triangle robot
+//! (MODEL-NOTES section 7, issue 5): three co-rotational Euler-Bernoulli beams in absolute
+//! coordinates welded at one node G ([`element`]), three rigid sleeves with inertia Jp pinned at
+//! the revolute points of Eqs. 1-3 through which the beams slide without friction, index-3
+//! generalized-alpha integration with a sparse LU. The driving forces follow from the pin
+//! reactions (Eq. 33). Its equations use only the robot parameters, `s_i(t)` and the start
+//! configuration; the rigid (Fermat-point) kinematics appears only as initial data and in the
+//! post-processing of [`solve`] (projection onto the rigid frames). The formulation, the
+//! convergence study behind the defaults and the deviations are in `docs/fem.md`.
+
+#![allow(clippy::needless_range_loop)] // index loops over DOFs read like the equations
+
+pub mod beam;
+pub mod element;
+pub mod error;
+mod integrator;
+mod solve;
+mod sparse;
+mod star;
+
+pub use error::FemError;
+pub use integrator::Stats;
+pub use solve::{solve, solve_with_stats, DEFAULT_DT, DEFAULT_RHO_INF};
+pub use star::InitialState;

@@ -1,0 +1,499 @@
+//! The assembled star: three co-rotational beams welded at one shared node G, and three rigid
+//! sleeves pinned at the revolute points `P_i(t)` (Eqs. 1-3) through which the beams slide.
+//!
+//! Unknowns (all in the fixed XY frame, SI units):
+//! - node j: `[x, y, phi]` (position [m], cross-section rotation increment [rad]); node 0 is G,
+//!   beam i (0-based) has nodes `1 + i ne + (k - 1)` at material coordinates `k h`, k = 1..ne;
+//! - sleeve i: rotation increment `psi_i` [rad] of its axis from the initial beam direction
+//!   `gamma0_i` (the angle of `e_xi(theta0)`), inertia Jp;
+//! - sleeve i: material coordinates `xi_ic, xi_il, xi_ir` [m] of its centre and its two edges on
+//!   beam i (massless: fixed by the constraints, frictionless because nothing else acts on them).
+//!
+//! Constraints of sleeve i (7 rows, multipliers `lambda`), with `a = [cos, sin](gamma0_i + psi_i)`:
+//!
+//! ```text
+//! r_i(xi_c) - P_i(t)              = 0   (2)  centre on the pin
+//! r_i(xi_l) - P_i(t) + Lp/2 a     = 0   (2)  left edge on the beam
+//! r_i(xi_r) - P_i(t) - Lp/2 a     = 0   (2)  right edge on the beam
+//! alpha_i(xi_c) - gamma0_i - psi_i = 0   (1)  beam tangent along the sleeve axis
+//! ```
+//!
+//! `r_i(xi)` and `alpha_i(xi)` are the element interpolations of [`crate::element`] in the element
+//! that contains `xi`; they are continuous (position and angle) across element boundaries, so a
+//! contact point slides from one element into the next without a jump.
+//!
+//! Equations of motion (Lagrange): `M(q) q_dd + f_conv(q, q_d) + f_int(q) + Phi_q^T lambda = 0`.
+//! The generalized force of the constraints on the beam is `-Phi_q^T lambda`: sleeve i pushes the
+//! beam with the point forces `-lambda_c`, `-lambda_l`, `-lambda_r`, and the beam pushes the sleeve,
+//! hence its pin and slider, with `F_i = lambda_c + lambda_l + lambda_r`.
+
+use flexstar_model::geometry::{e_x, revolute_point};
+use flexstar_model::RobotParams;
+
+use crate::element::{Element, ElementState};
+use crate::sparse::SparseLu;
+use crate::FemError;
+
+/// Elements per contact-point window of the sparsity pattern.
+const WINDOW: usize = 8;
+/// Constraint rows per sleeve.
+pub(crate) const ROWS: usize = 7;
+/// Contact point of each constraint row: 0 centre, 1 left edge, 2 right edge.
+const ROW_POINT: [usize; ROWS] = [0, 0, 1, 1, 2, 2, 0];
+
+/// Initial state of the star: undeformed, moving rigidly (initial data from the rigid
+/// kinematics at t = 0: this is allowed, the equations never use it again).
+#[derive(Debug, Clone, Copy)]
+pub struct InitialState {
+    /// Centre G [m] and its velocity [m/s].
+    pub g: [f64; 2],
+    pub g_dot: [f64; 2],
+    /// Orientation theta [rad] (beam i along `e_xi(theta)`) and its rate [rad/s].
+    pub theta: f64,
+    pub theta_dot: f64,
+    /// Distance from G to pin i along beam i [m] and its rate [m/s].
+    pub xp: [f64; 3],
+    pub xp_dot: [f64; 3],
+}
+
+/// Pin kinematics at one instant: revolute points, and the actuator jets.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Pins {
+    pub p: [[f64; 2]; 3],
+    /// `[s, s', s'']` of each actuator.
+    pub s: [[f64; 3]; 3],
+}
+
+impl Pins {
+    pub fn new(params: &RobotParams, s: [[f64; 3]; 3]) -> Self {
+        Pins {
+            p: [0, 1, 2].map(|i| revolute_point(i, params.d, s[i][0])),
+            s,
+        }
+    }
+}
+
+/// The assembled model with its sparse iteration matrix.
+pub(crate) struct Star {
+    pub params: RobotParams,
+    /// Elements per beam.
+    pub ne: usize,
+    /// Element length [m].
+    pub h: f64,
+    pub elements: Vec<Element>,
+    /// Initial angle of beam i [rad].
+    pub gamma0: [f64; 3],
+    pub n_nodes: usize,
+    /// Number of generalized coordinates (nodes, sleeve rotations, contact coordinates).
+    pub n_dof: usize,
+    /// Size of the Newton system (coordinates + multipliers).
+    pub n_sys: usize,
+    /// First element of the pattern window of every contact point [sleeve][point].
+    win: [[usize; 3]; 3],
+    lu: Option<SparseLu>,
+    slots: Vec<(usize, usize)>,
+    pub vals: Vec<f64>,
+    states: Vec<ElementState>,
+    /// Offsets of the slot groups.
+    off_psi: usize,
+    off_con: usize,
+    ncol_c: usize,
+    /// Window width in elements (WINDOW, or the whole beam if shorter).
+    ww: usize,
+    /// Symbolic factorisations done so far.
+    pub symbolic_count: usize,
+}
+
+impl Star {
+    /// Mesh the star with `ne` elements per beam around the initial pose.
+    pub fn new(params: &RobotParams, ne: usize, init: &InitialState) -> Result<(Self, Vec<f64>, Vec<f64>), FemError> {
+        let h = params.l / ne as f64;
+        if params.lp < 2.0 * h * (1.0 - 1e-12) {
+            let needed = (2.0 * params.l / params.lp).ceil() as usize;
+            return Err(FemError::MeshTooCoarse {
+                per_beam: ne,
+                h,
+                lp: params.lp,
+                needed,
+            });
+        }
+        let n_nodes = 1 + 3 * ne;
+        let n_dof = 3 * n_nodes + 12;
+        let n_sys = n_dof + 3 * ROWS;
+        let mut q = vec![0.0; n_dof];
+        let mut v = vec![0.0; n_dof];
+        let mut gamma0 = [0.0; 3];
+        let mut elements = Vec::with_capacity(3 * ne);
+        let perp = |r: [f64; 2]| [-(r[1]), r[0]];
+        for i in 0..3 {
+            let ex = e_x(i, init.theta);
+            gamma0[i] = ex[1].atan2(ex[0]);
+            for k in 0..ne {
+                elements.push(Element {
+                    nodes: [node(ne, i, k), node(ne, i, k + 1)],
+                    l0: h,
+                    c0: ex[0],
+                    s0: ex[1],
+                });
+            }
+            for k in 0..=ne {
+                let j = node(ne, i, k);
+                let rel = [k as f64 * h * ex[0], k as f64 * h * ex[1]];
+                q[3 * j] = init.g[0] + rel[0];
+                q[3 * j + 1] = init.g[1] + rel[1];
+                let w = perp(rel);
+                v[3 * j] = init.g_dot[0] + init.theta_dot * w[0];
+                v[3 * j + 1] = init.g_dot[1] + init.theta_dot * w[1];
+                v[3 * j + 2] = init.theta_dot;
+            }
+        }
+        let psi0 = 3 * n_nodes;
+        for i in 0..3 {
+            v[psi0 + i] = init.theta_dot;
+            for (p, off) in [0.0, -0.5 * params.lp, 0.5 * params.lp].iter().enumerate() {
+                q[psi0 + 3 + 3 * i + p] = init.xp[i] + off;
+                v[psi0 + 3 + 3 * i + p] = init.xp_dot[i];
+            }
+        }
+        let mut star = Star {
+            params: *params,
+            ne,
+            h,
+            elements,
+            gamma0,
+            n_nodes,
+            n_dof,
+            n_sys,
+            win: [[usize::MAX; 3]; 3],
+            lu: None,
+            slots: Vec::new(),
+            vals: Vec::new(),
+            states: Vec::with_capacity(3 * ne),
+            off_psi: 0,
+            off_con: 0,
+            ncol_c: 3 * (WINDOW.min(ne) + 1) + 2,
+            ww: WINDOW.min(ne),
+            symbolic_count: 0,
+        };
+        star.states = star
+            .elements
+            .iter()
+            .map(|el| ElementState::new(el, &star.element_q(el, &q)))
+            .collect();
+        Ok((star, q, v))
+    }
+
+    /// Index of the sleeve rotation psi_i.
+    pub fn psi(&self, i: usize) -> usize {
+        3 * self.n_nodes + i
+    }
+
+    /// Index of contact coordinate `p` (0 centre, 1 left, 2 right) of sleeve i.
+    pub fn xi(&self, i: usize, p: usize) -> usize {
+        3 * self.n_nodes + 3 + 3 * i + p
+    }
+
+    /// Global node index of node k (0 = G, ne = tip) of beam i.
+    pub fn node(&self, i: usize, k: usize) -> usize {
+        node(self.ne, i, k)
+    }
+
+    fn element_q(&self, el: &Element, q: &[f64]) -> [f64; 6] {
+        let (a, b) = (3 * el.nodes[0], 3 * el.nodes[1]);
+        [q[a], q[a + 1], q[a + 2], q[b], q[b + 1], q[b + 2]]
+    }
+
+    /// Element of beam i that holds material coordinate xi, and the local coordinate zeta (which
+    /// leaves [0, 1] only when xi leaves (0, L), i.e. when the sleeve is off the beam).
+    pub fn locate(&self, xi: f64) -> (usize, f64) {
+        let x = xi / self.h;
+        let e = if x.is_finite() {
+            (x.floor().max(0.0) as usize).min(self.ne - 1)
+        } else {
+            0
+        };
+        (e, x - e as f64)
+    }
+
+    /// Rebuild the pattern and its symbolic factorisation if a contact point left its window.
+    fn ensure_pattern(&mut self, q: &[f64]) -> Result<(), String> {
+        let mut rebuild = self.lu.is_none();
+        for i in 0..3 {
+            for p in 0..3 {
+                let (e, _) = self.locate(q[self.xi(i, p)]);
+                let lo = self.win[i][p];
+                if lo == usize::MAX || e < lo || e >= lo + self.ww {
+                    rebuild = true;
+                    self.win[i][p] = e.saturating_sub(self.ww / 2).min(self.ne - self.ww);
+                }
+            }
+        }
+        if !rebuild {
+            return Ok(());
+        }
+        let mut slots = Vec::new();
+        for el in &self.elements {
+            let d = dofs(el);
+            for a in d {
+                for b in d {
+                    slots.push((a, b));
+                }
+            }
+        }
+        self.off_psi = slots.len();
+        for i in 0..3 {
+            slots.push((self.psi(i), self.psi(i)));
+            for p in 0..3 {
+                slots.push((self.xi(i, p), self.xi(i, p)));
+            }
+        }
+        self.off_con = slots.len();
+        for i in 0..3 {
+            for r in 0..ROWS {
+                let row = self.n_dof + ROWS * i + r;
+                let p = ROW_POINT[r];
+                let cols = self.window_cols(i, p);
+                for &c in &cols {
+                    slots.push((row, c));
+                }
+                for &c in &cols {
+                    slots.push((c, row));
+                }
+            }
+        }
+        self.lu = Some(SparseLu::new(self.n_sys, &slots)?);
+        self.vals = vec![0.0; slots.len()];
+        self.slots = slots;
+        self.symbolic_count += 1;
+        Ok(())
+    }
+
+    /// Columns of a constraint row of contact point p of sleeve i: the window's node DOFs, then
+    /// the contact coordinate, then the sleeve rotation.
+    fn window_cols(&self, i: usize, p: usize) -> Vec<usize> {
+        let lo = self.win[i][p];
+        let mut c = Vec::with_capacity(self.ncol_c);
+        for k in lo..=lo + self.ww {
+            let j = self.node(i, k);
+            c.extend_from_slice(&[3 * j, 3 * j + 1, 3 * j + 2]);
+        }
+        c.push(self.xi(i, p));
+        c.push(self.psi(i));
+        c
+    }
+
+    /// Assemble the residual and the iteration matrix at coordinates `q`, velocities `v`,
+    /// accelerations `qdd` and multipliers `lam` (21), for pins `pins`:
+    ///
+    /// ```text
+    /// res[dof]  = cf (M(q) qdd + f_conv(q, v) + f_int(q)) + Phi_q^T lam      (Jp psi_dd for sleeves)
+    /// res[con]  = Phi(q, t)
+    /// matrix    = [ M + ck K    Phi_q^T ]
+    ///             [ Phi_q       0       ]
+    /// ```
+    /// (Hessian terms of the constraints, the velocity and q dependence of the inertia are left
+    /// out of the matrix: they are `O(h^2)` against the kept terms, see docs/fem.md.)
+    /// Returns the strain energy and kinetic energy of the star (beams only) as a by-product.
+    #[allow(clippy::too_many_arguments)]
+    pub fn assemble(
+        &mut self,
+        q: &[f64],
+        v: &[f64],
+        qdd: &[f64],
+        lam: &[f64],
+        pins: &Pins,
+        cf: f64,
+        ck: f64,
+        res: &mut [f64],
+        t: f64,
+    ) -> Result<(), FemError> {
+        self.ensure_pattern(q)
+            .map_err(|reason| FemError::LinearSolver { t, reason })?;
+        let (ea, ei, rho) = (self.params.ea(), self.params.ei(), self.params.rho);
+        res.iter_mut().for_each(|r| *r = 0.0);
+        for (e, el) in self.elements.iter().enumerate() {
+            let qe = self.element_q(el, q);
+            let ve = self.element_q(el, v);
+            let ae = self.element_q(el, qdd);
+            let st = ElementState::new(el, &qe);
+            if !(st.ln.is_finite() && st.ln > 0.0) {
+                return Err(FemError::NonFinite {
+                    t,
+                    element: e,
+                    reason: format!("element chord length {}", st.ln),
+                });
+            }
+            let (fi, k) = st.internal(ea, ei);
+            let (fc, m) = st.inertia(rho, &ve);
+            let d = dofs(el);
+            let slot = &mut self.vals[36 * e..36 * e + 36];
+            for a in 0..6 {
+                let mut ma = 0.0;
+                for b in 0..6 {
+                    ma += m[a][b] * ae[b];
+                    slot[6 * a + b] = m[a][b] + ck * k[a][b];
+                }
+                res[d[a]] += cf * (ma + fc[a] + fi[a]);
+            }
+            self.states[e] = st;
+        }
+        let lp2 = 0.5 * self.params.lp;
+        for i in 0..3 {
+            let ps = self.psi(i);
+            res[ps] += cf * self.params.jp * qdd[ps];
+            self.vals[self.off_psi + 4 * i] = self.params.jp;
+            for p in 0..3 {
+                self.vals[self.off_psi + 4 * i + 1 + p] = 0.0;
+            }
+            let ang = self.gamma0[i] + q[ps];
+            let (a, aperp) = ([ang.cos(), ang.sin()], [-ang.sin(), ang.cos()]);
+            for r in 0..ROWS {
+                let p = ROW_POINT[r];
+                let xi_idx = self.xi(i, p);
+                let (e, z) = self.locate(q[xi_idx]);
+                let ge = i * self.ne + e;
+                let st = self.states[ge];
+                let na = self.node(i, e);
+                let (phi, grad, gxi, gpsi) = if r < 6 {
+                    let k = r % 2;
+                    let pos = st.position([q[3 * na], q[3 * na + 1]], z);
+                    let jac = st.jacobian(z);
+                    let rz = st.dr_dzeta(z);
+                    let (off, gpsi) = match p {
+                        0 => (0.0, 0.0),
+                        1 => (lp2 * a[k], lp2 * aperp[k]),
+                        _ => (-lp2 * a[k], -lp2 * aperp[k]),
+                    };
+                    (pos[k] - pins.p[i][k] + off, jac[k], rz[k] / self.h, gpsi)
+                } else {
+                    let (al, g, az) = st.angle(z);
+                    (al - q[ps], g, az / self.h, -1.0)
+                };
+                let row = self.n_dof + ROWS * i + r;
+                let l = lam[ROWS * i + r];
+                res[row] = phi;
+                let d = dofs(&self.elements[ge]);
+                for a in 0..6 {
+                    res[d[a]] += grad[a] * l;
+                }
+                res[xi_idx] += gxi * l;
+                res[ps] += gpsi * l;
+                // matrix slots: row block then transposed block
+                let base = self.off_con + (ROWS * i + r) * 2 * self.ncol_c;
+                let lo = self.win[i][p];
+                let nc = self.ncol_c;
+                self.vals[base..base + 2 * nc].iter_mut().for_each(|x| *x = 0.0);
+                let c0 = 3 * (e - lo);
+                for a in 0..6 {
+                    self.vals[base + c0 + a] = grad[a];
+                    self.vals[base + nc + c0 + a] = grad[a];
+                }
+                self.vals[base + nc - 2] = gxi;
+                self.vals[base + 2 * nc - 2] = gxi;
+                self.vals[base + nc - 1] = gpsi;
+                self.vals[base + 2 * nc - 1] = gpsi;
+            }
+        }
+        if let Some(k) = res.iter().position(|r| !r.is_finite()) {
+            return Err(FemError::NonFinite {
+                t,
+                element: if k < 3 * self.n_nodes {
+                    self.element_of_dof(k)
+                } else {
+                    0
+                },
+                reason: format!("residual row {k}"),
+            });
+        }
+        Ok(())
+    }
+
+    fn element_of_dof(&self, k: usize) -> usize {
+        let j = k / 3;
+        if j == 0 {
+            0
+        } else {
+            j - 1
+        }
+    }
+
+    /// Factor the matrix of the last [`Star::assemble`].
+    pub fn factor(&mut self, t: f64) -> Result<(), FemError> {
+        let lu = self.lu.as_mut().expect("assemble before factor");
+        lu.factor(&self.vals)
+            .map_err(|reason| FemError::LinearSolver { t, reason })
+    }
+
+    /// Solve with the last factorisation, in place.
+    pub fn solve(&mut self, rhs: &mut [f64]) {
+        self.lu.as_mut().expect("factor before solve").solve(rhs)
+    }
+
+    /// Constraint values `Phi(q, t)` (21), for the consistent initial accelerations.
+    pub fn constraints(&self, q: &[f64], pins: &Pins) -> Vec<f64> {
+        let lp2 = 0.5 * self.params.lp;
+        let mut out = vec![0.0; 3 * ROWS];
+        for i in 0..3 {
+            let ang = self.gamma0[i] + q[self.psi(i)];
+            let a = [ang.cos(), ang.sin()];
+            for r in 0..ROWS {
+                let p = ROW_POINT[r];
+                let (e, z) = self.locate(q[self.xi(i, p)]);
+                let el = &self.elements[i * self.ne + e];
+                let st = ElementState::new(el, &self.element_q(el, q));
+                let na = self.node(i, e);
+                out[ROWS * i + r] = if r < 6 {
+                    let k = r % 2;
+                    let pos = st.position([q[3 * na], q[3 * na + 1]], z);
+                    let off = match p {
+                        0 => 0.0,
+                        1 => lp2 * a[k],
+                        _ => -lp2 * a[k],
+                    };
+                    pos[k] - pins.p[i][k] + off
+                } else {
+                    st.angle(z).0 - q[self.psi(i)]
+                };
+            }
+        }
+        out
+    }
+
+    /// Strain energy of the beams [J].
+    pub fn strain_energy(&self, q: &[f64]) -> f64 {
+        let (ea, ei) = (self.params.ea(), self.params.ei());
+        self.elements
+            .iter()
+            .map(|el| ElementState::new(el, &self.element_q(el, q)).strain_energy(ea, ei))
+            .sum()
+    }
+
+    /// Kinetic energy of the beams [J] (exact for the element interpolation, Gauss quadrature).
+    pub fn kinetic_energy_beams(&self, q: &[f64], v: &[f64]) -> f64 {
+        self.elements
+            .iter()
+            .map(|el| {
+                ElementState::new(el, &self.element_q(el, q)).kinetic_energy(self.params.rho, &self.element_q(el, v))
+            })
+            .sum()
+    }
+
+    /// Material positions (from G) of the nodes of one beam [m].
+    pub fn node_x(&self) -> Vec<f64> {
+        (0..=self.ne).map(|k| k as f64 * self.h).collect()
+    }
+}
+
+/// Global node index of node k (0 = G) of beam i with `ne` elements per beam.
+pub(crate) fn node(ne: usize, i: usize, k: usize) -> usize {
+    if k == 0 {
+        0
+    } else {
+        1 + i * ne + (k - 1)
+    }
+}
+
+fn dofs(el: &Element) -> [usize; 6] {
+    let (a, b) = (3 * el.nodes[0], 3 * el.nodes[1]);
+    [a, a + 1, a + 2, b, b + 1, b + 2]
+}

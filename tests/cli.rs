@@ -119,9 +119,97 @@ fn case2_beyond_its_span_is_refused_with_the_time() {
     assert!(!out.join("case2").join("kinematics.csv").exists());
 }
 
+/// case1 shortened to `t_end` seconds, written into `dir`.
+fn short_case1(dir: &Path, t_end: &str) -> String {
+    write(
+        dir,
+        "short.toml",
+        &case1_with("t_end = 0.5", &format!("t_end = {t_end}")),
+    )
+}
+
+#[test]
+fn run_writes_the_contracted_solver_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = short_case1(dir.path(), "0.05");
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    for (args, file) in [
+        (
+            vec!["--solver", "amm", "--family", "slide-free", "--modes", "12"],
+            "amm-slide-free.csv",
+        ),
+        (vec!["--solver", "amm"], "amm-pinned-free.csv"), // family from the config's [amm] section
+        (vec!["--solver", "fem", "--elements", "108"], "fem.csv"),
+    ] {
+        let mut all = vec!["run", cfg.as_str()];
+        all.extend(args.iter().copied());
+        all.extend(["--out", out_s]);
+        let o = flexstar(&all);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        let text = std::fs::read_to_string(out.join("case1").join(file)).unwrap();
+        let header = text.lines().next().unwrap();
+        assert!(
+            header.starts_with("t,w1G,w2G,w3G,w1tip,w2tip,w3tip,Fa1,Fa2,Fa3"),
+            "{file}: {header}"
+        );
+        assert_eq!(text.lines().count(), 1 + 51, "{file}: one row per 1 ms output step");
+    }
+}
+
+#[test]
+fn run_refuses_bad_settings_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = short_case1(dir.path(), "0.05");
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (&["--solver", "amm", "--family", "hinged-free"], "hinged-free"),
+        (&["--solver", "amm", "--modes", "0"], "amm.modes"),
+        (&["--solver", "amm", "--modes", "100000"], "amm.modes"),
+        (&["--solver", "amm", "--dt", "0.01"], "output interval"),
+        (&["--solver", "fem", "--elements", "301"], "fem.elements"),
+    ];
+    for (args, needle) in cases {
+        let mut all = vec!["run", cfg.as_str()];
+        all.extend(args.iter().copied());
+        all.extend(["--out", out_s]);
+        let o = flexstar(&all);
+        assert!(!o.status.success(), "{args:?} accepted");
+        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+        assert!(!out.join("case1").exists() || std::fs::read_dir(out.join("case1")).unwrap().count() == 0);
+    }
+    // a trajectory that leaves the feasible range: refused with the time, nothing written
+    let text = std::fs::read_to_string(config("case2.toml"))
+        .unwrap()
+        .replace("t_end = 0.4", "t_end = 0.5");
+    let cfg2 = write(dir.path(), "case2-long.toml", &text);
+    for solver in ["amm", "fem"] {
+        let o = flexstar(&["run", &cfg2, "--solver", solver, "--out", out_s]);
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains("sleeve 2"), "{solver}: {}", stderr(&o));
+        assert!(!out.join("case2").join(format!("{solver}.csv")).exists());
+    }
+}
+
+#[test]
+fn modes_lists_textbook_roots() {
+    // free-free: two rigid modes, then beta L = 4.730041, 7.853205 (Blevins, table 8-1)
+    let o = flexstar(&["modes", "--family", "free-free", "-n", "4"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("4.7300407") && text.contains("7.8532046"), "{text}");
+}
+
 #[test]
 fn every_subcommand_has_help() {
-    for sub in [vec!["--help"], vec!["kinematics", "--help"]] {
+    for sub in [
+        vec!["--help"],
+        vec!["kinematics", "--help"],
+        vec!["run", "--help"],
+        vec!["modes", "--help"],
+        vec!["verify", "--help"],
+    ] {
         let o = flexstar(&sub);
         assert!(o.status.success());
         assert!(String::from_utf8_lossy(&o.stdout).contains("Usage"));

@@ -22,12 +22,21 @@ struct Cli {
 enum Command {
     /// Rigid kinematics of an experiment: writes DIR/<name>/kinematics.csv
     Kinematics(commands::kinematics::Args),
+    /// Run the AMM or the FEM on an experiment: writes DIR/<name>/amm-<family>.csv or fem.csv
+    Run(commands::run::Args),
+    /// List the assumed modes of a family: beta*L and natural frequency per mode
+    Modes(commands::modes::Args),
+    /// Reproduce and check Table I: four cases, three families, FEM; table, figures, report
+    Verify(commands::verify::Args),
 }
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Kinematics(args) => commands::kinematics::run(args),
+        Command::Run(args) => commands::run::run(args),
+        Command::Modes(args) => commands::modes::run(args),
+        Command::Verify(args) => commands::verify::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

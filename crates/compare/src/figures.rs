@@ -183,7 +183,10 @@ fn bounds(panel: &Panel) -> ((f64, f64), (f64, f64)) {
 /// Tick labels: plain decimals for moderate magnitudes, exponents otherwise.
 fn tick(v: &f64) -> String {
     let a = v.abs();
-    if a == 0.0 || (1e-2..1e4).contains(&a) {
+    if a < 1e-10 {
+        return "0".into();
+    }
+    if (1e-2..1e4).contains(&a) {
         let s = format!("{v:.3}");
         let s = s.trim_end_matches('0').trim_end_matches('.');
         if s == "-0" {
@@ -339,13 +342,15 @@ pub fn figure_forces(case: &str, runs: &[Run], rigid: Option<(&[f64], &[[f64; 3]
 /// (b) absolute shape with the elastic part magnified by `magnify`, over the rigid star
 /// (`rigid`: the rigid kinematics at the snapshot time, post-processing only).
 pub fn figure_star(case: &str, runs: &[Run], rigid: &RigidState, magnify: f64) -> Option<Figure> {
-    let mut deflection = Panel {
-        title: "(a) elastic deflection w_i(x)".into(),
-        x_label: "x [m]".into(),
-        y_label: "w [mm]".into(),
-        series: vec![],
-        equal_axes: false,
-    };
+    let mut deflection: Vec<Panel> = (0..3)
+        .map(|i| Panel {
+            title: format!("(a) beam {}: elastic deflection", i + 1),
+            x_label: "x [m]".into(),
+            y_label: "w_i(x) [mm]".into(),
+            series: vec![],
+            equal_axes: false,
+        })
+        .collect();
     let mut absolute = Panel {
         title: format!("(b) star, elastic part x{magnify:.0}"),
         x_label: "X [m]".into(),
@@ -360,9 +365,8 @@ pub fn figure_star(case: &str, runs: &[Run], rigid: &RigidState, magnify: f64) -
         };
         t_snap = Some(shape.t);
         for (i, b) in shape.beams.iter().enumerate() {
-            let label = if i == 0 { r.label.clone() } else { String::new() };
-            deflection.series.push(Series {
-                label: label.clone(),
+            deflection[i].series.push(Series {
+                label: r.label.clone(),
                 x: b.x.clone(),
                 y: scaled(&b.w, 1e3),
                 style: r.style,
@@ -375,6 +379,7 @@ pub fn figure_star(case: &str, runs: &[Run], rigid: &RigidState, magnify: f64) -
                         (q[0] + magnify * (p[0] - q[0]), q[1] + magnify * (p[1] - q[1]))
                     })
                     .unzip();
+            let label = if i == 0 { r.label.clone() } else { String::new() };
             absolute.series.push(Series {
                 label,
                 x: xs,
@@ -393,10 +398,11 @@ pub fn figure_star(case: &str, runs: &[Run], rigid: &RigidState, magnify: f64) -
             style: RIGID_STYLE,
         });
     }
+    deflection.push(absolute);
     Some(Figure {
         name: format!("{case}-star"),
-        caption: format!("{case}: beam shapes at t = {t:.3} s"),
-        panels: vec![deflection, absolute],
+        caption: format!("{case}: beam shapes at t = {t:.3} s (deflection in the rigid frames; star magnified)"),
+        panels: deflection,
     })
 }
 

@@ -13,6 +13,7 @@ pub mod paper;
 pub mod report;
 pub mod table;
 pub mod thresholds;
+pub mod verify;
 
 pub use behaviour::Behaviour;
 pub use evp::{point_evps, CompareError, Point, PointEvps};

@@ -52,7 +52,10 @@ impl TimeSpan {
 
     pub fn validate(&self) -> Result<(), ModelError> {
         if !self.t_end.is_finite() || self.t_end <= 0.0 {
-            return Err(ModelError::invalid("time.t_end", format!("the time span must be non-empty: need t_end > 0, got {}", self.t_end)));
+            return Err(ModelError::invalid(
+                "time.t_end",
+                format!("the time span must be non-empty: need t_end > 0, got {}", self.t_end),
+            ));
         }
         if !self.dt_out.is_finite() || self.dt_out <= 0.0 || self.dt_out > self.t_end {
             return Err(ModelError::invalid(
@@ -61,7 +64,10 @@ impl TimeSpan {
             ));
         }
         if self.t_end / self.dt_out > 1e7 {
-            return Err(ModelError::invalid("time.dt_out", format!("more than 1e7 output steps ({} / {})", self.t_end, self.dt_out)));
+            return Err(ModelError::invalid(
+                "time.dt_out",
+                format!("more than 1e7 output steps ({} / {})", self.t_end, self.dt_out),
+            ));
         }
         Ok(())
     }
@@ -96,10 +102,17 @@ impl ModeFamily {
 impl std::str::FromStr for ModeFamily {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        [ModeFamily::PinnedFree, ModeFamily::SlideFree, ModeFamily::FreeFree, ModeFamily::ClampedFree]
-            .into_iter()
-            .find(|f| f.name() == s)
-            .ok_or_else(|| format!("unknown mode family `{s}`: expected pinned-free, slide-free, free-free or clamped-free"))
+        [
+            ModeFamily::PinnedFree,
+            ModeFamily::SlideFree,
+            ModeFamily::FreeFree,
+            ModeFamily::ClampedFree,
+        ]
+        .into_iter()
+        .find(|f| f.name() == s)
+        .ok_or_else(|| {
+            format!("unknown mode family `{s}`: expected pinned-free, slide-free, free-free or clamped-free")
+        })
     }
 }
 
@@ -125,7 +138,12 @@ pub struct AmmSettings {
 
 impl Default for AmmSettings {
     fn default() -> Self {
-        AmmSettings { family: ModeFamily::FreeFree, modes: 25, dt: None, snapshots: Vec::new() }
+        AmmSettings {
+            family: ModeFamily::FreeFree,
+            modes: 25,
+            dt: None,
+            snapshots: Vec::new(),
+        }
     }
 }
 
@@ -145,7 +163,12 @@ pub struct FemSettings {
 
 impl Default for FemSettings {
     fn default() -> Self {
-        FemSettings { elements: 300, dt: None, rho_inf: None, snapshots: Vec::new() }
+        FemSettings {
+            elements: 300,
+            dt: None,
+            rho_inf: None,
+            snapshots: Vec::new(),
+        }
     }
 }
 
@@ -174,7 +197,10 @@ pub struct Experiment {
 impl Experiment {
     /// Read, parse and validate an experiment file.
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Read { file: path.to_path_buf(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Read {
+            file: path.to_path_buf(),
+            source,
+        })?;
         Self::from_toml_str(&text, path)
     }
 
@@ -192,16 +218,28 @@ impl Experiment {
     /// Check every value (keys named relative to the file).
     pub fn validate(&self) -> Result<(), ModelError> {
         let name_ok = !self.name.is_empty()
-            && self.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_' || c == '.')
+            && self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_' || c == '.')
             && !self.name.starts_with('.');
         if !name_ok {
-            return Err(ModelError::invalid("name", format!("must be a non-empty file name of letters, digits, '-', '_', '.', got {:?}", self.name)));
+            return Err(ModelError::invalid(
+                "name",
+                format!(
+                    "must be a non-empty file name of letters, digits, '-', '_', '.', got {:?}",
+                    self.name
+                ),
+            ));
         }
         self.robot.validate()?;
         self.time.validate()?;
         self.trajectory.validate(&self.robot)?;
         if self.amm.modes == 0 || self.amm.modes > 400 {
-            return Err(ModelError::invalid("amm.modes", format!("need 1 <= modes <= 400, got {}", self.amm.modes)));
+            return Err(ModelError::invalid(
+                "amm.modes",
+                format!("need 1 <= modes <= 400, got {}", self.amm.modes),
+            ));
         }
         if let Some(dt) = self.amm.dt {
             check_step("amm.dt", dt, self.time.dt_out)?;
@@ -209,7 +247,10 @@ impl Experiment {
         if self.fem.elements < 3 || self.fem.elements % 3 != 0 || self.fem.elements > 30_000 {
             return Err(ModelError::invalid(
                 "fem.elements",
-                format!("need a multiple of 3 between 3 and 30000 (three equal beams), got {}", self.fem.elements),
+                format!(
+                    "need a multiple of 3 between 3 and 30000 (three equal beams), got {}",
+                    self.fem.elements
+                ),
             ));
         }
         if let Some(dt) = self.fem.dt {
@@ -217,12 +258,24 @@ impl Experiment {
         }
         if let Some(r) = self.fem.rho_inf {
             if !(0.0..=1.0).contains(&r) {
-                return Err(ModelError::invalid("fem.rho_inf", format!("need 0 <= rho_inf <= 1, got {r}")));
+                return Err(ModelError::invalid(
+                    "fem.rho_inf",
+                    format!("need 0 <= rho_inf <= 1, got {r}"),
+                ));
             }
         }
-        for (key, snaps) in [("amm.snapshots", &self.amm.snapshots), ("fem.snapshots", &self.fem.snapshots)] {
-            if let Some(bad) = snaps.iter().find(|t| !t.is_finite() || **t < 0.0 || **t > self.time.t_end) {
-                return Err(ModelError::invalid(key, format!("snapshot times must lie in [0, t_end = {}], got {bad}", self.time.t_end)));
+        for (key, snaps) in [
+            ("amm.snapshots", &self.amm.snapshots),
+            ("fem.snapshots", &self.fem.snapshots),
+        ] {
+            if let Some(bad) = snaps
+                .iter()
+                .find(|t| !t.is_finite() || **t < 0.0 || **t > self.time.t_end)
+            {
+                return Err(ModelError::invalid(
+                    key,
+                    format!("snapshot times must lie in [0, t_end = {}], got {bad}", self.time.t_end),
+                ));
             }
         }
         Ok(())
@@ -235,7 +288,10 @@ pub fn check_step(key: &str, dt: f64, dt_out: f64) -> Result<(), ModelError> {
         return Err(ModelError::invalid(key, format!("the step must be positive, got {dt}")));
     }
     if dt > dt_out * (1.0 + 1e-12) {
-        return Err(ModelError::invalid(key, format!("the step {dt} s is larger than the output interval time.dt_out = {dt_out} s")));
+        return Err(ModelError::invalid(
+            key,
+            format!("the step {dt} s is larger than the output interval time.dt_out = {dt_out} s"),
+        ));
     }
     Ok(())
 }
@@ -268,23 +324,33 @@ s3 = [0.0, 0.0, 1.0]
     #[test]
     fn unknown_key_is_named() {
         let text = CASE1.replace("[time]", "[robot]\nLq = 0.1\n[time]");
-        let err = Experiment::from_toml_str(&text, Path::new("bad.toml")).unwrap_err().to_string();
+        let err = Experiment::from_toml_str(&text, Path::new("bad.toml"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("bad.toml") && err.contains("Lq"), "{err}");
         let text = CASE1.replace("kind = \"polynomial\"", "kind = \"polynomial\"\ns4 = [1.0]");
-        let err = Experiment::from_toml_str(&text, Path::new("bad.toml")).unwrap_err().to_string();
+        let err = Experiment::from_toml_str(&text, Path::new("bad.toml"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("s4"), "{err}");
     }
 
     #[test]
     fn invalid_values_name_file_and_key() {
         let text = CASE1.replace("[time]", "[robot]\nrho = -1.0\n[time]");
-        let err = Experiment::from_toml_str(&text, Path::new("neg.toml")).unwrap_err().to_string();
+        let err = Experiment::from_toml_str(&text, Path::new("neg.toml"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("neg.toml") && err.contains("robot.rho"), "{err}");
         let text = CASE1.replace("t_end = 0.5", "t_end = 0.0");
-        let err = Experiment::from_toml_str(&text, Path::new("e.toml")).unwrap_err().to_string();
+        let err = Experiment::from_toml_str(&text, Path::new("e.toml"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("time.t_end"), "{err}");
         let text = CASE1.replace("[trajectory]", "[amm]\ndt = 0.01\n[trajectory]");
-        let err = Experiment::from_toml_str(&text, Path::new("e.toml")).unwrap_err().to_string();
+        let err = Experiment::from_toml_str(&text, Path::new("e.toml"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("amm.dt"), "{err}");
     }
 }

@@ -17,11 +17,7 @@ pub enum ModelError {
     Parse { file: PathBuf, message: String },
     /// A value that parsed but is physically or numerically meaningless.
     #[error("{file}: key `{key}`: {reason}")]
-    Invalid {
-        file: PathBuf,
-        key: String,
-        reason: String,
-    },
+    Invalid { file: PathBuf, key: String, reason: String },
     /// The inverse kinematics of a task-space pose has no solution (a beam parallel to its slider).
     #[error("inverse kinematics: {0}")]
     InverseKinematics(String),

@@ -67,11 +67,7 @@ pub fn e_w<D: Scalar>(i: usize, theta: D) -> [D; 2] {
 ///
 /// Revolute point i is where the line `G + r e_xi` (r > 0) meets slider line i. Fails when a beam
 /// is parallel to its slider or points away from it.
-pub fn inverse_kinematics<D: Scalar>(
-    params: &RobotParams,
-    g: [D; 2],
-    theta: D,
-) -> Result<[D; 3], ModelError> {
+pub fn inverse_kinematics<D: Scalar>(params: &RobotParams, g: [D; 2], theta: D) -> Result<[D; 3], ModelError> {
     let mut s = [D::zero(); 3];
     for (i, si) in s.iter_mut().enumerate() {
         let ex = e_x(i, theta);

@@ -11,7 +11,10 @@ pub fn write_atomically<F>(path: &Path, fill: F) -> Result<(), ModelError>
 where
     F: FnOnce(&mut dyn Write) -> Result<(), Box<dyn std::error::Error + Send + Sync>>,
 {
-    let err = |reason: String| ModelError::Write { file: path.to_path_buf(), reason };
+    let err = |reason: String| ModelError::Write {
+        file: path.to_path_buf(),
+        reason,
+    };
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => std::path::PathBuf::from("."),

@@ -97,23 +97,35 @@ impl RobotParams {
         ];
         for (key, v) in positive {
             if !v.is_finite() || v <= 0.0 {
-                return Err(ModelError::invalid(key, format!("must be a positive finite number, got {v}")));
+                return Err(ModelError::invalid(
+                    key,
+                    format!("must be a positive finite number, got {v}"),
+                ));
             }
         }
         for (key, v) in [("robot.mpp_mpa", self.mpp_mpa), ("robot.Jp", self.jp)] {
             if !v.is_finite() || v < 0.0 {
-                return Err(ModelError::invalid(key, format!("must be a finite number >= 0, got {v}")));
+                return Err(ModelError::invalid(
+                    key,
+                    format!("must be a finite number >= 0, got {v}"),
+                ));
             }
         }
         if let Some(ea) = self.ea {
             if !ea.is_finite() || ea <= 0.0 {
-                return Err(ModelError::invalid("robot.EA", format!("must be a positive finite number, got {ea}")));
+                return Err(ModelError::invalid(
+                    "robot.EA",
+                    format!("must be a positive finite number, got {ea}"),
+                ));
             }
         }
         if self.lp >= self.l {
             return Err(ModelError::invalid(
                 "robot.Lp",
-                format!("the sleeve must be shorter than the beam: 0 < Lp < L = {}, got {}", self.l, self.lp),
+                format!(
+                    "the sleeve must be shorter than the beam: 0 < Lp < L = {}, got {}",
+                    self.l, self.lp
+                ),
             ));
         }
         if self.d + self.lp / 2.0 >= self.l {

@@ -10,9 +10,7 @@ use crate::error::ModelError;
 use crate::output::write_atomically;
 
 /// Fixed leading CSV columns of every solver result (issue contract).
-pub const RESPONSE_HEADER: [&str; 10] = [
-    "t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3",
-];
+pub const RESPONSE_HEADER: [&str; 10] = ["t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3"];
 
 /// A named extra output column (multipliers, sleeve rotations, ...), one value per output time.
 #[derive(Debug, Clone, PartialEq)]

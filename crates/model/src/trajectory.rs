@@ -42,7 +42,11 @@ pub struct Jet {
 
 impl Jet {
     pub fn from_dual2(x: Dual2<f64>) -> Self {
-        Jet { v: x.re, d1: x.v1, d2: x.v2 }
+        Jet {
+            v: x.re,
+            d1: x.v1,
+            d2: x.v2,
+        }
     }
 }
 
@@ -89,10 +93,16 @@ impl Trajectory {
             Trajectory::Polynomial { s1, s2, s3 } => {
                 for (key, c) in [("trajectory.s1", s1), ("trajectory.s2", s2), ("trajectory.s3", s3)] {
                     if let Some(bad) = c.iter().find(|v| !v.is_finite()) {
-                        return Err(ModelError::invalid(key, format!("coefficients must be finite, got {bad}")));
+                        return Err(ModelError::invalid(
+                            key,
+                            format!("coefficients must be finite, got {bad}"),
+                        ));
                     }
                     if c.len() > 12 {
-                        return Err(ModelError::invalid(key, format!("at most 12 coefficients, got {}", c.len())));
+                        return Err(ModelError::invalid(
+                            key,
+                            format!("at most 12 coefficients, got {}", c.len()),
+                        ));
                     }
                 }
             }
@@ -148,8 +158,16 @@ mod tests {
     fn quintic_is_rest_to_rest() {
         let p = RobotParams::paper();
         let tr = Trajectory::Quintic {
-            from: Pose { gx: 0.0, gy: 0.0, theta: 0.0 },
-            to: Pose { gx: 0.02, gy: -0.01, theta: 0.1 },
+            from: Pose {
+                gx: 0.0,
+                gy: 0.0,
+                theta: 0.0,
+            },
+            to: Pose {
+                gx: 0.02,
+                gy: -0.01,
+                theta: 0.1,
+            },
             t0: 0.0,
             t1: 0.4,
         };

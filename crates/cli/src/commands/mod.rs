@@ -1,6 +1,9 @@
 //! One module per subcommand.
 
 pub mod kinematics;
+pub mod modes;
+pub mod run;
+pub mod verify;
 
 use std::path::{Path, PathBuf};
 

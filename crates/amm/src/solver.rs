@@ -11,7 +11,7 @@
 
 use flexstar_kinematics::{check_trajectory, RigidState};
 use flexstar_model::config::check_step;
-use flexstar_model::{AmmSettings, BeamShape, Column, Experiment, ModeFamily, Response, StarShape};
+use flexstar_model::{AmmSettings, BeamShape, Experiment, ModeFamily, Response, StarShape};
 use flexstar_numerics::GenAlpha;
 
 use crate::error::AmmError;
@@ -296,14 +296,7 @@ fn integrate<F: FnMut(&System, &[f64])>(
         record(&st, &w[1], &q, &sys.lam);
     }
 
-    resp.extra = EXTRA_COLUMNS
-        .iter()
-        .zip(extra)
-        .map(|(name, values)| Column {
-            name: name.to_string(),
-            values,
-        })
-        .collect();
+    resp.set_extra(&EXTRA_COLUMNS, extra);
     resp.shapes = shapes;
     Ok(resp)
 }

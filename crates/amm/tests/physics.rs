@@ -18,11 +18,7 @@ const ALL: [ModeFamily; 4] = [
 ];
 
 fn col<'r>(r: &'r Response, name: &str) -> &'r [f64] {
-    &r.extra
-        .iter()
-        .find(|c| c.name == name)
-        .unwrap_or_else(|| panic!("no column {name}"))
-        .values
+    r.column(name).unwrap_or_else(|| panic!("no column {name}"))
 }
 
 fn tip_scale(r: &Response) -> f64 {

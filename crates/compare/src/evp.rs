@@ -13,6 +13,7 @@
 //!   tip peak of the same case) has no EVP ("n/a") and leaves the mean.
 
 use flexstar_model::Response;
+use flexstar_numerics::measures::max_abs;
 
 /// Relative size below which a reference response counts as zero (G in case 1 by symmetry, tip C
 /// in case 4): 1 % of the largest tip peak of the same FEM run.
@@ -40,20 +41,7 @@ impl Point {
     }
 }
 
-/// Trapezoidal integral of |f| over the samples t (non-uniform steps allowed).
-pub fn integral_abs(t: &[f64], f: &[f64]) -> f64 {
-    t.windows(2)
-        .zip(f.windows(2))
-        .map(|(tt, ff)| 0.5 * (tt[1] - tt[0]) * (ff[0].abs() + ff[1].abs()))
-        .sum()
-}
-
-/// Eq. 45 for one scalar history [%]; `None` when the reference integral vanishes.
-pub fn evp(t: &[f64], test: &[f64], reference: &[f64]) -> Option<f64> {
-    let diff: Vec<f64> = test.iter().zip(reference).map(|(a, b)| a - b).collect();
-    let den = integral_abs(t, reference);
-    (den > 0.0).then(|| integral_abs(t, &diff) / den * 100.0)
-}
+pub use flexstar_numerics::measures::{evp, integral_abs};
 
 /// Norm of the elastic displacement vector of G from its three projections w_iG [m].
 pub fn g_norm(w: [f64; 3]) -> f64 {
@@ -84,10 +72,6 @@ fn error_history(test: &Response, reference: &Response, point: Point) -> Vec<f64
             .map(|(a, b)| a - b)
             .collect(),
     }
-}
-
-fn peak(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 /// EVP at each point and their mean, for one test response against the FEM reference.
@@ -122,11 +106,11 @@ pub fn point_evps(test: &Response, reference: &Response) -> Result<PointEvps, Co
             nb: reference.len(),
         });
     }
-    let scale = (0..3).map(|i| peak(&reference.w_tip[i])).fold(0.0, f64::max);
+    let scale = (0..3).map(|i| max_abs(&reference.w_tip[i])).fold(0.0, f64::max);
     let t = &reference.t;
     let points = Point::ALL.map(|p| {
         let reference_h = history(reference, p);
-        if peak(&reference_h) <= NEGLIGIBLE * scale {
+        if max_abs(&reference_h) <= NEGLIGIBLE * scale {
             return None;
         }
         let err = error_history(test, reference, p);
@@ -149,24 +133,6 @@ mod tests {
             r.push(ti, g(ti), [y, -y, 0.0], [0.0; 3]);
         }
         r
-    }
-
-    #[test]
-    fn evp_of_a_scaled_copy_is_the_scale_error() {
-        // w_test = 1.1 w_ref everywhere: EVP = 10 % exactly, whatever the signal.
-        let t: Vec<f64> = (0..=1000).map(|k| k as f64 * 1e-3).collect();
-        let f = |t: f64| (20.0 * t).sin() * t;
-        let a: Vec<f64> = t.iter().map(|&x| 1.1 * f(x)).collect();
-        let b: Vec<f64> = t.iter().map(|&x| f(x)).collect();
-        assert!((evp(&t, &a, &b).unwrap() - 10.0).abs() < 1e-10);
-    }
-
-    #[test]
-    fn trapezoid_integral_of_sine() {
-        // int_0^pi |sin| = 2, trapezoid error ~ pi h^2 / 12 * ... (h = pi/1000)
-        let t: Vec<f64> = (0..=1000).map(|k| k as f64 * std::f64::consts::PI / 1000.0).collect();
-        let f: Vec<f64> = t.iter().map(|x| x.sin()).collect();
-        assert!((integral_abs(&t, &f) - 2.0).abs() < 2e-6);
     }
 
     #[test]

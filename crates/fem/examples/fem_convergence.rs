@@ -4,36 +4,18 @@
 
 use std::time::Instant;
 
-use flexstar_model::{Experiment, FemSettings, Response, TimeSpan, Trajectory};
+use flexstar_model::{catalogue, Experiment, FemSettings, Response};
+use flexstar_numerics::measures::{self, integral_abs};
 
 fn case(c: usize) -> Experiment {
-    let (k, t_end) = match c {
-        1 => ([1.0, 1.0, 1.0], 0.5),
-        2 => ([1.0, -0.5, -0.5], 0.4),
-        3 => ([1.0, 0.0, 0.5], 0.5),
-        _ => ([1.0, -1.0, 0.0], 0.5),
-    };
-    Experiment {
-        name: format!("case{c}"),
-        description: String::new(),
-        robot: Default::default(),
-        time: TimeSpan { t_end, dt_out: 1e-3 },
-        trajectory: Trajectory::quadratic(k),
-        amm: Default::default(),
-        fem: Default::default(),
-        source: Default::default(),
-    }
+    catalogue::paper_case(c)
 }
 
-/// EVP = int |a - b| dt / int |b| dt * 100 (trapezoidal rule); None where b is identically ~0.
+/// EVP (Eq. 45); None where the reference is identically ~0 (symmetry).
 fn evp(t: &[f64], a: &[f64], b: &[f64]) -> Option<f64> {
-    let (mut num, mut den) = (0.0, 0.0);
-    for k in 1..t.len() {
-        let h = t[k] - t[k - 1];
-        num += 0.5 * h * ((a[k] - b[k]).abs() + (a[k - 1] - b[k - 1]).abs());
-        den += 0.5 * h * (b[k].abs() + b[k - 1].abs());
-    }
-    (den > 1e-9 * t[t.len() - 1]).then(|| num / den * 100.0)
+    (integral_abs(t, b) > 1e-9 * t[t.len() - 1])
+        .then(|| measures::evp(t, a, b))
+        .flatten()
 }
 
 fn run(exp: &Experiment, n: usize, dt: f64, rho: f64) -> (Response, f64) {

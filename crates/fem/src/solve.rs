@@ -2,7 +2,7 @@
 //! into the shared [`Response`] (MODEL-NOTES section 2).
 
 use flexstar_kinematics::RigidState;
-use flexstar_model::{BeamShape, Column, Experiment, FemSettings, Response, StarShape};
+use flexstar_model::{BeamShape, Experiment, FemSettings, Response, StarShape};
 
 use crate::integrator::{integrate, RunSettings, Stats};
 use crate::star::InitialState;
@@ -165,14 +165,7 @@ pub fn solve_with_stats(
             extra[9 + k].push(v);
         }
     }
-    resp.extra = names
-        .iter()
-        .zip(extra)
-        .map(|(name, values)| Column {
-            name: name.to_string(),
-            values,
-        })
-        .collect();
+    resp.set_extra(&names, extra);
     for snap in &hist.snapshots {
         let r = rigid(snap.t)?;
         let g = [r.g[0].v, r.g[1].v];

@@ -10,19 +10,11 @@
 
 use flexstar_fem::{solve, solve_with_stats, FemError};
 use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
-use flexstar_model::{Experiment, FemSettings, Pose, Response, RobotParams, TimeSpan, Trajectory};
+use flexstar_model::{catalogue, Experiment, FemSettings, Pose, Response, RobotParams, Trajectory};
+use flexstar_numerics::measures::max_abs;
 
 fn experiment(robot: RobotParams, trajectory: Trajectory, t_end: f64) -> Experiment {
-    Experiment {
-        name: "test".into(),
-        description: String::new(),
-        robot,
-        time: TimeSpan { t_end, dt_out: 1e-3 },
-        trajectory,
-        amm: Default::default(),
-        fem: Default::default(),
-        source: Default::default(),
-    }
+    catalogue::experiment("test", robot, trajectory, t_end, 1e-3)
 }
 
 fn coarse() -> FemSettings {
@@ -33,33 +25,19 @@ fn coarse() -> FemSettings {
 }
 
 fn col<'a>(r: &'a Response, name: &str) -> &'a [f64] {
-    &r.extra
-        .iter()
-        .find(|c| c.name == name)
-        .unwrap_or_else(|| panic!("no column {name}"))
-        .values
-}
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+    r.column(name).unwrap_or_else(|| panic!("no column {name}"))
 }
 
 /// Rest-to-rest task-space quintic (zero velocity and acceleration at both ends), general motion.
 fn quintic() -> Trajectory {
-    Trajectory::Quintic {
-        from: Pose {
-            gx: 0.0,
-            gy: 0.0,
-            theta: 0.0,
-        },
-        to: Pose {
+    catalogue::quintic_from_origin(
+        Pose {
             gx: 0.03,
             gy: -0.02,
             theta: 0.25,
         },
-        t0: 0.0,
-        t1: 0.3,
-    }
+        0.3,
+    )
 }
 
 #[test]

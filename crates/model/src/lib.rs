@@ -7,6 +7,7 @@
 //! Conventions (frames, signs, units) are written once, in `docs/conventions.md`; the items here
 //! follow them. All quantities are SI: metres, seconds, kilograms, newtons, radians.
 
+pub mod catalogue;
 pub mod config;
 pub mod error;
 pub mod geometry;

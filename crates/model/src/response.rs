@@ -81,6 +81,23 @@ impl Response {
         }
     }
 
+    /// The extra column `name`, if present.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.extra.iter().find(|c| c.name == name).map(|c| c.values.as_slice())
+    }
+
+    /// Set the extra columns from parallel lists of names and values.
+    pub fn set_extra<S: AsRef<str>>(&mut self, names: &[S], values: Vec<Vec<f64>>) {
+        self.extra = names
+            .iter()
+            .zip(values)
+            .map(|(name, values)| Column {
+                name: name.as_ref().to_string(),
+                values,
+            })
+            .collect();
+    }
+
     /// Number of output rows.
     pub fn len(&self) -> usize {
         self.t.len()

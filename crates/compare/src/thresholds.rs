@@ -67,7 +67,7 @@ impl Thresholds {
         })?;
         for (name, c) in &t.case {
             for (f, band) in &c.evp {
-                if !(band[0] <= band[1]) || !band[0].is_finite() || !band[1].is_finite() {
+                if !band[0].is_finite() || !band[1].is_finite() || band[0] > band[1] {
                     return Err(ThresholdsError::Read {
                         file: file.clone(),
                         reason: format!("case.{name}.evp.{f}: need low <= high, got {band:?}"),

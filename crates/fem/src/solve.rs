@@ -51,7 +51,7 @@ pub fn solve_with_stats(
     exp.trajectory
         .validate(params)
         .map_err(|e| FemError::Input(e.to_string()))?;
-    if settings.elements < 3 || settings.elements % 3 != 0 {
+    if settings.elements < 3 || !settings.elements.is_multiple_of(3) {
         return Err(FemError::Input(format!(
             "fem.elements must be a positive multiple of 3 (three equal beams), got {}",
             settings.elements

@@ -134,7 +134,8 @@ fn derivatives_agree_with_finite_differences() {
         for t in [0.1, 0.2, 0.3] {
             let st = RigidState::at(&p, tr, t).unwrap();
             let at = |t: f64| RigidState::at(&p, tr, t).unwrap();
-            let checks: [(&dyn Fn(f64) -> f64, [f64; 2]); 6] = [
+            type Check<'a> = (&'a dyn Fn(f64) -> f64, [f64; 2]);
+            let checks: [Check; 6] = [
                 (&|t| at(t).g[0].v, [st.g[0].d1, st.g[0].d2]),
                 (&|t| at(t).g[1].v, [st.g[1].d1, st.g[1].d2]),
                 (&|t| at(t).theta.v, [st.theta.d1, st.theta.d2]),

@@ -244,7 +244,7 @@ impl Experiment {
         if let Some(dt) = self.amm.dt {
             check_step("amm.dt", dt, self.time.dt_out)?;
         }
-        if self.fem.elements < 3 || self.fem.elements % 3 != 0 || self.fem.elements > 30_000 {
+        if self.fem.elements < 3 || !self.fem.elements.is_multiple_of(3) || self.fem.elements > 30_000 {
             return Err(ModelError::invalid(
                 "fem.elements",
                 format!(

@@ -120,8 +120,8 @@ mod tests {
         let p = RobotParams::paper();
         let (g, th) = ([0.013f64, -0.021], 0.17f64);
         let s = inverse_kinematics(&p, g, th).unwrap();
-        for i in 0..3 {
-            let q = revolute_point(i, p.d, s[i]);
+        for (i, si) in s.iter().enumerate() {
+            let q = revolute_point(i, p.d, *si);
             let ex = e_x(i, th);
             let rel = [q[0] - g[0], q[1] - g[1]];
             // cross product with the beam direction vanishes, dot product positive

@@ -44,6 +44,9 @@ pub struct Panel {
     pub y_label: String,
     pub series: Vec<Series>,
     pub equal_axes: bool,
+    /// Smallest y span shown, so that a response that is zero up to round-off (w_G in case 1)
+    /// draws as a flat line instead of magnified noise.
+    pub min_y_span: f64,
 }
 
 /// A figure: panels side by side, a caption on top.
@@ -165,6 +168,10 @@ fn bounds(panel: &Panel) -> ((f64, f64), (f64, f64)) {
         let span = (r.1 - r.0).abs().max(1e-12 * (1.0 + r.0.abs()));
         (r.0 - 0.05 * span, r.1 + 0.05 * span)
     };
+    if y.1 - y.0 < panel.min_y_span {
+        let mid = 0.5 * (y.0 + y.1);
+        y = (mid - 0.5 * panel.min_y_span, mid + 0.5 * panel.min_y_span);
+    }
     let (mut x, mut y) = (pad(x), pad(y));
     if panel.equal_axes {
         let (w, h) = (x.1 - x.0, y.1 - y.0);
@@ -292,6 +299,7 @@ fn per_beam(runs: &[Run], title: &str, y_label: &str, pick: impl Fn(&Response, u
                 })
                 .collect(),
             equal_axes: false,
+            min_y_span: 1e-3,
         })
         .collect()
 }
@@ -349,6 +357,7 @@ pub fn figure_star(case: &str, runs: &[Run], rigid: &RigidState, magnify: f64) -
             y_label: "w_i(x) [mm]".into(),
             series: vec![],
             equal_axes: false,
+            min_y_span: 1e-3,
         })
         .collect();
     let mut absolute = Panel {
@@ -357,6 +366,7 @@ pub fn figure_star(case: &str, runs: &[Run], rigid: &RigidState, magnify: f64) -
         y_label: "Y [m]".into(),
         series: vec![],
         equal_axes: true,
+        min_y_span: 0.0,
     };
     let mut t_snap = None;
     for r in runs {

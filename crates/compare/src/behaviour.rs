@@ -9,6 +9,7 @@ use flexstar_model::{ModeFamily, Response};
 use serde::{Deserialize, Serialize};
 
 use crate::evp::g_norm;
+use flexstar_numerics::measures::max_abs;
 
 /// Behaviour of the junction G.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -48,24 +49,18 @@ pub struct JunctionMeasures {
     pub slope_rel: Option<f64>,
 }
 
-fn peak(v: impl Iterator<Item = f64>) -> f64 {
-    v.fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
 /// Measure the junction in a reference response (`slopeG` extra column: elastic rotation of the
 /// beams at G relative to the rigid star [rad]).
 pub fn measure(reference: &Response, beam_length: f64) -> JunctionMeasures {
     let tip = (0..3)
-        .map(|i| peak(reference.w_tip[i].iter().copied()))
+        .map(|i| max_abs(&reference.w_tip[i]))
         .fold(0.0, f64::max)
         .max(f64::MIN_POSITIVE);
-    let wg =
-        peak((0..reference.len()).map(|k| g_norm([reference.w_g[0][k], reference.w_g[1][k], reference.w_g[2][k]])));
-    let slope = reference
-        .extra
-        .iter()
-        .find(|c| c.name == "slopeG")
-        .map(|c| peak(c.values.iter().copied()) * beam_length / tip);
+    let g: Vec<f64> = (0..reference.len())
+        .map(|k| g_norm([reference.w_g[0][k], reference.w_g[1][k], reference.w_g[2][k]]))
+        .collect();
+    let wg = max_abs(&g);
+    let slope = reference.column("slopeG").map(|v| max_abs(v) * beam_length / tip);
     JunctionMeasures {
         w_g_rel: wg / tip,
         slope_rel: slope,

@@ -8,7 +8,7 @@ use flexstar_model::{ModeFamily, Response};
 use serde::Serialize;
 
 use crate::behaviour::{classify, is_correct, measure, Behaviour, JunctionMeasures};
-use crate::evp::{point_evps, CompareError, Point, PointEvps};
+use crate::evp::{point_evps, CompareError, PointEvps};
 use crate::paper::{paper_case, PaperCase};
 
 /// Solver results of one case: the FEM reference and the AMM runs.
@@ -317,9 +317,4 @@ impl TableI {
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("table serialises")
     }
-}
-
-/// The point names in EVP order, for labels.
-pub fn point_names() -> [&'static str; 4] {
-    Point::ALL.map(|p| p.name())
 }

@@ -34,15 +34,7 @@ fn amm_free_free_agrees_with_fem_on_a_smooth_motion() {
         None,
     )
     .unwrap();
-    let amm = flexstar_amm::solve(
-        &exp,
-        &AmmSettings {
-            family: ModeFamily::FreeFree,
-            modes: 40,
-            ..AmmSettings::default()
-        },
-    )
-    .unwrap();
+    let amm = flexstar_amm::solve(&exp, &AmmSettings::paper(ModeFamily::FreeFree, 40)).unwrap();
     let e = point_evps(&amm, &fem).unwrap();
     eprintln!("EVP A/B/C/G = {:?}, mean {:?}", e.points, e.mean);
     for (p, v) in ["A", "B", "C"].iter().zip(&e.points) {

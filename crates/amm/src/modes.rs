@@ -61,7 +61,7 @@ fn orders_at_g(family: ModeFamily) -> [usize; 2] {
         ModeFamily::ClampedFree => [0, 1],
         ModeFamily::PinnedFree => [0, 2],
         ModeFamily::SlideFree => [1, 3],
-        ModeFamily::FreeFree => [2, 3],
+        ModeFamily::FreeFree | ModeFamily::Enriched => [2, 3],
     }
 }
 
@@ -72,7 +72,7 @@ fn rigid_modes(family: ModeFamily) -> &'static [(f64, f64)] {
         ModeFamily::ClampedFree => &[],
         ModeFamily::PinnedFree => &[(0.0, S3)],
         ModeFamily::SlideFree => &[(1.0, 0.0)],
-        ModeFamily::FreeFree => &[(1.0, 0.0), (-S3, 2.0 * S3)],
+        ModeFamily::FreeFree | ModeFamily::Enriched => &[(1.0, 0.0), (-S3, 2.0 * S3)],
     }
 }
 
@@ -89,7 +89,7 @@ fn characteristic(family: ModeFamily, b: f64) -> f64 {
     let (s, c) = b.sin_cos();
     match family {
         ModeFamily::ClampedFree => c + sech(b),
-        ModeFamily::FreeFree => c - sech(b),
+        ModeFamily::FreeFree | ModeFamily::Enriched => c - sech(b),
         ModeFamily::PinnedFree => s - c * b.tanh(),
         ModeFamily::SlideFree => s + c * b.tanh(),
     }
@@ -100,7 +100,7 @@ fn asymptote(family: ModeFamily, n: usize) -> f64 {
     let n = n as f64;
     match family {
         ModeFamily::ClampedFree => (2.0 * n - 1.0) * FRAC_PI_2,
-        ModeFamily::FreeFree => (2.0 * n + 1.0) * FRAC_PI_2,
+        ModeFamily::FreeFree | ModeFamily::Enriched => (2.0 * n + 1.0) * FRAC_PI_2,
         ModeFamily::PinnedFree => (4.0 * n + 1.0) * FRAC_PI_4,
         ModeFamily::SlideFree => (4.0 * n - 1.0) * FRAC_PI_4,
     }
@@ -259,6 +259,12 @@ impl ModeSet {
                     format!("must be a positive finite number, got {v}"),
                 ));
             }
+        }
+        if family == ModeFamily::Enriched {
+            return Err(AmmError::invalid(
+                "amm.family",
+                "the enriched family is not available yet",
+            ));
         }
         let l = params.l;
         let rigid = rigid_modes(family);

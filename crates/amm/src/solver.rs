@@ -11,7 +11,7 @@
 
 use flexstar_kinematics::{check_trajectory, RigidState};
 use flexstar_model::config::check_step;
-use flexstar_model::{AmmSettings, BeamShape, Experiment, ModeFamily, Response, StarShape};
+use flexstar_model::{AmmSettings, BeamShape, Experiment, ModeCount, ModeFamily, Response, RunInfo, StarShape};
 use flexstar_numerics::GenAlpha;
 
 use crate::error::AmmError;
@@ -43,14 +43,23 @@ pub const EXTRA_COLUMNS: [&str; 25] = [
 ];
 
 /// Check everything the solver needs before any work; returns the step ceiling [s].
-fn validate(exp: &Experiment, settings: &AmmSettings) -> Result<f64, AmmError> {
+fn validate(exp: &Experiment, settings: &AmmSettings) -> Result<(f64, usize), AmmError> {
     exp.robot.validate()?;
     exp.time.validate()?;
     exp.trajectory.validate(&exp.robot)?;
-    if settings.modes == 0 || settings.modes > MAX_MODES {
+    let modes = match settings.mode_count() {
+        ModeCount::Fixed(n) => n,
+        ModeCount::Tolerance(_) => {
+            return Err(AmmError::invalid(
+                "amm.tol",
+                "an automatic number of modes is not available yet: set amm.modes",
+            ))
+        }
+    };
+    if modes == 0 || modes > MAX_MODES {
         return Err(AmmError::invalid(
             "amm.modes",
-            format!("need 1 <= modes <= {MAX_MODES}, got {}", settings.modes),
+            format!("need 1 <= modes <= {MAX_MODES}, got {modes}"),
         ));
     }
     if exp.robot.jp <= 0.0 {
@@ -86,7 +95,7 @@ fn validate(exp: &Experiment, settings: &AmmSettings) -> Result<f64, AmmError> {
         ));
     }
     check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))?;
-    Ok(dt)
+    Ok((dt, modes))
 }
 
 /// A time at which the integration stops: an output row and/or a snapshot.
@@ -143,9 +152,10 @@ fn integrate<F: FnMut(&System, &[f64])>(
     settings: &AmmSettings,
     mut observe: F,
 ) -> Result<Response, AmmError> {
-    let dt_max = validate(exp, settings)?;
+    let started = std::time::Instant::now();
+    let (dt_max, n_modes) = validate(exp, settings)?;
     let params = &exp.robot;
-    let modes = ModeSet::new(settings.family, settings.modes, params)?;
+    let modes = ModeSet::new(settings.family, n_modes, params)?;
     let mut sys = System::new(modes, params);
     let (nm, nb, n) = (sys.nm, sys.nb, sys.dim());
 
@@ -298,6 +308,15 @@ fn integrate<F: FnMut(&System, &[f64])>(
 
     resp.set_extra(&EXTRA_COLUMNS, extra);
     resp.shapes = shapes;
+    resp.info = RunInfo {
+        solver: "amm".into(),
+        family: Some(settings.family.name().into()),
+        model: Some(settings.model.name().into()),
+        modes: Some(n_modes),
+        dt: dt_max,
+        wall_s: started.elapsed().as_secs_f64(),
+        ..RunInfo::default()
+    };
     Ok(resp)
 }
 
@@ -323,12 +342,7 @@ mod tests {
     fn position_constraints_hold_at_every_step() {
         // index-3 scheme: C(t_n) q_n = 0 to round-off at every step, no drift (issue 4 item 3)
         for fam in ModeFamily::PAPER {
-            let settings = AmmSettings {
-                family: fam,
-                modes: 20,
-                dt: None,
-                snapshots: vec![],
-            };
+            let settings = AmmSettings::paper(fam, 20);
             let (mut worst, mut qmax, mut steps) = (0.0f64, 0.0f64, 0);
             integrate(&case([1.0, 0.0, 0.5], 0.2), &settings, |sys, q| {
                 worst = worst.max(sys.constraint_residual(q));

@@ -121,6 +121,7 @@ fn roots_approach_asymptotes_exponentially() {
                 ),
                 ModeFamily::PinnedFree => ((4.0 * nf + 1.0) * PI / 4.0, -(-(4.0 * nf + 1.0) * PI / 2.0).exp()),
                 ModeFamily::SlideFree => ((4.0 * nf - 1.0) * PI / 4.0, (-(4.0 * nf - 1.0) * PI / 2.0).exp()),
+                ModeFamily::Enriched => unreachable!("not an analytic family"),
             };
             let got = bl[r + n - 1] - a;
             if n >= 3 && eps.abs() > 1e-10 {

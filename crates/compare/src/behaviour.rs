@@ -83,7 +83,8 @@ pub fn is_correct(family: ModeFamily, behaviour: Behaviour) -> bool {
     match family {
         ModeFamily::PinnedFree => behaviour == Behaviour::Pinned,
         ModeFamily::SlideFree => behaviour == Behaviour::Slide,
-        ModeFamily::FreeFree => true,
+        // neither displacement nor slope imposed at G; enriched also carries moment and shear there
+        ModeFamily::FreeFree | ModeFamily::Enriched => true,
         // clamped at G: neither displacement nor slope
         ModeFamily::ClampedFree => false,
     }

@@ -119,9 +119,9 @@ pub fn run_verify(opts: &VerifyOptions) -> Result<VerifyOutcome, VerifyError> {
                 }),
             Job::Amm(k, family, modes) => {
                 let settings = flexstar_model::AmmSettings {
-                    family,
-                    modes,
-                    ..exps[k].amm.clone()
+                    snapshots: exps[k].amm.snapshots.clone(),
+                    dt: exps[k].amm.dt,
+                    ..flexstar_model::AmmSettings::paper(family, modes)
                 };
                 flexstar_amm::solve(&exps[k], &settings)
                     .map(|r| Done::Amm(k, family, modes, r))

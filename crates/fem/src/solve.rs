@@ -2,7 +2,7 @@
 //! into the shared [`Response`] (MODEL-NOTES section 2).
 
 use flexstar_kinematics::RigidState;
-use flexstar_model::{BeamShape, Experiment, FemSettings, Response, StarShape};
+use flexstar_model::{BeamShape, Experiment, FemSettings, Response, RunInfo, StarShape};
 
 use crate::integrator::{integrate, RunSettings, Stats};
 use crate::star::InitialState;
@@ -45,6 +45,7 @@ pub fn solve_with_stats(
     settings: &FemSettings,
     progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> Result<(Response, Stats), FemError> {
+    let started = std::time::Instant::now();
     let params = &exp.robot;
     params.validate().map_err(|e| FemError::Input(e.to_string()))?;
     exp.time.validate().map_err(|e| FemError::Input(e.to_string()))?;
@@ -189,6 +190,13 @@ pub fn solve_with_stats(
     if let Some(cb) = progress {
         cb(1.0);
     }
+    resp.info = RunInfo {
+        solver: "fem".into(),
+        elements: Some(settings.elements),
+        dt,
+        wall_s: started.elapsed().as_secs_f64(),
+        ..RunInfo::default()
+    };
     Ok((resp, hist.stats))
 }
 

@@ -74,7 +74,8 @@ impl TimeSpan {
 }
 
 /// Assumed-mode families (Eq. 34-1, MODEL-NOTES section 4), named by the boundary condition at G
-/// then at the tip.
+/// then at the tip; `Enriched` is flexstar's addition (free-free modes plus junction shapes that
+/// carry the moment and shear the weld at G transmits, `docs/amm.md` section 7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ModeFamily {
@@ -82,11 +83,21 @@ pub enum ModeFamily {
     SlideFree,
     FreeFree,
     ClampedFree,
+    Enriched,
 }
 
 impl ModeFamily {
     /// The three families of the paper, in Table I's column order.
     pub const PAPER: [ModeFamily; 3] = [ModeFamily::PinnedFree, ModeFamily::SlideFree, ModeFamily::FreeFree];
+
+    /// Every family, in the order used by listings.
+    pub const ALL: [ModeFamily; 5] = [
+        ModeFamily::PinnedFree,
+        ModeFamily::SlideFree,
+        ModeFamily::FreeFree,
+        ModeFamily::ClampedFree,
+        ModeFamily::Enriched,
+    ];
 
     /// Kebab-case name used in files and on the command line.
     pub fn name(&self) -> &'static str {
@@ -95,6 +106,7 @@ impl ModeFamily {
             ModeFamily::SlideFree => "slide-free",
             ModeFamily::FreeFree => "free-free",
             ModeFamily::ClampedFree => "clamped-free",
+            ModeFamily::Enriched => "enriched",
         }
     }
 }
@@ -102,16 +114,8 @@ impl ModeFamily {
 impl std::str::FromStr for ModeFamily {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        [
-            ModeFamily::PinnedFree,
-            ModeFamily::SlideFree,
-            ModeFamily::FreeFree,
-            ModeFamily::ClampedFree,
-        ]
-        .into_iter()
-        .find(|f| f.name() == s)
-        .ok_or_else(|| {
-            format!("unknown mode family `{s}`: expected pinned-free, slide-free, free-free or clamped-free")
+        ModeFamily::ALL.into_iter().find(|f| f.name() == s).ok_or_else(|| {
+            format!("unknown mode family `{s}`: expected pinned-free, slide-free, free-free, clamped-free or enriched")
         })
     }
 }
@@ -122,14 +126,74 @@ impl std::fmt::Display for ModeFamily {
     }
 }
 
+/// Which equations the AMM integrates (`[amm] model`, `--model`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AmmModel {
+    /// The paper's equations (Eqs. 30-44) as printed, corrected only where `docs/amm.md` section 1
+    /// says: no axial-inertia stiffening (Eq. 23 dropped), sleeve rows at the rigid xp_i.
+    Paper,
+    /// The paper's equations with the terms it drops restored (`docs/amm.md` section 8): the
+    /// geometric stiffness of the axial inertia force (Eq. 23) and the sleeve rows (Eqs. 41-43) at
+    /// the material point xp_i - u_i, with Fa (Eq. 33) along the forces they then carry.
+    Full,
+}
+
+impl AmmModel {
+    /// Name used in files and on the command line.
+    pub fn name(&self) -> &'static str {
+        match self {
+            AmmModel::Paper => "paper",
+            AmmModel::Full => "full",
+        }
+    }
+}
+
+impl std::str::FromStr for AmmModel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "paper" => Ok(AmmModel::Paper),
+            "full" => Ok(AmmModel::Full),
+            _ => Err(format!("unknown AMM model `{s}`: expected paper or full")),
+        }
+    }
+}
+
+impl std::fmt::Display for AmmModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Default modes per beam of the paper's families (paper, section 8).
+pub const PAPER_MODES: usize = 25;
+
+/// Default error tolerance of the enriched family [%] (issue 9): the automatic N stops when the
+/// estimated EVP of the truncation is below it.
+pub const DEFAULT_TOL_PERCENT: f64 = 0.5;
+
+/// How the number of modes per beam is chosen (see [`AmmSettings::mode_count`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ModeCount {
+    /// N fixed.
+    Fixed(usize),
+    /// N raised until the estimated truncation EVP is below this many percent.
+    Tolerance(f64),
+}
+
 /// `[amm]` section: settings of the assumed-modes solver. Command-line flags override them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct AmmSettings {
-    /// Mode family.
+    /// Mode family (default: enriched).
     pub family: ModeFamily,
-    /// Modes per beam N, rigid ones included (paper: 25).
-    pub modes: usize,
+    /// Equations (default: full).
+    pub model: AmmModel,
+    /// Modes per beam N, rigid ones and junction shapes included; fixes N (exclusive with `tol`).
+    pub modes: Option<usize>,
+    /// Error tolerance [%]: N is raised until the estimated EVP of the truncation is below it.
+    pub tol: Option<f64>,
     /// Integration step [s]; `None` takes the solver's default (from its convergence study).
     pub dt: Option<f64>,
     /// Times [s] at which the deformed star is recorded (t_end is always added).
@@ -139,11 +203,72 @@ pub struct AmmSettings {
 impl Default for AmmSettings {
     fn default() -> Self {
         AmmSettings {
-            family: ModeFamily::FreeFree,
-            modes: 25,
+            family: ModeFamily::Enriched,
+            model: AmmModel::Full,
+            modes: None,
+            tol: None,
             dt: None,
             snapshots: Vec::new(),
         }
+    }
+}
+
+impl AmmSettings {
+    /// The paper's setting: `family` with N modes and the paper's equations.
+    pub fn paper(family: ModeFamily, modes: usize) -> Self {
+        AmmSettings {
+            family,
+            model: AmmModel::Paper,
+            modes: Some(modes),
+            ..AmmSettings::default()
+        }
+    }
+
+    /// flexstar's accurate reduced model: enriched basis, full model, automatic N at the default
+    /// tolerance.
+    pub fn accurate() -> Self {
+        AmmSettings::default()
+    }
+
+    /// How N is chosen: `modes` if given; else `tol` if given; else the default tolerance for the
+    /// enriched family and [`PAPER_MODES`] for the paper's families.
+    pub fn mode_count(&self) -> ModeCount {
+        match (self.modes, self.tol) {
+            (Some(n), _) => ModeCount::Fixed(n),
+            (None, Some(p)) => ModeCount::Tolerance(p),
+            (None, None) if self.family == ModeFamily::Enriched => ModeCount::Tolerance(DEFAULT_TOL_PERCENT),
+            (None, None) => ModeCount::Fixed(PAPER_MODES),
+        }
+    }
+
+    /// Check the values (keys named relative to the experiment file).
+    pub fn validate(&self, dt_out: f64) -> Result<(), ModelError> {
+        if let Some(n) = self.modes {
+            if n == 0 || n > 400 {
+                return Err(ModelError::invalid(
+                    "amm.modes",
+                    format!("need 1 <= modes <= 400, got {n}"),
+                ));
+            }
+        }
+        if let Some(p) = self.tol {
+            if !p.is_finite() || p <= 0.0 {
+                return Err(ModelError::invalid(
+                    "amm.tol",
+                    format!("the tolerance must be a positive percentage, got {p}"),
+                ));
+            }
+            if self.modes.is_some() {
+                return Err(ModelError::invalid(
+                    "amm.tol",
+                    "give either modes (a fixed N) or tol (N chosen to meet the tolerance), not both",
+                ));
+            }
+        }
+        if let Some(dt) = self.dt {
+            check_step("amm.dt", dt, dt_out)?;
+        }
+        Ok(())
     }
 }
 
@@ -235,15 +360,7 @@ impl Experiment {
         self.robot.validate()?;
         self.time.validate()?;
         self.trajectory.validate(&self.robot)?;
-        if self.amm.modes == 0 || self.amm.modes > 400 {
-            return Err(ModelError::invalid(
-                "amm.modes",
-                format!("need 1 <= modes <= 400, got {}", self.amm.modes),
-            ));
-        }
-        if let Some(dt) = self.amm.dt {
-            check_step("amm.dt", dt, self.time.dt_out)?;
-        }
+        self.amm.validate(self.time.dt_out)?;
         if self.fem.elements < 3 || !self.fem.elements.is_multiple_of(3) || self.fem.elements > 30_000 {
             return Err(ModelError::invalid(
                 "fem.elements",
@@ -316,7 +433,9 @@ s3 = [0.0, 0.0, 1.0]
     fn parses_minimal_file_with_paper_defaults() {
         let e = Experiment::from_toml_str(CASE1, Path::new("case1.toml")).unwrap();
         assert_eq!(e.robot, RobotParams::paper());
-        assert_eq!(e.amm.modes, 25);
+        assert_eq!(e.amm.family, ModeFamily::Enriched);
+        assert_eq!(e.amm.model, AmmModel::Full);
+        assert_eq!(e.amm.mode_count(), ModeCount::Tolerance(DEFAULT_TOL_PERCENT));
         assert_eq!(e.fem.elements, 300);
         assert_eq!(e.time.output_times().len(), 501);
     }
@@ -347,6 +466,23 @@ s3 = [0.0, 0.0, 1.0]
             .unwrap_err()
             .to_string();
         assert!(err.contains("time.t_end"), "{err}");
+        for (bad, key) in [
+            ("tol = 0.0", "amm.tol"),
+            ("tol = nan", "amm.tol"),
+            ("tol = 1.0\nmodes = 20", "amm.tol"),
+            ("modes = 0", "amm.modes"),
+        ] {
+            let text = CASE1.replace("[trajectory]", &format!("[amm]\n{bad}\n[trajectory]"));
+            let err = Experiment::from_toml_str(&text, Path::new("e.toml"))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(key) && err.contains("e.toml"), "{bad}: {err}");
+        }
+        let text = CASE1.replace("[trajectory]", "[amm]\nmodel = \"exact\"\n[trajectory]");
+        let err = Experiment::from_toml_str(&text, Path::new("e.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("exact") && err.contains("model"), "{err}");
         let text = CASE1.replace("[trajectory]", "[amm]\ndt = 0.01\n[trajectory]");
         let err = Experiment::from_toml_str(&text, Path::new("e.toml"))
             .unwrap_err()

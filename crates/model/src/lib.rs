@@ -16,8 +16,8 @@ pub mod params;
 pub mod response;
 pub mod trajectory;
 
-pub use config::{AmmSettings, Experiment, FemSettings, ModeFamily, TimeSpan};
+pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, ModeFamily, TimeSpan};
 pub use error::ModelError;
 pub use params::RobotParams;
-pub use response::{BeamShape, Column, Response, StarShape};
+pub use response::{BeamShape, Column, Response, RunInfo, StarShape};
 pub use trajectory::{Pose, Trajectory};

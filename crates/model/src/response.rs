@@ -37,11 +37,37 @@ pub struct StarShape {
     pub beams: [BeamShape; 3],
 }
 
+/// What produced a response and at what cost: the solver's resolved settings, written to the
+/// sidecar JSON beside every solver CSV ([`Response::write_sidecar`]).
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+pub struct RunInfo {
+    /// `amm` or `fem`.
+    pub solver: String,
+    /// AMM mode family.
+    pub family: Option<String>,
+    /// AMM equations (`paper` or `full`).
+    pub model: Option<String>,
+    /// AMM modes per beam N actually used.
+    pub modes: Option<usize>,
+    /// AMM: estimated EVP of the modal truncation [%] (mean over the tips and G, Eq. 45).
+    pub error_estimate_percent: Option<f64>,
+    /// AMM: the tolerance [%] N was chosen for, when chosen automatically.
+    pub tol_percent: Option<f64>,
+    /// FEM elements in the whole star.
+    pub elements: Option<usize>,
+    /// Integration step [s].
+    pub dt: f64,
+    /// Wall-clock time of the solve [s].
+    pub wall_s: f64,
+}
+
 /// Time histories produced by a solver at the output times.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Response {
     /// Solver label, e.g. `amm-free-free` or `fem`.
     pub label: String,
+    /// Resolved settings and cost of the run.
+    pub info: RunInfo,
     /// Output times [s].
     pub t: Vec<f64>,
     /// `w_iG` [m], i = 1..3.
@@ -68,6 +94,7 @@ impl Response {
             fa: [v(), v(), v()],
             extra: Vec::new(),
             shapes: Vec::new(),
+            info: RunInfo::default(),
         }
     }
 
@@ -142,6 +169,31 @@ impl Response {
             out.flush()?;
             Ok(())
         })
+    }
+
+    /// Write the sidecar JSON of a run (`<csv name>.json`), whole or not at all: `flexstar_version`,
+    /// every field of [`RunInfo`] and the resolved `experiment`.
+    pub fn write_sidecar(&self, path: &Path, experiment: &crate::Experiment) -> Result<(), ModelError> {
+        let mut doc = serde_json::Map::new();
+        doc.insert("flexstar_version".into(), env!("CARGO_PKG_VERSION").into());
+        doc.insert("label".into(), self.label.clone().into());
+        let info = serde_json::to_value(&self.info).map_err(|e| ModelError::Write {
+            file: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        if let serde_json::Value::Object(fields) = info {
+            doc.extend(fields);
+        }
+        let exp = serde_json::to_value(experiment).map_err(|e| ModelError::Write {
+            file: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        doc.insert("experiment".into(), exp);
+        let text = serde_json::to_string_pretty(&serde_json::Value::Object(doc)).map_err(|e| ModelError::Write {
+            file: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        crate::output::write_string_atomically(path, &(text + "\n"))
     }
 
     /// Write the deformed-star snapshots as CSV (`t,beam,x,w,X,Y`), whole or not at all.

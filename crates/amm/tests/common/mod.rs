@@ -23,10 +23,8 @@ pub fn quintic(params: RobotParams, t_end: f64) -> Experiment {
 
 pub fn settings(family: ModeFamily, modes: usize, dt: Option<f64>) -> AmmSettings {
     AmmSettings {
-        family,
-        modes,
         dt,
-        snapshots: Vec::new(),
+        ..AmmSettings::paper(family, modes)
     }
 }
 

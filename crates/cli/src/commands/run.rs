@@ -58,17 +58,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 exp.amm.family = f;
             }
             if let Some(n) = args.modes {
-                exp.amm.modes = n;
+                exp.amm.modes = Some(n);
+                exp.amm.tol = None;
             }
             if args.dt.is_some() {
                 exp.amm.dt = args.dt;
             }
             exp.validate()
                 .map_err(|e| anyhow::anyhow!("{cfg} with the command-line flags: {e}"))?;
-            eprintln!(
-                "{}: AMM, {} modes per beam, {}",
-                exp.name, exp.amm.modes, exp.amm.family
-            );
+            eprintln!("{}: AMM, {:?}, {}", exp.name, exp.amm.mode_count(), exp.amm.family);
             let r = flexstar_amm::solve(&exp, &exp.amm)?;
             (r, format!("amm-{}", exp.amm.family))
         }
@@ -105,6 +103,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let csv = dir.join(format!("{file}.csv"));
     response.write_csv(&csv)?;
     response.write_shapes_csv(&dir.join(format!("{file}-shapes.csv")))?;
+    response.write_sidecar(&dir.join(format!("{file}.json")), &exp)?;
     let peak = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     eprintln!(
         "{}: {} rows to {} in {:.2} s; peak |tip| A/B/C = {:.3e}/{:.3e}/{:.3e} m, peak |w_iG| = {:.3e} m",

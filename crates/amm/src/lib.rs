@@ -16,6 +16,7 @@
 // Units are written in brackets after a quantity ([m], [Hz]) as in the other flexstar crates.
 #![allow(rustdoc::broken_intra_doc_links)]
 
+pub mod adaptive;
 pub mod error;
 pub mod modes;
 pub mod solver;

@@ -11,9 +11,13 @@
 
 use flexstar_kinematics::{check_trajectory, RigidState};
 use flexstar_model::config::check_step;
-use flexstar_model::{AmmSettings, BeamShape, Experiment, ModeCount, ModeFamily, Response, RunInfo, StarShape};
+use flexstar_model::geometry::slider_direction;
+use flexstar_model::{
+    AmmModel, AmmSettings, BeamShape, Experiment, ModeCount, ModeFamily, Response, RunInfo, StarShape,
+};
 use flexstar_numerics::GenAlpha;
 
+use crate::adaptive;
 use crate::error::AmmError;
 use crate::modes::{ModeSet, MAX_MODES};
 use crate::system::{Row, System};
@@ -43,19 +47,14 @@ pub const EXTRA_COLUMNS: [&str; 25] = [
 ];
 
 /// Check everything the solver needs before any work; returns the step ceiling [s].
-fn validate(exp: &Experiment, settings: &AmmSettings) -> Result<(f64, usize), AmmError> {
+fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize) -> Result<f64, AmmError> {
     exp.robot.validate()?;
     exp.time.validate()?;
     exp.trajectory.validate(&exp.robot)?;
-    let modes = match settings.mode_count() {
-        ModeCount::Fixed(n) => n,
-        ModeCount::Tolerance(_) => {
-            return Err(AmmError::invalid(
-                "amm.tol",
-                "an automatic number of modes is not available yet: set amm.modes",
-            ))
-        }
-    };
+    settings.validate(exp.time.dt_out).map_err(|e| match e {
+        flexstar_model::ModelError::Invalid { key, reason, .. } => AmmError::invalid(key, reason),
+        other => other.into(),
+    })?;
     if modes == 0 || modes > MAX_MODES {
         return Err(AmmError::invalid(
             "amm.modes",
@@ -95,7 +94,7 @@ fn validate(exp: &Experiment, settings: &AmmSettings) -> Result<(f64, usize), Am
         ));
     }
     check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))?;
-    Ok((dt, modes))
+    Ok(dt)
 }
 
 /// A time at which the integration stops: an output row and/or a snapshot.
@@ -142,21 +141,33 @@ fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 ///
 /// Every input error (modes, step, snapshots, Jp, an infeasible trajectory) is returned before
 /// any integration.
+///
+/// N is `settings.modes` when given; otherwise (`tol`, or the enriched family's default tolerance)
+/// it is raised until the estimated truncation EVP is below the tolerance (`adaptive` module),
+/// and `info.modes` / `info.error_estimate_percent` report the N used and the estimate.
 pub fn solve(exp: &Experiment, settings: &AmmSettings) -> Result<Response, AmmError> {
-    integrate(exp, settings, |_, _| {})
+    match settings.mode_count() {
+        ModeCount::Fixed(n) => integrate(exp, settings, n, |_, _| {}),
+        ModeCount::Tolerance(tol) => {
+            // every input error before any work, at the first N
+            validate(exp, settings, adaptive::first_modes(exp))?;
+            adaptive::solve_to_tolerance(exp, tol, |n| integrate(exp, settings, n, |_, _| {}))
+        }
+    }
 }
 
 /// [`solve`] with an observer called after every step with the system and the coordinates q.
 fn integrate<F: FnMut(&System, &[f64])>(
     exp: &Experiment,
     settings: &AmmSettings,
+    n_modes: usize,
     mut observe: F,
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
-    let (dt_max, n_modes) = validate(exp, settings)?;
+    let dt_max = validate(exp, settings, n_modes)?;
     let params = &exp.robot;
     let modes = ModeSet::new(settings.family, n_modes, params)?;
-    let mut sys = System::new(modes, params);
+    let mut sys = System::new(modes, params, settings.model);
     let (nm, nb, n) = (sys.nm, sys.nb, sys.dim());
 
     let out_times = exp.time.output_times();
@@ -236,7 +247,8 @@ fn integrate<F: FnMut(&System, &[f64])>(
     acc.copy_from_slice(&qdd);
 
     let (phi0, phil) = (sys.phi0.clone(), sys.phil.clone());
-    let mut record = |st: &RigidState, stop: &Stop, q: &[f64], lam: &[f64]| {
+    let full = settings.model == AmmModel::Full;
+    let mut record = |st: &RigidState, stop: &Stop, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]| {
         let beam_val =
             |i: usize, coef: &[f64]| -> f64 { q[i * nb..i * nb + nm].iter().zip(coef).map(|(a, p)| a * p).sum() };
         if let Some(s) = stop.snapshot {
@@ -258,9 +270,20 @@ fn integrate<F: FnMut(&System, &[f64])>(
             let w_tip = [0, 1, 2].map(|i| beam_val(i, &phil));
             let lam_of = |k: usize| col_rows[k].map_or(0.0, |r| lam[r]);
             let fa = [0, 1, 2].map(|i| {
-                let normal = lam_of(7 + i) + lam_of(10 + i) + lam_of(13 + i);
-                let thp = q[i * nb + nm + 1];
-                params.mpp_mpa * st.s[i].d2 + normal * (st.theta.v + thp).cos()
+                let (fp, fl, fr) = (lam_of(7 + i), lam_of(10 + i), lam_of(13 + i));
+                let inertia = params.mpp_mpa * st.s[i].d2;
+                if full {
+                    // Eq. 33 along the forces the full model's sleeve rows carry: each row's
+                    // force on the beam is lambda (e_w + c_u e_x), c_u its u gradient (-w')
+                    let d = slider_direction(i);
+                    let (ew, ex) = (st.e_w(i), st.e_x(i));
+                    let (wd, xd) = (ew[0] * d[0] + ew[1] * d[1], ex[0] * d[0] + ex[1] * d[1]);
+                    let [cp, cr, cl] = axial[i];
+                    inertia + (fp + fl + fr) * wd + (fp * cp + fr * cr + fl * cl) * xd
+                } else {
+                    let thp = q[i * nb + nm + 1];
+                    inertia + (fp + fl + fr) * (st.theta.v + thp).cos()
+                }
             });
             resp.push(st.t, w_g, w_tip, fa);
             for (k, col) in extra.iter_mut().enumerate() {
@@ -275,7 +298,7 @@ fn integrate<F: FnMut(&System, &[f64])>(
         }
     };
 
-    record(&st, &stops[0], &q, &sys.lam);
+    record(&st, &stops[0], &q, &sys.lam, &sys.sleeve_axial);
     for w in stops.windows(2) {
         let (t0, t1) = (w[0].t, w[1].t);
         let nsub = (((t1 - t0) / dt_max) - 1e-9).ceil().max(1.0) as usize;
@@ -303,7 +326,7 @@ fn integrate<F: FnMut(&System, &[f64])>(
             }
             observe(&sys, &q);
         }
-        record(&st, &w[1], &q, &sys.lam);
+        record(&st, &w[1], &q, &sys.lam, &sys.sleeve_axial);
     }
 
     resp.set_extra(&EXTRA_COLUMNS, extra);
@@ -323,7 +346,7 @@ fn integrate<F: FnMut(&System, &[f64])>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flexstar_model::{FemSettings, RobotParams, TimeSpan, Trajectory};
+    use flexstar_model::{AmmModel, FemSettings, RobotParams, TimeSpan, Trajectory};
 
     fn case(k: [f64; 3], t_end: f64) -> Experiment {
         Experiment {
@@ -344,7 +367,7 @@ mod tests {
         for fam in ModeFamily::PAPER {
             let settings = AmmSettings::paper(fam, 20);
             let (mut worst, mut qmax, mut steps) = (0.0f64, 0.0f64, 0);
-            integrate(&case([1.0, 0.0, 0.5], 0.2), &settings, |sys, q| {
+            integrate(&case([1.0, 0.0, 0.5], 0.2), &settings, 20, |sys, q| {
                 worst = worst.max(sys.constraint_residual(q));
                 qmax = qmax.max(q.iter().fold(0.0f64, |m, v| m.max(v.abs())));
                 steps += 1;
@@ -360,7 +383,11 @@ mod tests {
     fn rows_dropped_per_family() {
         // MODEL-NOTES section 4: pinned-free loses sum w_iG, slide-free the slope equalities
         let p = RobotParams::paper();
-        let count = |fam| System::new(ModeSet::new(fam, 25, &p).unwrap(), &p).rows.len();
+        let count = |fam| {
+            System::new(ModeSet::new(fam, 25, &p).unwrap(), &p, AmmModel::Paper)
+                .rows
+                .len()
+        };
         assert_eq!(count(ModeFamily::FreeFree), 18);
         assert_eq!(count(ModeFamily::PinnedFree), 17);
         assert_eq!(count(ModeFamily::SlideFree), 16);

@@ -21,10 +21,10 @@
 //! are eliminated by the Schur complement `A = C S^-1 C^T`, a small dense LU per step.
 
 use flexstar_kinematics::RigidState;
-use flexstar_model::RobotParams;
+use flexstar_model::{AmmModel, RobotParams};
 
 use crate::error::AmmError;
-use crate::modes::{ModeSet, Triplet};
+use crate::modes::{ModeSet, SleeveBending, Triplet};
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
 
@@ -70,7 +70,11 @@ struct BeamRows {
     ids: Vec<usize>,
     basis: Vec<usize>,
     sc: Vec<f64>,
+    /// Gradient of the row in u_i (the Jacobian column; per step for the full model's sleeve rows).
     cu: Vec<f64>,
+    /// Coefficient of u_i in the row's own value (1 for the Fix rows; 0 for the sleeve rows, where
+    /// u_i enters the full model only through the material point xp_i - u_i).
+    gu: Vec<f64>,
     ct: Vec<f64>,
     /// The sleeve basis vectors B_MID..B_MSLOPE of this beam (refreshed per step), N each.
     sleeve: [Vec<f64>; 4],
@@ -79,6 +83,8 @@ struct BeamRows {
     scaled: [Vec<f64>; 4],
     /// Gram matrix `B_a . D^-1 B_b` of the six basis vectors.
     gram: [[f64; NB]; NB],
+    /// Full model: mode slopes at the sleeve edges and curvature at its centre.
+    bent: SleeveBending,
     /// `B_a . D^-1 Phi`.
     g: [f64; NB],
 }
@@ -101,6 +107,13 @@ pub(crate) struct System {
     pub(crate) phil: Vec<f64>,
     pub(crate) rows: Vec<Row>,
     beams: [BeamRows; 3],
+    model: AmmModel,
+    /// Full model: geometric stiffness matrices of the axial inertia force (Eq. 23), N x N each.
+    g1: Vec<f64>,
+    g2: Vec<f64>,
+    /// Full model: u_i-gradients of the rows Fp_i, FR_i, FL_i at the last solve (`-w'` at the
+    /// material point in the sleeve; 0 in the paper's model): the axial direction of their forces.
+    pub(crate) sleeve_axial: [[f64; 3]; 3],
     // arrowhead data of S (the same for the three beams)
     inv_d: Vec<f64>,
     w: Vec<f64>,
@@ -125,7 +138,7 @@ fn negligible(v: &[f64], scale: &[f64]) -> bool {
 impl System {
     /// Build the system for `modes`, keeping the constraint rows that do not vanish identically
     /// for the family (pinned-free: no `Fw`; slide-free: no slope equalities; clamped-free: neither).
-    pub(crate) fn new(modes: ModeSet, params: &RobotParams) -> Self {
+    pub(crate) fn new(modes: ModeSet, params: &RobotParams, model: AmmModel) -> Self {
         let nm = modes.len();
         let nb = nm + 2;
         let l = params.l;
@@ -163,10 +176,12 @@ impl System {
             basis: Vec::new(),
             sc: Vec::new(),
             cu: Vec::new(),
+            gu: Vec::new(),
             ct: Vec::new(),
             sleeve: std::array::from_fn(|_| vec![0.0; nm]),
             scaled: std::array::from_fn(|_| vec![0.0; nm]),
             gram: [[0.0; NB]; NB],
+            bent: SleeveBending::new(if model == AmmModel::Full { nm } else { 0 }),
             g: [0.0; NB],
         });
         for (k, row) in rows.iter().enumerate() {
@@ -201,13 +216,22 @@ impl System {
                     beam.basis.push(basis);
                     beam.sc.push(sc);
                     beam.cu.push(cu);
+                    beam.gu.push(cu);
                     beam.ct.push(ct);
                 }
             }
         }
         let m = rows.len();
         let n = 3 * nb;
+        let (g1, g2) = match model {
+            AmmModel::Full => modes.axial_stiffening(),
+            AmmModel::Paper => (Vec::new(), Vec::new()),
+        };
         System {
+            model,
+            g1,
+            g2,
+            sleeve_axial: [[0.0; 3]; 3],
             nm,
             nb,
             rho: params.rho,
@@ -251,11 +275,40 @@ impl System {
         }
     }
 
-    /// Eqs. 41-43: refresh the sleeve basis vectors for the sleeve positions xp_i(t).
-    fn update_sleeve_rows(&mut self, xp: [f64; 3]) {
-        for (beam, &x) in self.beams.iter_mut().zip(&xp) {
+    /// Eqs. 41-43: refresh the sleeve rows for the sleeve positions xp_i(t).
+    ///
+    /// Paper model: the rows at the rigid material points xp_i, xp_i +- Lp/2, constant in u_i.
+    /// Full model (`docs/amm.md` section 8): at the material point that sits in the sleeve,
+    /// `xp_i - u_i`, linearised about the predictor `qhat` (one Newton step of the nonlinear rows
+    /// per time step, exact to O(h^4)): alpha part `phi(xp - u^ + e)`, u gradient `-w^'(xp - u^ + e)`
+    /// (`+w^''` for the slope row), while the rows' values keep no u term.
+    fn update_sleeve_rows(&mut self, xp: [f64; 3], qhat: &[f64]) {
+        let (nm, nb) = (self.nm, self.nb);
+        let full = self.model == AmmModel::Full;
+        for (i, (beam, &x)) in self.beams.iter_mut().zip(&xp).enumerate() {
+            let alpha = &qhat[i * nb..i * nb + nm];
+            let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
             let [mid, right, left, mslope] = &mut beam.sleeve;
-            self.modes.triplet_at(&self.tri, x, left, mid, right, mslope);
+            let bent = if full { Some(&mut beam.bent) } else { None };
+            self.modes
+                .triplet_at(&self.tri, x - u_hat, left, mid, right, mslope, bent);
+            if full {
+                let slope_mid = dot(mslope, alpha);
+                let slope_right = dot(&beam.bent.slope_right, alpha);
+                let slope_left = dot(&beam.bent.slope_left, alpha);
+                let curvature = dot(&beam.bent.curvature, alpha);
+                for (k, id) in beam.ids.iter().enumerate() {
+                    let c = match self.rows[*id] {
+                        Row::Fp(_) => -slope_mid,
+                        Row::FR(_) => -slope_right,
+                        Row::FL(_) => -slope_left,
+                        Row::Mp(_) => curvature,
+                        _ => continue,
+                    };
+                    beam.cu[k] = c;
+                }
+                self.sleeve_axial[i] = [-slope_mid, -slope_right, -slope_left];
+            }
             mslope.iter_mut().for_each(|v| *v = -*v);
         }
     }
@@ -314,7 +367,7 @@ impl System {
         let thd = st.theta.d1;
         let thdd = st.theta.d2;
         let ag = st.a_g();
-        self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v]);
+        self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
         self.factor_s(bp, gp, thd, thdd);
 
         // residual r = f - D vhat - K qhat, per beam
@@ -343,6 +396,14 @@ impl System {
                 + rho * thdd * phi_q
                 + rho * l * thd * thd * qu;
             r[nm + 1] = -self.jp * thdd;
+            if self.model == AmmModel::Full {
+                // Eq. 23: - rho (th'^2 G1 - a_x G2) alpha, at the predictor (docs/amm.md section 8)
+                let (c1, c2) = (rho * thd * thd, -rho * ax);
+                let rows = self.g1.chunks_exact(nm).zip(self.g2.chunks_exact(nm));
+                for (rj, (row1, row2)) in r[..nm].iter_mut().zip(rows) {
+                    *rj -= c1 * dot(row1, qa) + c2 * dot(row2, qa);
+                }
+            }
         }
 
         // Gram data of the junction vectors (shared by the beams)
@@ -416,7 +477,7 @@ impl System {
                 let (bk, sk) = (beam.basis[k], beam.sc[k]);
                 let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };
                 let mut cz = (beam.cu[k] - p * gk) * y_r + beam.ct[k] * r[nm + 1] * inv_jp;
-                let mut cq = beam.cu[k] * qhat[o + nm] + beam.ct[k] * qhat[o + nm + 1];
+                let mut cq = beam.gu[k] * qhat[o + nm] + beam.ct[k] * qhat[o + nm + 1];
                 if bk != NONE {
                     cz += sk * bdr[bk];
                     cq += sk * bq[bk];
@@ -480,7 +541,7 @@ impl System {
         for (i, beam) in self.beams.iter().enumerate() {
             let o = i * nb;
             for (k, &g) in beam.ids.iter().enumerate() {
-                let mut v = beam.cu[k] * q[o + nm] + beam.ct[k] * q[o + nm + 1];
+                let mut v = beam.gu[k] * q[o + nm] + beam.ct[k] * q[o + nm + 1];
                 if beam.basis[k] != NONE {
                     v += beam.sc[k] * dot(self.basis(beam, beam.basis[k]), &q[o..o + nm]);
                 }

@@ -294,6 +294,19 @@ fn bad_input_is_rejected_before_any_work() {
         let e = solve(&exp, &settings(ModeFamily::FreeFree, n, None)).unwrap_err();
         assert_eq!(key_of(e), "amm.modes");
     }
+    // issue 9: a tolerance that is not a positive finite percentage, or given with modes
+    for tol in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let s = flexstar_model::AmmSettings {
+            tol: Some(tol),
+            ..flexstar_model::AmmSettings::accurate()
+        };
+        assert_eq!(key_of(solve(&exp, &s).unwrap_err()), "amm.tol", "tol = {tol}");
+    }
+    let s = flexstar_model::AmmSettings {
+        tol: Some(0.5),
+        ..settings(ModeFamily::Enriched, 50, None)
+    };
+    assert_eq!(key_of(solve(&exp, &s).unwrap_err()), "amm.tol");
     let e = solve(&exp, &settings(ModeFamily::FreeFree, 25, Some(2e-3))).unwrap_err();
     assert!(key_of(e).contains("amm.dt"));
     let e = solve(&exp, &settings(ModeFamily::FreeFree, 25, Some(-1e-4))).unwrap_err();

@@ -10,6 +10,7 @@
 pub mod catalogue;
 pub mod config;
 pub mod error;
+pub mod evp;
 pub mod geometry;
 pub mod output;
 pub mod params;

@@ -28,9 +28,16 @@ pub struct Args {
     /// AMM mode family (overrides [amm] family): pinned-free, slide-free, free-free, clamped-free
     #[arg(long)]
     family: Option<ModeFamily>,
-    /// AMM modes per beam N, rigid ones included (overrides [amm] modes)
+    /// AMM modes per beam N, rigid ones included (overrides [amm] modes and tol: a fixed N)
     #[arg(long)]
     modes: Option<usize>,
+    /// AMM equations: paper (as printed) or full (the dropped terms restored; overrides [amm] model)
+    #[arg(long)]
+    model: Option<flexstar_model::AmmModel>,
+    /// AMM error tolerance [%]: N is raised until the estimated truncation EVP is below it
+    /// (overrides [amm] tol and modes)
+    #[arg(long)]
+    tol: Option<f64>,
     /// FEM elements in the whole star, a multiple of 3 (overrides [fem] elements)
     #[arg(long)]
     elements: Option<usize>,
@@ -61,6 +68,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 exp.amm.modes = Some(n);
                 exp.amm.tol = None;
             }
+            if let Some(p) = args.tol {
+                exp.amm.tol = Some(p);
+                exp.amm.modes = None;
+            }
+            if let Some(m) = args.model {
+                exp.amm.model = m;
+            }
             if args.dt.is_some() {
                 exp.amm.dt = args.dt;
             }
@@ -71,8 +85,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             (r, format!("amm-{}", exp.amm.family))
         }
         Solver::Fem => {
-            if args.family.is_some() || args.modes.is_some() {
-                bail!("--family and --modes apply to --solver amm only");
+            if args.family.is_some() || args.modes.is_some() || args.model.is_some() || args.tol.is_some() {
+                bail!("--family, --modes, --model and --tol apply to --solver amm only");
             }
             if let Some(n) = args.elements {
                 exp.fem.elements = n;

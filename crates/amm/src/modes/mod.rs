@@ -26,6 +26,9 @@ use flexstar_model::{ModeFamily, RobotParams};
 
 use crate::error::AmmError;
 
+mod junction;
+use junction::JunctionShape;
+
 /// Largest number of modes per beam accepted (issue 4: "absurdly large" beyond this).
 pub const MAX_MODES: usize = 400;
 
@@ -53,6 +56,8 @@ pub struct ModeSet {
     psi_int: Vec<f64>,
     /// Modes after this index have roots exactly pi apart (see `triplet_at`).
     recur_from: usize,
+    /// Enriched family: the two junction shapes, after the analytic modes in `shapes`.
+    junction: Vec<JunctionShape>,
 }
 
 /// Boundary conditions at G as derivative orders (Eq. 34-1).
@@ -260,21 +265,24 @@ impl ModeSet {
                 ));
             }
         }
-        if family == ModeFamily::Enriched {
+        let enriched = family == ModeFamily::Enriched;
+        if enriched && n < 4 {
             return Err(AmmError::invalid(
-                "amm.family",
-                "the enriched family is not available yet",
+                "amm.modes",
+                format!("the enriched family needs N >= 4 (two rigid modes, at least two elastic modes or junction shapes), got {n}"),
             ));
         }
+        // the enriched family: N - 2 free-free modes, then two junction shapes
+        let n_analytic = if enriched { n - 2 } else { n };
         let l = params.l;
         let rigid = rigid_modes(family);
-        let mut shapes = Vec::with_capacity(n);
-        for &(a, b) in rigid.iter().take(n) {
+        let mut shapes = Vec::with_capacity(n_analytic);
+        for &(a, b) in rigid.iter().take(n_analytic) {
             shapes.push(Shape::Rigid { a, b });
         }
         let orders = orders_at_g(family);
         let mut k = 1;
-        while shapes.len() < n {
+        while shapes.len() < n_analytic {
             let bl = elastic_root(family, k)?;
             let a = [
                 basis_row(bl, 0.0, orders[0]),
@@ -324,15 +332,15 @@ impl ModeSet {
             .iter()
             .map(|s| if let Shape::Elastic { bl, .. } = s { *bl } else { 0.0 })
             .collect();
-        let mut recur_from = n;
-        for m in (1..n).rev() {
+        let mut recur_from = n_analytic;
+        for m in (1..n_analytic).rev() {
             if bls[m - 1] >= 40.0 && (bls[m] - bls[m - 1] - PI).abs() < 1e-12 * bls[m] {
                 recur_from = m - 1;
             } else {
                 break;
             }
         }
-        Ok(ModeSet {
+        let mut set = ModeSet {
             family,
             l,
             ei_over_rho,
@@ -342,7 +350,55 @@ impl ModeSet {
             phi_int,
             psi_int,
             recur_from,
-        })
+            junction: Vec::new(),
+        };
+        if enriched {
+            set.add_junction_shapes();
+        }
+        Ok(set)
+    }
+
+    /// Enriched family: build the two junction shapes against the analytic modes (Rayleigh-Ritz,
+    /// `junction` module) and append their lambda and integrals.
+    fn add_junction_shapes(&mut self) {
+        let b_max = self.beta_l().into_iter().fold(1.0, f64::max);
+        let (x, w) = junction::composite_rule(junction::panels_for(b_max));
+        let values: Vec<Vec<[f64; 4]>> = x
+            .iter()
+            .map(|&xi| self.shapes.iter().map(|s| s.eval(xi)).collect())
+            .collect();
+        let phi: Vec<Vec<f64>> = values.iter().map(|r| r.iter().map(|v| v[0]).collect()).collect();
+        let phi2: Vec<Vec<f64>> = values.iter().map(|r| r.iter().map(|v| v[2]).collect()).collect();
+        let shapes = junction::build(&x, &w, &phi, &phi2);
+        let (sqrt_l, l) = (self.l.sqrt(), self.l);
+        for sh in shapes {
+            let (mut i0, mut i1) = (0.0, 0.0);
+            for (q, (&xi, &wq)) in x.iter().zip(&w).enumerate() {
+                let h = junction::eval(&sh, xi, &values[q])[0];
+                i0 += wq * h;
+                i1 += wq * xi * h;
+            }
+            self.lambda.push(self.ei_over_rho * sh.mu / l.powi(4));
+            self.phi_int.push(sqrt_l * i0);
+            self.psi_int.push(sqrt_l * l * i1);
+            self.junction.push(sh);
+        }
+    }
+
+    /// Number of analytic modes (all of them but the enriched family's junction shapes).
+    fn analytic_len(&self) -> usize {
+        self.shapes.len()
+    }
+
+    /// `Phi^(k)(xi)`, k = 0..=3, of mode m on the unit interval (analytic or junction shape).
+    fn eval_unit(&self, m: usize, xi: f64) -> [f64; 4] {
+        match m.checked_sub(self.analytic_len()) {
+            None => self.shapes[m].eval(xi),
+            Some(j) => {
+                let kept: Vec<[f64; 4]> = self.shapes.iter().map(|s| s.eval(xi)).collect();
+                junction::eval(&self.junction[j], xi, &kept)
+            }
+        }
     }
 
     /// The family of these modes.
@@ -350,9 +406,9 @@ impl ModeSet {
         self.family
     }
 
-    /// Number of modes N (rigid ones included).
+    /// Number of modes N (rigid ones and junction shapes included).
     pub fn len(&self) -> usize {
-        self.shapes.len()
+        self.shapes.len() + self.junction.len()
     }
 
     /// Always false: a mode set holds at least one mode.
@@ -370,7 +426,8 @@ impl ModeSet {
         self.l
     }
 
-    /// Eq. 34-1: dimensionless roots beta_m L, 0 for rigid modes.
+    /// Eq. 34-1: dimensionless roots beta_m L, 0 for rigid modes; for the junction shapes of the
+    /// enriched family the equivalent `(lambda rho / EI)^(1/4) L` of their Ritz value.
     pub fn beta_l(&self) -> Vec<f64> {
         self.shapes
             .iter()
@@ -378,6 +435,7 @@ impl ModeSet {
                 Shape::Rigid { .. } => 0.0,
                 Shape::Elastic { bl, .. } => *bl,
             })
+            .chain(self.junction.iter().map(|j| j.mu.powf(0.25)))
             .collect()
     }
 
@@ -410,7 +468,7 @@ impl ModeSet {
     /// `[phi, phi', phi'', phi''']` in `[m^-1/2, m^-3/2, m^-5/2, m^-7/2]`.
     pub fn eval(&self, m: usize, x: f64) -> [f64; 4] {
         let xi = x / self.l;
-        let v = self.shapes[m].eval(xi);
+        let v = self.eval_unit(m, xi);
         let s = 1.0 / self.l.sqrt();
         [
             v[0] * s,
@@ -447,6 +505,14 @@ impl ModeSet {
                 }
             }
         }
+        let na = self.analytic_len();
+        for (j, sh) in self.junction.iter().enumerate() {
+            let (p, dp) = junction::poly_value_slope(sh.p, xi);
+            val[na + j] = p * s - dot(&sh.c, &val[..na]);
+            if let Some(d) = slope.as_deref_mut() {
+                d[na + j] = dp * sd - dot(&sh.c, &d[..na]);
+            }
+        }
     }
 }
 
@@ -481,6 +547,9 @@ impl ModeSet {
     /// below beta L = 40. Above, consecutive roots are pi apart to round-off (the distance to the
     /// asymptote is below 2 exp(-40)), so sin, cos and the exponentials of mode m + 1 follow from
     /// those of mode m by one rotation by pi x / L and two products. Needs `0 <= x - h`, `x + h <= L`.
+    /// With `bent`, also `phi_m'(x - h)`, `phi_m'(x + h)` and `phi_m''(x)` (the full model's
+    /// gradients of the sleeve rows in u, `docs/amm.md` section 8).
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn triplet_at(
         &self,
         tri: &Triplet,
@@ -489,6 +558,7 @@ impl ModeSet {
         mid: &mut [f64],
         right: &mut [f64],
         slope: &mut [f64],
+        mut bent: Option<&mut SleeveBending>,
     ) {
         let xi = x / self.l;
         let eta = tri.h / self.l;
@@ -504,6 +574,11 @@ impl ModeSet {
                     left[m] = (a + b * (xi - eta)) * s;
                     right[m] = (a + b * (xi + eta)) * s;
                     slope[m] = b * sd;
+                    if let Some(bn) = bent.as_deref_mut() {
+                        bn.slope_left[m] = b * sd;
+                        bn.slope_right[m] = b * sd;
+                        bn.curvature[m] = 0.0;
+                    }
                 }
                 Shape::Elastic { bl, c, e } => {
                     if m > self.recur_from {
@@ -523,10 +598,86 @@ impl ModeSet {
                     let (pc, qs) = (p * f[0], q * f[1]);
                     right[m] = (pc + qs + g1 * f[2] + g2 * f[3]) * s;
                     left[m] = (pc - qs + g1 * f[3] + g2 * f[2]) * s;
+                    if let Some(bn) = bent.as_deref_mut() {
+                        let (qc, ps) = (q * f[0], p * f[1]);
+                        bn.slope_right[m] = bl * (qc - ps - g1 * f[2] + g2 * f[3]) * sd;
+                        bn.slope_left[m] = bl * (qc + ps - g1 * f[3] + g2 * f[2]) * sd;
+                        bn.curvature[m] = bl * bl * (g1 + g2 - p) * sd / self.l;
+                    }
                 }
             }
         }
+        let na = self.analytic_len();
+        for (j, sh) in self.junction.iter().enumerate() {
+            let c = &sh.c[..];
+            let at = |z: f64| junction::poly_value_slope(sh.p, z);
+            let ((pl, dl), (pm, dm), (pr, dr)) = (at(xi - eta), at(xi), at(xi + eta));
+            left[na + j] = pl * s - dot(c, &left[..na]);
+            mid[na + j] = pm * s - dot(c, &mid[..na]);
+            right[na + j] = pr * s - dot(c, &right[..na]);
+            slope[na + j] = dm * sd - dot(c, &slope[..na]);
+            if let Some(bn) = bent.as_deref_mut() {
+                let d2 = junction::poly_curvature(sh.p, xi);
+                bn.slope_left[na + j] = dl * sd - dot(c, &bn.slope_left[..na]);
+                bn.slope_right[na + j] = dr * sd - dot(c, &bn.slope_right[..na]);
+                bn.curvature[na + j] = d2 * sd / self.l - dot(c, &bn.curvature[..na]);
+            }
+        }
     }
+
+    /// Geometric stiffness of the axial inertia force (Eq. 23, full model; `docs/amm.md`
+    /// section 8): with `N(x) = rho [th'^2 (L^2 - x^2)/2 - a_x (L - x)]`, the tension of the part
+    /// of the beam between x and the free tip, `int N phi_j' phi_m' dx = rho (th'^2 G1 - a_x G2)`.
+    /// Returns `(G1, G2)`, row-major N x N: `G1_jm = int (L^2 - x^2)/2 phi_j' phi_m' dx` [-] and
+    /// `G2_jm = int (L - x) phi_j' phi_m' dx` [1/m].
+    pub fn axial_stiffening(&self) -> (Vec<f64>, Vec<f64>) {
+        let n = self.len();
+        let b_max = self.beta_l().into_iter().fold(1.0, f64::max);
+        let (x, w) = junction::composite_rule(junction::panels_for(b_max));
+        let (mut g1, mut g2) = (vec![0.0; n * n], vec![0.0; n * n]);
+        let (mut val, mut d) = (vec![0.0; n], vec![0.0; n]);
+        for (&xi, &wq) in x.iter().zip(&w) {
+            let xm = xi * self.l;
+            self.values_at(xm, &mut val, Some(&mut d));
+            // dx = L dxi
+            let f1 = wq * self.l * 0.5 * (self.l * self.l - xm * xm);
+            let f2 = wq * self.l * (self.l - xm);
+            for j in 0..n {
+                let (a1, a2) = (f1 * d[j], f2 * d[j]);
+                let (r1, r2) = (&mut g1[j * n..(j + 1) * n], &mut g2[j * n..(j + 1) * n]);
+                for m in 0..n {
+                    r1[m] += a1 * d[m];
+                    r2[m] += a2 * d[m];
+                }
+            }
+        }
+        (g1, g2)
+    }
+}
+
+/// Slopes at the sleeve edges and curvature at the sleeve centre of every mode (see
+/// [`ModeSet::triplet_at`]).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SleeveBending {
+    pub(crate) slope_left: Vec<f64>,
+    pub(crate) slope_right: Vec<f64>,
+    pub(crate) curvature: Vec<f64>,
+}
+
+impl SleeveBending {
+    pub(crate) fn new(n: usize) -> Self {
+        SleeveBending {
+            slope_left: vec![0.0; n],
+            slope_right: vec![0.0; n],
+            curvature: vec![0.0; n],
+        }
+    }
+}
+
+/// Plain dot product.
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 #[cfg(test)]
@@ -599,7 +750,7 @@ mod tests {
             let mut b = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
             for x in [0.015, 0.18, 0.3, 0.485] {
                 let [l, m, r, d] = &mut b;
-                ms.triplet_at(&tri, x, l, m, r, d);
+                ms.triplet_at(&tri, x, l, m, r, d, None);
                 for k in 0..n {
                     let want = [
                         ms.eval(k, x - 0.015)[0],

@@ -77,6 +77,9 @@ pub struct Stats {
     /// Symbolic factorisations (one per sparsity pattern; a new one when a sleeve's contact
     /// point leaves its window of elements).
     pub symbolic_factorisations: usize,
+    /// Factorisations that fell back from the structured solver (banded beam blocks and a dense
+    /// border, `docs/fem.md` section 3) to the general sparse LU (0 in the paper cases).
+    pub sparse_fallbacks: usize,
 }
 
 /// Everything a run produces.
@@ -404,6 +407,7 @@ pub(crate) fn integrate(
         }
     }
     stats.symbolic_factorisations = star.symbolic_count;
+    stats.sparse_fallbacks = star.sparse_fallbacks;
     Ok(History {
         samples,
         snapshots,

@@ -13,6 +13,7 @@
 #![allow(clippy::needless_range_loop)] // index loops over DOFs read like the equations
 
 pub mod beam;
+mod bordered;
 pub mod element;
 pub mod error;
 mod integrator;

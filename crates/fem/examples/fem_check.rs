@@ -134,15 +134,16 @@ fn main() -> ExitCode {
         }
         timing.push((k, stats, secs));
     }
-    println!("| case | time [s] | steps | Newton it. | it./step | ms/step | us/iteration | symbolic | fallbacks |");
+    println!("| case | time [s] | steps | Newton it. | it./step | ms/step | us/iteration | factorisations | symbolic | fallbacks |");
     for (k, s, secs) in timing {
         println!(
-            "| {k} | {secs:.3} | {} | {} | {:.2} | {:.3} | {:.1} | {} | {} |",
+            "| {k} | {secs:.3} | {} | {} | {:.2} | {:.3} | {:.1} | {} | {} | {} |",
             s.steps,
             s.newton_iterations,
             s.newton_iterations as f64 / s.steps as f64,
             1e3 * secs / s.steps as f64,
             1e6 * secs / s.newton_iterations as f64,
+            s.factorisations,
             s.symbolic_factorisations,
             s.sparse_fallbacks,
         );

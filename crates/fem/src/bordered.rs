@@ -11,8 +11,8 @@
 //! ```
 //!
 //! Each `B_i` is factorised by a banded Cholesky `B_i = L_i L_i^T` with the beam's nodes ordered
-//! from the tip to G, so that `W_i = L_i^{-1} E_i` is non-zero only from the sleeve's window to
-//! the G end (the G columns of `E_i` live in the last three rows). The Schur complement
+//! from the tip to G, so that the multiplier columns of `W_i = L_i^{-1} E_i` are non-zero only
+//! from the sleeve's window to the G end, and its G columns only in the last three rows. The Schur complement
 //! `S = S0 - sum_i W_i^T W_i` (36 x 36) is factorised by a dense LU with partial pivoting. Work per
 //! factorisation: O(ne) for the bands, O(ne x 10 columns) for `W_i`, 36^3/3 for `S`; no
 //! allocation after construction.
@@ -24,8 +24,9 @@
 
 /// Half bandwidth of a beam block: node DOFs couple with the next node's 3 DOFs.
 const HB: usize = 5;
-/// Border columns of one beam block: the 3 DOFs of G and the 7 multipliers of its sleeve.
-const WC: usize = 10;
+/// Stored columns of `W_i`: the 7 multipliers of sleeve i and one zero pad (8 = two 4-wide SIMD
+/// lanes). The 3 G columns of `W_i` are non-zero only in the last three rows (`wg`).
+const WC: usize = 8;
 /// Border unknowns per sleeve: 7 multipliers, 3 contact coordinates, 1 rotation.
 const SLEEVE_BORDER: usize = 11;
 /// Border size: G and three sleeves.
@@ -56,8 +57,10 @@ pub(crate) struct Bordered {
     lay: Layout,
     /// Lower band of `L_i`, row-major, `HB + 1` values per row (diagonal last), per beam.
     band: [Vec<f64>; 3],
-    /// `W_i` row-major, `WC` values per row, per beam.
+    /// Multiplier columns of `W_i` row-major, `WC` values per row, per beam.
     w: [Vec<f64>; 3],
+    /// G columns of `W_i` in its last three rows, `[row][G DOF]`, per beam.
+    wg: [[[f64; 3]; 3]; 3],
     /// First non-zero row of the multiplier columns of `W_i` (beam-local, tip-first ordering).
     first: [usize; 3],
     /// Schur complement, LU factors in place (row-major) and row permutation.
@@ -78,14 +81,6 @@ fn border_xi(i: usize, p: usize) -> usize {
 }
 fn border_psi(i: usize) -> usize {
     3 + SLEEVE_BORDER * i + ROWS + 3
-}
-/// Border index of column a of `W_i`: G DOFs, then the multipliers of sleeve i.
-fn border_col(i: usize, a: usize) -> usize {
-    if a < 3 {
-        a
-    } else {
-        border_nu(i, a - 3)
-    }
 }
 
 #[inline]
@@ -113,6 +108,7 @@ impl Bordered {
             lay,
             band: std::array::from_fn(|_| vec![0.0; n * (HB + 1)]),
             w: std::array::from_fn(|_| vec![0.0; n * WC]),
+            wg: [[[0.0; 3]; 3]; 3],
             first: [0; 3],
             s: vec![0.0; NS * NS],
             perm: [0; NS],
@@ -216,13 +212,6 @@ impl Bordered {
         self.first[i] = first;
         let w = &mut self.w[i];
         w[first * WC..].iter_mut().for_each(|x| *x = 0.0);
-        let blk0 = &vals[36 * i * ne..36 * i * ne + 36];
-        for c in 0..3 {
-            let j = 3 * (ne - 1) + c;
-            for g in 0..3 {
-                w[j * WC + g] = blk0[6 * (3 + c) + g];
-            }
-        }
         for r in 0..ROWS {
             let p = [0, 0, 1, 1, 2, 2, 0][r];
             let lo = win[i][p];
@@ -236,7 +225,7 @@ impl Bordered {
                         self.s[c * NS + nu] += v;
                         self.s[nu * NS + c] += v;
                     } else {
-                        w[(3 * (ne - k) + c) * WC + 3 + r] = v;
+                        w[(3 * (ne - k) + c) * WC + r] = v;
                     }
                 }
             }
@@ -248,14 +237,16 @@ impl Bordered {
                 self.s[nu * NS + col] += v;
             }
         }
+        // W = L^{-1} E, multiplier columns: rows first..n
         let band = &self.band[i];
         for j in first..n {
             let mut row = [0.0; WC];
             row.copy_from_slice(&w[j * WC..j * WC + WC]);
             for m in first.max(j.saturating_sub(HB))..j {
                 let f = band[at(j, m)];
+                let wm = &w[m * WC..m * WC + WC];
                 for a in 0..WC {
-                    row[a] -= f * w[m * WC + a];
+                    row[a] -= f * wm[a];
                 }
             }
             let d = 1.0 / band[at(j, j)];
@@ -264,22 +255,44 @@ impl Bordered {
             }
             w[j * WC..j * WC + WC].copy_from_slice(&row);
         }
+        // G columns: E_G lives in the rows of node 1 (the last three), from element 0
+        let blk0 = &vals[36 * i * ne..36 * i * ne + 36];
+        let mut wg = [[0.0; 3]; 3];
+        for c in 0..3 {
+            let j = n - 3 + c;
+            for g in 0..3 {
+                let mut v = blk0[6 * (3 + c) + g];
+                for m in 0..c {
+                    v -= band[at(j, n - 3 + m)] * wg[m][g];
+                }
+                wg[c][g] = v / band[at(j, j)];
+            }
+        }
+        self.wg[i] = wg;
+        // S -= W^T W
         let mut acc = [[0.0; WC]; WC];
         for j in first..n {
             let row = &w[j * WC..j * WC + WC];
-            for a in 0..WC {
-                for b in a..WC {
+            for a in 0..ROWS {
+                for b in 0..WC {
                     acc[a][b] += row[a] * row[b];
                 }
             }
         }
-        for a in 0..WC {
-            for b in a..WC {
-                let (ga, gb) = (border_col(i, a), border_col(i, b));
-                self.s[ga * NS + gb] -= acc[a][b];
-                if a != b {
-                    self.s[gb * NS + ga] -= acc[a][b];
-                }
+        for a in 0..ROWS {
+            for b in 0..ROWS {
+                self.s[border_nu(i, a) * NS + border_nu(i, b)] -= acc[a][b];
+            }
+        }
+        for g in 0..3 {
+            for h in 0..3 {
+                let v: f64 = (0..3).map(|c| wg[c][g] * wg[c][h]).sum();
+                self.s[g * NS + h] -= v;
+            }
+            for a in 0..ROWS {
+                let v: f64 = (0..3).map(|c| wg[c][g] * w[(n - 3 + c) * WC + a]).sum();
+                self.s[g * NS + border_nu(i, a)] -= v;
+                self.s[border_nu(i, a) * NS + g] -= v;
             }
         }
     }
@@ -341,12 +354,16 @@ impl Bordered {
             let w = &self.w[i];
             let mut acc = [0.0; WC];
             for j in self.first[i]..n {
+                let wj = &w[j * WC..j * WC + WC];
                 for a in 0..WC {
-                    acc[a] += w[j * WC + a] * y[j];
+                    acc[a] += wj[a] * y[j];
                 }
             }
-            for a in 0..WC {
-                xs[border_col(i, a)] -= acc[a];
+            for a in 0..ROWS {
+                xs[border_nu(i, a)] -= acc[a];
+            }
+            for g in 0..3 {
+                xs[g] -= (0..3).map(|c| self.wg[i][c][g] * y[n - 3 + c]).sum::<f64>();
             }
             self.y[i] = y;
         }
@@ -372,13 +389,17 @@ impl Bordered {
         for i in 0..3 {
             let mut y = std::mem::take(&mut self.y[i]);
             let w = &self.w[i];
-            let xb: [f64; WC] = std::array::from_fn(|a| xs[border_col(i, a)]);
+            let xb: [f64; WC] = std::array::from_fn(|a| if a < ROWS { xs[border_nu(i, a)] } else { 0.0 });
             for j in self.first[i]..n {
+                let wj = &w[j * WC..j * WC + WC];
                 let mut v = 0.0;
                 for a in 0..WC {
-                    v += w[j * WC + a] * xb[a];
+                    v += wj[a] * xb[a];
                 }
                 y[j] -= v;
+            }
+            for c in 0..3 {
+                y[n - 3 + c] -= (0..3).map(|g| self.wg[i][c][g] * xs[g]).sum::<f64>();
             }
             let band = &self.band[i];
             for j in (0..n).rev() {

@@ -227,8 +227,9 @@ impl Star {
     }
 
     /// Rebuild the pattern (slot layout of the constraint rows) if a contact point left its
-    /// window; the sparse LU's symbolic factorisation is then redone on demand.
-    fn ensure_pattern(&mut self, q: &[f64]) -> Result<(), String> {
+    /// window; the sparse LU's symbolic factorisation is then redone on demand. Returns whether
+    /// the pattern was rebuilt.
+    fn ensure_pattern(&mut self, q: &[f64]) -> Result<bool, String> {
         let mut rebuild = self.bordered.is_none();
         for i in 0..3 {
             for p in 0..3 {
@@ -241,7 +242,7 @@ impl Star {
             }
         }
         if !rebuild {
-            return Ok(());
+            return Ok(false);
         }
         let mut slots = Vec::new();
         for el in &self.elements {
@@ -288,7 +289,7 @@ impl Star {
         self.vals = vec![0.0; slots.len()];
         self.slots = slots;
         self.symbolic_count += 1;
-        Ok(())
+        Ok(true)
     }
 
     /// Columns of a constraint row of contact point p of sleeve i: the window's node DOFs, then
@@ -316,7 +317,9 @@ impl Star {
     /// ```
     /// (Hessian terms of the constraints, the velocity and q dependence of the inertia are left
     /// out of the matrix: they are `O(h^2)` against the kept terms, see docs/fem.md.)
-    /// Returns the strain energy and kinetic energy of the star (beams only) as a by-product.
+    /// With `matrix == false` only the residual is evaluated (for a modified Newton iteration with
+    /// the last factorisation, `crate::integrator`), unless the pattern had to be rebuilt. Returns
+    /// whether the matrix was assembled (and must be factorised before the next solve).
     #[allow(clippy::too_many_arguments)]
     pub fn assemble(
         &mut self,
@@ -329,9 +332,12 @@ impl Star {
         ck: f64,
         res: &mut [f64],
         t: f64,
-    ) -> Result<(), FemError> {
-        self.ensure_pattern(q)
+        matrix: bool,
+    ) -> Result<bool, FemError> {
+        let rebuilt = self
+            .ensure_pattern(q)
             .map_err(|reason| FemError::LinearSolver { t, reason })?;
+        let matrix = matrix || rebuilt;
         let (ea, ei, rho) = (self.params.ea(), self.params.ei(), self.params.rho);
         res.iter_mut().for_each(|r| *r = 0.0);
         for (e, el) in self.elements.iter().enumerate() {
@@ -346,17 +352,25 @@ impl Star {
                     reason: format!("element chord length {}", st.ln),
                 });
             }
-            let (fi, k) = st.internal(ea, ei);
-            let (fc, m) = st.inertia(rho, &ve);
             let d = dofs(el);
-            let slot = &mut self.vals[36 * e..36 * e + 36];
-            for a in 0..6 {
-                let mut ma = 0.0;
-                for b in 0..6 {
-                    ma += m[a][b] * ae[b];
-                    slot[6 * a + b] = m[a][b] + ck * k[a][b];
+            if matrix {
+                let (fi, k) = st.internal(ea, ei);
+                let (fc, m) = st.inertia(rho, &ve);
+                let slot = &mut self.vals[36 * e..36 * e + 36];
+                for a in 0..6 {
+                    let mut ma = 0.0;
+                    for b in 0..6 {
+                        ma += m[a][b] * ae[b];
+                        slot[6 * a + b] = m[a][b] + ck * k[a][b];
+                    }
+                    res[d[a]] += cf * (ma + fc[a] + fi[a]);
                 }
-                res[d[a]] += cf * (ma + fc[a] + fi[a]);
+            } else {
+                let fi = st.internal_force(ea, ei);
+                let fm = st.inertia_force(rho, &ve, &ae);
+                for a in 0..6 {
+                    res[d[a]] += cf * (fm[a] + fi[a]);
+                }
             }
             self.states[e] = st;
         }
@@ -364,9 +378,11 @@ impl Star {
         for i in 0..3 {
             let ps = self.psi(i);
             res[ps] += cf * self.params.jp * qdd[ps];
-            self.vals[self.off_psi + 4 * i] = self.params.jp;
-            for p in 0..3 {
-                self.vals[self.off_psi + 4 * i + 1 + p] = 0.0;
+            if matrix {
+                self.vals[self.off_psi + 4 * i] = self.params.jp;
+                for p in 0..3 {
+                    self.vals[self.off_psi + 4 * i + 1 + p] = 0.0;
+                }
             }
             let ang = self.gamma0[i] + q[ps];
             let (a, aperp) = ([ang.cos(), ang.sin()], [-ang.sin(), ang.cos()]);
@@ -401,6 +417,9 @@ impl Star {
                 }
                 res[xi_idx] += gxi * l;
                 res[ps] += gpsi * l;
+                if !matrix {
+                    continue;
+                }
                 // matrix slots: row block then transposed block
                 let base = self.off_con + (ROWS * i + r) * 2 * self.ncol_c;
                 let lo = self.win[i][p];
@@ -428,7 +447,7 @@ impl Star {
                 reason: format!("residual row {k}"),
             });
         }
-        Ok(())
+        Ok(matrix)
     }
 
     fn element_of_dof(&self, k: usize) -> usize {
@@ -563,7 +582,8 @@ mod tests {
         let pins = Pins::new(&params, [[0.01, 0.1, 2.0], [-0.02, 0.0, 2.0], [0.0, 0.1, -1.0]]);
         let mut res = vec![0.0; star.n_sys];
         let bp = 6e-8;
-        star.assemble(&q, &v, &qdd, &lam, &pins, bp, bp, &mut res, 0.0).unwrap();
+        star.assemble(&q, &v, &qdd, &lam, &pins, bp, bp, &mut res, 0.0, true)
+            .unwrap();
         assert_eq!(star.win[0][1], 0, "the test wants a window that holds G");
         let b: Vec<f64> = (0..star.n_sys).map(|k| (k as f64 * 1.3).sin()).collect();
         let mut x = b.clone();

@@ -80,8 +80,8 @@ pub struct Stats {
     pub steps: usize,
     /// Newton iterations (residual evaluations and solves) in all.
     pub newton_iterations: usize,
-    /// Symbolic factorisations (one per sparsity pattern; a new one when a sleeve's contact
-    /// point leaves its window of elements).
+    /// Sparsity patterns built (one at the start, a new one when a sleeve's contact point leaves
+    /// its window of elements); the sparse LU fallback redoes its symbolic factorisation on these.
     pub symbolic_factorisations: usize,
     /// Factorisations that fell back from the structured solver (banded beam blocks and a dense
     /// border, `docs/fem.md` section 3) to the general sparse LU (0 in the paper cases).

@@ -143,14 +143,9 @@ impl ElementState {
     pub fn internal(&self, ea: f64, ei: f64) -> ([f64; 6], Mat6) {
         let (c, s, ln) = (self.c, self.s, self.ln);
         let [n, m1, m2] = self.local_forces(ea, ei);
-        let r = [-c, -s, 0.0, c, s, 0.0];
+        let (r, b1, b2) = self.b_rows();
         let z = [s, -c, 0.0, -s, c, 0.0];
-        let b1 = [-s / ln, c / ln, 1.0, s / ln, -c / ln, 0.0];
-        let b2 = [-s / ln, c / ln, 0.0, s / ln, -c / ln, 1.0];
-        let mut f = [0.0; 6];
-        for j in 0..6 {
-            f[j] = n * r[j] + m1 * b1[j] + m2 * b2[j];
-        }
+        let f = self.internal_force(ea, ei);
         let ka = ea / self.l0;
         let k4 = 4.0 * ei / self.l0;
         let k2 = 2.0 * ei / self.l0;
@@ -167,6 +162,49 @@ impl ElementState {
             }
         }
         (f, k)
+    }
+
+    /// Internal force vector `f = B^T [N, M1, M2]` alone (the first half of
+    /// [`ElementState::internal`], for residual-only evaluations).
+    #[inline]
+    pub fn internal_force(&self, ea: f64, ei: f64) -> [f64; 6] {
+        let [n, m1, m2] = self.local_forces(ea, ei);
+        let (r, b1, b2) = self.b_rows();
+        std::array::from_fn(|j| n * r[j] + m1 * b1[j] + m2 * b2[j])
+    }
+
+    /// Rows of `B = d[u, th1, th2] / d q_e`: `r`, `b1`, `b2`.
+    #[inline]
+    fn b_rows(&self) -> ([f64; 6], [f64; 6], [f64; 6]) {
+        let (c, s, ln) = (self.c, self.s, self.ln);
+        (
+            [-c, -s, 0.0, c, s, 0.0],
+            [-s / ln, c / ln, 1.0, s / ln, -c / ln, 0.0],
+            [-s / ln, c / ln, 0.0, s / ln, -c / ln, 1.0],
+        )
+    }
+
+    /// Full inertia force `M(q) qdd + f_conv = int rho J^T (J qdd + r_conv) dx` [N, N m] without
+    /// forming `M` (4-point Gauss quadrature, as [`ElementState::inertia`]).
+    pub fn inertia_force(&self, rho: f64, qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
+        let (pts, wts) = gauss_legendre(4);
+        let mut f = [0.0; 6];
+        for (p, wg) in pts.iter().zip(wts) {
+            let z = 0.5 * (p + 1.0);
+            let wq = 0.5 * wg * rho * self.l0;
+            let jac = self.jacobian(z);
+            let rc = self.convective(z, qd);
+            let mut acc = rc;
+            for k in 0..2 {
+                for j in 0..6 {
+                    acc[k] += jac[k][j] * qdd[j];
+                }
+            }
+            for i in 0..6 {
+                f[i] += wq * (jac[0][i] * acc[0] + jac[1][i] * acc[1]);
+            }
+        }
+        f
     }
 
     /// Interpolated position `r(zeta)` [m] of the material point at `zeta` in [0, 1].

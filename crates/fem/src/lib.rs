@@ -4,7 +4,8 @@
 //! (MODEL-NOTES section 7, issue 5): three co-rotational Euler-Bernoulli beams in absolute
 //! coordinates welded at one node G ([`element`]), three rigid sleeves with inertia Jp pinned at
 //! the revolute points of Eqs. 1-3 through which the beams slide without friction, index-3
-//! generalized-alpha integration with a sparse LU. The driving forces follow from the pin
+//! generalized-alpha integration with a structured direct solver (banded beam blocks and a dense
+//! border, `bordered`). The driving forces follow from the pin
 //! reactions (Eq. 33). Its equations use only the robot parameters, `s_i(t)` and the start
 //! configuration; the rigid (Fermat-point) kinematics appears only as initial data and in the
 //! post-processing of [`solve`] (projection onto the rigid frames). The formulation, the
@@ -13,6 +14,7 @@
 #![allow(clippy::needless_range_loop)] // index loops over DOFs read like the equations
 
 pub mod beam;
+mod bordered;
 pub mod element;
 pub mod error;
 mod integrator;

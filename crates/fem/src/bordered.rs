@@ -1,0 +1,421 @@
+//! Structured direct solver of the Newton matrix of the star (issue 13): three banded beam blocks
+//! coupled only through a small border (the weld node G, and per sleeve its 7 multipliers, 3
+//! contact coordinates and its rotation).
+//!
+//! With the unknowns split into beam DOFs `b` (nodes 1..ne of each beam) and border DOFs `s`
+//! (36: G, then `[nu_i (7), xi_i (3), psi_i]` per sleeve), the symmetric matrix is
+//!
+//! ```text
+//! [ B   E ]    B = diag(B_1, B_2, B_3),  B_i = (M + beta' K) of beam i without G:
+//! [ E^T S0]    banded, half bandwidth 5, symmetric positive definite
+//! ```
+//!
+//! Each `B_i` is factorised by a banded Cholesky `B_i = L_i L_i^T` with the beam's nodes ordered
+//! from the tip to G, so that the multiplier columns of `W_i = L_i^{-1} E_i` are non-zero only
+//! from the sleeve's window to the G end, and its G columns only in the last three rows. The Schur complement
+//! `S = S0 - sum_i W_i^T W_i` (36 x 36) is factorised by a dense LU with partial pivoting. Work per
+//! factorisation: O(ne) for the bands, O(ne x 10 columns) for `W_i`, 36^3/3 for `S`; no
+//! allocation after construction.
+//!
+//! The layout of the matrix values (element blocks, sleeve diagonals, constraint rows in window
+//! columns) is the slot layout of `crate::star`, described by [`Layout`]. A non-positive Cholesky
+//! pivot or a singular Schur complement is reported as an error; the caller then falls back to
+//! the general sparse LU.
+
+/// Half bandwidth of a beam block: node DOFs couple with the next node's 3 DOFs.
+const HB: usize = 5;
+/// Stored columns of `W_i`: the 7 multipliers of sleeve i and one zero pad (8 = two 4-wide SIMD
+/// lanes). The 3 G columns of `W_i` are non-zero only in the last three rows (`wg`).
+const WC: usize = 8;
+/// Border unknowns per sleeve: 7 multipliers, 3 contact coordinates, 1 rotation.
+const SLEEVE_BORDER: usize = 11;
+/// Border size: G and three sleeves.
+pub(crate) const NS: usize = 3 + 3 * SLEEVE_BORDER;
+/// Constraint rows per sleeve.
+const ROWS: usize = 7;
+
+/// Where the values of the Newton matrix sit in the star's value array.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Layout {
+    /// Elements per beam.
+    pub ne: usize,
+    /// Nodes (1 + 3 ne) and generalized coordinates.
+    pub n_nodes: usize,
+    pub n_dof: usize,
+    /// Offset of the sleeve diagonals `[psi_i, xi_i0, xi_i1, xi_i2]` (4 per sleeve).
+    pub off_psi: usize,
+    /// Offset of the constraint rows: per row `2 ncol` values, the row block then its transpose,
+    /// columns = the window's node DOFs, then `xi`, then `psi`.
+    pub off_con: usize,
+    pub ncol: usize,
+    /// Window width in elements (the window covers nodes `lo..=lo + ww`).
+    pub ww: usize,
+}
+
+/// The factorisation and its workspaces.
+pub(crate) struct Bordered {
+    lay: Layout,
+    /// Lower band of `L_i`, row-major, `HB + 1` values per row (diagonal last), per beam.
+    band: [Vec<f64>; 3],
+    /// Multiplier columns of `W_i` row-major, `WC` values per row, per beam.
+    w: [Vec<f64>; 3],
+    /// G columns of `W_i` in its last three rows, `[row][G DOF]`, per beam.
+    wg: [[[f64; 3]; 3]; 3],
+    /// First non-zero row of the multiplier columns of `W_i` (beam-local, tip-first ordering).
+    first: [usize; 3],
+    /// Schur complement, LU factors in place (row-major) and row permutation.
+    s: Vec<f64>,
+    perm: [usize; NS],
+    /// Global unknown of every border index.
+    global: [usize; NS],
+    /// Work vectors of the beams.
+    y: [Vec<f64>; 3],
+}
+
+/// Border index of multiplier r, contact coordinate p and rotation of sleeve i.
+fn border_nu(i: usize, r: usize) -> usize {
+    3 + SLEEVE_BORDER * i + r
+}
+fn border_xi(i: usize, p: usize) -> usize {
+    3 + SLEEVE_BORDER * i + ROWS + p
+}
+fn border_psi(i: usize) -> usize {
+    3 + SLEEVE_BORDER * i + ROWS + 3
+}
+
+#[inline]
+fn at(j: usize, k: usize) -> usize {
+    j * (HB + 1) + HB - (j - k)
+}
+
+impl Bordered {
+    pub fn new(lay: Layout) -> Self {
+        let n = 3 * lay.ne;
+        let mut global = [0usize; NS];
+        for (c, g) in global.iter_mut().enumerate().take(3) {
+            *g = c;
+        }
+        for i in 0..3 {
+            for r in 0..ROWS {
+                global[border_nu(i, r)] = lay.n_dof + ROWS * i + r;
+            }
+            for p in 0..3 {
+                global[border_xi(i, p)] = 3 * lay.n_nodes + 3 + 3 * i + p;
+            }
+            global[border_psi(i)] = 3 * lay.n_nodes + i;
+        }
+        Bordered {
+            lay,
+            band: std::array::from_fn(|_| vec![0.0; n * (HB + 1)]),
+            w: std::array::from_fn(|_| vec![0.0; n * WC]),
+            wg: [[[0.0; 3]; 3]; 3],
+            first: [0; 3],
+            s: vec![0.0; NS * NS],
+            perm: [0; NS],
+            global,
+            y: std::array::from_fn(|_| vec![0.0; n]),
+        }
+    }
+
+    /// Global DOF of beam-local row j (tip-first) of beam i: node k = ne - j / 3.
+    #[inline]
+    fn global_row(&self, i: usize, j: usize) -> usize {
+        let ne = self.lay.ne;
+        3 * (i * ne + ne - j / 3) + j % 3
+    }
+
+    /// Factorise the matrix whose values are `vals` (star slot layout) with the windows `win`
+    /// (first element of the window of each contact point, [sleeve][point]). `Err` names the
+    /// failing pivot.
+    pub fn factor(&mut self, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), String> {
+        self.s.iter_mut().for_each(|x| *x = 0.0);
+        for i in 0..3 {
+            self.fill_beam(i, vals);
+            self.cholesky(i)?;
+            self.border_columns(i, vals, win);
+        }
+        let l = self.lay;
+        for i in 0..3 {
+            self.s[border_psi(i) * (NS + 1)] += vals[l.off_psi + 4 * i];
+            for p in 0..3 {
+                self.s[border_xi(i, p) * (NS + 1)] += vals[l.off_psi + 4 * i + 1 + p];
+            }
+        }
+        self.lu_schur()
+    }
+
+    /// Band of beam i from its element blocks; the G-G part of element 0 goes to the border.
+    fn fill_beam(&mut self, i: usize, vals: &[f64]) {
+        let ne = self.lay.ne;
+        let band = &mut self.band[i];
+        band.iter_mut().for_each(|x| *x = 0.0);
+        for k in 0..ne {
+            let blk = &vals[36 * (i * ne + k)..36 * (i * ne + k) + 36];
+            for a in 0..6 {
+                let na = k + a / 3;
+                for b in 0..6 {
+                    let nb = k + b / 3;
+                    let v = blk[6 * a + b];
+                    if na == 0 && nb == 0 {
+                        self.s[(a % 3) * NS + b % 3] += v;
+                    } else if na > 0 && nb > 0 {
+                        let (ra, rb) = (3 * (ne - na) + a % 3, 3 * (ne - nb) + b % 3);
+                        if ra >= rb {
+                            band[at(ra, rb)] += v;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// In-place banded Cholesky of beam i.
+    fn cholesky(&mut self, i: usize) -> Result<(), String> {
+        let n = 3 * self.lay.ne;
+        let band = &mut self.band[i];
+        for j in 0..n {
+            let lo = j.saturating_sub(HB);
+            for k in lo..j {
+                let mut v = band[at(j, k)];
+                for m in lo.max(k.saturating_sub(HB))..k {
+                    v -= band[at(j, m)] * band[at(k, m)];
+                }
+                band[at(j, k)] = v / band[at(k, k)];
+            }
+            let mut d = band[at(j, j)];
+            for m in lo..j {
+                d -= band[at(j, m)] * band[at(j, m)];
+            }
+            if !(d > 0.0 && d.is_finite()) {
+                return Err(format!(
+                    "beam {} block not positive definite at row {j} (pivot {d:e})",
+                    i + 1
+                ));
+            }
+            band[at(j, j)] = d.sqrt();
+        }
+        Ok(())
+    }
+
+    /// `E_i` (G columns from element 0, multiplier columns from the constraint rows; couplings
+    /// of the multipliers with G, xi and psi go to the border), then `W_i = L_i^{-1} E_i` and
+    /// `S -= W_i^T W_i`.
+    fn border_columns(&mut self, i: usize, vals: &[f64], win: &[[usize; 3]; 3]) {
+        let l = self.lay;
+        let (ne, n) = (l.ne, 3 * l.ne);
+        // first row touched by a window: node min(lo + ww, ne), tip-first
+        let first = (0..3)
+            .map(|p| 3 * (ne - (win[i][p] + l.ww).min(ne)))
+            .min()
+            .unwrap_or(0)
+            .min(n - 3);
+        self.first[i] = first;
+        let w = &mut self.w[i];
+        w[first * WC..].iter_mut().for_each(|x| *x = 0.0);
+        for r in 0..ROWS {
+            let p = [0, 0, 1, 1, 2, 2, 0][r];
+            let lo = win[i][p];
+            let base = l.off_con + (ROWS * i + r) * 2 * l.ncol;
+            let nu = border_nu(i, r);
+            for wn in 0..=l.ww {
+                let k = lo + wn;
+                for c in 0..3 {
+                    let v = vals[base + 3 * wn + c];
+                    if k == 0 {
+                        self.s[c * NS + nu] += v;
+                        self.s[nu * NS + c] += v;
+                    } else {
+                        w[(3 * (ne - k) + c) * WC + r] = v;
+                    }
+                }
+            }
+            for (col, v) in [
+                (border_xi(i, p), vals[base + l.ncol - 2]),
+                (border_psi(i), vals[base + l.ncol - 1]),
+            ] {
+                self.s[col * NS + nu] += v;
+                self.s[nu * NS + col] += v;
+            }
+        }
+        // W = L^{-1} E, multiplier columns: rows first..n
+        let band = &self.band[i];
+        for j in first..n {
+            let mut row = [0.0; WC];
+            row.copy_from_slice(&w[j * WC..j * WC + WC]);
+            for m in first.max(j.saturating_sub(HB))..j {
+                let f = band[at(j, m)];
+                let wm = &w[m * WC..m * WC + WC];
+                for a in 0..WC {
+                    row[a] -= f * wm[a];
+                }
+            }
+            let d = 1.0 / band[at(j, j)];
+            for a in 0..WC {
+                row[a] *= d;
+            }
+            w[j * WC..j * WC + WC].copy_from_slice(&row);
+        }
+        // G columns: E_G lives in the rows of node 1 (the last three), from element 0
+        let blk0 = &vals[36 * i * ne..36 * i * ne + 36];
+        let mut wg = [[0.0; 3]; 3];
+        for c in 0..3 {
+            let j = n - 3 + c;
+            for g in 0..3 {
+                let mut v = blk0[6 * (3 + c) + g];
+                for m in 0..c {
+                    v -= band[at(j, n - 3 + m)] * wg[m][g];
+                }
+                wg[c][g] = v / band[at(j, j)];
+            }
+        }
+        self.wg[i] = wg;
+        // S -= W^T W
+        let mut acc = [[0.0; WC]; WC];
+        for j in first..n {
+            let row = &w[j * WC..j * WC + WC];
+            for a in 0..ROWS {
+                for b in 0..WC {
+                    acc[a][b] += row[a] * row[b];
+                }
+            }
+        }
+        for a in 0..ROWS {
+            for b in 0..ROWS {
+                self.s[border_nu(i, a) * NS + border_nu(i, b)] -= acc[a][b];
+            }
+        }
+        for g in 0..3 {
+            for h in 0..3 {
+                let v: f64 = (0..3).map(|c| wg[c][g] * wg[c][h]).sum();
+                self.s[g * NS + h] -= v;
+            }
+            for a in 0..ROWS {
+                let v: f64 = (0..3).map(|c| wg[c][g] * w[(n - 3 + c) * WC + a]).sum();
+                self.s[g * NS + border_nu(i, a)] -= v;
+                self.s[border_nu(i, a) * NS + g] -= v;
+            }
+        }
+    }
+
+    /// Dense LU with partial pivoting of the Schur complement, in place.
+    fn lu_schur(&mut self) -> Result<(), String> {
+        let s = &mut self.s;
+        for k in 0..NS {
+            let mut p = k;
+            for r in k + 1..NS {
+                if s[r * NS + k].abs() > s[p * NS + k].abs() {
+                    p = r;
+                }
+            }
+            self.perm[k] = p;
+            if p != k {
+                for c in 0..NS {
+                    s.swap(k * NS + c, p * NS + c);
+                }
+            }
+            let d = s[k * NS + k];
+            if d == 0.0 || !d.is_finite() {
+                return Err(format!("border Schur complement singular at pivot {k} ({d:e})"));
+            }
+            for r in k + 1..NS {
+                let f = s[r * NS + k] / d;
+                s[r * NS + k] = f;
+                if f != 0.0 {
+                    for c in k + 1..NS {
+                        s[r * NS + c] -= f * s[k * NS + c];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Solve `A x = rhs` in place (global ordering of the star) with the last factorisation.
+    pub fn solve(&mut self, rhs: &mut [f64]) {
+        let n = 3 * self.lay.ne;
+        let mut xs = [0.0; NS];
+        for (b, x) in xs.iter_mut().enumerate() {
+            *x = rhs[self.global[b]];
+        }
+        // forward: y_i = L_i^{-1} b_i, xs -= W_i^T y_i
+        for i in 0..3 {
+            let mut y = std::mem::take(&mut self.y[i]);
+            for j in 0..n {
+                y[j] = rhs[self.global_row(i, j)];
+            }
+            let band = &self.band[i];
+            for j in 0..n {
+                let mut v = y[j];
+                for m in j.saturating_sub(HB)..j {
+                    v -= band[at(j, m)] * y[m];
+                }
+                y[j] = v / band[at(j, j)];
+            }
+            let w = &self.w[i];
+            let mut acc = [0.0; WC];
+            for j in self.first[i]..n {
+                let wj = &w[j * WC..j * WC + WC];
+                for a in 0..WC {
+                    acc[a] += wj[a] * y[j];
+                }
+            }
+            for a in 0..ROWS {
+                xs[border_nu(i, a)] -= acc[a];
+            }
+            for g in 0..3 {
+                xs[g] -= (0..3).map(|c| self.wg[i][c][g] * y[n - 3 + c]).sum::<f64>();
+            }
+            self.y[i] = y;
+        }
+        // border: S xs = rhs_s - sum W^T y
+        for k in 0..NS {
+            xs.swap(k, self.perm[k]);
+        }
+        for k in 0..NS {
+            let mut v = xs[k];
+            for c in 0..k {
+                v -= self.s[k * NS + c] * xs[c];
+            }
+            xs[k] = v;
+        }
+        for k in (0..NS).rev() {
+            let mut v = xs[k];
+            for c in k + 1..NS {
+                v -= self.s[k * NS + c] * xs[c];
+            }
+            xs[k] = v / self.s[k * NS + k];
+        }
+        // back: x_i = L_i^{-T} (y_i - W_i xs)
+        for i in 0..3 {
+            let mut y = std::mem::take(&mut self.y[i]);
+            let w = &self.w[i];
+            let xb: [f64; WC] = std::array::from_fn(|a| if a < ROWS { xs[border_nu(i, a)] } else { 0.0 });
+            for j in self.first[i]..n {
+                let wj = &w[j * WC..j * WC + WC];
+                let mut v = 0.0;
+                for a in 0..WC {
+                    v += wj[a] * xb[a];
+                }
+                y[j] -= v;
+            }
+            for c in 0..3 {
+                y[n - 3 + c] -= (0..3).map(|g| self.wg[i][c][g] * xs[g]).sum::<f64>();
+            }
+            let band = &self.band[i];
+            for j in (0..n).rev() {
+                let mut v = y[j];
+                for m in j + 1..(j + HB + 1).min(n) {
+                    v -= band[at(m, j)] * y[m];
+                }
+                y[j] = v / band[at(j, j)];
+            }
+            for j in 0..n {
+                rhs[self.global_row(i, j)] = y[j];
+            }
+            self.y[i] = y;
+        }
+        for (b, x) in xs.iter().enumerate() {
+            rhs[self.global[b]] = *x;
+        }
+    }
+}

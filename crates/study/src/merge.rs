@@ -110,7 +110,7 @@ pub fn merge(dir: &Path) -> Result<MergeReport, StudyError> {
             )));
         }
     }
-    Ok(join(dir, n, &shards)?)
+    join(dir, n, &shards)
 }
 
 fn join(dir: &Path, n: usize, shards: &[(usize, Meta, Table, PathBuf)]) -> Result<MergeReport, StudyError> {

@@ -28,6 +28,9 @@ enum Command {
     Modes(commands::modes::Args),
     /// Reproduce and check Table I: four cases, three families, FEM; table, figures, report
     Verify(commands::verify::Args),
+    /// Design studies: sweep experiment keys over a grid or a Latin hypercube, in parallel or in
+    /// shards on a cluster (`sweep merge DIR` joins the shards); results.csv, plots, study.html
+    Sweep(commands::sweep::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -37,6 +40,7 @@ fn main() -> std::process::ExitCode {
         Command::Run(args) => commands::run::run(args),
         Command::Modes(args) => commands::modes::run(args),
         Command::Verify(args) => commands::verify::run(args),
+        Command::Sweep(args) => commands::sweep::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -77,9 +77,9 @@ pub const FAMILY_COLORS: [RGBColor; 4] = [
 
 static FONT: Once = Once::new();
 
-/// Register the bundled DejaVu Sans (see assets/DejaVuSans-LICENSE.txt) so that text renders
-/// without system fonts.
-fn register_font() {
+/// Register the bundled DejaVu Sans (see assets/DejaVuSans-LICENSE.txt) as `sans-serif` so that
+/// text renders without system fonts; idempotent. Other crates drawing with plotters call it first.
+pub fn register_font() {
     FONT.call_once(|| {
         let _ = plotters::style::register_font(
             "sans-serif",

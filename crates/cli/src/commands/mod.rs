@@ -3,6 +3,7 @@
 pub mod kinematics;
 pub mod modes;
 pub mod run;
+pub mod sweep;
 pub mod verify;
 
 use std::path::{Path, PathBuf};

@@ -1,0 +1,285 @@
+//! The study's report from its results folder alone (`results.csv` and its sidecar): every metric
+//! against every varied key, heat maps when exactly two keys are gridded, and `study.html` with
+//! the table's summary and every plot inline. Used after a run and after a merge.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use flexstar_model::output::write_string_atomically;
+
+use crate::error::StudyError;
+use crate::plots::{solver_color, Heat, PointSet, Scatter};
+use crate::shard::{meta_file, results_file, Meta};
+use crate::table::{Table, OK};
+
+/// Most points drawn per plot; larger studies are thinned evenly (every k-th row).
+pub const MAX_POINTS: usize = 5000;
+
+/// The plotted metric columns with their axis labels.
+pub fn metric_labels() -> Vec<(&'static str, &'static str)> {
+    vec![
+        ("peak_tip_m", "peak |w_i(L)| over A, B, C [m]"),
+        ("peak_wG_m", "peak |w_iG| [m]"),
+        ("peak_Fa_N", "peak |Fa_i| [N]"),
+        ("evp_percent", "mean EVP of the AMM vs FEM [%]"),
+        ("residual_tip_m", "residual |w_i(L)| after the motion [m]"),
+        ("error_estimate_percent", "AMM error estimate [%]"),
+        ("modes", "AMM modes per beam"),
+        ("wall_s", "wall time per solve [s]"),
+    ]
+}
+
+/// What was written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReportOutcome {
+    pub html: PathBuf,
+    /// The SVG files in `plots/`.
+    pub plots: Vec<PathBuf>,
+}
+
+struct Plot {
+    file: String,
+    caption: String,
+    svg: String,
+}
+
+/// Write `dir/plots/*.svg` and `dir/study.html` from `dir/results.csv`.
+pub fn write_report(dir: &Path) -> Result<ReportOutcome, StudyError> {
+    let results = results_file(dir, None);
+    let table = Table::read(&results)?;
+    let meta = Meta::read(&meta_file(&results))?;
+    let plots = make_plots(&table, &meta)?;
+    let plot_dir = dir.join("plots");
+    let mut files = Vec::new();
+    for p in &plots {
+        let f = plot_dir.join(&p.file);
+        write_string_atomically(&f, &p.svg)?;
+        files.push(f);
+    }
+    let html = dir.join("study.html");
+    write_string_atomically(&html, &html_page(&table, &meta, &plots))?;
+    Ok(ReportOutcome { html, plots: files })
+}
+
+fn num(s: &str) -> Option<f64> {
+    s.parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+/// File-name form of a key (`robot.Lp` -> `robot-Lp`).
+fn slug(s: &str) -> String {
+    s.chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '-' })
+        .collect()
+}
+
+/// The metrics with at least one value in the table.
+fn present_metrics(table: &Table) -> Vec<(usize, &'static str, &'static str)> {
+    metric_labels()
+        .into_iter()
+        .filter_map(|(m, label)| {
+            let c = table.column(m)?;
+            table.rows.iter().any(|r| num(&r[c]).is_some()).then_some((c, m, label))
+        })
+        .collect()
+}
+
+fn make_plots(table: &Table, meta: &Meta) -> Result<Vec<Plot>, StudyError> {
+    let keys = table.keys();
+    let (solver, status) = (table.column("solver").unwrap_or(0), table.column("status").unwrap_or(0));
+    let ok: Vec<&Vec<String>> = table.rows.iter().filter(|r| r[status] == OK).collect();
+    let stride = ok.len().div_ceil(MAX_POINTS).max(1);
+    let grid = !meta.grid_levels.is_empty();
+    let mut plots = Vec::new();
+    for (mc, metric, label) in present_metrics(table) {
+        for (j, key) in keys.iter().enumerate() {
+            let kc = j + 1;
+            if !ok.iter().all(|r| num(&r[kc]).is_some()) {
+                continue; // a key with text values (a mode family) has no axis
+            }
+            let sets = meta
+                .solvers
+                .iter()
+                .map(|s| PointSet {
+                    label: s.clone(),
+                    color: solver_color(s),
+                    points: ok
+                        .iter()
+                        .step_by(stride)
+                        .filter(|r| &r[solver] == s)
+                        .filter_map(|r| Some((num(&r[kc])?, num(&r[mc])?)))
+                        .collect(),
+                })
+                .filter(|s| !s.points.is_empty())
+                .collect();
+            let scatter = Scatter {
+                title: format!("{metric} against {key}"),
+                x_label: key.clone(),
+                y_label: label.to_string(),
+                sets,
+                connect: grid && keys.len() == 1,
+            };
+            plots.push(Plot {
+                file: format!("{}-vs-{}.svg", slug(metric), slug(key)),
+                caption: format!("{label} against {key}{}", thinned(stride)),
+                svg: scatter.to_svg()?,
+            });
+        }
+        if grid && keys.len() == 2 {
+            for s in &meta.solvers {
+                if let Some(heat) = heat(table, &ok, s, mc, metric) {
+                    plots.push(Plot {
+                        file: format!("heat-{}-{}.svg", slug(metric), s),
+                        caption: format!("{label}, {s}: heat map over {} and {}", keys[0], keys[1]),
+                        svg: heat.to_svg()?,
+                    });
+                }
+            }
+        }
+    }
+    Ok(plots)
+}
+
+fn thinned(stride: usize) -> String {
+    if stride > 1 {
+        format!(" (every {stride}th run drawn)")
+    } else {
+        String::new()
+    }
+}
+
+/// Levels of a key column in the order of first appearance, numbers sorted ascending.
+fn levels(rows: &[&Vec<String>], col: usize) -> Vec<String> {
+    let mut v: Vec<String> = Vec::new();
+    for r in rows {
+        if !v.contains(&r[col]) {
+            v.push(r[col].clone());
+        }
+    }
+    if v.iter().all(|s| num(s).is_some()) {
+        v.sort_by(|a, b| num(a).unwrap_or(0.0).total_cmp(&num(b).unwrap_or(0.0)));
+    }
+    v
+}
+
+fn heat(table: &Table, ok: &[&Vec<String>], solver: &str, mc: usize, metric: &str) -> Option<Heat> {
+    let sc = table.column("solver")?;
+    let all: Vec<&Vec<String>> = table.rows.iter().collect();
+    let (xl, yl) = (levels(&all, 1), levels(&all, 2));
+    let mut values = vec![vec![None; xl.len()]; yl.len()];
+    let mut any = false;
+    for r in ok.iter().filter(|r| r[sc] == solver) {
+        let (ix, iy) = (xl.iter().position(|l| *l == r[1])?, yl.iter().position(|l| *l == r[2])?);
+        values[iy][ix] = num(&r[mc]);
+        any |= values[iy][ix].is_some();
+    }
+    let keys = table.keys();
+    any.then(|| Heat {
+        title: format!("{metric} ({solver})"),
+        x_label: keys[0].clone(),
+        y_label: keys[1].clone(),
+        x_levels: xl,
+        y_levels: yl,
+        values,
+    })
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+/// Summary of one metric of one solver: count, min, median, max and the cases of the extremes.
+fn summary_rows(table: &Table, meta: &Meta) -> String {
+    let keys = table.keys();
+    let (sc, st) = (table.column("solver").unwrap_or(0), table.column("status").unwrap_or(0));
+    let case = |r: &Vec<String>| {
+        keys.iter()
+            .enumerate()
+            .map(|(j, k)| format!("{k} = {}", r[j + 1]))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut h = String::new();
+    for s in &meta.solvers {
+        for (mc, metric, _) in present_metrics(table) {
+            let mut v: Vec<(f64, &Vec<String>)> = table
+                .rows
+                .iter()
+                .filter(|r| &r[sc] == s && r[st] == OK)
+                .filter_map(|r| Some((num(&r[mc])?, r)))
+                .collect();
+            if v.is_empty() {
+                continue;
+            }
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let (lo, hi) = (v[0], v[v.len() - 1]);
+            let _ = writeln!(
+                h,
+                "<tr><td>{s}</td><td>{metric}</td><td>{}</td><td>{:.4e}</td><td>{:.4e}</td><td>{:.4e}</td><td>{}</td><td>{}</td></tr>",
+                v.len(),
+                lo.0,
+                v[v.len() / 2].0,
+                hi.0,
+                escape(&case(lo.1)),
+                escape(&case(hi.1))
+            );
+        }
+    }
+    h
+}
+
+fn html_page(table: &Table, meta: &Meta, plots: &[Plot]) -> String {
+    let st = table.column("status").unwrap_or(0);
+    let failed: Vec<&Vec<String>> = table.rows.iter().filter(|r| r[st] != OK).collect();
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>flexstar study {name}</title>\n<style>\nbody{{font-family:sans-serif;max-width:1600px;margin:2em auto;padding:0 1em;color:#222}}\ntable{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #bbb;padding:3px 7px;text-align:left}}\nth{{background:#eee}}figure{{display:inline-block;margin:0.5em}}svg{{max-width:100%;height:auto}}\n</style></head><body>\n<h1>flexstar study: {name}</h1>\n",
+        name = escape(&meta.study)
+    );
+    let _ = writeln!(
+        h,
+        "<p>Study file <code>{}</code>, hash <code>{}</code>; {} cases x {} ({}); varied: {}. {} rows, {} ok, {} failed.</p>",
+        escape(&meta.study_file),
+        meta.hash,
+        meta.total_cases,
+        meta.solvers.join(" + "),
+        if meta.grid_levels.is_empty() { "Latin hypercube".to_string() } else { format!("grid {:?}", meta.grid_levels) },
+        escape(&meta.keys.join(", ")),
+        table.rows.len(),
+        table.rows.len() - failed.len(),
+        failed.len()
+    );
+    h.push_str("<h2>Summary</h2>\n<table><tr><th>solver</th><th>metric</th><th>runs</th><th>min</th><th>median</th><th>max</th><th>case of the min</th><th>case of the max</th></tr>\n");
+    h.push_str(&summary_rows(table, meta));
+    h.push_str("</table>\n");
+    if !failed.is_empty() {
+        let _ = writeln!(h, "<h2>Failed runs ({})</h2>\n<table><tr>", failed.len());
+        for c in table.header.iter().take(st + 1) {
+            let _ = write!(h, "<th>{}</th>", escape(c));
+        }
+        h.push_str("</tr>\n");
+        for r in failed.iter().take(50) {
+            h.push_str("<tr>");
+            for c in r.iter().take(st + 1) {
+                let _ = write!(h, "<td>{}</td>", escape(c));
+            }
+            h.push_str("</tr>\n");
+        }
+        h.push_str("</table>\n");
+        if failed.len() > 50 {
+            let _ = writeln!(h, "<p>... and {} more (see results.csv).</p>", failed.len() - 50);
+        }
+    }
+    h.push_str("<h2>Plots</h2>\n");
+    for p in plots {
+        let svg = p.svg.find("<svg").map_or(p.svg.as_str(), |i| &p.svg[i..]);
+        let _ = writeln!(
+            h,
+            "<figure id=\"{}\">{svg}<figcaption>{}</figcaption></figure>",
+            escape(&p.file),
+            escape(&p.caption)
+        );
+    }
+    h.push_str("</body></html>\n");
+    h
+}

@@ -1,0 +1,303 @@
+//! Running a study: every case of the study (or of one shard) in parallel with rayon, each case's
+//! rows appended to the results table as soon as it finishes, cases already in the table skipped
+//! (an interrupted study resumes), and the finished table rewritten in the study's case order.
+
+use std::collections::{HashMap, HashSet};
+use std::io::Write;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use flexstar_model::{Experiment, Response};
+use rayon::prelude::*;
+
+use crate::error::StudyError;
+use crate::metrics::{mean_evp, motion_end, peaks, residual_tip};
+use crate::patch::value_text;
+use crate::sample::Case;
+use crate::shard::{meta_file, results_file, Meta, Shard};
+use crate::spec::{Sampling, Solver, Study};
+use crate::table::{header, records_bytes, Row, Table, OK};
+
+/// Where and how to run.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Results go to `<out>/<study name>/`.
+    pub out: PathBuf,
+    /// Worker threads; `None` uses rayon's default (`RAYON_NUM_THREADS` or every core).
+    pub jobs: Option<usize>,
+    /// Run only this slice of the cases.
+    pub shard: Option<Shard>,
+}
+
+/// What a run did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutcome {
+    /// The results table written.
+    pub results: PathBuf,
+    /// Cases this table holds (the whole study or the shard).
+    pub cases: usize,
+    /// Cases found already done in the table and skipped.
+    pub skipped: usize,
+    /// Cases run now.
+    pub ran: usize,
+    /// Rows of the finished table whose status is not `ok`.
+    pub failed_rows: usize,
+    /// Wall-clock time of the run [s].
+    pub seconds: f64,
+}
+
+/// Run `study` as `opts` say; `progress(done, total)` is called after each case of this run.
+///
+/// Errors are raised before any case runs (keys, an existing table of another study) or when a
+/// file cannot be written; a case that fails is a row whose `status` says why.
+pub fn run_study(
+    study: &Study,
+    opts: &RunOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<RunOutcome, StudyError> {
+    let started = Instant::now();
+    let all = study.cases();
+    let mine: Vec<&Case> = all
+        .iter()
+        .filter(|c| opts.shard.is_none_or(|s| s.holds(c.index)))
+        .collect();
+    let dir = opts.out.join(&study.name);
+    let results = results_file(&dir, opts.shard);
+    let meta = meta_of(study, all.len(), &mine, opts.shard);
+    let done = prepare_table(&results, &meta, &header(&study.keys()))?;
+    let todo: Vec<&Case> = mine
+        .iter()
+        .copied()
+        .filter(|c| {
+            !study
+                .solvers
+                .iter()
+                .all(|s| done.contains(&(c.run_id.clone(), s.name().to_string())))
+        })
+        .collect();
+
+    let file = std::fs::OpenOptions::new()
+        .append(true)
+        .open(&results)
+        .map_err(|e| write_error(&results, e.to_string()))?;
+    let file = Mutex::new(file);
+    let finished = AtomicUsize::new(0);
+    let work = || {
+        todo.par_iter().try_for_each(|case| {
+            let rows: Vec<Vec<String>> = run_case(study, case).iter().map(Row::record).collect();
+            let bytes = records_bytes(&rows).map_err(|e| write_error(&results, e.to_string()))?;
+            {
+                let mut f = file.lock().unwrap_or_else(|p| p.into_inner());
+                f.write_all(&bytes)
+                    .and_then(|_| f.flush())
+                    .map_err(|e| write_error(&results, e.to_string()))?;
+            }
+            progress(finished.fetch_add(1, Ordering::Relaxed) + 1, todo.len());
+            Ok::<(), StudyError>(())
+        })
+    };
+    match opts.jobs {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| StudyError::invalid(&study.file, "--jobs", e.to_string()))?
+            .install(work)?,
+        None => work()?,
+    }
+    drop(file);
+
+    let table = finish_table(&results, &mine, &study.solvers)?;
+    let status = table.column("status").unwrap_or(0);
+    Ok(RunOutcome {
+        failed_rows: table.rows.iter().filter(|r| r[status] != OK).count(),
+        results,
+        cases: mine.len(),
+        skipped: mine.len() - todo.len(),
+        ran: todo.len(),
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+fn write_error(file: &std::path::Path, reason: String) -> StudyError {
+    StudyError::Write(flexstar_model::ModelError::Write {
+        file: file.to_path_buf(),
+        reason,
+    })
+}
+
+fn meta_of(study: &Study, total: usize, mine: &[&Case], shard: Option<Shard>) -> Meta {
+    Meta {
+        study: study.name.clone(),
+        hash: study.hash.clone(),
+        study_file: study.file.display().to_string(),
+        keys: study.keys(),
+        solvers: study.solvers.iter().map(|s| s.name().to_string()).collect(),
+        grid_levels: match study.sampling {
+            Sampling::Grid => study.vary.iter().map(|v| v.grid_values().len()).collect(),
+            Sampling::Lhs { .. } => Vec::new(),
+        },
+        shard: shard.map(|s| [s.k, s.n]),
+        total_cases: total,
+        cases: mine.iter().map(|c| c.run_id.clone()).collect(),
+    }
+}
+
+/// Create the table (header only) and its sidecar, or check that an existing one belongs to this
+/// study and return the `(run_id, solver)` pairs it already holds. A last line cut short by an
+/// interruption is removed so that appending starts on a fresh line.
+fn prepare_table(
+    results: &std::path::Path,
+    meta: &Meta,
+    header: &[String],
+) -> Result<HashSet<(String, String)>, StudyError> {
+    let meta_path = meta_file(results);
+    if !results.exists() {
+        Table {
+            header: header.to_vec(),
+            rows: Vec::new(),
+        }
+        .write(results)?;
+        meta.write(&meta_path)?;
+        return Ok(HashSet::new());
+    }
+    let other = |reason: String| StudyError::Results {
+        file: results.to_path_buf(),
+        reason,
+    };
+    if !meta_path.exists() {
+        return Err(other(format!(
+            "exists without its sidecar {}: cannot tell which study wrote it (move it away to start afresh)",
+            meta_path.display()
+        )));
+    }
+    let old = Meta::read(&meta_path)?;
+    if old.hash != meta.hash || old.shard != meta.shard {
+        return Err(other(format!(
+            "was written by another study or split (hash {}, shard {:?}; this run: hash {}, shard {:?}): \
+             give another --out or move it away",
+            old.hash, old.shard, meta.hash, meta.shard
+        )));
+    }
+    let text_len = std::fs::metadata(results).map(|m| m.len()).unwrap_or(0);
+    let table = Table::read(results)?;
+    if table.header != header {
+        return Err(other("its header is not this study's".into()));
+    }
+    let whole = records_bytes(std::iter::once(&table.header).chain(&table.rows)).map_err(|e| other(e.to_string()))?;
+    if whole.len() as u64 != text_len {
+        table.write(results)?; // drop a cut-short last line
+    }
+    let (id, solver) = (0, table.column("solver").unwrap_or(0));
+    Ok(table.rows.iter().map(|r| (r[id].clone(), r[solver].clone())).collect())
+}
+
+/// Rewrite the table in the study's case order (solvers in the study's order), keeping the last
+/// row of any (run_id, solver) pair written twice.
+fn finish_table(results: &std::path::Path, mine: &[&Case], solvers: &[Solver]) -> Result<Table, StudyError> {
+    let mut table = Table::read(results)?;
+    let solver_col = table.column("solver").unwrap_or(0);
+    let order: HashMap<&str, usize> = mine.iter().map(|c| (c.run_id.as_str(), c.index)).collect();
+    let solver_rank = |s: &str| solvers.iter().position(|x| x.name() == s).unwrap_or(usize::MAX);
+    let mut last: HashMap<(String, String), Vec<String>> = HashMap::new();
+    for r in table.rows.drain(..) {
+        last.insert((r[0].clone(), r[solver_col].clone()), r);
+    }
+    let mut rows: Vec<Vec<String>> = last.into_values().collect();
+    rows.sort_by_key(|r| {
+        (
+            order.get(r[0].as_str()).copied().unwrap_or(usize::MAX),
+            solver_rank(&r[solver_col]),
+        )
+    });
+    table.rows = rows;
+    table.write(results)?;
+    Ok(table)
+}
+
+/// A solver's outcome: the response or why there is none, and the wall time [s].
+type Solved = (Result<Response, String>, f64);
+
+fn solve(exp: &Experiment, solver: Solver) -> Solved {
+    let started = Instant::now();
+    let result = catch_unwind(AssertUnwindSafe(|| match solver {
+        Solver::Amm => flexstar_amm::solve(exp, &exp.amm).map_err(|e| e.to_string()),
+        Solver::Fem => flexstar_fem::solve(exp, &exp.fem, None).map_err(|e| e.to_string()),
+    }));
+    let result = match result {
+        Ok(Ok(r)) => Ok(r),
+        Ok(Err(e)) => Err(format!("failed: {e}")),
+        Err(panic) => Err(format!(
+            "failed: the solver panicked: {}",
+            panic
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("(no message)")
+        )),
+    };
+    (result, started.elapsed().as_secs_f64())
+}
+
+/// Run every solver of the study on one case and make its rows (one per solver).
+pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
+    let values: Vec<String> = case.values.iter().map(value_text).collect();
+    let exp = study.experiment(&case.values);
+    let solved: Vec<(Solver, Solved)> = study
+        .solvers
+        .iter()
+        .map(|&s| {
+            let out = match &exp {
+                Ok(e) => solve(e, s),
+                Err(reason) => (Err(format!("invalid: {reason}")), 0.0),
+            };
+            (s, out)
+        })
+        .collect();
+    let response = |want: Solver| {
+        solved
+            .iter()
+            .find(|(s, _)| *s == want)
+            .and_then(|(_, (r, _))| r.as_ref().ok())
+    };
+    let evp = match (response(Solver::Amm), response(Solver::Fem)) {
+        (Some(a), Some(f)) => mean_evp(a, f),
+        _ => None,
+    };
+    let rest_from = exp.as_ref().ok().and_then(motion_end);
+    solved
+        .iter()
+        .map(|(solver, (result, wall_s))| {
+            let mut row = Row {
+                run_id: case.run_id.clone(),
+                values: values.clone(),
+                solver: solver.name().to_string(),
+                status: OK.to_string(),
+                peak_tip_m: None,
+                peak_wg_m: None,
+                peak_fa_n: None,
+                evp_percent: None,
+                wall_s: *wall_s,
+                residual_tip_m: None,
+                modes: None,
+                error_estimate_percent: None,
+            };
+            match result {
+                Ok(r) => {
+                    let p = peaks(r);
+                    row.peak_tip_m = Some(p.tip_m);
+                    row.peak_wg_m = Some(p.w_g_m);
+                    row.peak_fa_n = Some(p.fa_n);
+                    row.evp_percent = if *solver == Solver::Amm { evp } else { None };
+                    row.residual_tip_m = rest_from.map(|t| residual_tip(r, t));
+                    row.modes = r.info.modes;
+                    row.error_estimate_percent = r.info.error_estimate_percent;
+                }
+                Err(reason) => row.status = reason.replace(['\n', '\r'], " "),
+            }
+            row
+        })
+        .collect()
+}

@@ -1,0 +1,408 @@
+//! Study files (TOML): a base experiment, the solvers, and the keys to vary.
+//!
+//! ```toml
+//! name = "sleeve-study"
+//! base = "case3.toml"              # an experiment, path relative to the study file
+//! solvers = ["amm"]                # any of "amm", "fem" (default ["amm"])
+//! [[vary]]
+//! key = "robot.Lp"                 # any experiment key, or scale.duration
+//! values = [0.02, 0.03, 0.04]
+//! [[vary]]
+//! key = "robot.Jp"
+//! linspace = [1e-4, 4e-4, 4]       # n points from a to b; or logspace = [a, b, n] (geometric)
+//! # sampling = "grid" (default, full factorial) or "lhs" with samples = 200 and seed = 1
+//! ```
+//! Unknown keys are rejected; every error names the study file, the key and the reason.
+
+use std::path::{Path, PathBuf};
+
+use flexstar_model::{Experiment, ModelError};
+use serde::Deserialize;
+
+use crate::error::StudyError;
+use crate::hash::hex64;
+use crate::patch::{self, SCALE_DURATION};
+
+/// Largest number of cases a study may expand to.
+pub const MAX_CASES: usize = 100_000_000;
+
+/// A solver run on every case.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Solver {
+    /// The assumed-modes model, `flexstar_amm::solve` with the case's `[amm]` settings.
+    Amm,
+    /// The finite-element reference, `flexstar_fem::solve` with the case's `[fem]` settings.
+    Fem,
+}
+
+impl Solver {
+    /// Name in study files and in the `solver` column.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Solver::Amm => "amm",
+            Solver::Fem => "fem",
+        }
+    }
+}
+
+/// The levels of one varied key.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Levels {
+    /// Listed values, any TOML type (numbers, strings such as mode families, arrays).
+    Values(Vec<toml::Value>),
+    /// `linspace = [a, b, n]`: n equally spaced points from a to b (integers when a and b are
+    /// integers and every point is one).
+    Linspace { a: f64, b: f64, n: usize, integer: bool },
+    /// `logspace = [a, b, n]`: n geometrically spaced points from a to b (both > 0).
+    Logspace { a: f64, b: f64, n: usize },
+}
+
+/// One `[[vary]]` entry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Vary {
+    /// Dotted experiment key (`robot.Lp`, `trajectory.to.Gx`, ...) or [`SCALE_DURATION`].
+    pub key: String,
+    pub levels: Levels,
+}
+
+/// How the cases are drawn from the levels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sampling {
+    /// Full factorial: every combination of levels, the first key varying slowest.
+    Grid,
+    /// Latin hypercube: `samples` points; each key's range (linspace/logspace bounds, uniform or
+    /// log-uniform; or its list of values) is cut into `samples` equal strata, each used once.
+    Lhs { samples: usize, seed: u64 },
+}
+
+/// A validated study.
+#[derive(Debug, Clone)]
+pub struct Study {
+    /// The study file.
+    pub file: PathBuf,
+    /// Name; results go to `<out>/<name>/`.
+    pub name: String,
+    pub description: String,
+    /// The base experiment file (resolved against the study file's folder).
+    pub base_file: PathBuf,
+    /// The base experiment as a TOML document, patched per case.
+    pub base: toml::Table,
+    /// The base experiment, validated.
+    pub base_experiment: Experiment,
+    pub solvers: Vec<Solver>,
+    pub vary: Vec<Vary>,
+    pub sampling: Sampling,
+    /// FNV-1a hash of the study file and the base file (bytes): shards and resumed tables must
+    /// carry the same one.
+    pub hash: String,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StudyFile {
+    name: String,
+    #[serde(default)]
+    description: String,
+    base: PathBuf,
+    #[serde(default = "default_solvers")]
+    solvers: Vec<String>,
+    vary: Vec<VaryFile>,
+    sampling: Option<String>,
+    samples: Option<usize>,
+    seed: Option<u64>,
+}
+
+fn default_solvers() -> Vec<String> {
+    vec!["amm".into()]
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct VaryFile {
+    key: String,
+    values: Option<Vec<toml::Value>>,
+    linspace: Option<Vec<toml::Value>>,
+    logspace: Option<Vec<toml::Value>>,
+}
+
+impl Study {
+    /// Read, parse and validate a study file and its base experiment; every `[[vary]]` key is
+    /// checked against the experiment format ([`Study::check_keys`]).
+    pub fn load(path: &Path) -> Result<Study, StudyError> {
+        let text = std::fs::read_to_string(path).map_err(|source| StudyError::Read {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        let raw: StudyFile = toml::from_str(&text).map_err(|e| StudyError::Parse {
+            file: path.to_path_buf(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        let name = check_name(path, &raw.name)?;
+        let base_file = path.parent().unwrap_or(Path::new("")).join(&raw.base);
+        let base_text = std::fs::read_to_string(&base_file).map_err(|source| StudyError::Base {
+            study: path.to_path_buf(),
+            source: ModelError::Read {
+                file: base_file.clone(),
+                source,
+            },
+        })?;
+        let base_experiment = Experiment::from_toml_str(&base_text, &base_file).map_err(|source| StudyError::Base {
+            study: path.to_path_buf(),
+            source,
+        })?;
+        let base: toml::Table = base_text.parse().map_err(|e: toml::de::Error| StudyError::Base {
+            study: path.to_path_buf(),
+            source: ModelError::Parse {
+                file: base_file.clone(),
+                message: e.to_string(),
+            },
+        })?;
+        let study = Study {
+            file: path.to_path_buf(),
+            name,
+            description: raw.description,
+            base_file,
+            base,
+            base_experiment,
+            solvers: solvers(path, &raw.solvers)?,
+            vary: raw.vary.into_iter().map(|v| vary(path, v)).collect::<Result<_, _>>()?,
+            sampling: sampling(path, raw.sampling.as_deref(), raw.samples, raw.seed)?,
+            hash: hex64(format!("{text}\0{base_text}").as_bytes()),
+        };
+        study.check_shape()?;
+        study.check_keys()?;
+        Ok(study)
+    }
+
+    /// The varied keys in the study's order (the columns after `run_id`).
+    pub fn keys(&self) -> Vec<String> {
+        self.vary.iter().map(|v| v.key.clone()).collect()
+    }
+
+    /// At least one key, no key twice, and not more than [`MAX_CASES`] cases.
+    fn check_shape(&self) -> Result<(), StudyError> {
+        if self.vary.is_empty() {
+            return Err(StudyError::invalid(
+                &self.file,
+                "vary",
+                "a study needs at least one [[vary]] entry",
+            ));
+        }
+        for (i, v) in self.vary.iter().enumerate() {
+            if self.vary[..i].iter().any(|w| w.key == v.key) {
+                return Err(self.vary_error(&v.key, "the key is varied twice"));
+            }
+        }
+        let count = match self.sampling {
+            Sampling::Lhs { samples, .. } => Some(samples),
+            Sampling::Grid => self
+                .vary
+                .iter()
+                .try_fold(1usize, |acc, v| acc.checked_mul(v.grid_values().len())),
+        };
+        match count {
+            Some(c) if c <= MAX_CASES => Ok(()),
+            _ => Err(StudyError::invalid(
+                &self.file,
+                "vary",
+                format!("the study expands to more than {MAX_CASES} cases"),
+            )),
+        }
+    }
+
+    /// Check every `[[vary]]` key once, before any run: each probe value of the key (every listed
+    /// value; the bounds of a range) is patched alone into the base experiment and parsed by the
+    /// experiment loader. A key the loader does not know, or a value of the wrong type, is an
+    /// error naming the study file and the key; a value the loader parses but refuses (out of
+    /// range, infeasible motion) is not: those cases become rows with their reason.
+    pub fn check_keys(&self) -> Result<(), StudyError> {
+        for v in &self.vary {
+            for value in v.probe_values() {
+                let doc = patch::case_document(&self.base, std::slice::from_ref(&v.key), std::slice::from_ref(&value))
+                    .map_err(|reason| self.vary_error(&v.key, reason))?;
+                let text = toml::to_string(&doc).map_err(|e| self.vary_error(&v.key, e.to_string()))?;
+                if let Err(ModelError::Parse { message, .. }) = Experiment::from_toml_str(&text, &self.base_file) {
+                    return Err(self.vary_error(
+                        &v.key,
+                        format!(
+                            "not accepted by the experiment format of {} with value {}: {}",
+                            self.base_file.display(),
+                            patch::value_text(&value),
+                            parse_reason(&message)
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn vary_error(&self, key: &str, reason: impl Into<String>) -> StudyError {
+        StudyError::VaryKey {
+            file: self.file.clone(),
+            key: key.to_string(),
+            reason: reason.into(),
+        }
+    }
+
+    /// The experiment of one case: the base document with the case's values patched in, parsed
+    /// and validated by the experiment loader. Errors (a bad value, an infeasible motion) are
+    /// returned as text for the case's `status`.
+    pub fn experiment(&self, values: &[toml::Value]) -> Result<Experiment, String> {
+        let doc = patch::case_document(&self.base, &self.keys(), values)?;
+        let text = toml::to_string(&doc).map_err(|e| e.to_string())?;
+        Experiment::from_toml_str(&text, &self.base_file).map_err(|e| e.to_string())
+    }
+}
+
+/// The line of a TOML parse message that says why (the message also quotes the patched document).
+fn parse_reason(message: &str) -> String {
+    message
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('|') && !l.starts_with("-->") && !l.starts_with("TOML parse error"))
+        .filter(|l| !l.chars().next().is_some_and(|c| c.is_ascii_digit()))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn check_name(file: &Path, name: &str) -> Result<String, StudyError> {
+    let ok = !name.is_empty()
+        && !name.starts_with('.')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_' || c == '.');
+    if ok {
+        Ok(name.to_string())
+    } else {
+        Err(StudyError::invalid(
+            file,
+            "name",
+            format!("must be a non-empty file name of letters, digits, '-', '_', '.', got {name:?}"),
+        ))
+    }
+}
+
+fn solvers(file: &Path, names: &[String]) -> Result<Vec<Solver>, StudyError> {
+    if names.is_empty() {
+        return Err(StudyError::invalid(
+            file,
+            "solvers",
+            "name at least one solver: \"amm\", \"fem\"",
+        ));
+    }
+    let mut out = Vec::new();
+    for n in names {
+        let s = match n.as_str() {
+            "amm" => Solver::Amm,
+            "fem" => Solver::Fem,
+            other => {
+                return Err(StudyError::invalid(
+                    file,
+                    "solvers",
+                    format!("unknown solver `{other}`: expected \"amm\" or \"fem\""),
+                ))
+            }
+        };
+        if out.contains(&s) {
+            return Err(StudyError::invalid(file, "solvers", format!("`{n}` is listed twice")));
+        }
+        out.push(s);
+    }
+    Ok(out)
+}
+
+fn sampling(
+    file: &Path,
+    kind: Option<&str>,
+    samples: Option<usize>,
+    seed: Option<u64>,
+) -> Result<Sampling, StudyError> {
+    match kind.unwrap_or("grid") {
+        "grid" => {
+            if samples.is_some() || seed.is_some() {
+                return Err(StudyError::invalid(
+                    file,
+                    if samples.is_some() { "samples" } else { "seed" },
+                    "used with sampling = \"lhs\" only",
+                ));
+            }
+            Ok(Sampling::Grid)
+        }
+        "lhs" => match samples {
+            Some(n) if n >= 1 => Ok(Sampling::Lhs {
+                samples: n,
+                seed: seed.unwrap_or(1),
+            }),
+            _ => Err(StudyError::invalid(
+                file,
+                "samples",
+                "sampling = \"lhs\" needs samples >= 1",
+            )),
+        },
+        other => Err(StudyError::invalid(
+            file,
+            "sampling",
+            format!("unknown sampling `{other}`: expected \"grid\" or \"lhs\""),
+        )),
+    }
+}
+
+fn vary(file: &Path, v: VaryFile) -> Result<Vary, StudyError> {
+    let err = |reason: String| StudyError::VaryKey {
+        file: file.to_path_buf(),
+        key: v.key.clone(),
+        reason,
+    };
+    let key_ok = !v.key.is_empty() && v.key.split('.').all(|p| !p.is_empty()) && v.key.contains('.');
+    if !key_ok {
+        return Err(err(
+            "a key is a dotted experiment key such as robot.Lp or time.t_end, or scale.duration".into(),
+        ));
+    }
+    if v.key.starts_with("scale.") && v.key != SCALE_DURATION {
+        return Err(err(format!("the only scale key is {SCALE_DURATION}")));
+    }
+    let levels = match (v.values, v.linspace, v.logspace) {
+        (Some(values), None, None) => {
+            if values.is_empty() {
+                return Err(err("empty range: `values` lists no value".into()));
+            }
+            Levels::Values(values)
+        }
+        (None, Some(r), None) => {
+            let (a, b, n) = range(&r).map_err(|m| err(format!("linspace = [a, b, n]: {m}")))?;
+            let integer = r[0].is_integer() && r[1].is_integer();
+            Levels::Linspace { a, b, n, integer }
+        }
+        (None, None, Some(r)) => {
+            let (a, b, n) = range(&r).map_err(|m| err(format!("logspace = [a, b, n]: {m}")))?;
+            if a <= 0.0 || b <= 0.0 {
+                return Err(err(format!(
+                    "logspace = [a, b, n] needs a > 0 and b > 0, got a = {a}, b = {b}"
+                )));
+            }
+            Levels::Logspace { a, b, n }
+        }
+        _ => return Err(err("give exactly one of values, linspace or logspace".into())),
+    };
+    Ok(Vary { key: v.key, levels })
+}
+
+fn range(r: &[toml::Value]) -> Result<(f64, f64, usize), String> {
+    if r.len() != 3 {
+        return Err(format!("three entries expected, got {}", r.len()));
+    }
+    let num = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+    let (Some(a), Some(b)) = (num(&r[0]), num(&r[1])) else {
+        return Err("a and b must be numbers".into());
+    };
+    if !a.is_finite() || !b.is_finite() {
+        return Err(format!("a and b must be finite, got {a}, {b}"));
+    }
+    match r[2].as_integer() {
+        Some(n) if n >= 1 => Ok((a, b, n as usize)),
+        Some(n) => Err(format!("empty range: n = {n}, need n >= 1")),
+        None => Err(format!("n must be a whole number, got {}", r[2])),
+    }
+}

@@ -25,5 +25,25 @@ fn paper_cases(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, paper_cases);
+/// Issue 9 item 5: one paper case with the defaults (enriched family, full model, automatic N at
+/// tol 0.5 %: runs at N = 40, 46, 53), target at most 20 ms on one core; and one run at the N the
+/// defaults settle on.
+fn accurate_model(c: &mut Criterion) {
+    let mut group = c.benchmark_group("amm_accurate_defaults");
+    group.sample_size(10);
+    for case in [3, 1, 2, 4] {
+        let exp = common::paper_case(case);
+        let settings = flexstar_model::AmmSettings::accurate();
+        group.bench_function(format!("case{case}_auto"), |b| b.iter(|| solve(&exp, &settings).unwrap()));
+    }
+    let exp = common::paper_case(3);
+    let fixed = flexstar_model::AmmSettings {
+        modes: Some(53),
+        ..flexstar_model::AmmSettings::accurate()
+    };
+    group.bench_function("case3_n53", |b| b.iter(|| solve(&exp, &fixed).unwrap()));
+    group.finish();
+}
+
+criterion_group!(benches, paper_cases, accurate_model);
 criterion_main!(benches);

@@ -10,7 +10,7 @@ pub enum AmmError {
     #[error("amm: key `{key}`: {reason}")]
     InvalidSetting { key: String, reason: String },
     /// A mode-family name that is not one of the four known families.
-    #[error("amm: unknown mode family `{0}`: expected pinned-free, slide-free, free-free or clamped-free")]
+    #[error("amm: unknown mode family `{0}`: expected pinned-free, slide-free, free-free, clamped-free or enriched")]
     UnknownFamily(String),
     /// The experiment itself is invalid (robot, time span or trajectory).
     #[error("amm: {0}")]

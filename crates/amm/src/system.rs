@@ -114,6 +114,9 @@ pub(crate) struct System {
     /// Full model: u_i-gradients of the rows Fp_i, FR_i, FL_i at the last solve (`-w'` at the
     /// material point in the sleeve; 0 in the paper's model): the axial direction of their forces.
     pub(crate) sleeve_axial: [[f64; 3]; 3],
+    /// Full model: the axial acceleration u_i'' of each beam at the last solve, part of the axial
+    /// inertia force of Eq. 23 (the whole axially rigid beam accelerates with it).
+    udd: [f64; 3],
     // arrowhead data of S (the same for the three beams)
     inv_d: Vec<f64>,
     w: Vec<f64>,
@@ -232,6 +235,7 @@ impl System {
             g1,
             g2,
             sleeve_axial: [[0.0; 3]; 3],
+            udd: [0.0; 3],
             nm,
             nb,
             rho: params.rho,
@@ -398,7 +402,7 @@ impl System {
             r[nm + 1] = -self.jp * thdd;
             if self.model == AmmModel::Full {
                 // Eq. 23: - rho (th'^2 G1 - a_x G2) alpha, at the predictor (docs/amm.md section 8)
-                let (c1, c2) = (rho * thd * thd, -rho * ax);
+                let (c1, c2) = (rho * thd * thd, -rho * (ax + self.udd[i]));
                 let rows = self.g1.chunks_exact(nm).zip(self.g2.chunks_exact(nm));
                 for (rj, (row1, row2)) in r[..nm].iter_mut().zip(rows) {
                     *rj -= c1 * dot(row1, qa) + c2 * dot(row2, qa);
@@ -529,6 +533,7 @@ impl System {
         }
         for i in 0..3 {
             self.arrow_solve(&mut qdd[i * nb..(i + 1) * nb]);
+            self.udd[i] = qdd[i * nb + nm];
         }
         Ok(())
     }

@@ -160,14 +160,27 @@ fn energy_balance_holds_at_paper_stiffness() {
         assert!(wmax > 1e-3, "the drivers must do work");
         let energy =
             |k: usize| col(&r, "Ek_star")[k] + col(&r, "Ek_sleeves")[k] + col(&r, "Ek_sliders")[k] + col(&r, "U")[k];
+        // the error is bounded against the strain energy, the smallest part of the balance (0.2-1 %
+        // of the work), so that a defect in the elastic terms cannot hide in the rigid ones
+        let umax = max_abs(col(&r, "U"));
+        assert!(
+            umax > 1e-4 * wmax,
+            "the elastic energy must be a real part of the balance"
+        );
         let mut worst: f64 = 0.0;
         for k in 0..r.len() {
-            worst = worst.max((energy(k) - energy(0) - w[k]).abs() / wmax);
+            worst = worst.max((energy(k) - energy(0) - w[k]).abs());
         }
-        eprintln!("energy balance: worst |E - W| / max W = {worst:.2e}");
-        assert!(worst < 0.02, "energy balance off by {:.3} %", worst * 100.0);
-        // the elastic energy is a real part of it (the check is not about rigid motion only)
-        assert!(max_abs(col(&r, "U")) > 1e-4 * wmax);
+        eprintln!(
+            "energy balance: worst |E - W| = {:.2e} of max W, {:.2e} of max U",
+            worst / wmax,
+            worst / umax
+        );
+        assert!(
+            worst < 1e-2 * umax,
+            "energy balance off by {:.3} % of the strain energy",
+            worst / umax * 100.0
+        );
     }
 }
 

@@ -7,7 +7,7 @@ use flexstar_model::{ModeFamily, RobotParams};
 /// Print beta*L and the natural frequency of each mode of a family (rigid modes included).
 #[derive(clap::Args)]
 pub struct Args {
-    /// Mode family: pinned-free, slide-free, free-free, clamped-free
+    /// Mode family: pinned-free, slide-free, free-free, clamped-free, enriched (its last two are the junction shapes)
     #[arg(long)]
     family: ModeFamily,
     /// Number of modes N, rigid ones included

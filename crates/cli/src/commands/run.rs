@@ -25,7 +25,7 @@ pub struct Args {
     /// Which model to run
     #[arg(long, value_enum)]
     solver: Solver,
-    /// AMM mode family (overrides [amm] family): pinned-free, slide-free, free-free, clamped-free
+    /// AMM mode family (overrides [amm] family): pinned-free, slide-free, free-free, clamped-free, enriched
     #[arg(long)]
     family: Option<ModeFamily>,
     /// AMM modes per beam N, rigid ones included (overrides [amm] modes and tol: a fixed N)

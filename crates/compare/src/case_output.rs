@@ -8,11 +8,11 @@ use std::path::Path;
 
 use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
 use flexstar_model::output::write_string_atomically;
-use flexstar_model::{small_deflection_check, Experiment, Provenance, Response, ValidityExceeded};
+use flexstar_model::{small_deflection_check, Experiment, ModeFamily, Provenance, Response, ValidityExceeded};
 use serde::Serialize;
 
 use crate::figures::{
-    figure_forces, figure_star, figure_tips, figure_w_g, Figure, Run, Style, FAMILY_COLORS, FEM_STYLE,
+    figure_forces, figure_star, figure_tips, figure_w_g, Figure, Run, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE,
 };
 use crate::runs::CaseResults;
 use crate::table::{opt_number, TableRow};
@@ -58,9 +58,18 @@ pub fn validity_warnings(exp: &Experiment, case: &CaseResults) -> Vec<ValidityWa
         .collect()
 }
 
-fn run_style(k: usize) -> Style {
+/// The colour of a family (the same in every figure); a second run of a family already drawn
+/// takes the next of [`EXTRA_COLORS`].
+fn run_style(family: ModeFamily, used: &mut Vec<ModeFamily>) -> Style {
+    let k = ModeFamily::ALL.iter().position(|f| *f == family).unwrap_or(0);
+    let repeats = used.iter().filter(|f| **f == family).count();
+    used.push(family);
+    let color = match repeats {
+        0 => FAMILY_COLORS[k % FAMILY_COLORS.len()],
+        n => EXTRA_COLORS[(n - 1) % EXTRA_COLORS.len()],
+    };
     Style {
-        color: FAMILY_COLORS[k % FAMILY_COLORS.len()],
+        color,
         width: 2,
         dashed: false,
     }
@@ -74,11 +83,12 @@ pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>,
         response: &case.fem,
         style: FEM_STYLE,
     }];
-    for (k, (run, r)) in case.amm.iter().enumerate() {
+    let mut used = Vec::new();
+    for (run, r) in &case.amm {
         runs.push(Run {
             label: format!("AMM {}", run.label),
             response: r,
-            style: run_style(k),
+            style: run_style(run.settings.family, &mut used),
         });
     }
     let kin = |t: f64| {

@@ -72,12 +72,18 @@ pub const RIGID_STYLE: Style = Style {
     width: 1,
     dashed: true,
 };
-pub const FAMILY_COLORS: [RGBColor; 4] = [
+/// One colour per mode family, in the order of `ModeFamily::ALL` (pinned-free red, slide-free
+/// blue, free-free green, clamped-free purple, enriched orange), so that a family has the same
+/// colour in every figure and report.
+pub const FAMILY_COLORS: [RGBColor; 5] = [
     RGBColor(214, 39, 40),
     RGBColor(31, 119, 180),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
 ];
+/// Colours for further runs of a family already drawn (e.g. the same family at another N).
+pub const EXTRA_COLORS: [RGBColor; 3] = [RGBColor(140, 86, 75), RGBColor(227, 119, 194), RGBColor(23, 190, 207)];
 
 static FONT: Once = Once::new();
 

@@ -4,9 +4,17 @@
 verify out="out/verify":
     cargo run --release --bin flexstar -- verify --out {{out}}
 
-# The whole test suite (what CI runs).
+# AMM against FEM on your experiment: figures, EVPs and a report in out/<name>/.
+compare config *flags:
+    cargo run --release --bin flexstar -- compare {{config}} {{flags}}
+
+# Install the flexstar binary (release build in ./target, shared with `just test`).
+install:
+    cargo install --locked --path crates/cli
+
+# The whole test suite (what CI runs: the README's test command, release profile).
 test:
-    cargo test --workspace
+    cargo test --workspace --release
 
 # Criterion benchmarks of the solvers.
 bench:

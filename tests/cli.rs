@@ -167,7 +167,10 @@ fn run_refuses_bad_settings_before_any_work() {
         (&["--solver", "amm", "--family", "hinged-free"], "hinged-free"),
         (&["--solver", "amm", "--modes", "0"], "amm.modes"),
         (&["--solver", "amm", "--modes", "100000"], "amm.modes"),
-        (&["--solver", "amm", "--dt", "0.01"], "output interval"),
+        (
+            &["--solver", "amm", "--dt", "0.01"],
+            "short.toml: key `--dt`: the step 0.01 s is larger than the output interval",
+        ),
         (&["--solver", "fem", "--elements", "301"], "fem.elements"),
     ];
     for (args, needle) in cases {
@@ -209,9 +212,213 @@ fn every_subcommand_has_help() {
         vec!["run", "--help"],
         vec!["modes", "--help"],
         vec!["verify", "--help"],
+        vec!["compare", "--help"],
     ] {
         let o = flexstar(&sub);
         assert!(o.status.success());
         assert!(String::from_utf8_lossy(&o.stdout).contains("Usage"));
     }
+}
+
+/// case1 shortened to 0.05 s with a small mesh and N = 12, written into `dir` as `name`.
+fn small_case1(dir: &Path, name: &str) -> String {
+    let text = case1_with("t_end = 0.5", "t_end = 0.05")
+        .replace("elements = 300", "elements = 108")
+        .replace("modes = 25", "modes = 12");
+    write(dir, name, &text)
+}
+
+#[test]
+fn compare_writes_its_outputs_for_any_experiment() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_case1(dir.path(), "mine.toml");
+    let out = dir.path().join("out");
+    let o = flexstar(&[
+        "compare",
+        &cfg,
+        "--families",
+        "free-free,slide-free",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let case = out.join("case1");
+    let csv = std::fs::read_to_string(case.join("compare.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next().unwrap(), "model,evp_A,evp_B,evp_C,evp_G,evp_mean");
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // the config's own family first, then the families asked
+    let models: Vec<&str> = rows.iter().map(|r| r[0]).collect();
+    assert_eq!(models, ["amm-pinned-free", "amm-free-free", "amm-slide-free"]);
+    for r in &rows {
+        // case 1 is symmetric: G does not move in the FEM, so its EVP is n/a as in Table I
+        assert_eq!(r[4], "n/a", "{r:?}");
+        for v in [r[1], r[2], r[3], r[5]] {
+            assert!(v.parse::<f64>().unwrap() >= 0.0, "{r:?}");
+        }
+    }
+    for f in [
+        "compare.md",
+        "compare.json",
+        "report.html",
+        "fem.csv",
+        "fem.json",
+        "amm-slide-free.csv",
+        "amm-slide-free.json",
+        "figures/case1-tips.svg",
+        "figures/case1-forces.png",
+    ] {
+        assert!(case.join(f).exists(), "{f} missing");
+    }
+    let sidecar = std::fs::read_to_string(case.join("fem.json")).unwrap();
+    for key in [
+        "\"flexstar_version\"",
+        "\"commit\"",
+        "\"date\"",
+        "\"small_deflection\": null",
+        "\"wall_s\"",
+    ] {
+        assert!(sidecar.contains(key), "{key} missing in {sidecar}");
+    }
+    let html = std::fs::read_to_string(case.join("report.html")).unwrap();
+    assert!(
+        !html.contains("paper's"),
+        "no paper wording in a report of the user's experiment"
+    );
+    assert!(html.contains("<figcaption>") && html.contains("href=\"fem.csv\""));
+}
+
+#[cfg(unix)]
+#[test]
+fn output_files_have_normal_permissions_and_exact_numbers() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_case1(dir.path(), "mine.toml");
+    let out = dir.path().join("out");
+    let o = flexstar(&["run", &cfg, "--solver", "amm", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = flexstar(&["kinematics", &cfg, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // what File::create gives in the same place under the test's umask
+    let reference = out.join("case1").join("reference");
+    std::fs::File::create(&reference).unwrap();
+    let want = std::fs::metadata(&reference).unwrap().permissions().mode() & 0o777;
+    for f in [
+        "amm-pinned-free.csv",
+        "amm-pinned-free.json",
+        "amm-pinned-free-shapes.csv",
+        "kinematics.csv",
+    ] {
+        let mode = std::fs::metadata(out.join("case1").join(f))
+            .unwrap()
+            .permissions()
+            .mode()
+            & 0o777;
+        assert_eq!(mode, want, "{f}: {mode:o} instead of {want:o}");
+    }
+    for f in ["amm-pinned-free.csv", "kinematics.csv"] {
+        let text = std::fs::read_to_string(out.join("case1").join(f)).unwrap();
+        for field in text.lines().skip(1).flat_map(|l| l.split(',')) {
+            assert!(!field.starts_with("-0") || field.starts_with("-0."), "{f}: {field}");
+            let v: f64 = field.parse().unwrap();
+            assert!(v != 0.0 || field == "0", "{f}: zero written as {field}");
+            // shortest exact form: no shorter spelling of the same value
+            assert!(
+                field.len() <= format!("{v:e}").len() && field.len() <= format!("{v}").len(),
+                "{f}: {field}"
+            );
+        }
+    }
+}
+
+#[test]
+fn compare_refuses_bad_input_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let good = small_case1(dir.path(), "mine.toml");
+    let bad_key = write(dir.path(), "bad.toml", &case1_with("Lp = 0.03", "Lp = 0.03\nLq = 1.0"));
+    let long2 = write(
+        dir.path(),
+        "case2-long.toml",
+        &std::fs::read_to_string(config("case2.toml"))
+            .unwrap()
+            .replace("t_end = 0.4", "t_end = 0.5"),
+    );
+    let cases: [(&[&str], &[&str]); 4] = [
+        (&[bad_key.as_str()], &["bad.toml", "Lq"]),
+        (
+            &[good.as_str(), "--modes", "0"],
+            &["mine.toml", "--modes 0", "amm.modes"],
+        ),
+        (&[long2.as_str()], &["case2-long.toml", "t = 0.43", "sleeve 2"]),
+        (&[good.as_str(), "--families", "hinged-free"], &["hinged-free"]),
+    ];
+    for (args, needles) in cases {
+        let mut all = vec!["compare"];
+        all.extend(args.iter().copied());
+        all.extend(["--out", out_s]);
+        let o = flexstar(&all);
+        assert!(!o.status.success(), "{args:?} accepted");
+        for n in needles {
+            assert!(stderr(&o).contains(n), "{args:?}: missing {n:?} in {}", stderr(&o));
+        }
+        assert!(!out.exists(), "{args:?}: output written");
+    }
+    // --out names a file: refused before any solve, the file untouched
+    let file = write(dir.path(), "not-a-dir", "keep");
+    let started = std::time::Instant::now();
+    let o = flexstar(&["compare", &good, "--out", &file]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("not-a-dir"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "keep");
+    let o2 = flexstar(&["run", &good, "--solver", "fem", "--out", &file]);
+    assert!(
+        !o2.status.success() && stderr(&o2).contains("not-a-dir"),
+        "{}",
+        stderr(&o2)
+    );
+    eprintln!("refusals took {:.2} s", started.elapsed().as_secs_f64());
+}
+
+#[test]
+fn verify_runs_from_any_directory_with_its_built_in_cases() {
+    // from an empty directory, with --out naming a file: the built-in cases and thresholds load
+    // (no "configs/... not found") and the output check refuses before any solve
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "a-file", "x");
+    let o = Command::new(env!("CARGO_BIN_EXE_flexstar"))
+        .args(["verify", "--out", &file])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let msg = stderr(&o);
+    assert!(msg.contains("a-file") && msg.contains("not a directory"), "{msg}");
+    assert!(!msg.contains("thresholds.toml: cannot"), "{msg}");
+}
+
+#[test]
+fn small_deflection_range_is_reported_with_the_time() {
+    // s_i = 50 t^2 for 0.07 s: tips reach 40 % of L, far outside linear beam theory
+    let dir = tempfile::tempdir().unwrap();
+    let text = case1_with("t_end = 0.5", "t_end = 0.07")
+        .replace("s1 = [0.0, 0.0, 1.0]", "s1 = [0.0, 0.0, 50.0]")
+        .replace("s2 = [0.0, 0.0, 1.0]", "s2 = [0.0, 0.0, 50.0]")
+        .replace("s3 = [0.0, 0.0, 1.0]", "s3 = [0.0, 0.0, 50.0]")
+        .replace("modes = 25", "modes = 12");
+    let cfg = write(dir.path(), "fast.toml", &text);
+    let out = dir.path().join("out");
+    let o = flexstar(&["run", &cfg, "--solver", "amm", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let msg = stderr(&o);
+    assert!(
+        msg.contains("warning: ") && msg.contains("fast.toml") && msg.contains("small-deflection"),
+        "{msg}"
+    );
+    let sidecar = std::fs::read_to_string(out.join("case1").join("amm-pinned-free.json")).unwrap();
+    assert!(
+        sidecar.contains("\"quantity\": \"|w1tip| / L\"") && sidecar.contains("\"bound\": 0.05"),
+        "{sidecar}"
+    );
 }

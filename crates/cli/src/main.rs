@@ -4,6 +4,7 @@
 //! files. Exit code 0 on success, 1 on any error (with the reason on stderr).
 
 mod commands;
+mod progress;
 
 use clap::{Parser, Subcommand};
 
@@ -26,6 +27,8 @@ enum Command {
     Run(commands::run::Args),
     /// List the assumed modes of a family: beta*L and natural frequency per mode
     Modes(commands::modes::Args),
+    /// Compare the AMM with the FEM on any experiment: EVPs, figures, report in DIR/<name>/
+    Compare(commands::compare::Args),
     /// Reproduce and check Table I: four cases, three families, FEM; table, figures, report
     Verify(commands::verify::Args),
     /// Design studies: sweep experiment keys over a grid or a Latin hypercube, in parallel or in
@@ -39,6 +42,7 @@ fn main() -> std::process::ExitCode {
         Command::Kinematics(args) => commands::kinematics::run(args),
         Command::Run(args) => commands::run::run(args),
         Command::Modes(args) => commands::modes::run(args),
+        Command::Compare(args) => commands::compare::run(args),
         Command::Verify(args) => commands::verify::run(args),
         Command::Sweep(args) => commands::sweep::run(args),
     };

@@ -2,7 +2,7 @@
 //! "actual behaviour of point G"), and which mode families can represent it.
 //!
 //! A family is *correct* when its boundary conditions at G can represent the actual behaviour
-//! (MODEL-NOTES section 5): pinned-free forces `w_G = 0`, slide-free forces a zero slope at G,
+//! (docs/paper-defects.md, Table I): pinned-free forces `w_G = 0`, slide-free forces a zero slope at G,
 //! free-free forces neither (only zero moment and shear, which the junction constraints relax).
 
 use flexstar_model::{ModeFamily, Response};
@@ -96,7 +96,7 @@ mod tests {
 
     #[test]
     fn verdict_rules_of_the_paper() {
-        // MODEL-NOTES section 5: the marks of the paper's text for the three behaviours.
+        // docs/paper-defects.md, Table I: the marks of the paper's text for the three behaviours.
         use Behaviour::*;
         use ModeFamily::*;
         assert!(is_correct(PinnedFree, Pinned) && !is_correct(SlideFree, Pinned) && is_correct(FreeFree, Pinned));

@@ -10,6 +10,7 @@ use flexstar_kinematics::RigidState;
 use flexstar_model::Response;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// A figure could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
@@ -49,10 +50,13 @@ pub struct Panel {
     pub min_y_span: f64,
 }
 
-/// A figure: panels side by side, a caption on top.
+/// A figure: a title and one legend strip on top (outside every plot area, so that it never
+/// covers data), panels side by side below; `caption` is the one or two sentences saying what to
+/// look at, shown under the figure in the report and in `compare.md`.
 #[derive(Debug, Clone)]
 pub struct Figure {
     pub name: String,
+    pub title: String,
     pub caption: String,
     pub panels: Vec<Panel>,
 }
@@ -68,12 +72,18 @@ pub const RIGID_STYLE: Style = Style {
     width: 1,
     dashed: true,
 };
-pub const FAMILY_COLORS: [RGBColor; 4] = [
+/// One colour per mode family, in the order of `ModeFamily::ALL` (pinned-free red, slide-free
+/// blue, free-free green, clamped-free purple, enriched orange), so that a family has the same
+/// colour in every figure and report.
+pub const FAMILY_COLORS: [RGBColor; 5] = [
     RGBColor(214, 39, 40),
     RGBColor(31, 119, 180),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
 ];
+/// Colours for further runs of a family already drawn (e.g. the same family at another N).
+pub const EXTRA_COLORS: [RGBColor; 3] = [RGBColor(140, 86, 75), RGBColor(227, 119, 194), RGBColor(23, 190, 207)];
 
 static FONT: Once = Once::new();
 
@@ -91,19 +101,35 @@ pub fn register_font() {
 
 const PANEL_W: u32 = 520;
 const PANEL_H: u32 = 400;
-const CAPTION_H: u32 = 40;
+const CAPTION_H: u32 = 36;
+const LEGEND_H: u32 = 28;
 
 impl Figure {
     pub fn size(&self) -> (u32, u32) {
-        (PANEL_W * self.panels.len().max(1) as u32, PANEL_H + CAPTION_H)
+        (
+            PANEL_W * self.panels.len().max(1) as u32,
+            PANEL_H + CAPTION_H + LEGEND_H,
+        )
+    }
+
+    /// Legend entries: every labelled series once, in order of appearance.
+    pub fn legend(&self) -> Vec<(String, Style)> {
+        let mut v: Vec<(String, Style)> = Vec::new();
+        for s in self.panels.iter().flat_map(|p| &p.series) {
+            if !s.label.is_empty() && !v.iter().any(|(l, _)| *l == s.label) {
+                v.push((s.label.clone(), s.style));
+            }
+        }
+        v
     }
 
     /// Draw on any plotters backend.
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String> {
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let (top, body) = root.split_vertically(CAPTION_H);
-        top.titled(&self.caption, ("sans-serif", 18))
-            .map_err(|e| e.to_string())?;
+        let (top, rest) = root.split_vertically(CAPTION_H);
+        top.titled(&self.title, ("sans-serif", 18)).map_err(|e| e.to_string())?;
+        let (legend, body) = rest.split_vertically(LEGEND_H);
+        draw_legend(&legend, &self.legend())?;
         let areas = body.split_evenly((1, self.panels.len().max(1)));
         for (panel, area) in self.panels.iter().zip(areas) {
             draw_panel(panel, &area)?;
@@ -137,10 +163,7 @@ impl Figure {
             .map_err(|e| err(e.to_string()))?;
         // PNG: drawn into a temporary file beside the target, renamed when complete
         let png = dir.join(format!("{}.png", self.name));
-        let tmp = tempfile::Builder::new()
-            .suffix(".png")
-            .tempfile_in(dir)
-            .map_err(|e| err(e.to_string()))?;
+        let tmp = flexstar_model::output::temp_file_in(dir, ".png").map_err(|e| err(e.to_string()))?;
         {
             let root = BitMapBackend::new(tmp.path(), self.size()).into_drawing_area();
             self.draw(root).map_err(err)?;
@@ -148,6 +171,51 @@ impl Figure {
         tmp.persist(&png).map_err(|e| err(e.to_string()))?;
         Ok(())
     }
+}
+
+/// One row of legend entries, centred: a line sample in the run's style, then its label.
+fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &[(String, Style)]) -> Result<(), String> {
+    const SAMPLE: i32 = 28;
+    const GAP: i32 = 8;
+    const SPACING: i32 = 26;
+    let font: TextStyle = ("sans-serif", 14).into_font().into();
+    let widths: Vec<i32> = entries
+        .iter()
+        .map(|(l, _)| {
+            area.estimate_text_size(l, &font)
+                .map(|(w, _)| w as i32)
+                .map_err(|e| e.to_string())
+        })
+        .collect::<Result<_, _>>()?;
+    let total: i32 = widths.iter().map(|w| SAMPLE + GAP + w).sum::<i32>() + SPACING * (entries.len() as i32 - 1).max(0);
+    let (w, h) = area.dim_in_pixel();
+    let mut x = ((w as i32 - total) / 2).max(4);
+    let y = h as i32 / 2;
+    for ((label, style), tw) in entries.iter().zip(widths) {
+        let shape = ShapeStyle {
+            color: style.color.to_rgba(),
+            filled: false,
+            stroke_width: style.width.max(2),
+        };
+        if style.dashed {
+            for k in 0..3 {
+                let x0 = x + k * 10;
+                area.draw(&PathElement::new(vec![(x0, y), (x0 + 6, y)], shape))
+                    .map_err(|e| e.to_string())?;
+            }
+        } else {
+            area.draw(&PathElement::new(vec![(x, y), (x + SAMPLE, y)], shape))
+                .map_err(|e| e.to_string())?;
+        }
+        area.draw(&Text::new(
+            label.clone(),
+            (x + SAMPLE + GAP, y),
+            font.pos(Pos::new(HPos::Left, VPos::Center)),
+        ))
+        .map_err(|e| e.to_string())?;
+        x += SAMPLE + GAP + tw + SPACING;
+    }
+    Ok(())
 }
 
 fn bounds(panel: &Panel) -> ((f64, f64), (f64, f64)) {
@@ -238,36 +306,17 @@ fn draw_panel<DB: DrawingBackend>(panel: &Panel, area: &DrawingArea<DB, Shift>) 
                 .map(|(a, b)| (*a, *b))
                 .filter(|(a, b)| a.is_finite() && b.is_finite())
                 .collect();
-        let anno = if s.style.dashed {
+        // no legend inside the plot area: the figure's legend strip names every curve
+        if s.style.dashed {
             chart
                 .draw_series(DashedLineSeries::new(pts, 6, 4, style))
-                .map_err(|e| e.to_string())?
+                .map_err(|e| e.to_string())?;
         } else {
             chart
                 .draw_series(LineSeries::new(pts, style))
-                .map_err(|e| e.to_string())?
-        };
-        if !s.label.is_empty() {
-            anno.label(s.label.as_str()).legend(move |(x, y)| {
-                PathElement::new(
-                    vec![(x, y), (x + 18, y)],
-                    ShapeStyle {
-                        color: color.to_rgba(),
-                        filled: false,
-                        stroke_width: 2,
-                    },
-                )
-            });
+                .map_err(|e| e.to_string())?;
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(180, 180, 180))
-        .label_font(("sans-serif", 12))
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(|e| e.to_string())?;
     Ok(())
 }
 
@@ -308,7 +357,11 @@ fn per_beam(runs: &[Run], title: &str, y_label: &str, pick: impl Fn(&Response, u
 pub fn figure_w_g(case: &str, runs: &[Run]) -> Figure {
     Figure {
         name: format!("{case}-wG"),
-        caption: format!("{case}: elastic displacement of G in the rigid frames x_i w_i"),
+        title: format!("{case}: elastic displacement of G in the rigid frames x_i w_i"),
+        caption: "The junction G's elastic displacement seen from each beam's rigid frame, every AMM run against \
+                  the FEM (black). Pinned-free modes hold G still (a flat zero line), so where the FEM's G moves \
+                  that family cannot follow; the EVP at G compares the length of this displacement vector."
+            .into(),
         panels: per_beam(runs, "w_G in frame", "w_iG [mm]", |r, i| scaled(&r.w_g[i], 1e3)),
     }
 }
@@ -317,7 +370,10 @@ pub fn figure_w_g(case: &str, runs: &[Run]) -> Figure {
 pub fn figure_tips(case: &str, runs: &[Run]) -> Figure {
     let mut f = Figure {
         name: format!("{case}-tips"),
-        caption: format!("{case}: elastic tip displacements w_i(L) (A, B, C)"),
+        title: format!("{case}: elastic tip displacements w_i(L) (A, B, C)"),
+        caption: "Tip deflections of the three beams, the responses behind the EVPs at A, B and C. Compare each \
+                  run's phase and amplitude with the FEM (black): a curve that drifts away from it has a large EVP."
+            .into(),
         panels: per_beam(runs, "tip of beam", "w_i(L) [mm]", |r, i| scaled(&r.w_tip[i], 1e3)),
     };
     for (p, name) in f.panels.iter_mut().zip(["A", "B", "C"]) {
@@ -341,7 +397,12 @@ pub fn figure_forces(case: &str, runs: &[Run], rigid: Option<(&[f64], &[[f64; 3]
     }
     Figure {
         name: format!("{case}-forces"),
-        caption: format!("{case}: driving forces Fa_i (Eq. 33)"),
+        title: format!("{case}: driving forces Fa_i (Eq. 33)"),
+        caption: "Actuator forces against the rigid-body inverse dynamics (grey dashed): the elastic star adds an \
+                  oscillation around the rigid curve. The FEM's forces also carry a small fast ripple (a few per \
+                  cent, 100-400 Hz): they come from the sleeve pin reactions, which feel the local bending of the \
+                  beam inside the moving sleeve, modes that the AMM's truncated basis does not hold."
+            .into(),
         panels,
     }
 }
@@ -411,7 +472,12 @@ pub fn figure_star(case: &str, runs: &[Run], rigid: &RigidState, magnify: f64) -
     deflection.push(absolute);
     Some(Figure {
         name: format!("{case}-star"),
-        caption: format!("{case}: beam shapes at t = {t:.3} s (deflection in the rigid frames; star magnified)"),
+        title: format!("{case}: beam shapes at t = {t:.3} s (deflection in the rigid frames; star magnified)"),
+        caption: format!(
+            "(a) Deflection along each beam at the end of the motion, in its rigid frame; look at G (x = 0): \
+             its value and slope show what the junction does, and at the sleeve, where the beam is held. \
+             (b) The whole star with the elastic part magnified {magnify:.0} times over the rigid star (grey dashed)."
+        ),
         panels: deflection,
     })
 }

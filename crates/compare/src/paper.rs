@@ -1,8 +1,9 @@
 //! The paper's Table I, as printed, for display beside the regenerated one.
 //!
-//! Source: paper, Table I and sections 8-9, with the two printing defects of MODEL-NOTES
-//! section 5 corrected: the case-4 row repeats case 3's numbers (so case 4 has no usable EVPs,
-//! shown as `None`) and slide-free in case 1 is incorrect according to the text.
+//! Source: paper, Table I and sections 8-9, with the two printing defects of
+//! `docs/paper-defects.md` (section "Table I") corrected: the case-4 row repeats case 3's numbers
+//! (so case 4 has no usable EVPs, shown as `None`) and slide-free in case 1 is incorrect
+//! according to the text.
 
 use flexstar_model::ModeFamily;
 
@@ -60,4 +61,20 @@ pub const PAPER_TABLE: [PaperCase; 4] = [
 /// The paper's entry for a case name, if it is one of the four.
 pub fn paper_case(name: &str) -> Option<&'static PaperCase> {
     PAPER_TABLE.iter().find(|c| c.case == name)
+}
+
+/// Where flexstar's regenerated row departs from the paper, the finding in two or three
+/// sentences (shown under Table I for the paper's own cases only; details in
+/// `docs/validation.md`).
+pub fn finding(case: &str) -> Option<&'static str> {
+    match case {
+        "case2" => Some(
+            "The paper calls G's behaviour in case 2 a slide (zero slope at G). The FEM shows the junction also \
+             turns once sleeve J nears G (peak slope_G L reaches 40 % of the largest tip deflection, as in case 1), \
+             and the free-free AMM, which can represent any junction, converges to the same slope. So only \
+             free-free is correct here; slide-free is still the most accurate at N = 25, but free-free overtakes \
+             it from N = 50 on (see the N table).",
+        ),
+        _ => None,
+    }
 }

@@ -4,43 +4,33 @@
 
 use std::fmt::Write as _;
 
-use flexstar_model::{ModeFamily, Response};
+use flexstar_model::ModeFamily;
 use serde::Serialize;
 
 use crate::behaviour::{classify, is_correct, measure, Behaviour, JunctionMeasures};
 use crate::evp::{point_evps, CompareError, PointEvps};
 use crate::paper::{paper_case, PaperCase};
+pub use crate::runs::CaseResults;
 
-/// Solver results of one case: the FEM reference and the AMM runs.
-#[derive(Debug, Clone)]
-pub struct CaseResults {
-    pub name: String,
-    pub description: String,
-    /// Beam length L [m] (lever arm of the slope at G).
-    pub beam_length: f64,
-    pub fem: Response,
-    /// AMM runs at the nominal number of modes, one per family.
-    pub amm: Vec<(ModeFamily, Response)>,
-    /// AMM runs at other numbers of modes: (family, N, response).
-    pub n_study: Vec<(ModeFamily, usize, Response)>,
-    /// Nominal number of modes of `amm`.
-    pub modes: usize,
-}
-
-/// One family in one case.
+/// One AMM run in one case.
 #[derive(Debug, Clone, Serialize)]
 pub struct FamilyEntry {
+    /// The run's label (a family name for the paper's runs).
+    pub label: String,
     pub family: ModeFamily,
+    /// Modes per beam N, when fixed.
+    pub modes: Option<usize>,
     pub evp: PointEvps,
     pub correct: bool,
     pub most_accurate: bool,
 }
 
-/// Mean EVP of a family at another N.
+/// Mean EVP of a further run (a family at another N).
 #[derive(Debug, Clone, Serialize)]
 pub struct NStudyEntry {
+    pub label: String,
     pub family: ModeFamily,
-    pub modes: usize,
+    pub modes: Option<usize>,
     pub mean: Option<f64>,
 }
 
@@ -51,9 +41,11 @@ pub struct TableRow {
     pub description: String,
     pub behaviour: Behaviour,
     pub measures: JunctionMeasures,
+    /// N of the first compared run (0 when not fixed).
     pub modes: usize,
     pub families: Vec<FamilyEntry>,
-    pub most_accurate: Option<ModeFamily>,
+    /// Label of the run with the smallest mean EVP.
+    pub most_accurate: Option<String>,
     pub n_study: Vec<NStudyEntry>,
     #[serde(skip)]
     pub paper: Option<&'static PaperCase>,
@@ -71,16 +63,21 @@ fn family_index(f: ModeFamily) -> Option<usize> {
 
 impl TableRow {
     /// Compute the row of one case.
-    pub fn compute(case: &CaseResults) -> Result<Self, CompareError> {
+    /// Compute the row of one case; `with_paper`: show the paper's numbers for a case of the
+    /// same name (only for the paper's own experiments).
+    pub fn compute(case: &CaseResults, with_paper: bool) -> Result<Self, CompareError> {
         let measures = measure(&case.fem, case.beam_length);
         let behaviour = classify(&measures);
         let mut families = Vec::new();
-        for (family, r) in &case.amm {
+        for (run, r) in &case.amm {
             let evp = point_evps(r, &case.fem)?;
+            let family = run.settings.family;
             families.push(FamilyEntry {
-                family: *family,
+                label: run.label.clone(),
+                family,
+                modes: run.settings.modes,
                 evp,
-                correct: is_correct(*family, behaviour),
+                correct: is_correct(family, behaviour),
                 most_accurate: false,
             });
         }
@@ -94,12 +91,13 @@ impl TableRow {
             families[k].most_accurate = true;
         }
         let n_study = case
-            .n_study
+            .extra
             .iter()
-            .map(|(family, modes, r)| {
+            .map(|(run, r)| {
                 Ok(NStudyEntry {
-                    family: *family,
-                    modes: *modes,
+                    label: run.label.clone(),
+                    family: run.settings.family,
+                    modes: run.settings.modes,
                     mean: point_evps(r, &case.fem)?.mean,
                 })
             })
@@ -109,21 +107,38 @@ impl TableRow {
             description: case.description.clone(),
             behaviour,
             measures,
-            modes: case.modes,
-            most_accurate: best.map(|k| families[k].family),
+            modes: families.first().and_then(|e| e.modes).unwrap_or(0),
+            most_accurate: best.map(|k| families[k].label.clone()),
             families,
             n_study,
-            paper: paper_case(&case.name),
+            paper: if with_paper { paper_case(&case.name) } else { None },
         })
     }
 
+    /// The run of family `f` (the first one, if several).
     pub fn family(&self, f: ModeFamily) -> Option<&FamilyEntry> {
         self.families.iter().find(|e| e.family == f)
+    }
+
+    /// The run labelled `label`.
+    pub fn run(&self, label: &str) -> Option<&FamilyEntry> {
+        self.families.iter().find(|e| e.label == label)
+    }
+
+    /// The family of the most accurate run.
+    pub fn most_accurate_family(&self) -> Option<ModeFamily> {
+        self.families.iter().find(|e| e.most_accurate).map(|e| e.family)
     }
 }
 
 fn pct(v: Option<f64>) -> String {
     v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "n/a".into())
+}
+
+/// A value for a CSV file: the shortest exact form, or `n/a`.
+pub fn opt_number(v: Option<f64>) -> String {
+    v.map(flexstar_model::output::fmt_number)
+        .unwrap_or_else(|| "n/a".into())
 }
 
 fn mark(ok: bool) -> &'static str {
@@ -135,29 +150,86 @@ fn mark(ok: bool) -> &'static str {
 }
 
 impl TableI {
-    pub fn compute(cases: &[CaseResults]) -> Result<Self, CompareError> {
+    /// The table of `cases`; `with_paper`: the paper's numbers beside ours (paper cases only).
+    pub fn compute(cases: &[CaseResults], with_paper: bool) -> Result<Self, CompareError> {
         Ok(TableI {
-            rows: cases.iter().map(TableRow::compute).collect::<Result<_, _>>()?,
+            rows: cases
+                .iter()
+                .map(|c| TableRow::compute(c, with_paper))
+                .collect::<Result<_, _>>()?,
         })
     }
 
-    /// Markdown: the summary table (ours beside the paper's), the per-point EVPs and the N study.
+    /// Column labels: every run label in the order first met.
+    pub fn labels(&self) -> Vec<String> {
+        let mut v: Vec<String> = Vec::new();
+        for r in &self.rows {
+            for e in &r.families {
+                if !v.contains(&e.label) {
+                    v.push(e.label.clone());
+                }
+            }
+        }
+        v
+    }
+
+    /// Markdown: the summary table (ours beside the paper's for the paper's cases, with the
+    /// paper-specific findings as notes under it), the per-point EVPs, the junction measures and
+    /// the N study.
     pub fn to_markdown(&self) -> String {
         let mut s = String::new();
+        let labels = self.labels();
+        let with_paper = self.rows.iter().any(|r| r.paper.is_some());
         let _ = writeln!(s, "## Table I (regenerated)\n");
-        let _ = writeln!(s, "Mean EVP (Eq. 45) over the points A, B, C, G that have a non-negligible FEM response, in %; *n/a*: reference negligible. Paper values in brackets (N = 25; the paper's case-4 row is a misprint of case 3 and has no usable EVPs).\n");
-        let _ = writeln!(
+        let _ = write!(
             s,
-            "| case | behaviour of G (paper) | pinned-free | slide-free | free-free | most accurate (paper) |"
+            "Mean EVP (Eq. 45) over the points A, B, C, G whose FEM response is not negligible, in %; \
+             *n/a*: negligible reference (below 1 % of the largest FEM tip peak). *correct*: the run's boundary \
+             conditions at G can represent what G does in the FEM; **best**: smallest mean EVP."
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|");
+        if with_paper {
+            let _ = write!(
+                s,
+                " Paper values in brackets (N = 25; the paper's case-4 row repeats case 3, so case 4 has none)."
+            );
+        }
+        let _ = writeln!(s, "\n");
+        let _ = write!(
+            s,
+            "| case | behaviour of G{} |",
+            if with_paper { " (paper)" } else { "" }
+        );
+        for l in &labels {
+            let _ = write!(s, " {l} |");
+        }
+        let _ = writeln!(s, " most accurate{} |", if with_paper { " (paper)" } else { "" });
+        let _ = writeln!(s, "|---|---|{}---|", "---|".repeat(labels.len()));
+        let mut notes = Vec::new();
         for row in &self.rows {
-            let paper_b = row.paper.map(|p| p.behaviour.name()).unwrap_or("-");
-            let mut cells = Vec::new();
-            for f in ModeFamily::PAPER {
-                let k = family_index(f).expect("paper family");
+            let note = row.paper.and_then(|_| crate::paper::finding(&row.case));
+            let marker = match note {
+                Some(n) => {
+                    notes.push((row.case.clone(), n));
+                    format!(" [note {}]", notes.len())
+                }
+                None => String::new(),
+            };
+            let paper_b = row
+                .paper
+                .map(|p| format!(" ({})", p.behaviour.name()))
+                .unwrap_or_default();
+            let _ = write!(
+                s,
+                "| {} ({}) | {}{}{} |",
+                row.case,
+                row.description,
+                row.behaviour.name(),
+                paper_b,
+                marker
+            );
+            for l in &labels {
                 let ours = row
-                    .family(f)
+                    .run(l)
                     .map(|e| {
                         format!(
                             "{} {}{}",
@@ -167,49 +239,37 @@ impl TableI {
                         )
                     })
                     .unwrap_or_else(|| "-".into());
-                let paper = row
-                    .paper
-                    .map(|p| {
-                        format!(
-                            " ({} {})",
-                            p.evp[k].map(|v| format!("{v:.2}")).unwrap_or_else(|| "n/a".into()),
-                            mark(p.correct[k])
-                        )
-                    })
-                    .unwrap_or_default();
-                cells.push(format!("{ours}{paper}"));
+                let paper = match (row.paper, row.run(l).and_then(|e| family_index(e.family))) {
+                    (Some(p), Some(k)) => match p.evp[k] {
+                        Some(v) => format!(" ({v:.2} {})", mark(p.correct[k])),
+                        None => format!(" (no EVP, {})", mark(p.correct[k])),
+                    },
+                    _ => String::new(),
+                };
+                let _ = write!(s, " {ours}{paper} |");
             }
-            let best = row.most_accurate.map(|f| f.name()).unwrap_or("-");
-            let paper_best = row.paper.map(|p| p.most_accurate.name()).unwrap_or("-");
-            let _ = writeln!(
-                s,
-                "| {} ({}) | {} ({}) | {} | {} | {} | {} ({}) |",
-                row.case,
-                row.description,
-                row.behaviour.name(),
-                paper_b,
-                cells[0],
-                cells[1],
-                cells[2],
-                best,
-                paper_best
-            );
+            let best = row.most_accurate.clone().unwrap_or_else(|| "-".into());
+            let paper_best = row
+                .paper
+                .map(|p| format!(" ({})", p.most_accurate.name()))
+                .unwrap_or_default();
+            let _ = writeln!(s, " {best}{paper_best} |");
         }
-        let _ = writeln!(
-            s,
-            "\n### EVP per point (%), N = {}\n",
-            self.rows.first().map(|r| r.modes).unwrap_or(0)
-        );
-        let _ = writeln!(s, "| case | family | A | B | C | G | mean |");
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+        for (k, (case, n)) in notes.iter().enumerate() {
+            let _ = writeln!(s, "\n**Note {} ({case}).** {n}", k + 1);
+        }
+        let _ = writeln!(s, "\n### EVP per point (%)\n");
+        let _ = writeln!(s, "| case | run | N | A | B | C | G | mean |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
         for row in &self.rows {
             for e in &row.families {
                 let p = e.evp.points;
                 let _ = writeln!(
                     s,
-                    "| {} | {} | {} | {} | {} | {} | {} |",
+                    "| {} | {} | {} | {} | {} | {} | {} | {} |",
                     row.case,
-                    e.family,
+                    e.label,
+                    e.modes.map(|n| n.to_string()).unwrap_or_else(|| "auto".into()),
                     pct(p[0]),
                     pct(p[1]),
                     pct(p[2]),
@@ -219,6 +279,12 @@ impl TableI {
             }
         }
         let _ = writeln!(s, "\n### Junction measures (FEM)\n");
+        let _ = writeln!(
+            s,
+            "How the behaviour of G is read from the FEM: *moves* when peak |w_G| is at least 1 % of the largest \
+             tip peak, *turns* when peak |slope_G| L is at least 5 % of it. Pinned: turns only; slide: moves only; \
+             general: both.\n"
+        );
         let _ = writeln!(
             s,
             "| case | peak w_G / peak tip | peak slope_G L / peak tip | behaviour |"
@@ -236,53 +302,58 @@ impl TableI {
                 row.behaviour.name()
             );
         }
-        if self.rows.iter().any(|r| !r.n_study.is_empty()) {
-            let mut ns: Vec<usize> = self
-                .rows
-                .iter()
-                .flat_map(|r| r.n_study.iter().map(|e| e.modes))
-                .collect();
-            ns.push(self.rows[0].modes);
-            ns.sort_unstable();
-            ns.dedup();
-            let _ = writeln!(s, "\n### Mean EVP (%) against the number of modes N\n");
-            let _ = write!(s, "| case | family |");
-            for n in &ns {
-                let _ = write!(s, " N = {n} |");
-            }
-            let _ = writeln!(s, "\n|---|---|{}", "---|".repeat(ns.len()));
-            for row in &self.rows {
-                for f in ModeFamily::PAPER {
-                    let _ = write!(s, "| {} | {} |", row.case, f);
-                    for n in &ns {
-                        let v = if *n == row.modes {
-                            row.family(f).and_then(|e| e.evp.mean)
-                        } else {
-                            row.n_study
-                                .iter()
-                                .find(|e| e.family == f && e.modes == *n)
-                                .and_then(|e| e.mean)
-                        };
-                        let _ = write!(s, " {} |", pct(v));
-                    }
-                    let _ = writeln!(s);
-                }
-            }
-        }
+        self.n_study_markdown(&mut s);
         s
     }
 
-    /// CSV, one line per case and family.
+    fn n_study_markdown(&self, s: &mut String) {
+        if self.rows.iter().all(|r| r.n_study.is_empty()) {
+            return;
+        }
+        let mut ns: Vec<usize> = self
+            .rows
+            .iter()
+            .flat_map(|r| r.n_study.iter().filter_map(|e| e.modes))
+            .chain(self.rows.iter().map(|r| r.modes))
+            .collect();
+        ns.sort_unstable();
+        ns.dedup();
+        let _ = writeln!(s, "\n### Mean EVP (%) against the number of modes N\n");
+        let _ = write!(s, "| case | run |");
+        for n in &ns {
+            let _ = write!(s, " N = {n} |");
+        }
+        let _ = writeln!(s, "\n|---|---|{}", "---|".repeat(ns.len()));
+        for row in &self.rows {
+            for e in &row.families {
+                let _ = write!(s, "| {} | {} |", row.case, e.label);
+                for n in &ns {
+                    let v = if Some(*n) == e.modes {
+                        e.evp.mean
+                    } else {
+                        row.n_study
+                            .iter()
+                            .find(|x| x.label == e.label && x.modes == Some(*n))
+                            .and_then(|x| x.mean)
+                    };
+                    let _ = write!(s, " {} |", pct(v));
+                }
+                let _ = writeln!(s);
+            }
+        }
+    }
+
+    /// CSV, one line per case and run; numbers in the shortest exact form, `n/a` where Table I
+    /// has it, empty paper columns where the paper has no entry.
     pub fn to_csv(&self) -> String {
-        let mut s = String::from("case,family,modes,behaviour,evp_A,evp_B,evp_C,evp_G,evp_mean,correct,most_accurate,paper_behaviour,paper_evp_mean,paper_correct,paper_most_accurate\n");
-        let opt = |v: Option<f64>| v.map(|x| format!("{x:.6}")).unwrap_or_else(|| "n/a".into());
+        let mut s = String::from("case,model,family,modes,behaviour,evp_A,evp_B,evp_C,evp_G,evp_mean,correct,most_accurate,paper_behaviour,paper_evp_mean,paper_correct,paper_most_accurate\n");
         for row in &self.rows {
             for e in &row.families {
                 let k = family_index(e.family);
                 let (pb, pe, pc, pm) = match (row.paper, k) {
                     (Some(p), Some(k)) => (
                         p.behaviour.name().to_string(),
-                        opt(p.evp[k]),
+                        opt_number(p.evp[k]),
                         p.correct[k].to_string(),
                         (p.most_accurate == e.family).to_string(),
                     ),
@@ -291,16 +362,17 @@ impl TableI {
                 let p = e.evp.points;
                 let _ = writeln!(
                     s,
-                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                     row.case,
+                    e.label,
                     e.family,
-                    row.modes,
+                    e.modes.map(|n| n.to_string()).unwrap_or_else(|| "auto".into()),
                     row.behaviour.name(),
-                    opt(p[0]),
-                    opt(p[1]),
-                    opt(p[2]),
-                    opt(p[3]),
-                    opt(e.evp.mean),
+                    opt_number(p[0]),
+                    opt_number(p[1]),
+                    opt_number(p[2]),
+                    opt_number(p[3]),
+                    opt_number(e.evp.mean),
                     e.correct,
                     e.most_accurate,
                     pb,

@@ -1,276 +1,195 @@
-//! `flexstar verify`: the four paper cases with the three mode families and the FEM, run in
-//! parallel (rayon); Table I, figures and report written to an output directory; the checks of
-//! `configs/thresholds.toml` applied.
+//! `flexstar verify`: [`compare`](crate::compare) over the paper's four cases (the three mode
+//! families at the thresholds' N, plus the N study), then Table I beside the paper's and the
+//! checks of `configs/thresholds.toml`. The cases and the thresholds are built into the binary;
+//! `--configs` / `--thresholds` replace them (and drop the paper-specific notes).
+//!
+//! Outputs in `DIR/`: `table1.{md,csv,json}`, `checks.txt` (every check, its value and bound),
+//! `report.html` (all cases), and per case `DIR/<case>/` what `compare` writes.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
-use flexstar_model::output::write_string_atomically;
-use flexstar_model::{Experiment, ModeFamily, Response};
+use flexstar_model::output::{ensure_writable_dir, write_string_atomically};
+use flexstar_model::{Experiment, ModeFamily, Provenance};
 use rayon::prelude::*;
 
-use crate::figures::{
-    figure_forces, figure_star, figure_tips, figure_w_g, Figure, Run, Style, FAMILY_COLORS, FEM_STYLE,
-};
-use crate::report::html_report;
-use crate::table::{CaseResults, TableI};
-use crate::thresholds::Thresholds;
+use crate::builtin::paper_experiments;
+use crate::case_output::{validity_warnings, write_case, ValidityWarning};
+use crate::figures::Figure;
+use crate::report::{html_report, ReportCase, ReportInput};
+use crate::runs::{preflight, run_cases, AmmRun, CaseSpec, ProgressFn};
+use crate::table::TableI;
+use crate::thresholds::{Check, Thresholds};
+use crate::Error;
+
+/// Kept for callers of the previous API.
+pub type VerifyError = Error;
 
 /// What to verify and where to write.
 #[derive(Debug, Clone)]
 pub struct VerifyOptions {
-    /// Experiment files, one per case.
-    pub configs: Vec<PathBuf>,
-    /// The thresholds file.
-    pub thresholds: PathBuf,
-    /// Output directory (table, figures, report, per-case CSV).
+    /// Experiment files, one per case; `None`: the paper's four cases built into the binary.
+    pub configs: Option<Vec<PathBuf>>,
+    /// Thresholds file; `None`: the built-in `configs/thresholds.toml`.
+    pub thresholds: Option<PathBuf>,
+    /// Output directory.
     pub out: PathBuf,
-    /// Draw figures and the report (the CI regression test checks numbers only).
+    /// Draw figures and the reports (the CI regression test checks numbers only).
     pub figures: bool,
     /// Also run the AMM at the `n_study` mode counts of the thresholds file (table columns only).
     pub n_study: bool,
-}
-
-/// Errors that stop a verify run (a failed check is not an error: see [`VerifyOutcome`]).
-#[derive(Debug, thiserror::Error)]
-pub enum VerifyError {
-    #[error(transparent)]
-    Config(#[from] flexstar_model::ModelError),
-    #[error(transparent)]
-    Thresholds(#[from] crate::thresholds::ThresholdsError),
-    #[error("{case}: AMM {family}: {source}")]
-    Amm {
-        case: String,
-        family: ModeFamily,
-        #[source]
-        source: flexstar_amm::AmmError,
-    },
-    #[error("{case}: FEM: {source}")]
-    Fem {
-        case: String,
-        #[source]
-        source: flexstar_fem::FemError,
-    },
-    #[error(transparent)]
-    Compare(#[from] crate::evp::CompareError),
-    #[error(transparent)]
-    Figure(#[from] crate::figures::FigureError),
-    #[error("{case}: rigid kinematics: {source}")]
-    Kinematics {
-        case: String,
-        #[source]
-        source: flexstar_kinematics::KinematicsError,
-    },
+    /// Version, commit and date written into every output.
+    pub provenance: Provenance,
 }
 
 /// The result of a verify run.
 #[derive(Debug)]
 pub struct VerifyOutcome {
     pub table: TableI,
-    /// Failed checks; empty when everything holds.
+    /// Every check with its value and bound.
+    pub checks: Vec<Check>,
+    /// The failed checks, as sentences; empty when everything holds.
     pub failures: Vec<String>,
+    /// Runs that leave the small-deflection range of the AMM.
+    pub warnings: Vec<ValidityWarning>,
     /// Wall time of the solves and of the whole run [s].
     pub solve_seconds: f64,
     pub total_seconds: f64,
 }
 
-enum Job {
-    Fem(usize),
-    Amm(usize, ModeFamily, usize),
-}
-
-enum Done {
-    Fem(usize, Response),
-    Amm(usize, ModeFamily, usize, Response),
-}
-
-/// Run every case, write outputs, apply the thresholds.
-pub fn run_verify(opts: &VerifyOptions) -> Result<VerifyOutcome, VerifyError> {
-    let start = Instant::now();
-    let thresholds = Thresholds::load(&opts.thresholds)?;
-    let exps: Vec<Experiment> = opts
-        .configs
+/// The AMM runs of a paper case: the three families of Table I at N = `modes` (the paper's
+/// equations), and the N study. flexstar's own models are added to `amm` as further
+/// [`AmmRun`]s.
+pub fn verify_spec(exp: Experiment, modes: usize, n_study: &[usize]) -> CaseSpec {
+    let amm = ModeFamily::PAPER
         .iter()
-        .map(|c| Experiment::load(c))
-        .collect::<Result<_, _>>()?;
-    let mut jobs = Vec::new();
-    for k in 0..exps.len() {
-        jobs.push(Job::Fem(k));
-    }
-    for k in 0..exps.len() {
-        for f in ModeFamily::PAPER {
-            jobs.push(Job::Amm(k, f, thresholds.modes));
-            for &n in thresholds.n_study.iter().filter(|_| opts.n_study) {
-                if n != thresholds.modes {
-                    jobs.push(Job::Amm(k, f, n));
-                }
-            }
-        }
-    }
-    let done: Vec<Done> = jobs
-        .par_iter()
-        .map(|job| match *job {
-            Job::Fem(k) => flexstar_fem::solve(&exps[k], &exps[k].fem, None)
-                .map(|r| Done::Fem(k, r))
-                .map_err(|source| VerifyError::Fem {
-                    case: exps[k].name.clone(),
-                    source,
-                }),
-            Job::Amm(k, family, modes) => {
-                let settings = flexstar_model::AmmSettings {
-                    snapshots: exps[k].amm.snapshots.clone(),
-                    dt: exps[k].amm.dt,
-                    ..flexstar_model::AmmSettings::paper(family, modes)
-                };
-                flexstar_amm::solve(&exps[k], &settings)
-                    .map(|r| Done::Amm(k, family, modes, r))
-                    .map_err(|source| VerifyError::Amm {
-                        case: exps[k].name.clone(),
-                        family,
-                        source,
-                    })
-            }
-        })
-        .collect::<Result<_, _>>()?;
-    let solve_seconds = start.elapsed().as_secs_f64();
-
-    let mut cases: Vec<CaseResults> = exps
+        .map(|f| AmmRun::paper(&exp.amm, *f, modes))
+        .collect();
+    let extra = ModeFamily::PAPER
         .iter()
-        .map(|e| CaseResults {
-            name: e.name.clone(),
-            description: e.description.clone(),
-            beam_length: e.robot.l,
-            fem: Response::default(),
-            amm: Vec::new(),
-            n_study: Vec::new(),
-            modes: thresholds.modes,
+        .flat_map(|f| {
+            n_study
+                .iter()
+                .filter(|n| **n != modes)
+                .map(|n| AmmRun::paper(&exp.amm, *f, *n))
+                .collect::<Vec<_>>()
         })
         .collect();
-    for d in done {
-        match d {
-            Done::Fem(k, r) => cases[k].fem = r,
-            Done::Amm(k, f, n, r) if n == thresholds.modes => cases[k].amm.push((f, r)),
-            Done::Amm(k, f, n, r) => cases[k].n_study.push((f, n, r)),
-        }
-    }
-    for c in &mut cases {
-        c.amm
-            .sort_by_key(|(f, _)| ModeFamily::PAPER.iter().position(|g| g == f));
-    }
-    let table = TableI::compute(&cases)?;
-    let failures = thresholds.check(&table);
+    CaseSpec { exp, amm, extra }
+}
 
-    write_outputs(opts, &exps, &cases, &table, &failures)?;
+/// Run every case, write the outputs, apply the thresholds.
+pub fn run_verify(opts: &VerifyOptions, progress: Option<ProgressFn>) -> Result<VerifyOutcome, Error> {
+    let start = Instant::now();
+    let thresholds = match &opts.thresholds {
+        Some(p) => Thresholds::load(p)?,
+        None => Thresholds::builtin()?,
+    };
+    let paper = opts.configs.is_none();
+    let exps: Vec<Experiment> = match &opts.configs {
+        Some(files) => files.iter().map(|c| Experiment::load(c)).collect::<Result<_, _>>()?,
+        None => paper_experiments(),
+    };
+    let n_study: &[usize] = if opts.n_study { &thresholds.n_study } else { &[] };
+    let specs: Vec<CaseSpec> = exps
+        .into_iter()
+        .map(|e| verify_spec(e, thresholds.modes, n_study))
+        .collect();
+    preflight(&specs)?;
+    ensure_writable_dir(&opts.out)?;
+    for s in &specs {
+        ensure_writable_dir(&opts.out.join(&s.exp.name))?;
+    }
+    let cases = run_cases(&specs, progress)?;
+    let solve_seconds = start.elapsed().as_secs_f64();
+    let table = TableI::compute(&cases, paper)?;
+    let checks = thresholds.check(&table);
+    let failures = checks.iter().filter(|c| !c.ok).map(|c| c.to_string()).collect();
+
+    // per case: what compare writes
+    let per_case: Vec<Vec<Figure>> = specs
+        .par_iter()
+        .zip(cases.par_iter())
+        .zip(table.rows.par_iter())
+        .map(|((s, c), row)| {
+            let dir = opts.out.join(&s.exp.name);
+            let figs = write_case(&dir, &s.exp, c, row, &opts.provenance, opts.figures)?;
+            if opts.figures {
+                let html = html_report(&ReportInput {
+                    title: format!("flexstar compare: {}", s.exp.name),
+                    provenance: &opts.provenance,
+                    table: None,
+                    checks: None,
+                    cases: vec![ReportCase {
+                        exp: &s.exp,
+                        case: c,
+                        row,
+                        figures: &figs,
+                        dir: Path::new(""),
+                    }],
+                })?;
+                write_string_atomically(&dir.join("report.html"), &html)?;
+            }
+            Ok(figs)
+        })
+        .collect::<Result<_, Error>>()?;
+
+    let out = &opts.out;
+    write_string_atomically(&out.join("table1.md"), &table.to_markdown())?;
+    write_string_atomically(&out.join("table1.csv"), &table.to_csv())?;
+    write_string_atomically(&out.join("table1.json"), &table.to_json())?;
+    write_string_atomically(&out.join("checks.txt"), &checks_text(&checks))?;
+    if opts.figures {
+        let html = html_report(&ReportInput {
+            title: if paper {
+                "flexstar verify: the paper's four cases, AMM against FEM".into()
+            } else {
+                "flexstar verify".into()
+            },
+            provenance: &opts.provenance,
+            table: Some(&table),
+            checks: Some(&checks),
+            cases: specs
+                .iter()
+                .zip(&cases)
+                .zip(&table.rows)
+                .zip(&per_case)
+                .map(|(((s, c), row), figs)| ReportCase {
+                    exp: &s.exp,
+                    case: c,
+                    row,
+                    figures: figs,
+                    dir: Path::new(&s.exp.name),
+                })
+                .collect(),
+        })?;
+        write_string_atomically(&out.join("report.html"), &html)?;
+    }
+    let warnings = specs
+        .iter()
+        .zip(&cases)
+        .flat_map(|(s, c)| validity_warnings(&s.exp, c))
+        .collect();
     Ok(VerifyOutcome {
         table,
+        checks,
         failures,
+        warnings,
         solve_seconds,
         total_seconds: start.elapsed().as_secs_f64(),
     })
 }
 
-fn family_style(f: ModeFamily) -> Style {
-    let k = ModeFamily::PAPER.iter().position(|g| *g == f).unwrap_or(3);
-    Style {
-        color: FAMILY_COLORS[k],
-        width: 2,
-        dashed: false,
-    }
-}
-
-/// The paper's figure set for one case.
-pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>, VerifyError> {
-    let mut runs = vec![Run {
-        label: "FEM".into(),
-        response: &case.fem,
-        style: FEM_STYLE,
-    }];
-    for (f, r) in &case.amm {
-        runs.push(Run {
-            label: format!("AMM {f}"),
-            response: r,
-            style: family_style(*f),
-        });
-    }
-    let kin = |t: f64| {
-        RigidState::at(&exp.robot, &exp.trajectory, t).map_err(|source| VerifyError::Kinematics {
-            case: exp.name.clone(),
-            source,
-        })
-    };
-    let t = &case.fem.t;
-    let rigid: Vec<[f64; 3]> = t
-        .iter()
-        .map(|&ti| kin(ti).map(|s| rigid_inverse_dynamics(&exp.robot, &s).fa))
-        .collect::<Result<_, _>>()?;
-    let mut figs = vec![figure_w_g(&exp.name, &runs), figure_tips(&exp.name, &runs)];
-    let last = kin(exp.time.t_end)?;
-    let peak = case
-        .fem
-        .w_tip
-        .iter()
-        .flatten()
-        .fold(0.0f64, |m, v| m.max(v.abs()))
-        .max(1e-9);
-    // magnify the elastic part to about a fifth of the beam length
-    let magnify = (0.2 * exp.robot.l / peak).clamp(1.0, 1e4).round();
-    if let Some(f) = figure_star(&exp.name, &runs, &last, magnify) {
-        figs.push(f);
-    }
-    figs.push(figure_forces(&exp.name, &runs, Some((t, &rigid))));
-    Ok(figs)
-}
-
-fn write_outputs(
-    opts: &VerifyOptions,
-    exps: &[Experiment],
-    cases: &[CaseResults],
-    table: &TableI,
-    failures: &[String],
-) -> Result<(), VerifyError> {
-    let out = &opts.out;
-    for c in cases {
-        let dir = out.join(&c.name);
-        c.fem.write_csv(&dir.join("fem.csv"))?;
-        for (f, r) in &c.amm {
-            r.write_csv(&dir.join(format!("amm-{f}.csv")))?;
-        }
-    }
-    write_string_atomically(&out.join("table1.md"), &table.to_markdown())?;
-    write_string_atomically(&out.join("table1.csv"), &table.to_csv())?;
-    write_string_atomically(&out.join("table1.json"), &table.to_json())?;
-    let checks = if failures.is_empty() {
-        "all checks hold\n".to_string()
-    } else {
-        failures.iter().map(|f| format!("FAIL {f}\n")).collect()
-    };
-    write_string_atomically(&out.join("checks.txt"), &checks)?;
-    if !opts.figures {
-        return Ok(());
-    }
-    let figdir = out.join("figures");
-    let per_case: Vec<(String, Vec<Figure>)> = exps
-        .par_iter()
-        .zip(cases.par_iter())
-        .map(|(e, c)| {
-            let figs = case_figures(e, c)?;
-            for f in &figs {
-                f.write(&figdir)?;
-            }
-            Ok((e.name.clone(), figs))
-        })
-        .collect::<Result<_, VerifyError>>()?;
-    let notes = "Regenerated by `flexstar verify` from configs/case1..4.toml. Reference: the FEM of crates/fem. \
-                 How EVPs are computed and why rankings may differ from the paper: docs/validation.md.";
-    let html = html_report(table, failures, &per_case, notes)?;
-    write_string_atomically(&out.join("report.html"), &html)?;
-    Ok(())
-}
-
-/// The default experiment files of the four paper cases, relative to `root`.
-pub fn paper_configs(root: &Path) -> Vec<PathBuf> {
-    (1..=4)
-        .map(|k| root.join("configs").join(format!("case{k}.toml")))
-        .collect()
+/// `checks.txt`: one line per check, `PASS` or `FAIL`, the value found and the bound, then a
+/// summary line.
+pub fn checks_text(checks: &[Check]) -> String {
+    let mut s: String = checks.iter().map(|c| format!("{c}\n")).collect();
+    let failed = checks.iter().filter(|c| !c.ok).count();
+    s.push_str(&format!(
+        "{} checks, {} passed, {} failed\n",
+        checks.len(),
+        checks.len() - failed,
+        failed
+    ));
+    s
 }

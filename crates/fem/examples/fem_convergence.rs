@@ -1,4 +1,4 @@
-//! Convergence study of docs/fem.md: for each paper case, the EVP (MODEL-NOTES section 5) of
+//! Convergence study of docs/fem.md: for each paper case, the EVP (Eq. 45, docs/validation.md) of
 //! every tip and G response of a run (dt, N) against runs with the step halved, the mesh doubled,
 //! and both. Usage: `fem_convergence DT N RHO_INF [CASES]`, e.g. `fem_convergence 5e-4 300 0.9 1234`.
 

@@ -1,7 +1,7 @@
 //! # flexstar-fem
 //!
 //! The independent finite-element reference model of the flexible star-triangle robot
-//! (MODEL-NOTES section 7, issue 5): three co-rotational Euler-Bernoulli beams in absolute
+//! (docs/paper-defects.md, "independent reference"; issue 5): three co-rotational Euler-Bernoulli beams in absolute
 //! coordinates welded at one node G ([`element`]), three rigid sleeves with inertia Jp pinned at
 //! the revolute points of Eqs. 1-3 through which the beams slide without friction, index-3
 //! generalized-alpha integration with a structured direct solver (banded beam blocks and a dense

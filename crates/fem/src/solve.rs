@@ -1,7 +1,7 @@
 //! The public entry point: run the FEM on an experiment and post-process its absolute results
-//! into the shared [`Response`] (MODEL-NOTES section 2).
+//! into the shared [`Response`] (projections of `docs/conventions.md`).
 
-use flexstar_kinematics::RigidState;
+use flexstar_kinematics::{check_trajectory, RigidState};
 use flexstar_model::{BeamShape, Experiment, FemSettings, Response, RunInfo, StarShape};
 
 use crate::integrator::{integrate, RunSettings, Stats};
@@ -78,6 +78,10 @@ pub fn solve_with_stats(
             "fem.snapshots must lie in [0, t_end = {t_end}], got {bad}"
         )));
     }
+    // the same feasibility scan as the AMM and the kinematics, before any work: a pre-flight check
+    // of the requested motion only (the FEM's equations never use the rigid kinematics)
+    check_trajectory(params, &exp.trajectory, t_end, exp.time.dt_out.min(1e-3))
+        .map_err(|e| FemError::Input(e.to_string()))?;
     let rigid = |t: f64| {
         RigidState::at(params, &exp.trajectory, t).map_err(|e| FemError::PostProcessing {
             t,

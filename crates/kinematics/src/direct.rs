@@ -96,7 +96,7 @@ mod tests {
 
     #[test]
     fn start_configuration() {
-        // MODEL-NOTES section 2: at s = 0, G = O, theta = 0, xp_i = d.
+        // docs/conventions.md, Frames: at s = 0, G = O, theta = 0, xp_i = d.
         let pose = direct_kinematics(0.18, [0.0f64; 3]).unwrap();
         assert!(pose.g[0].abs() < 1e-15 && pose.g[1].abs() < 1e-15);
         assert!(pose.theta.abs() < 1e-15);

@@ -1,4 +1,4 @@
-//! Where a trajectory leaves the feasible range (MODEL-NOTES section 6).
+//! Where a trajectory leaves the feasible range (docs/conventions.md, Feasible range).
 //!
 //! A motion is physically possible while, for every beam and slider,
 //! `Lp/2 < xp_i` (the sleeve does not reach the junction G), `xp_i + Lp/2 < L` (it does not slide

@@ -1,6 +1,6 @@
 //! # flexstar-kinematics
 //!
-//! Rigid kinematics of the star-triangle robot (paper, section 3; MODEL-NOTES sections 2 and 6):
+//! Rigid kinematics of the star-triangle robot (paper, section 3; docs/conventions.md):
 //!
 //! - [`direct`]: G as the Fermat point of the revolute points I, J, K (Eqs. 4-7), the orientation
 //!   theta (Eq. 9) and the sleeve positions xp_i (Eq. 10), generic over dual numbers so that

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use flexstar_model::output::write_atomically;
+use flexstar_model::output::{fmt_number, write_atomically};
 use flexstar_model::Experiment;
 
 use crate::feasibility::check_trajectory;
@@ -63,7 +63,7 @@ pub fn write_kinematics_csv(path: &Path, states: &[RigidState]) -> Result<(), Ki
         let mut out = csv::Writer::from_writer(w);
         out.write_record(KINEMATICS_HEADER)?;
         for st in states {
-            out.write_record(row(st).iter().map(|v| format!("{v:e}")))?;
+            out.write_record(row(st).iter().map(|v| fmt_number(*v)))?;
         }
         out.flush()?;
         Ok(())

@@ -70,7 +70,7 @@ mod tests {
 
     #[test]
     fn the_four_paper_cases_parse_with_their_spans() {
-        // MODEL-NOTES section 6: end times 0.5, 0.4, 0.5, 0.5 s.
+        // docs/paper-defects.md (the four cases): end times 0.5, 0.4, 0.5, 0.5 s.
         for (k, t_end) in [(1, 0.5), (2, 0.4), (3, 0.5), (4, 0.5)] {
             let e = paper_case(k);
             assert_eq!(e.name, format!("case{k}"));

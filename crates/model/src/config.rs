@@ -73,7 +73,7 @@ impl TimeSpan {
     }
 }
 
-/// Assumed-mode families (Eq. 34-1, MODEL-NOTES section 4), named by the boundary condition at G
+/// Assumed-mode families (Eq. 34-1, docs/paper-defects.md), named by the boundary condition at G
 /// then at the tip; `Enriched` is flexstar's addition (free-free modes plus junction shapes that
 /// carry the moment and shear the weld at G transmits, `docs/amm.md` section 7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -4,7 +4,7 @@
 //! EVP = int_0^tf |w_AMM(x0, t) - w_FEM(x0, t)| dt / int_0^tf |w_FEM(x0, t)| dt * 100 %
 //! ```
 //!
-//! Decisions the paper leaves open (MODEL-NOTES section 5; written up in docs/validation.md):
+//! Decisions the paper leaves open (written up in docs/validation.md, section 2):
 //! - integrals by the trapezoidal rule on the common output times of both responses;
 //! - at G the paper does not say which frame it uses; flexstar uses the 2-D elastic displacement
 //!   vector of G, whose norm is frame-independent: with three directions 120 degrees apart,

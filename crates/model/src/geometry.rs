@@ -1,8 +1,8 @@
 //! Base geometry (Eqs. 1-3) and the closed-form inverse kinematics of the rigid robot.
 //!
-//! Frame: the fixed XY frame with origin O at the centre of the base triangle (MODEL-NOTES
-//! section 2). Functions are generic over [`num_dual::DualNum`] so that time derivatives of any
-//! geometric quantity come out exact by automatic differentiation.
+//! Frame: the fixed XY frame with origin O at the centre of the base triangle
+//! (`docs/conventions.md`, Frames). Functions are generic over [`num_dual::DualNum`] so that time
+//! derivatives of any geometric quantity come out exact by automatic differentiation.
 
 use num_dual::DualNum;
 

@@ -16,9 +16,11 @@ pub mod output;
 pub mod params;
 pub mod response;
 pub mod trajectory;
+pub mod validity;
 
 pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, ModeFamily, TimeSpan};
 pub use error::ModelError;
 pub use params::RobotParams;
 pub use response::{BeamShape, Column, Response, RunInfo, StarShape};
 pub use trajectory::{Pose, Trajectory};
+pub use validity::{small_deflection_check, Provenance, ValidityExceeded};

@@ -1,10 +1,24 @@
-//! Result files are written whole or not at all: into a temporary file beside the target, then
-//! renamed over it.
+//! Result files: written whole or not at all (into a temporary file beside the target, then
+//! renamed over it), with the permissions of any new file (`0666` less the umask, not the
+//! temporary file's `0600`), and numbers in the shortest form that reads back exactly.
 
 use std::io::Write;
 use std::path::Path;
 
 use crate::error::ModelError;
+
+/// A temporary file in `dir`, created with mode `0666` less the process umask (as `File::create`
+/// would), so that the result it becomes has normal permissions.
+pub fn temp_file_in(dir: &Path, suffix: &str) -> std::io::Result<tempfile::NamedTempFile> {
+    let mut b = tempfile::Builder::new();
+    b.prefix(".flexstar-").suffix(suffix);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    b.tempfile_in(dir)
+}
 
 /// Write `path` through `fill`; on any error nothing is left at `path` (an older file is kept).
 pub fn write_atomically<F>(path: &Path, fill: F) -> Result<(), ModelError>
@@ -15,12 +29,9 @@ where
         file: path.to_path_buf(),
         reason,
     };
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
+    let dir = parent_dir(path);
     std::fs::create_dir_all(&dir).map_err(|e| err(e.to_string()))?;
-    let mut tmp = tempfile::NamedTempFile::new_in(&dir).map_err(|e| err(e.to_string()))?;
+    let mut tmp = temp_file_in(&dir, ".tmp").map_err(|e| err(e.to_string()))?;
     {
         let mut buf = std::io::BufWriter::new(tmp.as_file_mut());
         fill(&mut buf).map_err(|e| err(e.to_string()))?;
@@ -30,12 +41,55 @@ where
     Ok(())
 }
 
+fn parent_dir(path: &Path) -> std::path::PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    }
+}
+
 /// Write a string to `path`, whole or not at all.
 pub fn write_string_atomically(path: &Path, text: &str) -> Result<(), ModelError> {
     write_atomically(path, |w| {
         w.write_all(text.as_bytes())?;
         Ok(())
     })
+}
+
+/// Create the directory `dir` (and its parents) and check that a file can be written in it, so
+/// that a run fails before any work instead of after it (e.g. `--out` names an existing file, or
+/// a read-only place). The probe file is removed again.
+pub fn ensure_writable_dir(dir: &Path) -> Result<(), ModelError> {
+    let err = |reason: String| ModelError::Write {
+        file: dir.to_path_buf(),
+        reason,
+    };
+    if dir.exists() && !dir.is_dir() {
+        return Err(err("exists and is not a directory".into()));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| err(format!("cannot create the output directory: {e}")))?;
+    temp_file_in(dir, ".probe").map_err(|e| err(format!("the output directory is not writable: {e}")))?;
+    Ok(())
+}
+
+/// A number as written into result files: the shortest decimal that parses back to exactly the
+/// same `f64` (plain or with an exponent, whichever is shorter; plain on a tie), and `0` for
+/// both zeros (no `-0`). Non-finite values are written `NaN`, `inf`, `-inf`.
+pub fn fmt_number(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    // Rust's `{}` and `{:e}` both print the shortest digits that round-trip
+    let plain = format!("{v}");
+    let sci = format!("{v:e}");
+    if sci.len() < plain.len() {
+        sci
+    } else {
+        plain
+    }
 }
 
 #[cfg(test)]
@@ -53,5 +107,60 @@ mod tests {
         assert!(r.is_err());
         assert!(!path.exists());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn new_files_get_the_permissions_of_file_create() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        // reference: what File::create gives under this process's umask
+        let reference = dir.path().join("reference");
+        std::fs::File::create(&reference).unwrap();
+        let want = std::fs::metadata(&reference).unwrap().permissions().mode() & 0o777;
+        let path = dir.path().join("x.csv");
+        write_string_atomically(&path, "a\n").unwrap();
+        let got = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
+        assert_eq!(got, want, "got {got:o}, File::create gives {want:o}");
+        assert_ne!(got & 0o044, 0, "readable by others under the usual umask 022 ({got:o})");
+    }
+
+    #[test]
+    fn numbers_are_shortest_and_read_back_exactly() {
+        assert_eq!(fmt_number(0.0), "0");
+        assert_eq!(fmt_number(-0.0), "0");
+        assert_eq!(fmt_number(0.5), "0.5");
+        assert_eq!(fmt_number(0.001), "1e-3");
+        assert_eq!(fmt_number(0.01), "0.01");
+        assert_eq!(fmt_number(1.5e-7), "1.5e-7");
+        assert_eq!(fmt_number(-2.0), "-2");
+        assert_eq!(fmt_number(123456789.0), "123456789");
+        assert_eq!(fmt_number(1e21), "1e21");
+        // exact read-back over a spread of magnitudes and awkward values
+        let mut x = 0.1f64;
+        for k in 0..2000 {
+            let v = if k % 2 == 0 { x } else { -x / 3.0 };
+            let s = fmt_number(v);
+            assert_eq!(s.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{v:e} -> {s}");
+            assert!(s.len() <= format!("{v:e}").len() && s.len() <= format!("{v}").len());
+            x *= 1.0373;
+            if x > 1e150 {
+                x = 1e-150;
+            }
+        }
+    }
+
+    #[test]
+    fn unwritable_output_is_found_before_any_work() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("plain-file");
+        std::fs::write(&file, "x").unwrap();
+        let e = ensure_writable_dir(&file).unwrap_err().to_string();
+        assert!(e.contains("plain-file") && e.contains("not a directory"), "{e}");
+        let e = ensure_writable_dir(&file.join("sub")).unwrap_err().to_string();
+        assert!(e.contains("plain-file"), "{e}");
+        let ok = dir.path().join("a/b");
+        ensure_writable_dir(&ok).unwrap();
+        assert_eq!(std::fs::read_dir(&ok).unwrap().count(), 0, "the probe is removed");
     }
 }

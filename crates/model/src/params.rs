@@ -1,4 +1,4 @@
-//! Robot parameters (paper, section 8; MODEL-NOTES section 1).
+//! Robot parameters (paper, section 8; docs/paper-defects.md, Parameters).
 
 use serde::{Deserialize, Serialize};
 
@@ -33,7 +33,7 @@ pub struct RobotParams {
     #[serde(rename = "Jp")]
     pub jp: f64,
     /// Axial stiffness EA [N] used by models with axially flexible beams (FEM).
-    /// Default `E * rho / 7800` (steel density), MODEL-NOTES section 1: 6e6 N.
+    /// Default `E * rho / 7800` (steel density), docs/paper-defects.md: 6e6 N.
     #[serde(rename = "EA")]
     pub ea: Option<f64>,
 }
@@ -147,7 +147,7 @@ mod tests {
 
     #[test]
     fn paper_values_give_ei_half() {
-        // MODEL-NOTES section 1: EI = 0.5 N m^2, EA = 6e6 N.
+        // paper, section 8 (docs/paper-defects.md): EI = 0.5 N m^2, EA = 6e6 N.
         let p = RobotParams::paper();
         assert!((p.ei() - 0.5).abs() < 1e-12);
         assert!((p.ea() - 6e6).abs() < 1e-6);

@@ -1,13 +1,15 @@
 //! The result every solver returns, and its CSV form.
 //!
-//! Elastic outputs follow MODEL-NOTES section 2: `w_iG` is the elastic displacement of G projected
+//! Elastic outputs follow `docs/conventions.md`: `w_iG` is the elastic displacement of G projected
 //! on `e_wi`; the tip value `w_i(L)` is `(tip - (G_rigid + L e_xi)) . e_wi` [m]; `Fa_i` is the force
-//! the actuator applies to slider i along its +s direction [N] (Eq. 33).
+//! the actuator applies to slider i along its +s direction [N] (Eq. 33). Every column of every
+//! file is listed with its unit in `docs/outputs.md`.
 
 use std::path::Path;
 
 use crate::error::ModelError;
-use crate::output::write_atomically;
+use crate::output::{fmt_number, write_atomically};
+pub use crate::validity::{small_deflection_check, Provenance, ValidityExceeded};
 
 /// Fixed leading CSV columns of every solver result (issue contract).
 pub const RESPONSE_HEADER: [&str; 10] = ["t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3"];
@@ -164,18 +166,35 @@ impl Response {
                     row.extend(group.iter().map(|c| c[k]));
                 }
                 row.extend(self.extra.iter().map(|c| c.values[k]));
-                out.write_record(row.iter().map(|v| format!("{v:e}")))?;
+                out.write_record(row.iter().map(|v| fmt_number(*v)))?;
             }
             out.flush()?;
             Ok(())
         })
     }
 
-    /// Write the sidecar JSON of a run (`<csv name>.json`), whole or not at all: `flexstar_version`,
-    /// every field of [`RunInfo`] and the resolved `experiment`.
-    pub fn write_sidecar(&self, path: &Path, experiment: &crate::Experiment) -> Result<(), ModelError> {
+    /// Write the sidecar JSON of a run (`<csv name>.json`), whole or not at all:
+    /// `flexstar_version`, `commit` (when known), `date` (UTC, of the run), the `label`, every field
+    /// of [`RunInfo`], `small_deflection` (the check of [`small_deflection_check`]: `null` when the
+    /// run stays in range, else the first time, the quantity, its value and the bound) and the
+    /// resolved `experiment`. Fields are listed in `docs/outputs.md`.
+    pub fn write_sidecar(
+        &self,
+        path: &Path,
+        experiment: &crate::Experiment,
+        provenance: &Provenance,
+    ) -> Result<(), ModelError> {
         let mut doc = serde_json::Map::new();
-        doc.insert("flexstar_version".into(), env!("CARGO_PKG_VERSION").into());
+        doc.insert("flexstar_version".into(), provenance.version.clone().into());
+        doc.insert(
+            "commit".into(),
+            provenance
+                .commit
+                .clone()
+                .map(Into::into)
+                .unwrap_or(serde_json::Value::Null),
+        );
+        doc.insert("date".into(), provenance.date.clone().into());
         doc.insert("label".into(), self.label.clone().into());
         let info = serde_json::to_value(&self.info).map_err(|e| ModelError::Write {
             file: path.to_path_buf(),
@@ -184,6 +203,12 @@ impl Response {
         if let serde_json::Value::Object(fields) = info {
             doc.extend(fields);
         }
+        let validity =
+            serde_json::to_value(small_deflection_check(self, experiment.robot.l)).map_err(|e| ModelError::Write {
+                file: path.to_path_buf(),
+                reason: e.to_string(),
+            })?;
+        doc.insert("small_deflection".into(), validity);
         let exp = serde_json::to_value(experiment).map_err(|e| ModelError::Write {
             file: path.to_path_buf(),
             reason: e.to_string(),
@@ -205,12 +230,12 @@ impl Response {
                 for (i, b) in s.beams.iter().enumerate() {
                     for k in 0..b.x.len() {
                         out.write_record([
-                            format!("{:e}", s.t),
+                            fmt_number(s.t),
                             format!("{}", i + 1),
-                            format!("{:e}", b.x[k]),
-                            format!("{:e}", b.w[k]),
-                            format!("{:e}", b.pos[k][0]),
-                            format!("{:e}", b.pos[k][1]),
+                            fmt_number(b.x[k]),
+                            fmt_number(b.w[k]),
+                            fmt_number(b.pos[k][0]),
+                            fmt_number(b.pos[k][1]),
                         ])?;
                     }
                 }

@@ -16,7 +16,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let exp = super::load(&args.config)?;
-    let states = kinematics_table(&exp)?;
+    let states = kinematics_table(&exp).map_err(|e| anyhow::anyhow!("{}: {e}", args.config.display()))?;
     let dir = super::case_dir(&args.out, &exp)?;
     let path = dir.join("kinematics.csv");
     write_kinematics_csv(&path, &states)?;

@@ -3,9 +3,9 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use anyhow::bail;
+use anyhow::{anyhow, bail};
 use flexstar_model::config::check_step;
-use flexstar_model::{ModeFamily, Response};
+use flexstar_model::{small_deflection_check, ModeFamily, Response};
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Solver {
@@ -53,13 +53,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut exp = super::load(&args.config)?;
     let cfg = args.config.display();
     if let Some(dt) = args.dt {
-        check_step("--dt", dt, exp.time.dt_out)?;
+        check_step("--dt", dt, exp.time.dt_out).map_err(|e| e.in_file(&args.config))?;
     }
+    // the feasibility scan of both solvers, here too so that nothing is created for a motion
+    // that is refused
+    flexstar_kinematics::check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))
+        .map_err(|e| anyhow!("{cfg}: {e}"))?;
     let started = std::time::Instant::now();
+    let dir;
     let (response, file): (Response, String) = match args.solver {
         Solver::Amm => {
             if args.elements.is_some() {
-                bail!("--elements applies to --solver fem only");
+                bail!("{cfg}: --elements applies to --solver fem only");
             }
             if let Some(f) = args.family {
                 exp.amm.family = f;
@@ -80,13 +85,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             }
             exp.validate()
                 .map_err(|e| anyhow::anyhow!("{cfg} with the command-line flags: {e}"))?;
+            dir = super::case_dir(&args.out, &exp)?;
             eprintln!("{}: AMM, {:?}, {}", exp.name, exp.amm.mode_count(), exp.amm.family);
-            let r = flexstar_amm::solve(&exp, &exp.amm)?;
+            let r = flexstar_amm::solve(&exp, &exp.amm).map_err(|e| anyhow!("{cfg}: {e}"))?;
             (r, format!("amm-{}", exp.amm.family))
         }
         Solver::Fem => {
             if args.family.is_some() || args.modes.is_some() || args.model.is_some() || args.tol.is_some() {
-                bail!("--family, --modes, --model and --tol apply to --solver amm only");
+                bail!("{cfg}: --family, --modes, --model and --tol apply to --solver amm only");
             }
             if let Some(n) = args.elements {
                 exp.fem.elements = n;
@@ -96,6 +102,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             }
             exp.validate()
                 .map_err(|e| anyhow::anyhow!("{cfg} with the command-line flags: {e}"))?;
+            dir = super::case_dir(&args.out, &exp)?;
             eprintln!("{}: FEM, {} elements", exp.name, exp.fem.elements);
             let r = if std::io::stderr().is_terminal() {
                 let bar = indicatif::ProgressBar::new(1000);
@@ -109,15 +116,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 r
             } else {
                 flexstar_fem::solve(&exp, &exp.fem, None)
-            }?;
+            }
+            .map_err(|e| anyhow!("{cfg}: {e}"))?;
             (r, "fem".to_string())
         }
     };
-    let dir = super::case_dir(&args.out, &exp)?;
     let csv = dir.join(format!("{file}.csv"));
     response.write_csv(&csv)?;
     response.write_shapes_csv(&dir.join(format!("{file}-shapes.csv")))?;
-    response.write_sidecar(&dir.join(format!("{file}.json")), &exp)?;
+    response.write_sidecar(&dir.join(format!("{file}.json")), &exp, &super::provenance())?;
+    if let Some(v) = small_deflection_check(&response, exp.robot.l) {
+        eprintln!("warning: {cfg}: {file} {v}");
+    }
     let peak = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     eprintln!(
         "{}: {} rows to {} in {:.2} s; peak |tip| A/B/C = {:.3e}/{:.3e}/{:.3e} m, peak |w_iG| = {:.3e} m",

@@ -1,0 +1,60 @@
+//! `flexstar compare CONFIG [--families F,...] [--modes N] [--out DIR]`.
+
+use std::path::PathBuf;
+
+use flexstar_compare::compare::{run_compare, CompareOptions};
+use flexstar_model::ModeFamily;
+
+use crate::progress::Reporter;
+
+/// Run the AMM (the experiment's [amm] settings, plus any families asked) and the FEM on an
+/// experiment and compare them: writes DIR/<name>/compare.md, compare.csv, compare.json, the
+/// figures, report.html, and every run's CSV and sidecar JSON.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Experiment file (TOML)
+    config: PathBuf,
+    /// Further mode families to run, comma-separated: pinned-free, slide-free, free-free,
+    /// clamped-free, enriched
+    #[arg(long, value_delimiter = ',')]
+    families: Vec<ModeFamily>,
+    /// Modes per beam N for every AMM run (overrides [amm] modes / tol)
+    #[arg(long)]
+    modes: Option<usize>,
+    /// Output directory; results go to DIR/<name>/
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// Skip the figures and the HTML report
+    #[arg(long)]
+    no_figures: bool,
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let opts = CompareOptions {
+        config: args.config,
+        families: args.families,
+        modes: args.modes,
+        out: args.out,
+        figures: !args.no_figures,
+        provenance: super::provenance(),
+    };
+    let reporter = Reporter::new("compare");
+    let tick = |p| reporter.update(p);
+    let outcome = run_compare(&opts, Some(&tick));
+    reporter.finish();
+    let outcome = outcome?;
+    super::print_warnings(&outcome.warnings);
+    println!(
+        "{}",
+        std::fs::read_to_string(outcome.dir.join("compare.csv"))?.trim_end()
+    );
+    eprintln!(
+        "compare: solves {:.2} s, total {:.2} s; behaviour of G: {}; closest to the FEM: {}; outputs in {}",
+        outcome.solve_seconds,
+        outcome.total_seconds,
+        outcome.row.behaviour.name(),
+        outcome.row.most_accurate.as_deref().unwrap_or("-"),
+        outcome.dir.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,302 @@
+//! The outputs of one experiment, as `flexstar compare` writes them into `DIR/<name>/` (and
+//! `flexstar verify` for each paper case): every run's CSV, shapes and sidecar JSON, the EVPs
+//! (`compare.md`, `compare.csv`, `compare.json`), the figure set and a report for the
+//! experiment. Columns and fields are listed in `docs/outputs.md`.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
+use flexstar_model::output::write_string_atomically;
+use flexstar_model::{small_deflection_check, Experiment, ModeFamily, Provenance, Response, ValidityExceeded};
+use serde::Serialize;
+
+use crate::figures::{
+    figure_forces, figure_star, figure_tips, figure_w_g, Figure, Run, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE,
+};
+use crate::runs::CaseResults;
+use crate::table::{opt_number, TableRow};
+use crate::Error;
+
+/// Header of `compare.csv` (issue 14 contract).
+pub const COMPARE_CSV_HEADER: &str = "model,evp_A,evp_B,evp_C,evp_G,evp_mean";
+
+/// A run that leaves the small-deflection range the AMM assumes.
+#[derive(Debug, Clone, Serialize)]
+pub struct ValidityWarning {
+    /// Experiment file.
+    pub file: String,
+    /// Run file stem (`fem`, `amm-<label>`).
+    pub run: String,
+    pub exceeded: ValidityExceeded,
+}
+
+impl std::fmt::Display for ValidityWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {} {}", self.file, self.run, self.exceeded)
+    }
+}
+
+/// Every run of a case with its file stem: the FEM first, then the AMM runs.
+pub fn runs_of(case: &CaseResults) -> Vec<(String, &Response)> {
+    std::iter::once(("fem".to_string(), &case.fem))
+        .chain(case.amm.iter().map(|(run, r)| (run.file_stem(), r)))
+        .collect()
+}
+
+/// The small-deflection check of every run of a case.
+pub fn validity_warnings(exp: &Experiment, case: &CaseResults) -> Vec<ValidityWarning> {
+    runs_of(case)
+        .into_iter()
+        .filter_map(|(run, r)| {
+            small_deflection_check(r, exp.robot.l).map(|exceeded| ValidityWarning {
+                file: exp.source.display().to_string(),
+                run,
+                exceeded,
+            })
+        })
+        .collect()
+}
+
+/// The colour of a family (the same in every figure); a second run of a family already drawn
+/// takes the next of [`EXTRA_COLORS`].
+fn run_style(family: ModeFamily, used: &mut Vec<ModeFamily>) -> Style {
+    let k = ModeFamily::ALL.iter().position(|f| *f == family).unwrap_or(0);
+    let repeats = used.iter().filter(|f| **f == family).count();
+    used.push(family);
+    let color = match repeats {
+        0 => FAMILY_COLORS[k % FAMILY_COLORS.len()],
+        n => EXTRA_COLORS[(n - 1) % EXTRA_COLORS.len()],
+    };
+    Style {
+        color,
+        width: 2,
+        dashed: false,
+    }
+}
+
+/// The figure set of one case: w_G, tips, the deformed star at its last snapshot, and the driving
+/// forces over the rigid-body inverse dynamics.
+pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>, Error> {
+    let mut runs = vec![Run {
+        label: "FEM".into(),
+        response: &case.fem,
+        style: FEM_STYLE,
+    }];
+    let mut used = Vec::new();
+    for (run, r) in &case.amm {
+        runs.push(Run {
+            label: format!("AMM {}", run.label),
+            response: r,
+            style: run_style(run.settings.family, &mut used),
+        });
+    }
+    let kin = |t: f64| {
+        RigidState::at(&exp.robot, &exp.trajectory, t).map_err(|source| Error::Kinematics {
+            file: exp.source.display().to_string(),
+            source: Box::new(source),
+        })
+    };
+    let t = &case.fem.t;
+    let rigid: Vec<[f64; 3]> = t
+        .iter()
+        .map(|&ti| kin(ti).map(|s| rigid_inverse_dynamics(&exp.robot, &s).fa))
+        .collect::<Result<_, _>>()?;
+    let mut figs = vec![figure_w_g(&exp.name, &runs), figure_tips(&exp.name, &runs)];
+    let last = kin(exp.time.t_end)?;
+    let peak = case
+        .fem
+        .w_tip
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+        .max(1e-9);
+    // magnify the elastic part to about a fifth of the beam length
+    let magnify = (0.2 * exp.robot.l / peak).clamp(1.0, 1e4).round();
+    if let Some(f) = figure_star(&exp.name, &runs, &last, magnify) {
+        figs.push(f);
+    }
+    figs.push(figure_forces(&exp.name, &runs, Some((t, &rigid))));
+    Ok(figs)
+}
+
+/// `compare.csv`: one row per AMM run, `model` = its file stem, EVPs in %, `n/a` where the FEM
+/// reference is negligible.
+pub fn compare_csv(row: &TableRow) -> String {
+    let mut s = format!("{COMPARE_CSV_HEADER}\n");
+    for e in &row.families {
+        let p = e.evp.points;
+        let _ = writeln!(
+            s,
+            "amm-{},{},{},{},{},{}",
+            e.label,
+            opt_number(p[0]),
+            opt_number(p[1]),
+            opt_number(p[2]),
+            opt_number(p[3]),
+            opt_number(e.evp.mean)
+        );
+    }
+    s
+}
+
+fn pct(v: Option<f64>) -> String {
+    v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "n/a".into())
+}
+
+/// `compare.md`: what was run, the EVPs, the behaviour of G, the figures.
+pub fn compare_markdown(exp: &Experiment, case: &CaseResults, row: &TableRow, figures: &[Figure]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# {}: AMM against FEM\n", exp.name);
+    if !exp.description.is_empty() {
+        let _ = writeln!(s, "{}\n", exp.description);
+    }
+    let _ = writeln!(
+        s,
+        "Experiment file `{}`; t = 0 .. {} s, output every {} s.\n",
+        exp.source.display(),
+        exp.time.t_end,
+        exp.time.dt_out
+    );
+    let _ = writeln!(s, "## Runs\n");
+    let _ = writeln!(s, "{}", runs_markdown(case));
+    let _ = writeln!(s, "## EVP (Eq. 45), % of the FEM response\n");
+    let _ = writeln!(
+        s,
+        "`EVP = int |w_AMM - w_FEM| dt / int |w_FEM| dt * 100` at the tips A, B, C and at G (length of G's \
+         elastic displacement vector); *n/a*: the FEM response there is below 1 % of its largest tip peak, \
+         left out of the mean.\n"
+    );
+    let _ = writeln!(s, "| run | A | B | C | G | mean | correct at G |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    for e in &row.families {
+        let p = e.evp.points;
+        let _ = writeln!(
+            s,
+            "| {}{} | {} | {} | {} | {} | {} | {} |",
+            e.label,
+            if e.most_accurate { " (**best**)" } else { "" },
+            pct(p[0]),
+            pct(p[1]),
+            pct(p[2]),
+            pct(p[3]),
+            pct(e.evp.mean),
+            if e.correct { "yes" } else { "no" }
+        );
+    }
+    let m = row.measures;
+    let _ = writeln!(
+        s,
+        "\n## Behaviour of G (from the FEM): {}\n\npeak |w_G| / peak tip = {:.3e} (moves when >= 1e-2); \
+         peak |slope_G| L / peak tip = {} (turns when >= 5e-2). A run is *correct at G* when its modes' boundary \
+         conditions at G can represent that: pinned-free forces w_G = 0, slide-free a zero slope, free-free \
+         neither.\n",
+        row.behaviour.name(),
+        m.w_g_rel,
+        m.slope_rel.map(|v| format!("{v:.3e}")).unwrap_or_else(|| "n/a".into())
+    );
+    let warnings = validity_warnings(exp, case);
+    if !warnings.is_empty() {
+        let _ = writeln!(s, "## Model validity\n");
+        for w in &warnings {
+            let _ = writeln!(s, "- {} {}", w.run, w.exceeded);
+        }
+        let _ = writeln!(s);
+    }
+    if !figures.is_empty() {
+        let _ = writeln!(s, "## Figures\n");
+        for f in figures {
+            let _ = writeln!(s, "![{}](figures/{}.png)\n\n{}\n", f.title, f.name, f.caption);
+        }
+    }
+    s
+}
+
+/// The run metadata table (Markdown): solver, settings, wall time, small-deflection check.
+pub fn runs_markdown(case: &CaseResults) -> String {
+    let mut s =
+        String::from("| run | solver | family | model | N | elements | dt [s] | wall time [s] | small deflection |\n");
+    s.push_str("|---|---|---|---|---|---|---|---|---|\n");
+    for (stem, r) in runs_of(case) {
+        let i = &r.info;
+        let opt = |v: &Option<String>| v.clone().unwrap_or_else(|| "-".into());
+        let check = match small_deflection_check(r, case.beam_length) {
+            None => "in range".to_string(),
+            Some(v) => format!("**left at t = {:.4} s** ({})", v.t, v.quantity),
+        };
+        let _ = writeln!(
+            s,
+            "| {stem} | {} | {} | {} | {} | {} | {} | {:.2} | {check} |",
+            i.solver,
+            opt(&i.family),
+            opt(&i.model),
+            i.modes.map(|n| n.to_string()).unwrap_or_else(|| "-".into()),
+            i.elements.map(|n| n.to_string()).unwrap_or_else(|| "-".into()),
+            short(i.dt),
+            i.wall_s
+        );
+    }
+    s
+}
+
+#[derive(Serialize)]
+struct RunJson<'a> {
+    run: String,
+    info: &'a flexstar_model::RunInfo,
+    small_deflection: Option<ValidityExceeded>,
+}
+
+/// `compare.json`: provenance, the experiment file, the row (EVPs, verdicts, behaviour, junction
+/// measures) and every run's settings, cost and small-deflection check.
+pub fn compare_json(exp: &Experiment, case: &CaseResults, row: &TableRow, prov: &Provenance) -> String {
+    let runs: Vec<RunJson> = runs_of(case)
+        .into_iter()
+        .map(|(run, r)| RunJson {
+            run,
+            info: &r.info,
+            small_deflection: small_deflection_check(r, exp.robot.l),
+        })
+        .collect();
+    let doc = serde_json::json!({
+        "flexstar_version": prov.version,
+        "commit": prov.commit,
+        "date": prov.date,
+        "experiment": exp.name,
+        "file": exp.source.display().to_string(),
+        "comparison": row,
+        "runs": runs,
+    });
+    serde_json::to_string_pretty(&doc).expect("plain data serialises") + "\n"
+}
+
+/// Write every output of one case into `dir` (see the module docs); returns the figures (empty
+/// when `figures` is false) for a combined report. `report`: the HTML of this case's own report,
+/// built by the caller from the figures (so that `verify` and `compare` share the page layout).
+pub fn write_case(
+    dir: &Path,
+    exp: &Experiment,
+    case: &CaseResults,
+    row: &TableRow,
+    prov: &Provenance,
+    figures: bool,
+) -> Result<Vec<Figure>, Error> {
+    for (stem, r) in runs_of(case) {
+        r.write_csv(&dir.join(format!("{stem}.csv")))?;
+        r.write_shapes_csv(&dir.join(format!("{stem}-shapes.csv")))?;
+        r.write_sidecar(&dir.join(format!("{stem}.json")), exp, prov)?;
+    }
+    let figs = if figures { case_figures(exp, case)? } else { Vec::new() };
+    let figdir = dir.join("figures");
+    for f in &figs {
+        f.write(&figdir)?;
+    }
+    write_string_atomically(&dir.join("compare.csv"), &compare_csv(row))?;
+    write_string_atomically(&dir.join("compare.md"), &compare_markdown(exp, case, row, &figs))?;
+    write_string_atomically(&dir.join("compare.json"), &compare_json(exp, case, row, prov))?;
+    Ok(figs)
+}
+
+/// A step for display: four significant digits (`1.667e-4`); files keep the exact value.
+fn short(v: f64) -> String {
+    format!("{v:.3e}")
+}

@@ -1,0 +1,278 @@
+//! The solver runs behind `flexstar compare` and `flexstar verify`: per experiment, the FEM
+//! reference and a list of AMM runs, each a (label, [`AmmSettings`]) pair, run in parallel (rayon)
+//! after every check that can be made before the work.
+//!
+//! A new AMM variant (e.g. flexstar's accurate model) is one more [`AmmRun`] in the list; the
+//! EVPs, Table I, the figures and the report pick it up by its label.
+
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use flexstar_kinematics::check_trajectory;
+use flexstar_model::{AmmSettings, Experiment, ModeFamily, Response};
+use rayon::prelude::*;
+
+/// One AMM run of an experiment: a label (unique within the experiment, used as column name,
+/// `compare.csv` model and file name `amm-<label>.csv`) and the solver settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AmmRun {
+    pub label: String,
+    pub settings: AmmSettings,
+}
+
+impl AmmRun {
+    /// The run of one mode family with the experiment's other `[amm]` settings (model, N or tol,
+    /// step, snapshots), labelled by the family's name.
+    pub fn family(exp_settings: &AmmSettings, family: ModeFamily) -> Self {
+        AmmRun {
+            label: family.name().to_string(),
+            settings: AmmSettings {
+                family,
+                ..exp_settings.clone()
+            },
+        }
+    }
+
+    /// The paper's setting (`AmmSettings::paper`) for `family` with N modes, keeping the
+    /// experiment's step and snapshots, labelled by the family's name.
+    pub fn paper(exp_settings: &AmmSettings, family: ModeFamily, modes: usize) -> Self {
+        AmmRun {
+            label: family.name().to_string(),
+            settings: AmmSettings {
+                snapshots: exp_settings.snapshots.clone(),
+                dt: exp_settings.dt,
+                ..AmmSettings::paper(family, modes)
+            },
+        }
+    }
+
+    /// File stem of the run's outputs: `amm-<label>`.
+    pub fn file_stem(&self) -> String {
+        format!("amm-{}", self.label)
+    }
+}
+
+/// What to run for one experiment.
+#[derive(Debug, Clone)]
+pub struct CaseSpec {
+    pub exp: Experiment,
+    /// The AMM runs compared with the FEM (EVPs, figures, table columns).
+    pub amm: Vec<AmmRun>,
+    /// Further AMM runs reported as mean EVPs only (the N study of `verify`).
+    pub extra: Vec<AmmRun>,
+}
+
+/// Solver results of one experiment.
+#[derive(Debug, Clone)]
+pub struct CaseResults {
+    pub name: String,
+    pub description: String,
+    /// Beam length L [m] (lever arm of the slope at G, small-deflection bound).
+    pub beam_length: f64,
+    pub fem: Response,
+    /// The compared AMM runs, in the order of [`CaseSpec::amm`].
+    pub amm: Vec<(AmmRun, Response)>,
+    /// The further runs of [`CaseSpec::extra`].
+    pub extra: Vec<(AmmRun, Response)>,
+}
+
+/// Errors that stop the runs (each names the experiment file).
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("{file}: {reason}")]
+    Input { file: String, reason: String },
+    #[error("{file}: AMM {label}: {source}")]
+    Amm {
+        file: String,
+        label: String,
+        #[source]
+        source: Box<flexstar_amm::AmmError>,
+    },
+    #[error("{file}: FEM: {source}")]
+    Fem {
+        file: String,
+        #[source]
+        source: Box<flexstar_fem::FemError>,
+    },
+}
+
+/// Progress of a batch of runs, as reported to the caller's callback.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Runs finished.
+    pub done: usize,
+    /// Runs in all.
+    pub total: usize,
+    /// Fraction of the whole work done, 0..1 (FEM runs report partial progress, AMM runs count
+    /// when they finish).
+    pub fraction: f64,
+    /// Seconds since the start.
+    pub elapsed: f64,
+}
+
+/// Callback receiving [`Progress`]; called from worker threads.
+pub type ProgressFn<'a> = &'a (dyn Fn(Progress) + Sync);
+
+/// Everything that can be checked before the work, for every experiment and run: the settings
+/// of each AMM run (keys named relative to the experiment file), unique labels, and the
+/// feasibility of the trajectory over the whole span.
+pub fn preflight(specs: &[CaseSpec]) -> Result<(), RunError> {
+    for spec in specs {
+        let exp = &spec.exp;
+        let file = exp.source.display().to_string();
+        let input = |reason: String| RunError::Input {
+            file: file.clone(),
+            reason,
+        };
+        for run in spec.amm.iter().chain(&spec.extra) {
+            run.settings
+                .validate(exp.time.dt_out)
+                .map_err(|e| input(format!("AMM {}: {}", run.label, strip_file(&e.to_string()))))?;
+        }
+        for (k, run) in spec.amm.iter().enumerate() {
+            if spec.amm[..k].iter().any(|r| r.label == run.label) {
+                return Err(input(format!("two AMM runs labelled {}", run.label)));
+            }
+        }
+        check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))
+            .map_err(|e| input(e.to_string()))?;
+    }
+    Ok(())
+}
+
+/// A model error raised without a file starts with ": "; drop it (the caller names the file).
+fn strip_file(msg: &str) -> &str {
+    msg.strip_prefix(": ").unwrap_or(msg)
+}
+
+enum Job {
+    Fem(usize),
+    Amm(usize, usize),
+    Extra(usize, usize),
+}
+
+/// Weight of a FEM run in the progress fraction, against 1 for an AMM run (the FEM takes about
+/// twenty times as long as one AMM run at the paper's settings).
+const FEM_WEIGHT: f64 = 20.0;
+
+struct Tracker<'a> {
+    start: Instant,
+    total: usize,
+    /// Per job: its weight in the progress fraction.
+    weights: Vec<f64>,
+    done: AtomicUsize,
+    /// Per job: fraction done, as f64 bits.
+    fractions: Vec<AtomicU64>,
+    callback: Option<ProgressFn<'a>>,
+    last: Mutex<f64>,
+}
+
+impl Tracker<'_> {
+    fn set(&self, job: usize, f: f64, finished: bool) {
+        self.fractions[job].store(f.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
+        if finished {
+            self.done.fetch_add(1, Ordering::Relaxed);
+        }
+        let Some(cb) = self.callback else { return };
+        let elapsed = self.start.elapsed().as_secs_f64();
+        // at most ten reports a second, and every finished run
+        {
+            let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+            if !finished && elapsed - *last < 0.1 {
+                return;
+            }
+            *last = elapsed;
+        }
+        let sum: f64 = self
+            .fractions
+            .iter()
+            .zip(&self.weights)
+            .map(|(a, w)| w * f64::from_bits(a.load(Ordering::Relaxed)))
+            .sum();
+        let all: f64 = self.weights.iter().sum();
+        cb(Progress {
+            done: self.done.load(Ordering::Relaxed),
+            total: self.total,
+            fraction: if all > 0.0 { sum / all } else { 1.0 },
+            elapsed,
+        });
+    }
+}
+
+/// Run every FEM and AMM run of `specs` in parallel, after [`preflight`]. Results come back in
+/// the order of `specs`.
+pub fn run_cases(specs: &[CaseSpec], progress: Option<ProgressFn>) -> Result<Vec<CaseResults>, RunError> {
+    preflight(specs)?;
+    // AMM runs first: they are short, and a failing one stops the batch early
+    let mut jobs = Vec::new();
+    for (k, s) in specs.iter().enumerate() {
+        jobs.extend((0..s.amm.len()).map(|j| Job::Amm(k, j)));
+    }
+    for (k, s) in specs.iter().enumerate() {
+        jobs.extend((0..s.extra.len()).map(|j| Job::Extra(k, j)));
+    }
+    jobs.extend((0..specs.len()).map(Job::Fem));
+    let tracker = Tracker {
+        start: Instant::now(),
+        total: jobs.len(),
+        weights: jobs
+            .iter()
+            .map(|j| if matches!(j, Job::Fem(_)) { FEM_WEIGHT } else { 1.0 })
+            .collect(),
+        done: AtomicUsize::new(0),
+        fractions: (0..jobs.len()).map(|_| AtomicU64::new(0)).collect(),
+        callback: progress,
+        last: Mutex::new(f64::NEG_INFINITY),
+    };
+    let file = |k: usize| specs[k].exp.source.display().to_string();
+    let results: Vec<Response> = jobs
+        .par_iter()
+        .enumerate()
+        .map(|(j, job)| {
+            let r = match *job {
+                Job::Fem(k) => {
+                    let exp = &specs[k].exp;
+                    let tick = |f: f64| tracker.set(j, f, false);
+                    flexstar_fem::solve(exp, &exp.fem, Some(&tick)).map_err(|source| RunError::Fem {
+                        file: file(k),
+                        source: Box::new(source),
+                    })
+                }
+                Job::Amm(k, i) | Job::Extra(k, i) => {
+                    let run = match job {
+                        Job::Amm(..) => &specs[k].amm[i],
+                        _ => &specs[k].extra[i],
+                    };
+                    flexstar_amm::solve(&specs[k].exp, &run.settings).map_err(|source| RunError::Amm {
+                        file: file(k),
+                        label: run.label.clone(),
+                        source: Box::new(source),
+                    })
+                }
+            }?;
+            tracker.set(j, 1.0, true);
+            Ok(r)
+        })
+        .collect::<Result<_, RunError>>()?;
+
+    let mut cases: Vec<CaseResults> = specs
+        .iter()
+        .map(|s| CaseResults {
+            name: s.exp.name.clone(),
+            description: s.exp.description.clone(),
+            beam_length: s.exp.robot.l,
+            fem: Response::default(),
+            amm: Vec::new(),
+            extra: Vec::new(),
+        })
+        .collect();
+    for (job, r) in jobs.iter().zip(results) {
+        match *job {
+            Job::Fem(k) => cases[k].fem = r,
+            Job::Amm(k, i) => cases[k].amm.push((specs[k].amm[i].clone(), r)),
+            Job::Extra(k, i) => cases[k].extra.push((specs[k].extra[i].clone(), r)),
+        }
+    }
+    Ok(cases)
+}

@@ -1,0 +1,172 @@
+//! Where a run stands: the small-deflection check of the AMM's assumptions, and the provenance
+//! (version, commit, date) written beside every result.
+//!
+//! **Small-deflection range.** The AMM (paper, sections 4-7) is linear in the elastic
+//! displacement: a beam point moves along the rigid `e_wi` only, its axial shortening
+//! (`1/2 int w'^2`), the geometric stiffening of the axial force and the rotation of the sleeve
+//! contact direction are dropped. Those terms are of relative order `slope^2`. flexstar keeps the
+//! slope below [`SLOPE_BOUND`] = 0.075 rad, where `slope^2` is 0.56 %, below the ~1 % at which
+//! the EVPs of Table I are resolved. Two measurable quantities stand for the slope:
+//! - the tip deflection `|w_i(L)|` against [`TIP_BOUND`] `* L` = 0.05 L: a cantilever bent by a
+//!   tip load has a tip slope of 1.5 w(L)/L, so 0.05 L is the same 0.075 rad;
+//! - the slope at the sleeves `|thp_i|` (the `thp1..3` columns, sleeve rotation relative to the
+//!   rigid beam = beam slope at the sleeve) against [`SLOPE_BOUND`] directly.
+//!
+//! Past that range the AMM's numbers lose their meaning; the FEM, geometrically nonlinear
+//! (co-rotational, large rotations), stays valid and is the tool to use there.
+
+use serde::Serialize;
+
+use crate::response::Response;
+
+/// Tip deflection bound, as a fraction of the beam length L.
+pub const TIP_BOUND: f64 = 0.05;
+/// Slope bound at the sleeves [rad].
+pub const SLOPE_BOUND: f64 = 0.075;
+
+/// The first time a run leaves the small-deflection range.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ValidityExceeded {
+    /// First output time at which a bound is exceeded [s].
+    pub t: f64,
+    /// The quantity, e.g. `|w2tip| / L` or `|thp1|`.
+    pub quantity: String,
+    /// Its value at `t` (dimensionless or rad).
+    pub value: f64,
+    /// The bound it exceeds (same unit).
+    pub bound: f64,
+    /// Its peak over the run (same unit).
+    pub peak: f64,
+}
+
+impl std::fmt::Display for ValidityExceeded {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "leaves the small-deflection range the AMM assumes at t = {:.4} s: {} = {:.4} > {} (peak {:.4}); \
+             the AMM's results past that time are outside its model, the FEM (geometrically nonlinear) stays valid",
+            self.t, self.quantity, self.value, self.bound, self.peak
+        )
+    }
+}
+
+/// Check a response against the small-deflection bounds ([`TIP_BOUND`] on the tips, [`SLOPE_BOUND`]
+/// on `thp1..3` where present); `None` while it stays in range. `l`: beam length [m].
+pub fn small_deflection_check(r: &Response, l: f64) -> Option<ValidityExceeded> {
+    let mut series: Vec<(String, Vec<f64>, f64)> = (0..3)
+        .map(|i| {
+            (
+                format!("|w{}tip| / L", i + 1),
+                r.w_tip[i].iter().map(|w| w.abs() / l).collect(),
+                TIP_BOUND,
+            )
+        })
+        .collect();
+    for i in 1..=3 {
+        if let Some(c) = r.column(&format!("thp{i}")) {
+            series.push((format!("|thp{i}|"), c.iter().map(|v| v.abs()).collect(), SLOPE_BOUND));
+        }
+    }
+    let mut first: Option<(usize, usize)> = None;
+    for (s, (_, values, bound)) in series.iter().enumerate() {
+        if let Some(k) = values.iter().position(|v| *v > *bound || !v.is_finite()) {
+            if first.is_none_or(|(k0, _)| k < k0) {
+                first = Some((k, s));
+            }
+        }
+    }
+    let (k, s) = first?;
+    let (quantity, values, bound) = &series[s];
+    Some(ValidityExceeded {
+        t: r.t[k],
+        quantity: quantity.clone(),
+        value: values[k],
+        bound: *bound,
+        peak: values.iter().fold(0.0, |m, v| m.max(*v)),
+    })
+}
+
+/// What produced a result: flexstar's version, the commit it was built from (when known) and
+/// the date of the run (UTC, ISO 8601).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Provenance {
+    pub version: String,
+    pub commit: Option<String>,
+    pub date: String,
+}
+
+impl Provenance {
+    /// This build's version, the given commit, and now.
+    pub fn now(commit: Option<&str>) -> Self {
+        let secs = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_secs())
+            .unwrap_or(0);
+        Provenance {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            commit: commit.filter(|c| !c.is_empty()).map(str::to_string),
+            date: utc_date_time(secs),
+        }
+    }
+}
+
+/// `YYYY-MM-DDTHH:MM:SSZ` for seconds since 1970-01-01 UTC (proleptic Gregorian calendar; days to
+/// civil date after H. Hinnant, "chrono-Compatible Low-Level Date Algorithms").
+pub fn utc_date_time(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dates_of_known_instants() {
+        // reference instants: `date -u -d @SECS` (GNU coreutils)
+        assert_eq!(utc_date_time(0), "1970-01-01T00:00:00Z");
+        assert_eq!(utc_date_time(951_782_400), "2000-02-29T00:00:00Z");
+        assert_eq!(utc_date_time(1_700_000_000), "2023-11-14T22:13:20Z");
+        assert_eq!(utc_date_time(4_107_542_399), "2100-02-28T23:59:59Z");
+    }
+
+    fn response(tips: &[f64]) -> Response {
+        let mut r = Response::with_capacity("x", tips.len());
+        for (k, w) in tips.iter().enumerate() {
+            r.push(k as f64 * 0.1, [0.0; 3], [0.0, *w, 0.0], [0.0; 3]);
+        }
+        r
+    }
+
+    #[test]
+    fn first_time_past_the_bound_is_reported() {
+        let l = 0.5;
+        assert_eq!(small_deflection_check(&response(&[0.0, 0.01, -0.024]), l), None);
+        let v = small_deflection_check(&response(&[0.0, 0.01, -0.026, 0.04]), l).unwrap();
+        assert_eq!(v.quantity, "|w2tip| / L");
+        assert!((v.t - 0.2).abs() < 1e-12 && (v.value - 0.052).abs() < 1e-12 && (v.peak - 0.08).abs() < 1e-12);
+        // a sleeve slope past the bound before the tips
+        let mut r = response(&[0.0, 0.0, 0.03]);
+        r.set_extra(
+            &["thp1", "thp2", "thp3"],
+            vec![vec![0.0, 0.08, 0.0], vec![0.0; 3], vec![0.0; 3]],
+        );
+        let v = small_deflection_check(&r, l).unwrap();
+        assert_eq!((v.quantity.as_str(), v.t), ("|thp1|", 0.1));
+    }
+}

@@ -34,7 +34,9 @@ fn accurate_model(c: &mut Criterion) {
     for case in [3, 1, 2, 4] {
         let exp = common::paper_case(case);
         let settings = flexstar_model::AmmSettings::accurate();
-        group.bench_function(format!("case{case}_auto"), |b| b.iter(|| solve(&exp, &settings).unwrap()));
+        group.bench_function(format!("case{case}_auto"), |b| {
+            b.iter(|| solve(&exp, &settings).unwrap())
+        });
     }
     let exp = common::paper_case(3);
     let fixed = flexstar_model::AmmSettings {

@@ -6,7 +6,7 @@
 //! `e(N_prev) - e(N) = e(N) ((N / N_prev)^p - 1)`; the enriched family's observed rate on the
 //! paper's cases is p ~ 5 (`docs/amm.md` section 9), for which `(1.15)^5 - 1 ~ 1`, so the
 //! estimate of e(N) is d itself. N starts where the modes first resolve the sleeve (wavelength
-//! 2L/N below Lp, MODEL-NOTES section 5, plus a margin) and grows by 15 % until the estimate is below
+//! 2L/N below Lp, `docs/amm.md` section 3, plus a margin) and grows by 15 % until the estimate is below
 //! the tolerance, up to [`MAX_AUTO_MODES`].
 
 use flexstar_model::evp::point_evps;

@@ -10,7 +10,7 @@
 //!   constraints of Eqs. 38-43) and their per-step linear solve;
 //! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]).
 //!
-//! Frames and signs follow MODEL-NOTES sections 2-3; the derivation, the departures from the
+//! Frames and signs follow `docs/conventions.md`; the derivation, the departures from the
 //! printed paper and the convergence study are in `docs/amm.md`. SI units throughout.
 
 // Units are written in brackets after a quantity ([m], [Hz]) as in the other flexstar crates.

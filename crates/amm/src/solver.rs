@@ -133,7 +133,7 @@ fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 ///
 /// `settings` are the `[amm]` settings after command-line overrides (`exp.amm` is not read).
 /// Returns the response at `exp.time.output_times()`, labelled `amm-<family>`: `w_iG = w_i(0)`,
-/// tip `w_i(L)` (rigid beam frames, MODEL-NOTES section 2) [m], `Fa_i` (Eq. 33) [N], then the
+/// tip `w_i(L)` (rigid beam frames, `docs/conventions.md`) [m], `Fa_i` (Eq. 33) [N], then the
 /// columns [`EXTRA_COLUMNS`]: every multiplier (Fix [N], MiG [N m], Fw, Fp, FLp, FRp [N],
 /// Mp [N m]), the sleeve rotations thp_i [rad] and the axial displacements u_i [m]; and the
 /// deformed star at `settings.snapshots` and t_end. Multipliers of rows dropped for the family
@@ -381,7 +381,7 @@ mod tests {
 
     #[test]
     fn rows_dropped_per_family() {
-        // MODEL-NOTES section 4: pinned-free loses sum w_iG, slide-free the slope equalities
+        // docs/amm.md section 1: pinned-free loses sum w_iG, slide-free the slope equalities
         let p = RobotParams::paper();
         let count = |fam| {
             System::new(ModeSet::new(fam, 25, &p).unwrap(), &p, AmmModel::Paper)

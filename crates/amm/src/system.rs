@@ -28,7 +28,7 @@ use crate::modes::{ModeSet, SleeveBending, Triplet};
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
 
-/// One constraint row and its multiplier (MODEL-NOTES section 3; Eqs. 24-29, 38-43). Beams are
+/// One constraint row and its multiplier (`docs/amm.md` section 1; Eqs. 24-29, 38-43). Beams are
 /// 0-based here. The multiplier is the generalized force on the beam for the row as written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Row {

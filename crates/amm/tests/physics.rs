@@ -320,7 +320,7 @@ fn bad_input_is_rejected_before_any_work() {
         key_of(solve(&no_jp, &settings(ModeFamily::FreeFree, 25, None)).unwrap_err()),
         "robot.Jp"
     );
-    // case 2 run past 0.4 s: sleeve J reaches G (MODEL-NOTES section 6)
+    // case 2 run past 0.4 s: sleeve J reaches G (docs/paper-defects.md)
     let mut long = paper_case(2);
     long.time.t_end = 0.5;
     match solve(&long, &settings(ModeFamily::SlideFree, 25, None)).unwrap_err() {

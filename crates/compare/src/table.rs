@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use flexstar_model::ModeFamily;
+use flexstar_model::{AmmModel, ModeFamily};
 use serde::Serialize;
 
 use crate::behaviour::{classify, is_correct, measure, Behaviour, JunctionMeasures};
@@ -20,6 +20,8 @@ pub struct FamilyEntry {
     pub family: ModeFamily,
     /// Modes per beam N, when fixed.
     pub modes: Option<usize>,
+    /// Modes per beam the run used (the automatic choice when `modes` is not fixed).
+    pub modes_used: Option<usize>,
     pub evp: PointEvps,
     pub correct: bool,
     pub most_accurate: bool,
@@ -57,6 +59,15 @@ pub struct TableI {
     pub rows: Vec<TableRow>,
 }
 
+/// N of a run as shown: the fixed N, or `N (auto)` for an automatic choice.
+fn n_label(e: &FamilyEntry) -> String {
+    match (e.modes, e.modes_used) {
+        (Some(n), _) => n.to_string(),
+        (None, Some(n)) => format!("{n} (auto)"),
+        (None, None) => "auto".into(),
+    }
+}
+
 fn family_index(f: ModeFamily) -> Option<usize> {
     ModeFamily::PAPER.iter().position(|g| *g == f)
 }
@@ -76,14 +87,24 @@ impl TableRow {
                 label: run.label.clone(),
                 family,
                 modes: run.settings.modes,
+                modes_used: r.info.modes,
                 evp,
                 correct: is_correct(family, behaviour),
                 most_accurate: false,
             });
         }
+        // the paper's verdict "most accurate" is among the paper's model runs when there are any
+        // (flexstar's accurate model stands beside them, not in the ranking)
+        let any_paper = case.amm.iter().any(|(run, _)| run.settings.model == AmmModel::Paper);
+        let ranked: Vec<bool> = case
+            .amm
+            .iter()
+            .map(|(run, _)| !any_paper || run.settings.model == AmmModel::Paper)
+            .collect();
         let best = families
             .iter()
             .enumerate()
+            .filter(|(k, _)| ranked[*k])
             .filter_map(|(k, f)| f.evp.mean.map(|m| (k, m)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(k, _)| k);
@@ -269,7 +290,7 @@ impl TableI {
                     "| {} | {} | {} | {} | {} | {} | {} | {} |",
                     row.case,
                     e.label,
-                    e.modes.map(|n| n.to_string()).unwrap_or_else(|| "auto".into()),
+                    n_label(e),
                     pct(p[0]),
                     pct(p[1]),
                     pct(p[2]),
@@ -325,7 +346,8 @@ impl TableI {
         }
         let _ = writeln!(s, "\n|---|---|{}", "---|".repeat(ns.len()));
         for row in &self.rows {
-            for e in &row.families {
+            // runs with a fixed N that the study repeats at other N (not the automatic-N runs)
+            for e in row.families.iter().filter(|e| e.modes.is_some()) {
                 let _ = write!(s, "| {} | {} |", row.case, e.label);
                 for n in &ns {
                     let v = if Some(*n) == e.modes {
@@ -366,7 +388,7 @@ impl TableI {
                     row.case,
                     e.label,
                     e.family,
-                    e.modes.map(|n| n.to_string()).unwrap_or_else(|| "auto".into()),
+                    e.modes.or(e.modes_used).map(|n| n.to_string()).unwrap_or_default(),
                     row.behaviour.name(),
                     opt_number(p[0]),
                     opt_number(p[1]),

@@ -45,8 +45,23 @@ pub struct Thresholds {
     /// Further N for the convergence columns of the table (not checked).
     #[serde(default)]
     pub n_study: Vec<usize>,
+    /// Hard upper bounds on flexstar's accurate model (issue 9 item 5), every case.
+    #[serde(default)]
+    pub accurate: Option<AccurateBounds>,
     /// Per case name.
     pub case: BTreeMap<String, CaseThresholds>,
+}
+
+/// `[accurate]`: upper bounds on the accurate model's EVP against the FEM [%] in every case.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AccurateBounds {
+    /// Label of the run (Table I column), `enriched`.
+    pub label: String,
+    /// Largest mean EVP over A, B, C, G [%].
+    pub mean_max: f64,
+    /// Largest EVP at any single point [%].
+    pub point_max: f64,
 }
 
 /// Errors reading the thresholds file.
@@ -188,6 +203,23 @@ impl Thresholds {
                     fmt(v),
                     format!("[{}, {}] %", band[0], band[1]),
                     matches!(v, Some(v) if v >= band[0] && v <= band[1]),
+                );
+            }
+            if let Some(acc) = &self.accurate {
+                let run = row.run(&acc.label);
+                let mean = run.and_then(|e| e.evp.mean);
+                push(
+                    format!("mean EVP of the accurate model ({})", acc.label),
+                    fmt(mean),
+                    format!("<= {} %", acc.mean_max),
+                    matches!(mean, Some(v) if v <= acc.mean_max),
+                );
+                let worst = run.map(|e| e.evp.points.iter().flatten().fold(0.0f64, |a, b| a.max(*b)));
+                push(
+                    format!("largest point EVP of the accurate model ({})", acc.label),
+                    fmt(worst),
+                    format!("<= {} %", acc.point_max),
+                    matches!(worst, Some(v) if v <= acc.point_max),
                 );
             }
         }

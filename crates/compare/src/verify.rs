@@ -61,10 +61,19 @@ pub struct VerifyOutcome {
 /// equations), and the N study. flexstar's own models are added to `amm` as further
 /// [`AmmRun`]s.
 pub fn verify_spec(exp: Experiment, modes: usize, n_study: &[usize]) -> CaseSpec {
-    let amm = ModeFamily::PAPER
+    let mut amm: Vec<AmmRun> = ModeFamily::PAPER
         .iter()
         .map(|f| AmmRun::paper(&exp.amm, *f, modes))
         .collect();
+    // flexstar's accurate reduced model beside the paper's families (issue 9): enriched family,
+    // full model, automatic N at the default tolerance
+    amm.push(AmmRun {
+        label: ModeFamily::Enriched.name().to_string(),
+        settings: flexstar_model::AmmSettings {
+            snapshots: exp.amm.snapshots.clone(),
+            ..flexstar_model::AmmSettings::accurate()
+        },
+    });
     let extra = ModeFamily::PAPER
         .iter()
         .flat_map(|f| {

@@ -1,4 +1,4 @@
-//! Assumed-mode families of one beam (Eq. 34-1; MODEL-NOTES section 4), G at x = 0, free tip at
+//! Assumed-mode families of one beam (Eq. 34-1; `docs/amm.md`, Mode families), G at x = 0, free tip at
 //! x = L.
 //!
 //! Each elastic mode solves `(EI/rho) phi'''' = lambda phi` with `lambda = (EI/rho) beta^4`. It is

@@ -214,6 +214,15 @@ impl TableI {
                 " Paper values in brackets (N = 25; the paper's case-4 row repeats case 3, so case 4 has none)."
             );
         }
+        let accurate = self.rows.iter().flat_map(|r| &r.families).any(|e| e.modes.is_none());
+        if with_paper && accurate {
+            let _ = write!(
+                s,
+                " *enriched*: flexstar's accurate reduced model (free-free modes plus junction shapes, the \
+                 paper's dropped terms restored, N chosen for a 0.5 % error estimate; docs/amm.md sections \
+                 7-9), shown beside the paper's families and not ranked with them."
+            );
+        }
         let _ = writeln!(s, "\n");
         let _ = write!(
             s,

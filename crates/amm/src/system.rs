@@ -117,6 +117,8 @@ pub(crate) struct System {
     /// Full model: the axial acceleration u_i'' of each beam at the last solve, part of the axial
     /// inertia force of Eq. 23 (the whole axially rigid beam accelerates with it).
     udd: [f64; 3],
+    /// Sleeve positions xp_i of the last solve [m].
+    xp: [f64; 3],
     // arrowhead data of S (the same for the three beams)
     inv_d: Vec<f64>,
     w: Vec<f64>,
@@ -236,6 +238,7 @@ impl System {
             g2,
             sleeve_axial: [[0.0; 3]; 3],
             udd: [0.0; 3],
+            xp: [0.0; 3],
             nm,
             nb,
             rho: params.rho,
@@ -289,6 +292,7 @@ impl System {
     fn update_sleeve_rows(&mut self, xp: [f64; 3], qhat: &[f64]) {
         let (nm, nb) = (self.nm, self.nb);
         let full = self.model == AmmModel::Full;
+        self.xp = xp;
         for (i, (beam, &x)) in self.beams.iter_mut().zip(&xp).enumerate() {
             let alpha = &qhat[i * nb..i * nb + nm];
             let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
@@ -536,6 +540,28 @@ impl System {
             self.udd[i] = qdd[i * nb + nm];
         }
         Ok(())
+    }
+
+    /// The sleeve rows of Eqs. 41-42 evaluated exactly (nonlinear in u) at the state q, for tests:
+    /// largest `|w_i(xp_i - u_i + e) - e thp_i|` over the beams and e in {0, +-Lp/2}, and largest
+    /// `|w_i(xp_i + e) - e thp_i|` (the same rows at the rigid material points, as the paper takes
+    /// them) [m].
+    #[cfg(test)]
+    pub(crate) fn sleeve_gaps(&self, q: &[f64], lp: f64) -> (f64, f64) {
+        let (nm, nb) = (self.nm, self.nb);
+        let mut v = vec![0.0; nm];
+        let (mut at_material, mut at_rigid) = (0.0f64, 0.0f64);
+        for i in 0..3 {
+            let o = i * nb;
+            let (alpha, u, thp) = (&q[o..o + nm], q[o + nm], q[o + nm + 1]);
+            for e in [-0.5 * lp, 0.0, 0.5 * lp] {
+                self.modes.values_at(self.xp[i] - u + e, &mut v, None);
+                at_material = at_material.max((dot(&v, alpha) - e * thp).abs());
+                self.modes.values_at(self.xp[i] + e, &mut v, None);
+                at_rigid = at_rigid.max((dot(&v, alpha) - e * thp).abs());
+            }
+        }
+        (at_material, at_rigid)
     }
 
     /// Largest |C q| over the rows (constraint residual, for tests).

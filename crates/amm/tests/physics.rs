@@ -129,6 +129,10 @@ fn slide_free_has_no_slope_moments_and_free_free_balances_them() {
 
 /// Largest |Fa_amm - Fa_rigid| over time and actuators, relative to the largest |Fa_rigid|.
 fn stiff_limit_error(fam: ModeFamily, to: Pose) -> f64 {
+    stiff_limit_error_with(&settings(fam, 10, Some(1e-4)), to)
+}
+
+fn stiff_limit_error_with(amm: &flexstar_model::AmmSettings, to: Pose) -> f64 {
     let mut p = RobotParams::paper();
     p.e *= 1e4;
     let mut exp = common::quintic(p, 0.5);
@@ -142,7 +146,7 @@ fn stiff_limit_error(fam: ModeFamily, to: Pose) -> f64 {
         t0: 0.0,
         t1: 0.5,
     };
-    let r = solve(&exp, &settings(fam, 10, Some(1e-4))).unwrap();
+    let r = solve(&exp, amm).unwrap();
     let (mut err, mut scale) = (0.0f64, 0.0f64);
     for k in 0..r.len() {
         let st = RigidState::at(&p, &exp.trajectory, r.t[k]).unwrap();
@@ -186,6 +190,42 @@ fn stiff_star_reproduces_rigid_inverse_dynamics() {
         assert!(
             e < 5e-3,
             "{fam} to {to:?}: Fa off the rigid inverse dynamics by {:.3} %",
+            e * 100.0
+        );
+    }
+}
+
+#[test]
+fn stiff_accurate_model_reproduces_rigid_inverse_dynamics() {
+    // issue 9: the full model's Fa (Eq. 33 along the sleeve forces it carries, with their axial
+    // components) must reach the rigid-body inverse dynamics in the stiff limit, like free-free
+    let accurate = flexstar_model::AmmSettings {
+        modes: Some(12),
+        dt: Some(1e-4),
+        ..flexstar_model::AmmSettings::accurate()
+    };
+    for to in [
+        Pose {
+            gx: 0.03,
+            gy: -0.02,
+            theta: 0.3,
+        },
+        Pose {
+            gx: 0.0,
+            gy: 0.0,
+            theta: 0.3,
+        },
+        Pose {
+            gx: 0.03,
+            gy: -0.02,
+            theta: 0.0,
+        },
+    ] {
+        let e = stiff_limit_error_with(&accurate, to);
+        eprintln!("enriched, full, to {to:?}: {:.3} %", e * 100.0);
+        assert!(
+            e < 5e-3,
+            "to {to:?}: Fa off the rigid inverse dynamics by {:.3} %",
             e * 100.0
         );
     }

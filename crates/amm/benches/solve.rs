@@ -26,7 +26,7 @@ fn paper_cases(c: &mut Criterion) {
 }
 
 /// Issue 9 item 5: one paper case with the defaults (enriched family, full model, automatic N at
-/// tol 0.5 %: runs at N = 40, 46, 53), target at most 20 ms on one core; and one run at the N the
+/// tol 0.5 %: runs at N = 46, 53), target at most 20 ms on one core; and one run at the N the
 /// defaults settle on.
 fn accurate_model(c: &mut Criterion) {
     let mut group = c.benchmark_group("amm_accurate_defaults");

@@ -229,11 +229,15 @@ impl Shape {
         match *self {
             Shape::Rigid { a, b } => [a + b * xi, b, 0.0, 0.0],
             Shape::Elastic { bl, c, .. } => {
+                // the rows of `basis_row` for k = 0..3 share one sin/cos pair and two exponentials
+                let (sn, cs) = (bl * xi).sin_cos();
+                let (e1, e2) = ((-bl * xi).exp(), (-bl * (1.0 - xi)).exp());
+                let rows = [(cs, sn), (-sn, cs), (-cs, -sn), (sn, -cs)];
                 let mut out = [0.0; 4];
                 let mut bk = 1.0;
-                for (k, o) in out.iter_mut().enumerate() {
-                    let r = basis_row(bl, xi, k);
-                    *o = bk * (c[0] * r[0] + c[1] * r[1] + c[2] * r[2] + c[3] * r[3]);
+                for (k, (o, (rc, rs))) in out.iter_mut().zip(rows).enumerate() {
+                    let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+                    *o = bk * (c[0] * rc + c[1] * rs + c[2] * sign * e1 + c[3] * e2);
                     bk *= bl;
                 }
                 out

@@ -1,0 +1,191 @@
+//! The three kinds of actuator law: a force table (e.g. a solver's own `Fa` output fed back),
+//! force polynomials, and a PD servo on each slider with optional rigid-body feedforward.
+
+use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
+use flexstar_model::{RobotParams, Trajectory};
+
+use crate::{ActuatorLaw, DriveError};
+
+/// `Fa_i(t)` [N] sampled at increasing times [s], linearly interpolated in between.
+///
+/// Linear interpolation is exact for the round trip at the solver's own step: an inverse run
+/// that writes `Fa` at every solver step gives back, at those steps, the very values the direct
+/// run evaluates there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForceTable {
+    t: Vec<f64>,
+    fa: Vec<[f64; 3]>,
+}
+
+impl ForceTable {
+    /// Build from samples; times must be finite and strictly increasing, forces finite.
+    /// Errors name the sample (1-based row) and the reason; the caller adds file and key.
+    pub fn new(t: Vec<f64>, fa: Vec<[f64; 3]>) -> Result<Self, DriveError> {
+        if t.len() != fa.len() {
+            return Err(DriveError::Table(format!(
+                "{} times but {} force rows",
+                t.len(),
+                fa.len()
+            )));
+        }
+        if t.len() < 2 {
+            return Err(DriveError::Table(format!("need at least two samples, got {}", t.len())));
+        }
+        for (k, (tk, f)) in t.iter().zip(&fa).enumerate() {
+            if !tk.is_finite() || f.iter().any(|v| !v.is_finite()) {
+                return Err(DriveError::Table(format!("row {}: non-finite value", k + 1)));
+            }
+            if k > 0 && *tk <= t[k - 1] {
+                return Err(DriveError::Table(format!(
+                    "row {}: time {tk} s does not increase (previous {} s)",
+                    k + 1,
+                    t[k - 1]
+                )));
+            }
+        }
+        Ok(ForceTable { t, fa })
+    }
+
+    /// First and last sample time [s].
+    pub fn span(&self) -> (f64, f64) {
+        (self.t[0], self.t[self.t.len() - 1])
+    }
+
+    /// Check that the table covers `[t0, t1]` [s] (with a relative slack of 1e-9 for times
+    /// written with fewer digits than the solver keeps).
+    pub fn check_covers(&self, t0: f64, t1: f64) -> Result<(), DriveError> {
+        let (a, b) = self.span();
+        let slack = 1e-9 * t1.abs().max(1.0);
+        if a > t0 + slack || b < t1 - slack {
+            return Err(DriveError::Table(format!(
+                "samples span [{a}, {b}] s but the run needs [{t0}, {t1}] s"
+            )));
+        }
+        Ok(())
+    }
+
+    /// `Fa(t)` [N], linear between samples, held constant outside the span.
+    pub fn at(&self, t: f64) -> [f64; 3] {
+        let n = self.t.len();
+        if t <= self.t[0] {
+            return self.fa[0];
+        }
+        if t >= self.t[n - 1] {
+            return self.fa[n - 1];
+        }
+        let k = self.t.partition_point(|&tk| tk <= t).min(n - 1);
+        let (t0, t1) = (self.t[k - 1], self.t[k]);
+        let r = (t - t0) / (t1 - t0);
+        let (f0, f1) = (self.fa[k - 1], self.fa[k]);
+        [0, 1, 2].map(|i| f0[i] + r * (f1[i] - f0[i]))
+    }
+}
+
+impl ActuatorLaw for ForceTable {
+    fn force(&self, t: f64, _s: [f64; 3], _v: [f64; 3]) -> Result<[f64; 3], DriveError> {
+        Ok(self.at(t))
+    }
+    fn stiffness(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
+    fn damping(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
+}
+
+/// `Fa_i(t) = sum_k c_ik t^k` [N], coefficients in increasing powers of t [s].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForcePolynomials {
+    /// Coefficients of `Fa1`, `Fa2`, `Fa3`.
+    pub coefficients: [Vec<f64>; 3],
+}
+
+impl ActuatorLaw for ForcePolynomials {
+    fn force(&self, t: f64, _s: [f64; 3], _v: [f64; 3]) -> Result<[f64; 3], DriveError> {
+        Ok([0, 1, 2].map(|i| self.coefficients[i].iter().rev().fold(0.0, |acc, c| acc * t + c)))
+    }
+    fn stiffness(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
+    fn damping(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
+}
+
+/// A PD loop on each slider tracking the reference trajectory:
+/// `Fa_i = ff_i(t) + kp_i (s_ref,i(t) - s_i) + kd_i (s_ref,i'(t) - s_i')` [N].
+///
+/// The feedforward `ff` is the rigid-body inverse dynamics of the reference (Eq. 33 with a rigid
+/// star, [`rigid_inverse_dynamics`]) or zero.
+#[derive(Debug, Clone)]
+pub struct Servo {
+    /// Proportional gains [N/m].
+    pub kp: [f64; 3],
+    /// Derivative gains [N s/m].
+    pub kd: [f64; 3],
+    /// Add the rigid-body inverse dynamics of the reference.
+    pub rigid_feedforward: bool,
+    /// The reference motion `s_ref(t)`.
+    pub reference: Trajectory,
+    /// The robot (masses for the feedforward).
+    pub params: RobotParams,
+}
+
+impl Servo {
+    /// Gains from a closed-loop bandwidth `f_bw` [Hz] and damping ratio `zeta` for a slider of
+    /// mass `m` [kg] treated as a free mass: `kp = m (2 pi f_bw)^2`, `kd = 2 zeta m (2 pi f_bw)`.
+    pub fn gains_from_bandwidth(m: f64, f_bw: f64, zeta: f64) -> (f64, f64) {
+        let wn = 2.0 * std::f64::consts::PI * f_bw;
+        (m * wn * wn, 2.0 * zeta * m * wn)
+    }
+
+    /// Reference `s_ref`, `s_ref'` and the feedforward at time `t`; errors if the reference
+    /// itself is not a valid pose at `t`.
+    pub fn reference_at(&self, t: f64) -> Result<ReferencePoint, DriveError> {
+        let jets = self
+            .reference
+            .jets(&self.params, t)
+            .map_err(|e| DriveError::Reference {
+                t,
+                reason: e.to_string(),
+            })?;
+        let ff = if self.rigid_feedforward {
+            let state = RigidState::at(&self.params, &self.reference, t).map_err(|e| DriveError::Reference {
+                t,
+                reason: e.to_string(),
+            })?;
+            rigid_inverse_dynamics(&self.params, &state).fa
+        } else {
+            [0.0; 3]
+        };
+        Ok(ReferencePoint {
+            s: jets.map(|j| j.v),
+            v: jets.map(|j| j.d1),
+            feedforward: ff,
+        })
+    }
+}
+
+/// The servo's reference at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReferencePoint {
+    /// `s_ref` [m].
+    pub s: [f64; 3],
+    /// `s_ref'` [m/s].
+    pub v: [f64; 3],
+    /// Feedforward force [N] (zero without feedforward).
+    pub feedforward: [f64; 3],
+}
+
+impl ActuatorLaw for Servo {
+    fn force(&self, t: f64, s: [f64; 3], v: [f64; 3]) -> Result<[f64; 3], DriveError> {
+        let r = self.reference_at(t)?;
+        Ok([0, 1, 2].map(|i| r.feedforward[i] + self.kp[i] * (r.s[i] - s[i]) + self.kd[i] * (r.v[i] - v[i])))
+    }
+    fn stiffness(&self) -> [f64; 3] {
+        self.kp
+    }
+    fn damping(&self) -> [f64; 3] {
+        self.kd
+    }
+}

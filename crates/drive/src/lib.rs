@@ -82,7 +82,7 @@ mod tests {
             kd: [1e3; 3],
             rigid_feedforward: true,
             reference: reference.clone(),
-            params: params.clone(),
+            params,
         };
         let t = 0.2;
         let jets = reference.jets(&params, t).unwrap();

@@ -67,10 +67,15 @@ pub struct Infeasible {
 
 /// Smallest feasibility margin at time t and the limit it belongs to; negative means violated.
 fn margin(params: &RobotParams, traj: &Trajectory, t: f64) -> (f64, Violation) {
-    let s = match traj.s(params, t) {
-        Ok(s) => s,
-        Err(e) => return (-1.0, Violation::Trajectory(e.to_string())),
-    };
+    match traj.s(params, t) {
+        Ok(s) => configuration_margin(params, s),
+        Err(e) => (-1.0, Violation::Trajectory(e.to_string())),
+    }
+}
+
+/// Smallest feasibility margin of the configuration `s` [m] (a length [m]; the angle limit is
+/// scaled by Lp) and the limit it belongs to; negative or zero means violated.
+fn configuration_margin(params: &RobotParams, s: [f64; 3]) -> (f64, Violation) {
     let mut worst = (f64::INFINITY, Violation::Trajectory(String::new()));
     let mut take = |m: f64, v: Violation| {
         if m < worst.0 {
@@ -140,10 +145,14 @@ pub fn check_trajectory(params: &RobotParams, traj: &Trajectory, t_end: f64, sca
 
 /// Is `s` (at rest) inside the feasible range? Used by property tests and samplers.
 pub fn is_feasible_configuration(params: &RobotParams, s: [f64; 3]) -> bool {
-    let traj = Trajectory::Polynomial {
-        s1: vec![s[0]],
-        s2: vec![s[1]],
-        s3: vec![s[2]],
-    };
-    margin(params, &traj, 0.0).0 > 0.0
+    check_configuration(params, s).is_ok()
+}
+
+/// Check one configuration `s` [m] (e.g. a state of a direct-dynamics run, where the motion is
+/// not known in advance): `Err` names the limit reached.
+pub fn check_configuration(params: &RobotParams, s: [f64; 3]) -> Result<(), Violation> {
+    match configuration_margin(params, s) {
+        (m, _) if m > 0.0 => Ok(()),
+        (_, violation) => Err(violation),
+    }
 }

@@ -189,3 +189,34 @@ impl ActuatorLaw for Servo {
         self.kd
     }
 }
+
+/// The rigid-body inverse dynamics of a trajectory [N] at time `t` (Eq. 33 with a rigid star).
+fn rigid_forces(params: &RobotParams, trajectory: &Trajectory, t: f64) -> Result<[f64; 3], DriveError> {
+    let state = RigidState::at(params, trajectory, t).map_err(|e| DriveError::Reference {
+        t,
+        reason: e.to_string(),
+    })?;
+    Ok(rigid_inverse_dynamics(params, &state).fa)
+}
+
+/// The forces that move the *rigid* robot along `trajectory` (Eq. 33 with a rigid star), as a
+/// drive: the open-loop input of the stiff-limit check.
+#[derive(Debug, Clone)]
+pub struct RigidInverseForces {
+    /// The motion the forces are computed for.
+    pub trajectory: Trajectory,
+    /// The robot.
+    pub params: RobotParams,
+}
+
+impl ActuatorLaw for RigidInverseForces {
+    fn force(&self, t: f64, _s: [f64; 3], _v: [f64; 3]) -> Result<[f64; 3], DriveError> {
+        rigid_forces(&self.params, &self.trajectory, t)
+    }
+    fn stiffness(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
+    fn damping(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
+}

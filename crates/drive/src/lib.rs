@@ -28,8 +28,10 @@ pub trait ActuatorLaw: Send + Sync {
 }
 
 mod laws;
+pub mod rigid_forward;
 
-pub use laws::{ForcePolynomials, ForceTable, ReferencePoint, Servo};
+pub use laws::{ForcePolynomials, ForceTable, ReferencePoint, RigidInverseForces, Servo};
+pub use rigid_forward::{rigid_forward_dynamics, RigidSample};
 
 /// Errors of the drives; the config loader adds file and key.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

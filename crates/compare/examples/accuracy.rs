@@ -2,7 +2,8 @@
 //! of `docs/validation.md`): mean and largest point EVP (Eq. 45) per case, and the AMM's wall time.
 //!
 //! `cargo run --release -p flexstar-compare --example accuracy -- FAMILY MODEL N [N ...]`
-//! (N = 0: automatic N at the default tolerance; `tol=P` for another tolerance).
+//! (N = 0: automatic N at the default tolerance; `tol=P` for another tolerance). The environment
+//! variable `AMM_DT` sets the AMM's step [s] (default: the solver's).
 
 use flexstar_compare::evp::point_evps;
 use flexstar_model::catalogue::paper_case;
@@ -26,6 +27,7 @@ fn main() {
         let mut settings = AmmSettings {
             family,
             model,
+            dt: std::env::var("AMM_DT").ok().map(|v| v.parse().expect("AMM_DT")),
             ..AmmSettings::default()
         };
         if let Some(p) = spec.strip_prefix("tol=") {

@@ -22,6 +22,8 @@
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, Par};
 use flexstar_model::{ModeFamily, RobotParams};
 
 use crate::error::AmmError;
@@ -228,10 +230,21 @@ impl Shape {
     fn eval(&self, xi: f64) -> [f64; 4] {
         match *self {
             Shape::Rigid { a, b } => [a + b * xi, b, 0.0, 0.0],
+            Shape::Elastic { bl, .. } => {
+                let (sn, cs) = (bl * xi).sin_cos();
+                self.eval_from([sn, cs, (-bl * xi).exp(), (-bl * (1.0 - xi)).exp()], xi)
+            }
+        }
+    }
+
+    /// [`Shape::eval`] from `[sin(b xi), cos(b xi), exp(-b xi), exp(-b (1 - xi))]`.
+    #[inline]
+    fn eval_from(&self, trig: [f64; 4], xi: f64) -> [f64; 4] {
+        match *self {
+            Shape::Rigid { a, b } => [a + b * xi, b, 0.0, 0.0],
             Shape::Elastic { bl, c, .. } => {
                 // the rows of `basis_row` for k = 0..3 share one sin/cos pair and two exponentials
-                let (sn, cs) = (bl * xi).sin_cos();
-                let (e1, e2) = ((-bl * xi).exp(), (-bl * (1.0 - xi)).exp());
+                let [sn, cs, e1, e2] = trig;
                 let rows = [(cs, sn), (-sn, cs), (-cs, -sn), (sn, -cs)];
                 let mut out = [0.0; 4];
                 let mut bk = 1.0;
@@ -365,12 +378,8 @@ impl ModeSet {
     /// Enriched family: build the two junction shapes against the analytic modes (Rayleigh-Ritz,
     /// `junction` module) and append their lambda and integrals.
     fn add_junction_shapes(&mut self) {
-        let b_max = self.beta_l().into_iter().fold(1.0, f64::max);
-        let (x, w) = junction::composite_rule(junction::panels_for(b_max));
-        let values: Vec<Vec<[f64; 4]>> = x
-            .iter()
-            .map(|&xi| self.shapes.iter().map(|s| s.eval(xi)).collect())
-            .collect();
+        let (x, w) = junction::composite_rule(junction::panels_for(self.analytic_beta_max()));
+        let values: Vec<Vec<[f64; 4]>> = x.iter().map(|&xi| self.analytic_derivatives(xi)).collect();
         let phi: Vec<Vec<f64>> = values.iter().map(|r| r.iter().map(|v| v[0]).collect()).collect();
         let phi2: Vec<Vec<f64>> = values.iter().map(|r| r.iter().map(|v| v[2]).collect()).collect();
         let shapes = junction::build(&x, &w, &phi, &phi2);
@@ -387,6 +396,30 @@ impl ModeSet {
             self.psi_int.push(sqrt_l * l * i1);
             self.junction.push(sh);
         }
+    }
+
+    /// `Phi^(k)(xi)`, k = 0..=3, of every analytic mode on the unit interval, with the
+    /// trigonometric recurrence of [`ModeSet::values_at`].
+    fn analytic_derivatives(&self, xi: f64) -> Vec<[f64; 4]> {
+        let mut trig = ModeTrig::new(xi, self.recur_from);
+        self.shapes
+            .iter()
+            .enumerate()
+            .map(|(m, sh)| match *sh {
+                Shape::Rigid { .. } => sh.eval(xi),
+                Shape::Elastic { bl, e, .. } => sh.eval_from(trig.next(m, bl, e), xi),
+            })
+            .collect()
+    }
+
+    /// Largest beta L of the analytic modes (at least 1): what a quadrature of products of modes
+    /// must resolve. The junction shapes are polynomials minus analytic modes, so they add no
+    /// faster oscillation (their `mu^(1/4)` can be far larger, but it is not a wavenumber).
+    fn analytic_beta_max(&self) -> f64 {
+        self.shapes
+            .iter()
+            .map(|s| if let Shape::Elastic { bl, .. } = s { *bl } else { 0.0 })
+            .fold(1.0, f64::max)
     }
 
     /// Number of analytic modes (all of them but the enriched family's junction shapes).
@@ -483,12 +516,13 @@ impl ModeSet {
     }
 
     /// All modes at x [m]: `val[m] = phi_m(x)` and, if given, `slope[m] = phi_m'(x)`.
-    /// The per-step kernel of the constraint matrix (Eqs. 41-43): one sin/cos pair and one
-    /// exponential per elastic mode, no allocation.
+    /// One sin/cos pair and one exponential per elastic mode below beta L = 40, the recurrence of
+    /// [`ModeSet::triplet_at`] above; no allocation.
     pub fn values_at(&self, x: f64, val: &mut [f64], mut slope: Option<&mut [f64]>) {
         let xi = x / self.l;
         let s = 1.0 / self.l.sqrt();
         let sd = s / self.l;
+        let mut trig = ModeTrig::new(xi, self.recur_from);
         for (m, sh) in self.shapes.iter().enumerate() {
             match *sh {
                 Shape::Rigid { a, b } => {
@@ -498,10 +532,7 @@ impl ModeSet {
                     }
                 }
                 Shape::Elastic { bl, c, e } => {
-                    let (sn, cs) = (bl * xi).sin_cos();
-                    let e1 = (-bl * xi).exp();
-                    // exp(-b(1 - xi)) = exp(-b) / exp(-b xi) while both are representable
-                    let e2 = if bl < 600.0 { e / e1 } else { (-bl * (1.0 - xi)).exp() };
+                    let [sn, cs, e1, e2] = trig.next(m, bl, e);
                     val[m] = (c[0] * cs + c[1] * sn + c[2] * e1 + c[3] * e2) * s;
                     if let Some(d) = slope.as_deref_mut() {
                         d[m] = bl * (-c[0] * sn + c[1] * cs - c[2] * e1 + c[3] * e2) * sd;
@@ -517,6 +548,55 @@ impl ModeSet {
                 d[na + j] = dp * sd - dot(&sh.c, &d[..na]);
             }
         }
+    }
+}
+
+/// `sin(b xi)`, `cos(b xi)`, `exp(-b xi)`, `exp(-b (1 - xi))` of the elastic modes in order:
+/// direct evaluation up to mode `recur_from`, then one rotation by `pi xi` and two products per
+/// mode (consecutive roots are pi apart to round-off there; see [`ModeSet::triplet_at`]).
+struct ModeTrig {
+    recur_from: usize,
+    rot: (f64, f64),
+    q: (f64, f64),
+    last: [f64; 4],
+    xi: f64,
+}
+
+impl ModeTrig {
+    fn new(xi: f64, recur_from: usize) -> Self {
+        ModeTrig {
+            recur_from,
+            rot: (PI * xi).sin_cos(),
+            q: ((-PI * xi).exp(), (-PI * (1.0 - xi)).exp()),
+            last: [0.0; 4],
+            xi,
+        }
+    }
+
+    /// The four values for mode `m` with root `bl` and `e = exp(-bl)`; modes must come in order.
+    #[inline]
+    fn next(&mut self, m: usize, bl: f64, e: f64) -> [f64; 4] {
+        let [sn, cs, e1, e2] = self.last;
+        self.last = if m > self.recur_from {
+            let (rs, rc) = self.rot;
+            [
+                sn * rc + cs * rs,
+                cs * rc - sn * rs,
+                e1 * self.q.0,
+                if e2 > 1e-290 { e2 * self.q.1 } else { 0.0 },
+            ]
+        } else {
+            let (sn, cs) = (bl * self.xi).sin_cos();
+            let e1 = (-bl * self.xi).exp();
+            // exp(-b(1 - xi)) = exp(-b) / exp(-b xi) while both are representable
+            let e2 = if bl < 600.0 {
+                e / e1
+            } else {
+                (-bl * (1.0 - self.xi)).exp()
+            };
+            [sn, cs, e1, e2]
+        };
+        self.last
     }
 }
 
@@ -568,9 +648,7 @@ impl ModeSet {
         let eta = tri.h / self.l;
         let s = 1.0 / self.l.sqrt();
         let sd = s / self.l;
-        let (rs, rc) = (PI * xi).sin_cos();
-        let (q1, q2) = ((-PI * xi).exp(), (-PI * (1.0 - xi)).exp());
-        let (mut sn, mut cs, mut e1, mut e2) = (0.0, 0.0, 0.0, 0.0);
+        let mut trig = ModeTrig::new(xi, self.recur_from);
         for (m, (sh, f)) in self.shapes.iter().zip(&tri.f).enumerate() {
             match *sh {
                 Shape::Rigid { a, b } => {
@@ -585,15 +663,7 @@ impl ModeSet {
                     }
                 }
                 Shape::Elastic { bl, c, e } => {
-                    if m > self.recur_from {
-                        (sn, cs) = (sn * rc + cs * rs, cs * rc - sn * rs);
-                        e1 *= q1;
-                        e2 = if e2 > 1e-290 { e2 * q2 } else { 0.0 };
-                    } else {
-                        (sn, cs) = (bl * xi).sin_cos();
-                        e1 = (-bl * xi).exp();
-                        e2 = if bl < 600.0 { e / e1 } else { (-bl * (1.0 - xi)).exp() };
-                    }
+                    let [sn, cs, e1, e2] = trig.next(m, bl, e);
                     let p = c[0] * cs + c[1] * sn;
                     let q = c[1] * cs - c[0] * sn;
                     let (g1, g2) = (c[2] * e1, c[3] * e2);
@@ -636,26 +706,45 @@ impl ModeSet {
     /// `G2_jm = int (L - x) phi_j' phi_m' dx` [1/m].
     pub fn axial_stiffening(&self) -> (Vec<f64>, Vec<f64>) {
         let n = self.len();
-        let b_max = self.beta_l().into_iter().fold(1.0, f64::max);
-        let (x, w) = junction::composite_rule(junction::panels_for(b_max));
-        let (mut g1, mut g2) = (vec![0.0; n * n], vec![0.0; n * n]);
-        let (mut val, mut d) = (vec![0.0; n], vec![0.0; n]);
-        for (&xi, &wq) in x.iter().zip(&w) {
+        let (x, w) = junction::composite_rule(junction::panels_for(self.analytic_beta_max()));
+        // slopes at the nodes (rows), and the same rows weighted by the two axial force profiles:
+        // G = D^T diag(f) D, two matrix products
+        let mut d = Mat::<f64>::zeros(x.len(), n);
+        let mut d1 = Mat::<f64>::zeros(x.len(), n);
+        let mut d2 = Mat::<f64>::zeros(x.len(), n);
+        let (mut val, mut slope) = (vec![0.0; n], vec![0.0; n]);
+        for (q, (&xi, &wq)) in x.iter().zip(&w).enumerate() {
             let xm = xi * self.l;
-            self.values_at(xm, &mut val, Some(&mut d));
+            self.values_at(xm, &mut val, Some(&mut slope));
             // dx = L dxi
             let f1 = wq * self.l * 0.5 * (self.l * self.l - xm * xm);
             let f2 = wq * self.l * (self.l - xm);
-            for j in 0..n {
-                let (a1, a2) = (f1 * d[j], f2 * d[j]);
-                let (r1, r2) = (&mut g1[j * n..(j + 1) * n], &mut g2[j * n..(j + 1) * n]);
-                for m in 0..n {
-                    r1[m] += a1 * d[m];
-                    r2[m] += a2 * d[m];
-                }
+            for (m, &v) in slope.iter().enumerate() {
+                d[(q, m)] = v;
+                d1[(q, m)] = f1 * v;
+                d2[(q, m)] = f2 * v;
             }
         }
-        (g1, g2)
+        let product = |weighted: &Mat<f64>| {
+            let mut g = Mat::<f64>::zeros(n, n);
+            matmul(
+                g.as_mut(),
+                Accum::Replace,
+                d.transpose(),
+                weighted.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            // row-major, exactly symmetric
+            let mut out = vec![0.0; n * n];
+            for j in 0..n {
+                for m in 0..n {
+                    out[j * n + m] = 0.5 * (g[(j, m)] + g[(m, j)]);
+                }
+            }
+            out
+        };
+        (product(&d1), product(&d2))
     }
 }
 

@@ -20,6 +20,8 @@
 //! three beams (it depends on th only) and is solved in O(N). The constraints (at most 18 rows)
 //! are eliminated by the Schur complement `A = C S^-1 C^T`, a small dense LU per step.
 
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, Par};
 use flexstar_kinematics::RigidState;
 use flexstar_model::{AmmModel, RobotParams};
 
@@ -108,9 +110,12 @@ pub(crate) struct System {
     pub(crate) rows: Vec<Row>,
     beams: [BeamRows; 3],
     model: AmmModel,
-    /// Full model: geometric stiffness matrices of the axial inertia force (Eq. 23), N x N each.
-    g1: Vec<f64>,
-    g2: Vec<f64>,
+    /// Full model: geometric stiffness matrices of the axial inertia force (Eq. 23), stacked
+    /// `[G1; G2]` (2N x N), and their products with the three beams' modal coordinates (2N x 3).
+    g12: Mat<f64>,
+    g12_q: Mat<f64>,
+    /// The three beams' modal coordinates as columns (N x 3), the right side of that product.
+    alpha_cols: Mat<f64>,
     /// Full model: u_i-gradients of the rows Fp_i, FR_i, FL_i at the last solve (`-w'` at the
     /// material point in the sleeve; 0 in the paper's model): the axial direction of their forces.
     pub(crate) sleeve_axial: [[f64; 3]; 3],
@@ -228,14 +233,23 @@ impl System {
         }
         let m = rows.len();
         let n = 3 * nb;
-        let (g1, g2) = match model {
-            AmmModel::Full => modes.axial_stiffening(),
-            AmmModel::Paper => (Vec::new(), Vec::new()),
+        let g12 = match model {
+            AmmModel::Full => {
+                let (g1, g2) = modes.axial_stiffening();
+                Mat::from_fn(
+                    2 * nm,
+                    nm,
+                    |r, c| if r < nm { g1[r * nm + c] } else { g2[(r - nm) * nm + c] },
+                )
+            }
+            AmmModel::Paper => Mat::zeros(0, 0),
         };
+        let kg_rows = g12.nrows();
         System {
             model,
-            g1,
-            g2,
+            g12,
+            g12_q: Mat::zeros(kg_rows, 3),
+            alpha_cols: Mat::zeros(if kg_rows > 0 { nm } else { 0 }, 3),
             sleeve_axial: [[0.0; 3]; 3],
             udd: [0.0; 3],
             xp: [0.0; 3],
@@ -336,6 +350,26 @@ impl System {
     }
 
     /// Solve `S x = r` for one beam block (O(N)), in place.
+    /// Full model: `[G1; G2] alpha_i` for the three beams at once (one matrix product, SIMD by
+    /// faer), the geometric stiffness of Eq. 23 applied to the predicted modal coordinates.
+    fn geometric_stiffness_products(&mut self, qhat: &[f64]) {
+        let (nm, nb) = (self.nm, self.nb);
+        for i in 0..3 {
+            let mut col = self.alpha_cols.col_mut(i);
+            for (j, v) in qhat[i * nb..i * nb + nm].iter().enumerate() {
+                col[j] = *v;
+            }
+        }
+        matmul(
+            self.g12_q.as_mut(),
+            Accum::Replace,
+            self.g12.as_ref(),
+            self.alpha_cols.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+    }
+
     #[inline]
     fn arrow_solve(&self, x: &mut [f64]) {
         let nm = self.nm;
@@ -377,6 +411,9 @@ impl System {
         let ag = st.a_g();
         self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
         self.factor_s(bp, gp, thd, thdd);
+        if self.model == AmmModel::Full {
+            self.geometric_stiffness_products(qhat);
+        }
 
         // residual r = f - D vhat - K qhat, per beam
         for i in 0..3 {
@@ -407,9 +444,9 @@ impl System {
             if self.model == AmmModel::Full {
                 // Eq. 23: - rho (th'^2 G1 - a_x G2) alpha, at the predictor (docs/amm.md section 8)
                 let (c1, c2) = (rho * thd * thd, -rho * (ax + self.udd[i]));
-                let rows = self.g1.chunks_exact(nm).zip(self.g2.chunks_exact(nm));
-                for (rj, (row1, row2)) in r[..nm].iter_mut().zip(rows) {
-                    *rj -= c1 * dot(row1, qa) + c2 * dot(row2, qa);
+                let col = self.g12_q.col(i);
+                for (j, rj) in r[..nm].iter_mut().enumerate() {
+                    *rj -= c1 * col[j] + c2 * col[nm + j];
                 }
             }
         }

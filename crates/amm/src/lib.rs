@@ -8,6 +8,7 @@
 //!   evaluated stably to hundreds of modes;
 //! - `system` (private): the constrained linear time-varying equations (Eqs. 37, 44, 31 with the
 //!   constraints of Eqs. 38-43) and their per-step linear solve;
+//! - [`pose_modes`]: the modes of the star held at rest at one pose, and its linearised system;
 //! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]).
 //!
 //! Frames and signs follow `docs/conventions.md`; the derivation, the departures from the
@@ -19,6 +20,7 @@
 pub mod adaptive;
 pub mod error;
 pub mod modes;
+pub mod pose_modes;
 pub mod solver;
 mod system;
 

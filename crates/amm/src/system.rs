@@ -303,7 +303,7 @@ impl System {
     /// `xp_i - u_i`, linearised about the predictor `qhat` (one Newton step of the nonlinear rows
     /// per time step, exact to O(h^4)): alpha part `phi(xp - u^ + e)`, u gradient `-w^'(xp - u^ + e)`
     /// (`+w^''` for the slope row), while the rows' values keep no u term.
-    fn update_sleeve_rows(&mut self, xp: [f64; 3], qhat: &[f64]) {
+    pub(crate) fn update_sleeve_rows(&mut self, xp: [f64; 3], qhat: &[f64]) {
         let (nm, nb) = (self.nm, self.nb);
         let full = self.model == AmmModel::Full;
         self.xp = xp;
@@ -599,6 +599,27 @@ impl System {
             }
         }
         (at_material, at_rigid)
+    }
+
+    /// The constraint Jacobian C (rows x 3 (N + 2), row-major) at the last sleeve update: the
+    /// rows of Eqs. 38-43 as written in [`Row`] (for the modal analysis at a pose).
+    pub(crate) fn constraint_matrix(&self) -> Vec<f64> {
+        let (nm, nb, n) = (self.nm, self.nb, self.dim());
+        let mut c = vec![0.0; self.rows.len() * n];
+        for (i, beam) in self.beams.iter().enumerate() {
+            let o = i * nb;
+            for (k, &g) in beam.ids.iter().enumerate() {
+                let row = &mut c[g * n..(g + 1) * n];
+                row[o + nm] += beam.cu[k];
+                row[o + nm + 1] += beam.ct[k];
+                if beam.basis[k] != NONE {
+                    for (r, v) in row[o..o + nm].iter_mut().zip(self.basis(beam, beam.basis[k])) {
+                        *r += beam.sc[k] * v;
+                    }
+                }
+            }
+        }
+        c
     }
 
     /// Largest |C q| over the rows (constraint residual, for tests).

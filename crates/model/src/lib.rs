@@ -15,6 +15,7 @@ pub mod geometry;
 pub mod output;
 pub mod params;
 pub mod response;
+pub mod rest_pose;
 pub mod trajectory;
 pub mod validity;
 
@@ -22,5 +23,6 @@ pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, Mode
 pub use error::ModelError;
 pub use params::RobotParams;
 pub use response::{BeamShape, Column, Response, RunInfo, StarShape};
+pub use rest_pose::{RestPose, Sliders};
 pub use trajectory::{Pose, Trajectory};
 pub use validity::{small_deflection_check, Provenance, ValidityExceeded};

@@ -1,0 +1,232 @@
+//! Vibration modes of the star held at rest at one pose (issue 11): the constrained eigenproblem
+//! of the AMM's equations (Eqs. 37, 44, 31 with the constraints of Eqs. 38-43) linearised about
+//! the rest state, solved on the null space of the constraints
+//! ([`flexstar_numerics::eigen::constrained_modes`]).
+//!
+//! At rest (`theta' = theta'' = 0`, `a_G = 0`) the equations of beam i reduce to
+//!
+//! ```text
+//! rho alpha_j'' + rho lambda_j alpha_j = (C^T mu)_j,   rho L u_i'' = (C^T mu)_u,   Jp thp_i'' = (C^T mu)_thp
+//! ```
+//! (orthonormal modes, so M and K are diagonal; the full model's axial-inertia stiffness of Eq. 23
+//! vanishes with theta' and a_x, and its sleeve rows at the material point `xp - u` have no u
+//! gradient at zero deflection). The rigid frame is the pose's, held fixed, so the coordinates are
+//! absolute small displacements; the free-free rigid modes of the basis carry the star's rigid
+//! motion.
+//!
+//! Sliders free: three more coordinates `ds_i` (slider i along `u_i`, mass `mpp_mpa`); the pin then
+//! moves by `ds_i u_i`, whose normal component `ds_i (u_i . e_wi) = ds_i cos(theta)` enters the
+//! sleeve rows of Eqs. 41-42 (`w_i(xp_i + e) - e thp_i - ds_i cos(theta) = 0`); its axial component
+//! slides the sleeve along the beam, which is free at rest.
+
+use flexstar_model::{AmmModel, ModeFamily, RestPose, RobotParams, Sliders};
+use flexstar_numerics::eigen::constrained_modes;
+
+use crate::error::AmmError;
+use crate::modes::ModeSet;
+use crate::system::{Row, System};
+
+/// Default modes per beam of the modal analysis (enriched family): the first six frequencies of
+/// the paper's robot at the centre pose change by less than 0.06 % from 60 to 80 (0.5 % from 40 to
+/// 80) (test `modes_converge_in_n`).
+pub const DEFAULT_MODAL_MODES: usize = 60;
+
+/// The linearised AMM at a pose: `M q'' + K q = B f + C^T mu`, `C q = 0`.
+///
+/// Coordinates: per beam i, `[alpha_i (N), u_i, thp_i]`, then `[ds_1, ds_2, ds_3]` when the
+/// sliders are free. Matrices row-major.
+#[derive(Debug, Clone)]
+pub struct PoseSystem {
+    /// Number of coordinates n.
+    pub n: usize,
+    /// Modes per beam N.
+    pub nm: usize,
+    /// Mass matrix [kg] (n x n).
+    pub m: Vec<f64>,
+    /// Stiffness matrix [N/m] (n x n).
+    pub k: Vec<f64>,
+    /// Constraint Jacobian (rows x n).
+    pub c: Vec<f64>,
+    /// Number of constraint rows.
+    pub rows: usize,
+    /// How the sliders are held.
+    pub sliders: Sliders,
+    /// The mode set of the beams.
+    pub modes: ModeSet,
+}
+
+impl PoseSystem {
+    /// Index of the first coordinate of beam i (its alpha block).
+    pub fn beam_offset(&self, i: usize) -> usize {
+        i * (self.nm + 2)
+    }
+
+    /// Index of the slider coordinate ds_i (sliders free only).
+    pub fn slider_index(&self, i: usize) -> Option<usize> {
+        (self.sliders == Sliders::Free).then(|| 3 * (self.nm + 2) + i)
+    }
+
+    /// Transverse displacement of beam i at material coordinate x [m] from G, along `e_wi` of
+    /// the pose, for the coordinate vector q [m].
+    pub fn deflection(&self, q: &[f64], i: usize, x: f64) -> f64 {
+        let o = self.beam_offset(i);
+        (0..self.nm).map(|j| self.modes.eval(j, x)[0] * q[o + j]).sum()
+    }
+
+    /// Row vector `r` with `r . q` = the deflection of beam i at x (see [`PoseSystem::deflection`]).
+    pub fn deflection_row(&self, i: usize, x: f64) -> Vec<f64> {
+        let mut r = vec![0.0; self.n];
+        let o = self.beam_offset(i);
+        for j in 0..self.nm {
+            r[o + j] = self.modes.eval(j, x)[0];
+        }
+        r
+    }
+}
+
+/// Modes of the star at a pose.
+#[derive(Debug, Clone)]
+pub struct PoseModes {
+    /// Natural frequencies [Hz], ascending (rigid modes at round-off size, see [`PoseModes::rigid`]).
+    pub freq_hz: Vec<f64>,
+    /// `omega^2` [1/s^2] of the same modes.
+    pub omega2: Vec<f64>,
+    /// Mass-normalised shapes in the coordinates of [`PoseSystem`].
+    pub shapes: Vec<Vec<f64>>,
+    /// Number of leading rigid (zero-frequency) modes: 3 with free sliders, 0 locked.
+    pub rigid: usize,
+    /// The system they belong to.
+    pub system: PoseSystem,
+}
+
+/// Assemble the linearised AMM at `pose` with N = `nm` modes of `family` per beam (the same for
+/// the paper's and the full model: their differences vanish at rest, module docs).
+pub fn pose_system(
+    params: &RobotParams,
+    pose: &RestPose,
+    sliders: Sliders,
+    family: ModeFamily,
+    nm: usize,
+) -> Result<PoseSystem, AmmError> {
+    let modes = ModeSet::new(family, nm, params)?;
+    // At rest the full model's extra terms vanish (module docs): its constraint rows equal the
+    // paper model's, so the system is built without the axial-inertia matrices it never uses here.
+    let mut sys = System::new(modes.clone(), params, AmmModel::Paper);
+    let nb = nm + 2;
+    sys.update_sleeve_rows(pose.xp, &vec![0.0; sys.dim()]);
+    let c_beams = sys.constraint_matrix();
+    let rows = sys.rows.len();
+    let n_beams = 3 * nb;
+    let n = n_beams + if sliders == Sliders::Free { 3 } else { 0 };
+    let mut m = vec![0.0; n * n];
+    let mut k = vec![0.0; n * n];
+    let lambda = modes.lambda();
+    for i in 0..3 {
+        let o = i * nb;
+        for j in 0..nm {
+            m[(o + j) * n + o + j] = params.rho;
+            k[(o + j) * n + o + j] = params.rho * lambda[j];
+        }
+        m[(o + nm) * n + o + nm] = params.rho * params.l;
+        m[(o + nm + 1) * n + o + nm + 1] = params.jp;
+    }
+    let mut c = vec![0.0; rows * n];
+    for r in 0..rows {
+        c[r * n..r * n + n_beams].copy_from_slice(&c_beams[r * n_beams..(r + 1) * n_beams]);
+    }
+    if sliders == Sliders::Free {
+        let cos_th = pose.theta.cos();
+        for i in 0..3 {
+            m[(n_beams + i) * n + n_beams + i] = params.mpp_mpa;
+        }
+        for (r, row) in sys.rows.iter().enumerate() {
+            if let Row::Fp(i) | Row::FR(i) | Row::FL(i) = *row {
+                c[r * n + n_beams + i] = -cos_th;
+            }
+        }
+    }
+    Ok(PoseSystem {
+        n,
+        nm,
+        m,
+        k,
+        c,
+        rows,
+        sliders,
+        modes,
+    })
+}
+
+/// The first `count` modes of the star at `pose` (rigid ones included when the sliders are free).
+pub fn pose_modes(
+    params: &RobotParams,
+    pose: &RestPose,
+    sliders: Sliders,
+    family: ModeFamily,
+    nm: usize,
+    count: usize,
+) -> Result<PoseModes, AmmError> {
+    let system = pose_system(params, pose, sliders, family, nm)?;
+    let rigid = if sliders == Sliders::Free { 3 } else { 0 };
+    let out = constrained_modes(system.n, &system.m, &system.k, &system.c, system.rows, count + rigid)
+        .map_err(|reason| AmmError::SingularConstraints { t: 0.0, reason })?;
+    let mut omega2 = out.omega2;
+    let mut freq_hz: Vec<f64> = omega2
+        .iter()
+        .map(|w| w.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+        .collect();
+    // rigid modes: zero by construction, round-off here
+    for j in 0..rigid.min(omega2.len()) {
+        omega2[j] = 0.0;
+        freq_hz[j] = 0.0;
+    }
+    Ok(PoseModes {
+        freq_hz,
+        omega2,
+        shapes: out.shapes,
+        rigid,
+        system,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn centre(params: &RobotParams) -> RestPose {
+        RestPose {
+            s: [0.0; 3],
+            g: [0.0; 2],
+            theta: 0.0,
+            xp: [params.d; 3],
+        }
+    }
+
+    fn freqs(n: usize, sliders: Sliders) -> PoseModes {
+        let p = RobotParams::paper();
+        pose_modes(&p, &centre(&p), sliders, ModeFamily::Enriched, n, 6).unwrap()
+    }
+
+    /// Convergence in N behind DEFAULT_MODAL_MODES (a refined run as the reference).
+    #[test]
+    fn modes_converge_in_n() {
+        let (a, b) = (freqs(DEFAULT_MODAL_MODES, Sliders::Locked), freqs(80, Sliders::Locked));
+        for (x, y) in a.freq_hz.iter().zip(&b.freq_hz) {
+            assert!((x / y - 1.0).abs() < 1e-3, "{x} vs {y}");
+        }
+    }
+
+    /// Free sliders: exactly three rigid modes (the mechanism's three degrees of freedom), the
+    /// next frequency clearly above zero, and the rigid shapes satisfy the constraints.
+    #[test]
+    fn free_sliders_give_three_rigid_modes() {
+        let p = RobotParams::paper();
+        let sys = pose_system(&p, &centre(&p), Sliders::Free, ModeFamily::Enriched, 30).unwrap();
+        let out = constrained_modes(sys.n, &sys.m, &sys.k, &sys.c, sys.rows, 5).unwrap();
+        let first_elastic = out.omega2[3];
+        assert!(first_elastic > 1.0, "{first_elastic}");
+        for w in &out.omega2[..3] {
+            assert!(w.abs() < 1e-7 * first_elastic, "{w} vs {first_elastic}");
+        }
+    }
+}

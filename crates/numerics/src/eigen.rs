@@ -1,0 +1,226 @@
+//! Undamped vibration modes of a constrained linear system, shared by the AMM and the FEM:
+//!
+//! ```text
+//! M q'' + K q = 0,   C q = 0        (M, K symmetric n x n; C r x n of full row rank)
+//! ```
+//!
+//! The constraints are eliminated on their null space (Householder QR of `C^T`:
+//! `C^T = Q [R; 0]`, `q = Z y` with `Z` the last `n - r` columns of `Q`), which leaves the
+//! generalised symmetric problem `Z^T K Z y = omega^2 Z^T M Z y`. `Z^T M Z` must be positive
+//! definite (every constrained motion carries kinetic energy; massless coordinates are allowed
+//! as long as the constraints fix them); it is reduced to a standard problem with its Cholesky
+//! factor `L` (`L^-1 Z^T K Z L^-T`) and solved densely with faer.
+
+use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
+use faer::{Mat, Par, Side};
+
+/// Modes of a constrained system, lowest first.
+#[derive(Debug, Clone)]
+pub struct ConstrainedModes {
+    /// Squared circular frequencies `omega^2` [rad^2/s^2], ascending; zero-energy (rigid) modes
+    /// come out at round-off size and may be slightly negative.
+    pub omega2: Vec<f64>,
+    /// Shapes in the full coordinates (`C x = 0`), mass-normalised (`x^T M x = 1`), one per
+    /// requested mode.
+    pub shapes: Vec<Vec<f64>>,
+    /// Number of independent constraint rows eliminated.
+    pub rank: usize,
+}
+
+impl ConstrainedModes {
+    /// Natural frequencies [Hz] of the first modes (`sqrt(max(omega^2, 0)) / 2 pi`).
+    pub fn frequencies_hz(&self) -> Vec<f64> {
+        self.omega2
+            .iter()
+            .map(|w| w.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+            .collect()
+    }
+}
+
+/// One Householder reflector `H = I - 2 v v^T` (`|v| = 1`) acting on coordinates `start..n`.
+struct Reflector {
+    start: usize,
+    v: Vec<f64>,
+}
+
+impl Reflector {
+    /// `x <- H x`.
+    fn apply_vec(&self, x: &mut [f64]) {
+        let tail = &mut x[self.start..];
+        let s: f64 = tail.iter().zip(&self.v).map(|(a, b)| a * b).sum();
+        for (a, b) in tail.iter_mut().zip(&self.v) {
+            *a -= 2.0 * s * b;
+        }
+    }
+
+    /// `A <- H A H` for a symmetric dense `A` (both sides, so `A` stays symmetric).
+    fn apply_both(&self, a: &mut Mat<f64>) {
+        let (s, m) = (self.start, self.v.len());
+        let v = faer::ColRef::from_slice(&self.v);
+        // left: rows s.. -= 2 v (v^T A[s.., :])
+        let w: faer::Row<f64> = v.transpose() * a.as_ref().subrows(s, m);
+        let mut rows = a.as_mut().subrows_mut(s, m);
+        rows -= (2.0 * v) * &w;
+        // right: cols s.. -= 2 (A[:, s..] v) v^T
+        let z: faer::Col<f64> = a.as_ref().subcols(s, m) * v;
+        let mut cols = a.as_mut().subcols_mut(s, m);
+        cols -= &z * (2.0 * v.transpose());
+    }
+}
+
+/// Householder QR of `C^T` (`c`: r x n, row-major): the reflectors, and the number of rows
+/// kept. Fails when a row is (numerically) a combination of the others.
+fn null_space_reflectors(n: usize, c: &[f64], rows: usize) -> Result<Vec<Reflector>, String> {
+    // columns of C^T = rows of C
+    let mut cols: Vec<Vec<f64>> = c.chunks_exact(n).map(|r| r.to_vec()).collect();
+    let scale = cols
+        .iter()
+        .map(|r| r.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .fold(0.0f64, f64::max);
+    let mut refl = Vec::with_capacity(rows);
+    for j in 0..rows {
+        let x = &cols[j][j..];
+        let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(norm > 1e-11 * scale) {
+            return Err(format!(
+                "constraint row {} of {rows} is a combination of the others (residual norm {norm:e})",
+                j + 1
+            ));
+        }
+        let alpha = if x[0] > 0.0 { -norm } else { norm };
+        let mut v = x.to_vec();
+        v[0] -= alpha;
+        let vn = v.iter().map(|a| a * a).sum::<f64>().sqrt();
+        v.iter_mut().for_each(|a| *a /= vn);
+        let h = Reflector { start: j, v };
+        for col in cols.iter_mut().skip(j) {
+            h.apply_vec(col);
+        }
+        refl.push(h);
+    }
+    Ok(refl)
+}
+
+fn to_mat(n: usize, a: &[f64]) -> Mat<f64> {
+    Mat::from_fn(n, n, |i, j| 0.5 * (a[i * n + j] + a[j * n + i]))
+}
+
+/// The first `count` modes (all if `count` exceeds the free coordinates) of `M q'' + K q = 0`
+/// with `C q = 0`. `m`, `k`: n x n row-major (symmetrised here); `c`: `rows` x n row-major.
+///
+/// Errors (as text, the caller adds context): dependent constraint rows, a mass matrix that is
+/// not positive definite on the constrained motions, an eigensolver failure, non-finite input.
+pub fn constrained_modes(
+    n: usize,
+    m: &[f64],
+    k: &[f64],
+    c: &[f64],
+    rows: usize,
+    count: usize,
+) -> Result<ConstrainedModes, String> {
+    if m.len() != n * n || k.len() != n * n || c.len() != rows * n || rows >= n {
+        return Err(format!(
+            "inconsistent sizes: n = {n}, M {}, K {}, C {} with {rows} rows",
+            m.len(),
+            k.len(),
+            c.len()
+        ));
+    }
+    if m.iter().chain(k).chain(c).any(|v| !v.is_finite()) {
+        return Err("non-finite entry in M, K or C".into());
+    }
+    let refl = null_space_reflectors(n, c, rows)?;
+    let (mut mq, mut kq) = (to_mat(n, m), to_mat(n, k));
+    for h in &refl {
+        h.apply_both(&mut mq);
+        h.apply_both(&mut kq);
+    }
+    let p = n - rows;
+    let mr = mq.as_ref().submatrix(rows, rows, p, p).to_owned();
+    let mut s = kq.as_ref().submatrix(rows, rows, p, p).to_owned();
+    let llt = mr
+        .llt(Side::Lower)
+        .map_err(|e| format!("the mass matrix is not positive definite on the constrained motions ({e:?})"))?;
+    let l = llt.L();
+    // S = L^-1 Kr L^-T
+    solve_lower_triangular_in_place(l, s.as_mut(), Par::Seq);
+    let mut st = s.transpose().to_owned();
+    solve_lower_triangular_in_place(l, st.as_mut(), Par::Seq);
+    let sym = Mat::from_fn(p, p, |i, j| 0.5 * (st[(i, j)] + st[(j, i)]));
+    let eig = sym
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|e| format!("symmetric eigensolver failed ({e:?})"))?;
+    let count = count.min(p);
+    let omega2: Vec<f64> = (0..count).map(|j| eig.S()[j]).collect();
+    // shapes: x_r = L^-T y, x = Q [0; x_r]
+    let mut y = eig.U().subcols(0, count).to_owned();
+    solve_upper_triangular_in_place(l.transpose(), y.as_mut(), Par::Seq);
+    let shapes = (0..count)
+        .map(|j| {
+            let mut x = vec![0.0; n];
+            for (r, xr) in x[rows..].iter_mut().enumerate() {
+                *xr = y[(r, j)];
+            }
+            for h in refl.iter().rev() {
+                h.apply_vec(&mut x);
+            }
+            x
+        })
+        .collect();
+    Ok(ConstrainedModes {
+        omega2,
+        shapes,
+        rank: rows,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Fixed-fixed chain of `n` unit masses and unit springs, written as a free-free chain of
+    /// n + 2 masses with the two end masses held by constraints: the textbook frequencies are
+    /// `omega_j = 2 sin(j pi / (2 (n + 1)))`, j = 1..n.
+    #[test]
+    fn constrained_chain_matches_textbook() {
+        let n = 12;
+        let nt = n + 2;
+        let mut k = vec![0.0; nt * nt];
+        for e in 0..nt - 1 {
+            for (a, b, v) in [(e, e, 1.0), (e + 1, e + 1, 1.0), (e, e + 1, -1.0), (e + 1, e, -1.0)] {
+                k[a * nt + b] += v;
+            }
+        }
+        let mut m = vec![0.0; nt * nt];
+        for i in 0..nt {
+            m[i * nt + i] = 1.0;
+        }
+        // constraints written as mixtures (q0 + q_last = 0, q0 - q_last = 0): same null space
+        let mut c = vec![0.0; 2 * nt];
+        c[0] = 1.0;
+        c[nt - 1] = 1.0;
+        c[nt] = 1.0;
+        c[2 * nt - 1] = -1.0;
+        let modes = constrained_modes(nt, &m, &k, &c, 2, n).unwrap();
+        for (j, w2) in modes.omega2.iter().enumerate() {
+            let exact = 2.0 * ((j + 1) as f64 * std::f64::consts::PI / (2.0 * (n as f64 + 1.0))).sin();
+            assert!((w2.sqrt() - exact).abs() < 1e-12, "mode {j}: {} vs {exact}", w2.sqrt());
+        }
+        // shapes satisfy the constraints and are mass-normalised
+        for x in &modes.shapes {
+            assert!(x[0].abs() < 1e-13 && x[nt - 1].abs() < 1e-13);
+            let mass: f64 = x.iter().map(|v| v * v).sum();
+            assert!((mass - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn dependent_constraints_are_refused() {
+        let n = 3;
+        let m = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        let k = m;
+        let c = [1.0, 1.0, 0.0, 2.0, 2.0, 0.0];
+        let err = constrained_modes(n, &m, &k, &c, 2, 1).unwrap_err();
+        assert!(err.contains("combination"), "{err}");
+    }
+}

@@ -20,7 +20,7 @@
 //! slides the sleeve along the beam, which is free at rest.
 
 use flexstar_model::{AmmModel, ModeFamily, RestPose, RobotParams, Sliders};
-use flexstar_numerics::eigen::constrained_modes;
+use flexstar_numerics::eigen::{constrained_modes, rigid_shift};
 
 use crate::error::AmmError;
 use crate::modes::ModeSet;
@@ -168,8 +168,16 @@ pub fn pose_modes(
 ) -> Result<PoseModes, AmmError> {
     let system = pose_system(params, pose, sliders, family, nm)?;
     let rigid = if sliders == Sliders::Free { 3 } else { 0 };
-    let out = constrained_modes(system.n, &system.m, &system.k, &system.c, system.rows, count + rigid)
-        .map_err(|reason| AmmError::SingularConstraints { t: 0.0, reason })?;
+    let out = constrained_modes(
+        system.n,
+        &system.m,
+        &system.k,
+        &system.c,
+        system.rows,
+        count + rigid,
+        rigid_shift(sliders == Sliders::Free),
+    )
+    .map_err(|reason| AmmError::SingularConstraints { t: 0.0, reason })?;
     let mut omega2 = out.omega2;
     let mut freq_hz: Vec<f64> = omega2
         .iter()
@@ -222,7 +230,7 @@ mod tests {
     fn free_sliders_give_three_rigid_modes() {
         let p = RobotParams::paper();
         let sys = pose_system(&p, &centre(&p), Sliders::Free, ModeFamily::Enriched, 30).unwrap();
-        let out = constrained_modes(sys.n, &sys.m, &sys.k, &sys.c, sys.rows, 5).unwrap();
+        let out = constrained_modes(sys.n, &sys.m, &sys.k, &sys.c, sys.rows, 5, rigid_shift(true)).unwrap();
         let first_elastic = out.omega2[3];
         assert!(first_elastic > 1.0, "{first_elastic}");
         for w in &out.omega2[..3] {

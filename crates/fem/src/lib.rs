@@ -18,6 +18,7 @@ mod bordered;
 pub mod element;
 pub mod error;
 mod integrator;
+pub mod pose_modes;
 mod solve;
 mod sparse;
 mod star;

@@ -40,7 +40,7 @@ const WINDOW: usize = 8;
 /// Constraint rows per sleeve.
 pub(crate) const ROWS: usize = 7;
 /// Contact point of each constraint row: 0 centre, 1 left edge, 2 right edge.
-const ROW_POINT: [usize; ROWS] = [0, 0, 1, 1, 2, 2, 0];
+pub(crate) const ROW_POINT: [usize; ROWS] = [0, 0, 1, 1, 2, 2, 0];
 
 /// Initial state of the star: undeformed, moving rigidly (initial data from the rigid
 /// kinematics at t = 0: this is allowed, the equations never use it again).
@@ -374,7 +374,6 @@ impl Star {
             }
             self.states[e] = st;
         }
-        let lp2 = 0.5 * self.params.lp;
         for i in 0..3 {
             let ps = self.psi(i);
             res[ps] += cf * self.params.jp * qdd[ps];
@@ -384,8 +383,6 @@ impl Star {
                     self.vals[self.off_psi + 4 * i + 1 + p] = 0.0;
                 }
             }
-            let ang = self.gamma0[i] + q[ps];
-            let (a, aperp) = ([ang.cos(), ang.sin()], [-ang.sin(), ang.cos()]);
             for r in 0..ROWS {
                 let p = ROW_POINT[r];
                 let xi_idx = self.xi(i, p);
@@ -393,21 +390,7 @@ impl Star {
                 let ge = i * self.ne + e;
                 let st = self.states[ge];
                 let na = self.node(i, e);
-                let (phi, grad, gxi, gpsi) = if r < 6 {
-                    let k = r % 2;
-                    let pos = st.position([q[3 * na], q[3 * na + 1]], z);
-                    let jac = st.jacobian(z);
-                    let rz = st.dr_dzeta(z);
-                    let (off, gpsi) = match p {
-                        0 => (0.0, 0.0),
-                        1 => (lp2 * a[k], lp2 * aperp[k]),
-                        _ => (-lp2 * a[k], -lp2 * aperp[k]),
-                    };
-                    (pos[k] - pins.p[i][k] + off, jac[k], rz[k] / self.h, gpsi)
-                } else {
-                    let (al, g, az) = st.angle(z);
-                    (al - q[ps], g, az / self.h, -1.0)
-                };
+                let (phi, grad, gxi, gpsi) = self.row_terms(&st, [q[3 * na], q[3 * na + 1]], i, q[ps], pins.p[i], r, z);
                 let row = self.n_dof + ROWS * i + r;
                 let l = lam[ROWS * i + r];
                 res[row] = phi;
@@ -448,6 +431,40 @@ impl Star {
             });
         }
         Ok(matrix)
+    }
+
+    /// Value, element gradient, contact-coordinate derivative and sleeve-rotation derivative of
+    /// constraint row `r` of sleeve i (module docs), for the state `st` of the element holding the
+    /// contact point at local coordinate `z`, its first node at `node_a`, the sleeve rotation
+    /// `psi` (axis at the angle `gamma0_i + psi`) and the pin `pin`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn row_terms(
+        &self,
+        st: &ElementState,
+        node_a: [f64; 2],
+        i: usize,
+        psi: f64,
+        pin: [f64; 2],
+        r: usize,
+        z: f64,
+    ) -> (f64, [f64; 6], f64, f64) {
+        if r < 6 {
+            let (k, lp2) = (r % 2, 0.5 * self.params.lp);
+            let ang = self.gamma0[i] + psi;
+            let (a, aperp) = ([ang.cos(), ang.sin()], [-ang.sin(), ang.cos()]);
+            let pos = st.position(node_a, z);
+            let jac = st.jacobian(z);
+            let rz = st.dr_dzeta(z);
+            let (off, gpsi) = match ROW_POINT[r] {
+                0 => (0.0, 0.0),
+                1 => (lp2 * a[k], lp2 * aperp[k]),
+                _ => (-lp2 * a[k], -lp2 * aperp[k]),
+            };
+            (pos[k] - pin[k] + off, jac[k], rz[k] / self.h, gpsi)
+        } else {
+            let (al, g, az) = st.angle(z);
+            (al - psi, g, az / self.h, -1.0)
+        }
     }
 
     fn element_of_dof(&self, k: usize) -> usize {

@@ -6,10 +6,9 @@
 //!
 //! The constraints are eliminated on their null space (Householder QR of `C^T`:
 //! `C^T = Q [R; 0]`, `q = Z y` with `Z` the last `n - r` columns of `Q`), which leaves the
-//! generalised symmetric problem `Z^T K Z y = omega^2 Z^T M Z y`. `Z^T M Z` must be positive
-//! definite (every constrained motion carries kinetic energy; massless coordinates are allowed
-//! as long as the constraints fix them); it is reduced to a standard problem with its Cholesky
-//! factor `L` (`L^-1 Z^T K Z L^-T`) and solved densely with faer.
+//! generalised symmetric problem `Z^T K Z y = omega^2 Z^T M Z y` (massless coordinates are
+//! allowed as long as the constraints fix them), reduced to a standard one with the Cholesky
+//! factor of the shifted stiffness (see [`constrained_modes`]) and solved densely with faer.
 
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Mat, Par, Side};
@@ -34,6 +33,17 @@ impl ConstrainedModes {
             .iter()
             .map(|w| w.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
             .collect()
+    }
+}
+
+/// The shift for [`constrained_modes`] in the robot's modal analyses: 0 with locked sliders (no
+/// rigid mode), `(2 pi 0.1 Hz)^2` with free sliders (below the first elastic frequency of any
+/// sensible robot; the rigid modes then come out at round-off size).
+pub fn rigid_shift(sliders_free: bool) -> f64 {
+    if sliders_free {
+        (2.0 * std::f64::consts::PI * 0.1).powi(2)
+    } else {
+        0.0
     }
 }
 
@@ -101,15 +111,19 @@ fn null_space_reflectors(n: usize, c: &[f64], rows: usize) -> Result<Vec<Reflect
     Ok(refl)
 }
 
-fn to_mat(n: usize, a: &[f64]) -> Mat<f64> {
-    Mat::from_fn(n, n, |i, j| 0.5 * (a[i * n + j] + a[j * n + i]))
-}
-
 /// The first `count` modes (all if `count` exceeds the free coordinates) of `M q'' + K q = 0`
 /// with `C q = 0`. `m`, `k`: n x n row-major (symmetrised here); `c`: `rows` x n row-major.
 ///
-/// Errors (as text, the caller adds context): dependent constraint rows, a mass matrix that is
-/// not positive definite on the constrained motions, an eigensolver failure, non-finite input.
+/// `shift` (sigma [1/s^2], >= 0) must make `K + sigma M` positive definite on the constrained
+/// motions: 0 when K alone is (no rigid modes), otherwise a value of the order of the first
+/// nonzero `omega^2` or below. The problem is solved in its inverse form
+/// `L^-1 M L^-T z = mu z` with `K + sigma M = L L^T` and `omega^2 = 1/mu - sigma`: the lowest modes
+/// are the largest `mu`, computed to a precision relative to the fundamental (the direct form
+/// `L_M^-1 K L_M^-T` loses them when M is ill-conditioned, as a FEM mass matrix with rotational
+/// degrees of freedom is). Coordinates are scaled by `1/sqrt(M_ii)` (Jacobi) first.
+///
+/// Errors (as text, the caller adds context): dependent constraint rows, `K + sigma M` not
+/// positive definite on the constrained motions, an eigensolver failure, non-finite input.
 pub fn constrained_modes(
     n: usize,
     m: &[f64],
@@ -117,6 +131,7 @@ pub fn constrained_modes(
     c: &[f64],
     rows: usize,
     count: usize,
+    shift: f64,
 ) -> Result<ConstrainedModes, String> {
     if m.len() != n * n || k.len() != n * n || c.len() != rows * n || rows >= n {
         return Err(format!(
@@ -126,23 +141,38 @@ pub fn constrained_modes(
             c.len()
         ));
     }
-    if m.iter().chain(k).chain(c).any(|v| !v.is_finite()) {
-        return Err("non-finite entry in M, K or C".into());
+    if m.iter().chain(k).chain(c).any(|v| !v.is_finite()) || !(shift >= 0.0) {
+        return Err("non-finite entry in M, K or C, or a negative shift".into());
     }
-    let refl = null_space_reflectors(n, c, rows)?;
-    let (mut mq, mut kq) = (to_mat(n, m), to_mat(n, k));
+    // Jacobi scaling q = D q~ (massless coordinates keep scale 1)
+    let d: Vec<f64> = (0..n)
+        .map(|i| {
+            let mii = m[i * n + i];
+            if mii > 0.0 {
+                1.0 / mii.sqrt()
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let cs: Vec<f64> = c.iter().enumerate().map(|(idx, v)| v * d[idx % n]).collect();
+    let refl = null_space_reflectors(n, &cs, rows)?;
+    let scaled = |a: &[f64]| Mat::from_fn(n, n, |i, j| 0.5 * (a[i * n + j] + a[j * n + i]) * d[i] * d[j]);
+    let (mut mq, mut kq) = (scaled(m), scaled(k));
     for h in &refl {
         h.apply_both(&mut mq);
         h.apply_both(&mut kq);
     }
     let p = n - rows;
     let mr = mq.as_ref().submatrix(rows, rows, p, p).to_owned();
-    let mut s = kq.as_ref().submatrix(rows, rows, p, p).to_owned();
-    let llt = mr
-        .llt(Side::Lower)
-        .map_err(|e| format!("the mass matrix is not positive definite on the constrained motions ({e:?})"))?;
+    let kr = kq.as_ref().submatrix(rows, rows, p, p);
+    let ks = Mat::from_fn(p, p, |i, j| kr[(i, j)] + shift * mr[(i, j)]);
+    let llt = ks.llt(Side::Lower).map_err(|e| {
+        format!("K + {shift:e} M is not positive definite on the constrained motions ({e:?}): a mechanism, or too small a shift")
+    })?;
     let l = llt.L();
-    // S = L^-1 Kr L^-T
+    // S = L^-1 Mr L^-T
+    let mut s = mr;
     solve_lower_triangular_in_place(l, s.as_mut(), Par::Seq);
     let mut st = s.transpose().to_owned();
     solve_lower_triangular_in_place(l, st.as_mut(), Par::Seq);
@@ -151,19 +181,25 @@ pub fn constrained_modes(
         .self_adjoint_eigen(Side::Lower)
         .map_err(|e| format!("symmetric eigensolver failed ({e:?})"))?;
     let count = count.min(p);
-    let omega2: Vec<f64> = (0..count).map(|j| eig.S()[j]).collect();
-    // shapes: x_r = L^-T y, x = Q [0; x_r]
-    let mut y = eig.U().subcols(0, count).to_owned();
+    // largest mu first
+    let order: Vec<usize> = (0..count).map(|j| p - 1 - j).collect();
+    let omega2: Vec<f64> = order.iter().map(|&j| 1.0 / eig.S()[j] - shift).collect();
+    // shapes: x_r = L^-T z / sqrt(mu) (mass-normalised), x = D Q [0; x_r]
+    let mut y = Mat::from_fn(p, count, |r, j| eig.U()[(r, order[j])]);
     solve_upper_triangular_in_place(l.transpose(), y.as_mut(), Par::Seq);
-    let shapes = (0..count)
-        .map(|j| {
+    let shapes = order
+        .iter()
+        .enumerate()
+        .map(|(j, &jj)| {
+            let scale = 1.0 / eig.S()[jj].sqrt();
             let mut x = vec![0.0; n];
             for (r, xr) in x[rows..].iter_mut().enumerate() {
-                *xr = y[(r, j)];
+                *xr = y[(r, j)] * scale;
             }
             for h in refl.iter().rev() {
                 h.apply_vec(&mut x);
             }
+            x.iter_mut().zip(&d).for_each(|(a, b)| *a *= b);
             x
         })
         .collect();
@@ -201,7 +237,7 @@ mod tests {
         c[nt - 1] = 1.0;
         c[nt] = 1.0;
         c[2 * nt - 1] = -1.0;
-        let modes = constrained_modes(nt, &m, &k, &c, 2, n).unwrap();
+        let modes = constrained_modes(nt, &m, &k, &c, 2, n, 0.0).unwrap();
         for (j, w2) in modes.omega2.iter().enumerate() {
             let exact = 2.0 * ((j + 1) as f64 * std::f64::consts::PI / (2.0 * (n as f64 + 1.0))).sin();
             assert!((w2.sqrt() - exact).abs() < 1e-12, "mode {j}: {} vs {exact}", w2.sqrt());
@@ -220,7 +256,7 @@ mod tests {
         let m = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
         let k = m;
         let c = [1.0, 1.0, 0.0, 2.0, 2.0, 0.0];
-        let err = constrained_modes(n, &m, &k, &c, 2, 1).unwrap_err();
+        let err = constrained_modes(n, &m, &k, &c, 2, 1, 0.0).unwrap_err();
         assert!(err.contains("combination"), "{err}");
     }
 }

@@ -1,0 +1,248 @@
+//! Vibration modes of the star held at rest at one pose (issue 11): the mass matrix and the
+//! tangent stiffness of the co-rotational model at the undeformed configuration, and the
+//! Jacobian `Phi_q` of the sleeve constraints (module docs of `star`), solved on the null space
+//! of the constraints ([`flexstar_numerics::eigen::constrained_modes`]).
+//!
+//! At rest the constraint forces vanish, so the constraint Hessian adds no stiffness; the mesh
+//! is undeformed, so the tangent stiffness is the linear one. The pose is data ([`RestPose`]:
+//! G, theta, xp_i and the sliders s_i); no rigid kinematics enters the equations. With free
+//! sliders, slider i adds the coordinate `s_i` (mass `mpp_mpa`) and the pin rows of sleeve i
+//! read `r_i(xi) - P_i(s_i) + ... = 0` with `dP_i/ds_i = u_i` (Eqs. 1-3).
+
+use flexstar_model::geometry::{e_w, slider_direction};
+use flexstar_model::{RestPose, RobotParams, Sliders};
+use flexstar_numerics::eigen::{constrained_modes, rigid_shift};
+
+use crate::element::ElementState;
+use crate::star::{InitialState, Star, ROWS, ROW_POINT};
+use crate::FemError;
+
+/// The linearised FEM at a pose: `M q'' + K q = B f - Phi_q^T lambda`, `Phi_q q = 0`.
+///
+/// Coordinates: those of the time-domain model (nodes `[x, y, phi]`, node 0 = G, beam i node k
+/// at `1 + i ne + k - 1`; then the sleeve rotations psi_i; then the contact coordinates), then
+/// `[s_1, s_2, s_3]` when the sliders are free. Matrices dense, row-major.
+#[derive(Debug, Clone)]
+pub struct PoseSystem {
+    /// Number of coordinates n.
+    pub n: usize,
+    /// Elements per beam.
+    pub ne: usize,
+    /// Mass matrix (n x n) [kg, kg m, kg m^2].
+    pub m: Vec<f64>,
+    /// Tangent stiffness (n x n).
+    pub k: Vec<f64>,
+    /// Constraint Jacobian Phi_q (rows x n).
+    pub c: Vec<f64>,
+    /// Number of constraint rows (21).
+    pub rows: usize,
+    /// How the sliders are held.
+    pub sliders: Sliders,
+    /// Orientation of the pose [rad] (for projections on e_wi).
+    pub theta: f64,
+    /// Element length [m].
+    pub h: f64,
+}
+
+impl PoseSystem {
+    /// Global node index of node k (0 = G, ne = tip) of beam i.
+    pub fn node(&self, i: usize, k: usize) -> usize {
+        crate::star::node(self.ne, i, k)
+    }
+
+    /// Index of the slider coordinate s_i (free sliders only).
+    pub fn slider_index(&self, i: usize) -> Option<usize> {
+        (self.sliders == Sliders::Free).then(|| self.n - 3 + i)
+    }
+
+    /// Row vector `r` with `r . q` = the displacement of node k of beam i along `e_wi` of the pose.
+    pub fn deflection_row(&self, i: usize, k: usize) -> Vec<f64> {
+        let mut r = vec![0.0; self.n];
+        let ew = e_w(i, self.theta);
+        let j = self.node(i, k);
+        r[3 * j] = ew[0];
+        r[3 * j + 1] = ew[1];
+        r
+    }
+
+    /// Displacements along `e_wi` of the nodes of beam i (k = 0..=ne, at x = k h) for q.
+    pub fn deflections(&self, q: &[f64], i: usize) -> Vec<f64> {
+        let ew = e_w(i, self.theta);
+        (0..=self.ne)
+            .map(|k| {
+                let j = self.node(i, k);
+                q[3 * j] * ew[0] + q[3 * j + 1] * ew[1]
+            })
+            .collect()
+    }
+}
+
+/// Modes of the star at a pose.
+#[derive(Debug, Clone)]
+pub struct PoseModes {
+    /// Natural frequencies [Hz], ascending (rigid modes set to 0, see `rigid`).
+    pub freq_hz: Vec<f64>,
+    /// `omega^2` [1/s^2] of the same modes.
+    pub omega2: Vec<f64>,
+    /// Mass-normalised shapes in the coordinates of [`PoseSystem`].
+    pub shapes: Vec<Vec<f64>>,
+    /// Number of leading rigid modes: 3 with free sliders, 0 locked.
+    pub rigid: usize,
+    /// The system they belong to.
+    pub system: PoseSystem,
+}
+
+/// Assemble M, K and Phi_q at `pose` with `elements` elements in the whole star.
+pub fn pose_system(
+    params: &RobotParams,
+    pose: &RestPose,
+    sliders: Sliders,
+    elements: usize,
+) -> Result<PoseSystem, FemError> {
+    if elements < 3 || elements % 3 != 0 {
+        return Err(FemError::Input(format!(
+            "fem.elements must be a positive multiple of 3, got {elements}"
+        )));
+    }
+    let ne = elements / 3;
+    let init = InitialState {
+        g: pose.g,
+        g_dot: [0.0; 2],
+        theta: pose.theta,
+        theta_dot: 0.0,
+        xp: pose.xp,
+        xp_dot: [0.0; 3],
+    };
+    let (star, q, _) = Star::new(params, ne, &init)?;
+    let nd = star.n_dof;
+    let n = nd + if sliders == Sliders::Free { 3 } else { 0 };
+    let mut m = vec![0.0; n * n];
+    let mut k = vec![0.0; n * n];
+    let (ea, ei, rho) = (params.ea(), params.ei(), params.rho);
+    let zero = [0.0; 6];
+    let states: Vec<ElementState> = star
+        .elements
+        .iter()
+        .map(|el| ElementState::new(el, &element_q(el.nodes, &q)))
+        .collect();
+    for (el, st) in star.elements.iter().zip(&states) {
+        let d = dofs(el.nodes);
+        let (_, ke) = st.internal(ea, ei);
+        let (_, me) = st.inertia(rho, &zero);
+        for a in 0..6 {
+            for b in 0..6 {
+                m[d[a] * n + d[b]] += me[a][b];
+                k[d[a] * n + d[b]] += ke[a][b];
+            }
+        }
+    }
+    let rows = 3 * ROWS;
+    let mut c = vec![0.0; rows * n];
+    let pins = pose.s.map(|_| [0.0; 2]);
+    for i in 0..3 {
+        let ps = star.psi(i);
+        m[ps * n + ps] = params.jp;
+        if let Some(si) = (sliders == Sliders::Free).then_some(nd + i) {
+            m[si * n + si] = params.mpp_mpa;
+        }
+        for r in 0..ROWS {
+            let xi_idx = star.xi(i, ROW_POINT[r]);
+            let (e, z) = star.locate(q[xi_idx]);
+            let ge = i * star.ne + e;
+            let na = star.node(i, e);
+            // the pin only shifts the row's value, not its gradient
+            let (_, grad, gxi, gpsi) = star.row_terms(&states[ge], [q[3 * na], q[3 * na + 1]], i, q[ps], pins[i], r, z);
+            let row = &mut c[(ROWS * i + r) * n..(ROWS * i + r + 1) * n];
+            for (a, &da) in dofs(star.elements[ge].nodes).iter().enumerate() {
+                row[da] += grad[a];
+            }
+            row[xi_idx] += gxi;
+            row[ps] += gpsi;
+            if sliders == Sliders::Free && r < 6 {
+                row[nd + i] -= slider_direction(i)[r % 2];
+            }
+        }
+    }
+    Ok(PoseSystem {
+        n,
+        ne,
+        m,
+        k,
+        c,
+        rows,
+        sliders,
+        theta: pose.theta,
+        h: star.h,
+    })
+}
+
+/// The first `count` modes (after the rigid ones when the sliders are free) of the star at `pose`.
+pub fn pose_modes(
+    params: &RobotParams,
+    pose: &RestPose,
+    sliders: Sliders,
+    elements: usize,
+    count: usize,
+) -> Result<PoseModes, FemError> {
+    let system = pose_system(params, pose, sliders, elements)?;
+    let rigid = if sliders == Sliders::Free { 3 } else { 0 };
+    let out = constrained_modes(
+        system.n,
+        &system.m,
+        &system.k,
+        &system.c,
+        system.rows,
+        count + rigid,
+        rigid_shift(sliders == Sliders::Free),
+    )
+    .map_err(|reason| FemError::LinearSolver { t: 0.0, reason })?;
+    let mut omega2 = out.omega2;
+    let mut freq_hz: Vec<f64> = omega2
+        .iter()
+        .map(|w| w.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+        .collect();
+    for j in 0..rigid.min(omega2.len()) {
+        omega2[j] = 0.0;
+        freq_hz[j] = 0.0;
+    }
+    Ok(PoseModes {
+        freq_hz,
+        omega2,
+        shapes: out.shapes,
+        rigid,
+        system,
+    })
+}
+
+fn element_q(nodes: [usize; 2], q: &[f64]) -> [f64; 6] {
+    let (a, b) = (3 * nodes[0], 3 * nodes[1]);
+    [q[a], q[a + 1], q[a + 2], q[b], q[b + 1], q[b + 2]]
+}
+
+fn dofs(nodes: [usize; 2]) -> [usize; 6] {
+    let (a, b) = (3 * nodes[0], 3 * nodes[1]);
+    [a, a + 1, a + 2, b, b + 1, b + 2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Free sliders: three rigid modes (the mechanism), the elastic ones clearly above.
+    #[test]
+    fn free_sliders_give_three_rigid_modes() {
+        let p = RobotParams::paper();
+        let pose = RestPose {
+            s: [0.0; 3],
+            g: [0.0; 2],
+            theta: 0.0,
+            xp: [p.d; 3],
+        };
+        let sys = pose_system(&p, &pose, Sliders::Free, 150).unwrap();
+        let out = constrained_modes(sys.n, &sys.m, &sys.k, &sys.c, sys.rows, 5, rigid_shift(true)).unwrap();
+        for w in &out.omega2[..3] {
+            assert!(w.abs() < 1e-7 * out.omega2[3], "{w} vs {}", out.omega2[3]);
+        }
+        assert!(out.omega2[3] > 1.0);
+    }
+}

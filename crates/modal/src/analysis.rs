@@ -1,0 +1,71 @@
+//! Modes at one pose from both solvers, side by side (`modal.csv`).
+
+use std::path::Path;
+
+use flexstar_amm::pose_modes::DEFAULT_MODAL_MODES;
+use flexstar_model::output::{fmt_number, write_atomically};
+use flexstar_model::{Experiment, RestPose, Sliders};
+
+use crate::ModalError;
+
+/// Header of `modal.csv` (issue 11, exactly).
+pub const MODAL_HEADER: &str = "mode,f_amm_hz,f_fem_hz,rel_diff";
+
+/// Modes per beam of the AMM for an experiment: `[amm] modes` if given, else
+/// [`DEFAULT_MODAL_MODES`].
+pub fn amm_modes_per_beam(exp: &Experiment) -> usize {
+    exp.amm.modes.unwrap_or(DEFAULT_MODAL_MODES)
+}
+
+/// Both analyses at one pose.
+pub struct Modal {
+    pub amm: flexstar_amm::pose_modes::PoseModes,
+    pub fem: flexstar_fem::pose_modes::PoseModes,
+    /// K requested (elastic modes); the rigid ones come first when the sliders are free.
+    pub k: usize,
+}
+
+impl Modal {
+    /// Rows of `modal.csv`: mode number (1-based, rigid ones included), AMM and FEM frequency
+    /// [Hz], `(f_amm - f_fem) / f_fem` (0 for the rigid modes, which are 0 Hz in both).
+    pub fn rows(&self) -> Vec<(usize, f64, f64, f64)> {
+        let n = self.amm.rigid + self.k;
+        (0..n)
+            .map(|j| {
+                let (a, f) = (self.amm.freq_hz[j], self.fem.freq_hz[j]);
+                let rel = if j < self.amm.rigid { 0.0 } else { (a - f) / f };
+                (j + 1, a, f, rel)
+            })
+            .collect()
+    }
+}
+
+/// Modes at `pose` from the AMM (the experiment's family, N from [`amm_modes_per_beam`]) and the
+/// FEM (`[fem] elements`): the first `k` elastic modes, after the three rigid ones when the
+/// sliders are free.
+pub fn modal(exp: &Experiment, pose: &RestPose, sliders: Sliders, k: usize) -> Result<Modal, ModalError> {
+    crate::check_k(k)?;
+    let amm =
+        flexstar_amm::pose_modes::pose_modes(&exp.robot, pose, sliders, exp.amm.family, amm_modes_per_beam(exp), k)?;
+    let fem = flexstar_fem::pose_modes::pose_modes(&exp.robot, pose, sliders, exp.fem.elements, k)?;
+    if amm.freq_hz.len() < amm.rigid + k {
+        return Err(ModalError::Input(format!(
+            "--modes {k}: the AMM with N = {} modes per beam has only {} modes",
+            amm_modes_per_beam(exp),
+            amm.freq_hz.len() - amm.rigid
+        )));
+    }
+    Ok(Modal { amm, fem, k })
+}
+
+/// Write `modal.csv` (whole or not at all).
+pub fn write_modal_csv(path: &Path, modal: &Modal) -> Result<(), ModalError> {
+    write_atomically(path, |w| {
+        writeln!(w, "{MODAL_HEADER}")?;
+        for (m, a, f, r) in modal.rows() {
+            writeln!(w, "{m},{},{},{}", fmt_number(a), fmt_number(f), fmt_number(r))?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}

@@ -1,0 +1,173 @@
+//! Frequency maps: the first K frequencies over a grid of task-space poses (`freqmap.csv`).
+
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use flexstar_model::output::{fmt_number, write_atomically};
+use flexstar_model::{Experiment, Sliders};
+use rayon::prelude::*;
+
+use crate::analysis::amm_modes_per_beam;
+use crate::pose::pose_from_task;
+use crate::ModalError;
+
+/// Largest number of grid points accepted.
+pub const MAX_POINTS: usize = 100_000;
+
+/// One axis of the grid: `N` points from `min` to `max` inclusive [m].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Axis {
+    pub min: f64,
+    pub max: f64,
+    pub n: usize,
+}
+
+impl Axis {
+    /// Parse `MIN:MAX:N` (`flag` names the option in errors); N >= 2, MIN < MAX.
+    pub fn parse(flag: &str, text: &str) -> Result<Self, ModalError> {
+        let bad = |why: &str| ModalError::Input(format!("{flag} {text}: {why} (expected MIN:MAX:N, N >= 2)"));
+        let parts: Vec<&str> = text.split(':').collect();
+        if parts.len() != 3 {
+            return Err(bad("three fields needed"));
+        }
+        let min: f64 = parts[0].trim().parse().map_err(|_| bad("MIN is not a number"))?;
+        let max: f64 = parts[1].trim().parse().map_err(|_| bad("MAX is not a number"))?;
+        let n: usize = parts[2].trim().parse().map_err(|_| bad("N is not a whole number"))?;
+        if n < 2 {
+            return Err(bad("N must be at least 2"));
+        }
+        if !(min.is_finite() && max.is_finite() && min < max) {
+            return Err(bad("need finite MIN < MAX"));
+        }
+        Ok(Axis { min, max, n })
+    }
+
+    /// The k-th point [m].
+    pub fn at(&self, k: usize) -> f64 {
+        self.min + (self.max - self.min) * k as f64 / (self.n - 1) as f64
+    }
+}
+
+/// Which solver computes the map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Solver {
+    Amm,
+    Fem,
+}
+
+/// One grid point: the pose, and the first K frequencies [Hz] or why the pose is infeasible.
+#[derive(Debug, Clone)]
+pub struct MapPoint {
+    pub gx: f64,
+    pub gy: f64,
+    pub theta: f64,
+    pub result: Result<Vec<f64>, String>,
+}
+
+/// Check the grid size before any work: at most [`MAX_POINTS`] points.
+pub fn check_grid(gx: &Axis, gy: &Axis) -> Result<(), ModalError> {
+    let n = gx.n.saturating_mul(gy.n);
+    if n > MAX_POINTS {
+        return Err(ModalError::Input(format!(
+            "the grid --gx x --gy has {n} points, more than the limit {MAX_POINTS}"
+        )));
+    }
+    Ok(())
+}
+
+/// The first `k` frequencies (sliders locked) over the grid, in parallel; `progress(done, total)`
+/// is called from the worker threads. Infeasible poses are kept with the reason.
+pub fn freqmap<P>(
+    exp: &Experiment,
+    gx: &Axis,
+    gy: &Axis,
+    theta: f64,
+    k: usize,
+    solver: Solver,
+    progress: P,
+) -> Result<Vec<MapPoint>, ModalError>
+where
+    P: Fn(usize, usize) + Sync,
+{
+    crate::check_k(k)?;
+    check_grid(gx, gy)?;
+    let total = gx.n * gy.n;
+    let done = AtomicUsize::new(0);
+    let points = (0..total)
+        .into_par_iter()
+        .map(|idx| {
+            let (x, y) = (gx.at(idx % gx.n), gy.at(idx / gx.n));
+            let result = point(exp, x, y, theta, k, solver);
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            MapPoint {
+                gx: x,
+                gy: y,
+                theta,
+                result,
+            }
+        })
+        .collect();
+    Ok(points)
+}
+
+fn point(exp: &Experiment, gx: f64, gy: f64, theta: f64, k: usize, solver: Solver) -> Result<Vec<f64>, String> {
+    let pose = pose_from_task(&exp.robot, gx, gy, theta).map_err(|e| e.to_string())?;
+    let f = match solver {
+        Solver::Amm => {
+            flexstar_amm::pose_modes::pose_modes(
+                &exp.robot,
+                &pose,
+                Sliders::Locked,
+                exp.amm.family,
+                amm_modes_per_beam(exp),
+                k,
+            )
+            .map_err(|e| e.to_string())?
+            .freq_hz
+        }
+        Solver::Fem => {
+            flexstar_fem::pose_modes::pose_modes(&exp.robot, &pose, Sliders::Locked, exp.fem.elements, k)
+                .map_err(|e| e.to_string())?
+                .freq_hz
+        }
+    };
+    Ok(f)
+}
+
+/// Write `freqmap.csv`: header `Gx,Gy,theta,feasible,f1_hz,...,fK_hz`; an infeasible pose has
+/// `feasible = false` and its frequency fields empty, the reason in the sidecar
+/// `freqmap-infeasible.csv` (`Gx,Gy,theta,reason`).
+pub fn write_freqmap_csv(dir: &Path, points: &[MapPoint], k: usize) -> Result<(), ModalError> {
+    write_atomically(&dir.join("freqmap.csv"), |w| {
+        let cols: Vec<String> = (1..=k).map(|j| format!("f{j}_hz")).collect();
+        writeln!(w, "Gx,Gy,theta,feasible,{}", cols.join(","))?;
+        for p in points {
+            let head = format!("{},{},{}", fmt_number(p.gx), fmt_number(p.gy), fmt_number(p.theta));
+            match &p.result {
+                Ok(f) => {
+                    let v: Vec<String> = f.iter().take(k).map(|x| fmt_number(*x)).collect();
+                    writeln!(w, "{head},true,{}", v.join(","))?;
+                }
+                Err(_) => writeln!(w, "{head},false{}", ",".repeat(k))?,
+            }
+        }
+        Ok(())
+    })?;
+    write_atomically(&dir.join("freqmap-infeasible.csv"), |w| {
+        writeln!(w, "Gx,Gy,theta,reason")?;
+        for p in points {
+            if let Err(reason) = &p.result {
+                let r = reason.replace('"', "'");
+                writeln!(
+                    w,
+                    "{},{},{},\"{r}\"",
+                    fmt_number(p.gx),
+                    fmt_number(p.gy),
+                    fmt_number(p.theta)
+                )?;
+            }
+        }
+        Ok(())
+    })?;
+    Ok(())
+}

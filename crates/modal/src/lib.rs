@@ -1,0 +1,36 @@
+//! # flexstar-modal
+//!
+//! Vibration modes of the star over the workspace and linear models for control (issue 11),
+//! above both solvers and below the CLI:
+//!
+//! - [`pose`]: the rest pose from a time of the experiment's trajectory or a task-space pose,
+//!   checked against the feasible range (the limit is named);
+//! - [`analysis`]: modes at a pose from the AMM and the FEM side by side (`modal.csv`);
+//! - [`freqmap`]: the first K frequencies over a grid of poses, in parallel (`freqmap.csv`);
+//! - [`linear`]: the state-space model (A, B, C, D) with free sliders, Matrix Market files
+//!   (sprs) and `statespace.json`.
+//!
+//! The physics (mass, stiffness and constraints at a pose) lives in the solvers:
+//! `flexstar_amm::pose_modes` and `flexstar_fem::pose_modes`. SI units; frames as in
+//! `docs/conventions.md`.
+
+pub mod analysis;
+pub mod error;
+pub mod freqmap;
+pub mod linear;
+pub mod pose;
+
+pub use error::ModalError;
+
+/// Largest number of modes K a command accepts.
+pub const MAX_K: usize = 50;
+
+/// Check K (`--modes`): 1 <= K <= [`MAX_K`].
+pub fn check_k(k: usize) -> Result<(), ModalError> {
+    if k == 0 || k > MAX_K {
+        return Err(ModalError::Input(format!(
+            "--modes K must satisfy 1 <= K <= {MAX_K}, got {k}"
+        )));
+    }
+    Ok(())
+}

@@ -99,7 +99,7 @@ pub fn pose_system(
     sliders: Sliders,
     elements: usize,
 ) -> Result<PoseSystem, FemError> {
-    if elements < 3 || elements % 3 != 0 {
+    if elements < 3 || !elements.is_multiple_of(3) {
         return Err(FemError::Input(format!(
             "fem.elements must be a positive multiple of 3, got {elements}"
         )));

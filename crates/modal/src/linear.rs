@@ -56,7 +56,7 @@ pub struct StateSpace {
 /// Derivatives of the rigid star (G [m], theta [rad]) with respect to s_j at the pose.
 fn rigid_jacobian(exp: &Experiment, pose: &RestPose) -> Result<[[f64; 3]; 3], ModalError> {
     let mut jac = [[0.0; 3]; 3];
-    for j in 0..3 {
+    for (j, _) in pose.s.iter().enumerate() {
         let s = [0, 1, 2].map(|i| Dual2::new(pose.s[i], if i == j { 1.0 } else { 0.0 }, 0.0));
         let st = RigidState::from_actuators(&exp.robot, s, 0.0).map_err(|e| ModalError::Infeasible(e.to_string()))?;
         jac[0][j] = st.g[0].d1;
@@ -104,9 +104,9 @@ pub fn linearize(exp: &Experiment, pose: &RestPose) -> Result<StateSpace, ModalE
             for (hv, v) in h[row].iter_mut().zip(dr) {
                 *hv += v;
             }
-            for j in 0..3 {
+            for (j, ((jx, jy), jt)) in jac[0].iter().zip(&jac[1]).zip(&jac[2]).enumerate() {
                 let s_j = sys.slider_index(j).expect("sliders free");
-                h[row][s_j] -= jac[0][j] * ew[0] + jac[1][j] * ew[1] + lever * jac[2][j];
+                h[row][s_j] -= jx * ew[0] + jy * ew[1] + lever * jt;
             }
         }
     }

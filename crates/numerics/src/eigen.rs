@@ -91,7 +91,7 @@ fn null_space_reflectors(n: usize, c: &[f64], rows: usize) -> Result<Vec<Reflect
     for j in 0..rows {
         let x = &cols[j][j..];
         let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if !(norm > 1e-11 * scale) {
+        if norm.is_nan() || norm <= 1e-11 * scale {
             return Err(format!(
                 "constraint row {} of {rows} is a combination of the others (residual norm {norm:e})",
                 j + 1
@@ -141,7 +141,7 @@ pub fn constrained_modes(
             c.len()
         ));
     }
-    if m.iter().chain(k).chain(c).any(|v| !v.is_finite()) || !(shift >= 0.0) {
+    if m.iter().chain(k).chain(c).any(|v| !v.is_finite()) || shift.is_nan() || shift < 0.0 {
         return Err("non-finite entry in M, K or C, or a negative shift".into());
     }
     // Jacobi scaling q = D q~ (massless coordinates keep scale 1)

@@ -29,8 +29,13 @@ const HB: usize = 5;
 const WC: usize = 8;
 /// Border unknowns per sleeve: 7 multipliers, 3 contact coordinates, 1 rotation.
 const SLEEVE_BORDER: usize = 11;
-/// Border size: G and three sleeves.
-pub(crate) const NS: usize = 3 + 3 * SLEEVE_BORDER;
+/// Border size of the inverse problem: G and three sleeves.
+const NS_STAR: usize = 3 + 3 * SLEEVE_BORDER;
+/// Border size of the direct problem: also the three slider coordinates `s_i`.
+const NS_MAX: usize = NS_STAR + 3;
+/// Values per slider in the slider slot group: the diagonal, then `(row r, s_i)` and
+/// `(s_i, row r)` for the 6 position rows r of sleeve i.
+pub(crate) const SLIDER_SLOTS: usize = 13;
 /// Constraint rows per sleeve.
 const ROWS: usize = 7;
 
@@ -50,6 +55,8 @@ pub(crate) struct Layout {
     pub ncol: usize,
     /// Window width in elements (the window covers nodes `lo..=lo + ww`).
     pub ww: usize,
+    /// Direct problem only: offset of the slider slot group ([`SLIDER_SLOTS`] values per slider).
+    pub off_sl: Option<usize>,
 }
 
 /// The factorisation and its workspaces.
@@ -65,9 +72,11 @@ pub(crate) struct Bordered {
     first: [usize; 3],
     /// Schur complement, LU factors in place (row-major) and row permutation.
     s: Vec<f64>,
-    perm: [usize; NS],
+    perm: [usize; NS_MAX],
+    /// Border size: 36, or 39 with the slider coordinates of the direct problem.
+    ns: usize,
     /// Global unknown of every border index.
-    global: [usize; NS],
+    global: [usize; NS_MAX],
     /// Work vectors of the beams.
     y: [Vec<f64>; 3],
 }
@@ -82,6 +91,9 @@ fn border_xi(i: usize, p: usize) -> usize {
 fn border_psi(i: usize) -> usize {
     3 + SLEEVE_BORDER * i + ROWS + 3
 }
+fn border_sl(i: usize) -> usize {
+    NS_STAR + i
+}
 
 #[inline]
 fn at(j: usize, k: usize) -> usize {
@@ -91,7 +103,8 @@ fn at(j: usize, k: usize) -> usize {
 impl Bordered {
     pub fn new(lay: Layout) -> Self {
         let n = 3 * lay.ne;
-        let mut global = [0usize; NS];
+        let ns = if lay.off_sl.is_some() { NS_MAX } else { NS_STAR };
+        let mut global = [0usize; NS_MAX];
         for (c, g) in global.iter_mut().enumerate().take(3) {
             *g = c;
         }
@@ -103,6 +116,8 @@ impl Bordered {
                 global[border_xi(i, p)] = 3 * lay.n_nodes + 3 + 3 * i + p;
             }
             global[border_psi(i)] = 3 * lay.n_nodes + i;
+            // slider coordinates follow the 12 sleeve coordinates (direct problem only)
+            global[border_sl(i)] = 3 * lay.n_nodes + 12 + i;
         }
         Bordered {
             lay,
@@ -110,8 +125,9 @@ impl Bordered {
             w: std::array::from_fn(|_| vec![0.0; n * WC]),
             wg: [[[0.0; 3]; 3]; 3],
             first: [0; 3],
-            s: vec![0.0; NS * NS],
-            perm: [0; NS],
+            s: vec![0.0; ns * ns],
+            perm: [0; NS_MAX],
+            ns,
             global,
             y: std::array::from_fn(|_| vec![0.0; n]),
         }
@@ -128,6 +144,7 @@ impl Bordered {
     /// (first element of the window of each contact point, [sleeve][point]). `Err` names the
     /// failing pivot.
     pub fn factor(&mut self, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), String> {
+        let ns = self.ns;
         self.s.iter_mut().for_each(|x| *x = 0.0);
         for i in 0..3 {
             self.fill_beam(i, vals);
@@ -136,16 +153,36 @@ impl Bordered {
         }
         let l = self.lay;
         for i in 0..3 {
-            self.s[border_psi(i) * (NS + 1)] += vals[l.off_psi + 4 * i];
+            self.s[border_psi(i) * (ns + 1)] += vals[l.off_psi + 4 * i];
             for p in 0..3 {
-                self.s[border_xi(i, p) * (NS + 1)] += vals[l.off_psi + 4 * i + 1 + p];
+                self.s[border_xi(i, p) * (ns + 1)] += vals[l.off_psi + 4 * i + 1 + p];
             }
+        }
+        if let Some(off) = l.off_sl {
+            self.slider_border(off, vals);
         }
         self.lu_schur()
     }
 
+    /// Direct problem: the slider coordinates' diagonal and their coupling with the position
+    /// rows of their sleeve (`-u_i`), all within the border.
+    fn slider_border(&mut self, off: usize, vals: &[f64]) {
+        let ns = self.ns;
+        for i in 0..3 {
+            let base = off + SLIDER_SLOTS * i;
+            let bs = border_sl(i);
+            self.s[bs * (ns + 1)] += vals[base];
+            for r in 0..6 {
+                let nu = border_nu(i, r);
+                self.s[nu * ns + bs] += vals[base + 1 + 2 * r];
+                self.s[bs * ns + nu] += vals[base + 2 + 2 * r];
+            }
+        }
+    }
+
     /// Band of beam i from its element blocks; the G-G part of element 0 goes to the border.
     fn fill_beam(&mut self, i: usize, vals: &[f64]) {
+        let ns = self.ns;
         let ne = self.lay.ne;
         let band = &mut self.band[i];
         band.iter_mut().for_each(|x| *x = 0.0);
@@ -157,7 +194,7 @@ impl Bordered {
                     let nb = k + b / 3;
                     let v = blk[6 * a + b];
                     if na == 0 && nb == 0 {
-                        self.s[(a % 3) * NS + b % 3] += v;
+                        self.s[(a % 3) * ns + b % 3] += v;
                     } else if na > 0 && nb > 0 {
                         let (ra, rb) = (3 * (ne - na) + a % 3, 3 * (ne - nb) + b % 3);
                         if ra >= rb {
@@ -201,6 +238,7 @@ impl Bordered {
     /// of the multipliers with G, xi and psi go to the border), then `W_i = L_i^{-1} E_i` and
     /// `S -= W_i^T W_i`.
     fn border_columns(&mut self, i: usize, vals: &[f64], win: &[[usize; 3]; 3]) {
+        let ns = self.ns;
         let l = self.lay;
         let (ne, n) = (l.ne, 3 * l.ne);
         // first row touched by a window: node min(lo + ww, ne), tip-first
@@ -222,8 +260,8 @@ impl Bordered {
                 for c in 0..3 {
                     let v = vals[base + 3 * wn + c];
                     if k == 0 {
-                        self.s[c * NS + nu] += v;
-                        self.s[nu * NS + c] += v;
+                        self.s[c * ns + nu] += v;
+                        self.s[nu * ns + c] += v;
                     } else {
                         w[(3 * (ne - k) + c) * WC + r] = v;
                     }
@@ -233,8 +271,8 @@ impl Bordered {
                 (border_xi(i, p), vals[base + l.ncol - 2]),
                 (border_psi(i), vals[base + l.ncol - 1]),
             ] {
-                self.s[col * NS + nu] += v;
-                self.s[nu * NS + col] += v;
+                self.s[col * ns + nu] += v;
+                self.s[nu * ns + col] += v;
             }
         }
         // W = L^{-1} E, multiplier columns: rows first..n
@@ -281,48 +319,49 @@ impl Bordered {
         }
         for a in 0..ROWS {
             for b in 0..ROWS {
-                self.s[border_nu(i, a) * NS + border_nu(i, b)] -= acc[a][b];
+                self.s[border_nu(i, a) * ns + border_nu(i, b)] -= acc[a][b];
             }
         }
         for g in 0..3 {
             for h in 0..3 {
                 let v: f64 = (0..3).map(|c| wg[c][g] * wg[c][h]).sum();
-                self.s[g * NS + h] -= v;
+                self.s[g * ns + h] -= v;
             }
             for a in 0..ROWS {
                 let v: f64 = (0..3).map(|c| wg[c][g] * w[(n - 3 + c) * WC + a]).sum();
-                self.s[g * NS + border_nu(i, a)] -= v;
-                self.s[border_nu(i, a) * NS + g] -= v;
+                self.s[g * ns + border_nu(i, a)] -= v;
+                self.s[border_nu(i, a) * ns + g] -= v;
             }
         }
     }
 
     /// Dense LU with partial pivoting of the Schur complement, in place.
     fn lu_schur(&mut self) -> Result<(), String> {
+        let ns = self.ns;
         let s = &mut self.s;
-        for k in 0..NS {
+        for k in 0..ns {
             let mut p = k;
-            for r in k + 1..NS {
-                if s[r * NS + k].abs() > s[p * NS + k].abs() {
+            for r in k + 1..ns {
+                if s[r * ns + k].abs() > s[p * ns + k].abs() {
                     p = r;
                 }
             }
             self.perm[k] = p;
             if p != k {
-                for c in 0..NS {
-                    s.swap(k * NS + c, p * NS + c);
+                for c in 0..ns {
+                    s.swap(k * ns + c, p * ns + c);
                 }
             }
-            let d = s[k * NS + k];
+            let d = s[k * ns + k];
             if d == 0.0 || !d.is_finite() {
                 return Err(format!("border Schur complement singular at pivot {k} ({d:e})"));
             }
-            for r in k + 1..NS {
-                let f = s[r * NS + k] / d;
-                s[r * NS + k] = f;
+            for r in k + 1..ns {
+                let f = s[r * ns + k] / d;
+                s[r * ns + k] = f;
                 if f != 0.0 {
-                    for c in k + 1..NS {
-                        s[r * NS + c] -= f * s[k * NS + c];
+                    for c in k + 1..ns {
+                        s[r * ns + c] -= f * s[k * ns + c];
                     }
                 }
             }
@@ -333,8 +372,9 @@ impl Bordered {
     /// Solve `A x = rhs` in place (global ordering of the star) with the last factorisation.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         let n = 3 * self.lay.ne;
-        let mut xs = [0.0; NS];
-        for (b, x) in xs.iter_mut().enumerate() {
+        let ns = self.ns;
+        let mut xs = [0.0; NS_MAX];
+        for (b, x) in xs.iter_mut().enumerate().take(ns) {
             *x = rhs[self.global[b]];
         }
         // forward: y_i = L_i^{-1} b_i, xs -= W_i^T y_i
@@ -368,22 +408,22 @@ impl Bordered {
             self.y[i] = y;
         }
         // border: S xs = rhs_s - sum W^T y
-        for k in 0..NS {
+        for k in 0..ns {
             xs.swap(k, self.perm[k]);
         }
-        for k in 0..NS {
+        for k in 0..ns {
             let mut v = xs[k];
             for c in 0..k {
-                v -= self.s[k * NS + c] * xs[c];
+                v -= self.s[k * ns + c] * xs[c];
             }
             xs[k] = v;
         }
-        for k in (0..NS).rev() {
+        for k in (0..ns).rev() {
             let mut v = xs[k];
-            for c in k + 1..NS {
-                v -= self.s[k * NS + c] * xs[c];
+            for c in k + 1..ns {
+                v -= self.s[k * ns + c] * xs[c];
             }
-            xs[k] = v / self.s[k * NS + k];
+            xs[k] = v / self.s[k * ns + k];
         }
         // back: x_i = L_i^{-T} (y_i - W_i xs)
         for i in 0..3 {
@@ -414,7 +454,7 @@ impl Bordered {
             }
             self.y[i] = y;
         }
-        for (b, x) in xs.iter().enumerate() {
+        for (b, x) in xs.iter().enumerate().take(ns) {
             rhs[self.global[b]] = *x;
         }
     }

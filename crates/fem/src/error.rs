@@ -49,6 +49,13 @@ pub enum FemError {
         "slider {slider} left its base side at t = {t} s: s = {s:.5} m, |s| must stay below sqrt(3) d = {limit:.5} m"
     )]
     SliderOffBase { t: f64, slider: usize, s: f64, limit: f64 },
+    /// The simulated configuration of a direct run left the feasible range (the reason names
+    /// the limit: slider off its base side, sleeve at G or off the tip, no Fermat point).
+    #[error("direct run left the feasible range at t = {t} s: {reason}")]
+    Infeasible { t: f64, reason: String },
+    /// The actuator law could not be evaluated (e.g. a servo reference outside its range).
+    #[error("actuator law at t = {t} s: {reason}")]
+    Drive { t: f64, reason: String },
     /// Post-processing with the rigid kinematics failed (no rigid configuration at an output time).
     #[error("post-processing at t = {t} s: {reason}")]
     PostProcessing { t: f64, reason: String },

@@ -25,5 +25,5 @@ mod star;
 
 pub use error::FemError;
 pub use integrator::Stats;
-pub use solve::{solve, solve_with_stats, DEFAULT_DT, DEFAULT_RHO_INF};
+pub use solve::{solve, solve_direct, solve_direct_with_stats, solve_with_stats, DEFAULT_DT, DEFAULT_RHO_INF};
 pub use star::InitialState;

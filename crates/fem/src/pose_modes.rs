@@ -113,7 +113,7 @@ pub fn pose_system(
         xp: pose.xp,
         xp_dot: [0.0; 3],
     };
-    let (star, q, _) = Star::new(params, ne, &init)?;
+    let (star, q, _) = Star::new(params, ne, &init, None)?;
     let nd = star.n_dof;
     let n = nd + if sliders == Sliders::Free { 3 } else { 0 };
     let mut m = vec![0.0; n * n];

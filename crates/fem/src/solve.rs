@@ -1,10 +1,14 @@
-//! The public entry point: run the FEM on an experiment and post-process its absolute results
-//! into the shared [`Response`] (projections of `docs/conventions.md`).
+//! The public entry points: run the FEM on an experiment, the inverse problem ([`solve`]: motion
+//! given, forces found) or the direct one ([`solve_direct`]: forces or a servo given, motion
+//! found), and post-process its absolute results into the shared [`Response`] (projections of
+//! `docs/conventions.md`).
 
-use flexstar_kinematics::{check_trajectory, RigidState};
-use flexstar_model::{BeamShape, Experiment, FemSettings, Response, RunInfo, StarShape};
+use flexstar_drive::ActuatorLaw;
+use flexstar_kinematics::{check_trajectory, direct_kinematics, RigidState};
+use flexstar_model::geometry::{e_w, e_x};
+use flexstar_model::{BeamShape, Experiment, FemSettings, Response, RobotParams, RunInfo, StarShape};
 
-use crate::integrator::{integrate, RunSettings, Stats};
+use crate::integrator::{integrate, History, Motion, RunSettings, Stats};
 use crate::star::InitialState;
 use crate::FemError;
 
@@ -12,6 +16,30 @@ use crate::FemError;
 pub const DEFAULT_DT: f64 = 5e-4;
 /// Default spectral radius at infinity of the generalized-alpha scheme (docs/fem.md).
 pub const DEFAULT_RHO_INF: f64 = 0.7;
+
+/// Names of the extra columns of every run (see [`solve`]).
+const EXTRA: [&str; 17] = [
+    "xp1",
+    "xp2",
+    "xp3",
+    "thp1",
+    "thp2",
+    "thp3",
+    "Fn1",
+    "Fn2",
+    "Fn3",
+    "dGx",
+    "dGy",
+    "Ek_star",
+    "Ek_sleeves",
+    "Ek_sliders",
+    "U",
+    "W",
+    "slopeG",
+];
+
+/// Extra columns a direct run writes first (see [`solve_direct`]).
+const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "Gy", "theta"];
 
 /// Run the finite-element reference on `exp` with `settings` (which override `exp.fem`).
 ///
@@ -47,6 +75,109 @@ pub fn solve_with_stats(
 ) -> Result<(Response, Stats), FemError> {
     let started = std::time::Instant::now();
     let params = &exp.robot;
+    let run = validate(exp, settings)?;
+    // the same feasibility scan as the AMM and the kinematics, before any work: a pre-flight check
+    // of the requested motion only (the FEM's equations never use the rigid kinematics)
+    check_trajectory(params, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))
+        .map_err(|e| FemError::Input(e.to_string()))?;
+    let rigid = |t: f64| {
+        RigidState::at(params, &exp.trajectory, t).map_err(|e| FemError::PostProcessing {
+            t,
+            reason: e.to_string(),
+        })
+    };
+    let r0 = rigid(0.0)?;
+    let (t_out, snaps) = times(exp, settings);
+    let motion = Motion::Prescribed(&exp.trajectory);
+    let hist = integrate(params, &motion, &t_out, &snaps, &initial_state(&r0), &run, progress)?;
+
+    // post-processing with the rigid kinematics of the prescribed motion
+    let frame = |t: f64, _s: [f64; 3]| {
+        let r = rigid(t)?;
+        Ok(Frame {
+            g: [r.g[0].v, r.g[1].v],
+            theta: r.theta.v,
+        })
+    };
+    let mut resp = post_process(params, &hist, "fem", &frame, r0.theta.v, false)?;
+    if let Some(cb) = progress {
+        cb(1.0);
+    }
+    resp.info = run_info("fem", settings, &run, started);
+    Ok((resp, hist.stats))
+}
+
+/// Direct dynamics (issue 10): the sliders move under the actuator law `law` instead of
+/// following `exp.trajectory`.
+///
+/// Each slider is a body of mass `mpp + mpa` on its rail, pushed along `+u_i` by
+/// `Fa_i(t, s_i, s_i')` and by the beam through the sleeve's pin (Eq. 33 read the other way
+/// round, `docs/fem.md` section 6); its coordinate `s_i` is an unknown of the FEM, and the servo's
+/// `kp`, `kd` (`law.stiffness()`, `law.damping()`) enter the iteration matrix. Initial state:
+/// `s(0)`, `s'(0)` from `exp.trajectory` at t = 0, the star undeformed and moving rigidly (as
+/// [`solve`] starts), so that the `Fa` of an inverse run fed back reproduces that run.
+///
+/// The configuration is checked at every step (sleeves on their beams, then the limits of
+/// `flexstar_kinematics::feasibility` on the simulated `s`): leaving the feasible range stops the
+/// run with [`FemError::Infeasible`] (or [`FemError::SleeveOffBeam`]), time and reason, and no
+/// output.
+///
+/// Returns the response labelled `fem-direct` (`info.solver = "fem-direct"`) at
+/// `exp.time.output_times()`: `w_iG`, `w_i(L)` projected on the rigid frames of the *simulated*
+/// sliders' direct kinematics (post-processing only), `Fa_i` [N] the law's forces at the output
+/// time, then the extra columns `s1..3` [m], `sd1..3` [m/s] (simulated sliders), `Gx, Gy` [m],
+/// `theta` [rad] (their rigid pose, Eqs. 4-9), then those of [`solve`] (with `dGx, dGy` and
+/// `slopeG` relative to that pose, `W` the work of the law's forces).
+pub fn solve_direct(
+    exp: &Experiment,
+    settings: &FemSettings,
+    law: &dyn ActuatorLaw,
+    progress: Option<&(dyn Fn(f64) + Sync)>,
+) -> Result<Response, FemError> {
+    solve_direct_with_stats(exp, settings, law, progress).map(|(r, _)| r)
+}
+
+/// [`solve_direct`], also returning the work counters.
+pub fn solve_direct_with_stats(
+    exp: &Experiment,
+    settings: &FemSettings,
+    law: &dyn ActuatorLaw,
+    progress: Option<&(dyn Fn(f64) + Sync)>,
+) -> Result<(Response, Stats), FemError> {
+    let started = std::time::Instant::now();
+    let params = &exp.robot;
+    let run = validate(exp, settings)?;
+    let r0 = RigidState::at(params, &exp.trajectory, 0.0).map_err(|e| FemError::Input(e.to_string()))?;
+    let (t_out, snaps) = times(exp, settings);
+    let motion = Motion::Driven {
+        law,
+        s0: r0.s.map(|s| s.v),
+        v0: r0.s.map(|s| s.d1),
+    };
+    let hist = integrate(params, &motion, &t_out, &snaps, &initial_state(&r0), &run, progress)?;
+
+    // post-processing with the rigid kinematics of the simulated sliders
+    let frame = |t: f64, s: [f64; 3]| {
+        let pose = direct_kinematics(params.d, s).ok_or_else(|| FemError::PostProcessing {
+            t,
+            reason: format!("no rigid configuration for the simulated sliders s = {s:?} m"),
+        })?;
+        Ok(Frame {
+            g: pose.g,
+            theta: pose.theta,
+        })
+    };
+    let mut resp = post_process(params, &hist, "fem-direct", &frame, r0.theta.v, true)?;
+    if let Some(cb) = progress {
+        cb(1.0);
+    }
+    resp.info = run_info("fem-direct", settings, &run, started);
+    Ok((resp, hist.stats))
+}
+
+/// Check the experiment and the settings; the run's numerical settings.
+fn validate(exp: &Experiment, settings: &FemSettings) -> Result<RunSettings, FemError> {
+    let params = &exp.robot;
     params.validate().map_err(|e| FemError::Input(e.to_string()))?;
     exp.time.validate().map_err(|e| FemError::Input(e.to_string()))?;
     exp.trajectory
@@ -78,70 +209,73 @@ pub fn solve_with_stats(
             "fem.snapshots must lie in [0, t_end = {t_end}], got {bad}"
         )));
     }
-    // the same feasibility scan as the AMM and the kinematics, before any work: a pre-flight check
-    // of the requested motion only (the FEM's equations never use the rigid kinematics)
-    check_trajectory(params, &exp.trajectory, t_end, exp.time.dt_out.min(1e-3))
-        .map_err(|e| FemError::Input(e.to_string()))?;
-    let rigid = |t: f64| {
-        RigidState::at(params, &exp.trajectory, t).map_err(|e| FemError::PostProcessing {
-            t,
-            reason: e.to_string(),
-        })
-    };
+    Ok(RunSettings {
+        ne: settings.elements / 3,
+        dt,
+        rho_inf,
+    })
+}
 
-    // initial data: the undeformed star in the rigid configuration at s(0), moving rigidly
-    let r0 = rigid(0.0)?;
-    let init = InitialState {
+/// Initial data: the undeformed star in the rigid configuration at s(0), moving rigidly.
+fn initial_state(r0: &RigidState) -> InitialState {
+    InitialState {
         g: [r0.g[0].v, r0.g[1].v],
         g_dot: [r0.g[0].d1, r0.g[1].d1],
         theta: r0.theta.v,
         theta_dot: r0.theta.d1,
         xp: r0.xp.map(|x| x.v),
         xp_dot: r0.xp.map(|x| x.d1),
-    };
-    let t_out = exp.time.output_times();
+    }
+}
+
+/// Output times and snapshot times (t_end always among the snapshots).
+fn times(exp: &Experiment, settings: &FemSettings) -> (Vec<f64>, Vec<f64>) {
     let mut snaps = settings.snapshots.clone();
-    snaps.push(t_end);
+    snaps.push(exp.time.t_end);
     snaps.sort_by(|a, b| a.total_cmp(b));
     snaps.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
-    let run = RunSettings {
-        ne: settings.elements / 3,
-        dt,
-        rho_inf,
-    };
-    let hist = integrate(params, &exp.trajectory, &t_out, &snaps, &init, &run, progress)?;
+    (exp.time.output_times(), snaps)
+}
 
-    // post-processing with the rigid kinematics
+fn run_info(solver: &str, settings: &FemSettings, run: &RunSettings, started: std::time::Instant) -> RunInfo {
+    RunInfo {
+        solver: solver.into(),
+        elements: Some(settings.elements),
+        dt: run.dt,
+        wall_s: started.elapsed().as_secs_f64(),
+        ..RunInfo::default()
+    }
+}
+
+/// The rigid frame the absolute results are projected on: centre G [m] and orientation theta
+/// [rad] (beam i along `e_xi(theta)`, Eqs. 11-12).
+struct Frame {
+    g: [f64; 2],
+    theta: f64,
+}
+
+/// Project the absolute history on the rigid frames given by `frame(t, s)` (`theta0` the frame's
+/// orientation at t = 0); `direct` adds the sliders' columns first.
+fn post_process(
+    params: &RobotParams,
+    hist: &History,
+    label: &str,
+    frame: &dyn Fn(f64, [f64; 3]) -> Result<Frame, FemError>,
+    theta0: f64,
+    direct: bool,
+) -> Result<Response, FemError> {
     let n = hist.samples.len();
-    let mut resp = Response::with_capacity("fem", n);
-    let names = [
-        "xp1",
-        "xp2",
-        "xp3",
-        "thp1",
-        "thp2",
-        "thp3",
-        "Fn1",
-        "Fn2",
-        "Fn3",
-        "dGx",
-        "dGy",
-        "Ek_star",
-        "Ek_sleeves",
-        "Ek_sliders",
-        "U",
-        "W",
-        "slopeG",
-    ];
-    let mut extra: Vec<Vec<f64>> = vec![Vec::with_capacity(n); names.len()];
+    let mut resp = Response::with_capacity(label, n);
+    let mut extra: Vec<Vec<f64>> = vec![Vec::with_capacity(n); EXTRA.len()];
+    let mut lead: Vec<Vec<f64>> = vec![Vec::with_capacity(n); if direct { DIRECT_EXTRA.len() } else { 0 }];
     for s in &hist.samples {
-        let r = rigid(s.t)?;
-        let g = [r.g[0].v, r.g[1].v];
+        let r = frame(s.t, s.s)?;
+        let g = r.g;
         let dg = [s.g[0] - g[0], s.g[1] - g[1]];
         let mut w_g = [0.0; 3];
         let mut w_tip = [0.0; 3];
         for i in 0..3 {
-            let (ex, ew) = (r.e_x(i), r.e_w(i));
+            let (ex, ew) = (e_x(i, r.theta), e_w(i, r.theta));
             w_g[i] = dot(dg, ew);
             let rel = [
                 s.tip[i][0] - g[0] - params.l * ex[0],
@@ -153,7 +287,7 @@ pub fn solve_with_stats(
             extra[6 + i].push(-dot(s.pin_force[i], ew));
         }
         resp.push(s.t, w_g, w_tip, s.fa);
-        let slope_g = wrap(s.phi_g - (r.theta.v - r0.theta.v));
+        let slope_g = wrap(s.phi_g - (r.theta - theta0));
         for (k, v) in [
             dg[0],
             dg[1],
@@ -169,13 +303,25 @@ pub fn solve_with_stats(
         {
             extra[9 + k].push(v);
         }
+        if direct {
+            let row = [s.s[0], s.s[1], s.s[2], s.sd[0], s.sd[1], s.sd[2], g[0], g[1], r.theta];
+            for (col, v) in lead.iter_mut().zip(row) {
+                col.push(v);
+            }
+        }
     }
-    resp.set_extra(&names, extra);
+    let names: Vec<&str> = if direct {
+        DIRECT_EXTRA.iter().chain(EXTRA.iter()).copied().collect()
+    } else {
+        EXTRA.to_vec()
+    };
+    lead.extend(extra);
+    resp.set_extra(&names, lead);
     for snap in &hist.snapshots {
-        let r = rigid(snap.t)?;
-        let g = [r.g[0].v, r.g[1].v];
+        let r = frame(snap.t, snap.s)?;
+        let g = r.g;
         let beams = [0, 1, 2].map(|i| {
-            let (ex, ew) = (r.e_x(i), r.e_w(i));
+            let (ex, ew) = (e_x(i, r.theta), e_w(i, r.theta));
             let pos = snap.beams[i].clone();
             let w = hist
                 .node_x
@@ -191,17 +337,7 @@ pub fn solve_with_stats(
         });
         resp.shapes.push(StarShape { t: snap.t, beams });
     }
-    if let Some(cb) = progress {
-        cb(1.0);
-    }
-    resp.info = RunInfo {
-        solver: "fem".into(),
-        elements: Some(settings.elements),
-        dt,
-        wall_s: started.elapsed().as_secs_f64(),
-        ..RunInfo::default()
-    };
-    Ok((resp, hist.stats))
+    Ok(resp)
 }
 
 fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {

@@ -26,11 +26,23 @@
 //! The generalized force of the constraints on the beam is `-Phi_q^T lambda`: sleeve i pushes the
 //! beam with the point forces `-lambda_c`, `-lambda_l`, `-lambda_r`, and the beam pushes the sleeve,
 //! hence its pin and slider, with `F_i = lambda_c + lambda_l + lambda_r`.
+//!
+//! **Direct problem** (issue 10): the slider coordinates `s_i` [m] become three more unknowns
+//! after the sleeve coordinates, the pins move with them (`P_i = P_i(s_i)`, linear, Eqs. 1-3, so
+//! the position rows gain the gradient `-u_i`), and each slider, a body of mass `mpp + mpa` on its
+//! rail pushed along `+u_i` by `Fa_i(t, s_i, s_i')`, adds the equation
+//!
+//! ```text
+//! (mpp + mpa) s_i'' - Fa_i - u_i . (lambda_c + lambda_l + lambda_r) = 0
+//! ```
+//!
+//! (the beam pushes the sleeve, hence the pin and the slider, with `F_i`): Eq. 33 read the other
+//! way round.
 
-use flexstar_model::geometry::{e_x, revolute_point};
+use flexstar_model::geometry::{e_x, revolute_point, slider_direction};
 use flexstar_model::RobotParams;
 
-use crate::bordered::{Bordered, Layout};
+use crate::bordered::{Bordered, Layout, SLIDER_SLOTS};
 use crate::element::{Element, ElementState};
 use crate::sparse::SparseLu;
 use crate::FemError;
@@ -74,6 +86,16 @@ impl Pins {
     }
 }
 
+/// The sliders' rows of the direct problem at one Newton iterate.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SliderRows {
+    /// `Fa_i` [N] of the actuator law at the iterate.
+    pub fa: [f64; 3],
+    /// Iteration-matrix diagonal `mpp + mpa + beta' kp_i + gamma' kd_i` of the scaled slider
+    /// equation (with `cf = 1, beta' = gamma' = 0` for the consistent initial accelerations).
+    pub diag: [f64; 3],
+}
+
 /// The assembled model with its sparse iteration matrix.
 pub(crate) struct Star {
     pub params: RobotParams,
@@ -110,11 +132,21 @@ pub(crate) struct Star {
     ww: usize,
     /// Symbolic factorisations done so far.
     pub symbolic_count: usize,
+    /// Direct problem: the slider coordinates are unknowns (after the sleeve coordinates).
+    pub direct: bool,
+    /// Offset of the slider slot group (direct problem only).
+    off_sl: usize,
 }
 
 impl Star {
-    /// Mesh the star with `ne` elements per beam around the initial pose.
-    pub fn new(params: &RobotParams, ne: usize, init: &InitialState) -> Result<(Self, Vec<f64>, Vec<f64>), FemError> {
+    /// Mesh the star with `ne` elements per beam around the initial pose. With `sliders`
+    /// (`[s_i, s_i']` [m, m/s] at t = 0) the slider coordinates are unknowns too (direct problem).
+    pub fn new(
+        params: &RobotParams,
+        ne: usize,
+        init: &InitialState,
+        sliders: Option<[[f64; 2]; 3]>,
+    ) -> Result<(Self, Vec<f64>, Vec<f64>), FemError> {
         let h = params.l / ne as f64;
         if params.lp < 2.0 * h * (1.0 - 1e-12) {
             let needed = (2.0 * params.l / params.lp).ceil() as usize;
@@ -126,7 +158,7 @@ impl Star {
             });
         }
         let n_nodes = 1 + 3 * ne;
-        let n_dof = 3 * n_nodes + 12;
+        let n_dof = 3 * n_nodes + 12 + if sliders.is_some() { 3 } else { 0 };
         let n_sys = n_dof + 3 * ROWS;
         let mut q = vec![0.0; n_dof];
         let mut v = vec![0.0; n_dof];
@@ -162,6 +194,10 @@ impl Star {
                 q[psi0 + 3 + 3 * i + p] = init.xp[i] + off;
                 v[psi0 + 3 + 3 * i + p] = init.xp_dot[i];
             }
+            if let Some(sl) = sliders {
+                q[psi0 + 12 + i] = sl[i][0];
+                v[psi0 + 12 + i] = sl[i][1];
+            }
         }
         let mut star = Star {
             params: *params,
@@ -185,6 +221,8 @@ impl Star {
             ncol_c: 3 * (WINDOW.min(ne) + 1) + 2,
             ww: WINDOW.min(ne),
             symbolic_count: 0,
+            direct: sliders.is_some(),
+            off_sl: 0,
         };
         star.states = star
             .elements
@@ -202,6 +240,17 @@ impl Star {
     /// Index of contact coordinate `p` (0 centre, 1 left, 2 right) of sleeve i.
     pub fn xi(&self, i: usize, p: usize) -> usize {
         3 * self.n_nodes + 3 + 3 * i + p
+    }
+
+    /// Index of the slider coordinate s_i (direct problem only).
+    pub fn slider(&self, i: usize) -> usize {
+        3 * self.n_nodes + 12 + i
+    }
+
+    /// Direct problem: pin kinematics from the slider unknowns (`[s, s', s'']` of each slider).
+    pub fn pins_of(&self, q: &[f64], v: &[f64], qdd: &[f64]) -> Pins {
+        let k = |i: usize| self.slider(i);
+        Pins::new(&self.params, [0, 1, 2].map(|i| [q[k(i)], v[k(i)], qdd[k(i)]]))
     }
 
     /// Global node index of node k (0 = G, ne = tip) of beam i.
@@ -274,6 +323,18 @@ impl Star {
                 }
             }
         }
+        self.off_sl = slots.len();
+        if self.direct {
+            for i in 0..3 {
+                let s = self.slider(i);
+                slots.push((s, s));
+                for r in 0..6 {
+                    let row = self.n_dof + ROWS * i + r;
+                    slots.push((row, s));
+                    slots.push((s, row));
+                }
+            }
+        }
         self.lu = None;
         if self.bordered.is_none() {
             self.bordered = Some(Bordered::new(Layout {
@@ -284,6 +345,7 @@ impl Star {
                 off_con: self.off_con,
                 ncol: self.ncol_c,
                 ww: self.ww,
+                off_sl: self.direct.then_some(self.off_sl),
             }));
         }
         self.vals = vec![0.0; slots.len()];
@@ -307,7 +369,8 @@ impl Star {
     }
 
     /// Assemble the residual and the iteration matrix at coordinates `q`, velocities `v`,
-    /// accelerations `qdd` and multipliers `lam` (21), for pins `pins`:
+    /// accelerations `qdd` and multipliers `lam` (21), for pins `pins` (in the direct problem:
+    /// [`Star::pins_of`] the same iterate, with the sliders' rows `sliders`):
     ///
     /// ```text
     /// res[dof]  = cf (M(q) qdd + f_conv(q, v) + f_int(q)) + Phi_q^T lam      (Jp psi_dd for sleeves)
@@ -317,6 +380,8 @@ impl Star {
     /// ```
     /// (Hessian terms of the constraints, the velocity and q dependence of the inertia are left
     /// out of the matrix: they are `O(h^2)` against the kept terms, see docs/fem.md.)
+    /// Direct problem: `res[s_i] = cf ((mpp + mpa) s_i'' - Fa_i) - u_i . (nu_c + nu_l + nu_r)`,
+    /// matrix diagonal `sliders.diag`, coupling `-u_i` with the sleeve's position rows.
     /// With `matrix == false` only the residual is evaluated (for a modified Newton iteration with
     /// the last factorisation, `crate::integrator`), unless the pattern had to be rebuilt. Returns
     /// whether the matrix was assembled (and must be factorised before the next solve).
@@ -328,6 +393,7 @@ impl Star {
         qdd: &[f64],
         lam: &[f64],
         pins: &Pins,
+        sliders: Option<&SliderRows>,
         cf: f64,
         ck: f64,
         res: &mut [f64],
@@ -419,6 +485,15 @@ impl Star {
                 self.vals[base + 2 * nc - 1] = gpsi;
             }
         }
+        match (self.direct, sliders) {
+            (true, Some(sl)) => self.assemble_sliders(sl, qdd, lam, cf, res, matrix),
+            (false, None) => {}
+            _ => {
+                return Err(FemError::Input(
+                    "internal: slider rows given to the inverse problem or missing in the direct one".into(),
+                ))
+            }
+        }
         if let Some(k) = res.iter().position(|r| !r.is_finite()) {
             return Err(FemError::NonFinite {
                 t,
@@ -464,6 +539,28 @@ impl Star {
         } else {
             let (al, g, az) = st.angle(z);
             (al - psi, g, az / self.h, -1.0)
+        }
+    }
+
+    /// The sliders' equations of the direct problem (see [`Star::assemble`]).
+    fn assemble_sliders(&mut self, sl: &SliderRows, qdd: &[f64], lam: &[f64], cf: f64, res: &mut [f64], matrix: bool) {
+        for i in 0..3 {
+            let si = self.slider(i);
+            let u = slider_direction(i);
+            res[si] += cf * (self.params.mpp_mpa * qdd[si] - sl.fa[i]);
+            let base = self.off_sl + SLIDER_SLOTS * i;
+            if matrix {
+                self.vals[base] = sl.diag[i];
+            }
+            for r in 0..6 {
+                // d Phi_r / d s_i = -u_i[r % 2] (Phi holds -P_i(s_i))
+                let g = -u[r % 2];
+                res[si] += g * lam[ROWS * i + r];
+                if matrix {
+                    self.vals[base + 1 + 2 * r] = g;
+                    self.vals[base + 2 + 2 * r] = g;
+                }
+            }
         }
     }
 
@@ -590,7 +687,7 @@ mod tests {
             xp: [0.02, 0.2, 0.41],
             xp_dot: [0.1, -0.2, 0.3],
         };
-        let (mut star, mut q, v) = Star::new(&params, 36, &init).unwrap();
+        let (mut star, mut q, v) = Star::new(&params, 36, &init, None).unwrap();
         for (j, x) in q.iter_mut().enumerate().take(3 * star.n_nodes) {
             *x += amp * ((j as f64 * 0.7).sin());
         }
@@ -599,7 +696,7 @@ mod tests {
         let pins = Pins::new(&params, [[0.01, 0.1, 2.0], [-0.02, 0.0, 2.0], [0.0, 0.1, -1.0]]);
         let mut res = vec![0.0; star.n_sys];
         let bp = 6e-8;
-        star.assemble(&q, &v, &qdd, &lam, &pins, bp, bp, &mut res, 0.0, true)
+        star.assemble(&q, &v, &qdd, &lam, &pins, None, bp, bp, &mut res, 0.0, true)
             .unwrap();
         assert_eq!(star.win[0][1], 0, "the test wants a window that holds G");
         let b: Vec<f64> = (0..star.n_sys).map(|k| (k as f64 * 1.3).sin()).collect();

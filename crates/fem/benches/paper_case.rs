@@ -3,8 +3,14 @@
 //! the 300-element time). Case 2 (s = [t^2, -0.5 t^2, -0.5 t^2], 0.4 s) at 300 and 3000 elements,
 //! and case 1 (s_i = t^2, 0.5 s) at 300. Run pinned to one core:
 //! `taskset -c 1 cargo bench -p flexstar-fem --bench paper_case`.
+//!
+//! Direct dynamics (issue 10): case 2 at 300 elements driven by the forces of its own inverse
+//! run (written at every solver step, fed back through a `ForceTable`), and by a 20 Hz servo with
+//! rigid feedforward: the cost of the three slider unknowns and of evaluating the law at every
+//! Newton iteration, against the inverse run above.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use flexstar_drive::{ForceTable, Servo};
 use flexstar_model::{catalogue, FemSettings};
 
 fn bench(c: &mut Criterion) {
@@ -22,6 +28,31 @@ fn bench(c: &mut Criterion) {
         };
         g.bench_function(name, |b| b.iter(|| flexstar_fem::solve(&exp, &settings, None).unwrap()));
     }
+    let mut exp = catalogue::paper_case(2);
+    exp.time.dt_out = flexstar_fem::DEFAULT_DT;
+    let settings = FemSettings::default();
+    let inverse = flexstar_fem::solve(&exp, &settings, None).unwrap();
+    let rows = (0..inverse.len())
+        .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
+        .collect();
+    let table = ForceTable::new(inverse.t.clone(), rows).unwrap();
+    g.bench_function("case2_0.4s_300el_inverse_every_step", |b| {
+        b.iter(|| flexstar_fem::solve(&exp, &settings, None).unwrap())
+    });
+    g.bench_function("case2_0.4s_300el_direct_forces", |b| {
+        b.iter(|| flexstar_fem::solve_direct(&exp, &settings, &table, None).unwrap())
+    });
+    let (kp, kd) = Servo::gains_from_bandwidth(exp.robot.mpp_mpa, 20.0, 0.7);
+    let servo = Servo {
+        kp: [kp; 3],
+        kd: [kd; 3],
+        rigid_feedforward: true,
+        reference: exp.trajectory.clone(),
+        params: exp.robot,
+    };
+    g.bench_function("case2_0.4s_300el_direct_servo20hz", |b| {
+        b.iter(|| flexstar_fem::solve_direct(&exp, &settings, &servo, None).unwrap())
+    });
     g.finish();
 }
 

@@ -676,8 +676,9 @@ mod tests {
     /// Solve `A x = b` with `Star::factor`/`Star::solve` on a deformed (node perturbation of
     /// amplitude `amp` [m, rad]), moving star whose sleeve 1 window holds G; check against the
     /// general sparse LU and against the residual `A x - b` computed from the slots. Returns
-    /// whether `Star::factor` fell back to the sparse LU.
-    fn solve_and_check(amp: f64) -> bool {
+    /// whether `Star::factor` fell back to the sparse LU. `direct`: with the slider unknowns and
+    /// rows of the direct problem (three more border unknowns).
+    fn solve_and_check(amp: f64, direct: bool) -> bool {
         let params = RobotParams::paper();
         let init = InitialState {
             g: [0.01, -0.02],
@@ -687,7 +688,8 @@ mod tests {
             xp: [0.02, 0.2, 0.41],
             xp_dot: [0.1, -0.2, 0.3],
         };
-        let (mut star, mut q, v) = Star::new(&params, 36, &init, None).unwrap();
+        let sliders = direct.then_some([[0.01, 0.1], [-0.02, 0.0], [0.0, 0.1]]);
+        let (mut star, mut q, v) = Star::new(&params, 36, &init, sliders).unwrap();
         for (j, x) in q.iter_mut().enumerate().take(3 * star.n_nodes) {
             *x += amp * ((j as f64 * 0.7).sin());
         }
@@ -696,7 +698,13 @@ mod tests {
         let pins = Pins::new(&params, [[0.01, 0.1, 2.0], [-0.02, 0.0, 2.0], [0.0, 0.1, -1.0]]);
         let mut res = vec![0.0; star.n_sys];
         let bp = 6e-8;
-        star.assemble(&q, &v, &qdd, &lam, &pins, None, bp, bp, &mut res, 0.0, true)
+        // a 1 kHz servo's kp, kd on the sliders (beta' kp ~ 0.5 kg, gamma' kd ~ 0.5 kg)
+        let rows = SliderRows {
+            fa: [1.0, -2.0, 0.5],
+            diag: [0.2 + bp * 7.9e6 + 3e-4 * 1.8e3; 3],
+        };
+        let sl = direct.then_some(&rows);
+        star.assemble(&q, &v, &qdd, &lam, &pins, sl, bp, bp, &mut res, 0.0, true)
             .unwrap();
         assert_eq!(star.win[0][1], 0, "the test wants a window that holds G");
         let b: Vec<f64> = (0..star.n_sys).map(|k| (k as f64 * 1.3).sin()).collect();
@@ -728,13 +736,25 @@ mod tests {
     #[test]
     fn bordered_solver_matches_sparse_lu_and_residual() {
         // strains ~1e-5: the beam blocks are positive definite, the structured solver takes them
-        assert!(!solve_and_check(1e-7), "the structured solver must take this matrix");
+        assert!(
+            !solve_and_check(1e-7, false),
+            "the structured solver must take this matrix"
+        );
+    }
+
+    #[test]
+    fn bordered_solver_takes_the_slider_rows_of_the_direct_problem() {
+        assert!(
+            !solve_and_check(1e-7, true),
+            "the structured solver must take this matrix"
+        );
+        assert!(solve_and_check(1e-4, true), "expected the fallback");
     }
 
     #[test]
     fn indefinite_beam_block_falls_back_to_sparse_lu() {
         // strains ~1e-2 (compressive forces ~4e4 N): the geometric stiffness makes a beam block
         // indefinite, the banded Cholesky refuses it and the sparse LU solves instead
-        assert!(solve_and_check(1e-4), "expected the fallback");
+        assert!(solve_and_check(1e-4, false), "expected the fallback");
     }
 }

@@ -3,7 +3,9 @@
 //! contact coordinates and its rotation).
 //!
 //! With the unknowns split into beam DOFs `b` (nodes 1..ne of each beam) and border DOFs `s`
-//! (36: G, then `[nu_i (7), xi_i (3), psi_i]` per sleeve), the symmetric matrix is
+//! (36: G, then `[nu_i (7), xi_i (3), psi_i]` per sleeve; 39 in the direct problem of issue 10,
+//! whose slider coordinates `s_i` couple only with their sleeve's multipliers and join the border
+//! last), the symmetric matrix is
 //!
 //! ```text
 //! [ B   E ]    B = diag(B_1, B_2, B_3),  B_i = (M + beta' K) of beam i without G:

@@ -8,7 +8,9 @@
 //! border, `bordered`). The driving forces follow from the pin
 //! reactions (Eq. 33). Its equations use only the robot parameters, `s_i(t)` and the start
 //! configuration; the rigid (Fermat-point) kinematics appears only as initial data and in the
-//! post-processing of [`solve`] (projection onto the rigid frames). The formulation, the
+//! post-processing of [`solve`] (projection onto the rigid frames). [`solve_direct`] solves the
+//! direct problem (issue 10): the sliders, bodies of mass `mpp + mpa`, move under an actuator law
+//! (`flexstar_drive`), their coordinates unknowns of the same equations. The formulation, the
 //! convergence study behind the defaults and the deviations are in `docs/fem.md`.
 
 #![allow(clippy::needless_range_loop)] // index loops over DOFs read like the equations

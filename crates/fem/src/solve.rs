@@ -112,7 +112,7 @@ pub fn solve_with_stats(
 ///
 /// Each slider is a body of mass `mpp + mpa` on its rail, pushed along `+u_i` by
 /// `Fa_i(t, s_i, s_i')` and by the beam through the sleeve's pin (Eq. 33 read the other way
-/// round, `docs/fem.md` section 6); its coordinate `s_i` is an unknown of the FEM, and the servo's
+/// round, `docs/fem.md` section 8); its coordinate `s_i` is an unknown of the FEM, and the servo's
 /// `kp`, `kd` (`law.stiffness()`, `law.damping()`) enter the iteration matrix. Initial state:
 /// `s(0)`, `s'(0)` from `exp.trajectory` at t = 0, the star undeformed and moving rigidly (as
 /// [`solve`] starts), so that the `Fa` of an inverse run fed back reproduces that run.

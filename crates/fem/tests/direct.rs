@@ -10,7 +10,9 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use flexstar_drive::{rigid_forward_dynamics, ActuatorLaw, ForcePolynomials, ForceTable, RigidInverseForces, Servo};
+use flexstar_drive::{
+    rigid_forward_dynamics, ActuatorLaw, DriveError, ForcePolynomials, ForceTable, RigidInverseForces, Servo,
+};
 use flexstar_fem::{solve, solve_direct, solve_direct_with_stats, solve_with_stats, FemError};
 use flexstar_model::evp::point_evps;
 use flexstar_model::{catalogue, Experiment, FemSettings, Pose, Response, RobotParams, Trajectory};
@@ -254,6 +256,46 @@ fn leaving_the_feasible_range_stops_with_time_and_reason() {
         other => panic!("expected a feasibility stop, got {other}"),
     }
     assert!(msg.contains("t = "), "{msg}");
+}
+
+/// A law that fails after `t_fail` [s] (a servo reference that cannot be evaluated, say).
+struct FailsLater {
+    t_fail: f64,
+}
+
+impl ActuatorLaw for FailsLater {
+    fn force(&self, t: f64, _s: [f64; 3], _v: [f64; 3]) -> Result<[f64; 3], DriveError> {
+        if t > self.t_fail {
+            return Err(DriveError::Reference {
+                t,
+                reason: "beyond the reference".into(),
+            });
+        }
+        Ok([0.0; 3])
+    }
+    fn stiffness(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
+    fn damping(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
+}
+
+#[test]
+fn a_failing_law_stops_the_run_with_its_time() {
+    let exp = catalogue::experiment(
+        "rest",
+        RobotParams::paper(),
+        Trajectory::quadratic([0.0; 3]),
+        0.05,
+        1e-3,
+    );
+    let err = solve_direct(&exp, &coarse(), &FailsLater { t_fail: 0.0102 }, None).unwrap_err();
+    match &err {
+        FemError::Drive { t, .. } => assert!((t - 0.0105).abs() < 1e-12, "{err}"),
+        other => panic!("expected a drive error, got {other}"),
+    }
+    assert!(err.to_string().contains("beyond the reference"), "{err}");
 }
 
 #[test]

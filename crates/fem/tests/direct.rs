@@ -61,8 +61,9 @@ fn slider_error(exp: &Experiment, r: &Response) -> f64 {
     worst
 }
 
-/// Inverse run, then its Fa fed back; returns (largest slider error [m], largest point EVP [%]).
-fn round_trip(exp: &Experiment) -> (f64, f64) {
+/// Inverse run, then its Fa fed back; returns (largest slider error [m], largest point EVP [%],
+/// energy defect of the direct run as a fraction of its largest strain energy).
+fn round_trip(exp: &Experiment) -> (f64, f64, f64) {
     let settings = FemSettings {
         dt: Some(exp.time.dt_out.min(5e-4)),
         ..coarse()
@@ -71,7 +72,8 @@ fn round_trip(exp: &Experiment) -> (f64, f64) {
     let direct = solve_direct(exp, &settings, &forces_of(&inverse), None).unwrap();
     let evp = point_evps(&direct, &inverse).unwrap();
     let worst_evp = evp.points.iter().flatten().fold(0.0f64, |m, e| m.max(*e));
-    (slider_error(exp, &direct), worst_evp)
+    let (defect, umax) = energy_defect(&direct);
+    (slider_error(exp, &direct), worst_evp, defect / umax)
 }
 
 #[test]
@@ -80,16 +82,19 @@ fn round_trip_at_the_solver_step_gives_the_inverse_run_back() {
     // very forces the inverse run found there. The paper's motions are quadratic (s'' constant),
     // which the generalized-alpha scheme integrates exactly: round-off is left (measured 5e-16 to
     // 3.5e-14 m, EVPs 1e-11 to 7e-10 %). The quintic's s'' varies: the scheme's own second-order
-    // error is left (measured 4.2e-7 m, EVPs <= 2.3e-3 %).
+    // error is left (measured 4.2e-7 m, EVPs <= 2.3e-3 %). Energy balance of the forces-driven
+    // runs (work of Fa = kinetic + strain energy): 1.6e-4 to 2.1e-3 of the largest strain energy.
     let mut cases: Vec<Experiment> = (1..=4).map(catalogue::paper_case).collect();
     cases.push(quintic_experiment(RobotParams::paper(), 0.4, 1e-3));
     for mut exp in cases {
         exp.time.dt_out = 5e-4;
-        let (ds, evp) = round_trip(&exp);
+        let (ds, evp, energy) = round_trip(&exp);
         eprintln!(
-            "{}: largest |s - s_inverse| {ds:.2e} m, largest EVP {evp:.2e} %",
+            "{}: largest |s - s_inverse| {ds:.2e} m, largest EVP {evp:.2e} %, |E - W| {energy:.2e} of max U",
             exp.name
         );
+        // the forces-driven run's own energy balance (bound as in the servo test below)
+        assert!(energy < 1e-2, "{}: energy balance off by {energy} of U", exp.name);
         assert!(ds < 1e-6, "{}: sliders {ds} m off the inverse run's motion", exp.name);
         assert!(
             evp < 0.1,
@@ -108,7 +113,7 @@ fn round_trip_difference_shrinks_with_the_inverse_output_step() {
     for dt_out in [4e-3, 2e-3, 1e-3] {
         let mut exp = catalogue::paper_case(1);
         exp.time.dt_out = dt_out;
-        let (ds, _) = round_trip(&exp);
+        let (ds, _, _) = round_trip(&exp);
         eprintln!("case 1, inverse output step {dt_out:e} s: largest |s - s_inverse| {ds:.2e} m");
         errors.push(ds);
     }

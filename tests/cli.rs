@@ -196,6 +196,87 @@ fn run_refuses_bad_settings_before_any_work() {
 }
 
 #[test]
+fn direct_runs_write_the_contracted_tables() {
+    // issue 10: an inverse run's output fed back with --forces, and a servo drive in the config
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = short_case1(dir.path(), "0.05");
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let o = flexstar(&["run", &cfg, "--solver", "amm", "--out", out_s]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let inverse = out.join("case1").join("amm-pinned-free.csv");
+    let o = flexstar(&[
+        "run",
+        &cfg,
+        "--solver",
+        "amm",
+        "--forces",
+        inverse.to_str().unwrap(),
+        "--out",
+        out_s,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(out.join("case1").join("amm-pinned-free-direct.csv")).unwrap();
+    let header = text.lines().next().unwrap();
+    assert!(
+        header.starts_with("t,s1,s2,s3,w1G,w2G,w3G,w1tip,w2tip,w3tip,Fa1,Fa2,Fa3,Gx,Gy,theta,"),
+        "{header}"
+    );
+    assert_eq!(text.lines().count(), 1 + 51);
+    // s1 = t^2 comes back (the forces sampled at 1 ms, linearly interpolated)
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!((last[1] - 0.05f64 * 0.05).abs() < 1e-5, "s1(0.05) = {}", last[1]);
+    assert!(out.join("case1").join("amm-pinned-free-direct.json").exists());
+
+    let servo = write(
+        dir.path(),
+        "servo.toml",
+        &case1_with("t_end = 0.5", "t_end = 0.05").replace(
+            "[amm]",
+            "[drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n\n[amm]",
+        ),
+    );
+    let o = flexstar(&["run", &servo, "--solver", "amm", "--out", out_s]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(out.join("case1").join("amm-pinned-free-direct.csv")).unwrap();
+    assert!(
+        text.starts_with("t,s1,s2,s3,w1G,w2G,w3G,w1tip,w2tip,w3tip,Fa1,Fa2,Fa3,Gx,Gy,theta,e1,e2,e3,"),
+        "{}",
+        text.lines().next().unwrap()
+    );
+}
+
+#[test]
+fn direct_runs_refuse_bad_forces_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = short_case1(dir.path(), "0.05");
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    for (name, text, needle) in [
+        ("nofa.csv", "t,F1,F2,F3\n0,1,1,1\n0.05,1,1,1\n", "Fa1"),
+        (
+            "back.csv",
+            "t,Fa1,Fa2,Fa3\n0,1,1,1\n0.03,1,1,1\n0.02,1,1,1\n0.05,1,1,1\n",
+            "row 3",
+        ),
+        ("short.csv", "t,Fa1,Fa2,Fa3\n0,1,1,1\n0.04,1,1,1\n", "span"),
+    ] {
+        let f = write(dir.path(), name, text);
+        let o = flexstar(&["run", &cfg, "--solver", "amm", "--forces", &f, "--out", out_s]);
+        assert!(!o.status.success(), "{name} accepted");
+        let msg = stderr(&o);
+        assert!(msg.contains(name) && msg.contains(needle), "{name}: {msg}");
+        assert!(!out.join("case1").exists(), "{name}: output created");
+    }
+}
+
+#[test]
 fn modes_lists_textbook_roots() {
     // free-free: two rigid modes, then beta L = 4.730041, 7.853205 (Blevins, table 8-1)
     let o = flexstar(&["modes", "--family", "free-free", "-n", "4"]);

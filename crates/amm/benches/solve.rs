@@ -47,5 +47,45 @@ fn accurate_model(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, paper_cases, accurate_model);
+/// Issue 10 item 6: a direct run (forces of the inverse run fed back, and a 20 Hz servo) against
+/// the inverse run of the same case; target at most twice the inverse time.
+fn direct_vs_inverse(c: &mut Criterion) {
+    use flexstar_amm::solve_direct;
+    use flexstar_drive::{ForceTable, Servo};
+    let mut group = c.benchmark_group("amm_direct_vs_inverse");
+    group.sample_size(10);
+    let paper = common::settings(ModeFamily::FreeFree, 25, None);
+    let accurate = flexstar_model::AmmSettings {
+        modes: Some(53),
+        ..flexstar_model::AmmSettings::accurate()
+    };
+    for (label, settings) in [("n25_free-free", paper), ("n53_accurate", accurate)] {
+        let exp = common::paper_case(3);
+        let inverse = solve(&exp, &settings).unwrap();
+        let fa = (0..inverse.len())
+            .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
+            .collect();
+        let table = ForceTable::new(inverse.t.clone(), fa).unwrap();
+        let (kp, kd) = Servo::gains_from_bandwidth(exp.robot.mpp_mpa, 20.0, 0.7);
+        let servo = Servo {
+            kp: [kp; 3],
+            kd: [kd; 3],
+            rigid_feedforward: true,
+            reference: exp.trajectory.clone(),
+            params: exp.robot,
+        };
+        group.bench_function(format!("case3_{label}_inverse"), |b| {
+            b.iter(|| solve(&exp, &settings).unwrap())
+        });
+        group.bench_function(format!("case3_{label}_direct_forces"), |b| {
+            b.iter(|| solve_direct(&exp, &settings, &table).unwrap())
+        });
+        group.bench_function(format!("case3_{label}_direct_servo"), |b| {
+            b.iter(|| solve_direct(&exp, &settings, &servo).unwrap())
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, paper_cases, accurate_model, direct_vs_inverse);
 criterion_main!(benches);

@@ -37,6 +37,13 @@ pub enum AmmError {
     /// The constraint matrix lost rank: the Schur complement `C S^-1 C^T` is singular at time `t`.
     #[error("amm: t = {t:.6} s: singular constraint system ({reason})")]
     SingularConstraints { t: f64, reason: String },
+    /// The actuator law could not be evaluated at time `t` (a direct run).
+    #[error("amm: t = {t:.6} s: drive: {source}")]
+    Drive {
+        t: f64,
+        #[source]
+        source: flexstar_drive::DriveError,
+    },
     /// The solution stopped being finite at time `t`.
     #[error("amm: t = {t:.6} s: the solution is no longer finite (step {dt:e} s)")]
     NonFinite { t: f64, dt: f64 },

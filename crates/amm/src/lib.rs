@@ -9,7 +9,8 @@
 //! - `system` (private): the constrained linear time-varying equations (Eqs. 37, 44, 31 with the
 //!   constraints of Eqs. 38-43) and their per-step linear solve;
 //! - [`pose_modes`]: the modes of the star held at rest at one pose, and its linearised system;
-//! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]).
+//! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]);
+//! - [`direct`]: the direct problem, sliders driven by forces or a servo ([`solve_direct`], issue 10).
 //!
 //! Frames and signs follow `docs/conventions.md`; the derivation, the departures from the
 //! printed paper and the convergence study are in `docs/amm.md`. SI units throughout.
@@ -18,12 +19,15 @@
 #![allow(rustdoc::broken_intra_doc_links)]
 
 pub mod adaptive;
+pub mod direct;
 pub mod error;
 pub mod modes;
 pub mod pose_modes;
+mod record;
 pub mod solver;
 mod system;
 
+pub use direct::{solve_direct, DIRECT_COLUMNS};
 pub use error::AmmError;
 pub use modes::{ModeSet, MAX_MODES};
 pub use solver::{parse_family, solve, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS};

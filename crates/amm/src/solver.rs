@@ -9,18 +9,16 @@
 //! drift). The system is linear, so each step is one linear solve (see the private `system` module and `docs/amm.md`).
 //! Initial accelerations are consistent: `M q''(0) = f(0) + C^T lambda(0)`, `C q''(0) = 0`.
 
-use flexstar_kinematics::{check_trajectory, RigidState};
+use flexstar_kinematics::{check_configuration, check_trajectory, Infeasible, RigidState};
 use flexstar_model::config::check_step;
-use flexstar_model::geometry::slider_direction;
-use flexstar_model::{
-    AmmModel, AmmSettings, BeamShape, Experiment, ModeCount, ModeFamily, Response, RunInfo, StarShape,
-};
+use flexstar_model::{AmmSettings, Experiment, ModeCount, ModeFamily, Response, RunInfo};
 use flexstar_numerics::GenAlpha;
 
 use crate::adaptive;
 use crate::error::AmmError;
 use crate::modes::{ModeSet, MAX_MODES};
-use crate::system::{Row, System};
+use crate::record::Recorder;
+use crate::system::System;
 
 /// Default integration step [s], 1/6 ms (six steps per default output interval), from the
 /// convergence study in `docs/amm.md`: halving it changes every tip and junction response of the
@@ -47,7 +45,9 @@ pub const EXTRA_COLUMNS: [&str; 25] = [
 ];
 
 /// Check everything the solver needs before any work; returns the step ceiling [s].
-fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize) -> Result<f64, AmmError> {
+/// `scan`: check the trajectory's feasibility over the whole span (an inverse run, or a servo's
+/// reference); otherwise only its start configuration (a forces-driven run).
+pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, scan: bool) -> Result<f64, AmmError> {
     exp.robot.validate()?;
     exp.time.validate()?;
     exp.trajectory.validate(&exp.robot)?;
@@ -93,19 +93,24 @@ fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize) -> Result<f6
             format!("snapshot times must lie in [0, t_end = {}], got {bad}", exp.time.t_end),
         ));
     }
-    check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))?;
+    if scan {
+        check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))?;
+    } else {
+        let s0 = exp.trajectory.s(&exp.robot, 0.0)?;
+        check_configuration(&exp.robot, s0).map_err(|violation| Infeasible { t: 0.0, violation })?;
+    }
     Ok(dt)
 }
 
 /// A time at which the integration stops: an output row and/or a snapshot.
 #[derive(Debug, Clone, Copy)]
-struct Stop {
-    t: f64,
-    output: Option<usize>,
-    snapshot: Option<usize>,
+pub(crate) struct Stop {
+    pub(crate) t: f64,
+    pub(crate) output: Option<usize>,
+    pub(crate) snapshot: Option<usize>,
 }
 
-fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
+pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
     let mut v: Vec<Stop> = out_times
         .iter()
         .enumerate()
@@ -150,7 +155,7 @@ pub fn solve(exp: &Experiment, settings: &AmmSettings) -> Result<Response, AmmEr
         ModeCount::Fixed(n) => integrate(exp, settings, n, |_, _| {}),
         ModeCount::Tolerance(tol) => {
             // every input error before any work, at the first N
-            validate(exp, settings, adaptive::first_modes(exp))?;
+            validate(exp, settings, adaptive::first_modes(exp), true)?;
             adaptive::solve_to_tolerance(exp, tol, |n| integrate(exp, settings, n, |_, _| {}))
         }
     }
@@ -164,11 +169,11 @@ fn integrate<F: FnMut(&System, &[f64])>(
     mut observe: F,
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
-    let dt_max = validate(exp, settings, n_modes)?;
+    let dt_max = validate(exp, settings, n_modes, true)?;
     let params = &exp.robot;
     let modes = ModeSet::new(settings.family, n_modes, params)?;
     let mut sys = System::new(modes, params, settings.model);
-    let (nm, nb, n) = (sys.nm, sys.nb, sys.dim());
+    let (nm, n) = (sys.nm, sys.dim());
 
     let out_times = exp.time.output_times();
     let mut snaps: Vec<f64> = settings.snapshots.clone();
@@ -177,56 +182,7 @@ fn integrate<F: FnMut(&System, &[f64])>(
     snaps.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * exp.time.dt_out);
     let stops = stops(&out_times, &snaps, 1e-9 * exp.time.dt_out);
 
-    // outputs, sized once
-    let n_out = out_times.len();
-    let mut resp = Response::with_capacity(format!("amm-{}", settings.family.name()), n_out);
-    let mut extra: Vec<Vec<f64>> = (0..EXTRA_COLUMNS.len()).map(|_| Vec::with_capacity(n_out)).collect();
-    let xs: Vec<f64> = (0..SHAPE_POINTS)
-        .map(|k| params.l * k as f64 / (SHAPE_POINTS - 1) as f64)
-        .collect();
-    let shape_phi: Vec<Vec<f64>> = xs
-        .iter()
-        .map(|&x| {
-            let mut v = vec![0.0; nm];
-            sys.modes.values_at(x, &mut v, None);
-            v
-        })
-        .collect();
-    let mut shapes: Vec<StarShape> = snaps
-        .iter()
-        .map(|&t| StarShape {
-            t,
-            beams: std::array::from_fn(|_| BeamShape {
-                x: xs.clone(),
-                w: vec![0.0; SHAPE_POINTS],
-                pos: vec![[0.0; 2]; SHAPE_POINTS],
-            }),
-        })
-        .collect();
-    // multiplier index of each named column
-    let lam_index = |r: Row| sys.rows.iter().position(|x| *x == r);
-    let col_rows: [Option<usize>; 19] = [
-        lam_index(Row::Fix(0)),
-        lam_index(Row::Fix(1)),
-        lam_index(Row::Fix(2)),
-        lam_index(Row::M1G),
-        None, // M2G = -M1G - M3G (Eq. 25-1)
-        lam_index(Row::M3G),
-        lam_index(Row::Fw),
-        lam_index(Row::Fp(0)),
-        lam_index(Row::Fp(1)),
-        lam_index(Row::Fp(2)),
-        lam_index(Row::FL(0)),
-        lam_index(Row::FL(1)),
-        lam_index(Row::FL(2)),
-        lam_index(Row::FR(0)),
-        lam_index(Row::FR(1)),
-        lam_index(Row::FR(2)),
-        lam_index(Row::Mp(0)),
-        lam_index(Row::Mp(1)),
-        lam_index(Row::Mp(2)),
-    ];
-
+    let mut rec = Recorder::new(&sys, settings, params, out_times.len(), &snaps);
     let ga = GenAlpha::new(RHO_INF);
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
@@ -246,56 +202,8 @@ fn integrate<F: FnMut(&System, &[f64])>(
     })?;
     acc.copy_from_slice(&qdd);
 
-    let (phi0, phil) = (sys.phi0.clone(), sys.phil.clone());
-    let full = settings.model == AmmModel::Full;
     let mut record = |st: &RigidState, stop: &Stop, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]| {
-        let beam_val =
-            |i: usize, coef: &[f64]| -> f64 { q[i * nb..i * nb + nm].iter().zip(coef).map(|(a, p)| a * p).sum() };
-        if let Some(s) = stop.snapshot {
-            let shape = &mut shapes[s];
-            for i in 0..3 {
-                let (ex, ew) = (st.e_x(i), st.e_w(i));
-                let u = q[i * nb + nm];
-                let b = &mut shape.beams[i];
-                for (k, phi) in shape_phi.iter().enumerate() {
-                    let w = beam_val(i, phi);
-                    let x = xs[k] + u;
-                    b.w[k] = w;
-                    b.pos[k] = [st.g[0].v + x * ex[0] + w * ew[0], st.g[1].v + x * ex[1] + w * ew[1]];
-                }
-            }
-        }
-        if stop.output.is_some() {
-            let w_g = [0, 1, 2].map(|i| beam_val(i, &phi0));
-            let w_tip = [0, 1, 2].map(|i| beam_val(i, &phil));
-            let lam_of = |k: usize| col_rows[k].map_or(0.0, |r| lam[r]);
-            let fa = [0, 1, 2].map(|i| {
-                let (fp, fl, fr) = (lam_of(7 + i), lam_of(10 + i), lam_of(13 + i));
-                let inertia = params.mpp_mpa * st.s[i].d2;
-                if full {
-                    // Eq. 33 along the forces the full model's sleeve rows carry: each row's
-                    // force on the beam is lambda (e_w + c_u e_x), c_u its u gradient (-w')
-                    let d = slider_direction(i);
-                    let (ew, ex) = (st.e_w(i), st.e_x(i));
-                    let (wd, xd) = (ew[0] * d[0] + ew[1] * d[1], ex[0] * d[0] + ex[1] * d[1]);
-                    let [cp, cr, cl] = axial[i];
-                    inertia + (fp + fl + fr) * wd + (fp * cp + fr * cr + fl * cl) * xd
-                } else {
-                    let thp = q[i * nb + nm + 1];
-                    inertia + (fp + fl + fr) * (st.theta.v + thp).cos()
-                }
-            });
-            resp.push(st.t, w_g, w_tip, fa);
-            for (k, col) in extra.iter_mut().enumerate() {
-                let val = match k {
-                    4 => -lam_of(3) - lam_of(5),
-                    0..=18 => lam_of(k),
-                    19..=21 => q[(k - 19) * nb + nm + 1],
-                    _ => q[(k - 22) * nb + nm],
-                };
-                col.push(val);
-            }
-        }
+        rec.record(st, stop, q, lam, axial, None);
     };
 
     record(&st, &stops[0], &q, &sys.lam, &sys.sleeve_axial);
@@ -329,8 +237,7 @@ fn integrate<F: FnMut(&System, &[f64])>(
         record(&st, &w[1], &q, &sys.lam, &sys.sleeve_axial);
     }
 
-    resp.set_extra(&EXTRA_COLUMNS, extra);
-    resp.shapes = shapes;
+    let mut resp = rec.finish(format!("amm-{}", settings.family.name()));
     resp.info = RunInfo {
         solver: "amm".into(),
         family: Some(settings.family.name().into()),
@@ -357,6 +264,7 @@ mod tests {
             trajectory: Trajectory::quadratic(k),
             amm: AmmSettings::default(),
             fem: FemSettings::default(),
+            drive: Default::default(),
             source: Default::default(),
         }
     }

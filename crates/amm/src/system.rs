@@ -387,15 +387,8 @@ impl System {
     /// ```text
     /// S qdd - C^T lambda = f - D vhat - K qhat,     C qdd = -C qhat / bp   (0 when bp = 0)
     /// ```
-    /// at the rigid state `st`. Writes `qdd` and `self.lam`.
-    ///
-    /// `A = C S^-1 C^T` is assembled without forming `S^-1 C^T`. Block elimination of the u row
-    /// of the arrowhead gives, for rows k and s of one beam (alpha part `ca`, u and thp
-    /// coefficients `cu`, `ct`),
-    /// `A_ks = ca_k D^-1 ca_s + (cu_k - p g_k)(cu_s + p g_s) / sigma + ct_k ct_s / Jp`, with
-    /// `g_k = ca_k . D^-1 Phi` and `sigma = s_uu + p^2 Phi D^-1 Phi`; and every alpha part is a
-    /// multiple of one of six vectors (phi(0), phi'(0), phi at the three sleeve points, phi'(xp)),
-    /// so only their 6x6 Gram matrix `B D^-1 B^T` is computed (21 dot products of length N).
+    /// at the rigid state `st`. Writes `qdd` and `self.lam`: [`System::prepare`], then
+    /// [`System::forcing`] and [`System::solve_prepared`].
     pub(crate) fn solve(
         &mut self,
         st: &RigidState,
@@ -405,17 +398,31 @@ impl System {
         vhat: &[f64],
         qdd: &mut [f64],
     ) -> Result<(), AmmError> {
+        self.prepare(st, bp, gp, qhat)?;
+        self.forcing(st, qhat, vhat);
+        self.solve_prepared(bp, Some(qhat), qdd);
+        self.set_axial_acceleration(qdd);
+        Ok(())
+    }
+
+    /// Remember the axial accelerations u_i'' of `qdd` (the full model's Eq. 23 term of the next
+    /// step).
+    pub(crate) fn set_axial_acceleration(&mut self, qdd: &[f64]) {
+        for i in 0..3 {
+            self.udd[i] = qdd[i * self.nb + self.nm];
+        }
+    }
+
+    /// The forcing `r = f - D vhat - K qhat` of the step at the rigid state `st`, into the
+    /// workspace (per beam: Eq. 37 alpha rows, Eqs. 30/44 u row, Eq. 31 thp row).
+    pub(crate) fn forcing(&mut self, st: &RigidState, qhat: &[f64], vhat: &[f64]) {
         let (nm, nb, rho, l) = (self.nm, self.nb, self.rho, self.l);
         let thd = st.theta.d1;
         let thdd = st.theta.d2;
         let ag = st.a_g();
-        self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
-        self.factor_s(bp, gp, thd, thdd);
         if self.model == AmmModel::Full {
             self.geometric_stiffness_products(qhat);
         }
-
-        // residual r = f - D vhat - K qhat, per beam
         for i in 0..3 {
             let ew = st.e_w(i);
             let ex = st.e_x(i);
@@ -450,6 +457,75 @@ impl System {
                 }
             }
         }
+    }
+
+    /// The derivative of [`System::forcing`] along a change of the rigid motion: `d_ag` of a_G
+    /// [m/s^2], `d_thd` of theta' [rad/s], `d_thdd` of theta'' [rad/s^2] (the direct dynamics'
+    /// sensitivity to the sliders' accelerations, `docs/amm.md` section 10), into the workspace.
+    /// The step matrix is not changed (it is frozen at the predictor). Call after
+    /// [`System::forcing`] with the same `st`, `qhat`, `vhat`.
+    pub(crate) fn forcing_derivative(
+        &mut self,
+        st: &RigidState,
+        d_ag: [f64; 2],
+        d_thd: f64,
+        d_thdd: f64,
+        qhat: &[f64],
+        vhat: &[f64],
+    ) {
+        let (nm, nb, rho, l) = (self.nm, self.nb, self.rho, self.l);
+        let thd = st.theta.d1;
+        for i in 0..3 {
+            let ew = st.e_w(i);
+            let ex = st.e_x(i);
+            let daw = d_ag[0] * ew[0] + d_ag[1] * ew[1];
+            let dax = d_ag[0] * ex[0] + d_ag[1] * ex[1];
+            let o = i * nb;
+            let (qa, qu) = (&qhat[o..o + nm], qhat[o + nm]);
+            let (va, vu) = (&vhat[o..o + nm], vhat[o + nm]);
+            let r = &mut self.resid[o..o + nb];
+            let mut phi_q = 0.0;
+            let mut phi_v = 0.0;
+            for j in 0..nm {
+                let pj = self.phi[j];
+                r[j] = -rho * (daw * pj + d_thdd * self.psi[j]) - 2.0 * rho * d_thd * pj * vu
+                    + 2.0 * rho * thd * d_thd * qa[j]
+                    - rho * d_thdd * pj * qu;
+                phi_q += pj * qa[j];
+                phi_v += pj * va[j];
+            }
+            r[nm] = -rho * (l * dax - thd * d_thd * l * l)
+                + 2.0 * rho * d_thd * phi_v
+                + rho * d_thdd * phi_q
+                + 2.0 * rho * l * thd * d_thd * qu;
+            r[nm + 1] = -self.jp * d_thdd;
+            if self.model == AmmModel::Full {
+                // G1 alpha, G2 alpha of the last forcing (the same qhat)
+                let (c1, c2) = (2.0 * rho * thd * d_thd, -rho * dax);
+                let col = self.g12_q.col(i);
+                for (j, rj) in r[..nm].iter_mut().enumerate() {
+                    *rj -= c1 * col[j] + c2 * col[nm + j];
+                }
+            }
+        }
+    }
+
+    /// Build and factor the step matrix at the rigid state `st`: sleeve rows at xp(st) (about the
+    /// predictor `qhat` for the full model), the arrowhead data of S, and the LU factors of the
+    /// Schur complement `A = C S^-1 C^T` (kept for [`System::solve_prepared`]).
+    ///
+    /// `A` is assembled without forming `S^-1 C^T`. Block elimination of the u row
+    /// of the arrowhead gives, for rows k and s of one beam (alpha part `ca`, u and thp
+    /// coefficients `cu`, `ct`),
+    /// `A_ks = ca_k D^-1 ca_s + (cu_k - p g_k)(cu_s + p g_s) / sigma + ct_k ct_s / Jp`, with
+    /// `g_k = ca_k . D^-1 Phi` and `sigma = s_uu + p^2 Phi D^-1 Phi`; and every alpha part is a
+    /// multiple of one of six vectors (phi(0), phi'(0), phi at the three sleeve points, phi'(xp)),
+    /// so only their 6x6 Gram matrix `B D^-1 B^T` is computed (21 dot products of length N).
+    pub(crate) fn prepare(&mut self, st: &RigidState, bp: f64, gp: f64, qhat: &[f64]) -> Result<(), AmmError> {
+        let thd = st.theta.d1;
+        let thdd = st.theta.d2;
+        self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
+        self.factor_s(bp, gp, thd, thdd);
 
         // Gram data of the junction vectors (shared by the beams)
         for (sv, v) in self.scaled0.iter_mut().zip([&self.phi0, &self.dphi0]) {
@@ -466,10 +542,8 @@ impl System {
         let m = self.rows.len();
         let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp);
         self.a.iter_mut().for_each(|v| *v = 0.0);
-        self.rhs.iter_mut().for_each(|v| *v = 0.0);
         let mut beams = std::mem::take(&mut self.beams);
-        for (i, beam) in beams.iter_mut().enumerate() {
-            let o = i * nb;
+        for beam in beams.iter_mut() {
             // sleeve vectors scaled by D^-1, the Gram matrix and g = B D^-1 Phi
             for (sv, v) in beam.scaled.iter_mut().zip(&beam.sleeve) {
                 for ((s, x), d) in sv.iter_mut().zip(v).zip(&self.inv_d) {
@@ -497,39 +571,7 @@ impl System {
             beam.g[B_PHI0] = w0;
             beam.g[B_DPHI0] = w1;
 
-            // c_k . S^-1 r = ca_k D^-1 r_a + (cu_k - p g_k) y_r + ct_k r_thp / Jp, and c_k . qhat
-            let r = &self.resid[o..o + nb];
-            let y_r = (r[nm] + p * dot(&self.w, &r[..nm])) * inv_sigma;
-            for ((d, x), di) in self.dinv_r.iter_mut().zip(&r[..nm]).zip(&self.inv_d) {
-                *d = x * di;
-            }
-            let mut bdr = [0.0; NB];
-            let mut bq = [0.0; NB];
-            let used = |a: usize| beam.basis.contains(&a);
-            for a in 0..NB {
-                if used(a) {
-                    let v = match a {
-                        B_PHI0 => &self.phi0,
-                        B_DPHI0 => &self.dphi0,
-                        _ => &beam.sleeve[a - B_MID],
-                    };
-                    bdr[a] = dot(v, &self.dinv_r);
-                    bq[a] = dot(v, &qhat[o..o + nm]);
-                }
-            }
             let mb = beam.ids.len();
-            for k in 0..mb {
-                let (bk, sk) = (beam.basis[k], beam.sc[k]);
-                let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };
-                let mut cz = (beam.cu[k] - p * gk) * y_r + beam.ct[k] * r[nm + 1] * inv_jp;
-                let mut cq = beam.gu[k] * qhat[o + nm] + beam.ct[k] * qhat[o + nm + 1];
-                if bk != NONE {
-                    cz += sk * bdr[bk];
-                    cq += sk * bq[bk];
-                }
-                let cq = if bp > 0.0 { cq / bp } else { 0.0 };
-                self.rhs[beam.ids[k]] -= cz + cq;
-            }
             for k in 0..mb {
                 let (bk, sk) = (beam.basis[k], beam.sc[k]);
                 let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };
@@ -547,8 +589,63 @@ impl System {
             }
         }
         self.beams = beams;
-        lu_solve(&mut self.a, &mut self.piv, &mut self.rhs, m)
-            .map_err(|reason| AmmError::SingularConstraints { t: st.t, reason })?;
+        lu_factor(&mut self.a, &mut self.piv, m).map_err(|reason| AmmError::SingularConstraints { t: st.t, reason })
+    }
+
+    /// Solve the prepared step for the forcing in the workspace ([`System::forcing`] or
+    /// [`System::forcing_derivative`]): `S qdd - C^T lambda = r`, `C qdd = -C qhat / bp` with
+    /// `qhat` given (and `bp > 0`), `C qdd = 0` without. Writes `qdd` and `self.lam`.
+    pub(crate) fn solve_prepared(&mut self, bp: f64, qhat: Option<&[f64]>, qdd: &mut [f64]) {
+        let (nm, nb) = (self.nm, self.nb);
+        let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp);
+        self.rhs.iter_mut().for_each(|v| *v = 0.0);
+        let beams = std::mem::take(&mut self.beams);
+        for (i, beam) in beams.iter().enumerate() {
+            let o = i * nb;
+            // c_k . S^-1 r = ca_k D^-1 r_a + (cu_k - p g_k) y_r + ct_k r_thp / Jp, and c_k . qhat
+            let r = &self.resid[o..o + nb];
+            let y_r = (r[nm] + p * dot(&self.w, &r[..nm])) * inv_sigma;
+            for ((d, x), di) in self.dinv_r.iter_mut().zip(&r[..nm]).zip(&self.inv_d) {
+                *d = x * di;
+            }
+            let mut bdr = [0.0; NB];
+            let mut bq = [0.0; NB];
+            let used = |a: usize| beam.basis.contains(&a);
+            for a in 0..NB {
+                if used(a) {
+                    let v = match a {
+                        B_PHI0 => &self.phi0,
+                        B_DPHI0 => &self.dphi0,
+                        _ => &beam.sleeve[a - B_MID],
+                    };
+                    bdr[a] = dot(v, &self.dinv_r);
+                    if let Some(qh) = qhat {
+                        bq[a] = dot(v, &qh[o..o + nm]);
+                    }
+                }
+            }
+            for k in 0..beam.ids.len() {
+                let (bk, sk) = (beam.basis[k], beam.sc[k]);
+                let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };
+                let mut cz = (beam.cu[k] - p * gk) * y_r + beam.ct[k] * r[nm + 1] * inv_jp;
+                if bk != NONE {
+                    cz += sk * bdr[bk];
+                }
+                let cq = match qhat {
+                    Some(qh) if bp > 0.0 => {
+                        let mut cq = beam.gu[k] * qh[o + nm] + beam.ct[k] * qh[o + nm + 1];
+                        if bk != NONE {
+                            cq += sk * bq[bk];
+                        }
+                        cq / bp
+                    }
+                    _ => 0.0,
+                };
+                self.rhs[beam.ids[k]] -= cz + cq;
+            }
+        }
+        self.beams = beams;
+        lu_apply(&self.a, &self.piv, &mut self.rhs, self.rows.len());
         self.lam.copy_from_slice(&self.rhs);
 
         // qdd = S^-1 (r + C^T lambda): collect the multipliers per basis vector, then one axpy each
@@ -574,9 +671,7 @@ impl System {
         }
         for i in 0..3 {
             self.arrow_solve(&mut qdd[i * nb..(i + 1) * nb]);
-            self.udd[i] = qdd[i * nb + nm];
         }
-        Ok(())
     }
 
     /// The sleeve rows of Eqs. 41-42 evaluated exactly (nonlinear in u) at the state q, for tests:
@@ -664,10 +759,10 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     s
 }
 
-/// In-place LU with partial pivoting of the dense m x m matrix `a` (row-major) and solve for `b`.
+/// In-place LU with partial pivoting of the dense m x m matrix `a` (row-major): `P a = L U`, the
+/// multipliers of L below the diagonal, `piv[k]` the original row now at position k.
 /// Fails when a pivot is below 1e-13 of the largest entry of its row before elimination.
-fn lu_solve(a: &mut [f64], piv: &mut [usize], b: &mut [f64], m: usize) -> Result<(), String> {
-    // row scales for the singularity test
+fn lu_factor(a: &mut [f64], piv: &mut [usize], m: usize) -> Result<(), String> {
     for (r, p) in piv.iter_mut().enumerate() {
         *p = r;
     }
@@ -696,31 +791,42 @@ fn lu_solve(a: &mut [f64], piv: &mut [usize], b: &mut [f64], m: usize) -> Result
         if arg != k {
             let (top, bottom) = a.split_at_mut(arg * m);
             top[k * m..(k + 1) * m].swap_with_slice(&mut bottom[..m]);
-            b.swap(k, arg);
             scale.swap(k, arg);
             piv.swap(k, arg);
         }
         let (top, bottom) = a.split_at_mut((k + 1) * m);
         let pivot_row = &top[k * m..(k + 1) * m];
         let inv = 1.0 / pivot_row[k];
-        let bk = b[k];
-        for (r, row) in bottom.chunks_exact_mut(m).enumerate() {
+        for row in bottom.chunks_exact_mut(m) {
             let f = row[k] * inv;
             if f != 0.0 {
                 row[k] = f;
                 for (x, p) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
                     *x -= f * p;
                 }
-                b[k + 1 + r] -= f * bk;
+            } else {
+                row[k] = 0.0;
             }
         }
     }
+    Ok(())
+}
+
+/// Solve `a x = b` in place with the factors of [`lu_factor`].
+fn lu_apply(a: &[f64], piv: &[usize], b: &mut [f64], m: usize) {
+    let mut y = [0.0f64; 32];
+    for k in 0..m {
+        let mut s = b[piv[k]];
+        for c in 0..k {
+            s -= a[k * m + c] * y[c];
+        }
+        y[k] = s;
+    }
     for k in (0..m).rev() {
-        let mut s = b[k];
+        let mut s = y[k];
         for c in k + 1..m {
             s -= a[k * m + c] * b[c];
         }
         b[k] = s / a[k * m + k];
     }
-    Ok(())
 }

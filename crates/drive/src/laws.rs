@@ -2,7 +2,7 @@
 //! force polynomials, and a PD servo on each slider with optional rigid-body feedforward.
 
 use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
-use flexstar_model::{RobotParams, Trajectory};
+use flexstar_model::{ForceSamples, RobotParams, Trajectory};
 
 use crate::{ActuatorLaw, DriveError};
 
@@ -21,28 +21,7 @@ impl ForceTable {
     /// Build from samples; times must be finite and strictly increasing, forces finite.
     /// Errors name the sample (1-based row) and the reason; the caller adds file and key.
     pub fn new(t: Vec<f64>, fa: Vec<[f64; 3]>) -> Result<Self, DriveError> {
-        if t.len() != fa.len() {
-            return Err(DriveError::Table(format!(
-                "{} times but {} force rows",
-                t.len(),
-                fa.len()
-            )));
-        }
-        if t.len() < 2 {
-            return Err(DriveError::Table(format!("need at least two samples, got {}", t.len())));
-        }
-        for (k, (tk, f)) in t.iter().zip(&fa).enumerate() {
-            if !tk.is_finite() || f.iter().any(|v| !v.is_finite()) {
-                return Err(DriveError::Table(format!("row {}: non-finite value", k + 1)));
-            }
-            if k > 0 && *tk <= t[k - 1] {
-                return Err(DriveError::Table(format!(
-                    "row {}: time {tk} s does not increase (previous {} s)",
-                    k + 1,
-                    t[k - 1]
-                )));
-            }
-        }
+        ForceSamples::check(&t, &fa).map_err(DriveError::Table)?;
         Ok(ForceTable { t, fa })
     }
 
@@ -55,13 +34,7 @@ impl ForceTable {
     /// written with fewer digits than the solver keeps).
     pub fn check_covers(&self, t0: f64, t1: f64) -> Result<(), DriveError> {
         let (a, b) = self.span();
-        let slack = 1e-9 * t1.abs().max(1.0);
-        if a > t0 + slack || b < t1 - slack {
-            return Err(DriveError::Table(format!(
-                "samples span [{a}, {b}] s but the run needs [{t0}, {t1}] s"
-            )));
-        }
-        Ok(())
+        ForceSamples::check_covers(a, b, t0, t1).map_err(DriveError::Table)
     }
 
     /// `Fa(t)` [N], linear between samples, held constant outside the span.

@@ -33,6 +33,45 @@ pub mod rigid_forward;
 pub use laws::{ForcePolynomials, ForceTable, ReferencePoint, RigidInverseForces, Servo};
 pub use rigid_forward::{rigid_forward_dynamics, RigidSample};
 
+use flexstar_model::{DriveKind, Experiment, Feedforward};
+
+/// The actuator law of an experiment's `[drive]` (issue 10): `None` for `kind = "motion"` (the
+/// trajectory is imposed), else the forces (table or polynomials) or the servo tracking
+/// `exp.trajectory` with its gains resolved (`bandwidth_hz` with the slider mass `mpp_mpa`).
+/// Errors name the `drive.` key.
+pub fn law_for(exp: &Experiment) -> Result<Option<Box<dyn ActuatorLaw>>, DriveError> {
+    let d = &exp.drive;
+    let invalid = |e: flexstar_model::ModelError| match e {
+        flexstar_model::ModelError::Invalid { key, reason, .. } => DriveError::Config(format!("key `{key}`: {reason}")),
+        other => DriveError::Config(other.to_string()),
+    };
+    d.validate(exp.time.t_end, exp.robot.mpp_mpa).map_err(invalid)?;
+    Ok(match d.kind {
+        DriveKind::Motion => None,
+        DriveKind::Forces => match (&d.samples, &d.fa1, &d.fa2, &d.fa3) {
+            (Some(s), _, _, _) => Some(Box::new(ForceTable::new(s.t.clone(), s.fa.clone())?)),
+            (None, Some(a), Some(b), Some(c)) => Some(Box::new(ForcePolynomials {
+                coefficients: [a.clone(), b.clone(), c.clone()],
+            })),
+            _ => {
+                return Err(DriveError::Config(
+                    "drive: forces given neither as a file nor as Fa1, Fa2, Fa3".into(),
+                ))
+            }
+        },
+        DriveKind::Servo => {
+            let g = d.servo_gains(exp.robot.mpp_mpa).map_err(invalid)?;
+            Some(Box::new(Servo {
+                kp: [g.kp; 3],
+                kd: [g.kd; 3],
+                rigid_feedforward: d.feedforward.unwrap_or_default() == Feedforward::Rigid,
+                reference: exp.trajectory.clone(),
+                params: exp.robot,
+            }))
+        }
+    })
+}
+
 /// Errors of the drives; the config loader adds file and key.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DriveError {
@@ -42,6 +81,37 @@ pub enum DriveError {
     /// The servo reference cannot be evaluated at time `t`.
     #[error("servo reference at t = {t} s: {reason}")]
     Reference { t: f64, reason: String },
+    /// The `[drive]` section cannot be turned into a law (the message names the key).
+    #[error("{0}")]
+    Config(String),
+}
+
+/// Add the servo's tracking errors `e_i = s_ref,i(t) - s_i(t)` [m] to a direct run's response
+/// as columns `e1, e2, e3` (after its other columns), from its `s1, s2, s3` columns and the
+/// reference `exp.trajectory`.
+pub fn add_tracking_errors(resp: &mut flexstar_model::Response, exp: &Experiment) -> Result<(), DriveError> {
+    let mut cols = [Vec::new(), Vec::new(), Vec::new()];
+    for (i, col) in cols.iter_mut().enumerate() {
+        let name = ["s1", "s2", "s3"][i];
+        let s = resp
+            .column(name)
+            .ok_or_else(|| DriveError::Config(format!("the direct run has no column {name}")))?;
+        *col = Vec::with_capacity(s.len());
+        for (&t, &si) in resp.t.iter().zip(s) {
+            let r = exp.trajectory.s(&exp.robot, t).map_err(|e| DriveError::Reference {
+                t,
+                reason: e.to_string(),
+            })?;
+            col.push(r[i] - si);
+        }
+    }
+    for (name, values) in ["e1", "e2", "e3"].into_iter().zip(cols) {
+        resp.extra.push(flexstar_model::Column {
+            name: name.into(),
+            values,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -64,6 +134,30 @@ mod tests {
         let err = ForceTable::new(vec![0.0, 0.0], vec![[0.0; 3]; 2]).unwrap_err();
         assert!(err.to_string().contains("row 2"), "{err}");
         assert!(ForceTable::new(vec![0.0, f64::NAN], vec![[0.0; 3]; 2]).is_err());
+    }
+
+    #[test]
+    fn law_for_builds_each_kind() {
+        let mut exp = flexstar_model::catalogue::paper_case(1);
+        assert!(law_for(&exp).unwrap().is_none());
+        exp.drive.kind = DriveKind::Forces;
+        exp.drive.fa1 = Some(vec![1.0, 2.0]);
+        exp.drive.fa2 = Some(vec![0.0]);
+        exp.drive.fa3 = Some(vec![0.0, 0.0, 3.0]);
+        let law = law_for(&exp).unwrap().unwrap();
+        assert_eq!(law.force(2.0, [0.0; 3], [0.0; 3]).unwrap(), [5.0, 0.0, 12.0]);
+        assert_eq!(law.stiffness(), [0.0; 3]);
+        let mut exp = flexstar_model::catalogue::paper_case(1);
+        exp.drive.kind = DriveKind::Servo;
+        exp.drive.bandwidth_hz = Some(20.0);
+        exp.drive.damping_ratio = Some(0.7);
+        let law = law_for(&exp).unwrap().unwrap();
+        let (kp, kd) = Servo::gains_from_bandwidth(exp.robot.mpp_mpa, 20.0, 0.7);
+        assert_eq!((law.stiffness()[1], law.damping()[2]), (kp, kd));
+        exp.drive.kp = Some(1.0);
+        exp.drive.kd = Some(1.0);
+        let e = law_for(&exp).err().unwrap().to_string();
+        assert!(e.contains("drive.bandwidth_hz"), "{e}");
     }
 
     #[test]

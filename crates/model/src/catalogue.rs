@@ -35,6 +35,7 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         trajectory,
         amm: AmmSettings::default(),
         fem: FemSettings::default(),
+        drive: Default::default(),
         source: Default::default(),
     }
 }

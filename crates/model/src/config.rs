@@ -24,6 +24,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::drive::DriveSettings;
 use crate::error::ModelError;
 use crate::params::RobotParams;
 use crate::trajectory::Trajectory;
@@ -314,6 +315,9 @@ pub struct Experiment {
     pub amm: AmmSettings,
     #[serde(default)]
     pub fem: FemSettings,
+    /// What moves the sliders (`[drive]`, issue 10): the trajectory (default), forces or a servo.
+    #[serde(default)]
+    pub drive: DriveSettings,
     /// Where the experiment was read from (not a TOML key).
     #[serde(skip)]
     pub source: PathBuf,
@@ -336,6 +340,7 @@ impl Experiment {
             message: e.to_string().trim_end().to_string(),
         })?;
         exp.source = path.to_path_buf();
+        exp.drive.read_file(path)?;
         exp.validate().map_err(|e| e.in_file(path))?;
         Ok(exp)
     }
@@ -361,6 +366,7 @@ impl Experiment {
         self.time.validate()?;
         self.trajectory.validate(&self.robot)?;
         self.amm.validate(self.time.dt_out)?;
+        self.drive.validate(self.time.t_end, self.robot.mpp_mpa)?;
         if self.fem.elements < 3 || !self.fem.elements.is_multiple_of(3) || self.fem.elements > 30_000 {
             return Err(ModelError::invalid(
                 "fem.elements",

@@ -9,6 +9,7 @@
 
 pub mod catalogue;
 pub mod config;
+pub mod drive;
 pub mod error;
 pub mod evp;
 pub mod geometry;
@@ -20,6 +21,7 @@ pub mod trajectory;
 pub mod validity;
 
 pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, ModeFamily, TimeSpan};
+pub use drive::{DriveKind, DriveSettings, Feedforward, ForceSamples};
 pub use error::ModelError;
 pub use params::RobotParams;
 pub use response::{BeamShape, Column, Response, RunInfo, StarShape};

@@ -173,6 +173,59 @@ impl Response {
         })
     }
 
+    /// Write the response as CSV with a chosen column order, whole or not at all: `t`, the extra
+    /// columns `leading`, the fixed columns (`w_iG`, tips, `Fa_i`), the extra columns `after`, then
+    /// every other extra column in its order. A direct run's file (issue 10) is written with
+    /// `leading = [s1, s2, s3]`, `after = [Gx, Gy, theta, (e1, e2, e3)]`. A named column that is
+    /// missing is an error.
+    pub fn write_csv_ordered(&self, path: &Path, leading: &[&str], after: &[&str]) -> Result<(), ModelError> {
+        let find = |name: &str| {
+            self.extra
+                .iter()
+                .position(|c| c.name == name)
+                .ok_or_else(|| ModelError::Write {
+                    file: path.to_path_buf(),
+                    reason: format!("the response has no column {name}"),
+                })
+        };
+        let lead: Vec<usize> = leading.iter().map(|n| find(n)).collect::<Result<_, _>>()?;
+        let mid: Vec<usize> = after.iter().map(|n| find(n)).collect::<Result<_, _>>()?;
+        let rest: Vec<usize> = (0..self.extra.len())
+            .filter(|k| !lead.contains(k) && !mid.contains(k))
+            .collect();
+        for c in &self.extra {
+            if c.values.len() != self.len() {
+                return Err(ModelError::Write {
+                    file: path.to_path_buf(),
+                    reason: format!("column {} has {} rows, expected {}", c.name, c.values.len(), self.len()),
+                });
+            }
+        }
+        let name = |k: &usize| self.extra[*k].name.clone();
+        let mut header = vec!["t".to_string()];
+        header.extend(lead.iter().map(name));
+        header.extend(RESPONSE_HEADER[1..].iter().map(|s| s.to_string()));
+        header.extend(mid.iter().map(name));
+        header.extend(rest.iter().map(name));
+        write_atomically(path, |w| {
+            let mut out = csv::Writer::from_writer(w);
+            out.write_record(&header)?;
+            let mut row = Vec::with_capacity(header.len());
+            for k in 0..self.len() {
+                row.clear();
+                row.push(self.t[k]);
+                row.extend(lead.iter().map(|c| self.extra[*c].values[k]));
+                for group in [&self.w_g, &self.w_tip, &self.fa] {
+                    row.extend(group.iter().map(|c| c[k]));
+                }
+                row.extend(mid.iter().chain(&rest).map(|c| self.extra[*c].values[k]));
+                out.write_record(row.iter().map(|v| fmt_number(*v)))?;
+            }
+            out.flush()?;
+            Ok(())
+        })
+    }
+
     /// Write the sidecar JSON of a run (`<csv name>.json`), whole or not at all:
     /// `flexstar_version`, `commit` (when known), `date` (UTC, of the run), the `label`, every field
     /// of [`RunInfo`], `small_deflection` (the check of [`small_deflection_check`]: `null` when the

@@ -5,7 +5,14 @@ use std::path::PathBuf;
 
 use anyhow::{anyhow, bail};
 use flexstar_model::config::check_step;
-use flexstar_model::{small_deflection_check, ModeFamily, Response};
+use flexstar_model::{small_deflection_check, DriveKind, DriveSettings, Experiment, ModeFamily, Response};
+
+/// The actuator law of the experiment's drive (a direct run).
+fn law_of(exp: &Experiment, cfg: &impl std::fmt::Display) -> anyhow::Result<Box<dyn flexstar_drive::ActuatorLaw>> {
+    flexstar_drive::law_for(exp)
+        .map_err(|e| anyhow!("{cfg}: {e}"))?
+        .ok_or_else(|| anyhow!("{cfg}: the drive is a motion, not a direct problem"))
+}
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Solver {
@@ -17,7 +24,10 @@ pub enum Solver {
 
 /// Run a solver on an experiment; writes DIR/<name>/amm-<family>.csv or DIR/<name>/fem.csv
 /// (`t,w1G,w2G,w3G,w1tip,w2tip,w3tip,Fa1,Fa2,Fa3` then more columns) and the deformed star
-/// snapshots in `...-shapes.csv`.
+/// snapshots in `...-shapes.csv`. With a `[drive]` of kind forces or servo (or `--forces FILE`)
+/// the direct problem: DIR/<name>/amm-<family>-direct.csv or fem-direct.csv
+/// (`t,s1,s2,s3,w1G,w2G,w3G,w1tip,w2tip,w3tip,Fa1,Fa2,Fa3,Gx,Gy,theta`, for a servo `e1,e2,e3`,
+/// then more columns).
 #[derive(clap::Args)]
 pub struct Args {
     /// Experiment file (TOML)
@@ -44,21 +54,58 @@ pub struct Args {
     /// Integration step [s] (overrides [amm] dt or [fem] dt)
     #[arg(long)]
     dt: Option<f64>,
+    /// Drive the sliders by these actuator forces instead (the direct problem): a CSV whose header
+    /// starts with t and names Fa1, Fa2, Fa3, e.g. a solver output; replaces the config's [drive]
+    #[arg(long, value_name = "FILE")]
+    forces: Option<PathBuf>,
     /// Output directory
     #[arg(long, default_value = "out")]
     out: PathBuf,
 }
 
+/// The FEM's direct dynamics (issue 10). Wiring point: `flexstar_fem::solve_direct(exp,
+/// &exp.fem, law, progress)` takes this place once it is on main.
+fn fem_direct(
+    _exp: &flexstar_model::Experiment,
+    _law: &dyn flexstar_drive::ActuatorLaw,
+    _progress: Option<&(dyn Fn(f64) + Sync)>,
+) -> anyhow::Result<Response> {
+    bail!("the FEM's direct dynamics (forces or servo drive) is not available in this build; use --solver amm")
+}
+
+/// Columns a direct run's file puts right after the fixed ones (issue 10 contract).
+fn direct_columns(servo: bool) -> Vec<&'static str> {
+    let mut v = vec!["Gx", "Gy", "theta"];
+    if servo {
+        v.extend(["e1", "e2", "e3"]);
+    }
+    v
+}
+
 pub fn run(args: Args) -> anyhow::Result<()> {
     let mut exp = super::load(&args.config)?;
     let cfg = args.config.display();
+    if let Some(f) = &args.forces {
+        if exp.drive.is_direct() {
+            eprintln!("note: --forces {} replaces the [drive] of {cfg}", f.display());
+        }
+        exp.drive = DriveSettings::forces_file(f)?;
+    }
     if let Some(dt) = args.dt {
         check_step("--dt", dt, exp.time.dt_out).map_err(|e| e.in_file(&args.config))?;
     }
+    let direct = exp.drive.is_direct();
+    let servo = exp.drive.kind == DriveKind::Servo;
     // the feasibility scan of both solvers, here too so that nothing is created for a motion
-    // that is refused
-    flexstar_kinematics::check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))
-        .map_err(|e| anyhow!("{cfg}: {e}"))?;
+    // that is refused (a forces-driven run: its start only; its motion is checked as it goes)
+    if direct && !servo {
+        let s0 = exp.trajectory.s(&exp.robot, 0.0).map_err(|e| anyhow!("{cfg}: {e}"))?;
+        flexstar_kinematics::check_configuration(&exp.robot, s0)
+            .map_err(|violation| anyhow!("{cfg}: {}", flexstar_kinematics::Infeasible { t: 0.0, violation }))?;
+    } else {
+        flexstar_kinematics::check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))
+            .map_err(|e| anyhow!("{cfg}: {e}"))?;
+    }
     let started = std::time::Instant::now();
     let dir;
     let (response, file): (Response, String) = match args.solver {
@@ -87,8 +134,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 .map_err(|e| anyhow::anyhow!("{cfg} with the command-line flags: {e}"))?;
             dir = super::case_dir(&args.out, &exp)?;
             eprintln!("{}: AMM, {:?}, {}", exp.name, exp.amm.mode_count(), exp.amm.family);
-            let r = flexstar_amm::solve(&exp, &exp.amm).map_err(|e| anyhow!("{cfg}: {e}"))?;
-            (r, format!("amm-{}", exp.amm.family))
+            if direct {
+                let law = law_of(&exp, &cfg)?;
+                let r = flexstar_amm::solve_direct(&exp, &exp.amm, law.as_ref()).map_err(|e| anyhow!("{cfg}: {e}"))?;
+                (r, format!("amm-{}-direct", exp.amm.family))
+            } else {
+                let r = flexstar_amm::solve(&exp, &exp.amm).map_err(|e| anyhow!("{cfg}: {e}"))?;
+                (r, format!("amm-{}", exp.amm.family))
+            }
         }
         Solver::Fem => {
             if args.family.is_some() || args.modes.is_some() || args.model.is_some() || args.tol.is_some() {
@@ -104,6 +157,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 .map_err(|e| anyhow::anyhow!("{cfg} with the command-line flags: {e}"))?;
             dir = super::case_dir(&args.out, &exp)?;
             eprintln!("{}: FEM, {} elements", exp.name, exp.fem.elements);
+            let law = if direct { Some(law_of(&exp, &cfg)?) } else { None };
+            let solve = |progress: Option<&(dyn Fn(f64) + Sync)>| -> anyhow::Result<Response> {
+                match &law {
+                    Some(law) => fem_direct(&exp, law.as_ref(), progress),
+                    None => Ok(flexstar_fem::solve(&exp, &exp.fem, progress)?),
+                }
+            };
             let r = if std::io::stderr().is_terminal() {
                 let bar = indicatif::ProgressBar::new(1000);
                 bar.set_style(
@@ -111,18 +171,26 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                         .expect("valid template"),
                 );
                 let tick = |f: f64| bar.set_position((f * 1000.0) as u64);
-                let r = flexstar_fem::solve(&exp, &exp.fem, Some(&tick));
+                let r = solve(Some(&tick));
                 bar.finish_and_clear();
                 r
             } else {
-                flexstar_fem::solve(&exp, &exp.fem, None)
+                solve(None)
             }
             .map_err(|e| anyhow!("{cfg}: {e}"))?;
-            (r, "fem".to_string())
+            (r, if direct { "fem-direct" } else { "fem" }.to_string())
         }
     };
+    let mut response = response;
     let csv = dir.join(format!("{file}.csv"));
-    response.write_csv(&csv)?;
+    if direct {
+        if servo {
+            flexstar_drive::add_tracking_errors(&mut response, &exp).map_err(|e| anyhow!("{cfg}: {e}"))?;
+        }
+        response.write_csv_ordered(&csv, &["s1", "s2", "s3"], &direct_columns(servo))?;
+    } else {
+        response.write_csv(&csv)?;
+    }
     response.write_shapes_csv(&dir.join(format!("{file}-shapes.csv")))?;
     response.write_sidecar(&dir.join(format!("{file}.json")), &exp, &super::provenance())?;
     if let Some(v) = small_deflection_check(&response, exp.robot.l) {

@@ -1,0 +1,400 @@
+//! Direct dynamics (issue 10; `docs/amm.md` section 10): the actuator forces (or a servo) are
+//! given and the slider positions s_i join the unknowns.
+//!
+//! ```text
+//! M q'' + D q' + K q = f(a_G, theta', theta'') + C(xp)^T lambda,   C(xp) q = 0   (Eqs. 30-32, 37, 44)
+//! (mpp + mpa) s_i'' = Fa_i(t, s_i, s_i') - F_i(lambda) e_wi . u_i               (Eq. 33)
+//! ```
+//! with `G, theta, xp` the exact direct kinematics of s (Eqs. 4-10), so that
+//! `a_G = J_G s'' + H_G[s', s']`, `theta'' = J_th s'' + H_th[s', s']` (Jacobians and Hessians by
+//! dual numbers, [`flexstar_kinematics::RigidState::from_actuators`]).
+//!
+//! Time integration: the elastic coordinates q and the sliders s share the index-3
+//! generalized-alpha step of [`crate::solve`]. Per step the unknowns are q'' and s''; the coupled
+//! step is linearised once about the predictor `s''_pred = s''_n`: the step matrix and the
+//! constraint rows are built at the predicted rigid state, the forcing is affine in the correction
+//! `ds''` through `d a_G / d s''`, `d theta' / d s''`, `d theta'' / d s''` (including the
+//! generalized-alpha dependence of s and s' on s''), so four right-hand sides of one factored
+//! system give `q'' = q''_0 + sum_k ds''_k q''_k` and the multipliers likewise, and Eq. 33
+//! becomes a 3 x 3 linear system for `ds''`. What the linearisation drops is of second order in
+//! the per-step change of s'' times the step (`docs/amm.md` section 10).
+
+use flexstar_drive::ActuatorLaw;
+use flexstar_kinematics::{check_configuration, direct_kinematics, Infeasible, RigidState};
+use flexstar_model::{AmmSettings, DriveKind, Experiment, ModeCount, Response, RobotParams, RunInfo};
+use flexstar_numerics::GenAlpha;
+use num_dual::{Dual2, HyperDual64};
+
+use crate::adaptive;
+use crate::error::AmmError;
+use crate::modes::ModeSet;
+use crate::record::Recorder;
+use crate::solver::{stops, validate, RHO_INF};
+use crate::system::System;
+
+/// Columns a direct run writes first among its extra columns: the sliders `s_i` [m] and `s_i'`
+/// [m/s], and the rigid pose of the simulated sliders by the exact direct kinematics: `Gx`, `Gy`
+/// [m] and `theta` [rad]. The columns of [`crate::EXTRA_COLUMNS`] follow.
+pub const DIRECT_COLUMNS: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "Gy", "theta"];
+
+/// Solve the direct problem: the sliders driven by `law`, from `s(0)`, `s'(0)` of
+/// `exp.trajectory` at t = 0 with the star at rest elastically (as an inverse run starts).
+///
+/// Returns the response labelled `amm-<family>-direct` (`info.solver = "amm-direct"`): the
+/// standard columns with `Fa_i` the law's forces at the output times, then [`DIRECT_COLUMNS`],
+/// then [`crate::EXTRA_COLUMNS`]. Every family, both models, fixed N or tolerance, as [`crate::solve`].
+///
+/// The trajectory is scanned for feasibility over the whole span when `exp.drive` is a servo
+/// (it is the reference); otherwise only its start. The configuration reached is checked at every
+/// step: leaving the feasible range stops the run with the time (to one step) and the reason.
+pub fn solve_direct(exp: &Experiment, settings: &AmmSettings, law: &dyn ActuatorLaw) -> Result<Response, AmmError> {
+    let scan = exp.drive.kind == DriveKind::Servo;
+    match settings.mode_count() {
+        ModeCount::Fixed(n) => integrate_direct(exp, settings, law, n),
+        ModeCount::Tolerance(tol) => {
+            validate(exp, settings, adaptive::first_modes(exp), scan)?;
+            adaptive::solve_to_tolerance(exp, tol, |n| integrate_direct(exp, settings, law, n))
+        }
+    }
+}
+
+/// The rigid state of sliders at `s` [m], `sd` [m/s], `sdd` [m/s^2] at time `t`.
+fn rigid_at(params: &RobotParams, s: [f64; 3], sd: [f64; 3], sdd: [f64; 3], t: f64) -> Result<RigidState, AmmError> {
+    let sv = [0, 1, 2].map(|i| Dual2::new(s[i], sd[i], sdd[i]));
+    RigidState::from_actuators(params, sv, t).map_err(|source| AmmError::Kinematics { t, source })
+}
+
+/// Derivatives of the rigid motion's a_G, theta' and theta'' with respect to s''_k, where
+/// `s = shat + bp s''` and `s' = sdhat + gp s''` (the terms of order bp dropped):
+/// `d a_G = J_G e_k + 2 gp H_G[s', e_k]`, `d theta'' = J_th e_k + 2 gp H_th[s', e_k]`,
+/// `d theta' = gp J_th e_k`, with J and the mixed second derivative H[s', e_k] exact from one
+/// hyper-dual evaluation of the direct kinematics at `s + eps1 s' + eps2 e_k` per slider.
+struct Sensitivity {
+    d_ag: [[f64; 2]; 3],
+    d_thd: [f64; 3],
+    d_thdd: [f64; 3],
+}
+
+fn sensitivity(params: &RobotParams, s: [f64; 3], sd: [f64; 3], gp: f64, t: f64) -> Result<Sensitivity, AmmError> {
+    let mut out = Sensitivity {
+        d_ag: [[0.0; 2]; 3],
+        d_thd: [0.0; 3],
+        d_thdd: [0.0; 3],
+    };
+    for k in 0..3 {
+        let sv = [0, 1, 2].map(|i| HyperDual64::new(s[i], sd[i], if i == k { 1.0 } else { 0.0 }, 0.0));
+        let pose = direct_kinematics(params.d, sv).ok_or_else(|| AmmError::Kinematics {
+            t,
+            source: flexstar_kinematics::KinematicsError::NoSolution {
+                t,
+                reason: "no Fermat point at the sliders' configuration".into(),
+            },
+        })?;
+        let (gx, gy, th) = (pose.g[0], pose.g[1], pose.theta);
+        // eps2: J e_k; eps1eps2: H[s', e_k]
+        out.d_ag[k] = [gx.eps2 + 2.0 * gp * gx.eps1eps2, gy.eps2 + 2.0 * gp * gy.eps1eps2];
+        out.d_thdd[k] = th.eps2 + 2.0 * gp * th.eps1eps2;
+        out.d_thd[k] = gp * th.eps2;
+    }
+    Ok(out)
+}
+
+/// Buffers of the coupled step: the base solution and one sensitivity per slider.
+struct Coupled {
+    qdd0: Vec<f64>,
+    lam0: Vec<f64>,
+    dqdd: [Vec<f64>; 3],
+    dlam: [Vec<f64>; 3],
+    qnew: Vec<f64>,
+}
+
+/// One coupled step (module docs): returns s'' and writes q'' and `sys.lam`. `shat`, `sdhat`:
+/// the sliders' predictors; `x_pred`: the predicted s''.
+#[allow(clippy::too_many_arguments)]
+fn coupled_step(
+    sys: &mut System,
+    rec: &Recorder,
+    buf: &mut Coupled,
+    law: &dyn ActuatorLaw,
+    params: &RobotParams,
+    t: f64,
+    (bp, gp): (f64, f64),
+    (shat, sdhat, x_pred): ([f64; 3], [f64; 3], [f64; 3]),
+    (qhat, vhat): (&[f64], &[f64]),
+    qdd: &mut [f64],
+) -> Result<[f64; 3], AmmError> {
+    let s = [0, 1, 2].map(|i| shat[i] + bp * x_pred[i]);
+    let sd = [0, 1, 2].map(|i| sdhat[i] + gp * x_pred[i]);
+    check_configuration(params, s).map_err(|violation| Infeasible { t, violation })?;
+    let st = rigid_at(params, s, sd, x_pred, t)?;
+    let sens = sensitivity(params, s, sd, gp, t)?;
+
+    // base solution at the predictor, then the sensitivities with the same factors
+    sys.prepare(&st, bp, gp, qhat)?;
+    sys.forcing(&st, qhat, vhat);
+    sys.solve_prepared(bp, Some(qhat), &mut buf.qdd0);
+    buf.lam0.copy_from_slice(&sys.lam);
+    for (qn, (qh, a)) in buf.qnew.iter_mut().zip(qhat.iter().zip(&buf.qdd0)) {
+        *qn = qh + bp * a;
+    }
+    for k in 0..3 {
+        sys.forcing_derivative(&st, sens.d_ag[k], sens.d_thd[k], sens.d_thdd[k], qhat, vhat);
+        sys.solve_prepared(bp, None, &mut buf.dqdd[k]);
+        buf.dlam[k].copy_from_slice(&sys.lam);
+    }
+
+    // Eq. 33 for the correction ds'': (m + kp bp + kd gp) ds'' + dPush/ds'' ds'' = residual
+    let fa = law.force(t, s, sd).map_err(|source| AmmError::Drive { t, source })?;
+    let (kp, kd) = (law.stiffness(), law.damping());
+    let m = params.mpp_mpa;
+    let mut a = [[0.0; 4]; 3];
+    for (i, row) in a.iter_mut().enumerate() {
+        for (k, dlam) in buf.dlam.iter().enumerate() {
+            row[k] = rec.sleeve_push(i, &st, &buf.qnew, dlam, &sys.sleeve_axial);
+        }
+        row[i] += m + kp[i] * bp + kd[i] * gp;
+        row[3] = fa[i] - m * x_pred[i] - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, &sys.sleeve_axial);
+    }
+    let dx = solve3(a).ok_or_else(|| AmmError::SingularConstraints {
+        t,
+        reason: "the sliders' equations (Eq. 33) are singular".into(),
+    })?;
+
+    qdd.copy_from_slice(&buf.qdd0);
+    sys.lam.copy_from_slice(&buf.lam0);
+    for ((dxk, dq), dl) in dx.iter().zip(&buf.dqdd).zip(&buf.dlam) {
+        for (q, d) in qdd.iter_mut().zip(dq) {
+            *q += dxk * d;
+        }
+        for (l, d) in sys.lam.iter_mut().zip(dl) {
+            *l += dxk * d;
+        }
+    }
+    sys.set_axial_acceleration(qdd);
+    Ok([0, 1, 2].map(|i| x_pred[i] + dx[i]))
+}
+
+/// Gaussian elimination with partial pivoting of a 3 x 3 system given as augmented rows.
+fn solve3(mut a: [[f64; 4]; 3]) -> Option<[f64; 3]> {
+    for k in 0..3 {
+        let p = (k..3).max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))?;
+        a.swap(k, p);
+        if a[k][k].abs() < 1e-300 || !a[k][k].is_finite() {
+            return None;
+        }
+        let pivot = a[k];
+        for row in a.iter_mut().skip(k + 1) {
+            let f = row[k] / pivot[k];
+            for (x, p) in row.iter_mut().zip(pivot).skip(k) {
+                *x -= f * p;
+            }
+        }
+    }
+    let mut x = [0.0; 3];
+    for k in (0..3).rev() {
+        let mut v = a[k][3];
+        for c in k + 1..3 {
+            v -= a[k][c] * x[c];
+        }
+        x[k] = v / a[k][k];
+    }
+    Some(x)
+}
+
+/// [`solve_direct`] at N = `n_modes`.
+fn integrate_direct(
+    exp: &Experiment,
+    settings: &AmmSettings,
+    law: &dyn ActuatorLaw,
+    n_modes: usize,
+) -> Result<Response, AmmError> {
+    let started = std::time::Instant::now();
+    let scan = exp.drive.kind == DriveKind::Servo;
+    let dt_max = validate(exp, settings, n_modes, scan)?;
+    let params = &exp.robot;
+    let modes = ModeSet::new(settings.family, n_modes, params)?;
+    let mut sys = System::new(modes, params, settings.model);
+    let n = sys.dim();
+
+    let out_times = exp.time.output_times();
+    let mut snaps: Vec<f64> = settings.snapshots.clone();
+    snaps.push(exp.time.t_end);
+    snaps.sort_by(|a, b| a.total_cmp(b));
+    snaps.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * exp.time.dt_out);
+    let stops = stops(&out_times, &snaps, 1e-9 * exp.time.dt_out);
+    let mut rec = Recorder::new(&sys, settings, params, out_times.len(), &snaps);
+    let mut cols: Vec<Vec<f64>> = (0..DIRECT_COLUMNS.len())
+        .map(|_| Vec::with_capacity(out_times.len()))
+        .collect();
+    let mut buf = Coupled {
+        qdd0: vec![0.0; n],
+        lam0: vec![0.0; sys.lam.len()],
+        dqdd: std::array::from_fn(|_| vec![0.0; n]),
+        dlam: std::array::from_fn(|_| vec![0.0; sys.lam.len()]),
+        qnew: vec![0.0; n],
+    };
+
+    let ga = GenAlpha::new(RHO_INF);
+    let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+
+    // initial state: s, s' of the trajectory at t = 0, the star at rest elastically; consistent
+    // accelerations of both (bp = gp = 0: the step is linear, the solve exact)
+    let jets = exp.trajectory.jets(params, 0.0)?;
+    let (mut s, mut sd) = (jets.map(|j| j.v), jets.map(|j| j.d1));
+    let mut sdd = coupled_step(
+        &mut sys,
+        &rec,
+        &mut buf,
+        law,
+        params,
+        0.0,
+        (0.0, 0.0),
+        (s, sd, jets.map(|j| j.d2)),
+        (&q, &v),
+        &mut qdd,
+    )?;
+    acc.copy_from_slice(&qdd);
+    let mut sacc = sdd;
+
+    let mut record = |rec: &mut Recorder, sys: &System, stop, t: f64, q: &[f64], s, sd, sdd| -> Result<(), AmmError> {
+        check_configuration(params, s).map_err(|violation| Infeasible { t, violation })?;
+        let st = rigid_at(params, s, sd, sdd, t)?;
+        let fa = law.force(t, s, sd).map_err(|source| AmmError::Drive { t, source })?;
+        rec.record(&st, stop, q, &sys.lam, &sys.sleeve_axial, Some(fa));
+        if stop.output.is_some() {
+            let vals = [s[0], s[1], s[2], sd[0], sd[1], sd[2], st.g[0].v, st.g[1].v, st.theta.v];
+            for (c, x) in cols.iter_mut().zip(vals) {
+                c.push(x);
+            }
+        }
+        Ok(())
+    };
+    record(&mut rec, &sys, &stops[0], 0.0, &q, s, sd, sdd)?;
+
+    for w in stops.windows(2) {
+        let (t0, t1) = (w[0].t, w[1].t);
+        let nsub = (((t1 - t0) / dt_max) - 1e-9).ceil().max(1.0) as usize;
+        let h = (t1 - t0) / nsub as f64;
+        let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
+        let apq = ga.a_per_qdd();
+        let predict = |x: f64, xd: f64, xa: f64, xdd: f64| {
+            let ap = (ga.alpha_f * xdd - ga.alpha_m * xa) / (1.0 - ga.alpha_m);
+            let xh = x + h * xd + h * h * ((0.5 - ga.beta) * xa + ga.beta * ap);
+            let vh = xd + h * ((1.0 - ga.gamma) * xa + ga.gamma * ap);
+            (ap, xh, vh)
+        };
+        for k in 1..=nsub {
+            let t = if k == nsub { t1 } else { t0 + k as f64 * h };
+            for i in 0..n {
+                (a_part[i], qhat[i], vhat[i]) = predict(q[i], v[i], acc[i], qdd[i]);
+            }
+            let mut sa_part = [0.0; 3];
+            let (mut shat, mut sdhat) = ([0.0; 3], [0.0; 3]);
+            for i in 0..3 {
+                (sa_part[i], shat[i], sdhat[i]) = predict(s[i], sd[i], sacc[i], sdd[i]);
+            }
+            sdd = coupled_step(
+                &mut sys,
+                &rec,
+                &mut buf,
+                law,
+                params,
+                t,
+                (bp, gp),
+                (shat, sdhat, sdd),
+                (&qhat, &vhat),
+                &mut qdd,
+            )?;
+            let mut norm = 0.0;
+            for i in 0..n {
+                q[i] = qhat[i] + bp * qdd[i];
+                v[i] = vhat[i] + gp * qdd[i];
+                acc[i] = a_part[i] + apq * qdd[i];
+                norm += q[i].abs();
+            }
+            for i in 0..3 {
+                s[i] = shat[i] + bp * sdd[i];
+                sd[i] = sdhat[i] + gp * sdd[i];
+                sacc[i] = sa_part[i] + apq * sdd[i];
+                norm += s[i].abs() + sd[i].abs();
+            }
+            if !norm.is_finite() {
+                return Err(AmmError::NonFinite { t, dt: h });
+            }
+        }
+        record(&mut rec, &sys, &w[1], t1, &q, s, sd, sdd)?;
+    }
+
+    let mut resp = rec.finish(format!("amm-{}-direct", settings.family.name()));
+    let mut extra: Vec<flexstar_model::Column> = DIRECT_COLUMNS
+        .iter()
+        .zip(cols)
+        .map(|(name, values)| flexstar_model::Column {
+            name: name.to_string(),
+            values,
+        })
+        .collect();
+    extra.append(&mut resp.extra);
+    resp.extra = extra;
+    resp.info = RunInfo {
+        solver: "amm-direct".into(),
+        family: Some(settings.family.name().into()),
+        model: Some(settings.model.name().into()),
+        modes: Some(n_modes),
+        dt: dt_max,
+        wall_s: started.elapsed().as_secs_f64(),
+        ..RunInfo::default()
+    };
+    Ok(resp)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sensitivity_matches_finite_differences() {
+        // s' = sdhat + gp s'' (bp = 0, the terms the sensitivity drops): the derivatives of a_G,
+        // theta', theta'' with respect to s''_k against central differences
+        let params = RobotParams::paper();
+        let (s, sdhat, x, gp) = ([0.03, -0.02, 0.05], [0.4, -0.3, 0.6], [2.0, -1.0, 3.0], 0.05);
+        let state = |x: [f64; 3]| {
+            let sd = [0, 1, 2].map(|i| sdhat[i] + gp * x[i]);
+            let st = rigid_at(&params, s, sd, x, 0.0).unwrap();
+            [st.g[0].d2, st.g[1].d2, st.theta.d1, st.theta.d2]
+        };
+        let sd = [0, 1, 2].map(|i| sdhat[i] + gp * x[i]);
+        let sens = sensitivity(&params, s, sd, gp, 0.0).unwrap();
+        let h = 1e-4;
+        for k in 0..3 {
+            let (mut xp, mut xm) = (x, x);
+            xp[k] += h;
+            xm[k] -= h;
+            let (fp, fm) = (state(xp), state(xm));
+            let fd: [f64; 4] = std::array::from_fn(|c| (fp[c] - fm[c]) / (2.0 * h));
+            let an = [sens.d_ag[k][0], sens.d_ag[k][1], sens.d_thd[k], sens.d_thdd[k]];
+            for c in 0..4 {
+                assert!(
+                    (fd[c] - an[c]).abs() < 1e-7 * (1.0 + fd[c].abs()),
+                    "k {k} c {c}: {} vs {}",
+                    fd[c],
+                    an[c]
+                );
+            }
+            // the gp H[s', e_k] term matters here: J e_k alone is off
+            let j_only = rigid_at(
+                &params,
+                s,
+                std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 }),
+                [0.0; 3],
+                0.0,
+            )
+            .unwrap();
+            assert!(
+                (j_only.theta.d1 - fd[3]).abs() > 1e-4,
+                "k {k}: the test does not probe the cross term"
+            );
+        }
+    }
+}

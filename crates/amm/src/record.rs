@@ -1,0 +1,174 @@
+//! The outputs of an AMM run at its output times and snapshots (shared by the inverse run,
+//! [`crate::solve`], and the direct run, [`crate::solve_direct`]).
+
+use flexstar_kinematics::RigidState;
+use flexstar_model::geometry::slider_direction;
+use flexstar_model::{AmmModel, AmmSettings, BeamShape, Response, RobotParams, StarShape};
+
+use crate::solver::{Stop, EXTRA_COLUMNS, SHAPE_POINTS};
+use crate::system::{Row, System};
+
+/// Output buffers, sized once.
+pub(crate) struct Recorder {
+    resp: Response,
+    extra: Vec<Vec<f64>>,
+    xs: Vec<f64>,
+    shape_phi: Vec<Vec<f64>>,
+    shapes: Vec<StarShape>,
+    /// Multiplier index of each named multiplier column (`None`: row dropped for the family).
+    col_rows: [Option<usize>; 19],
+    phi0: Vec<f64>,
+    phil: Vec<f64>,
+    nm: usize,
+    nb: usize,
+    full: bool,
+    mpp_mpa: f64,
+}
+
+impl Recorder {
+    pub(crate) fn new(sys: &System, settings: &AmmSettings, params: &RobotParams, n_out: usize, snaps: &[f64]) -> Self {
+        let (nm, nb) = (sys.nm, sys.nb);
+        let extra: Vec<Vec<f64>> = (0..EXTRA_COLUMNS.len()).map(|_| Vec::with_capacity(n_out)).collect();
+        let xs: Vec<f64> = (0..SHAPE_POINTS)
+            .map(|k| params.l * k as f64 / (SHAPE_POINTS - 1) as f64)
+            .collect();
+        let shape_phi: Vec<Vec<f64>> = xs
+            .iter()
+            .map(|&x| {
+                let mut v = vec![0.0; nm];
+                sys.modes.values_at(x, &mut v, None);
+                v
+            })
+            .collect();
+        let shapes: Vec<StarShape> = snaps
+            .iter()
+            .map(|&t| StarShape {
+                t,
+                beams: std::array::from_fn(|_| BeamShape {
+                    x: xs.clone(),
+                    w: vec![0.0; SHAPE_POINTS],
+                    pos: vec![[0.0; 2]; SHAPE_POINTS],
+                }),
+            })
+            .collect();
+        let lam_index = |r: Row| sys.rows.iter().position(|x| *x == r);
+        let col_rows: [Option<usize>; 19] = [
+            lam_index(Row::Fix(0)),
+            lam_index(Row::Fix(1)),
+            lam_index(Row::Fix(2)),
+            lam_index(Row::M1G),
+            None, // M2G = -M1G - M3G (Eq. 25-1)
+            lam_index(Row::M3G),
+            lam_index(Row::Fw),
+            lam_index(Row::Fp(0)),
+            lam_index(Row::Fp(1)),
+            lam_index(Row::Fp(2)),
+            lam_index(Row::FL(0)),
+            lam_index(Row::FL(1)),
+            lam_index(Row::FL(2)),
+            lam_index(Row::FR(0)),
+            lam_index(Row::FR(1)),
+            lam_index(Row::FR(2)),
+            lam_index(Row::Mp(0)),
+            lam_index(Row::Mp(1)),
+            lam_index(Row::Mp(2)),
+        ];
+        Recorder {
+            resp: Response::with_capacity(String::new(), n_out),
+            extra,
+            xs,
+            shape_phi,
+            shapes,
+            col_rows,
+            phi0: sys.phi0.clone(),
+            phil: sys.phil.clone(),
+            nm,
+            nb,
+            full: settings.model == AmmModel::Full,
+            mpp_mpa: params.mpp_mpa,
+        }
+    }
+
+    /// The multiplier of named column `k` (0 when the row is dropped).
+    fn lam_of(&self, lam: &[f64], k: usize) -> f64 {
+        self.col_rows[k].map_or(0.0, |r| lam[r])
+    }
+
+    /// Eq. 33 without the slider's inertia: the component along `+u_i` of the force of sleeve i on
+    /// beam i [N], linear in the multipliers `lam`. Paper model: `(Fp + FL + FR) cos(theta + thp_i)`;
+    /// full model: along the forces its sleeve rows carry, each row's force on the beam being
+    /// `lambda (e_w + c_u e_x)` with `c_u` its u gradient (`axial`, -w').
+    pub(crate) fn sleeve_push(&self, i: usize, st: &RigidState, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]) -> f64 {
+        let (fp, fl, fr) = (
+            self.lam_of(lam, 7 + i),
+            self.lam_of(lam, 10 + i),
+            self.lam_of(lam, 13 + i),
+        );
+        if self.full {
+            let d = slider_direction(i);
+            let (ew, ex) = (st.e_w(i), st.e_x(i));
+            let (wd, xd) = (ew[0] * d[0] + ew[1] * d[1], ex[0] * d[0] + ex[1] * d[1]);
+            let [cp, cr, cl] = axial[i];
+            (fp + fl + fr) * wd + (fp * cp + fr * cr + fl * cl) * xd
+        } else {
+            let thp = q[i * self.nb + self.nm + 1];
+            (fp + fl + fr) * (st.theta.v + thp).cos()
+        }
+    }
+
+    /// Record the state at `stop`: a snapshot of the deformed star and/or an output row. `fa`:
+    /// the actuator forces to write (a direct run's law); `None` computes them by Eq. 33.
+    pub(crate) fn record(
+        &mut self,
+        st: &RigidState,
+        stop: &Stop,
+        q: &[f64],
+        lam: &[f64],
+        axial: &[[f64; 3]; 3],
+        fa: Option<[f64; 3]>,
+    ) {
+        let (nm, nb) = (self.nm, self.nb);
+        let beam_val =
+            |i: usize, coef: &[f64]| -> f64 { q[i * nb..i * nb + nm].iter().zip(coef).map(|(a, p)| a * p).sum() };
+        if let Some(s) = stop.snapshot {
+            let shape = &mut self.shapes[s];
+            for i in 0..3 {
+                let (ex, ew) = (st.e_x(i), st.e_w(i));
+                let u = q[i * nb + nm];
+                let b = &mut shape.beams[i];
+                for (k, phi) in self.shape_phi.iter().enumerate() {
+                    let w = beam_val(i, phi);
+                    let x = self.xs[k] + u;
+                    b.w[k] = w;
+                    b.pos[k] = [st.g[0].v + x * ex[0] + w * ew[0], st.g[1].v + x * ex[1] + w * ew[1]];
+                }
+            }
+        }
+        if stop.output.is_some() {
+            let w_g = [0, 1, 2].map(|i| beam_val(i, &self.phi0));
+            let w_tip = [0, 1, 2].map(|i| beam_val(i, &self.phil));
+            let fa = fa.unwrap_or_else(|| {
+                [0, 1, 2].map(|i| self.mpp_mpa * st.s[i].d2 + self.sleeve_push(i, st, q, lam, axial))
+            });
+            self.resp.push(st.t, w_g, w_tip, fa);
+            for k in 0..self.extra.len() {
+                let val = match k {
+                    4 => -self.lam_of(lam, 3) - self.lam_of(lam, 5),
+                    0..=18 => self.lam_of(lam, k),
+                    19..=21 => q[(k - 19) * nb + nm + 1],
+                    _ => q[(k - 22) * nb + nm],
+                };
+                self.extra[k].push(val);
+            }
+        }
+    }
+
+    /// The response labelled `label`, with the columns [`EXTRA_COLUMNS`] and the snapshots.
+    pub(crate) fn finish(self, label: String) -> Response {
+        let mut resp = self.resp;
+        resp.label = label;
+        resp.set_extra(&EXTRA_COLUMNS, self.extra);
+        resp.shapes = self.shapes;
+        resp
+    }
+}

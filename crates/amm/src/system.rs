@@ -599,13 +599,15 @@ impl System {
         let (nm, nb) = (self.nm, self.nb);
         let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp);
         self.rhs.iter_mut().for_each(|v| *v = 0.0);
-        let beams = std::mem::take(&mut self.beams);
+        // disjoint borrows of the fields (no copy of the beams' workspaces)
+        let (beams, resid, dinv_r, rhs) = (&self.beams, &self.resid, &mut self.dinv_r, &mut self.rhs);
+        let (w, inv_d, phi0, dphi0) = (&self.w, &self.inv_d, &self.phi0, &self.dphi0);
         for (i, beam) in beams.iter().enumerate() {
             let o = i * nb;
             // c_k . S^-1 r = ca_k D^-1 r_a + (cu_k - p g_k) y_r + ct_k r_thp / Jp, and c_k . qhat
-            let r = &self.resid[o..o + nb];
-            let y_r = (r[nm] + p * dot(&self.w, &r[..nm])) * inv_sigma;
-            for ((d, x), di) in self.dinv_r.iter_mut().zip(&r[..nm]).zip(&self.inv_d) {
+            let r = &resid[o..o + nb];
+            let y_r = (r[nm] + p * dot(w, &r[..nm])) * inv_sigma;
+            for ((d, x), di) in dinv_r.iter_mut().zip(&r[..nm]).zip(inv_d) {
                 *d = x * di;
             }
             let mut bdr = [0.0; NB];
@@ -614,11 +616,11 @@ impl System {
             for a in 0..NB {
                 if used(a) {
                     let v = match a {
-                        B_PHI0 => &self.phi0,
-                        B_DPHI0 => &self.dphi0,
+                        B_PHI0 => phi0,
+                        B_DPHI0 => dphi0,
                         _ => &beam.sleeve[a - B_MID],
                     };
-                    bdr[a] = dot(v, &self.dinv_r);
+                    bdr[a] = dot(v, dinv_r);
                     if let Some(qh) = qhat {
                         bq[a] = dot(v, &qh[o..o + nm]);
                     }
@@ -641,10 +643,9 @@ impl System {
                     }
                     _ => 0.0,
                 };
-                self.rhs[beam.ids[k]] -= cz + cq;
+                rhs[beam.ids[k]] -= cz + cq;
             }
         }
-        self.beams = beams;
         lu_apply(&self.a, &self.piv, &mut self.rhs, self.rows.len());
         self.lam.copy_from_slice(&self.rhs);
 

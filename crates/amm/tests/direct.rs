@@ -170,3 +170,21 @@ fn leaving_the_feasible_range_stops_with_time_and_reason() {
     }
     assert!(msg.contains("t = 0."), "{msg}");
 }
+
+#[test]
+fn automatic_n_runs_the_direct_problem_too() {
+    // tol mode (the accurate defaults: enriched, full, tol 0.5 %): the direct run driven by the
+    // inverse run's forces (every solver step) picks the same N and gives the same vibration
+    let mut exp = case(3, 0.1, DEFAULT_DT);
+    exp.amm = AmmSettings::accurate();
+    let inverse = solve(&exp, &exp.amm).unwrap();
+    let direct = solve_direct(&exp, &exp.amm, &table(&inverse)).unwrap();
+    assert_eq!(direct.info.modes, inverse.info.modes);
+    assert!(direct.info.error_estimate_percent.is_some());
+    assert_eq!(direct.info.solver, "amm-direct");
+    let evp = point_evps(&direct, &inverse).unwrap();
+    let worst = evp.points.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
+    eprintln!("N = {:?}, worst point EVP {worst:.2e} %", direct.info.modes);
+    assert!(worst < 0.1, "{worst} %");
+    assert!(slider_error(&exp, &direct) < 1e-6);
+}

@@ -233,6 +233,28 @@ fn direct_runs_write_the_contracted_tables() {
         .collect();
     assert!((last[1] - 0.05f64 * 0.05).abs() < 1e-5, "s1(0.05) = {}", last[1]);
     assert!(out.join("case1").join("amm-pinned-free-direct.json").exists());
+    // the FEM driven by the same forces: the same leading columns
+    let o = flexstar(&[
+        "run",
+        &cfg,
+        "--solver",
+        "fem",
+        "--elements",
+        "108",
+        "--forces",
+        inverse.to_str().unwrap(),
+        "--out",
+        out_s,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(out.join("case1").join("fem-direct.csv")).unwrap();
+    assert!(
+        text.starts_with("t,s1,s2,s3,w1G,w2G,w3G,w1tip,w2tip,w3tip,Fa1,Fa2,Fa3,Gx,Gy,theta,"),
+        "{}",
+        text.lines().next().unwrap()
+    );
+    assert_eq!(text.lines().count(), 1 + 51);
+    assert!(out.join("case1").join("fem-direct.json").exists());
 
     let servo = write(
         dir.path(),

@@ -63,14 +63,13 @@ pub struct Args {
     out: PathBuf,
 }
 
-/// The FEM's direct dynamics (issue 10). Wiring point: `flexstar_fem::solve_direct(exp,
-/// &exp.fem, law, progress)` takes this place once it is on main.
+/// The FEM's direct dynamics (issue 10): each slider a body on its rail pushed by the law.
 fn fem_direct(
-    _exp: &flexstar_model::Experiment,
-    _law: &dyn flexstar_drive::ActuatorLaw,
-    _progress: Option<&(dyn Fn(f64) + Sync)>,
+    exp: &flexstar_model::Experiment,
+    law: &dyn flexstar_drive::ActuatorLaw,
+    progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> anyhow::Result<Response> {
-    bail!("the FEM's direct dynamics (forces or servo drive) is not available in this build; use --solver amm")
+    Ok(flexstar_fem::solve_direct(exp, &exp.fem, law, progress)?)
 }
 
 /// Columns a direct run's file puts right after the fixed ones (issue 10 contract).

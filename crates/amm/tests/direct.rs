@@ -188,3 +188,42 @@ fn automatic_n_runs_the_direct_problem_too() {
     assert!(worst < 0.1, "{worst} %");
     assert!(slider_error(&exp, &direct) < 1e-6);
 }
+
+#[test]
+fn stiff_limit_matches_the_rigid_forward_dynamics() {
+    // EI x 1e4: under the rigid inverse dynamics' forces of each paper motion, the AMM's sliders
+    // must move as the rigid robot's forward dynamics says (flexstar-drive: virtual power on the
+    // Fermat-point Jacobians, RK4 at 1e-4 s; no AMM code). Paper model, free-free modes: the
+    // family whose rigid modes let G move freely (docs/amm.md section 4). Measured: 5.5e-8 to
+    // 1.1e-7 m over travels of 0.16-0.25 m.
+    use flexstar_drive::{rigid_forward_dynamics, RigidInverseForces};
+    for k in 1..=4 {
+        let mut exp = paper_case(k);
+        exp.robot.i *= 1e4;
+        let robot = exp.robot;
+        let law = RigidInverseForces {
+            trajectory: exp.trajectory.clone(),
+            params: robot,
+        };
+        let settings = AmmSettings::paper(flexstar_model::ModeFamily::FreeFree, 25);
+        let r = solve_direct(&exp, &settings, &law).unwrap();
+        let s0 = exp.trajectory.s(&robot, 0.0).unwrap();
+        let v0 = exp.trajectory.jets(&robot, 0.0).unwrap().map(|j| j.d1);
+        let reference = rigid_forward_dynamics(&robot, s0, v0, &law, exp.time.t_end, exp.time.dt_out, 1e-4).unwrap();
+        assert_eq!(reference.len(), r.len());
+        let (mut worst, mut travel) = (0.0f64, 0.0f64);
+        for (n, rs) in reference.iter().enumerate() {
+            for i in 0..3 {
+                let s = r.column(["s1", "s2", "s3"][i]).unwrap()[n];
+                worst = worst.max((s - rs.s[i]).abs());
+                travel = travel.max((s - s0[i]).abs());
+            }
+        }
+        eprintln!("case {k} stiff limit: largest |s_amm - s_rigid| {worst:.2e} m over a travel of {travel:.3} m");
+        assert!(travel > 1e-2, "case {k}: the motion must be visible");
+        assert!(
+            worst < 1e-6,
+            "case {k}: stiff AMM {worst:e} m off the rigid forward dynamics"
+        );
+    }
+}

@@ -13,6 +13,7 @@ pub mod behaviour;
 pub mod builtin;
 pub mod case_output;
 pub mod compare;
+pub mod direct_figures;
 pub mod evp;
 pub mod figures;
 pub mod paper;

@@ -58,6 +58,10 @@ pub struct Args {
     /// starts with t and names Fa1, Fa2, Fa3, e.g. a solver output; replaces the config's [drive]
     #[arg(long, value_name = "FILE")]
     forces: Option<PathBuf>,
+    /// Also draw figures (SVG and PNG) in DIR/<name>/figures/: for a direct run the sliders
+    /// against the [trajectory], the servo's tracking errors, the tips and the forces
+    #[arg(long)]
+    figures: bool,
     /// Output directory
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -70,6 +74,39 @@ fn fem_direct(
     progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> anyhow::Result<Response> {
     Ok(flexstar_fem::solve_direct(exp, &exp.fem, law, progress)?)
+}
+
+/// `--figures`: a direct run's four figures, or the tips and forces of an inverse run.
+fn write_figures(
+    exp: &Experiment,
+    stem: &str,
+    r: &Response,
+    direct: bool,
+    dir: &std::path::Path,
+) -> anyhow::Result<()> {
+    use flexstar_compare::direct_figures::{direct_figures, run_style};
+    use flexstar_compare::figures::{figure_forces, figure_tips, Run};
+    let figs = if direct {
+        direct_figures(exp, stem, r)
+    } else {
+        let runs = [Run {
+            label: stem.to_string(),
+            response: r,
+            style: run_style(r),
+        }];
+        let mut v = vec![figure_tips(&exp.name, &runs), figure_forces(&exp.name, &runs, None)];
+        for (f, kind) in v.iter_mut().zip(["tips", "forces"]) {
+            f.name = format!("{stem}-{kind}");
+        }
+        v
+    };
+    let figdir = dir.join("figures");
+    std::fs::create_dir_all(&figdir).map_err(|e| anyhow!("{}: {e}", figdir.display()))?;
+    for f in &figs {
+        f.write(&figdir)?;
+    }
+    eprintln!("{}: {} figures in {}", exp.name, figs.len(), figdir.display());
+    Ok(())
 }
 
 /// Columns a direct run's file puts right after the fixed ones (issue 10 contract).
@@ -192,6 +229,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     response.write_shapes_csv(&dir.join(format!("{file}-shapes.csv")))?;
     response.write_sidecar(&dir.join(format!("{file}.json")), &exp, &super::provenance())?;
+    if args.figures {
+        write_figures(&exp, &file, &response, direct, &dir)?;
+    }
     if let Some(v) = small_deflection_check(&response, exp.robot.l) {
         eprintln!("warning: {cfg}: {file} {v}");
     }

@@ -525,3 +525,34 @@ fn small_deflection_range_is_reported_with_the_time() {
         "{sidecar}"
     );
 }
+
+#[test]
+fn a_servo_run_with_figures_draws_sliders_tracking_tips_and_forces() {
+    let out = tempfile::tempdir().unwrap();
+    let cfg = root().join("configs/servo/case4-servo.toml");
+    let o = flexstar(&[
+        "run",
+        cfg.to_str().unwrap(),
+        "--solver",
+        "amm",
+        "--modes",
+        "25",
+        "--figures",
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let dir = out.path().join("case4-servo");
+    let header = std::fs::read_to_string(dir.join("amm-enriched-direct.csv")).unwrap();
+    assert!(header.starts_with("t,s1,s2,s3,w1G,w2G,w3G,w1tip,w2tip,w3tip,Fa1,Fa2,Fa3,Gx,Gy,theta,e1,e2,e3"));
+    for kind in ["sliders", "tracking", "tips", "forces"] {
+        for ext in ["svg", "png"] {
+            let f = dir.join(format!("figures/amm-enriched-direct-{kind}.{ext}"));
+            assert!(
+                f.metadata().map(|m| m.len() > 1000).unwrap_or(false),
+                "{} missing",
+                f.display()
+            );
+        }
+    }
+}

@@ -97,6 +97,54 @@ pub enum RunError {
     },
 }
 
+/// Why a solver run of an experiment failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    #[error(transparent)]
+    Amm(#[from] flexstar_amm::AmmError),
+    #[error(transparent)]
+    Fem(#[from] flexstar_fem::FemError),
+    #[error(transparent)]
+    Drive(#[from] flexstar_drive::DriveError),
+}
+
+/// The AMM run of `exp` with `settings`, for the experiment's drive: the inverse problem (motion
+/// prescribed, `flexstar_amm::solve`) or the direct one (forces or a servo,
+/// `flexstar_amm::solve_direct`; a servo's run gains the tracking errors `e1..e3`).
+pub fn solve_amm(exp: &Experiment, settings: &AmmSettings) -> Result<Response, SolveError> {
+    match flexstar_drive::law_for(exp)? {
+        None => Ok(flexstar_amm::solve(exp, settings)?),
+        Some(law) => {
+            let mut r = flexstar_amm::solve_direct(exp, settings, law.as_ref())?;
+            add_servo_columns(exp, &mut r)?;
+            Ok(r)
+        }
+    }
+}
+
+/// The FEM run of `exp` with `settings` for the experiment's drive (see [`solve_amm`]).
+pub fn solve_fem(
+    exp: &Experiment,
+    settings: &flexstar_model::FemSettings,
+    progress: Option<&(dyn Fn(f64) + Sync)>,
+) -> Result<Response, SolveError> {
+    match flexstar_drive::law_for(exp)? {
+        None => Ok(flexstar_fem::solve(exp, settings, progress)?),
+        Some(law) => {
+            let mut r = flexstar_fem::solve_direct(exp, settings, law.as_ref(), progress)?;
+            add_servo_columns(exp, &mut r)?;
+            Ok(r)
+        }
+    }
+}
+
+fn add_servo_columns(exp: &Experiment, r: &mut Response) -> Result<(), flexstar_drive::DriveError> {
+    if exp.drive.kind == flexstar_model::DriveKind::Servo {
+        flexstar_drive::add_tracking_errors(r, exp)?;
+    }
+    Ok(())
+}
+
 /// Progress of a batch of runs, as reported to the caller's callback.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Progress {
@@ -200,6 +248,24 @@ impl Tracker<'_> {
     }
 }
 
+fn run_error(file: String, label: &str, e: SolveError) -> RunError {
+    match e {
+        SolveError::Amm(source) => RunError::Amm {
+            file,
+            label: label.to_string(),
+            source: Box::new(source),
+        },
+        SolveError::Fem(source) => RunError::Fem {
+            file,
+            source: Box::new(source),
+        },
+        SolveError::Drive(e) => RunError::Input {
+            file,
+            reason: e.to_string(),
+        },
+    }
+}
+
 /// Run every FEM and AMM run of `specs` in parallel, after [`preflight`]. Results come back in
 /// the order of `specs`.
 pub fn run_cases(specs: &[CaseSpec], progress: Option<ProgressFn>) -> Result<Vec<CaseResults>, RunError> {
@@ -234,21 +300,14 @@ pub fn run_cases(specs: &[CaseSpec], progress: Option<ProgressFn>) -> Result<Vec
                 Job::Fem(k) => {
                     let exp = &specs[k].exp;
                     let tick = |f: f64| tracker.set(j, f, false);
-                    flexstar_fem::solve(exp, &exp.fem, Some(&tick)).map_err(|source| RunError::Fem {
-                        file: file(k),
-                        source: Box::new(source),
-                    })
+                    solve_fem(exp, &exp.fem, Some(&tick)).map_err(|e| run_error(file(k), "fem", e))
                 }
                 Job::Amm(k, i) | Job::Extra(k, i) => {
                     let run = match job {
                         Job::Amm(..) => &specs[k].amm[i],
                         _ => &specs[k].extra[i],
                     };
-                    flexstar_amm::solve(&specs[k].exp, &run.settings).map_err(|source| RunError::Amm {
-                        file: file(k),
-                        label: run.label.clone(),
-                        source: Box::new(source),
-                    })
+                    solve_amm(&specs[k].exp, &run.settings).map_err(|e| run_error(file(k), &run.label, e))
                 }
             }?;
             tracker.set(j, 1.0, true);

@@ -223,8 +223,8 @@ type Solved = (Result<Response, String>, f64);
 fn solve(exp: &Experiment, solver: Solver) -> Solved {
     let started = Instant::now();
     let result = catch_unwind(AssertUnwindSafe(|| match solver {
-        Solver::Amm => flexstar_amm::solve(exp, &exp.amm).map_err(|e| e.to_string()),
-        Solver::Fem => flexstar_fem::solve(exp, &exp.fem, None).map_err(|e| e.to_string()),
+        Solver::Amm => flexstar_compare::runs::solve_amm(exp, &exp.amm).map_err(|e| e.to_string()),
+        Solver::Fem => flexstar_compare::runs::solve_fem(exp, &exp.fem, None).map_err(|e| e.to_string()),
     }));
     let result = match result {
         Ok(Ok(r)) => Ok(r),

@@ -17,7 +17,8 @@
 //! eigenproblem (faer), `X = Q Z`. Stops when the requested Ritz values change by less than
 //! [`TOL`] relative in one iteration.
 
-use faer::{Mat, Side};
+use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::{Mat, MatRef, Par, Side};
 use flexstar_numerics::eigen::ConstrainedModes;
 
 use crate::sparse::SparseLu;
@@ -25,8 +26,9 @@ use crate::sparse::SparseLu;
 /// Relative change of the requested Ritz values `omega^2 + sigma` in one iteration below which
 /// they count as converged: above their round-off floor (1e-9 to 3e-9 relative for the robot at
 /// 150 elements, from the bordered system's condition: axial `EA/h` against `rho h omega^2`).
-/// Ritz values converge twice as fast as the vectors, so the iteration then runs as many
-/// iterations again for the shapes.
+/// Ritz values converge twice as fast as the vectors, so the iteration then runs half as many
+/// iterations again (plus one) for the shapes: they then lie in the dense path's span to 1e-10
+/// (M-norm), their round-off floor (test `sparse_and_dense_paths_agree`).
 pub const TOL: f64 = 1e-8;
 /// A Ritz value whose change is below this (relative) and no longer decreases geometrically
 /// (at least 0.3 of the previous change) has reached its round-off floor: converged. (With a
@@ -124,59 +126,38 @@ pub fn sparse_constrained_modes(
     let (d, m, bordered) = scaled_system(n, m, k, c, rows, shift)?;
     let m = &m;
     let mut lu = bordered_lu(n + rows, &bordered)?;
-    // y = Op x: one solve and one step of iterative refinement on the bordered system
-    let apply = |lu: &mut SparseLu, x: &[f64]| -> Vec<f64> {
-        let mut b = vec![0.0; n + rows];
-        mul(m, x, &mut b[..n]);
-        let mut y = b.clone();
-        lu.solve(&mut y);
-        let mut r = vec![0.0; n + rows];
-        mul(&bordered, &y, &mut r);
-        r.iter_mut().zip(&b).for_each(|(ri, bi)| *ri = bi - *ri);
-        lu.solve(&mut r);
-        y.iter_mut().zip(&r).for_each(|(yi, ri)| *yi += ri);
-        y.truncate(n);
-        y
-    };
-    let mut x = start_vectors(n, p);
+    let np = n + rows;
+    // X (n x p), column-major
+    let mut x: Vec<f64> = start_vectors(n, p).concat();
     let mut prev: Vec<f64> = vec![f64::INFINITY; count];
     let mut prev_change: Vec<f64> = vec![f64::INFINITY; count];
     let mut stop_at = None;
     for it in 0..MAX_ITER {
-        let mut y: Vec<Vec<f64>> = x.iter().map(|xj| apply(&mut lu, xj)).collect();
+        let mut mx = vec![0.0; n * p];
+        for (xj, mxj) in x.chunks_exact(n).zip(mx.chunks_exact_mut(n)) {
+            mul(m, xj, mxj);
+        }
+        let y = apply(&mut lu, &bordered, &mx, n, np, p);
+        let mut y: Vec<Vec<f64>> = y.chunks_exact(np).map(|c| c[..n].to_vec()).collect();
         if y.iter().flatten().any(|v| !v.is_finite()) {
             return Err("the bordered system K + sigma M with the constraints is singular".into());
         }
         let r = m_orthonormalise(m, &mut y)?;
-        // (K + sigma M) Q = M X R^-1
-        let mut mx = Mat::<f64>::zeros(n, p);
-        let mut tmp = vec![0.0; n];
-        for (j, xj) in x.iter().enumerate() {
-            mul(m, xj, &mut tmp);
-            mx.col_mut(j).iter_mut().zip(&tmp).for_each(|(a, b)| *a = *b);
-        }
-        let mut aq_t = mx.transpose().to_owned();
-        faer::linalg::triangular_solve::solve_lower_triangular_in_place(r.transpose(), aq_t.as_mut(), faer::Par::Seq);
+        let q = Mat::from_fn(n, p, |i, j| y[j][i]);
+        // (K + sigma M) Q = M X R^-1, transposed: R^T (A Q)^T = (M X)^T
+        let mut aq_t = MatRef::from_column_major_slice(&mx, n, p).transpose().to_owned();
+        solve_lower_triangular_in_place(r.transpose(), aq_t.as_mut(), Par::Seq);
         // projected stiffness Q^T A Q (p x p), symmetrised
-        let kr = Mat::from_fn(p, p, |i, j| {
-            y[i].iter().zip(aq_t.row(j).iter()).map(|(a, b)| a * b).sum::<f64>()
-        });
+        let kr = &aq_t * &q;
         let kr = Mat::from_fn(p, p, |i, j| 0.5 * (kr[(i, j)] + kr[(j, i)]));
         let eig = kr
             .self_adjoint_eigen(Side::Lower)
             .map_err(|e| format!("projected eigenproblem failed ({e:?})"))?;
         let theta: Vec<f64> = (0..p).map(|j| eig.S()[j]).collect();
-        let z = eig.U();
-        x = (0..p)
-            .map(|j| {
-                let mut v = vec![0.0; n];
-                for (i, yi) in y.iter().enumerate() {
-                    let zij = z[(i, j)];
-                    v.iter_mut().zip(yi).for_each(|(a, b)| *a += zij * b);
-                }
-                v
-            })
-            .collect();
+        let xm = &q * eig.U();
+        for (j, xj) in x.chunks_exact_mut(n).enumerate() {
+            xj.iter_mut().zip(xm.col(j).iter()).for_each(|(a, b)| *a = *b);
+        }
         // rigid modes (theta = sigma) are resolved to the precision of the first elastic one
         let floor = TOL * theta.iter().copied().find(|&t| t > 2.0 * shift).unwrap_or(0.0);
         let mut converged = true;
@@ -189,21 +170,41 @@ pub fn sparse_constrained_modes(
         }
         prev.copy_from_slice(&theta[..count]);
         if converged && stop_at.is_none() {
-            stop_at = Some(2 * it + 1);
+            stop_at = Some(it + 1 + it / 2);
         }
         if stop_at == Some(it) {
-            x.truncate(count);
-            for xj in x.iter_mut() {
-                xj.iter_mut().zip(&d).for_each(|(a, b)| *a *= b);
-            }
+            let shapes = x
+                .chunks_exact(n)
+                .take(count)
+                .map(|xj| xj.iter().zip(&d).map(|(a, b)| a * b).collect())
+                .collect();
             return Ok(ConstrainedModes {
                 omega2: theta[..count].iter().map(|t| t - shift).collect(),
-                shapes: x,
+                shapes,
                 rank: rows,
             });
         }
     }
     Err(format!("subspace iteration did not converge in {MAX_ITER} iterations"))
+}
+
+/// `Y = Op X` for the p columns of `M X` (`mx`, n x p column-major): the bordered solve with one
+/// step of iterative refinement; returns the (n + rows) x p solutions, column-major.
+fn apply(lu: &mut SparseLu, bordered: &Triplets, mx: &[f64], n: usize, np: usize, p: usize) -> Vec<f64> {
+    let mut b = vec![0.0; np * p];
+    for (bj, mxj) in b.chunks_exact_mut(np).zip(mx.chunks_exact(n)) {
+        bj[..n].copy_from_slice(mxj);
+    }
+    let mut y = b.clone();
+    lu.solve_many(&mut y, p);
+    let mut r = vec![0.0; np * p];
+    for ((rj, yj), bj) in r.chunks_exact_mut(np).zip(y.chunks_exact(np)).zip(b.chunks_exact(np)) {
+        mul(bordered, yj, rj);
+        rj.iter_mut().zip(bj).for_each(|(ri, bi)| *ri = bi - *ri);
+    }
+    lu.solve_many(&mut r, p);
+    y.iter_mut().zip(&r).for_each(|(yi, ri)| *yi += ri);
+    y
 }
 
 /// Jacobi scaling `q = D q~` (`D_ii = 1/sqrt(M_ii)`, 1 for massless coordinates) and constraint

@@ -332,8 +332,8 @@ mod tests {
     /// The sparse subspace iteration reproduces the dense null-space solution: omega^2 within
     /// 1e-7 relative to the first elastic one, and every sparse shape lies in the span of the dense
     /// shapes (M-projection, as the pairs of equal frequencies make single shapes arbitrary within
-    /// their pair). 150 elements, an off-centre pose, sliders locked and free. Measured: 6e-9
-    /// locked, 4.5e-8 free; that is the round-off floor of the problem (axial EA/h against the
+    /// their pair). 150 elements, an off-centre pose, sliders locked and free. Measured: omega^2
+    /// 6e-9 locked, 4.5e-8 free; shapes 2e-11 and 4e-10 (M-norm). That is the round-off floor of the problem (axial EA/h against the
     /// bending frequencies), not a convergence error: the dense path itself moves by 3e-8 when its
     /// shift goes from (2 pi 0.1 Hz)^2 to 50 1/s^2, and the sparse iterates jitter by 1e-9.
     #[test]

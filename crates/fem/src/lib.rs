@@ -20,6 +20,7 @@ mod bordered;
 pub mod element;
 pub mod error;
 mod integrator;
+pub mod modal_solver;
 pub mod pose_modes;
 mod solve;
 mod sparse;

@@ -92,6 +92,16 @@ impl SparseLu {
         Ok(())
     }
 
+    /// Solve `A X = B` in place for `ncols` right-hand sides stored column-major in `rhs`
+    /// (`n x ncols`) with the last factorisation.
+    pub fn solve_many(&mut self, rhs: &mut [f64], ncols: usize) {
+        assert!(self.factored, "solve before factor");
+        let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(&self.lu_symbolic, &self.numeric);
+        let mut mem = MemBuffer::new(self.lu_symbolic.solve_in_place_scratch::<f64>(ncols, Par::Seq));
+        let m = MatMut::from_column_major_slice_mut(rhs, self.n, ncols);
+        lu.solve_in_place_with_conj(faer::Conj::No, m, Par::Seq, MemStack::new(&mut mem));
+    }
+
     /// Solve `A x = rhs` in place with the last factorisation.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         assert!(self.factored, "solve before factor");

@@ -19,6 +19,8 @@
 //! sleeve rows of Eqs. 41-42 (`w_i(xp_i + e) - e thp_i - ds_i cos(theta) = 0`); its axial component
 //! slides the sleeve along the beam, which is free at rest.
 
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, Par};
 use flexstar_model::{AmmModel, ModeFamily, RestPose, RobotParams, Sliders};
 use flexstar_numerics::eigen::{constrained_modes, rigid_shift};
 
@@ -99,8 +101,180 @@ pub struct PoseModes {
     pub system: PoseSystem,
 }
 
-/// Assemble the linearised AMM at `pose` with N = `nm` modes of `family` per beam (the same for
-/// the paper's and the full model: their differences vanish at rest, module docs).
+/// The pose-independent part of the linearised AMM: the mode set and the constraint machinery of
+/// the beams, built once and reused for every pose of a frequency map (a map's cost is then the
+/// eigenproblems only).
+#[derive(Debug, Clone)]
+pub struct PoseModel {
+    params: RobotParams,
+    sys: System,
+}
+
+impl PoseModel {
+    /// N = `nm` modes of `family` per beam for the robot `params` (the same for the paper's and
+    /// the full model: their differences vanish at rest, module docs).
+    pub fn new(params: &RobotParams, family: ModeFamily, nm: usize) -> Result<Self, AmmError> {
+        let modes = ModeSet::new(family, nm, params)?;
+        // At rest the full model's extra terms vanish (module docs): its constraint rows equal the
+        // paper model's, so the system is built without the axial-inertia matrices it never uses.
+        let sys = System::new(modes, params, AmmModel::Paper);
+        Ok(PoseModel { params: *params, sys })
+    }
+
+    /// The mode set of the beams.
+    pub fn modes(&self) -> &ModeSet {
+        &self.sys.modes
+    }
+
+    /// Assemble `M`, `K`, `C` at `pose` (sliders held as `sliders`).
+    pub fn system_at(&self, pose: &RestPose, sliders: Sliders) -> PoseSystem {
+        let params = &self.params;
+        let mut sys = self.sys.clone();
+        let modes = sys.modes.clone();
+        let nm = modes.len();
+        let nb = nm + 2;
+        sys.update_sleeve_rows(pose.xp, &vec![0.0; sys.dim()]);
+        let c_beams = sys.constraint_matrix();
+        let rows = sys.rows.len();
+        let n_beams = 3 * nb;
+        let n = n_beams + if sliders == Sliders::Free { 3 } else { 0 };
+        let mut m = vec![0.0; n * n];
+        let mut k = vec![0.0; n * n];
+        let lambda = modes.lambda();
+        for i in 0..3 {
+            let o = i * nb;
+            for j in 0..nm {
+                m[(o + j) * n + o + j] = params.rho;
+                k[(o + j) * n + o + j] = params.rho * lambda[j];
+            }
+            m[(o + nm) * n + o + nm] = params.rho * params.l;
+            m[(o + nm + 1) * n + o + nm + 1] = params.jp;
+        }
+        let mut c = vec![0.0; rows * n];
+        for r in 0..rows {
+            c[r * n..r * n + n_beams].copy_from_slice(&c_beams[r * n_beams..(r + 1) * n_beams]);
+        }
+        if sliders == Sliders::Free {
+            let cos_th = pose.theta.cos();
+            for i in 0..3 {
+                m[(n_beams + i) * n + n_beams + i] = params.mpp_mpa;
+            }
+            for (r, row) in sys.rows.iter().enumerate() {
+                if let Row::Fp(i) | Row::FR(i) | Row::FL(i) = *row {
+                    c[r * n + n_beams + i] = -cos_th;
+                }
+            }
+        }
+        PoseSystem {
+            n,
+            nm,
+            m,
+            k,
+            c,
+            rows,
+            sliders,
+            modes,
+        }
+    }
+
+    /// The first `count` natural frequencies [Hz] at `pose`, values only (the per-point work of a
+    /// frequency map), laid out as [`PoseModes::freq_hz`]: the rigid zeros first when the sliders
+    /// are free, then `count` elastic ones.
+    ///
+    /// M and K of the AMM are diagonal, so with `x = M^(-1/2) y` the problem is the symmetric
+    /// `D = M^-1 K` restricted to the null space of `C M^(-1/2)`. With `Q` an orthonormal basis of
+    /// that matrix's row space (Gram-Schmidt, twice), `P = I - Q Q^T` and `P D P` has the
+    /// constrained `omega^2` plus `rows` exact zeros (the directions of `Q`), which are skipped:
+    /// one dense eigenvalue problem without vectors, no Cholesky factor (M diagonal is exactly
+    /// scaled, so the direct form keeps the low modes: absolute error ~ eps |D|, 1e-8 relative on
+    /// the paper robot's f1 at N = 60). Checked against [`PoseModel::modes_at`] (test
+    /// `frequencies_only_match_the_full_solver`).
+    pub fn frequencies_at(&self, pose: &RestPose, sliders: Sliders, count: usize) -> Result<Vec<f64>, AmmError> {
+        let sys = self.system_at(pose, sliders);
+        let (n, r) = (sys.n, sys.rows);
+        let fail = |reason: String| AmmError::SingularConstraints { t: 0.0, reason };
+        let inv_sqrt_m: Vec<f64> = (0..n).map(|j| 1.0 / sys.m[j * n + j].sqrt()).collect();
+        let d: Vec<f64> = (0..n).map(|j| sys.k[j * n + j] / sys.m[j * n + j]).collect();
+        let q = row_space_basis(n, r, |row, j| sys.c[row * n + j] * inv_sqrt_m[j]).map_err(fail)?;
+        let dq = Mat::from_fn(n, r, |i, k| d[i] * q[(i, k)]);
+        // A = D - Q (DQ)^T - (DQ) Q^T + Q (Q^T D Q) Q^T, on this thread (module docs of the map)
+        let mut g = Mat::<f64>::zeros(r, r);
+        matmul(g.as_mut(), Accum::Replace, q.transpose(), dq.as_ref(), 1.0, Par::Seq);
+        let mut qg = Mat::<f64>::zeros(n, r);
+        matmul(qg.as_mut(), Accum::Replace, q.as_ref(), g.as_ref(), 1.0, Par::Seq);
+        let mut a = Mat::from_fn(n, n, |i, j| if i == j { d[i] } else { 0.0 });
+        matmul(a.as_mut(), Accum::Add, q.as_ref(), dq.transpose(), -1.0, Par::Seq);
+        matmul(a.as_mut(), Accum::Add, dq.as_ref(), q.transpose(), -1.0, Par::Seq);
+        matmul(a.as_mut(), Accum::Add, qg.as_ref(), q.transpose(), 1.0, Par::Seq);
+        let a = Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+        let w = eigenvalues_seq(&a).map_err(|e| fail(format!("symmetric eigensolver failed ({e:?})")))?;
+        let rigid = if sliders == Sliders::Free { 3 } else { 0 };
+        let mut f: Vec<f64> = w
+            .iter()
+            .skip(r)
+            .take(count + rigid)
+            .map(|w2| w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+            .collect();
+        f.iter_mut().take(rigid).for_each(|x| *x = 0.0);
+        Ok(f)
+    }
+
+    /// The first `count` modes at `pose` (rigid ones included when the sliders are free).
+    pub fn modes_at(&self, pose: &RestPose, sliders: Sliders, count: usize) -> Result<PoseModes, AmmError> {
+        solve_modes(self.system_at(pose, sliders), count)
+    }
+}
+
+/// Eigenvalues (ascending) of a symmetric matrix, on the calling thread: a frequency map already
+/// runs one pose per core, so faer's own threads would only compete with it.
+fn eigenvalues_seq(a: &Mat<f64>) -> Result<Vec<f64>, faer::linalg::evd::EvdError> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::evd::{self_adjoint_evd, self_adjoint_evd_scratch, ComputeEigenvectors};
+    let n = a.nrows();
+    let mut s = faer::diag::Diag::<f64>::zeros(n);
+    let scratch = self_adjoint_evd_scratch::<f64>(n, ComputeEigenvectors::No, Par::Seq, Default::default());
+    self_adjoint_evd(
+        a.as_ref(),
+        s.as_mut(),
+        None,
+        Par::Seq,
+        MemStack::new(&mut MemBuffer::new(scratch)),
+        Default::default(),
+    )?;
+    Ok((0..n).map(|j| s[j]).collect())
+}
+
+/// Orthonormal basis (n x r, columns) of the rows of the r x n matrix `c(row, j)`: modified
+/// Gram-Schmidt applied twice; fails when a row is (numerically) a combination of the others.
+fn row_space_basis(n: usize, r: usize, c: impl Fn(usize, usize) -> f64) -> Result<Mat<f64>, String> {
+    let mut q = Mat::from_fn(n, r, |j, row| c(row, j));
+    let scale = (0..r).map(|k| q.col(k).norm_l2()).fold(0.0, f64::max);
+    for k in 0..r {
+        for _ in 0..2 {
+            for p in 0..k {
+                let proj: f64 = (0..n).map(|i| q[(i, p)] * q[(i, k)]).sum();
+                for i in 0..n {
+                    let v = q[(i, p)];
+                    q[(i, k)] -= proj * v;
+                }
+            }
+        }
+        let norm = q.col(k).norm_l2();
+        if norm.is_nan() || norm <= 1e-11 * scale {
+            return Err(format!(
+                "constraint row {} of {r} is a combination of the others (residual norm {norm:e})",
+                k + 1
+            ));
+        }
+        for i in 0..n {
+            q[(i, k)] /= norm;
+        }
+    }
+    Ok(q)
+}
+
+/// Assemble the linearised AMM at `pose` with N = `nm` modes of `family` per beam (builds a
+/// [`PoseModel`]; reuse one for many poses).
 pub fn pose_system(
     params: &RobotParams,
     pose: &RestPose,
@@ -108,53 +282,7 @@ pub fn pose_system(
     family: ModeFamily,
     nm: usize,
 ) -> Result<PoseSystem, AmmError> {
-    let modes = ModeSet::new(family, nm, params)?;
-    // At rest the full model's extra terms vanish (module docs): its constraint rows equal the
-    // paper model's, so the system is built without the axial-inertia matrices it never uses here.
-    let mut sys = System::new(modes.clone(), params, AmmModel::Paper);
-    let nb = nm + 2;
-    sys.update_sleeve_rows(pose.xp, &vec![0.0; sys.dim()]);
-    let c_beams = sys.constraint_matrix();
-    let rows = sys.rows.len();
-    let n_beams = 3 * nb;
-    let n = n_beams + if sliders == Sliders::Free { 3 } else { 0 };
-    let mut m = vec![0.0; n * n];
-    let mut k = vec![0.0; n * n];
-    let lambda = modes.lambda();
-    for i in 0..3 {
-        let o = i * nb;
-        for j in 0..nm {
-            m[(o + j) * n + o + j] = params.rho;
-            k[(o + j) * n + o + j] = params.rho * lambda[j];
-        }
-        m[(o + nm) * n + o + nm] = params.rho * params.l;
-        m[(o + nm + 1) * n + o + nm + 1] = params.jp;
-    }
-    let mut c = vec![0.0; rows * n];
-    for r in 0..rows {
-        c[r * n..r * n + n_beams].copy_from_slice(&c_beams[r * n_beams..(r + 1) * n_beams]);
-    }
-    if sliders == Sliders::Free {
-        let cos_th = pose.theta.cos();
-        for i in 0..3 {
-            m[(n_beams + i) * n + n_beams + i] = params.mpp_mpa;
-        }
-        for (r, row) in sys.rows.iter().enumerate() {
-            if let Row::Fp(i) | Row::FR(i) | Row::FL(i) = *row {
-                c[r * n + n_beams + i] = -cos_th;
-            }
-        }
-    }
-    Ok(PoseSystem {
-        n,
-        nm,
-        m,
-        k,
-        c,
-        rows,
-        sliders,
-        modes,
-    })
+    Ok(PoseModel::new(params, family, nm)?.system_at(pose, sliders))
 }
 
 /// The first `count` modes of the star at `pose` (rigid ones included when the sliders are free).
@@ -166,8 +294,12 @@ pub fn pose_modes(
     nm: usize,
     count: usize,
 ) -> Result<PoseModes, AmmError> {
-    let system = pose_system(params, pose, sliders, family, nm)?;
-    let rigid = if sliders == Sliders::Free { 3 } else { 0 };
+    PoseModel::new(params, family, nm)?.modes_at(pose, sliders, count)
+}
+
+/// The constrained eigenproblem of an assembled system.
+fn solve_modes(system: PoseSystem, count: usize) -> Result<PoseModes, AmmError> {
+    let rigid = if system.sliders == Sliders::Free { 3 } else { 0 };
     let out = constrained_modes(
         system.n,
         &system.m,
@@ -175,7 +307,7 @@ pub fn pose_modes(
         &system.c,
         system.rows,
         count + rigid,
-        rigid_shift(sliders == Sliders::Free),
+        rigid_shift(system.sliders == Sliders::Free),
     )
     .map_err(|reason| AmmError::SingularConstraints { t: 0.0, reason })?;
     let mut omega2 = out.omega2;
@@ -221,6 +353,30 @@ mod tests {
         let (a, b) = (freqs(DEFAULT_MODAL_MODES, Sliders::Locked), freqs(80, Sliders::Locked));
         for (x, y) in a.freq_hz.iter().zip(&b.freq_hz) {
             assert!((x / y - 1.0).abs() < 1e-3, "{x} vs {y}");
+        }
+    }
+
+    /// The values-only solver of a frequency map against the shared constrained eigensolver
+    /// (null space by Householder QR, Cholesky inverse form): two independent methods.
+    #[test]
+    fn frequencies_only_match_the_full_solver() {
+        let p = RobotParams::paper();
+        let model = PoseModel::new(&p, ModeFamily::Enriched, 40).unwrap();
+        let off = RestPose {
+            s: [0.0; 3],
+            g: [0.0; 2],
+            theta: 0.0,
+            xp: [0.12, 0.2, 0.26],
+        };
+        for pose in [centre(&p), off] {
+            for sliders in [Sliders::Locked, Sliders::Free] {
+                let full = model.modes_at(&pose, sliders, 8).unwrap().freq_hz;
+                let fast = model.frequencies_at(&pose, sliders, 8).unwrap();
+                assert_eq!(full.len(), fast.len());
+                for (a, b) in full.iter().zip(&fast) {
+                    assert!((a - b).abs() <= 1e-7 * a.max(1.0), "{sliders:?}: {a} vs {b}");
+                }
+            }
         }
     }
 

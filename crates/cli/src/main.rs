@@ -34,6 +34,12 @@ enum Command {
     /// Design studies: sweep experiment keys over a grid or a Latin hypercube, in parallel or in
     /// shards on a cluster (`sweep merge DIR` joins the shards); results.csv, plots, study.html
     Sweep(commands::sweep::Args),
+    /// Modes at a pose, AMM and FEM side by side: DIR/<name>/modal.csv, the first six shapes
+    Modal(commands::modal::ModalArgs),
+    /// First K frequencies over a grid of poses: DIR/<name>/freqmap.csv, heat map of f1 and f2
+    Freqmap(commands::modal::FreqmapArgs),
+    /// Linear state-space model about a pose, sliders free: DIR/<name>/linear/ (Matrix Market, JSON)
+    Linearize(commands::modal::LinearizeArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -45,6 +51,9 @@ fn main() -> std::process::ExitCode {
         Command::Compare(args) => commands::compare::run(args),
         Command::Verify(args) => commands::verify::run(args),
         Command::Sweep(args) => commands::sweep::run(args),
+        Command::Modal(args) => commands::modal::run_modal(args),
+        Command::Freqmap(args) => commands::modal::run_freqmap(args),
+        Command::Linearize(args) => commands::modal::run_linearize(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

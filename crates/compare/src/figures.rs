@@ -61,6 +61,79 @@ pub struct Figure {
     pub panels: Vec<Panel>,
 }
 
+/// A [`Figure`] laid out with `columns` panels per row (further panels wrap onto new rows)
+/// instead of all in one row.
+#[derive(Debug, Clone)]
+pub struct GridFigure {
+    pub figure: Figure,
+    pub columns: usize,
+}
+
+/// Something drawn on any plotters backend, written as SVG and PNG by [`svg_string`] and
+/// [`write_svg_png`] (shared by every crate that draws: compare, study, modal).
+pub trait Drawing {
+    /// File stem of the drawing (`<name>.svg`, `<name>.png`).
+    fn name(&self) -> &str;
+    /// Size in pixels (width, height).
+    fn size(&self) -> (u32, u32);
+    /// Draw on `root` (already sized); errors as text.
+    fn draw_on<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>;
+}
+
+/// The drawing as an SVG document.
+pub fn svg_string<D: Drawing>(d: &D) -> Result<String, FigureError> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, d.size()).into_drawing_area();
+        d.draw_on(root).map_err(|reason| FigureError {
+            name: d.name().to_string(),
+            reason,
+        })?;
+    }
+    Ok(svg)
+}
+
+/// Write `<dir>/<name>.svg` and `<dir>/<name>.png`, each whole or not at all.
+pub fn write_svg_png<D: Drawing>(d: &D, dir: &Path) -> Result<(), FigureError> {
+    register_font();
+    let err = |reason: String| FigureError {
+        name: d.name().to_string(),
+        reason,
+    };
+    let svg = svg_string(d)?;
+    flexstar_model::output::write_string_atomically(&dir.join(format!("{}.svg", d.name())), &svg)
+        .map_err(|e| err(e.to_string()))?;
+    // PNG: drawn into a temporary file beside the target, renamed when complete
+    let png = dir.join(format!("{}.png", d.name()));
+    let tmp = flexstar_model::output::temp_file_in(dir, ".png").map_err(|e| err(e.to_string()))?;
+    {
+        let root = BitMapBackend::new(tmp.path(), d.size()).into_drawing_area();
+        d.draw_on(root).map_err(err)?;
+    }
+    tmp.persist(&png).map_err(|e| err(e.to_string()))?;
+    Ok(())
+}
+
+/// Viridis-like colour of `u` in [0, 1] (five anchors of matplotlib's viridis, linearly blended);
+/// NaN maps to the dark end.
+pub fn colormap(u: f64) -> RGBColor {
+    const ANCHORS: [(f64, f64, f64); 5] = [
+        (68.0, 1.0, 84.0),
+        (59.0, 82.0, 139.0),
+        (33.0, 145.0, 140.0),
+        (94.0, 201.0, 98.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let u = if u.is_finite() { u.clamp(0.0, 1.0) } else { 0.0 };
+    let s = u * 4.0;
+    let i = (s.floor() as usize).min(3);
+    let f = s - i as f64;
+    let (a, b) = (ANCHORS[i], ANCHORS[i + 1]);
+    let mix = |p: f64, q: f64| (p + f * (q - p)).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
 /// Colours: FEM black, then one per AMM family, rigid grey.
 pub const FEM_STYLE: Style = Style {
     color: RGBColor(0, 0, 0),
@@ -106,10 +179,7 @@ const LEGEND_H: u32 = 28;
 
 impl Figure {
     pub fn size(&self) -> (u32, u32) {
-        (
-            PANEL_W * self.panels.len().max(1) as u32,
-            PANEL_H + CAPTION_H + LEGEND_H,
-        )
+        grid_size(self.panels.len(), self.panels.len())
     }
 
     /// Legend entries: every labelled series once, in order of appearance.
@@ -123,58 +193,78 @@ impl Figure {
         v
     }
 
-    /// Draw on any plotters backend.
-    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String> {
+    /// The figure as an SVG document.
+    pub fn to_svg_string(&self) -> Result<String, FigureError> {
+        svg_string(self)
+    }
+
+    /// Write `<dir>/<name>.svg` and `<dir>/<name>.png`, each whole or not at all.
+    pub fn write(&self, dir: &Path) -> Result<(), FigureError> {
+        write_svg_png(self, dir)
+    }
+
+    /// Draw with `columns` panels per row.
+    fn draw_grid<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>, columns: usize) -> Result<(), String> {
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let (top, rest) = root.split_vertically(CAPTION_H);
         top.titled(&self.title, ("sans-serif", 18)).map_err(|e| e.to_string())?;
         let (legend, body) = rest.split_vertically(LEGEND_H);
         draw_legend(&legend, &self.legend())?;
-        let areas = body.split_evenly((1, self.panels.len().max(1)));
+        let (cols, rows) = grid_shape(self.panels.len(), columns);
+        let areas = body.split_evenly((rows, cols));
         for (panel, area) in self.panels.iter().zip(areas) {
             draw_panel(panel, &area)?;
         }
         root.present().map_err(|e| e.to_string())
     }
+}
 
-    /// The figure as an SVG document.
-    pub fn to_svg_string(&self) -> Result<String, FigureError> {
-        register_font();
-        let mut svg = String::new();
-        {
-            let root = SVGBackend::with_string(&mut svg, self.size()).into_drawing_area();
-            self.draw(root).map_err(|reason| FigureError {
-                name: self.name.clone(),
-                reason,
-            })?;
-        }
-        Ok(svg)
+/// Columns and rows of `panels` panels at `columns` per row.
+fn grid_shape(panels: usize, columns: usize) -> (usize, usize) {
+    let n = panels.max(1);
+    let cols = columns.clamp(1, n);
+    (cols, n.div_ceil(cols))
+}
+
+/// Pixel size of a figure of `panels` panels at `columns` per row.
+fn grid_size(panels: usize, columns: usize) -> (u32, u32) {
+    let (cols, rows) = grid_shape(panels, columns);
+    (PANEL_W * cols as u32, PANEL_H * rows as u32 + CAPTION_H + LEGEND_H)
+}
+
+impl Drawing for Figure {
+    fn name(&self) -> &str {
+        &self.name
     }
 
-    /// Write `<dir>/<name>.svg` and `<dir>/<name>.png`, each whole or not at all.
-    pub fn write(&self, dir: &Path) -> Result<(), FigureError> {
-        register_font();
-        let err = |reason: String| FigureError {
-            name: self.name.clone(),
-            reason,
-        };
-        let svg = self.to_svg_string()?;
-        flexstar_model::output::write_string_atomically(&dir.join(format!("{}.svg", self.name)), &svg)
-            .map_err(|e| err(e.to_string()))?;
-        // PNG: drawn into a temporary file beside the target, renamed when complete
-        let png = dir.join(format!("{}.png", self.name));
-        let tmp = flexstar_model::output::temp_file_in(dir, ".png").map_err(|e| err(e.to_string()))?;
-        {
-            let root = BitMapBackend::new(tmp.path(), self.size()).into_drawing_area();
-            self.draw(root).map_err(err)?;
-        }
-        tmp.persist(&png).map_err(|e| err(e.to_string()))?;
-        Ok(())
+    fn size(&self) -> (u32, u32) {
+        Figure::size(self)
+    }
+
+    fn draw_on<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String> {
+        self.draw_grid(root, self.panels.len())
+    }
+}
+
+impl Drawing for GridFigure {
+    fn name(&self) -> &str {
+        &self.figure.name
+    }
+
+    fn size(&self) -> (u32, u32) {
+        grid_size(self.figure.panels.len(), self.columns)
+    }
+
+    fn draw_on<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String> {
+        self.figure.draw_grid(root, self.columns)
     }
 }
 
 /// One row of legend entries, centred: a line sample in the run's style, then its label.
-fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &[(String, Style)]) -> Result<(), String> {
+pub fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(String, Style)],
+) -> Result<(), String> {
     const SAMPLE: i32 = 28;
     const GAP: i32 = 8;
     const SPACING: i32 = 26;
@@ -256,7 +346,7 @@ fn bounds(panel: &Panel) -> ((f64, f64), (f64, f64)) {
 }
 
 /// Tick labels: plain decimals for moderate magnitudes, exponents otherwise.
-fn tick(v: &f64) -> String {
+pub fn tick(v: &f64) -> String {
     let a = v.abs();
     if a < 1e-10 {
         return "0".into();
@@ -487,4 +577,16 @@ fn rigid_length(runs: &[Run], i: usize) -> f64 {
     runs.iter()
         .filter_map(|r| r.response.shapes.last().and_then(|s| s.beams[i].x.last().copied()))
         .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colormap_ends_are_viridis_ends() {
+        assert_eq!(colormap(0.0), RGBColor(68, 1, 84));
+        assert_eq!(colormap(1.0), RGBColor(253, 231, 37));
+        assert_eq!(colormap(f64::NAN), RGBColor(68, 1, 84));
+    }
 }

@@ -3,6 +3,7 @@
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use flexstar_amm::pose_modes::PoseModel;
 use flexstar_model::output::{fmt_number, write_atomically};
 use flexstar_model::{Experiment, Sliders};
 use rayon::prelude::*;
@@ -92,12 +93,17 @@ where
     crate::check_k(k)?;
     check_grid(gx, gy)?;
     let total = gx.n * gy.n;
+    // the AMM's pose-independent part (mode set, constraint machinery) once per map
+    let amm = match solver {
+        Solver::Amm => Some(PoseModel::new(&exp.robot, exp.amm.family, amm_modes_per_beam(exp))?),
+        Solver::Fem => None,
+    };
     let done = AtomicUsize::new(0);
     let points = (0..total)
         .into_par_iter()
         .map(|idx| {
             let (x, y) = (gx.at(idx % gx.n), gy.at(idx / gx.n));
-            let result = point(exp, x, y, theta, k, solver);
+            let result = point(exp, amm.as_ref(), x, y, theta, k);
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             MapPoint {
                 gx: x,
@@ -110,22 +116,24 @@ where
     Ok(points)
 }
 
-fn point(exp: &Experiment, gx: f64, gy: f64, theta: f64, k: usize, solver: Solver) -> Result<Vec<f64>, String> {
+/// The first `k` frequencies at one grid point: by the AMM when `amm` is given, else the FEM.
+fn point(
+    exp: &Experiment,
+    amm: Option<&PoseModel>,
+    gx: f64,
+    gy: f64,
+    theta: f64,
+    k: usize,
+) -> Result<Vec<f64>, String> {
     let pose = pose_from_task(&exp.robot, gx, gy, theta).map_err(|e| e.to_string())?;
-    let f = match solver {
-        Solver::Amm => {
-            flexstar_amm::pose_modes::pose_modes(
-                &exp.robot,
-                &pose,
-                Sliders::Locked,
-                exp.amm.family,
-                amm_modes_per_beam(exp),
-                k,
-            )
-            .map_err(|e| e.to_string())?
-            .freq_hz
+    let f = match amm {
+        Some(model) => {
+            model
+                .modes_at(&pose, Sliders::Locked, k)
+                .map_err(|e| e.to_string())?
+                .freq_hz
         }
-        Solver::Fem => {
+        None => {
             flexstar_fem::pose_modes::pose_modes(&exp.robot, &pose, Sliders::Locked, exp.fem.elements, k)
                 .map_err(|e| e.to_string())?
                 .freq_hz

@@ -8,7 +8,8 @@
 //! - [`analysis`]: modes at a pose from the AMM and the FEM side by side (`modal.csv`);
 //! - [`freqmap`]: the first K frequencies over a grid of poses, in parallel (`freqmap.csv`);
 //! - [`linear`]: the state-space model (A, B, C, D) with free sliders, Matrix Market files
-//!   (sprs) and `statespace.json`.
+//!   (sprs) and `statespace.json`;
+//! - [`plots`]: mode shapes and frequency heat maps (SVG, PNG).
 //!
 //! The physics (mass, stiffness and constraints at a pose) lives in the solvers:
 //! `flexstar_amm::pose_modes` and `flexstar_fem::pose_modes`. SI units; frames as in
@@ -18,6 +19,7 @@ pub mod analysis;
 pub mod error;
 pub mod freqmap;
 pub mod linear;
+pub mod plots;
 pub mod pose;
 
 pub use error::ModalError;

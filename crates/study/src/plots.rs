@@ -137,23 +137,7 @@ impl Scatter {
     }
 }
 
-/// Viridis-like colour of `u` in [0, 1] (five anchors of matplotlib's viridis, linearly blended).
-pub fn colormap(u: f64) -> RGBColor {
-    const ANCHORS: [(f64, f64, f64); 5] = [
-        (68.0, 1.0, 84.0),
-        (59.0, 82.0, 139.0),
-        (33.0, 145.0, 140.0),
-        (94.0, 201.0, 98.0),
-        (253.0, 231.0, 37.0),
-    ];
-    let u = if u.is_finite() { u.clamp(0.0, 1.0) } else { 0.0 };
-    let s = u * 4.0;
-    let i = (s.floor() as usize).min(3);
-    let f = s - i as f64;
-    let (a, b) = (ANCHORS[i], ANCHORS[i + 1]);
-    let mix = |p: f64, q: f64| (p + f * (q - p)).round() as u8;
-    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
-}
+pub use flexstar_compare::figures::colormap;
 
 impl Heat {
     /// The heat map as an SVG document; cells without a value are grey, and each cell is labelled
@@ -249,17 +233,5 @@ impl Heat {
             root.present().map_err(|x| e(x.to_string()))?;
         }
         Ok(svg)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn colormap_ends_are_viridis_ends() {
-        assert_eq!(colormap(0.0), RGBColor(68, 1, 84));
-        assert_eq!(colormap(1.0), RGBColor(253, 231, 37));
-        assert_eq!(colormap(f64::NAN), RGBColor(68, 1, 84));
     }
 }

@@ -2,6 +2,7 @@
 
 pub mod compare;
 pub mod kinematics;
+pub mod modal;
 pub mod modes;
 pub mod run;
 pub mod sweep;

@@ -1,0 +1,302 @@
+//! End-to-end checks of `flexstar modal`, `freqmap` and `linearize` (issue 11): file contracts
+//! (paths, exact CSV headers, Matrix Market headers), agreement between the commands and with
+//! independent references (symmetry of the robot, the FEM), and bad input refused with the reason
+//! and no output. Small models (AMM N = 40, FEM 102 elements) keep each run well under a second.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn flexstar(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_flexstar"))
+        .args(args)
+        .output()
+        .expect("flexstar runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The paper's robot with case 3's motion and small solver settings, written into `dir`.
+fn small_config(dir: &Path) -> String {
+    let text = "name = \"small\"\n[time]\nt_end = 0.5\n[trajectory]\nkind = \"polynomial\"\n\
+                s1 = [0.0, 0.0, 1.0]\ns2 = [0.0]\ns3 = [0.0, 0.0, 0.5]\n[amm]\nmodes = 40\n[fem]\nelements = 102\n";
+    let p = dir.join("small.toml");
+    std::fs::write(&p, text).unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+fn rows(path: &Path) -> (String, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().to_string();
+    (
+        header,
+        lines.map(|l| l.split(',').map(String::from).collect()).collect(),
+    )
+}
+
+fn num(s: &str) -> f64 {
+    s.parse().unwrap_or_else(|_| panic!("not a number: {s:?}"))
+}
+
+/// Files left in `dir` (none when the directory does not exist).
+fn files_in(dir: &Path) -> Vec<PathBuf> {
+    match std::fs::read_dir(dir) {
+        Ok(rd) => rd.map(|e| e.unwrap().path()).collect(),
+        Err(_) => vec![],
+    }
+}
+
+/// modal.csv with the exact header; the centre pose's repeated pair (the star's three-fold
+/// symmetry) in both models; AMM and FEM within 1.5 % at this small N and mesh; the figures.
+#[test]
+fn modal_writes_the_contracted_table_and_shapes() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_config(dir.path());
+    let out = dir.path().join("out");
+    let o = flexstar(&["modal", &cfg, "--pose", "0,0,0", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let case = out.join("small");
+    let (header, r) = rows(&case.join("modal.csv"));
+    assert_eq!(header, "mode,f_amm_hz,f_fem_hz,rel_diff");
+    assert_eq!(r.len(), 6);
+    let f: Vec<[f64; 3]> = r.iter().map(|x| [num(&x[1]), num(&x[2]), num(&x[3])]).collect();
+    for (k, [a, fe, rel]) in f.iter().enumerate() {
+        assert_eq!(num(&r[k][0]), (k + 1) as f64);
+        assert!(
+            (rel - (a - fe) / fe).abs() < 1e-12 && rel.abs() < 0.015,
+            "mode {}: {a} vs {fe}",
+            k + 1
+        );
+    }
+    for col in 0..2 {
+        assert!((f[0][col] / f[1][col] - 1.0).abs() < 1e-6, "pair 1-2: {:?}", f);
+        assert!((f[3][col] / f[4][col] - 1.0).abs() < 1e-6, "pair 4-5: {:?}", f);
+    }
+    for ext in ["svg", "png"] {
+        let p = case.join(format!("modal-shapes.{ext}"));
+        assert!(
+            std::fs::metadata(&p).map(|m| m.len() > 1000).unwrap_or(false),
+            "{}",
+            p.display()
+        );
+    }
+    // free sliders: three rigid modes at 0 Hz first, then K elastic ones
+    let o = flexstar(&[
+        "modal",
+        &cfg,
+        "--at",
+        "0.25",
+        "--sliders",
+        "free",
+        "--modes",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, r) = rows(&case.join("modal.csv"));
+    assert_eq!(r.len(), 5);
+    assert!(r[..3].iter().all(|x| num(&x[1]) == 0.0 && num(&x[2]) == 0.0));
+    assert!(r[3..].iter().all(|x| num(&x[1]) > 1.0 && num(&x[3]).abs() < 0.015));
+}
+
+/// freqmap.csv with the exact header, infeasible poses marked with the reason in the sidecar;
+/// the map is mirror-symmetric in Gx at theta = 0 (the robot is); its value at the centre equals
+/// what `modal` reports there (the map's values-only solver against the full one).
+#[test]
+fn freqmap_writes_the_contracted_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_config(dir.path());
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let o = flexstar(&[
+        "freqmap",
+        &cfg,
+        "--gx",
+        "-0.3:0.3:5",
+        "--gy",
+        "-0.15:0.15:3",
+        "--modes",
+        "2",
+        "--out",
+        out_s,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let case = out.join("small");
+    let (header, r) = rows(&case.join("freqmap.csv"));
+    assert_eq!(header, "Gx,Gy,theta,feasible,f1_hz,f2_hz");
+    assert_eq!(r.len(), 15);
+    let infeasible: Vec<&Vec<String>> = r.iter().filter(|x| x[3] == "false").collect();
+    assert!(!infeasible.is_empty() && infeasible.len() < 15, "{r:?}");
+    assert!(infeasible.iter().all(|x| x[4].is_empty() && x[5].is_empty()));
+    let (h2, reasons) = rows(&case.join("freqmap-infeasible.csv"));
+    assert_eq!(h2, "Gx,Gy,theta,reason");
+    assert_eq!(reasons.len(), infeasible.len());
+    assert!(
+        reasons.iter().all(|x| x[3].contains("outside the workspace")),
+        "{reasons:?}"
+    );
+    // mirror symmetry Gx -> -Gx (row-major: Gx fastest)
+    for y in 0..3 {
+        for x in 0..5 {
+            let (a, b) = (&r[5 * y + x], &r[5 * y + 4 - x]);
+            assert_eq!(a[3], b[3], "feasibility not mirror-symmetric: {a:?} {b:?}");
+            if a[3] == "true" {
+                for c in 4..6 {
+                    assert!((num(&a[c]) / num(&b[c]) - 1.0).abs() < 1e-7, "{a:?} vs {b:?}");
+                }
+            }
+        }
+    }
+    for ext in ["svg", "png"] {
+        assert!(case.join(format!("freqmap.{ext}")).exists());
+    }
+    let centre = &r[7];
+    assert_eq!((num(&centre[0]), num(&centre[1])), (0.0, 0.0));
+    let o = flexstar(&["modal", &cfg, "--pose", "0,0,0", "--modes", "2", "--out", out_s]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, m) = rows(&case.join("modal.csv"));
+    for k in 0..2 {
+        assert!(
+            (num(&m[k][1]) / num(&centre[4 + k]) - 1.0).abs() < 1e-7,
+            "{m:?} vs {centre:?}"
+        );
+    }
+}
+
+/// linear/: the seven Matrix Market files and statespace.json; A holds -omega^2 of the modes
+/// `modal --sliders free` reports at the same pose (omega = 2 pi f).
+#[test]
+fn linearize_writes_the_state_space_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_config(dir.path());
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let o = flexstar(&["linearize", &cfg, "--pose", "0.03,-0.02,0.1", "--out", out_s]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lin = out.join("small").join("linear");
+    let mut dims = std::collections::HashMap::new();
+    for name in ["A", "B", "C", "D", "M", "K", "Phi_q"] {
+        let text = std::fs::read_to_string(lin.join(format!("{name}.mtx"))).unwrap();
+        assert!(
+            text.starts_with("%%MatrixMarket matrix coordinate real general"),
+            "{name}"
+        );
+        let size: Vec<usize> = text
+            .lines()
+            .find(|l| !l.starts_with('%'))
+            .unwrap()
+            .split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect();
+        dims.insert(name, (size[0], size[1]));
+    }
+    let n = dims["A"].0;
+    assert_eq!(dims["A"], (n, n));
+    assert_eq!(dims["B"], (n, 3));
+    assert_eq!(dims["C"], (9, n));
+    assert_eq!(dims["D"], (9, 3));
+    assert_eq!(dims["M"], dims["K"]);
+    assert_eq!(dims["Phi_q"].1, dims["M"].0);
+    let json = std::fs::read_to_string(lin.join("statespace.json")).unwrap();
+    for key in ["\"inputs\"", "\"outputs\"", "\"Fa1\"", "\"w3G\"", "\"pose\""] {
+        assert!(json.contains(key), "{key} missing in statespace.json");
+    }
+    // A's lower-left block: -omega_j^2 on the diagonal, against modal --sliders free
+    let o = flexstar(&[
+        "modal",
+        &cfg,
+        "--pose",
+        "0.03,-0.02,0.1",
+        "--sliders",
+        "free",
+        "--modes",
+        "4",
+        "--out",
+        out_s,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, m) = rows(&out.join("small").join("modal.csv"));
+    let a = std::fs::read_to_string(lin.join("A.mtx")).unwrap();
+    let entries: Vec<(usize, usize, f64)> = a
+        .lines()
+        .filter(|l| !l.starts_with('%'))
+        .skip(1)
+        .map(|l| {
+            let v: Vec<&str> = l.split_whitespace().collect();
+            (v[0].parse().unwrap(), v[1].parse().unwrap(), num(v[2]))
+        })
+        .collect();
+    let nr = n / 2;
+    for (j, row) in m.iter().enumerate().take(7).skip(3) {
+        let w = 2.0 * std::f64::consts::PI * num(&row[1]);
+        let e = entries
+            .iter()
+            .find(|(r, c, _)| *r == nr + j + 1 && *c == j + 1)
+            .expect("A entry");
+        assert!(
+            (e.2 / -(w * w) - 1.0).abs() < 1e-9,
+            "mode {}: {} vs {}",
+            j + 1,
+            e.2,
+            -(w * w)
+        );
+    }
+}
+
+/// Bad input: non-zero exit, the reason on stderr, no file written.
+#[test]
+fn bad_input_is_refused_before_any_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_config(dir.path());
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["modal", &cfg, "--pose", "0.3,0,0"], "outside the workspace"),
+        (vec!["modal", &cfg, "--pose", "0,0,1.2"], "outside the workspace"),
+        (vec!["modal", &cfg, "--pose", "0,0"], "GX,GY,THETA"),
+        (vec!["modal", &cfg, "--at", "0.6"], "span"),
+        (vec!["modal", &cfg, "--at", "-0.1"], "span"),
+        (vec!["modal", &cfg, "--at", "0.1", "--modes", "0"], "--modes"),
+        (vec!["modal", &cfg, "--at", "0.1", "--modes", "51"], "--modes"),
+        (
+            vec!["modal", &cfg, "--at", "0.1", "--pose", "0,0,0"],
+            "cannot be used with",
+        ),
+        (vec!["modal", &cfg], "required"),
+        (
+            vec!["freqmap", &cfg, "--gx", "0:0.1:1", "--gy", "0:0.1:3"],
+            "N must be at least 2",
+        ),
+        (
+            vec!["freqmap", &cfg, "--gx", "0:0.1:400", "--gy", "0:0.1:400"],
+            "100000",
+        ),
+        (vec!["freqmap", &cfg, "--gx", "0.1:0:3", "--gy", "0:0.1:3"], "MIN < MAX"),
+        (
+            vec!["freqmap", &cfg, "--gx", "0:0.1:3", "--gy", "0:0.1:3", "--modes", "99"],
+            "--modes",
+        ),
+        (vec!["linearize", &cfg, "--pose", "0,0.4,0"], "outside the workspace"),
+        (vec!["linearize", &cfg, "--at", "7"], "span"),
+    ];
+    for (mut args, needle) in cases {
+        args.extend(["--out", out_s]);
+        let o = flexstar(&args);
+        assert!(!o.status.success(), "{args:?} accepted");
+        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+        let left = files_in(&out.join("small"));
+        assert!(left.is_empty(), "{args:?} left {left:?}");
+    }
+}
+
+#[test]
+fn the_modal_commands_have_help() {
+    for sub in ["modal", "freqmap", "linearize"] {
+        let o = flexstar(&[sub, "--help"]);
+        assert!(o.status.success());
+        assert!(String::from_utf8_lossy(&o.stdout).contains("Usage"), "{sub}");
+    }
+}

@@ -95,7 +95,11 @@ where
     let total = gx.n * gy.n;
     // the AMM's pose-independent part (mode set, constraint machinery) once per map
     let amm = match solver {
-        Solver::Amm => Some(PoseModel::new(&exp.robot, exp.amm.family, amm_modes_per_beam(exp))?),
+        Solver::Amm => Some(PoseModel::new(
+            &exp.robot,
+            crate::analysis::amm_basis(exp).0,
+            amm_modes_per_beam(exp),
+        )?),
         Solver::Fem => None,
     };
     let done = AtomicUsize::new(0);

@@ -85,7 +85,7 @@ pub fn linearize(exp: &Experiment, pose: &RestPose) -> Result<StateSpace, ModalE
         &exp.robot,
         pose,
         Sliders::Free,
-        exp.amm.family,
+        crate::analysis::amm_basis(exp).0,
         amm_modes_per_beam(exp),
         ELASTIC_MODES,
     )?;

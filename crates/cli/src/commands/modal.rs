@@ -117,7 +117,7 @@ pub struct LinearizeArgs {
 fn warn_family(config: &Path, exp: &Experiment) {
     if exp.amm.family != flexstar_model::ModeFamily::Enriched {
         eprintln!(
-            "warning: {}: the AMM uses [amm] family = {} (N = {}); the accurate basis for modes is the enriched family (the default, as in configs/paper-robot.toml)",
+            "note: {}: [amm] family = {} is for the time-domain runs; the modes use the accurate basis (enriched, N = {})",
             config.display(),
             exp.amm.family,
             flexstar_modal::analysis::amm_modes_per_beam(exp)

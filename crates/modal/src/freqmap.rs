@@ -131,12 +131,10 @@ fn point(
 ) -> Result<Vec<f64>, String> {
     let pose = pose_from_task(&exp.robot, gx, gy, theta).map_err(|e| e.to_string())?;
     let f = match amm {
-        Some(model) => {
-            model
-                .modes_at(&pose, Sliders::Locked, k)
-                .map_err(|e| e.to_string())?
-                .freq_hz
-        }
+        // eigenvalues only (no shapes): a third of the cost of `modes_at`, equal to 1e-7
+        Some(model) => model
+            .frequencies_at(&pose, Sliders::Locked, k)
+            .map_err(|e| e.to_string())?,
         None => {
             flexstar_fem::pose_modes::pose_modes(&exp.robot, &pose, Sliders::Locked, exp.fem.elements, k)
                 .map_err(|e| e.to_string())?

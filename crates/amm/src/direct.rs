@@ -20,7 +20,7 @@
 //! the per-step change of s'' times the step (`docs/amm.md` section 10).
 
 use flexstar_drive::ActuatorLaw;
-use flexstar_kinematics::{check_configuration, direct_kinematics, Infeasible, RigidState};
+use flexstar_kinematics::{check_configuration, direct_kinematics, RigidState};
 use flexstar_model::{AmmSettings, DriveKind, Experiment, ModeCount, Response, RobotParams, RunInfo};
 use flexstar_numerics::GenAlpha;
 use num_dual::{Dual2, HyperDual64};
@@ -125,7 +125,7 @@ fn coupled_step(
 ) -> Result<[f64; 3], AmmError> {
     let s = [0, 1, 2].map(|i| shat[i] + bp * x_pred[i]);
     let sd = [0, 1, 2].map(|i| sdhat[i] + gp * x_pred[i]);
-    check_configuration(params, s).map_err(|violation| Infeasible { t, violation })?;
+    check_configuration(params, s).map_err(|violation| AmmError::DirectInfeasible { t, violation })?;
     let st = rigid_at(params, s, sd, x_pred, t)?;
     let sens = sensitivity(params, s, sd, gp, t)?;
 
@@ -258,7 +258,7 @@ fn integrate_direct(
     let mut sacc = sdd;
 
     let mut record = |rec: &mut Recorder, sys: &System, stop, t: f64, q: &[f64], s, sd, sdd| -> Result<(), AmmError> {
-        check_configuration(params, s).map_err(|violation| Infeasible { t, violation })?;
+        check_configuration(params, s).map_err(|violation| AmmError::DirectInfeasible { t, violation })?;
         let st = rigid_at(params, s, sd, sdd, t)?;
         let fa = law.force(t, s, sd).map_err(|source| AmmError::Drive { t, source })?;
         rec.record(&st, stop, q, &sys.lam, &sys.sleeve_axial, Some(fa));

@@ -18,6 +18,13 @@ pub enum AmmError {
     /// The trajectory leaves the feasible range (checked over the whole span before any work).
     #[error("amm: {0}")]
     Infeasible(#[from] Infeasible),
+    /// A direct run (forces or servo) left the feasible range at time `t` [s]: its motion is not
+    /// known in advance, so this is found as it goes; nothing is written.
+    #[error("amm: direct run left the feasible range at t = {t:.6} s: {violation}")]
+    DirectInfeasible {
+        t: f64,
+        violation: flexstar_kinematics::Violation,
+    },
     /// The rigid kinematics failed at time `t` (cannot happen after a successful feasibility scan,
     /// but is reported rather than unwrapped).
     #[error("amm: t = {t:.6} s: rigid kinematics: {source}")]

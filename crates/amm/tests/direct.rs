@@ -165,10 +165,10 @@ fn leaving_the_feasible_range_stops_with_time_and_reason() {
     let msg = err.to_string();
     eprintln!("{msg}");
     match err {
-        flexstar_amm::AmmError::Infeasible(inf) => assert!(inf.t > 0.01 && inf.t < 0.5, "{msg}"),
+        flexstar_amm::AmmError::DirectInfeasible { t, .. } => assert!(t > 0.01 && t < 0.5, "{msg}"),
         other => panic!("expected an infeasible motion, got {other}"),
     }
-    assert!(msg.contains("t = 0."), "{msg}");
+    assert!(msg.contains("direct run left the feasible range at t = 0."), "{msg}");
 }
 
 #[test]

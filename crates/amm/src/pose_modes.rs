@@ -191,6 +191,61 @@ impl PoseModel {
     /// `frequencies_only_match_the_full_solver`).
     pub fn frequencies_at(&self, pose: &RestPose, sliders: Sliders, count: usize) -> Result<Vec<f64>, AmmError> {
         let sys = self.system_at(pose, sliders);
+        let proj = Projected::new(&sys)?;
+        let rigid = if sliders == Sliders::Free { 3 } else { 0 };
+        let mut f: Vec<f64> = proj
+            .w
+            .iter()
+            .skip(proj.r)
+            .take(count + rigid)
+            .map(|w2| w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+            .collect();
+        f.iter_mut().take(rigid).for_each(|x| *x = 0.0);
+        Ok(f)
+    }
+
+    /// The first `count` modes at `pose` (rigid ones included when the sliders are free).
+    ///
+    /// Sliders locked: the eigenvalues of [`PoseModel::frequencies_at`], then each shape from its
+    /// eigenvalue alone ([`Projected::shapes`]); a shape that does not pass that method's check
+    /// sends the pose to the general constrained solver, which the sliders-free case always uses.
+    pub fn modes_at(&self, pose: &RestPose, sliders: Sliders, count: usize) -> Result<PoseModes, AmmError> {
+        let sys = self.system_at(pose, sliders);
+        if sliders == Sliders::Locked {
+            let proj = Projected::new(&sys)?;
+            let omega2: Vec<f64> = proj.w.iter().skip(proj.r).take(count).copied().collect();
+            if let Some(shapes) = proj.shapes(&omega2) {
+                let freq_hz = omega2
+                    .iter()
+                    .map(|w| w.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+                    .collect();
+                return Ok(PoseModes {
+                    freq_hz,
+                    omega2,
+                    shapes,
+                    rigid: 0,
+                    system: sys,
+                });
+            }
+        }
+        solve_modes(sys, count)
+    }
+}
+
+/// The constrained problem in mass-scaled coordinates `y = M^(1/2) q` (M and K diagonal):
+/// `D = M^-1 K`, `Q` an orthonormal basis of the constraint rows `C M^(-1/2)`, and the eigenvalues
+/// (ascending) of `A = P D P`, `P = I - Q Q^T`: the constrained `omega^2` after `r` exact zeros.
+struct Projected {
+    n: usize,
+    r: usize,
+    d: Vec<f64>,
+    inv_sqrt_m: Vec<f64>,
+    q: Mat<f64>,
+    w: Vec<f64>,
+}
+
+impl Projected {
+    fn new(sys: &PoseSystem) -> Result<Self, AmmError> {
         let (n, r) = (sys.n, sys.rows);
         let fail = |reason: String| AmmError::SingularConstraints { t: 0.0, reason };
         let inv_sqrt_m: Vec<f64> = (0..n).map(|j| 1.0 / sys.m[j * n + j].sqrt()).collect();
@@ -208,20 +263,77 @@ impl PoseModel {
         matmul(a.as_mut(), Accum::Add, qg.as_ref(), q.transpose(), 1.0, Par::Seq);
         let a = Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
         let w = eigenvalues_seq(&a).map_err(|e| fail(format!("symmetric eigensolver failed ({e:?})")))?;
-        let rigid = if sliders == Sliders::Free { 3 } else { 0 };
-        let mut f: Vec<f64> = w
-            .iter()
-            .skip(r)
-            .take(count + rigid)
-            .map(|w2| w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
-            .collect();
-        f.iter_mut().take(rigid).for_each(|x| *x = 0.0);
-        Ok(f)
+        Ok(Projected {
+            n,
+            r,
+            d,
+            inv_sqrt_m,
+            q,
+            w,
+        })
     }
 
-    /// The first `count` modes at `pose` (rigid ones included when the sliders are free).
-    pub fn modes_at(&self, pose: &RestPose, sliders: Sliders, count: usize) -> Result<PoseModes, AmmError> {
-        solve_modes(self.system_at(pose, sliders), count)
+    /// Mass-normalised shapes `q` of the eigenvalues `omega2` (positive, ascending), each from
+    /// its eigenvalue alone. An eigenvector y of `P D P` off the constraint directions satisfies
+    /// `(D - w) y = Q mu` and `Q^T y = 0`, so `y = (D - w)^-1 Q mu` with `mu` in the null space of
+    /// the r x r matrix `G(w) = Q^T (D - w)^-1 Q`; a w of multiplicity p (the star's symmetric
+    /// pairs) has a p-dimensional one. `None` when a null vector is not clean (relative singular
+    /// value above 1e-7, e.g. w on a diagonal entry of D): the caller then uses the general solver.
+    fn shapes(&self, omega2: &[f64]) -> Option<Vec<Vec<f64>>> {
+        let (n, r) = (self.n, self.r);
+        let mut shapes = Vec::with_capacity(omega2.len());
+        let mut k = 0;
+        while k < omega2.len() {
+            let mut e = k + 1;
+            while e < omega2.len() && (omega2[e] - omega2[k]).abs() <= 1e-6 * omega2[k].abs() {
+                e += 1;
+            }
+            let mult = e - k;
+            let w = omega2[k..e].iter().sum::<f64>() / mult as f64;
+            if w <= 0.0 {
+                return None;
+            }
+            let inv: Vec<f64> = self.d.iter().map(|di| 1.0 / (di - w)).collect();
+            if inv.iter().any(|v| !v.is_finite()) {
+                return None;
+            }
+            let g = Mat::from_fn(r, r, |a, b| {
+                (0..n).map(|i| self.q[(i, a)] * inv[i] * self.q[(i, b)]).sum::<f64>()
+            });
+            let eig = g.self_adjoint_eigen(faer::Side::Lower).ok()?;
+            let sv: Vec<f64> = (0..r).map(|j| eig.S()[j].abs()).collect();
+            let largest = sv.iter().fold(0.0f64, |m, v| m.max(*v));
+            let mut order: Vec<usize> = (0..r).collect();
+            order.sort_by(|a, b| sv[*a].total_cmp(&sv[*b]));
+            let mut cluster: Vec<Vec<f64>> = Vec::with_capacity(mult);
+            for &j in order.iter().take(mult) {
+                if sv[j] > 1e-7 * largest {
+                    return None;
+                }
+                let mu = eig.U().col(j);
+                let mut y: Vec<f64> = (0..n)
+                    .map(|i| inv[i] * (0..r).map(|a| self.q[(i, a)] * mu[a]).sum::<f64>())
+                    .collect();
+                for prev in &cluster {
+                    let c: f64 = y.iter().zip(prev).map(|(a, b)| a * b).sum();
+                    y.iter_mut().zip(prev).for_each(|(a, b)| *a -= c * b);
+                }
+                let norm = y.iter().map(|v| v * v).sum::<f64>().sqrt();
+                if !(norm > 0.0 && norm.is_finite()) {
+                    return None;
+                }
+                y.iter_mut().for_each(|v| *v /= norm);
+                cluster.push(y);
+            }
+            // y^T y = 1 gives q^T M q = 1 for q = M^(-1/2) y
+            shapes.extend(
+                cluster
+                    .into_iter()
+                    .map(|y| y.iter().zip(&self.inv_sqrt_m).map(|(v, s)| v * s).collect::<Vec<f64>>()),
+            );
+            k = e;
+        }
+        Some(shapes)
     }
 }
 
@@ -370,11 +482,41 @@ mod tests {
         };
         for pose in [centre(&p), off] {
             for sliders in [Sliders::Locked, Sliders::Free] {
-                let full = model.modes_at(&pose, sliders, 8).unwrap().freq_hz;
+                // the general constrained solver (null space, Cholesky, full eigendecomposition)
+                let general = solve_modes(model.system_at(&pose, sliders), 8).unwrap();
                 let fast = model.frequencies_at(&pose, sliders, 8).unwrap();
-                assert_eq!(full.len(), fast.len());
-                for (a, b) in full.iter().zip(&fast) {
+                assert_eq!(general.freq_hz.len(), fast.len());
+                for (a, b) in general.freq_hz.iter().zip(&fast) {
                     assert!((a - b).abs() <= 1e-7 * a.max(1.0), "{sliders:?}: {a} vs {b}");
+                }
+                // shapes from the eigenvalues alone (sliders locked) against the general
+                // solver's: each lies in the span of the general shapes of its frequency
+                // (mass inner product; the centre's symmetric pairs are 2-dimensional)
+                let modes = model.modes_at(&pose, sliders, 8).unwrap();
+                if sliders == Sliders::Locked {
+                    let proj = Projected::new(&general.system).unwrap();
+                    assert!(
+                        proj.shapes(&general.omega2).is_some(),
+                        "the eigenvalue-only shapes are used here"
+                    );
+                }
+                let sys = &general.system;
+                let n = sys.n;
+                let m_dot = |a: &[f64], b: &[f64]| (0..n).map(|i| a[i] * sys.m[i * n + i] * b[i]).sum::<f64>();
+                for (x, f) in modes.shapes.iter().zip(&modes.freq_hz) {
+                    assert!((m_dot(x, x) - 1.0).abs() < 1e-9, "mass normalisation");
+                    let mut rest = x.clone();
+                    for (phi, g) in general.shapes.iter().zip(&general.freq_hz) {
+                        if (g - f).abs() <= 1e-5 * f.max(1.0) {
+                            let c = m_dot(phi, x);
+                            rest.iter_mut().zip(phi).for_each(|(r, p)| *r -= c * p);
+                        }
+                    }
+                    let off_span = m_dot(&rest, &rest).sqrt();
+                    assert!(
+                        off_span < 1e-5,
+                        "{sliders:?} f = {f}: shape off the general solver's by {off_span:e}"
+                    );
                 }
             }
         }

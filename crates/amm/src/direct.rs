@@ -21,7 +21,7 @@
 
 use flexstar_drive::ActuatorLaw;
 use flexstar_kinematics::{check_configuration, direct_kinematics, RigidState};
-use flexstar_model::{AmmSettings, DriveKind, Experiment, ModeCount, Response, RobotParams, RunInfo};
+use flexstar_model::{AmmSettings, DriveKind, Experiment, ModeCount, Response, RobotParams};
 use flexstar_numerics::GenAlpha;
 use num_dual::{Dual2, HyperDual64};
 
@@ -337,15 +337,7 @@ fn integrate_direct(
         .collect();
     extra.append(&mut resp.extra);
     resp.extra = extra;
-    resp.info = RunInfo {
-        solver: "amm-direct".into(),
-        family: Some(settings.family.name().into()),
-        model: Some(settings.model.name().into()),
-        modes: Some(n_modes),
-        dt: dt_max,
-        wall_s: started.elapsed().as_secs_f64(),
-        ..RunInfo::default()
-    };
+    resp.info = crate::solver::run_info("amm-direct", settings, n_modes, dt_max, started);
     Ok(resp)
 }
 

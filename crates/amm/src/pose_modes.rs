@@ -86,20 +86,8 @@ impl PoseSystem {
     }
 }
 
-/// Modes of the star at a pose.
-#[derive(Debug, Clone)]
-pub struct PoseModes {
-    /// Natural frequencies [Hz], ascending (rigid modes at round-off size, see [`PoseModes::rigid`]).
-    pub freq_hz: Vec<f64>,
-    /// `omega^2` [1/s^2] of the same modes.
-    pub omega2: Vec<f64>,
-    /// Mass-normalised shapes in the coordinates of [`PoseSystem`].
-    pub shapes: Vec<Vec<f64>>,
-    /// Number of leading rigid (zero-frequency) modes: 3 with free sliders, 0 locked.
-    pub rigid: usize,
-    /// The system they belong to.
-    pub system: PoseSystem,
-}
+/// Modes of the star at a pose, in the coordinates of [`PoseSystem`].
+pub type PoseModes = flexstar_numerics::eigen::PoseModes<PoseSystem>;
 
 /// The pose-independent part of the linearised AMM: the mode set and the constraint machinery of
 /// the beams, built once and reused for every pose of a frequency map (a map's cost is then the
@@ -215,17 +203,7 @@ impl PoseModel {
             let proj = Projected::new(&sys)?;
             let omega2: Vec<f64> = proj.w.iter().skip(proj.r).take(count).copied().collect();
             if let Some(shapes) = proj.shapes(&omega2) {
-                let freq_hz = omega2
-                    .iter()
-                    .map(|w| w.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
-                    .collect();
-                return Ok(PoseModes {
-                    freq_hz,
-                    omega2,
-                    shapes,
-                    rigid: 0,
-                    system: sys,
-                });
+                return Ok(PoseModes::new(omega2, shapes, 0, sys));
             }
         }
         solve_modes(sys, count)
@@ -422,23 +400,7 @@ fn solve_modes(system: PoseSystem, count: usize) -> Result<PoseModes, AmmError> 
         rigid_shift(system.sliders == Sliders::Free),
     )
     .map_err(|reason| AmmError::SingularConstraints { t: 0.0, reason })?;
-    let mut omega2 = out.omega2;
-    let mut freq_hz: Vec<f64> = omega2
-        .iter()
-        .map(|w| w.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
-        .collect();
-    // rigid modes: zero by construction, round-off here
-    for j in 0..rigid.min(omega2.len()) {
-        omega2[j] = 0.0;
-        freq_hz[j] = 0.0;
-    }
-    Ok(PoseModes {
-        freq_hz,
-        omega2,
-        shapes: out.shapes,
-        rigid,
-        system,
-    })
+    Ok(PoseModes::new(out.omega2, out.shapes, rigid, system))
 }
 
 #[cfg(test)]

@@ -238,16 +238,28 @@ fn integrate<F: FnMut(&System, &[f64])>(
     }
 
     let mut resp = rec.finish(format!("amm-{}", settings.family.name()));
-    resp.info = RunInfo {
-        solver: "amm".into(),
+    resp.info = run_info("amm", settings, n_modes, dt_max, started);
+    Ok(resp)
+}
+
+/// What an AMM run reports about itself (sidecar JSON): `solver` ("amm" or "amm-direct"), the
+/// settings' family and model, N used, the largest step [s] and the wall time since `started`.
+pub(crate) fn run_info(
+    solver: &str,
+    settings: &AmmSettings,
+    n_modes: usize,
+    dt: f64,
+    started: std::time::Instant,
+) -> RunInfo {
+    RunInfo {
+        solver: solver.into(),
         family: Some(settings.family.name().into()),
         model: Some(settings.model.name().into()),
         modes: Some(n_modes),
-        dt: dt_max,
+        dt,
         wall_s: started.elapsed().as_secs_f64(),
         ..RunInfo::default()
-    };
-    Ok(resp)
+    }
 }
 
 #[cfg(test)]

@@ -86,20 +86,9 @@ impl PoseSystem {
     coordinate_helpers!();
 }
 
-/// Modes of the star at a pose.
-#[derive(Debug, Clone)]
-pub struct PoseModes {
-    /// Natural frequencies [Hz], ascending (rigid modes set to 0, see `rigid`).
-    pub freq_hz: Vec<f64>,
-    /// `omega^2` [1/s^2] of the same modes.
-    pub omega2: Vec<f64>,
-    /// Mass-normalised shapes in the coordinates of [`PoseSystem`] (the same as the sparse one's).
-    pub shapes: Vec<Vec<f64>>,
-    /// Number of leading rigid modes: 3 with free sliders, 0 locked.
-    pub rigid: usize,
-    /// The system they belong to (sparse; [`SparsePoseSystem::to_dense`] gives the dense one).
-    pub system: SparsePoseSystem,
-}
+/// Modes of the star at a pose; `system` is sparse ([`SparsePoseSystem::to_dense`] gives the
+/// dense one).
+pub type PoseModes = flexstar_numerics::eigen::PoseModes<SparsePoseSystem>;
 
 /// The linearised FEM at a pose in sparse form: the same matrices as [`PoseSystem`] as
 /// (row, column, value) triplets (duplicates summed, in assembly order).
@@ -297,22 +286,7 @@ pub fn pose_modes_dense(
 
 /// Frequencies from `omega^2`, the rigid modes set to exactly 0.
 fn finish(system: SparsePoseSystem, out: ConstrainedModes, rigid: usize) -> PoseModes {
-    let mut omega2 = out.omega2;
-    let mut freq_hz: Vec<f64> = omega2
-        .iter()
-        .map(|w| w.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
-        .collect();
-    for j in 0..rigid.min(omega2.len()) {
-        omega2[j] = 0.0;
-        freq_hz[j] = 0.0;
-    }
-    PoseModes {
-        freq_hz,
-        omega2,
-        shapes: out.shapes,
-        rigid,
-        system,
-    }
+    PoseModes::new(out.omega2, out.shapes, rigid, system)
 }
 
 fn element_q(nodes: [usize; 2], q: &[f64]) -> [f64; 6] {

@@ -13,6 +13,40 @@
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Mat, Par, Side};
 
+/// Modes of the star at a pose, from either solver (`S`: the solver's assembled system).
+#[derive(Debug, Clone)]
+pub struct PoseModes<S> {
+    /// Natural frequencies [Hz], ascending (rigid modes set to 0, see `rigid`).
+    pub freq_hz: Vec<f64>,
+    /// `omega^2` [1/s^2] of the same modes (rigid ones set to 0).
+    pub omega2: Vec<f64>,
+    /// Mass-normalised shapes in the coordinates of the system.
+    pub shapes: Vec<Vec<f64>>,
+    /// Number of leading rigid (zero-frequency) modes: 3 with free sliders, 0 locked.
+    pub rigid: usize,
+    /// The system they belong to.
+    pub system: S,
+}
+
+impl<S> PoseModes<S> {
+    /// From `omega^2` and shapes: frequencies in Hz, the first `rigid` modes (round-off size
+    /// by construction) set to exactly 0.
+    pub fn new(mut omega2: Vec<f64>, shapes: Vec<Vec<f64>>, rigid: usize, system: S) -> Self {
+        omega2.iter_mut().take(rigid).for_each(|w| *w = 0.0);
+        let freq_hz = omega2
+            .iter()
+            .map(|w| w.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+            .collect();
+        PoseModes {
+            freq_hz,
+            omega2,
+            shapes,
+            rigid,
+            system,
+        }
+    }
+}
+
 /// Modes of a constrained system, lowest first.
 #[derive(Debug, Clone)]
 pub struct ConstrainedModes {

@@ -47,6 +47,65 @@ fn main() {
                 }
             }
         }
+    } else if what == "accurate-step" {
+        // the accurate model (enriched, full) at N = AMM_N (default 53): EVP(h, h/2) per point and
+        // mean over A, B, C, G as in Table I (flexstar_model::evp), the four cases
+        let steps: Vec<f64> = std::env::var("AMM_STEPS")
+            .ok()
+            .map(|s| s.split(",").map(|x| x.parse().unwrap()).collect())
+            .unwrap_or(vec![1e-3, 5e-4, 2.5e-4, 1e-3 / 6.0]);
+        let n = std::env::var("AMM_N").ok().and_then(|s| s.parse().ok()).unwrap_or(53);
+        println!("| case | h [s] | A | B | C | G | mean |");
+        println!("|---|---|---|---|---|---|---|");
+        for case in 1..=4 {
+            let exp = common::paper_case(case);
+            for &h in &steps {
+                let at = |dt: f64| {
+                    let s = flexstar_model::AmmSettings {
+                        modes: Some(n),
+                        dt: Some(dt),
+                        ..flexstar_model::AmmSettings::accurate()
+                    };
+                    solve(&exp, &s).unwrap()
+                };
+                let p = flexstar_model::evp::point_evps(&at(h), &at(h / 2.0)).unwrap();
+                let cells: Vec<String> = p
+                    .points
+                    .iter()
+                    .map(|v| v.map_or("n/a".into(), |x| format!("{x:.3}")))
+                    .collect();
+                println!(
+                    "| {case} | {h:.3e} | {} | {:.3} |",
+                    cells.join(" | "),
+                    p.mean.unwrap_or(f64::NAN)
+                );
+            }
+        }
+    } else if what == "truncation" {
+        // the accurate model at the accurate default step: mean EVP (Table I rule) of N against
+        // N = 150, and the estimate of the automatic choice (the previous N of the sequence)
+        let at = |exp: &flexstar_model::Experiment, n: usize| {
+            let s = flexstar_model::AmmSettings {
+                modes: Some(n),
+                dt: Some(flexstar_amm::TOLERANCE_DT),
+                ..flexstar_model::AmmSettings::accurate()
+            };
+            solve(exp, &s).unwrap()
+        };
+        let mean = |a: &Response, b: &Response| flexstar_model::evp::point_evps(a, b).unwrap().mean.unwrap();
+        println!("| case | N | true truncation (vs N = 150) [%] | estimate (vs previous N) [%] | ratio |");
+        println!("|---|---|---|---|---|");
+        for case in 1..=4 {
+            let exp = common::paper_case(case);
+            let reference = at(&exp, 150);
+            let ns = [40, 46, 53, 61, 71];
+            let runs: Vec<Response> = ns.iter().map(|&n| at(&exp, n)).collect();
+            for k in 1..ns.len() {
+                let truth = mean(&runs[k], &reference);
+                let est = mean(&runs[k - 1], &runs[k]);
+                println!("| {case} | {} | {truth:.3} | {est:.3} | {:.2} |", ns[k], est / truth);
+            }
+        }
     } else if what == "amplitudes" {
         // largest |w| over time [mm] per point, N = 25, 50, 100 (default step)
         println!("| case | family | N | tip A | tip B | tip C | w1G | w2G | w3G | max Fa [N] |");

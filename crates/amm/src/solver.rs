@@ -25,6 +25,19 @@ use crate::system::System;
 /// paper's four cases by an EVP below 0.1 % (largest 0.090 %) for every family at N = 25, 50, 100.
 pub const DEFAULT_DT: f64 = 1.0e-3 / 6.0;
 
+/// Default step [s] of the accurate model (automatic N at the default tolerance of 0.5 %): the
+/// FEM's default step. There the time error of the enriched full model at N = 53, EVP(h, h/2)
+/// mean over A, B, C, G, is 0.06-0.13 % on the paper's four cases (at most 0.25 % at a point), a
+/// quarter of the tolerance; `docs/amm.md` section 9.
+pub const TOLERANCE_DT: f64 = 5.0e-4;
+
+/// Default step [s] when N follows a tolerance `tol` [%]: the time error is second order, so the
+/// step scales with the square root of the tolerance to keep the time error at about a quarter
+/// of it: `TOLERANCE_DT * sqrt(tol / 0.5)`, at most [`TOLERANCE_DT`] x 2 (1 ms).
+pub fn tolerance_step(tol: f64) -> f64 {
+    (TOLERANCE_DT * (tol / flexstar_model::config::DEFAULT_TOL_PERCENT).sqrt()).min(2.0 * TOLERANCE_DT)
+}
+
 /// Spectral radius at infinity of the generalized-alpha scheme: mild damping of the unresolved
 /// high modes and of the multiplier oscillations of index-3 schemes (`docs/amm.md`).
 pub const RHO_INF: f64 = 0.8;
@@ -75,7 +88,11 @@ pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, s
             check_step("amm.dt", dt, exp.time.dt_out)?;
             dt
         }
-        None => DEFAULT_DT.min(exp.time.dt_out),
+        None => match settings.mode_count() {
+            ModeCount::Tolerance(tol) => tolerance_step(tol),
+            ModeCount::Fixed(_) => DEFAULT_DT,
+        }
+        .min(exp.time.dt_out),
     };
     if exp.time.t_end / dt > 1e8 {
         return Err(AmmError::invalid(

@@ -26,7 +26,7 @@ use flexstar_kinematics::RigidState;
 use flexstar_model::{AmmModel, RobotParams};
 
 use crate::error::AmmError;
-use crate::modes::{ModeSet, SleeveBending, Triplet};
+use crate::modes::{dot, ModeSet, SleeveBending, Triplet};
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
 
@@ -61,6 +61,8 @@ const B_RIGHT: usize = 3; // phi_j(xp + Lp/2) (FR)
 const B_LEFT: usize = 4; // phi_j(xp - Lp/2)  (FL)
 const B_MSLOPE: usize = 5; // -phi_j'(xp)     (Mp)
 const NB: usize = 6;
+/// Most constraint rows that touch one beam (three Fix, Fw, two slope rows, four sleeve rows).
+const MAX_BEAM_ROWS: usize = 10;
 /// "This row has no alpha part."
 const NONE: usize = usize::MAX;
 
@@ -191,7 +193,11 @@ impl System {
             sleeve: std::array::from_fn(|_| vec![0.0; nm]),
             scaled: std::array::from_fn(|_| vec![0.0; nm]),
             gram: [[0.0; NB]; NB],
-            bent: SleeveBending::new(if model == AmmModel::Full { nm } else { 0 }),
+            bent: SleeveBending::new(if model == AmmModel::Full {
+                modes.analytic_len()
+            } else {
+                0
+            }),
             g: [0.0; NB],
         });
         for (k, row) in rows.iter().enumerate() {
@@ -231,6 +237,7 @@ impl System {
                 }
             }
         }
+        debug_assert!(beams.iter().all(|b| b.ids.len() <= MAX_BEAM_ROWS));
         let m = rows.len();
         let n = 3 * nb;
         let g12 = match model {
@@ -311,14 +318,13 @@ impl System {
             let alpha = &qhat[i * nb..i * nb + nm];
             let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
             let [mid, right, left, mslope] = &mut beam.sleeve;
-            let bent = if full { Some(&mut beam.bent) } else { None };
+            let bent = if full { Some((alpha, &mut beam.bent)) } else { None };
             self.modes
                 .triplet_at(&self.tri, x - u_hat, left, mid, right, mslope, bent);
             if full {
                 let slope_mid = dot(mslope, alpha);
-                let slope_right = dot(&beam.bent.slope_right, alpha);
-                let slope_left = dot(&beam.bent.slope_left, alpha);
-                let curvature = dot(&beam.bent.curvature, alpha);
+                let (slope_right, slope_left) = (beam.bent.slope_right, beam.bent.slope_left);
+                let curvature = beam.bent.curvature;
                 for (k, id) in beam.ids.iter().enumerate() {
                     let c = match self.rows[*id] {
                         Row::Fp(_) => -slope_mid,
@@ -542,11 +548,19 @@ impl System {
         let m = self.rows.len();
         let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp);
         self.a.iter_mut().for_each(|v| *v = 0.0);
-        let mut beams = std::mem::take(&mut self.beams);
+        // disjoint borrows of the fields (no copy of the beams' workspaces)
+        let (beams, a_mat, inv_d, phi0, dphi0, phi) = (
+            &mut self.beams,
+            &mut self.a,
+            &self.inv_d,
+            &self.phi0,
+            &self.dphi0,
+            &self.phi,
+        );
         for beam in beams.iter_mut() {
             // sleeve vectors scaled by D^-1, the Gram matrix and g = B D^-1 Phi
             for (sv, v) in beam.scaled.iter_mut().zip(&beam.sleeve) {
-                for ((s, x), d) in sv.iter_mut().zip(v).zip(&self.inv_d) {
+                for ((s, x), d) in sv.iter_mut().zip(v).zip(inv_d) {
                     *s = x * d;
                 }
             }
@@ -557,8 +571,8 @@ impl System {
             gram[B_DPHI0][B_DPHI0] = g11;
             for a in 0..4 {
                 let sa = &beam.scaled[a];
-                gram[B_MID + a][B_PHI0] = dot(sa, &self.phi0);
-                gram[B_MID + a][B_DPHI0] = dot(sa, &self.dphi0);
+                gram[B_MID + a][B_PHI0] = dot(sa, phi0);
+                gram[B_MID + a][B_DPHI0] = dot(sa, dphi0);
                 gram[B_PHI0][B_MID + a] = gram[B_MID + a][B_PHI0];
                 gram[B_DPHI0][B_MID + a] = gram[B_MID + a][B_DPHI0];
                 for b in a..4 {
@@ -566,29 +580,39 @@ impl System {
                     gram[B_MID + a][B_MID + b] = v;
                     gram[B_MID + b][B_MID + a] = v;
                 }
-                beam.g[B_MID + a] = dot(sa, &self.phi);
+                beam.g[B_MID + a] = dot(sa, phi);
             }
             beam.g[B_PHI0] = w0;
             beam.g[B_DPHI0] = w1;
 
+            // A_ks = (cu_k - p g_k)(cu_s + p g_s) / sigma + ct_k ct_s / Jp + sc_k sc_s gram[b_k][b_s],
+            // with the rows without an alpha part (basis NONE) given g = 0 and a zero Gram row
             let mb = beam.ids.len();
+            let mut left = [0.0; MAX_BEAM_ROWS];
+            let mut right = [0.0; MAX_BEAM_ROWS];
+            let mut gram_rows = [[0.0; MAX_BEAM_ROWS]; NB];
             for k in 0..mb {
                 let (bk, sk) = (beam.basis[k], beam.sc[k]);
                 let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };
-                let left = (beam.cu[k] - p * gk) * inv_sigma;
-                let row = beam.ids[k] * m;
-                for s in 0..mb {
-                    let (bs, ss) = (beam.basis[s], beam.sc[s]);
-                    let gs = if bs == NONE { 0.0 } else { ss * beam.g[bs] };
-                    let mut v = left * (beam.cu[s] + p * gs) + beam.ct[k] * beam.ct[s] * inv_jp;
-                    if bk != NONE && bs != NONE {
-                        v += sk * ss * beam.gram[bk][bs];
+                left[k] = (beam.cu[k] - p * gk) * inv_sigma;
+                right[k] = beam.cu[k] + p * gk;
+                if bk != NONE {
+                    for (a, row) in gram_rows.iter_mut().enumerate() {
+                        row[k] = sk * beam.gram[a][bk];
                     }
-                    self.a[row + beam.ids[s]] += v;
+                }
+            }
+            for k in 0..mb {
+                let (bk, sk) = (beam.basis[k], beam.sc[k]);
+                let ctk = beam.ct[k] * inv_jp;
+                let a_row = &mut a_mat[beam.ids[k] * m..(beam.ids[k] + 1) * m];
+                let zero = [0.0; MAX_BEAM_ROWS];
+                let gram_k = if bk == NONE { &zero } else { &gram_rows[bk] };
+                for s in 0..mb {
+                    a_row[beam.ids[s]] += left[k] * right[s] + ctk * beam.ct[s] + sk * gram_k[s];
                 }
             }
         }
-        self.beams = beams;
         lu_factor(&mut self.a, &mut self.piv, m).map_err(|reason| AmmError::SingularConstraints { t: st.t, reason })
     }
 
@@ -737,29 +761,6 @@ impl System {
     }
 }
 
-/// Dot product with four independent accumulators (breaks the add latency chain; the order of
-/// summation is fixed, so results are reproducible).
-#[inline]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0f64; 4];
-    let ca = a.chunks_exact(4);
-    let cb = b.chunks_exact(4);
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        acc[0] += x[0] * y[0];
-        acc[1] += x[1] * y[1];
-        acc[2] += x[2] * y[2];
-        acc[3] += x[3] * y[3];
-    }
-    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
-    }
-    s
-}
-
 /// In-place LU with partial pivoting of the dense m x m matrix `a` (row-major): `P a = L U`, the
 /// multipliers of L below the diagonal, `piv[k]` the original row now at position k.
 /// Fails when a pivot is below 1e-13 of the largest entry of its row before elimination.
@@ -768,17 +769,19 @@ fn lu_factor(a: &mut [f64], piv: &mut [usize], m: usize) -> Result<(), String> {
         *p = r;
     }
     // m <= 18 by construction (6 junction + 12 sleeve rows)
+    // inverse of each row's largest entry (the pivot test compares |a| / scale)
     let mut scale = [0.0f64; 32];
     for r in 0..m {
-        scale[r] = a[r * m..(r + 1) * m].iter().fold(0.0f64, |s, v| s.max(v.abs()));
-        if scale[r] == 0.0 || !scale[r].is_finite() {
+        let largest = a[r * m..(r + 1) * m].iter().fold(0.0f64, |s, v| s.max(v.abs()));
+        if largest == 0.0 || !largest.is_finite() {
             return Err(format!("constraint row {r} has no coupling"));
         }
+        scale[r] = 1.0 / largest;
     }
     for k in 0..m {
         let (mut best, mut arg) = (0.0, k);
         for r in k..m {
-            let v = a[r * m + k].abs() / scale[r];
+            let v = a[r * m + k].abs() * scale[r];
             if v > best {
                 best = v;
                 arg = r;

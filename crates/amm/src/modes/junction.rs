@@ -18,8 +18,6 @@
 //! computed with a composite 5-point Gauss-Legendre rule on panels of width at most a sixth of the
 //! shortest half-wavelength of the kept modes.
 
-use flexstar_numerics::quadrature::gauss_legendre;
-
 /// One junction shape on the unit interval:
 /// `H(xi) = p[0] (1 - xi)^4 + p[1] (1 - xi)^5 - sum_k c[k] Phi_k(xi)`, unit L2 norm on [0, 1].
 #[derive(Debug, Clone, PartialEq)]
@@ -80,15 +78,18 @@ pub(crate) fn poly_curvature(p: [f64; 2], xi: f64) -> f64 {
     12.0 * p[0] * y * y + 20.0 * p[1] * y * y * y
 }
 
-/// Nodes and weights of the composite 5-point Gauss-Legendre rule on [0, 1] with `panels` panels.
+/// Points per panel of [`composite_rule`].
+const PANEL_POINTS: usize = 10;
+
+/// Nodes and weights of the composite 10-point Gauss-Legendre rule on [0, 1] with `panels` panels.
 pub(crate) fn composite_rule(panels: usize) -> (Vec<f64>, Vec<f64>) {
-    let (pts, wts) = gauss_legendre(5);
+    let (pts, wts) = flexstar_numerics::quadrature::gauss_legendre_rule(PANEL_POINTS);
     let h = 1.0 / panels as f64;
-    let mut x = Vec::with_capacity(5 * panels);
-    let mut w = Vec::with_capacity(5 * panels);
+    let mut x = Vec::with_capacity(PANEL_POINTS * panels);
+    let mut w = Vec::with_capacity(PANEL_POINTS * panels);
     for k in 0..panels {
         let a = k as f64 * h;
-        for (p, wt) in pts.iter().zip(wts) {
+        for (p, wt) in pts.iter().zip(&wts) {
             x.push(a + 0.5 * h * (p + 1.0));
             w.push(0.5 * h * wt);
         }
@@ -96,9 +97,12 @@ pub(crate) fn composite_rule(panels: usize) -> (Vec<f64>, Vec<f64>) {
     (x, w)
 }
 
-/// Panels for functions up to the dimensionless wavenumber `b_max`: at least six per half-wave.
+/// Panels for products of functions up to the dimensionless wavenumber `b_max` (wavenumber
+/// `2 b_max`): panels of width `h` with `2 b_max h <= 1.5 pi`. The n-point Gauss error on a panel
+/// is `f^(2n) h^(2n+1) (n!)^4 / ((2n + 1) ((2n)!)^3)`; for `e^(i k x)` with `k h = 1.5 pi` and
+/// n = 10 that is `(k h)^20 * 5.8e-31 = 2e-17` of the panel's integral. At least four panels.
 pub(crate) fn panels_for(b_max: f64) -> usize {
-    ((6.0 * b_max / std::f64::consts::PI).ceil() as usize).max(24)
+    ((b_max / (0.75 * std::f64::consts::PI)).ceil() as usize).max(4)
 }
 
 /// Build the two junction shapes against the kept modes, given their values `phi[q][k]` and

@@ -1,0 +1,31 @@
+//! One paper case with the accurate model's defaults (issue 9 item 5), for instruction counts
+//! that the load of a shared machine does not disturb:
+//!
+//! ```sh
+//! cargo build --release -p flexstar-amm --example accurate_cost
+//! valgrind --tool=callgrind target/release/examples/accurate_cost CASE [N]
+//! ```
+//! runs `flexstar_amm::solve` once with `AmmSettings::accurate()` (automatic N), or at a fixed N.
+use flexstar_amm::solve;
+use flexstar_model::catalogue::paper_case;
+use flexstar_model::AmmSettings;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let usage = "usage: accurate_cost CASE [N]";
+    let Some(case) = args.get(1).and_then(|c| c.parse().ok()) else {
+        eprintln!("{usage}");
+        std::process::exit(2);
+    };
+    let settings = AmmSettings {
+        modes: args.get(2).map(|n| n.parse().expect(usage)),
+        ..AmmSettings::accurate()
+    };
+    let r = solve(&paper_case(case), &settings).expect("solve");
+    println!(
+        "case {case}: N = {:?}, estimate {:?} %, {} output rows",
+        r.info.modes,
+        r.info.error_estimate_percent,
+        r.len()
+    );
+}

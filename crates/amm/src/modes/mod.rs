@@ -747,13 +747,12 @@ impl ModeSet {
         tri
     }
 
-    /// `phi_m(x - h)`, `phi_m(x)`, `phi_m(x + h)` and `phi_m'(x)` for every mode, by angle
-    /// addition with the factors of `tri`: one sin/cos pair and one exponential per elastic mode
-    /// below beta L = 40. Above, consecutive roots are pi apart to round-off (the distance to the
-    /// asymptote is below 2 exp(-40)), so sin, cos and the exponentials of mode m + 1 follow from
-    /// those of mode m by one rotation by pi x / L and two products. Needs `0 <= x - h`, `x + h <= L`.
-    /// With `bent`, also `phi_m'(x - h)`, `phi_m'(x + h)` and `phi_m''(x)` (the full model's
-    /// gradients of the sleeve rows in u, `docs/amm.md` section 8).
+    /// `phi_m(x - h)`, `phi_m(x)`, `phi_m(x + h)` and `phi_m'(x)` for every mode [1/sqrt(m),
+    /// 1/m^1.5], by angle addition with the factors of `tri`, the sin, cos and exponentials at x
+    /// coming from the nominal-root recurrence of [`ModeTrig`] (two `sin_cos` and four `exp` per
+    /// call). Needs `0 <= x - h`, `x + h <= L`. With `bent = (alpha, out)`, also the beam's
+    /// bending at the sleeve, `w'(x - h)`, `w'(x + h)` and `w''(x)` for `w = sum alpha_m phi_m`
+    /// (the full model's gradients of the sleeve rows in u, `docs/amm.md` section 8).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn triplet_at(
         &self,

@@ -22,6 +22,8 @@ pub struct FamilyEntry {
     pub modes: Option<usize>,
     /// Modes per beam the run used (the automatic choice when `modes` is not fixed).
     pub modes_used: Option<usize>,
+    /// The run's own estimate of its truncation EVP [%] (automatic N only; `docs/amm.md` section 9).
+    pub error_estimate: Option<f64>,
     pub evp: PointEvps,
     pub correct: bool,
     pub most_accurate: bool,
@@ -88,6 +90,7 @@ impl TableRow {
                 family,
                 modes: run.settings.modes,
                 modes_used: r.info.modes,
+                error_estimate: r.info.error_estimate_percent,
                 evp,
                 correct: is_correct(family, behaviour),
                 most_accurate: false,

@@ -62,6 +62,9 @@ pub struct AccurateBounds {
     pub mean_max: f64,
     /// Largest EVP at any single point [%].
     pub point_max: f64,
+    /// Largest factor between the run's own error estimate and its mean EVP, either way
+    /// (issue 9: within a factor of 2).
+    pub estimate_ratio_max: Option<f64>,
 }
 
 /// Errors reading the thresholds file.
@@ -221,6 +224,22 @@ impl Thresholds {
                     format!("<= {} %", acc.point_max),
                     matches!(worst, Some(v) if v <= acc.point_max),
                 );
+                if let Some(max) = acc.estimate_ratio_max {
+                    let estimate = run.and_then(|e| e.error_estimate);
+                    let ratio = match (estimate, mean) {
+                        (Some(e), Some(m)) if e > 0.0 && m > 0.0 => Some(e / m),
+                        _ => None,
+                    };
+                    push(
+                        format!("error estimate / mean EVP of the accurate model ({})", acc.label),
+                        match (estimate, ratio) {
+                            (Some(e), Some(r)) => format!("{e:.2} % / {} = {r:.2}", fmt(mean)),
+                            _ => "n/a".into(),
+                        },
+                        format!("in [1/{max}, {max}]"),
+                        matches!(ratio, Some(r) if r <= max && r >= 1.0 / max),
+                    );
+                }
             }
         }
         out

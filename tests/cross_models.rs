@@ -6,8 +6,10 @@
 //! - `brisk`: a faster quintic turning the other way (G moves 10 mm and turns -0.06 rad in 0.2 s)
 //!   followed by 0.2 s of free vibration: the residual vibration after a stop, which is what an
 //!   input shaper or a trajectory planner cares about. Its amplitude keeps the tips below ~1 cm
-//!   (2 % of L), like the paper's cases; 2.5 times larger (tips 28 mm, 5.6 % of L) the AMM is 3 %
-//!   off on average and 8.6 % at G (`docs/amm.md` section 9): the linear model's limit.
+//!   (2 % of L), like the paper's cases; scaled up (2, 2.5, 4, 6 times: tips 22 to 82 mm) the AMM
+//!   stays 0.14-0.85 % off on average and 0.2-1.0 % at G since the full model carries the
+//!   foreshortening inertia of the bent beams (`docs/amm.md` section 8; without it, 8.6 % at G at
+//!   2.5 times). The test at twice the amplitude guards that term.
 //!
 //! On both, flexstar's accurate reduced model (enriched family, full model, automatic N at the
 //! default tolerance) must agree with the independent FEM within the issue's targets (mean EVP over
@@ -19,31 +21,9 @@ use std::path::Path;
 use flexstar_compare::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment, FemSettings};
 
-const SMOOTH: &str = r#"
-name = "smooth"
-[time]
-t_end = 0.4
-dt_out = 0.001
-[trajectory]
-kind = "quintic"
-from = { Gx = 0.0, Gy = 0.0, theta = 0.0 }
-to = { Gx = 0.012, Gy = -0.008, theta = 0.06 }
-t0 = 0.0
-t1 = 0.3
-"#;
-
-const BRISK: &str = r#"
-name = "brisk"
-[time]
-t_end = 0.4
-dt_out = 0.001
-[trajectory]
-kind = "quintic"
-from = { Gx = 0.0, Gy = 0.0, theta = 0.0 }
-to = { Gx = -0.008, Gy = 0.006, theta = -0.06 }
-t0 = 0.0
-t1 = 0.2
-"#;
+/// The two motions, as in `configs/motions/` (runnable with `flexstar run`).
+const SMOOTH: &str = include_str!("../configs/motions/smooth.toml");
+const BRISK: &str = include_str!("../configs/motions/brisk.toml");
 
 /// Bounds of one check: mean EVP, largest point EVP, largest ratio between estimate and truth.
 struct Bounds {
@@ -114,17 +94,39 @@ fn accurate_amm_agrees_with_fem_on_a_smooth_motion() {
 
 #[test]
 fn accurate_amm_agrees_with_fem_on_a_brisk_motion_and_its_residual_vibration() {
-    // Measured: mean 0.80 %, tips 0.23-0.35 %, G 2.35 %, estimate 0.36 % (ratio 2.2). The issue's
-    // point target (2 %) and estimate ratio (2) are not met at G yet (docs/amm.md section 9:
-    // the Coriolis part of the axial inertia force is still left out); these bounds guard what
-    // holds today, the targets stay open.
-    check(
-        BRISK,
-        0.2,
-        Bounds {
-            mean: 1.0,
-            point: 2.6,
-            ratio: 2.5,
-        },
-    );
+    // Measured (defaults, tolerance step 5e-4 s): mean 0.17 %, tips 0.16-0.17 %, G 0.19 %,
+    // estimate 0.36 %. Before the foreshortening inertia of the full model (docs/amm.md section
+    // 8): G 2.36 %, estimate 2.2 times too small. The point target holds; the estimate is now
+    // conservative by 2.10 (issue 9's factor 2 is missed on the safe side, as in case 1 at 2.17:
+    // docs/amm.md section 9), so the ratio bound is 2.2 until the estimator is revised.
+    check(BRISK, 0.2, Bounds { ratio: 2.2, ..TARGETS });
+}
+
+#[test]
+fn foreshortening_inertia_holds_at_twice_brisks_amplitude() {
+    // Isolates the full model's foreshortening term: a model error linear in the deflection keeps
+    // its relative size when the motion is scaled, a second-order one grows with it. `brisk` with
+    // its displacement doubled (tips 22 mm, 4.4 % of L): without the term the AMM is 5.7 % off
+    // the FEM at G (0.35 / 0.99 / 2.35 / 5.7 % at scales 1/4, 1/2, 1, 2); with it 0.34 % (flat in
+    // the scale: 0.35 / 0.36 / 0.24 / 0.34 %). Bound: the issue's point target, at N = 53 (the N
+    // the default tolerance chooses for brisk) to keep the test short.
+    let mut exp = Experiment::from_toml_str(BRISK, Path::new("brisk.toml")).unwrap();
+    if let flexstar_model::Trajectory::Quintic { to, .. } = &mut exp.trajectory {
+        to.gx *= 2.0;
+        to.gy *= 2.0;
+        to.theta *= 2.0;
+    } else {
+        panic!("brisk is a quintic");
+    }
+    let fem = flexstar_fem::solve(&exp, &FemSettings::default(), None).unwrap();
+    let settings = AmmSettings {
+        modes: Some(53),
+        ..AmmSettings::accurate()
+    };
+    let amm = flexstar_amm::solve(&exp, &settings).unwrap();
+    let e = point_evps(&amm, &fem).unwrap();
+    eprintln!("brisk x 2: EVP A/B/C/G = {:?}", e.points);
+    let g = e.points[3].expect("G moves");
+    assert!(g <= 1.0, "G: {g} %");
+    assert!(e.mean.unwrap() <= TARGETS.mean, "mean {:?}", e.mean);
 }

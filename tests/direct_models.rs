@@ -6,8 +6,8 @@
 //! vibration. The comparison is the one of Table I (Eq. 45 at A, B, C and G, elastic outputs
 //! projected on the rigid frames of each run's own sliders), plus the slider positions.
 //!
-//! Measured (accurate model at N = 53, FEM at 300 elements): mean EVP direct 0.14-0.23 % against
-//! 0.27-0.56 % for the inverse runs, worst point 0.42 % against 1.16 %; sliders within 1.2e-5 m
+//! Measured (accurate model at N = 53, FEM at 300 elements): mean EVP direct 0.11-0.21 % against
+//! 0.22-0.38 % for the inverse runs, worst point 0.38 % against 0.64 %; sliders within 1.2e-5 m
 //! over travels of 0.16-0.25 m. Under forces the two models agree better than under motions:
 //! with the motion prescribed, every difference in the star's elastic reaction shows in its
 //! vibration; with the forces prescribed, part of it goes into a slightly different slider motion.

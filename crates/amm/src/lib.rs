@@ -21,6 +21,7 @@
 pub mod adaptive;
 pub mod direct;
 pub mod error;
+mod foreshortening;
 pub mod modes;
 pub mod pose_modes;
 mod record;

@@ -179,7 +179,7 @@ pub fn solve(exp: &Experiment, settings: &AmmSettings) -> Result<Response, AmmEr
 }
 
 /// [`solve`] with an observer called after every step with the system and the coordinates q.
-fn integrate<F: FnMut(&System, &[f64])>(
+pub(crate) fn integrate<F: FnMut(&System, &[f64])>(
     exp: &Experiment,
     settings: &AmmSettings,
     n_modes: usize,

@@ -26,6 +26,7 @@ use flexstar_kinematics::RigidState;
 use flexstar_model::{AmmModel, RobotParams};
 
 use crate::error::AmmError;
+use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
 use crate::modes::{dot, ModeSet, SleeveBending, Triplet};
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
@@ -126,6 +127,8 @@ pub(crate) struct System {
     udd: [f64; 3],
     /// Sleeve positions xp_i of the last solve [m].
     xp: [f64; 3],
+    /// Full model: the foreshortening inertia of the bent beams in the u rows (`foreshortening`).
+    fore: Option<Foreshortening>,
     // arrowhead data of S (the same for the three beams)
     inv_d: Vec<f64>,
     w: Vec<f64>,
@@ -240,19 +243,21 @@ impl System {
         debug_assert!(beams.iter().all(|b| b.ids.len() <= MAX_BEAM_ROWS));
         let m = rows.len();
         let n = 3 * nb;
-        let g12 = match model {
+        let (g12, fore) = match model {
             AmmModel::Full => {
                 let (g1, g2) = modes.axial_stiffening();
-                Mat::from_fn(
+                let g12 = Mat::from_fn(
                     2 * nm,
                     nm,
                     |r, c| if r < nm { g1[r * nm + c] } else { g2[(r - nm) * nm + c] },
-                )
+                );
+                (g12, Some(Foreshortening::new(&modes, &g2, KEPT_ANALYTIC)))
             }
-            AmmModel::Paper => Mat::zeros(0, 0),
+            AmmModel::Paper => (Mat::zeros(0, 0), None),
         };
         let kg_rows = g12.nrows();
         System {
+            fore,
             model,
             g12,
             g12_q: Mat::zeros(kg_rows, 3),
@@ -412,10 +417,14 @@ impl System {
     }
 
     /// Remember the axial accelerations u_i'' of `qdd` (the full model's Eq. 23 term of the next
-    /// step).
+    /// step) and the modal accelerations (its foreshortening term).
     pub(crate) fn set_axial_acceleration(&mut self, qdd: &[f64]) {
+        let (nm, nb) = (self.nm, self.nb);
         for i in 0..3 {
-            self.udd[i] = qdd[i * self.nb + self.nm];
+            self.udd[i] = qdd[i * nb + nm];
+            if let Some(fore) = self.fore.as_mut() {
+                fore.remember(i, &qdd[i * nb..i * nb + nm]);
+            }
         }
     }
 
@@ -460,6 +469,10 @@ impl System {
                 let col = self.g12_q.col(i);
                 for (j, rj) in r[..nm].iter_mut().enumerate() {
                     *rj -= c1 * col[j] + c2 * col[nm + j];
+                }
+                // foreshortening inertia of the bent beam in its u row: + rho E''
+                if let Some(fore) = self.fore.as_mut() {
+                    r[nm] += rho * fore.second_derivative(i, col.subrows(nm, nm), va);
                 }
             }
         }

@@ -1,5 +1,5 @@
-//! Accuracy of AMM settings against the FEM on the paper's four cases (and the two extra motions
-//! of `docs/validation.md`): mean and largest point EVP (Eq. 45) per case, and the AMM's wall time.
+//! Accuracy of AMM settings against the FEM on the paper's four cases and the two motions of our
+//! own (`configs/motions/`, `tests/cross_models.rs`): mean and largest point EVP (Eq. 45) per case, and the AMM's wall time.
 //!
 //! `cargo run --release -p flexstar-compare --example accuracy -- FAMILY MODEL N [N ...]`
 //! (N = 0: automatic N at the default tolerance; `tol=P` for another tolerance). The environment
@@ -18,7 +18,14 @@ fn main() {
     }
     let family: ModeFamily = args[0].parse().expect("family");
     let model = args[1].parse().expect("model");
-    let cases: Vec<Experiment> = (1..=4).map(paper_case).collect();
+    let mut cases: Vec<Experiment> = (1..=4).map(paper_case).collect();
+    // the two motions of our own (tests/cross_models.rs)
+    for (file, text) in [
+        ("smooth.toml", include_str!("../../../configs/motions/smooth.toml")),
+        ("brisk.toml", include_str!("../../../configs/motions/brisk.toml")),
+    ] {
+        cases.push(Experiment::from_toml_str(text, std::path::Path::new(file)).expect("own motion"));
+    }
     let fems: Vec<_> = cases
         .par_iter()
         .map(|e| flexstar_fem::solve(e, &e.fem, None).expect("fem"))

@@ -95,11 +95,9 @@ fn accurate_amm_agrees_with_fem_on_a_smooth_motion() {
 #[test]
 fn accurate_amm_agrees_with_fem_on_a_brisk_motion_and_its_residual_vibration() {
     // Measured (defaults, tolerance step 5e-4 s): mean 0.17 %, tips 0.16-0.17 %, G 0.19 %,
-    // estimate 0.36 %. Before the foreshortening inertia of the full model (docs/amm.md section
-    // 8): G 2.36 %, estimate 2.2 times too small. The point target holds; the estimate is now
-    // conservative by 2.10 (issue 9's factor 2 is missed on the safe side, as in case 1 at 2.17:
-    // docs/amm.md section 9), so the ratio bound is 2.2 until the estimator is revised.
-    check(BRISK, 0.2, Bounds { ratio: 2.2, ..TARGETS });
+    // estimate 0.21 % (ratio 1.24). Before the foreshortening inertia of the full model
+    // (docs/amm.md section 8): G 2.36 %, estimate 2.2 times too small.
+    check(BRISK, 0.2, TARGETS);
 }
 
 #[test]

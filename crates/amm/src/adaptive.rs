@@ -3,11 +3,13 @@
 //! The solver estimates the EVP (Eq. 45, mean over A, B, C and G with the n/a rule of
 //! `flexstar_model::evp`) of its own modal truncation from two runs: N_prev and N = ~1.15 N_prev.
 //! If the error falls like N^-p, the difference d between the two runs is
-//! `e(N_prev) - e(N) = e(N) ((N / N_prev)^p - 1)`; the enriched family's observed rate on the
-//! paper's cases is p ~ 5 (`docs/amm.md` section 9), for which `(1.15)^5 - 1 ~ 1`, so the
-//! estimate of e(N) is d itself. N starts where the modes first resolve the sleeve (wavelength
-//! 2L/N below Lp, `docs/amm.md` section 3, plus a margin) and grows by 15 % until the estimate is below
-//! the tolerance, up to [`MAX_AUTO_MODES`].
+//! `e(N_prev) - e(N) = e(N) ((N / N_prev)^p - 1)`, so `e(N) = d / ((N / N_prev)^p - 1)`
+//! (Richardson). The rate [`RATE`] is measured: between N = 46 and 53 the truncation EVP of the
+//! paper's four cases against N = 150 falls by 2.4-2.9 times, p = 6.1-7.6 (`docs/amm.md`
+//! section 9; `cargo run --release -p flexstar-amm --example convergence -- truncation`).
+//! N starts where the modes first resolve the sleeve (wavelength 2L/N below Lp, `docs/amm.md`
+//! section 3, plus a margin) and grows by 15 % until the estimate is below the tolerance, up to
+//! [`MAX_AUTO_MODES`].
 
 use flexstar_model::evp::point_evps;
 use flexstar_model::{Experiment, Response};
@@ -19,6 +21,11 @@ pub const MAX_AUTO_MODES: usize = 200;
 
 /// Growth of N between two runs of the automatic choice.
 pub const GROWTH: f64 = 1.15;
+
+/// Convergence rate p of the truncation EVP, `e(N) ~ N^-p`, that turns the difference of two
+/// runs into the estimate (module docs): the median of the rates measured on the paper's cases
+/// between N = 46 and 53 (6.1, 6.8, 7.2, 7.6).
+pub const RATE: f64 = 7.0;
 
 /// Modes beyond the sleeve resolution `2 L / Lp` with which the automatic choice starts: at
 /// `2 L / Lp + 6` the paper's cases are still 1.6-2.1 % off the FEM, at `+ 12` about 1 %
@@ -42,10 +49,15 @@ pub fn next_modes(n: usize) -> usize {
     ((n as f64 * GROWTH).ceil() as usize).max(n + 2).min(MAX_AUTO_MODES)
 }
 
-/// Estimated truncation EVP [%] of `fine` from the coarser run `coarse`: the mean point EVP of
-/// `coarse` against `fine` (see the module docs). `None` when no point has a reference.
-pub fn truncation_estimate(coarse: &Response, fine: &Response) -> Option<f64> {
-    point_evps(coarse, fine).ok().and_then(|e| e.mean)
+/// Estimated truncation EVP [%] of `fine` (N = `n_fine`) from the coarser run `coarse`
+/// (N = `n_coarse`): the mean point EVP of `coarse` against `fine` divided by
+/// `(n_fine / n_coarse)^RATE - 1` (see the module docs). `None` when no point has a reference.
+pub fn truncation_estimate(coarse: &Response, fine: &Response, n_coarse: usize, n_fine: usize) -> Option<f64> {
+    let richardson = (n_fine as f64 / n_coarse as f64).powf(RATE) - 1.0;
+    point_evps(coarse, fine)
+        .ok()
+        .and_then(|e| e.mean)
+        .map(|d| d / richardson)
 }
 
 /// Raise N from [`first_modes`] until the estimate is below `tol` [%]; `run(n)` solves at N = n.
@@ -72,7 +84,7 @@ where
         }
         let mut next = run(n_next)?;
         wall += next.info.wall_s;
-        let estimate = truncation_estimate(&prev, &next).unwrap_or(0.0);
+        let estimate = truncation_estimate(&prev, &next, n, n_next).unwrap_or(0.0);
         next.info.error_estimate_percent = Some(estimate);
         next.info.tol_percent = Some(tol);
         next.info.wall_s = wall;

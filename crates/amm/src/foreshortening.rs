@@ -168,7 +168,7 @@ mod tests {
         let h = crate::DEFAULT_DT;
         let mut prev: Option<Vec<f64>> = None;
         let (mut err2, mut ref2) = (0.0, 0.0);
-        crate::solver::integrate(&exp, &settings, n, |sys, q| {
+        crate::solver::integrate(&exp, &settings, n, true, |sys, q| {
             if let Some(p) = &prev {
                 for b in 0..3 {
                     let o = b * sys.nb;

@@ -169,24 +169,28 @@ pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 /// and `info.modes` / `info.error_estimate_percent` report the N used and the estimate.
 pub fn solve(exp: &Experiment, settings: &AmmSettings) -> Result<Response, AmmError> {
     match settings.mode_count() {
-        ModeCount::Fixed(n) => integrate(exp, settings, n, |_, _| {}),
+        ModeCount::Fixed(n) => integrate(exp, settings, n, true, |_, _| {}),
         ModeCount::Tolerance(tol) => {
             // every input error before any work, at the first N
             validate(exp, settings, adaptive::first_modes(exp), true)?;
-            adaptive::solve_to_tolerance(exp, tol, |n| integrate(exp, settings, n, |_, _| {}))
+            // the trajectory was scanned once above; each run checks only its own settings
+            adaptive::solve_to_tolerance(exp, tol, |n| integrate(exp, settings, n, false, |_, _| {}))
         }
     }
 }
 
-/// [`solve`] with an observer called after every step with the system and the coordinates q.
+/// [`solve`] at N = `n_modes` with an observer called after every step with the system and the
+/// coordinates q; `scan`: check the trajectory's feasibility over the whole span first (off when
+/// the caller has, as the automatic N does once for all its runs).
 pub(crate) fn integrate<F: FnMut(&System, &[f64])>(
     exp: &Experiment,
     settings: &AmmSettings,
     n_modes: usize,
+    scan: bool,
     mut observe: F,
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
-    let dt_max = validate(exp, settings, n_modes, true)?;
+    let dt_max = validate(exp, settings, n_modes, scan)?;
     let params = &exp.robot;
     let modes = ModeSet::new(settings.family, n_modes, params)?;
     let mut sys = System::new(modes, params, settings.model);
@@ -305,7 +309,7 @@ mod tests {
         for fam in ModeFamily::PAPER {
             let settings = AmmSettings::paper(fam, 20);
             let (mut worst, mut qmax, mut steps) = (0.0f64, 0.0f64, 0);
-            integrate(&case([1.0, 0.0, 0.5], 0.2), &settings, 20, |sys, q| {
+            integrate(&case([1.0, 0.0, 0.5], 0.2), &settings, 20, true, |sys, q| {
                 worst = worst.max(sys.constraint_residual(q));
                 qmax = qmax.max(q.iter().fold(0.0f64, |m, v| m.max(v.abs())));
                 steps += 1;
@@ -328,7 +332,7 @@ mod tests {
             ..AmmSettings::accurate()
         };
         let (mut material, mut rigid) = (0.0f64, 0.0f64);
-        integrate(&exp, &settings, 30, |sys, q| {
+        integrate(&exp, &settings, 30, true, |sys, q| {
             let (m, r) = sys.sleeve_gaps(q, exp.robot.lp);
             material = material.max(m);
             rigid = rigid.max(r);

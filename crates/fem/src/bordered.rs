@@ -183,6 +183,7 @@ impl Bordered {
     }
 
     /// Band of beam i from its element blocks; the G-G part of element 0 goes to the border.
+    #[inline(never)]
     fn fill_beam(&mut self, i: usize, vals: &[f64]) {
         let ns = self.ns;
         let ne = self.lay.ne;
@@ -209,6 +210,7 @@ impl Bordered {
     }
 
     /// In-place banded Cholesky of beam i.
+    #[inline(never)]
     fn cholesky(&mut self, i: usize) -> Result<(), String> {
         let n = 3 * self.lay.ne;
         let band = &mut self.band[i];
@@ -239,6 +241,7 @@ impl Bordered {
     /// `E_i` (G columns from element 0, multiplier columns from the constraint rows; couplings
     /// of the multipliers with G, xi and psi go to the border), then `W_i = L_i^{-1} E_i` and
     /// `S -= W_i^T W_i`.
+    #[inline(never)]
     fn border_columns(&mut self, i: usize, vals: &[f64], win: &[[usize; 3]; 3]) {
         let ns = self.ns;
         let l = self.lay;
@@ -338,6 +341,7 @@ impl Bordered {
     }
 
     /// Dense LU with partial pivoting of the Schur complement, in place.
+    #[inline(never)]
     fn lu_schur(&mut self) -> Result<(), String> {
         let ns = self.ns;
         let s = &mut self.s;

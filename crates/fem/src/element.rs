@@ -23,19 +23,23 @@
 //! ```
 //!
 //! and its cross-section angle is `beta + H1' th1 + H2' th2`. The same `r(zeta)` defines the
-//! kinetic energy `T = 1/2 int rho |r_dot|^2 dx`, evaluated by 4-point Gauss quadrature (exact
-//! for the linearised element, where it reduces to the textbook consistent mass matrix). Its
-//! Lagrange equations give the inertia force `int rho J^T (J q_dd + r_conv) dx` with
-//! `J = dr/dq_e` and the convective acceleration `r_conv` (terms quadratic in `q_dot`).
-
-use flexstar_numerics::quadrature::gauss_legendre;
+//! kinetic energy `T = 1/2 int rho |r_dot|^2 dx`. Its Lagrange equations give the inertia force
+//! `int rho J^T (J q_dd + r_conv) dx` with `J = dr/dq_e` and the convective acceleration `r_conv`
+//! (terms quadratic in `q_dot`). Both are combinations of the basis `phi = [1 - zeta, zeta, H1, H2]`
+//! with coefficients fixed by the element state (`J = sum_k phi_k A_k`, `r_conv = H1 c_2 + H2 c_3`),
+//! so the integrals are exact in closed form through the Gram matrix `int phi_k phi_l` ([`GRAM`]);
+//! for the linearised element this is the textbook consistent mass matrix.
 
 /// 6x6 element matrix, row-major.
 pub type Mat6 = [[f64; 6]; 6];
 
 /// Wrap an angle to (-pi, pi].
+#[inline]
 fn wrap(a: f64) -> f64 {
     use std::f64::consts::PI;
+    if a > -PI && a <= PI {
+        return a;
+    }
     let w = (a + PI).rem_euclid(2.0 * PI) - PI;
     if w <= -PI {
         w + 2.0 * PI
@@ -185,26 +189,90 @@ impl ElementState {
     }
 
     /// Full inertia force `M(q) qdd + f_conv = int rho J^T (J qdd + r_conv) dx` [N, N m] without
-    /// forming `M` (4-point Gauss quadrature, as [`ElementState::inertia`]).
+    /// forming `M`, in closed form: with `J = sum_k phi_k A_k` and `r_conv = sum_k phi_k c_k`
+    /// ([`ElementState::basis`]), `f = rho l0 sum_k A_k^T sum_l G_kl (A_l qdd + c_l)` ([`GRAM`]).
+    #[inline]
     pub fn inertia_force(&self, rho: f64, qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
-        let (pts, wts) = gauss_legendre(4);
-        let mut f = [0.0; 6];
-        for (p, wg) in pts.iter().zip(wts) {
-            let z = 0.5 * (p + 1.0);
-            let wq = 0.5 * wg * rho * self.l0;
-            let jac = self.jacobian(z);
-            let rc = self.convective(z, qd);
-            let mut acc = rc;
+        let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
+        let jb = self.jbeta();
+        let l0 = self.l0;
+        let jq = jb[0] * qdd[0] + jb[1] * qdd[1] + jb[3] * qdd[3] + jb[4] * qdd[4];
+        let [cv2, cv3] = self.convective_coefficients(qd);
+        // u_k = A_k qdd + c_k (2-vectors)
+        let (g2, h2) = (l0 * (qdd[2] - jq) + cv2[1], -l0 * self.th1 * jq + cv2[0]);
+        let (g3, h3) = (l0 * (qdd[5] - jq) + cv3[1], -l0 * self.th2 * jq + cv3[0]);
+        let u: [[f64; 2]; 4] = [
+            [qdd[0], qdd[1]],
+            [qdd[3], qdd[4]],
+            [g2 * e2[0] + h2 * e1[0], g2 * e2[1] + h2 * e1[1]],
+            [g3 * e2[0] + h3 * e1[0], g3 * e2[1] + h3 * e1[1]],
+        ];
+        let v = gram_times(&u);
+        self.basis_transpose_times(rho, &v)
+    }
+
+    /// `rho l0 sum_k A_k^T v_k` (the transpose of the basis applied to four 2-vectors).
+    #[inline]
+    fn basis_transpose_times(&self, rho: f64, v: &[[f64; 2]; 4]) -> [f64; 6] {
+        let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
+        let jb = self.jbeta();
+        let l0 = self.l0;
+        let (p2, r2) = (e2[0] * v[2][0] + e2[1] * v[2][1], e1[0] * v[2][0] + e1[1] * v[2][1]);
+        let (p3, r3) = (e2[0] * v[3][0] + e2[1] * v[3][1], e1[0] * v[3][0] + e1[1] * v[3][1]);
+        let cj = l0 * (p2 + self.th1 * r2 + p3 + self.th2 * r3);
+        let rl = rho * l0;
+        [
+            rl * (v[0][0] - cj * jb[0]),
+            rl * (v[0][1] - cj * jb[1]),
+            rl * (l0 * p2),
+            rl * (v[1][0] - cj * jb[3]),
+            rl * (v[1][1] - cj * jb[4]),
+            rl * (l0 * p3),
+        ]
+    }
+
+    /// Coefficient matrices `A_k` (2 x 6) of the Jacobian in the basis
+    /// `phi = [1 - zeta, zeta, H1, H2]`: `J(zeta) = sum_k phi_k(zeta) A_k` (see
+    /// [`ElementState::jacobian`]): `A_0`, `A_1` pick node a's and node b's position, and
+    /// `A_2 = l0 (e2 (e_phia - jb)^T - th1 e1 jb^T)`, `A_3 = l0 (e2 (e_phib - jb)^T - th2 e1 jb^T)`
+    /// with `jb = d beta / d q_e`.
+    #[inline]
+    pub fn basis(&self) -> [[[f64; 6]; 2]; 4] {
+        let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
+        let jb = self.jbeta();
+        let l0 = self.l0;
+        let mut a = [[[0.0; 6]; 2]; 4];
+        a[0][0][0] = 1.0;
+        a[0][1][1] = 1.0;
+        a[1][0][3] = 1.0;
+        a[1][1][4] = 1.0;
+        for (m, (th, rot)) in [(self.th1, 2), (self.th2, 5)].into_iter().enumerate() {
             for k in 0..2 {
                 for j in 0..6 {
-                    acc[k] += jac[k][j] * qdd[j];
+                    a[2 + m][k][j] = -l0 * (e2[k] + th * e1[k]) * jb[j];
                 }
-            }
-            for i in 0..6 {
-                f[i] += wq * (jac[0][i] * acc[0] + jac[1][i] * acc[1]);
+                a[2 + m][k][rot] += l0 * e2[k];
             }
         }
-        f
+        a
+    }
+
+    /// The convective acceleration `r_conv = H1 c_2 + H2 c_3` ([`ElementState::convective`]):
+    /// returns `[c_2, c_3]`, each as `[e1 component, e2 component]`.
+    #[inline]
+    fn convective_coefficients(&self, qd: &[f64; 6]) -> [[f64; 2]; 2] {
+        let l0 = self.l0;
+        let ln2 = self.ln * self.ln;
+        let dd = [qd[3] - qd[0], qd[4] - qd[1]];
+        let bd = (self.d[0] * dd[1] - self.d[1] * dd[0]) / ln2;
+        let bdd_c = -2.0 * bd * (self.d[0] * dd[0] + self.d[1] * dd[1]) / ln2;
+        let c = |th: f64, rate: f64| {
+            [
+                l0 * (-2.0 * (rate - bd) * bd - th * bdd_c),
+                l0 * (-bdd_c - th * bd * bd),
+            ]
+        };
+        [c(self.th1, qd[2]), c(self.th2, qd[5])]
     }
 
     /// Interpolated position `r(zeta)` [m] of the material point at `zeta` in [0, 1].
@@ -293,45 +361,74 @@ impl ElementState {
 
     /// Inertia of the element (Lagrange equations of `T = 1/2 int rho |r_dot|^2 dx`):
     /// returns the convective inertia force `int rho J^T r_conv dx` [N, N m] and the consistent
-    /// mass matrix `M(q) = int rho J^T J dx`, both by 4-point Gauss quadrature. The full inertia
-    /// force is `M q_dd + f_conv`.
+    /// mass matrix `M(q) = int rho J^T J dx`, both in closed form ([`ElementState::mass`]). The
+    /// full inertia force is `M q_dd + f_conv`.
     pub fn inertia(&self, rho: f64, qd: &[f64; 6]) -> ([f64; 6], Mat6) {
-        let (pts, wts) = gauss_legendre(4);
-        let mut f = [0.0; 6];
-        let mut m = [[0.0; 6]; 6];
-        for (p, wg) in pts.iter().zip(wts) {
-            let z = 0.5 * (p + 1.0);
-            let wq = 0.5 * wg * rho * self.l0;
-            let jac = self.jacobian(z);
-            let rc = self.convective(z, qd);
-            for i in 0..6 {
-                f[i] += wq * (jac[0][i] * rc[0] + jac[1][i] * rc[1]);
-                for j in i..6 {
-                    m[i][j] += wq * (jac[0][i] * jac[0][j] + jac[1][i] * jac[1][j]);
+        (self.inertia_force(rho, qd, &[0.0; 6]), self.mass(rho))
+    }
+
+    /// Consistent mass matrix `M(q) = int rho J^T J dx = rho l0 sum_kl G_kl A_k^T A_l` [kg, kg m,
+    /// kg m^2] in closed form ([`ElementState::basis`], [`GRAM`]; exact, as the 4-point Gauss
+    /// quadrature it replaces).
+    #[inline]
+    pub fn mass(&self, rho: f64) -> Mat6 {
+        let a = self.basis();
+        // ag_l = sum_m G_lm A_m
+        let mut ag = [[[0.0; 6]; 2]; 4];
+        for l in 0..4 {
+            for m in 0..4 {
+                let g = GRAM[l][m];
+                for k in 0..2 {
+                    for j in 0..6 {
+                        ag[l][k][j] += g * a[m][k][j];
+                    }
                 }
             }
         }
+        let rl = rho * self.l0;
+        let mut mm = [[0.0; 6]; 6];
         for i in 0..6 {
-            for j in 0..i {
-                m[i][j] = m[j][i];
+            for j in i..6 {
+                let mut v = 0.0;
+                for l in 0..4 {
+                    v += a[l][0][i] * ag[l][0][j] + a[l][1][i] * ag[l][1][j];
+                }
+                mm[i][j] = rl * v;
+                mm[j][i] = rl * v;
             }
         }
-        (f, m)
+        mm
     }
 
-    /// Kinetic energy [J] of the element moving with velocities `qd`.
+    /// Kinetic energy [J] of the element moving with velocities `qd`:
+    /// `T = rho l0 / 2 sum_kl G_kl (A_k qd) . (A_l qd)` (closed form).
     pub fn kinetic_energy(&self, rho: f64, qd: &[f64; 6]) -> f64 {
-        let (pts, wts) = gauss_legendre(4);
-        let mut t = 0.0;
-        for (p, wg) in pts.iter().zip(wts) {
-            let z = 0.5 * (p + 1.0);
-            let jac = self.jacobian(z);
-            let v0: f64 = (0..6).map(|j| jac[0][j] * qd[j]).sum();
-            let v1: f64 = (0..6).map(|j| jac[1][j] * qd[j]).sum();
-            t += 0.5 * wg * (v0 * v0 + v1 * v1);
-        }
+        let a = self.basis();
+        let u: [[f64; 2]; 4] =
+            std::array::from_fn(|l| std::array::from_fn(|k| (0..6).map(|j| a[l][k][j] * qd[j]).sum()));
+        let v = gram_times(&u);
+        let t: f64 = (0..4).map(|l| u[l][0] * v[l][0] + u[l][1] * v[l][1]).sum();
         0.5 * rho * self.l0 * t
     }
+}
+
+/// Gram matrix `G_kl = int_0^1 phi_k phi_l dzeta` of the interpolation basis
+/// `phi = [1 - zeta, zeta, H1, H2]` (Beta-function integrals, exact fractions).
+pub const GRAM: [[f64; 4]; 4] = [
+    [1.0 / 3.0, 1.0 / 6.0, 1.0 / 20.0, -1.0 / 30.0],
+    [1.0 / 6.0, 1.0 / 3.0, 1.0 / 30.0, -1.0 / 20.0],
+    [1.0 / 20.0, 1.0 / 30.0, 1.0 / 105.0, -1.0 / 140.0],
+    [-1.0 / 30.0, -1.0 / 20.0, -1.0 / 140.0, 1.0 / 105.0],
+];
+
+/// `v_k = sum_l G_kl u_l` for four 2-vectors.
+#[inline]
+fn gram_times(u: &[[f64; 2]; 4]) -> [[f64; 2]; 4] {
+    std::array::from_fn(|k| {
+        std::array::from_fn(|c| {
+            GRAM[k][0] * u[0][c] + GRAM[k][1] * u[1][c] + GRAM[k][2] * u[2][c] + GRAM[k][3] * u[3][c]
+        })
+    })
 }
 
 #[cfg(test)]
@@ -463,6 +560,71 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// 4-point Gauss quadrature (exact for these degree-6 integrands) of `int rho J^T J dx`,
+    /// `int rho J^T (J qdd + r_conv) dx` and `T`, from the pointwise Jacobian and convective
+    /// acceleration (both checked against finite differences above).
+    fn quadrature(st: &ElementState, rho: f64, qd: &[f64; 6], qdd: &[f64; 6]) -> (Mat6, [f64; 6], f64) {
+        let (pts, wts) = flexstar_numerics::quadrature::gauss_legendre(4);
+        let (mut m, mut f, mut t) = ([[0.0; 6]; 6], [0.0; 6], 0.0);
+        for (p, wg) in pts.iter().zip(wts) {
+            let z = 0.5 * (p + 1.0);
+            let wq = 0.5 * wg * rho * st.l0;
+            let jac = st.jacobian(z);
+            let rc = st.convective(z, qd);
+            let acc: [f64; 2] = std::array::from_fn(|k| rc[k] + (0..6).map(|j| jac[k][j] * qdd[j]).sum::<f64>());
+            let vel: [f64; 2] = std::array::from_fn(|k| (0..6).map(|j| jac[k][j] * qd[j]).sum::<f64>());
+            t += 0.5 * wq * (vel[0] * vel[0] + vel[1] * vel[1]);
+            for i in 0..6 {
+                f[i] += wq * (jac[0][i] * acc[0] + jac[1][i] * acc[1]);
+                for j in 0..6 {
+                    m[i][j] += wq * (jac[0][i] * jac[0][j] + jac[1][i] * jac[1][j]);
+                }
+            }
+        }
+        (m, f, t)
+    }
+
+    #[test]
+    fn closed_form_inertia_matches_gauss_quadrature() {
+        let e = el();
+        let q = q0();
+        let qd = [0.3, -1.1, 4.0, -0.7, 0.9, -3.0];
+        let qdd = [12.0, -3.0, 40.0, 7.0, 2.0, -25.0];
+        let rho = 0.234;
+        let st = ElementState::new(&e, &q);
+        let (mq, fq, tq) = quadrature(&st, rho, &qd, &qdd);
+        let m = st.mass(rho);
+        let f = st.inertia_force(rho, &qd, &qdd);
+        let (fc, m2) = st.inertia(rho, &qd);
+        let (_, fcq, _) = quadrature(&st, rho, &qd, &[0.0; 6]);
+        let scale = mq.iter().flatten().fold(0.0f64, |a, x| a.max(x.abs()));
+        for i in 0..6 {
+            for j in 0..6 {
+                assert!(
+                    (m[i][j] - mq[i][j]).abs() < 1e-13 * scale,
+                    "M[{i}][{j}]: {} vs {}",
+                    m[i][j],
+                    mq[i][j]
+                );
+                assert_eq!(m[i][j], m2[i][j]);
+            }
+            assert!(
+                (f[i] - fq[i]).abs() < 1e-12 * (1.0 + fq[i].abs()),
+                "f[{i}]: {} vs {}",
+                f[i],
+                fq[i]
+            );
+            assert!(
+                (fc[i] - fcq[i]).abs() < 1e-12 * (1.0 + fcq[i].abs()),
+                "fc[{i}]: {} vs {}",
+                fc[i],
+                fcq[i]
+            );
+        }
+        let t = st.kinetic_energy(rho, &qd);
+        assert!((t - tq).abs() < 1e-13 * tq, "T: {t} vs {tq}");
     }
 
     #[test]

@@ -419,21 +419,19 @@ impl Star {
                 });
             }
             let d = dofs(el);
+            let fm = st.inertia_force(rho, &ve, &ae);
             if matrix {
                 let (fi, k) = st.internal(ea, ei);
-                let (fc, m) = st.inertia(rho, &ve);
+                let m = st.mass(rho);
                 let slot = &mut self.vals[36 * e..36 * e + 36];
                 for a in 0..6 {
-                    let mut ma = 0.0;
                     for b in 0..6 {
-                        ma += m[a][b] * ae[b];
                         slot[6 * a + b] = m[a][b] + ck * k[a][b];
                     }
-                    res[d[a]] += cf * (ma + fc[a] + fi[a]);
+                    res[d[a]] += cf * (fm[a] + fi[a]);
                 }
             } else {
                 let fi = st.internal_force(ea, ei);
-                let fm = st.inertia_force(rho, &ve, &ae);
                 for a in 0..6 {
                     res[d[a]] += cf * (fm[a] + fi[a]);
                 }

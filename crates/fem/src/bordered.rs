@@ -64,8 +64,12 @@ pub(crate) struct Layout {
 /// The factorisation and its workspaces.
 pub(crate) struct Bordered {
     lay: Layout,
-    /// Lower band of `L_i`, row-major, `HB + 1` values per row (diagonal last), per beam.
-    band: [Vec<f64>; 3],
+    /// Lower band of `L_i`, one row of `HB + 1` values per beam row (entry `(j, k)` at
+    /// `[j + HB][HB - (j - k)]`, diagonal last), with `HB` zero rows before and after so that
+    /// every row has the same fixed-length loops; per beam.
+    band: [Vec<[f64; HB + 1]>; 3],
+    /// Reciprocals of the diagonal of `L_i` (same padding, zero in the pad rows), per beam.
+    dinv: [Vec<f64>; 3],
     /// Multiplier columns of `W_i` row-major, `WC` values per row, per beam.
     w: [Vec<f64>; 3],
     /// G columns of `W_i` in its last three rows, `[row][G DOF]`, per beam.
@@ -79,7 +83,7 @@ pub(crate) struct Bordered {
     ns: usize,
     /// Global unknown of every border index.
     global: [usize; NS_MAX],
-    /// Work vectors of the beams.
+    /// Work vectors of the beams (same padding as the band: row j at `j + HB`).
     y: [Vec<f64>; 3],
 }
 
@@ -97,10 +101,28 @@ fn border_sl(i: usize) -> usize {
     NS_STAR + i
 }
 
-#[inline]
-fn at(j: usize, k: usize) -> usize {
-    j * (HB + 1) + HB - (j - k)
-}
+/// Lower-triangle entries `(a, b)` of an element block between two beam nodes, with their
+/// rows `(la, lb)` relative to the first row of the element's outer node (tip-first ordering:
+/// the element's node b, nearer the tip, comes first).
+const ELEMENT_BAND: [(usize, usize, usize, usize); 21] = {
+    let mut out = [(0, 0, 0, 0); 21];
+    let mut n = 0;
+    let mut a = 0;
+    while a < 6 {
+        let mut b = 0;
+        while b < 6 {
+            let la = if a < 3 { a + 3 } else { a - 3 };
+            let lb = if b < 3 { b + 3 } else { b - 3 };
+            if la >= lb {
+                out[n] = (a, b, la, lb);
+                n += 1;
+            }
+            b += 1;
+        }
+        a += 1;
+    }
+    out
+};
 
 impl Bordered {
     pub fn new(lay: Layout) -> Self {
@@ -123,7 +145,8 @@ impl Bordered {
         }
         Bordered {
             lay,
-            band: std::array::from_fn(|_| vec![0.0; n * (HB + 1)]),
+            band: std::array::from_fn(|_| vec![[0.0; HB + 1]; n + 2 * HB]),
+            dinv: std::array::from_fn(|_| vec![0.0; n + 2 * HB]),
             w: std::array::from_fn(|_| vec![0.0; n * WC]),
             wg: [[[0.0; 3]; 3]; 3],
             first: [0; 3],
@@ -131,7 +154,7 @@ impl Bordered {
             perm: [0; NS_MAX],
             ns,
             global,
-            y: std::array::from_fn(|_| vec![0.0; n]),
+            y: std::array::from_fn(|_| vec![0.0; n + 2 * HB]),
         }
     }
 
@@ -183,57 +206,61 @@ impl Bordered {
     }
 
     /// Band of beam i from its element blocks; the G-G part of element 0 goes to the border.
-    #[inline(never)]
     fn fill_beam(&mut self, i: usize, vals: &[f64]) {
         let ns = self.ns;
         let ne = self.lay.ne;
         let band = &mut self.band[i];
-        band.iter_mut().for_each(|x| *x = 0.0);
+        band.iter_mut().for_each(|r| *r = [0.0; HB + 1]);
         for k in 0..ne {
             let blk = &vals[36 * (i * ne + k)..36 * (i * ne + k) + 36];
-            for a in 0..6 {
-                let na = k + a / 3;
-                for b in 0..6 {
-                    let nb = k + b / 3;
-                    let v = blk[6 * a + b];
-                    if na == 0 && nb == 0 {
-                        self.s[(a % 3) * ns + b % 3] += v;
-                    } else if na > 0 && nb > 0 {
-                        let (ra, rb) = (3 * (ne - na) + a % 3, 3 * (ne - nb) + b % 3);
-                        if ra >= rb {
-                            band[at(ra, rb)] += v;
-                        }
-                    }
+            // rows of node k + 1 (then node k) start at 3 (ne - k - 1), stored HB further
+            let base = 3 * (ne - k - 1) + HB;
+            for &(a, b, la, lb) in &ELEMENT_BAND {
+                // node k = 0 is G: its rows belong to the border
+                if k > 0 || la < 3 {
+                    band[base + la][HB - (la - lb)] += blk[6 * a + b];
                 }
+            }
+        }
+        let blk0 = &vals[36 * i * ne..36 * i * ne + 36];
+        for a in 0..3 {
+            for b in 0..3 {
+                self.s[a * ns + b] += blk0[6 * a + b];
             }
         }
     }
 
-    /// In-place banded Cholesky of beam i.
-    #[inline(never)]
+    /// In-place banded Cholesky of beam i (rows in the padded storage; the pad rows are zero, so
+    /// every row runs the same fixed loops), with the reciprocals of the diagonal.
     fn cholesky(&mut self, i: usize) -> Result<(), String> {
         let n = 3 * self.lay.ne;
         let band = &mut self.band[i];
-        for j in 0..n {
-            let lo = j.saturating_sub(HB);
-            for k in lo..j {
-                let mut v = band[at(j, k)];
-                for m in lo.max(k.saturating_sub(HB))..k {
-                    v -= band[at(j, m)] * band[at(k, m)];
+        let dinv = &mut self.dinv[i];
+        for j in HB..n + HB {
+            let mut row = band[j];
+            // entry t of the row is column k = j - HB + t; row k holds (k, m) at HB - (k - m)
+            for t in 0..HB {
+                let rk = &band[j - HB + t];
+                let mut v = row[t];
+                for u in 0..t {
+                    v -= row[u] * rk[HB - t + u];
                 }
-                band[at(j, k)] = v / band[at(k, k)];
+                row[t] = v * dinv[j - HB + t];
             }
-            let mut d = band[at(j, j)];
-            for m in lo..j {
-                d -= band[at(j, m)] * band[at(j, m)];
+            let mut d = row[HB];
+            for u in 0..HB {
+                d -= row[u] * row[u];
             }
             if !(d > 0.0 && d.is_finite()) {
                 return Err(format!(
-                    "beam {} block not positive definite at row {j} (pivot {d:e})",
-                    i + 1
+                    "beam {} block not positive definite at row {} (pivot {d:e})",
+                    i + 1,
+                    j - HB
                 ));
             }
-            band[at(j, j)] = d.sqrt();
+            row[HB] = d.sqrt();
+            dinv[j] = 1.0 / row[HB];
+            band[j] = row;
         }
         Ok(())
     }
@@ -281,18 +308,19 @@ impl Bordered {
             }
         }
         // W = L^{-1} E, multiplier columns: rows first..n
-        let band = &self.band[i];
+        let (band, dinv) = (&self.band[i], &self.dinv[i]);
         for j in first..n {
             let mut row = [0.0; WC];
             row.copy_from_slice(&w[j * WC..j * WC + WC]);
+            let lj = &band[j + HB];
             for m in first.max(j.saturating_sub(HB))..j {
-                let f = band[at(j, m)];
+                let f = lj[HB - (j - m)];
                 let wm = &w[m * WC..m * WC + WC];
                 for a in 0..WC {
                     row[a] -= f * wm[a];
                 }
             }
-            let d = 1.0 / band[at(j, j)];
+            let d = dinv[j + HB];
             for a in 0..WC {
                 row[a] *= d;
             }
@@ -306,9 +334,9 @@ impl Bordered {
             for g in 0..3 {
                 let mut v = blk0[6 * (3 + c) + g];
                 for m in 0..c {
-                    v -= band[at(j, n - 3 + m)] * wg[m][g];
+                    v -= band[j + HB][HB - (c - m)] * wg[m][g];
                 }
-                wg[c][g] = v / band[at(j, j)];
+                wg[c][g] = v * dinv[j + HB];
             }
         }
         self.wg[i] = wg;
@@ -387,29 +415,31 @@ impl Bordered {
         for i in 0..3 {
             let mut y = std::mem::take(&mut self.y[i]);
             for j in 0..n {
-                y[j] = rhs[self.global_row(i, j)];
+                y[j + HB] = rhs[self.global_row(i, j)];
             }
-            let band = &self.band[i];
-            for j in 0..n {
+            let (band, dinv) = (&self.band[i], &self.dinv[i]);
+            // the pad entries are zero; the newest y is subtracted last (shortest dependency)
+            for j in HB..n + HB {
+                let row = &band[j];
                 let mut v = y[j];
-                for m in j.saturating_sub(HB)..j {
-                    v -= band[at(j, m)] * y[m];
+                for t in 0..HB {
+                    v -= row[t] * y[j - HB + t];
                 }
-                y[j] = v / band[at(j, j)];
+                y[j] = v * dinv[j];
             }
             let w = &self.w[i];
             let mut acc = [0.0; WC];
             for j in self.first[i]..n {
                 let wj = &w[j * WC..j * WC + WC];
                 for a in 0..WC {
-                    acc[a] += wj[a] * y[j];
+                    acc[a] += wj[a] * y[j + HB];
                 }
             }
             for a in 0..ROWS {
                 xs[border_nu(i, a)] -= acc[a];
             }
             for g in 0..3 {
-                xs[g] -= (0..3).map(|c| self.wg[i][c][g] * y[n - 3 + c]).sum::<f64>();
+                xs[g] -= (0..3).map(|c| self.wg[i][c][g] * y[HB + n - 3 + c]).sum::<f64>();
             }
             self.y[i] = y;
         }
@@ -442,21 +472,21 @@ impl Bordered {
                 for a in 0..WC {
                     v += wj[a] * xb[a];
                 }
-                y[j] -= v;
+                y[j + HB] -= v;
             }
             for c in 0..3 {
-                y[n - 3 + c] -= (0..3).map(|g| self.wg[i][c][g] * xs[g]).sum::<f64>();
+                y[HB + n - 3 + c] -= (0..3).map(|g| self.wg[i][c][g] * xs[g]).sum::<f64>();
             }
-            let band = &self.band[i];
-            for j in (0..n).rev() {
+            let (band, dinv) = (&self.band[i], &self.dinv[i]);
+            for j in (HB..n + HB).rev() {
                 let mut v = y[j];
-                for m in j + 1..(j + HB + 1).min(n) {
-                    v -= band[at(m, j)] * y[m];
+                for t in (1..=HB).rev() {
+                    v -= band[j + t][HB - t] * y[j + t];
                 }
-                y[j] = v / band[at(j, j)];
+                y[j] = v * dinv[j];
             }
             for j in 0..n {
-                rhs[self.global_row(i, j)] = y[j];
+                rhs[self.global_row(i, j)] = y[j + HB];
             }
             self.y[i] = y;
         }

@@ -144,27 +144,51 @@ impl ElementState {
 
     /// Internal force vector f = B^T [N, M1, M2] and tangent stiffness
     /// `K = B^T Kl B + N z z^T / l_n + (M1 + M2)(r z^T + z r^T) / l_n^2`.
+    ///
+    /// Evaluated through its structure: with `b1 = e_phia - z / l_n`, `b2 = e_phib - z / l_n`,
+    /// `r = [-rho, rho]`, `z = [zeta, -zeta]` (`rho = [c, s]`, `zeta = [s, -c]` per node),
+    /// the translational part is `[T, -T; -T, T]` with
+    /// `T = EA/l0 rho rho^T + (N / l_n + 2 (k4 + k2) / l_n^2) zeta zeta^T - (M1 + M2) / l_n^2 (rho zeta^T + zeta rho^T)`,
+    /// the rotation-translation coupling is `-(k4 + k2) / l_n z`, and the rotation block is
+    /// `[k4, k2; k2, k4]` (`k4 = 4 EI / l0`, `k2 = 2 EI / l0`).
     pub fn internal(&self, ea: f64, ei: f64) -> ([f64; 6], Mat6) {
         let (c, s, ln) = (self.c, self.s, self.ln);
         let [n, m1, m2] = self.local_forces(ea, ei);
-        let (r, b1, b2) = self.b_rows();
-        let z = [s, -c, 0.0, -s, c, 0.0];
         let f = self.internal_force(ea, ei);
-        let ka = ea / self.l0;
-        let k4 = 4.0 * ei / self.l0;
-        let k2 = 2.0 * ei / self.l0;
-        let gz = n / ln;
-        let gm = (m1 + m2) / (ln * ln);
+        let il0 = 1.0 / self.l0;
+        let (ka, k4, k2) = (ea * il0, 4.0 * ei * il0, 2.0 * ei * il0);
+        let iln = 1.0 / ln;
+        let gz = (n + 2.0 * (k4 + k2) * iln) * iln;
+        let gm = (m1 + m2) * iln * iln;
+        let (rho, zeta) = ([c, s], [s, -c]);
+        let t: [[f64; 2]; 2] = std::array::from_fn(|a| {
+            std::array::from_fn(|b| {
+                ka * rho[a] * rho[b] + gz * zeta[a] * zeta[b] - gm * (rho[a] * zeta[b] + zeta[a] * rho[b])
+            })
+        });
+        let z = [s, -c, 0.0, -s, c, 0.0];
+        let kc = -(k4 + k2) * iln;
         let mut k = [[0.0; 6]; 6];
-        for i in 0..6 {
-            for j in 0..6 {
-                k[i][j] = ka * r[i] * r[j]
-                    + k4 * (b1[i] * b1[j] + b2[i] * b2[j])
-                    + k2 * (b1[i] * b2[j] + b2[i] * b1[j])
-                    + gz * z[i] * z[j]
-                    + gm * (r[i] * z[j] + z[i] * r[j]);
+        for (a, sa) in [(0, 1.0), (3, -1.0)] {
+            for (b, sb) in [(0, 1.0), (3, -1.0)] {
+                for p in 0..2 {
+                    for q in 0..2 {
+                        k[a + p][b + q] = sa * sb * t[p][q];
+                    }
+                }
             }
         }
+        for a in [0, 1, 3, 4] {
+            let v = kc * z[a];
+            k[a][2] = v;
+            k[a][5] = v;
+            k[2][a] = v;
+            k[5][a] = v;
+        }
+        k[2][2] = k4;
+        k[5][5] = k4;
+        k[2][5] = k2;
+        k[5][2] = k2;
         (f, k)
     }
 

@@ -387,6 +387,7 @@ impl<'a> Recorder<'a> {
         let (q, v, pins) = (&st.q, &st.v, &st.pins);
         if self.out_k < self.t_out.len() && (self.t_out[self.out_k] - t).abs() < 1e-12 {
             let pos = |j: usize| [q[3 * j], q[3 * j + 1]];
+            let (ke_star, strain) = star.beam_energies(q, v);
             self.samples.push(Sample {
                 t: self.t_out[self.out_k],
                 g: pos(0),
@@ -396,10 +397,10 @@ impl<'a> Recorder<'a> {
                 xi_c: [0, 1, 2].map(|i| q[star.xi(i, 0)]),
                 fa,
                 pin_force,
-                ke_star: star.kinetic_energy_beams(q, v),
+                ke_star,
                 ke_sleeves: 0.5 * params.jp * (0..3).map(|i| v[star.psi(i)].powi(2)).sum::<f64>(),
                 ke_sliders: 0.5 * params.mpp_mpa * (0..3).map(|i| pins.s[i][1].powi(2)).sum::<f64>(),
-                strain: star.strain_energy(q),
+                strain,
                 work,
                 s: pins.s.map(|s| s[0]),
                 sd: pins.s.map(|s| s[1]),

@@ -628,23 +628,18 @@ impl Star {
         out
     }
 
-    /// Strain energy of the beams [J].
-    pub fn strain_energy(&self, q: &[f64]) -> f64 {
-        let (ea, ei) = (self.params.ea(), self.params.ei());
-        self.elements
-            .iter()
-            .map(|el| ElementState::new(el, &self.element_q(el, q)).strain_energy(ea, ei))
-            .sum()
-    }
-
-    /// Kinetic energy of the beams [J] (exact for the element interpolation, Gauss quadrature).
-    pub fn kinetic_energy_beams(&self, q: &[f64], v: &[f64]) -> f64 {
-        self.elements
-            .iter()
-            .map(|el| {
-                ElementState::new(el, &self.element_q(el, q)).kinetic_energy(self.params.rho, &self.element_q(el, v))
-            })
-            .sum()
+    /// Kinetic and strain energy of the beams [J] at coordinates `q` and velocities `v` (the
+    /// element interpolation's, exact: [`ElementState::kinetic_energy`],
+    /// [`ElementState::strain_energy`]), in one pass over the elements.
+    pub fn beam_energies(&self, q: &[f64], v: &[f64]) -> (f64, f64) {
+        let (ea, ei, rho) = (self.params.ea(), self.params.ei(), self.params.rho);
+        self.elements.iter().fold((0.0, 0.0), |(t, u), el| {
+            let st = ElementState::new(el, &self.element_q(el, q));
+            (
+                t + st.kinetic_energy(rho, &self.element_q(el, v)),
+                u + st.strain_energy(ea, ei),
+            )
+        })
     }
 
     /// Material positions (from G) of the nodes of one beam [m].

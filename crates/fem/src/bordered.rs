@@ -101,28 +101,32 @@ fn border_sl(i: usize) -> usize {
     NS_STAR + i
 }
 
-/// Lower-triangle entries `(a, b)` of an element block between two beam nodes, with their
-/// rows `(la, lb)` relative to the first row of the element's outer node (tip-first ordering:
-/// the element's node b, nearer the tip, comes first).
-const ELEMENT_BAND: [(usize, usize, usize, usize); 21] = {
-    let mut out = [(0, 0, 0, 0); 21];
-    let mut n = 0;
-    let mut a = 0;
-    while a < 6 {
-        let mut b = 0;
-        while b < 6 {
-            let la = if a < 3 { a + 3 } else { a - 3 };
-            let lb = if b < 3 { b + 3 } else { b - 3 };
-            if la >= lb {
-                out[n] = (a, b, la, lb);
-                n += 1;
-            }
-            b += 1;
+/// Row j (padded storage) of a banded Cholesky factorisation in place (the pad rows are zero, so
+/// every row runs the same fixed loops); returns the pivot, left unfactorised when it is not
+/// positive.
+#[inline(always)]
+fn cholesky_row(band: &mut [[f64; HB + 1]], dinv: &mut [f64], j: usize) -> f64 {
+    let mut row = band[j];
+    // entry t of the row is column k = j - HB + t; row k holds (k, m) at HB - (k - m)
+    for t in 0..HB {
+        let rk = &band[j - HB + t];
+        let mut v = row[t];
+        for u in 0..t {
+            v -= row[u] * rk[HB - t + u];
         }
-        a += 1;
+        row[t] = v * dinv[j - HB + t];
     }
-    out
-};
+    let mut d = row[HB];
+    for u in 0..HB {
+        d -= row[u] * row[u];
+    }
+    if d > 0.0 && d.is_finite() {
+        row[HB] = d.sqrt();
+        dinv[j] = 1.0 / row[HB];
+        band[j] = row;
+    }
+    d
+}
 
 impl Bordered {
     pub fn new(lay: Layout) -> Self {
@@ -173,7 +177,9 @@ impl Bordered {
         self.s.iter_mut().for_each(|x| *x = 0.0);
         for i in 0..3 {
             self.fill_beam(i, vals);
-            self.cholesky(i)?;
+        }
+        self.cholesky()?;
+        for i in 0..3 {
             self.border_columns(i, vals, win);
         }
         let l = self.lay;
@@ -212,13 +218,27 @@ impl Bordered {
         let band = &mut self.band[i];
         band.iter_mut().for_each(|r| *r = [0.0; HB + 1]);
         for k in 0..ne {
-            let blk = &vals[36 * (i * ne + k)..36 * (i * ne + k) + 36];
+            let blk: &[f64; 36] = vals[36 * (i * ne + k)..36 * (i * ne + k) + 36]
+                .try_into()
+                .expect("36 values per element");
             // rows of node k + 1 (then node k) start at 3 (ne - k - 1), stored HB further
             let base = 3 * (ne - k - 1) + HB;
-            for &(a, b, la, lb) in &ELEMENT_BAND {
-                // node k = 0 is G: its rows belong to the border
-                if k > 0 || la < 3 {
-                    band[base + la][HB - (la - lb)] += blk[6 * a + b];
+            let rows: &mut [[f64; HB + 1]; 6] = (&mut band[base..base + 6]).try_into().expect("6 rows");
+            // node k + 1 (element DOFs 3..6): rows 0..3
+            for r in 0..3 {
+                for c in 0..=r {
+                    rows[r][HB - (r - c)] += blk[6 * (3 + r) + 3 + c];
+                }
+            }
+            // node k (DOFs 0..3): rows 3..6, unless it is G (k = 0: the border's)
+            if k > 0 {
+                for r in 0..3 {
+                    for c in 0..3 {
+                        rows[3 + r][HB - (3 + r - c)] += blk[6 * r + 3 + c];
+                    }
+                    for c in 0..=r {
+                        rows[3 + r][HB - (r - c)] += blk[6 * r + c];
+                    }
                 }
             }
         }
@@ -230,37 +250,28 @@ impl Bordered {
         }
     }
 
-    /// In-place banded Cholesky of beam i (rows in the padded storage; the pad rows are zero, so
-    /// every row runs the same fixed loops), with the reciprocals of the diagonal.
-    fn cholesky(&mut self, i: usize) -> Result<(), String> {
+    /// In-place banded Cholesky of the three beams, with the reciprocals of the diagonal. The
+    /// three independent factorisations advance row by row together, so that the processor
+    /// overlaps their dependency chains (each row waits on the previous one: divisions and a
+    /// square root).
+    fn cholesky(&mut self) -> Result<(), String> {
         let n = 3 * self.lay.ne;
-        let band = &mut self.band[i];
-        let dinv = &mut self.dinv[i];
+        let [b0, b1, b2] = &mut self.band;
+        let [d0, d1, d2] = &mut self.dinv;
         for j in HB..n + HB {
-            let mut row = band[j];
-            // entry t of the row is column k = j - HB + t; row k holds (k, m) at HB - (k - m)
-            for t in 0..HB {
-                let rk = &band[j - HB + t];
-                let mut v = row[t];
-                for u in 0..t {
-                    v -= row[u] * rk[HB - t + u];
-                }
-                row[t] = v * dinv[j - HB + t];
-            }
-            let mut d = row[HB];
-            for u in 0..HB {
-                d -= row[u] * row[u];
-            }
-            if !(d > 0.0 && d.is_finite()) {
+            let p = [
+                cholesky_row(b0, d0, j),
+                cholesky_row(b1, d1, j),
+                cholesky_row(b2, d2, j),
+            ];
+            if let Some(i) = p.iter().position(|d| !(*d > 0.0 && d.is_finite())) {
                 return Err(format!(
-                    "beam {} block not positive definite at row {} (pivot {d:e})",
+                    "beam {} block not positive definite at row {} (pivot {:e})",
                     i + 1,
-                    j - HB
+                    j - HB,
+                    p[i]
                 ));
             }
-            row[HB] = d.sqrt();
-            dinv[j] = 1.0 / row[HB];
-            band[j] = row;
         }
         Ok(())
     }
@@ -403,6 +414,53 @@ impl Bordered {
         Ok(())
     }
 
+    /// `y_i <- L_i^{-1} y_i` for the three beams, advancing together (independent dependency
+    /// chains the processor overlaps). The pad entries are zero; the last `HB` unknowns of each
+    /// beam stay in registers (no reload of a value just stored), the newest one subtracted
+    /// last (shortest dependency chain).
+    fn forward(&mut self) {
+        let n = 3 * self.lay.ne;
+        let [y0, y1, y2] = &mut self.y;
+        let ys: [&mut [f64]; 3] = [y0, y1, y2];
+        let mut win = [[0.0; HB]; 3];
+        for j in HB..n + HB {
+            for i in 0..3 {
+                let row = &self.band[i][j];
+                let w = &mut win[i];
+                let v = ys[i][j] - row[0] * w[0] - row[1] * w[1] - row[2] * w[2] - row[3] * w[3] - row[4] * w[4];
+                *w = [w[1], w[2], w[3], w[4], v * self.dinv[i][j]];
+            }
+            for i in 0..3 {
+                ys[i][j] = win[i][HB - 1];
+            }
+        }
+    }
+
+    /// `y_i <- L_i^{-T} y_i` for the three beams, together as in [`Bordered::forward`].
+    fn backward(&mut self) {
+        let n = 3 * self.lay.ne;
+        let [y0, y1, y2] = &mut self.y;
+        let ys: [&mut [f64]; 3] = [y0, y1, y2];
+        // win[i][t] = y_i[j + HB - t] (t = 0 the farthest, HB - 1 the newest)
+        let mut win = [[0.0; HB]; 3];
+        for j in (HB..n + HB).rev() {
+            for i in 0..3 {
+                let b = &self.band[i];
+                let w = &mut win[i];
+                let v = ys[i][j]
+                    - b[j + 5][0] * w[0]
+                    - b[j + 4][1] * w[1]
+                    - b[j + 3][2] * w[2]
+                    - b[j + 2][3] * w[3]
+                    - b[j + 1][4] * w[4];
+                *w = [w[1], w[2], w[3], w[4], v * self.dinv[i][j]];
+            }
+            for i in 0..3 {
+                ys[i][j] = win[i][HB - 1];
+            }
+        }
+    }
+
     /// Solve `A x = rhs` in place (global ordering of the star) with the last factorisation.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         let n = 3 * self.lay.ne;
@@ -413,20 +471,13 @@ impl Bordered {
         }
         // forward: y_i = L_i^{-1} b_i, xs -= W_i^T y_i
         for i in 0..3 {
-            let mut y = std::mem::take(&mut self.y[i]);
             for j in 0..n {
-                y[j + HB] = rhs[self.global_row(i, j)];
+                self.y[i][j + HB] = rhs[self.global_row(i, j)];
             }
-            let (band, dinv) = (&self.band[i], &self.dinv[i]);
-            // the pad entries are zero; the newest y is subtracted last (shortest dependency)
-            for j in HB..n + HB {
-                let row = &band[j];
-                let mut v = y[j];
-                for t in 0..HB {
-                    v -= row[t] * y[j - HB + t];
-                }
-                y[j] = v * dinv[j];
-            }
+        }
+        self.forward();
+        for i in 0..3 {
+            let y = &self.y[i];
             let w = &self.w[i];
             let mut acc = [0.0; WC];
             for j in self.first[i]..n {
@@ -441,7 +492,6 @@ impl Bordered {
             for g in 0..3 {
                 xs[g] -= (0..3).map(|c| self.wg[i][c][g] * y[HB + n - 3 + c]).sum::<f64>();
             }
-            self.y[i] = y;
         }
         // border: S xs = rhs_s - sum W^T y
         for k in 0..ns {
@@ -463,7 +513,7 @@ impl Bordered {
         }
         // back: x_i = L_i^{-T} (y_i - W_i xs)
         for i in 0..3 {
-            let mut y = std::mem::take(&mut self.y[i]);
+            let y = &mut self.y[i];
             let w = &self.w[i];
             let xb: [f64; WC] = std::array::from_fn(|a| if a < ROWS { xs[border_nu(i, a)] } else { 0.0 });
             for j in self.first[i]..n {
@@ -477,18 +527,12 @@ impl Bordered {
             for c in 0..3 {
                 y[HB + n - 3 + c] -= (0..3).map(|g| self.wg[i][c][g] * xs[g]).sum::<f64>();
             }
-            let (band, dinv) = (&self.band[i], &self.dinv[i]);
-            for j in (HB..n + HB).rev() {
-                let mut v = y[j];
-                for t in (1..=HB).rev() {
-                    v -= band[j + t][HB - t] * y[j + t];
-                }
-                y[j] = v * dinv[j];
-            }
+        }
+        self.backward();
+        for i in 0..3 {
             for j in 0..n {
-                rhs[self.global_row(i, j)] = y[j + HB];
+                rhs[self.global_row(i, j)] = self.y[i][j + HB];
             }
-            self.y[i] = y;
         }
         for (b, x) in xs.iter().enumerate().take(ns) {
             rhs[self.global[b]] = *x;

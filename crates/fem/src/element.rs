@@ -90,6 +90,9 @@ pub struct ElementState {
     pub delta: f64,
     /// Chord vector d = xb - xa [m].
     pub d: [f64; 2],
+    /// Reciprocals `1 / l_n`, `1 / l0` [1/m] (divisions done once per state).
+    pub inv_ln: f64,
+    pub inv_l0: f64,
 }
 
 impl ElementState {
@@ -98,7 +101,8 @@ impl ElementState {
     pub fn new(el: &Element, q: &[f64; 6]) -> Self {
         let d = [q[3] - q[0], q[4] - q[1]];
         let ln = (d[0] * d[0] + d[1] * d[1]).sqrt();
-        let (c, s) = (d[0] / ln, d[1] / ln);
+        let inv_ln = 1.0 / ln;
+        let (c, s) = (d[0] * inv_ln, d[1] * inv_ln);
         let sd = el.c0 * s - el.s0 * c;
         let cd = el.c0 * c + el.s0 * s;
         let dp = sd.atan2(cd);
@@ -115,22 +119,24 @@ impl ElementState {
             th2,
             delta,
             d,
+            inv_ln,
+            inv_l0: 1.0 / el.l0,
         }
     }
 
     /// `d beta / d q_e` = z / l_n with z = [s, -c, 0, -s, c, 0].
     #[inline]
     pub fn jbeta(&self) -> [f64; 6] {
-        let (s, c) = (self.s / self.ln, self.c / self.ln);
+        let (s, c) = (self.s * self.inv_ln, self.c * self.inv_ln);
         [s, -c, 0.0, -s, c, 0.0]
     }
 
     /// Local forces `[N, M1, M2]` (axial force [N], end moments [N m]).
     #[inline]
     pub fn local_forces(&self, ea: f64, ei: f64) -> [f64; 3] {
-        let k = ei / self.l0;
+        let k = ei * self.inv_l0;
         [
-            ea * self.u / self.l0,
+            ea * self.u * self.inv_l0,
             k * (4.0 * self.th1 + 2.0 * self.th2),
             k * (2.0 * self.th1 + 4.0 * self.th2),
         ]
@@ -152,12 +158,12 @@ impl ElementState {
     /// the rotation-translation coupling is `-(k4 + k2) / l_n z`, and the rotation block is
     /// `[k4, k2; k2, k4]` (`k4 = 4 EI / l0`, `k2 = 2 EI / l0`).
     pub fn internal(&self, ea: f64, ei: f64) -> ([f64; 6], Mat6) {
-        let (c, s, ln) = (self.c, self.s, self.ln);
+        let (c, s) = (self.c, self.s);
         let [n, m1, m2] = self.local_forces(ea, ei);
         let f = self.internal_force(ea, ei);
-        let il0 = 1.0 / self.l0;
+        let il0 = self.inv_l0;
         let (ka, k4, k2) = (ea * il0, 4.0 * ei * il0, 2.0 * ei * il0);
-        let iln = 1.0 / ln;
+        let iln = self.inv_ln;
         let gz = (n + 2.0 * (k4 + k2) * iln) * iln;
         let gm = (m1 + m2) * iln * iln;
         let (rho, zeta) = ([c, s], [s, -c]);
@@ -204,11 +210,12 @@ impl ElementState {
     /// Rows of `B = d[u, th1, th2] / d q_e`: `r`, `b1`, `b2`.
     #[inline]
     fn b_rows(&self) -> ([f64; 6], [f64; 6], [f64; 6]) {
-        let (c, s, ln) = (self.c, self.s, self.ln);
+        let (c, s) = (self.c, self.s);
+        let (sl, cl) = (s * self.inv_ln, c * self.inv_ln);
         (
             [-c, -s, 0.0, c, s, 0.0],
-            [-s / ln, c / ln, 1.0, s / ln, -c / ln, 0.0],
-            [-s / ln, c / ln, 0.0, s / ln, -c / ln, 1.0],
+            [-sl, cl, 1.0, sl, -cl, 0.0],
+            [-sl, cl, 0.0, sl, -cl, 1.0],
         )
     }
 
@@ -286,10 +293,10 @@ impl ElementState {
     #[inline]
     fn convective_coefficients(&self, qd: &[f64; 6]) -> [[f64; 2]; 2] {
         let l0 = self.l0;
-        let ln2 = self.ln * self.ln;
+        let iln2 = self.inv_ln * self.inv_ln;
         let dd = [qd[3] - qd[0], qd[4] - qd[1]];
-        let bd = (self.d[0] * dd[1] - self.d[1] * dd[0]) / ln2;
-        let bdd_c = -2.0 * bd * (self.d[0] * dd[0] + self.d[1] * dd[1]) / ln2;
+        let bd = (self.d[0] * dd[1] - self.d[1] * dd[0]) * iln2;
+        let bdd_c = -2.0 * bd * (self.d[0] * dd[0] + self.d[1] * dd[1]) * iln2;
         let c = |th: f64, rate: f64| {
             [
                 l0 * (-2.0 * (rate - bd) * bd - th * bdd_c),
@@ -369,10 +376,10 @@ impl ElementState {
     pub fn convective(&self, zeta: f64, qd: &[f64; 6]) -> [f64; 2] {
         let h = hermite(zeta);
         let l0 = self.l0;
-        let ln2 = self.ln * self.ln;
+        let iln2 = self.inv_ln * self.inv_ln;
         let dd = [qd[3] - qd[0], qd[4] - qd[1]];
-        let bd = (self.d[0] * dd[1] - self.d[1] * dd[0]) / ln2;
-        let bdd_c = -2.0 * bd * (self.d[0] * dd[0] + self.d[1] * dd[1]) / ln2;
+        let bd = (self.d[0] * dd[1] - self.d[1] * dd[0]) * iln2;
+        let bdd_c = -2.0 * bd * (self.d[0] * dd[0] + self.d[1] * dd[1]) * iln2;
         let w = l0 * (h[0] * self.th1 + h[1] * self.th2);
         let wd = l0 * (h[0] * (qd[2] - bd) + h[1] * (qd[5] - bd));
         let wdd_c = -l0 * (h[0] + h[1]) * bdd_c;

@@ -70,8 +70,9 @@ pub(crate) struct Bordered {
     band: [Vec<[f64; HB + 1]>; 3],
     /// Reciprocals of the diagonal of `L_i` (same padding, zero in the pad rows), per beam.
     dinv: [Vec<f64>; 3],
-    /// Multiplier columns of `W_i` row-major, `WC` values per row, per beam.
-    w: [Vec<f64>; 3],
+    /// Multiplier columns of `W_i`, one row of `WC` values per beam row (row j at `j + HB`,
+    /// the padding of the band), per beam.
+    w: [Vec<[f64; WC]>; 3],
     /// G columns of `W_i` in its last three rows, `[row][G DOF]`, per beam.
     wg: [[[f64; 3]; 3]; 3],
     /// First non-zero row of the multiplier columns of `W_i` (beam-local, tip-first ordering).
@@ -151,7 +152,7 @@ impl Bordered {
             lay,
             band: std::array::from_fn(|_| vec![[0.0; HB + 1]; n + 2 * HB]),
             dinv: std::array::from_fn(|_| vec![0.0; n + 2 * HB]),
-            w: std::array::from_fn(|_| vec![0.0; n * WC]),
+            w: std::array::from_fn(|_| vec![[0.0; WC]; n + HB]),
             wg: [[[0.0; 3]; 3]; 3],
             first: [0; 3],
             s: vec![0.0; ns * ns],
@@ -292,7 +293,8 @@ impl Bordered {
             .min(n - 3);
         self.first[i] = first;
         let w = &mut self.w[i];
-        w[first * WC..].iter_mut().for_each(|x| *x = 0.0);
+        // rows first - HB..n zero (the pad before `first` keeps the loops below fixed-length)
+        w[first..].iter_mut().for_each(|x| *x = [0.0; WC]);
         for r in 0..ROWS {
             let p = [0, 0, 1, 1, 2, 2, 0][r];
             let lo = win[i][p];
@@ -306,7 +308,7 @@ impl Bordered {
                         self.s[c * ns + nu] += v;
                         self.s[nu * ns + c] += v;
                     } else {
-                        w[(3 * (ne - k) + c) * WC + r] = v;
+                        w[3 * (ne - k) + c + HB][r] = v;
                     }
                 }
             }
@@ -318,24 +320,29 @@ impl Bordered {
                 self.s[nu * ns + col] += v;
             }
         }
-        // W = L^{-1} E, multiplier columns: rows first..n
+        // W = L^{-1} E, multiplier columns: rows first..n, and their part of W^T W
         let (band, dinv) = (&self.band[i], &self.dinv[i]);
-        for j in first..n {
-            let mut row = [0.0; WC];
-            row.copy_from_slice(&w[j * WC..j * WC + WC]);
-            let lj = &band[j + HB];
-            for m in first.max(j.saturating_sub(HB))..j {
-                let f = lj[HB - (j - m)];
-                let wm = &w[m * WC..m * WC + WC];
+        let mut acc = [[0.0; WC]; ROWS];
+        for j in first + HB..n + HB {
+            let mut row = w[j];
+            let lj = &band[j];
+            for t in 0..HB {
+                let f = lj[t];
+                let wm = &w[j - HB + t];
                 for a in 0..WC {
                     row[a] -= f * wm[a];
                 }
             }
-            let d = dinv[j + HB];
+            let d = dinv[j];
             for a in 0..WC {
                 row[a] *= d;
             }
-            w[j * WC..j * WC + WC].copy_from_slice(&row);
+            w[j] = row;
+            for a in 0..ROWS {
+                for b in 0..WC {
+                    acc[a][b] += row[a] * row[b];
+                }
+            }
         }
         // G columns: E_G lives in the rows of node 1 (the last three), from element 0
         let blk0 = &vals[36 * i * ne..36 * i * ne + 36];
@@ -352,15 +359,6 @@ impl Bordered {
         }
         self.wg[i] = wg;
         // S -= W^T W
-        let mut acc = [[0.0; WC]; WC];
-        for j in first..n {
-            let row = &w[j * WC..j * WC + WC];
-            for a in 0..ROWS {
-                for b in 0..WC {
-                    acc[a][b] += row[a] * row[b];
-                }
-            }
-        }
         for a in 0..ROWS {
             for b in 0..ROWS {
                 self.s[border_nu(i, a) * ns + border_nu(i, b)] -= acc[a][b];
@@ -372,7 +370,7 @@ impl Bordered {
                 self.s[g * ns + h] -= v;
             }
             for a in 0..ROWS {
-                let v: f64 = (0..3).map(|c| wg[c][g] * w[(n - 3 + c) * WC + a]).sum();
+                let v: f64 = (0..3).map(|c| wg[c][g] * w[n - 3 + c + HB][a]).sum();
                 self.s[g * ns + border_nu(i, a)] -= v;
                 self.s[border_nu(i, a) * ns + g] -= v;
             }
@@ -480,10 +478,10 @@ impl Bordered {
             let y = &self.y[i];
             let w = &self.w[i];
             let mut acc = [0.0; WC];
-            for j in self.first[i]..n {
-                let wj = &w[j * WC..j * WC + WC];
+            for j in self.first[i] + HB..n + HB {
+                let wj = &w[j];
                 for a in 0..WC {
-                    acc[a] += wj[a] * y[j + HB];
+                    acc[a] += wj[a] * y[j];
                 }
             }
             for a in 0..ROWS {
@@ -516,13 +514,13 @@ impl Bordered {
             let y = &mut self.y[i];
             let w = &self.w[i];
             let xb: [f64; WC] = std::array::from_fn(|a| if a < ROWS { xs[border_nu(i, a)] } else { 0.0 });
-            for j in self.first[i]..n {
-                let wj = &w[j * WC..j * WC + WC];
+            for j in self.first[i] + HB..n + HB {
+                let wj = &w[j];
                 let mut v = 0.0;
                 for a in 0..WC {
                     v += wj[a] * xb[a];
                 }
-                y[j + HB] -= v;
+                y[j] -= v;
             }
             for c in 0..3 {
                 y[HB + n - 3 + c] -= (0..3).map(|g| self.wg[i][c][g] * xs[g]).sum::<f64>();

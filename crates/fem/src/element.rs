@@ -403,43 +403,77 @@ impl ElementState {
     /// quadrature it replaces).
     #[inline]
     pub fn mass(&self, rho: f64) -> Mat6 {
-        let a = self.basis();
-        // ag_l = sum_m G_lm A_m
-        let mut ag = [[[0.0; 6]; 2]; 4];
-        for l in 0..4 {
-            for m in 0..4 {
-                let g = GRAM[l][m];
-                for k in 0..2 {
-                    for j in 0..6 {
-                        ag[l][k][j] += g * a[m][k][j];
-                    }
-                }
-            }
+        // A_0 = P_a, A_1 = P_b (node positions), A_2 = q e_phia^T + p_2 jb^T,
+        // A_3 = q e_phib^T + p_3 jb^T with q = l0 e2, p_k = -l0 (e2 + th e1); expanded:
+        const G: [[f64; 4]; 4] = GRAM;
+        let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
+        let jb = self.jbeta();
+        let l0 = self.l0;
+        let q = [l0 * e2[0], l0 * e2[1]];
+        let p = [
+            [-l0 * (e2[0] + self.th1 * e1[0]), -l0 * (e2[1] + self.th1 * e1[1])],
+            [-l0 * (e2[0] + self.th2 * e1[0]), -l0 * (e2[1] + self.th2 * e1[1])],
+        ];
+        let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+        let (qp2, qp3) = (dot(q, p[0]), dot(q, p[1]));
+        let qq = l0 * l0;
+        let mut m = [[0.0; 6]; 6];
+        // node positions with each other
+        for x in 0..2 {
+            m[x][x] = G[0][0];
+            m[x][3 + x] = G[0][1];
+            m[3 + x][x] = G[1][0];
+            m[3 + x][3 + x] = G[1][1];
         }
-        let rl = rho * self.l0;
-        let mut mm = [[0.0; 6]; 6];
+        // rotation shape parts with each other: sum_kl G_kl A_k^T A_l, k, l in {2, 3}
+        let rot = [2, 5];
+        let gamma = G[2][2] * dot(p[0], p[0]) + 2.0 * G[2][3] * dot(p[0], p[1]) + G[3][3] * dot(p[1], p[1]);
+        let cr = [G[2][2] * qp2 + G[2][3] * qp3, G[3][2] * qp2 + G[3][3] * qp3];
         for i in 0..6 {
-            for j in i..6 {
-                let mut v = 0.0;
-                for l in 0..4 {
-                    v += a[l][0][i] * ag[l][0][j] + a[l][1][i] * ag[l][1][j];
-                }
-                mm[i][j] = rl * v;
-                mm[j][i] = rl * v;
+            for j in 0..6 {
+                m[i][j] += gamma * jb[i] * jb[j];
             }
         }
-        mm
+        for k in 0..2 {
+            for l in 0..2 {
+                m[rot[k]][rot[l]] += G[2 + k][2 + l] * qq;
+            }
+            for j in 0..6 {
+                m[rot[k]][j] += cr[k] * jb[j];
+                m[j][rot[k]] += cr[k] * jb[j];
+            }
+        }
+        // node positions with the rotation shapes: P_n^T (G_n2 A_2 + G_n3 A_3) and transposes
+        for (n, base) in [(0, 0), (1, 3)] {
+            let (g2, g3) = (G[n][2], G[n][3]);
+            for x in 0..2 {
+                let u = g2 * p[0][x] + g3 * p[1][x];
+                let mut r = [0.0; 6];
+                for j in 0..6 {
+                    r[j] = u * jb[j];
+                }
+                r[2] += g2 * q[x];
+                r[5] += g3 * q[x];
+                for j in 0..6 {
+                    m[base + x][j] += r[j];
+                    m[j][base + x] += r[j];
+                }
+            }
+        }
+        let rl = rho * l0;
+        for row in m.iter_mut() {
+            for v in row.iter_mut() {
+                *v *= rl;
+            }
+        }
+        m
     }
 
-    /// Kinetic energy [J] of the element moving with velocities `qd`:
-    /// `T = rho l0 / 2 sum_kl G_kl (A_k qd) . (A_l qd)` (closed form).
+    /// Kinetic energy [J] of the element moving with velocities `qd`: `T = 1/2 qd . M(q) qd`
+    /// (closed form: [`ElementState::inertia_force`] without its convective part).
     pub fn kinetic_energy(&self, rho: f64, qd: &[f64; 6]) -> f64 {
-        let a = self.basis();
-        let u: [[f64; 2]; 4] =
-            std::array::from_fn(|l| std::array::from_fn(|k| (0..6).map(|j| a[l][k][j] * qd[j]).sum()));
-        let v = gram_times(&u);
-        let t: f64 = (0..4).map(|l| u[l][0] * v[l][0] + u[l][1] * v[l][1]).sum();
-        0.5 * rho * self.l0 * t
+        let mqd = self.inertia_force(rho, &[0.0; 6], qd);
+        0.5 * (0..6).map(|j| qd[j] * mqd[j]).sum::<f64>()
     }
 }
 
@@ -653,6 +687,23 @@ mod tests {
                 fc[i],
                 fcq[i]
             );
+        }
+        // the basis expansion J = sum_k phi_k A_k that the closed forms rest on
+        let a = st.basis();
+        for z in [0.0, 0.3, 0.77, 1.0] {
+            let h = hermite(z);
+            let phi = [1.0 - z, z, h[0], h[1]];
+            let jac = st.jacobian(z);
+            for k in 0..2 {
+                for j in 0..6 {
+                    let v: f64 = (0..4).map(|l| phi[l] * a[l][k][j]).sum();
+                    assert!(
+                        (v - jac[k][j]).abs() < 1e-15,
+                        "J[{k}][{j}] at {z}: {v} vs {}",
+                        jac[k][j]
+                    );
+                }
+            }
         }
         let t = st.kinetic_energy(rho, &qd);
         assert!((t - tq).abs() < 1e-13 * tq, "T: {t} vs {tq}");

@@ -447,6 +447,9 @@ fn check_sleeves(star: &Star, q: &[f64], l: f64, t: f64) -> Result<(), FemError>
 
 /// Work vectors of the Newton iteration, allocated once.
 struct Workspace {
+    /// Weight of each coordinate's increment in the convergence test: the element length for
+    /// rotations (node rotations and sleeve rotations), 1 for lengths.
+    weight: Vec<f64>,
     a_part: Vec<f64>,
     qh: Vec<f64>,
     vh: Vec<f64>,
@@ -485,10 +488,7 @@ fn step(
     for k in 0..ws.nu.len() {
         ws.nu[k] = bp * st.lam[k];
     }
-    let rot_scale = star.h;
-    let is_rot = |j: usize, star: &Star| {
-        j < 3 * star.n_nodes && j % 3 == 2 || (j >= 3 * star.n_nodes && j < 3 * star.n_nodes + 3)
-    };
+    let inv_bp = 1.0 / bp;
     let mut converged = false;
     let mut last = (0.0, 0.0);
     let mut last_err = f64::INFINITY;
@@ -530,10 +530,9 @@ fn step(
         for j in 0..n_dof {
             let d = ws.dx[j];
             q1[j] += d;
-            qdd1[j] += d / bp;
-            v1[j] += gp / bp * d;
-            let s = if is_rot(j, star) { rot_scale } else { 1.0 };
-            dq_max = dq_max.max((d * s).abs());
+            qdd1[j] += d * inv_bp;
+            v1[j] += gp * inv_bp * d;
+            dq_max = dq_max.max((d * ws.weight[j]).abs());
         }
         let mut dl_max = 0.0f64;
         let mut l_max = 0.0f64;
@@ -626,7 +625,9 @@ pub(crate) fn integrate(
     let mut work = 0.0;
     rec.record(params, &star, &st, fa0, pf0, 0.0, 0.0);
 
+    let rot = |j: usize| j < 3 * star.n_nodes && j % 3 == 2 || (j >= 3 * star.n_nodes && j < 3 * star.n_nodes + 3);
     let mut ws = Workspace {
+        weight: (0..n_dof).map(|j| if rot(j) { star.h } else { 1.0 }).collect(),
         a_part: vec![0.0; n_dof],
         qh: vec![0.0; n_dof],
         vh: vec![0.0; n_dof],

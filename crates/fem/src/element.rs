@@ -75,8 +75,14 @@ pub fn atan2(y: f64, x: f64) -> f64 {
     }
     let swap = ay > ax;
     let r = if swap { ax / ay } else { ay / ax };
-    let (c, ac) = ATAN_POINTS[(r * 8.0 + 0.5) as usize];
-    let t = (r - c) / (1.0 + r * c);
+    let i = (r * 8.0 + 0.5) as usize;
+    // no reduction near 0 (the common case: small relative rotations)
+    let (t, ac) = if i == 0 {
+        (r, 0.0)
+    } else {
+        let (c, ac) = ATAN_POINTS[i];
+        ((r - c) / (1.0 + r * c), ac)
+    };
     let u = t * t;
     let p = -1.0 / 3.0
         + u * (1.0 / 5.0

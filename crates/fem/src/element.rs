@@ -84,10 +84,11 @@ pub fn atan2(y: f64, x: f64) -> f64 {
         ((r - c) / (1.0 + r * c), ac)
     };
     let u = t * t;
-    let p = -1.0 / 3.0
-        + u * (1.0 / 5.0
-            + u * (-1.0 / 7.0
-                + u * (1.0 / 9.0 + u * (-1.0 / 11.0 + u * (1.0 / 13.0 + u * (-1.0 / 15.0 + u * (1.0 / 17.0)))))));
+    // Estrin's scheme (short dependency chain) for sum_k (-1)^(k+1) u^k / (2k + 3), k = 0..7
+    let (u2, u4) = (u * u, u * u * (u * u));
+    let p = (-1.0 / 3.0 + u * (1.0 / 5.0))
+        + u2 * (-1.0 / 7.0 + u * (1.0 / 9.0))
+        + u4 * ((-1.0 / 11.0 + u * (1.0 / 13.0)) + u2 * (-1.0 / 15.0 + u * (1.0 / 17.0)));
     let mut a = ac + (t + t * u * p);
     if swap {
         a = FRAC_PI_2 - a;
@@ -157,8 +158,10 @@ impl ElementState {
         let ln = (d[0] * d[0] + d[1] * d[1]).sqrt();
         let inv_ln = 1.0 / ln;
         let (c, s) = (d[0] * inv_ln, d[1] * inv_ln);
-        let sd = el.c0 * s - el.s0 * c;
-        let cd = el.c0 * c + el.s0 * s;
+        // rotation of the chord from its initial direction (atan2 needs no normalised chord:
+        // off the chain of the square root and the division)
+        let sd = el.c0 * d[1] - el.s0 * d[0];
+        let cd = el.c0 * d[0] + el.s0 * d[1];
         let dp = atan2(sd, cd);
         let th1 = wrap(q[2] - dp);
         let delta = q[2] - th1;

@@ -123,7 +123,6 @@ pub(crate) struct Star {
     pub sparse_fallbacks: usize,
     slots: Vec<(usize, usize)>,
     pub vals: Vec<f64>,
-    states: Vec<ElementState>,
     /// Offsets of the slot groups.
     off_psi: usize,
     off_con: usize,
@@ -199,7 +198,7 @@ impl Star {
                 v[psi0 + 12 + i] = sl[i][1];
             }
         }
-        let mut star = Star {
+        let star = Star {
             params: *params,
             ne,
             h,
@@ -215,7 +214,6 @@ impl Star {
             sparse_fallbacks: 0,
             slots: Vec::new(),
             vals: Vec::new(),
-            states: Vec::with_capacity(3 * ne),
             off_psi: 0,
             off_con: 0,
             ncol_c: 3 * (WINDOW.min(ne) + 1) + 2,
@@ -224,11 +222,6 @@ impl Star {
             direct: sliders.is_some(),
             off_sl: 0,
         };
-        star.states = star
-            .elements
-            .iter()
-            .map(|el| ElementState::new(el, &star.element_q(el, &q)))
-            .collect();
         Ok((star, q, v))
     }
 
@@ -436,7 +429,6 @@ impl Star {
                     res[d[a]] += cf * (fm[a] + fi[a]);
                 }
             }
-            self.states[e] = st;
         }
         for i in 0..3 {
             let ps = self.psi(i);
@@ -452,7 +444,10 @@ impl Star {
                 let xi_idx = self.xi(i, p);
                 let (e, z) = self.locate(q[xi_idx]);
                 let ge = i * self.ne + e;
-                let st = self.states[ge];
+                // the state of the element holding the contact point (recomputed: cheaper than
+                // storing every element's state, which at 3000 elements leaves the cache)
+                let el = &self.elements[ge];
+                let st = ElementState::new(el, &self.element_q(el, q));
                 let na = self.node(i, e);
                 let (phi, grad, gxi, gpsi) = self.row_terms(&st, [q[3 * na], q[3 * na + 1]], i, q[ps], pins.p[i], r, z);
                 let row = self.n_dof + ROWS * i + r;

@@ -278,12 +278,7 @@ fn integrate_direct(
         let h = (t1 - t0) / nsub as f64;
         let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
         let apq = ga.a_per_qdd();
-        let predict = |x: f64, xd: f64, xa: f64, xdd: f64| {
-            let ap = (ga.alpha_f * xdd - ga.alpha_m * xa) / (1.0 - ga.alpha_m);
-            let xh = x + h * xd + h * h * ((0.5 - ga.beta) * xa + ga.beta * ap);
-            let vh = xd + h * ((1.0 - ga.gamma) * xa + ga.gamma * ap);
-            (ap, xh, vh)
-        };
+        let predict = |x: f64, xd: f64, xa: f64, xdd: f64| ga.predict(h, x, xd, xa, xdd);
         for k in 1..=nsub {
             let t = if k == nsub { t1 } else { t0 + k as f64 * h };
             for i in 0..n {

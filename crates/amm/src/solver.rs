@@ -233,13 +233,10 @@ pub(crate) fn integrate<F: FnMut(&System, &[f64])>(
         let nsub = (((t1 - t0) / dt_max) - 1e-9).ceil().max(1.0) as usize;
         let h = (t1 - t0) / nsub as f64;
         let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
-        let inv_one_minus_am = 1.0 / (1.0 - ga.alpha_m);
         for k in 1..=nsub {
             let t = if k == nsub { t1 } else { t0 + k as f64 * h };
             for i in 0..n {
-                a_part[i] = (ga.alpha_f * qdd[i] - ga.alpha_m * acc[i]) * inv_one_minus_am;
-                qhat[i] = q[i] + h * v[i] + h * h * ((0.5 - ga.beta) * acc[i] + ga.beta * a_part[i]);
-                vhat[i] = v[i] + h * ((1.0 - ga.gamma) * acc[i] + ga.gamma * a_part[i]);
+                (a_part[i], qhat[i], vhat[i]) = ga.predict(h, q[i], v[i], acc[i], qdd[i]);
             }
             st = kin(t)?;
             sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)?;

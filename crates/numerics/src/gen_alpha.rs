@@ -37,6 +37,20 @@ impl GenAlpha {
         }
     }
 
+    /// Predictor of one unknown over a step h (Arnold & Bruls 2007), from its position `q`,
+    /// velocity `v`, pseudo-acceleration `a` and acceleration `qdd` at the start of the step:
+    /// returns `(a_part, qhat, vhat)` with `a_part = (alpha_f qdd - alpha_m a) / (1 - alpha_m)`,
+    /// `qhat = q + h v + h^2 ((1/2 - beta) a + beta a_part)`, `vhat = v + h ((1 - gamma) a + gamma a_part)`;
+    /// the step then sets `q = qhat + beta' qdd_new`, `v = vhat + gamma' qdd_new`,
+    /// `a = a_part + a_per_qdd qdd_new`.
+    #[inline]
+    pub fn predict(&self, h: f64, q: f64, v: f64, a: f64, qdd: f64) -> (f64, f64, f64) {
+        let a_part = (self.alpha_f * qdd - self.alpha_m * a) * (1.0 / (1.0 - self.alpha_m));
+        let qhat = q + h * v + h * h * ((0.5 - self.beta) * a + self.beta * a_part);
+        let vhat = v + h * ((1.0 - self.gamma) * a + self.gamma * a_part);
+        (a_part, qhat, vhat)
+    }
+
     /// `d a_{n+1} / d qdd_{n+1}` = (1 - alpha_f) / (1 - alpha_m).
     pub fn a_per_qdd(&self) -> f64 {
         (1.0 - self.alpha_f) / (1.0 - self.alpha_m)

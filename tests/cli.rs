@@ -2,14 +2,10 @@
 //! handling of bad input (clear message, non-zero exit, no partial output).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn flexstar(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flexstar"))
-        .args(args)
-        .output()
-        .expect("flexstar runs")
-}
+mod common;
+use common::{flexstar, stderr};
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -17,10 +13,6 @@ fn root() -> PathBuf {
 
 fn config(name: &str) -> String {
     root().join("configs").join(name).to_string_lossy().into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 #[test]

@@ -4,18 +4,9 @@
 //! and no output. Small models (AMM N = 40, FEM 102 elements) keep each run well under a second.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn flexstar(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flexstar"))
-        .args(args)
-        .output()
-        .expect("flexstar runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::{flexstar, stderr};
 
 /// The paper's robot with case 3's motion and small solver settings, written into `dir`.
 fn small_config(dir: &Path) -> String {

@@ -3,18 +3,10 @@
 //! reports missing ones; bad input is refused before any run.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn flexstar(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flexstar"))
-        .args(args)
-        .output()
-        .expect("flexstar runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::{flexstar, stderr};
 
 /// 30 ms of case 3 with 5 free-free modes: a fast case.
 const BASE: &str = r#"

@@ -805,10 +805,9 @@ impl ModeSet {
             slope: &mut slope[r0..na],
         };
         let trig = ModeTrig::new(xi, &self.roots);
-        let (sc, sdc) = (s, sd);
         match bent.as_ref() {
-            Some((_, bn)) => elastic_triplets::<true>(tri, trig, out, &bn.alpha_eff[r0..na], sc, sdc, &mut bend),
-            None => elastic_triplets::<false>(tri, trig, out, &[], sc, sdc, &mut bend),
+            Some((_, bn)) => elastic_triplets::<true>(tri, trig, out, &bn.alpha_eff[r0..na], s, sd, &mut bend),
+            None => elastic_triplets::<false>(tri, trig, out, &[], s, sd, &mut bend),
         }
         let [mut sl, mut sr, mut cv] = bend;
         for (j, sh) in self.junction.iter().enumerate() {

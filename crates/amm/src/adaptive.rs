@@ -10,6 +10,14 @@
 //! N starts where the modes first resolve the sleeve (wavelength 2L/N below Lp, `docs/amm.md`
 //! section 3, plus a margin) and grows by 15 % until the estimate is below the tolerance, up to
 //! [`MAX_AUTO_MODES`].
+//!
+//! The pair runs at [`ESTIMATE_STEP_FACTOR`] times the delivered step: d is a difference of two
+//! runs at the same step, and their time errors (2-6 % at that step) cancel in it. On the paper's
+//! cases and the two motions of `configs/motions/`, d at 8 h is 0.97-1.00 times d at h
+//! (`cargo run --release -p flexstar-amm --example coarse_estimate -- 8 16`); at 16 h,
+//! with time errors of 8-21 %, 0.87-0.99. The chosen N then runs once at the delivered step,
+//! and the time error of the coarse step is checked against it: above
+//! [`MAX_ESTIMATE_TIME_ERROR`] the pairs are run again at the delivered step.
 
 use flexstar_model::evp::point_evps;
 use flexstar_model::{Experiment, Response};
@@ -26,6 +34,29 @@ pub const GROWTH: f64 = 1.15;
 /// runs into the estimate (module docs): the median of the rates measured on the paper's cases
 /// between N = 46 and 53 (6.1, 6.8, 7.2, 7.6).
 pub const RATE: f64 = 7.0;
+
+/// Step of the estimate's runs over the delivered step (module docs).
+pub const ESTIMATE_STEP_FACTOR: f64 = 8.0;
+
+/// Largest time error of the estimate's step [%]: the mean EVP (Eq. 45) of the chosen N's run at
+/// that step against its run at the delivered step. At 16 times the step the paper's cases reach
+/// 8-21 % and their pair differences 0.87-0.99 times those at the delivered step (module docs).
+pub const MAX_ESTIMATE_TIME_ERROR: f64 = 10.0;
+
+/// Fewest output rows of the estimate's coarse grid; shorter spans run their pairs at the
+/// delivered step.
+pub const MIN_ESTIMATE_ROWS: usize = 20;
+
+/// The coarse output grid of the estimate's runs for a delivered step `h` [s]: its interval is
+/// `every` times `exp.time.dt_out`, the first multiple at least [`ESTIMATE_STEP_FACTOR`] h, so that
+/// its times are a subset of the delivered ones. `None` (pairs at the delivered step) when that grid
+/// would have fewer than [`MIN_ESTIMATE_ROWS`] rows.
+pub fn estimate_grid(exp: &Experiment, h: f64) -> Option<usize> {
+    let dt_out = exp.time.dt_out;
+    let every = ((ESTIMATE_STEP_FACTOR * h / dt_out) - 1e-9).ceil().max(1.0) as usize;
+    let rows = (exp.time.t_end / (every as f64 * dt_out) - 1e-9).ceil() + 1.0;
+    (rows >= MIN_ESTIMATE_ROWS as f64).then_some(every)
+}
 
 /// Modes beyond the sleeve resolution `2 L / Lp` with which the automatic choice starts: at
 /// `2 L / Lp + 6` the paper's cases are still 1.6-2.1 % off the FEM, at `+ 12` about 1 %
@@ -60,21 +91,34 @@ pub fn truncation_estimate(coarse: &Response, fine: &Response, n_coarse: usize, 
         .map(|d| d / richardson)
 }
 
-/// Raise N from [`first_modes`] until the estimate is below `tol` [%]; `run(n)` solves at N = n.
-/// Returns the last run with `info.modes`, `info.error_estimate_percent` and `info.tol_percent`
-/// set, its wall time the sum over the runs. Fails with the estimate reached when the tolerance
-/// is not met at [`MAX_AUTO_MODES`].
-pub(crate) fn solve_to_tolerance<F>(exp: &Experiment, tol: f64, mut run: F) -> Result<Response, AmmError>
+/// The step a run of the automatic choice takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Pass {
+    /// A run of the estimate's pair: step [`ESTIMATE_STEP_FACTOR`] times the delivered one, on
+    /// an output grid `every` times coarser (module docs).
+    Estimate { every: usize },
+    /// A run at the delivered step and output grid.
+    Deliver,
+}
+
+/// The estimate's pair at N_prev and N, found by raising N from [`first_modes`] at `pass` until
+/// the estimate of the N-run is below `tol`: `(N, estimate, the N-run, wall time of all runs)`.
+fn raise_until_below<F>(
+    exp: &Experiment,
+    tol: f64,
+    pass: Pass,
+    run: &mut F,
+) -> Result<(usize, f64, Response, f64), AmmError>
 where
-    F: FnMut(usize) -> Result<Response, AmmError>,
+    F: FnMut(usize, Pass) -> Result<Response, AmmError>,
 {
     let mut n = first_modes(exp);
-    let mut prev = run(n)?;
+    let mut prev = run(n, pass)?;
     let mut wall = prev.info.wall_s;
+    let mut reached = f64::NAN;
     loop {
         let n_next = next_modes(n);
         if n_next == n {
-            let reached = prev.info.error_estimate_percent.unwrap_or(f64::NAN);
             return Err(AmmError::invalid(
                 "amm.tol",
                 format!(
@@ -82,18 +126,58 @@ where
                 ),
             ));
         }
-        let mut next = run(n_next)?;
+        let next = run(n_next, pass)?;
         wall += next.info.wall_s;
-        let estimate = truncation_estimate(&prev, &next, n, n_next).unwrap_or(0.0);
-        next.info.error_estimate_percent = Some(estimate);
-        next.info.tol_percent = Some(tol);
-        next.info.wall_s = wall;
-        if estimate <= tol {
-            return Ok(next);
+        reached = truncation_estimate(&prev, &next, n, n_next).unwrap_or(0.0);
+        if reached <= tol {
+            return Ok((n_next, reached, next, wall));
         }
         n = n_next;
         prev = next;
     }
+}
+
+/// Raise N from [`first_modes`] until the estimate is below `tol` [%]; `run(n, pass)` solves at
+/// N = n with the step of `pass`. With `every = Some(k)` the pairs run at the coarse step
+/// ([`Pass::Estimate`], output grid k times coarser), then the chosen N once at the delivered
+/// step; if the coarse step's own time error, the EVP of the chosen N's two runs, is above
+/// [`MAX_ESTIMATE_TIME_ERROR`], or with `every = None`, the pairs run at the delivered step.
+/// Returns the delivered run with `info.modes`, `info.error_estimate_percent` and
+/// `info.tol_percent` set, its wall time the sum over the runs. Fails with the estimate reached
+/// when the tolerance is not met at [`MAX_AUTO_MODES`].
+pub(crate) fn solve_to_tolerance<F>(
+    exp: &Experiment,
+    tol: f64,
+    every: Option<usize>,
+    mut run: F,
+) -> Result<Response, AmmError>
+where
+    F: FnMut(usize, Pass) -> Result<Response, AmmError>,
+{
+    let mut wall = 0.0;
+    if let Some(every) = every {
+        let pass = Pass::Estimate { every };
+        let (n, estimate, coarse, pair_wall) = raise_until_below(exp, tol, pass, &mut run)?;
+        let delivered = run(n, Pass::Deliver)?;
+        wall += pair_wall + delivered.info.wall_s;
+        let time_error = point_evps(&coarse, &delivered.every_nth(every))
+            .ok()
+            .and_then(|e| e.mean)
+            .unwrap_or(f64::INFINITY);
+        if time_error <= MAX_ESTIMATE_TIME_ERROR {
+            return Ok(finish(delivered, estimate, tol, wall));
+        }
+    }
+    let (_, estimate, delivered, pair_wall) = raise_until_below(exp, tol, Pass::Deliver, &mut run)?;
+    Ok(finish(delivered, estimate, tol, wall + pair_wall))
+}
+
+/// The delivered run with the automatic choice's report.
+fn finish(mut delivered: Response, estimate: f64, tol: f64, wall: f64) -> Response {
+    delivered.info.error_estimate_percent = Some(estimate);
+    delivered.info.tol_percent = Some(tol);
+    delivered.info.wall_s = wall;
+    delivered
 }
 
 #[cfg(test)]

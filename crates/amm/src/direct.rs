@@ -53,7 +53,9 @@ pub fn solve_direct(exp: &Experiment, settings: &AmmSettings, law: &dyn Actuator
         ModeCount::Fixed(n) => integrate_direct(exp, settings, law, n),
         ModeCount::Tolerance(tol) => {
             validate(exp, settings, adaptive::first_modes(exp), scan)?;
-            adaptive::solve_to_tolerance(exp, tol, |n| integrate_direct(exp, settings, law, n))
+            // the pairs at the delivered step: the coarse-step estimate (`adaptive`) is measured
+            // on inverse runs only, and a servo's loop may not tolerate the coarse step
+            adaptive::solve_to_tolerance(exp, tol, None, |n, _| integrate_direct(exp, settings, law, n))
         }
     }
 }

@@ -11,10 +11,10 @@
 
 use flexstar_kinematics::{check_configuration, check_trajectory, Infeasible, RigidState};
 use flexstar_model::config::check_step;
-use flexstar_model::{AmmSettings, Experiment, ModeCount, ModeFamily, Response, RunInfo};
+use flexstar_model::{AmmSettings, Experiment, ModeCount, ModeFamily, Response, RobotParams, RunInfo};
 use flexstar_numerics::GenAlpha;
 
-use crate::adaptive;
+use crate::adaptive::{self, Pass};
 use crate::error::AmmError;
 use crate::modes::{ModeSet, MAX_MODES};
 use crate::record::Recorder;
@@ -170,13 +170,50 @@ pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 pub fn solve(exp: &Experiment, settings: &AmmSettings) -> Result<Response, AmmError> {
     match settings.mode_count() {
         ModeCount::Fixed(n) => integrate(exp, settings, n, true, |_, _| {}),
-        ModeCount::Tolerance(tol) => {
-            // every input error before any work, at the first N
-            validate(exp, settings, adaptive::first_modes(exp), true)?;
-            // the trajectory was scanned once above; each run checks only its own settings
-            adaptive::solve_to_tolerance(exp, tol, |n| integrate(exp, settings, n, false, |_, _| {}))
-        }
+        ModeCount::Tolerance(tol) => solve_to_tolerance(exp, settings, tol),
     }
+}
+
+/// [`solve`] with N chosen for the tolerance `tol` [%] (`adaptive` module): the estimate's pairs
+/// at the coarse step on the coarse output grid, the chosen N at the delivered step `h`. The
+/// system of the last N is built once and reused by its runs at both steps.
+fn solve_to_tolerance(exp: &Experiment, settings: &AmmSettings, tol: f64) -> Result<Response, AmmError> {
+    // every input error before any work, at the first N; the trajectory is scanned once here
+    let h = validate(exp, settings, adaptive::first_modes(exp), true)?;
+    let every = adaptive::estimate_grid(exp, h);
+    let mut built: Option<(usize, System)> = None;
+    adaptive::solve_to_tolerance(exp, tol, every, |n, pass| {
+        let started = std::time::Instant::now();
+        let sys = match &built {
+            Some((m, sys)) if *m == n => sys.clone(),
+            _ => {
+                validate(exp, settings, n, false)?;
+                let sys = build_system(settings, n, &exp.robot)?;
+                built = Some((n, sys.clone()));
+                sys
+            }
+        };
+        match pass {
+            Pass::Deliver => integrate_system(exp, settings, sys, h, started, |_, _| {}),
+            Pass::Estimate { every } => {
+                let mut coarse = exp.clone();
+                coarse.time.dt_out = every as f64 * exp.time.dt_out;
+                let step = (adaptive::ESTIMATE_STEP_FACTOR * h).min(coarse.time.dt_out);
+                let pair_settings = AmmSettings {
+                    dt: Some(step),
+                    snapshots: Vec::new(),
+                    ..settings.clone()
+                };
+                integrate_system(&coarse, &pair_settings, sys, step, started, |_, _| {})
+            }
+        }
+    })
+}
+
+/// The constrained system of N = `n_modes` modes of `settings.family` for the robot `params`.
+pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, params: &RobotParams) -> Result<System, AmmError> {
+    let modes = ModeSet::new(settings.family, n_modes, params)?;
+    Ok(System::new(modes, params, settings.model))
 }
 
 /// [`solve`] at N = `n_modes` with an observer called after every step with the system and the
@@ -187,13 +224,26 @@ pub(crate) fn integrate<F: FnMut(&System, &[f64])>(
     settings: &AmmSettings,
     n_modes: usize,
     scan: bool,
-    mut observe: F,
+    observe: F,
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
     let dt_max = validate(exp, settings, n_modes, scan)?;
+    let sys = build_system(settings, n_modes, &exp.robot)?;
+    integrate_system(exp, settings, sys, dt_max, started, observe)
+}
+
+/// [`integrate`] with the system `sys` built (fresh, not yet stepped) and the inputs validated:
+/// steps of at most `dt_max` [s]; the reported wall time counts from `started`.
+pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
+    exp: &Experiment,
+    settings: &AmmSettings,
+    mut sys: System,
+    dt_max: f64,
+    started: std::time::Instant,
+    mut observe: F,
+) -> Result<Response, AmmError> {
     let params = &exp.robot;
-    let modes = ModeSet::new(settings.family, n_modes, params)?;
-    let mut sys = System::new(modes, params, settings.model);
+    let n_modes = sys.modes.len();
     let (nm, n) = (sys.nm, sys.dim());
 
     let out_times = exp.time.output_times();

@@ -127,6 +127,34 @@ impl Response {
             .collect();
     }
 
+    /// Rows 0, `every`, 2 `every`, ... and the last row: the response on a coarser output grid
+    /// whose interval is `every` times this one's (both end at t_end; `TimeSpan::output_times`).
+    /// Every column is kept; the deformed-star snapshots are kept as they are. `every = 0` is
+    /// taken as 1.
+    pub fn every_nth(&self, every: usize) -> Response {
+        let every = every.max(1);
+        let last = self.len().saturating_sub(1);
+        let keep: Vec<usize> = (0..self.len()).filter(|k| k % every == 0 || *k == last).collect();
+        let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
+        Response {
+            label: self.label.clone(),
+            info: self.info.clone(),
+            t: pick(&self.t),
+            w_g: self.w_g.each_ref().map(|c| pick(c)),
+            w_tip: self.w_tip.each_ref().map(|c| pick(c)),
+            fa: self.fa.each_ref().map(|c| pick(c)),
+            extra: self
+                .extra
+                .iter()
+                .map(|c| Column {
+                    name: c.name.clone(),
+                    values: pick(&c.values),
+                })
+                .collect(),
+            shapes: self.shapes.clone(),
+        }
+    }
+
     /// Number of output rows.
     pub fn len(&self) -> usize {
         self.t.len()
@@ -296,5 +324,42 @@ impl Response {
             out.flush()?;
             Ok(())
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::TimeSpan;
+
+    #[test]
+    fn every_nth_lands_on_the_coarser_output_grid() {
+        // a span that is not a multiple of either interval: both grids end at t_end
+        let fine = TimeSpan {
+            t_end: 0.0105,
+            dt_out: 1e-3,
+        };
+        let coarse = TimeSpan { dt_out: 4e-3, ..fine };
+        let mut r = Response::with_capacity("x", 0);
+        for (k, t) in fine.output_times().into_iter().enumerate() {
+            let v = k as f64;
+            r.push(t, [v, 0.0, 0.0], [0.0, v, 0.0], [0.0, 0.0, v]);
+        }
+        r.extra.push(Column {
+            name: "e".into(),
+            values: (0..r.len()).map(|k| -(k as f64)).collect(),
+        });
+        let c = r.every_nth(4);
+        let want = coarse.output_times();
+        assert_eq!(c.len(), want.len());
+        for (a, b) in c.t.iter().zip(&want) {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+        // rows 0, 4, 8 and the last (11, t_end = 10.5 ms): every column picks the same rows
+        assert_eq!(c.w_g[0], vec![0.0, 4.0, 8.0, 11.0]);
+        assert_eq!(c.w_tip[1], c.w_g[0]);
+        assert_eq!(c.fa[2], c.w_g[0]);
+        assert_eq!(c.extra[0].values, vec![0.0, -4.0, -8.0, -11.0]);
+        assert_eq!(r.every_nth(1), r);
     }
 }

@@ -61,15 +61,19 @@ impl Foreshortening {
     }
 
     /// `E''` of beam `beam` [m^2/s^2]: `alpha'^T G2 alpha'` on the kept modes at the velocity
-    /// `va`, plus `(G2 alpha) . alpha''` with `g2_alpha = G2 alpha` (N) and alpha'' of the last
-    /// solve. The u row of the beam gains `+rho E''` on its right-hand side.
-    pub(crate) fn second_derivative(&mut self, beam: usize, g2_alpha: ColRef<'_, f64>, va: &[f64]) -> f64 {
+    /// `va`, plus `(G2 alpha) . alpha''` with `g2_alpha = G2 alpha` on the modes `rows` (those of
+    /// Eq. 23's product, `geometric`) and alpha'' of the last solve. The u row of the beam gains
+    /// `+rho E''` on its right-hand side.
+    pub(crate) fn second_derivative(
+        &mut self,
+        beam: usize,
+        rows: &[usize],
+        g2_alpha: ColRef<'_, f64>,
+        va: &[f64],
+    ) -> f64 {
         let n = va.len();
         let add = &self.alpha_dd[beam * n..(beam + 1) * n];
-        let mut e2: f64 = match g2_alpha.try_as_col_major() {
-            Some(c) => add.iter().zip(c.as_slice()).map(|(a, g)| a * g).sum(),
-            None => add.iter().enumerate().map(|(j, a)| a * g2_alpha[j]).sum(),
-        };
+        let mut e2: f64 = rows.iter().enumerate().map(|(k, &j)| add[j] * g2_alpha[k]).sum();
         for (vk, &j) in self.v.iter_mut().zip(&self.kept) {
             *vk = va[j];
         }
@@ -137,7 +141,8 @@ mod tests {
             let e = 0.5 * psi * dot(&g2_alpha, &shape);
             let l = p.l;
             assert!((e - psi * psi * l * l / 4.0).abs() < 1e-8 * e, "{family}: E = {e}");
-            let e2 = fore.second_derivative(1, faer::ColRef::from_slice(&g2_alpha), &va);
+            let all: Vec<usize> = (0..n).collect();
+            let e2 = fore.second_derivative(1, &all, faer::ColRef::from_slice(&g2_alpha), &va);
             let exact = l * l / 2.0 * (psid * psid + psi * psidd);
             assert!(
                 (e2 - exact).abs() < 1e-8 * exact.abs(),

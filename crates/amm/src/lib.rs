@@ -22,6 +22,7 @@ pub mod adaptive;
 pub mod direct;
 pub mod error;
 mod foreshortening;
+mod geometric;
 pub mod modes;
 pub mod pose_modes;
 mod record;

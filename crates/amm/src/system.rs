@@ -20,13 +20,12 @@
 //! three beams (it depends on th only) and is solved in O(N). The constraints (at most 18 rows)
 //! are eliminated by the Schur complement `A = C S^-1 C^T`, a small dense LU per step.
 
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, Par};
 use flexstar_kinematics::RigidState;
 use flexstar_model::{AmmModel, RobotParams};
 
 use crate::error::AmmError;
 use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
+use crate::geometric::{self, GeometricStiffness};
 use crate::modes::{dot, ModeSet, SleeveBending, Triplet};
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
@@ -113,12 +112,9 @@ pub(crate) struct System {
     pub(crate) rows: Vec<Row>,
     beams: [BeamRows; 3],
     model: AmmModel,
-    /// Full model: geometric stiffness matrices of the axial inertia force (Eq. 23), stacked
-    /// `[G1; G2]` (2N x N), and their products with the three beams' modal coordinates (2N x 3).
-    g12: Mat<f64>,
-    g12_q: Mat<f64>,
-    /// The three beams' modal coordinates as columns (N x 3), the right side of that product.
-    alpha_cols: Mat<f64>,
+    /// Full model: the geometric stiffness of the axial inertia force (Eq. 23) on the modes
+    /// that carry it, and its products with the predicted modal coordinates.
+    geometric: Option<GeometricStiffness>,
     /// Full model: u_i-gradients of the rows Fp_i, FR_i, FL_i at the last solve (`-w'` at the
     /// material point in the sleeve; 0 in the paper's model): the axial direction of their forces.
     pub(crate) sleeve_axial: [[f64; 3]; 3],
@@ -243,25 +239,20 @@ impl System {
         debug_assert!(beams.iter().all(|b| b.ids.len() <= MAX_BEAM_ROWS));
         let m = rows.len();
         let n = 3 * nb;
-        let (g12, fore) = match model {
+        let (geometric, fore) = match model {
             AmmModel::Full => {
                 let (g1, g2) = modes.axial_stiffening();
-                let g12 = Mat::from_fn(
-                    2 * nm,
-                    nm,
-                    |r, c| if r < nm { g1[r * nm + c] } else { g2[(r - nm) * nm + c] },
-                );
-                (g12, Some(Foreshortening::new(&modes, &g2, KEPT_ANALYTIC)))
+                (
+                    Some(GeometricStiffness::new(&modes, &g1, &g2, geometric::KEPT_ANALYTIC)),
+                    Some(Foreshortening::new(&modes, &g2, KEPT_ANALYTIC)),
+                )
             }
-            AmmModel::Paper => (Mat::zeros(0, 0), None),
+            AmmModel::Paper => (None, None),
         };
-        let kg_rows = g12.nrows();
         System {
             fore,
             model,
-            g12,
-            g12_q: Mat::zeros(kg_rows, 3),
-            alpha_cols: Mat::zeros(if kg_rows > 0 { nm } else { 0 }, 3),
+            geometric,
             sleeve_axial: [[0.0; 3]; 3],
             udd: [0.0; 3],
             xp: [0.0; 3],
@@ -292,6 +283,15 @@ impl System {
             lam: vec![0.0; m],
             modes,
         }
+    }
+
+    /// The system with Eq. 23's product on the first `analytic` analytic modes (and the junction
+    /// shapes) instead of [`geometric::KEPT_ANALYTIC`], for the test of that truncation.
+    #[cfg(test)]
+    pub(crate) fn with_geometric_kept(mut self, analytic: usize) -> Self {
+        let (g1, g2) = self.modes.axial_stiffening();
+        self.geometric = Some(GeometricStiffness::new(&self.modes, &g1, &g2, analytic));
+        self
     }
 
     /// Number of unknowns, 3 (N + 2).
@@ -360,27 +360,6 @@ impl System {
         self.inv_sigma = 1.0 / sigma;
     }
 
-    /// Solve `S x = r` for one beam block (O(N)), in place.
-    /// Full model: `[G1; G2] alpha_i` for the three beams at once (one matrix product, SIMD by
-    /// faer), the geometric stiffness of Eq. 23 applied to the predicted modal coordinates.
-    fn geometric_stiffness_products(&mut self, qhat: &[f64]) {
-        let (nm, nb) = (self.nm, self.nb);
-        for i in 0..3 {
-            let mut col = self.alpha_cols.col_mut(i);
-            for (j, v) in qhat[i * nb..i * nb + nm].iter().enumerate() {
-                col[j] = *v;
-            }
-        }
-        matmul(
-            self.g12_q.as_mut(),
-            Accum::Replace,
-            self.g12.as_ref(),
-            self.alpha_cols.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-    }
-
     #[inline]
     fn arrow_solve(&self, x: &mut [f64]) {
         let nm = self.nm;
@@ -435,8 +414,8 @@ impl System {
         let thd = st.theta.d1;
         let thdd = st.theta.d2;
         let ag = st.a_g();
-        if self.model == AmmModel::Full {
-            self.geometric_stiffness_products(qhat);
+        if let Some(geo) = self.geometric.as_mut() {
+            geo.multiply(qhat, nb);
         }
         for i in 0..3 {
             let ew = st.e_w(i);
@@ -463,16 +442,16 @@ impl System {
                 + rho * thdd * phi_q
                 + rho * l * thd * thd * qu;
             r[nm + 1] = -self.jp * thdd;
-            if self.model == AmmModel::Full {
+            if let Some(geo) = &self.geometric {
                 // Eq. 23: - rho (th'^2 G1 - a_x G2) alpha, at the predictor (docs/amm.md section 8)
                 let (c1, c2) = (rho * thd * thd, -rho * (ax + self.udd[i]));
-                let col = self.g12_q.col(i);
-                for (j, rj) in r[..nm].iter_mut().enumerate() {
-                    *rj -= c1 * col[j] + c2 * col[nm + j];
+                let (g1a, g2a) = (geo.g1_alpha(i), geo.g2_alpha(i));
+                for (k, &j) in geo.kept().iter().enumerate() {
+                    r[j] -= c1 * g1a[k] + c2 * g2a[k];
                 }
                 // foreshortening inertia of the bent beam in its u row: + rho E''
                 if let Some(fore) = self.fore.as_mut() {
-                    r[nm] += rho * fore.second_derivative(i, col.subrows(nm, nm), va);
+                    r[nm] += rho * fore.second_derivative(i, geo.kept(), g2a, va);
                 }
             }
         }
@@ -518,12 +497,12 @@ impl System {
                 + rho * d_thdd * phi_q
                 + 2.0 * rho * l * thd * d_thd * qu;
             r[nm + 1] = -self.jp * d_thdd;
-            if self.model == AmmModel::Full {
+            if let Some(geo) = &self.geometric {
                 // G1 alpha, G2 alpha of the last forcing (the same qhat)
                 let (c1, c2) = (2.0 * rho * thd * d_thd, -rho * dax);
-                let col = self.g12_q.col(i);
-                for (j, rj) in r[..nm].iter_mut().enumerate() {
-                    *rj -= c1 * col[j] + c2 * col[nm + j];
+                let (g1a, g2a) = (geo.g1_alpha(i), geo.g2_alpha(i));
+                for (k, &j) in geo.kept().iter().enumerate() {
+                    r[j] -= c1 * g1a[k] + c2 * g2a[k];
                 }
             }
         }

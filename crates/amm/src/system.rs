@@ -23,6 +23,7 @@
 use flexstar_kinematics::RigidState;
 use flexstar_model::{AmmModel, RobotParams};
 
+use crate::constraint_lu::ConstraintLu;
 use crate::error::AmmError;
 use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
 use crate::geometric::{self, GeometricStiffness};
@@ -136,7 +137,8 @@ pub(crate) struct System {
     resid: Vec<f64>,
     a: Vec<f64>,
     rhs: Vec<f64>,
-    piv: Vec<usize>,
+    /// Factors of the Schur complement `a`.
+    lu: ConstraintLu,
     /// Multipliers of the last solve, in the order of `rows`.
     pub(crate) lam: Vec<f64>,
 }
@@ -279,7 +281,7 @@ impl System {
             resid: vec![0.0; n],
             a: vec![0.0; m * m],
             rhs: vec![0.0; m],
-            piv: vec![0; m],
+            lu: ConstraintLu::new(m),
             lam: vec![0.0; m],
             modes,
         }
@@ -605,7 +607,9 @@ impl System {
                 }
             }
         }
-        lu_factor(&mut self.a, &mut self.piv, m).map_err(|reason| AmmError::SingularConstraints { t: st.t, reason })
+        self.lu
+            .factor(&self.a)
+            .map_err(|reason| AmmError::SingularConstraints { t: st.t, reason })
     }
 
     /// Solve the prepared step for the forcing in the workspace ([`System::forcing`] or
@@ -662,7 +666,7 @@ impl System {
                 rhs[beam.ids[k]] -= cz + cq;
             }
         }
-        lu_apply(&self.a, &self.piv, &mut self.rhs, self.rows.len());
+        self.lu.solve(&mut self.rhs);
         self.lam.copy_from_slice(&self.rhs);
 
         // qdd = S^-1 (r + C^T lambda): collect the multipliers per basis vector, then one axpy each
@@ -750,79 +754,5 @@ impl System {
             }
         }
         r.iter().fold(0.0f64, |a, v| a.max(v.abs()))
-    }
-}
-
-/// In-place LU with partial pivoting of the dense m x m matrix `a` (row-major): `P a = L U`, the
-/// multipliers of L below the diagonal, `piv[k]` the original row now at position k.
-/// Fails when a pivot is below 1e-13 of the largest entry of its row before elimination.
-fn lu_factor(a: &mut [f64], piv: &mut [usize], m: usize) -> Result<(), String> {
-    for (r, p) in piv.iter_mut().enumerate() {
-        *p = r;
-    }
-    // m <= 18 by construction (6 junction + 12 sleeve rows)
-    // inverse of each row's largest entry (the pivot test compares |a| / scale)
-    let mut scale = [0.0f64; 32];
-    for r in 0..m {
-        let largest = a[r * m..(r + 1) * m].iter().fold(0.0f64, |s, v| s.max(v.abs()));
-        if largest == 0.0 || !largest.is_finite() {
-            return Err(format!("constraint row {r} has no coupling"));
-        }
-        scale[r] = 1.0 / largest;
-    }
-    for k in 0..m {
-        let (mut best, mut arg) = (0.0, k);
-        for r in k..m {
-            let v = a[r * m + k].abs() * scale[r];
-            if v > best {
-                best = v;
-                arg = r;
-            }
-        }
-        if best.is_nan() || best <= 1e-13 {
-            return Err(format!(
-                "rank-deficient at elimination step {k} of {m} (pivot ratio {best:e})"
-            ));
-        }
-        if arg != k {
-            let (top, bottom) = a.split_at_mut(arg * m);
-            top[k * m..(k + 1) * m].swap_with_slice(&mut bottom[..m]);
-            scale.swap(k, arg);
-            piv.swap(k, arg);
-        }
-        let (top, bottom) = a.split_at_mut((k + 1) * m);
-        let pivot_row = &top[k * m..(k + 1) * m];
-        let inv = 1.0 / pivot_row[k];
-        for row in bottom.chunks_exact_mut(m) {
-            let f = row[k] * inv;
-            if f != 0.0 {
-                row[k] = f;
-                for (x, p) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
-                    *x -= f * p;
-                }
-            } else {
-                row[k] = 0.0;
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Solve `a x = b` in place with the factors of [`lu_factor`].
-fn lu_apply(a: &[f64], piv: &[usize], b: &mut [f64], m: usize) {
-    let mut y = [0.0f64; 32];
-    for k in 0..m {
-        let mut s = b[piv[k]];
-        for c in 0..k {
-            s -= a[k * m + c] * y[c];
-        }
-        y[k] = s;
-    }
-    for k in (0..m).rev() {
-        let mut s = y[k];
-        for c in k + 1..m {
-            s -= a[k * m + c] * b[c];
-        }
-        b[k] = s / a[k * m + k];
     }
 }

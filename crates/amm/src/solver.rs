@@ -285,20 +285,24 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
         let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
         for k in 1..=nsub {
             let t = if k == nsub { t1 } else { t0 + k as f64 * h };
-            for i in 0..n {
-                (a_part[i], qhat[i], vhat[i]) = ga.predict(h, q[i], v[i], acc[i], qdd[i]);
+            let state = q.iter().zip(&v).zip(acc.iter().zip(&qdd));
+            let predicted = a_part.iter_mut().zip(qhat.iter_mut()).zip(vhat.iter_mut());
+            for (((ap, qh), vh), ((&qi, &vi), (&ai, &di))) in predicted.zip(state) {
+                (*ap, *qh, *vh) = ga.predict(h, qi, vi, ai, di);
             }
             st = kin(t)?;
             sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)?;
             let apq = ga.a_per_qdd();
-            let mut norm = 0.0;
-            for i in 0..n {
-                q[i] = qhat[i] + bp * qdd[i];
-                v[i] = vhat[i] + gp * qdd[i];
-                acc[i] = a_part[i] + apq * qdd[i];
-                norm += q[i].abs();
+            let mut finite = true;
+            let state = q.iter_mut().zip(v.iter_mut()).zip(acc.iter_mut());
+            let parts = qhat.iter().zip(&vhat).zip(a_part.iter().zip(&qdd));
+            for (((qi, vi), ai), ((&qh, &vh), (&ap, &di))) in state.zip(parts) {
+                *qi = qh + bp * di;
+                *vi = vh + gp * di;
+                *ai = ap + apq * di;
+                finite &= qi.is_finite();
             }
-            if !norm.is_finite() {
+            if !finite {
                 return Err(AmmError::NonFinite { t, dt: h });
             }
             observe(&sys, &q);

@@ -105,12 +105,15 @@ pub(crate) fn panels_for(b_max: f64) -> usize {
     ((b_max / (0.75 * std::f64::consts::PI)).ceil() as usize).max(4)
 }
 
-/// Build the two junction shapes against the kept modes, given their values `phi[q][k]` and
-/// second derivatives `phi2[q][k]` at the nodes `x` (weights `w`) of a rule that integrates
-/// products of them exactly to round-off.
-pub(crate) fn build(x: &[f64], w: &[f64], phi: &[Vec<f64>], phi2: &[Vec<f64>]) -> [JunctionShape; 2] {
-    let nk = phi.first().map_or(0, |r| r.len());
+/// Build the two junction shapes against the `nk` kept modes, given their values `phi` and
+/// second derivatives `phi2` at the nodes `x` (weights `w`; row-major, row q = node q) of a rule
+/// that integrates products of them exactly to round-off.
+pub(crate) fn build(x: &[f64], w: &[f64], phi: &[f64], phi2: &[f64], nk: usize) -> [JunctionShape; 2] {
     let nq = x.len();
+    let (phi, phi2): (Vec<&[f64]>, Vec<&[f64]>) = (
+        phi.chunks_exact(nk.max(1)).take(nq).collect(),
+        phi2.chunks_exact(nk.max(1)).take(nq).collect(),
+    );
     // remainders r_a at the nodes (value and second derivative), and their total projections
     let mut r = [vec![0.0; nq], vec![0.0; nq]];
     let mut r2 = [vec![0.0; nq], vec![0.0; nq]];
@@ -125,18 +128,13 @@ pub(crate) fn build(x: &[f64], w: &[f64], phi: &[Vec<f64>], phi2: &[Vec<f64>]) -
             let mut c = vec![0.0; nk];
             for q in 0..nq {
                 let wr = w[q] * r[a][q];
-                for (ck, pk) in c.iter_mut().zip(&phi[q]) {
+                for (ck, pk) in c.iter_mut().zip(phi[q]) {
                     *ck += wr * pk;
                 }
             }
             for q in 0..nq {
-                let (mut s, mut s2) = (0.0, 0.0);
-                for k in 0..nk {
-                    s += c[k] * phi[q][k];
-                    s2 += c[k] * phi2[q][k];
-                }
-                r[a][q] -= s;
-                r2[a][q] -= s2;
+                r[a][q] -= super::dot(&c, phi[q]);
+                r2[a][q] -= super::dot(&c, phi2[q]);
             }
             for (t, ck) in coef[a].iter_mut().zip(&c) {
                 *t += ck;

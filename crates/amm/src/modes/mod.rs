@@ -367,18 +367,31 @@ impl ModeSet {
     /// `junction` module) and append their lambda and integrals.
     fn add_junction_shapes(&mut self) {
         let (x, w) = junction::composite_rule(junction::panels_for(self.analytic_beta_max()));
-        let values: Vec<Vec<[f64; 4]>> = x.iter().map(|&xi| self.analytic_derivatives(xi)).collect();
-        let phi: Vec<Vec<f64>> = values.iter().map(|r| r.iter().map(|v| v[0]).collect()).collect();
-        let phi2: Vec<Vec<f64>> = values.iter().map(|r| r.iter().map(|v| v[2]).collect()).collect();
-        let shapes = junction::build(&x, &w, &phi, &phi2);
+        // the analytic modes' values and second derivatives at the nodes, row q = node q
+        let nk = self.analytic_len();
+        let (mut phi, mut phi2) = (vec![0.0; x.len() * nk], vec![0.0; x.len() * nk]);
+        for ((&xi, row), row2) in x.iter().zip(phi.chunks_exact_mut(nk)).zip(phi2.chunks_exact_mut(nk)) {
+            self.analytic_value_curvature(xi, row, row2);
+        }
+        let shapes = junction::build(&x, &w, &phi, &phi2, nk);
         let (sqrt_l, l) = (self.l.sqrt(), self.l);
+        let na = self.analytic_len();
         for sh in shapes {
-            let (mut i0, mut i1) = (0.0, 0.0);
-            for (q, (&xi, &wq)) in x.iter().zip(&w).enumerate() {
-                let h = junction::eval(&sh, xi, &values[q])[0];
-                i0 += wq * h;
-                i1 += wq * xi * h;
-            }
+            // int_0^1 H dxi and int_0^1 xi H dxi of H = p . (1 - xi)^(4, 5) - sum c_k Phi_k, exactly:
+            // int (1 - xi)^n = 1 / (n + 1), int xi (1 - xi)^n = 1 / ((n + 1)(n + 2)), and the
+            // analytic modes' integrals (above, in units of sqrt L and L sqrt L)
+            let i0 = sh.p[0] / 5.0 + sh.p[1] / 6.0
+                - sh.c
+                    .iter()
+                    .zip(&self.phi_int[..na])
+                    .map(|(c, v)| c * v / sqrt_l)
+                    .sum::<f64>();
+            let i1 = sh.p[0] / 30.0 + sh.p[1] / 42.0
+                - sh.c
+                    .iter()
+                    .zip(&self.psi_int[..na])
+                    .map(|(c, v)| c * v / (sqrt_l * l))
+                    .sum::<f64>();
             self.lambda.push(self.ei_over_rho * sh.mu / l.powi(4));
             self.phi_int.push(sqrt_l * i0);
             self.psi_int.push(sqrt_l * l * i1);
@@ -386,18 +399,20 @@ impl ModeSet {
         }
     }
 
-    /// `Phi^(k)(xi)`, k = 0..=3, of every analytic mode on the unit interval, with the
-    /// trigonometric recurrence of [`ModeSet::values_at`].
-    fn analytic_derivatives(&self, xi: f64) -> Vec<[f64; 4]> {
+    /// `Phi(xi)` and `Phi''(xi)` of every analytic mode on the unit interval (into `phi`, `phi2`),
+    /// with the trigonometric recurrence of [`ModeSet::values_at`].
+    fn analytic_value_curvature(&self, xi: f64, phi: &mut [f64], phi2: &mut [f64]) {
         let mut trig = ModeTrig::new(xi, &self.roots);
-        self.shapes
-            .iter()
-            .enumerate()
-            .map(|(m, sh)| match *sh {
-                Shape::Rigid { .. } => sh.eval(xi),
-                Shape::Elastic { bl, .. } => sh.eval_from(trig.next(m, bl), xi),
-            })
-            .collect()
+        for (m, (sh, (v, v2))) in self.shapes.iter().zip(phi.iter_mut().zip(phi2.iter_mut())).enumerate() {
+            (*v, *v2) = match *sh {
+                Shape::Rigid { a, b } => (a + b * xi, 0.0),
+                Shape::Elastic { bl, c, .. } => {
+                    let [sn, cs, e1, e2] = trig.next(m, bl);
+                    let (p, q) = (c[0] * cs + c[1] * sn, c[2] * e1 + c[3] * e2);
+                    (p + q, bl * bl * (q - p))
+                }
+            };
+        }
     }
 
     /// Largest beta L of the analytic modes (at least 1): what a quadrature of products of modes
@@ -535,6 +550,29 @@ impl ModeSet {
             if let Some(d) = slope.as_deref_mut() {
                 d[na + j] = dp * sd - dot(&sh.c, &d[..na]);
             }
+        }
+    }
+
+    /// The slopes `phi_m'(x)` [1/m^1.5] of every mode at `x` [m], as [`ModeSet::values_at`]
+    /// computes them (the set-up of Eq. 23 needs no values).
+    fn slopes_at(&self, x: f64, slope: &mut [f64]) {
+        let xi = x / self.l;
+        let sd = 1.0 / (self.l.sqrt() * self.l);
+        let mut trig = ModeTrig::new(xi, &self.roots);
+        for (m, (sh, d)) in self.shapes.iter().zip(slope.iter_mut()).enumerate() {
+            *d = match *sh {
+                Shape::Rigid { b, .. } => b * sd,
+                Shape::Elastic { bl, c, .. } => {
+                    let [sn, cs, e1, e2] = trig.next(m, bl);
+                    bl * (-c[0] * sn + c[1] * cs - c[2] * e1 + c[3] * e2) * sd
+                }
+            };
+        }
+        let na = self.analytic_len();
+        let (analytic, junction) = slope.split_at_mut(na);
+        for (sh, d) in self.junction.iter().zip(junction) {
+            let (_, dp) = junction::poly_value_slope(sh.p, xi);
+            *d = dp * sd - dot(&sh.c, analytic);
         }
     }
 }
@@ -841,22 +879,27 @@ impl ModeSet {
     pub fn axial_stiffening(&self) -> (Vec<f64>, Vec<f64>) {
         let n = self.len();
         let (x, w) = junction::composite_rule(junction::panels_for(self.analytic_beta_max()));
-        // slopes at the nodes (rows), and the same rows weighted by the two axial force profiles:
-        // G = D^T diag(f) D, two matrix products
-        let mut d = Mat::<f64>::zeros(x.len(), n);
-        let mut d1 = Mat::<f64>::zeros(x.len(), n);
-        let mut d2 = Mat::<f64>::zeros(x.len(), n);
-        let (mut val, mut slope) = (vec![0.0; n], vec![0.0; n]);
+        let nq = x.len();
+        // slopes at the nodes (column q: every mode at node q), and the same columns weighted by
+        // the two axial force profiles: G = D diag(f) D^T, two matrix products
+        let mut d = Mat::<f64>::zeros(n, nq);
+        let mut d1 = Mat::<f64>::zeros(n, nq);
+        let mut d2 = Mat::<f64>::zeros(n, nq);
         for (q, (&xi, &wq)) in x.iter().zip(&w).enumerate() {
             let xm = xi * self.l;
-            self.values_at(xm, &mut val, Some(&mut slope));
+            let slope = d
+                .col_mut(q)
+                .try_as_col_major_mut()
+                .expect("a column of a Mat is contiguous")
+                .as_slice_mut();
+            self.slopes_at(xm, slope);
             // dx = L dxi
             let f1 = wq * self.l * 0.5 * (self.l * self.l - xm * xm);
             let f2 = wq * self.l * (self.l - xm);
-            for (m, &v) in slope.iter().enumerate() {
-                d[(q, m)] = v;
-                d1[(q, m)] = f1 * v;
-                d2[(q, m)] = f2 * v;
+            for m in 0..n {
+                let v = d[(m, q)];
+                d1[(m, q)] = f1 * v;
+                d2[(m, q)] = f2 * v;
             }
         }
         let product = |weighted: &Mat<f64>| {
@@ -864,8 +907,8 @@ impl ModeSet {
             matmul(
                 g.as_mut(),
                 Accum::Replace,
-                d.transpose(),
-                weighted.as_ref(),
+                d.as_ref(),
+                weighted.transpose(),
                 1.0,
                 Par::Seq,
             );

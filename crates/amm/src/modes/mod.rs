@@ -896,10 +896,12 @@ impl ModeSet {
             // dx = L dxi
             let f1 = wq * self.l * 0.5 * (self.l * self.l - xm * xm);
             let f2 = wq * self.l * (self.l - xm);
-            for m in 0..n {
-                let v = d[(m, q)];
-                d1[(m, q)] = f1 * v;
-                d2[(m, q)] = f2 * v;
+            let col = d.col(q).try_as_col_major().expect("contiguous").as_slice();
+            for (f, dk) in [(f1, &mut d1), (f2, &mut d2)] {
+                let out = dk.col_mut(q).try_as_col_major_mut().expect("contiguous").as_slice_mut();
+                for (o, v) in out.iter_mut().zip(col) {
+                    *o = f * v;
+                }
             }
         }
         let product = |weighted: &Mat<f64>| {
@@ -947,28 +949,8 @@ impl SleeveBending {
     }
 }
 
-/// Dot product with four independent accumulators (breaks the add latency chain; the order of
-/// summation is fixed, so results are reproducible).
-#[inline]
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0f64; 4];
-    let ca = a.chunks_exact(4);
-    let cb = b.chunks_exact(4);
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        acc[0] += x[0] * y[0];
-        acc[1] += x[1] * y[1];
-        acc[2] += x[2] * y[2];
-        acc[3] += x[3] * y[3];
-    }
-    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
-    }
-    s
-}
+/// Dot product (`flexstar_numerics::vector::dot`: fused multiply-add where the processor has it).
+pub(crate) use flexstar_numerics::vector::dot;
 
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]

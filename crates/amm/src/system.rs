@@ -28,6 +28,7 @@ use crate::error::AmmError;
 use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
 use crate::geometric::{self, GeometricStiffness};
 use crate::modes::{dot, ModeSet, SleeveBending, Triplet};
+use flexstar_numerics::vector::dots;
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
 
@@ -533,11 +534,8 @@ impl System {
                 *s = x * d;
             }
         }
-        let g00 = dot(&self.scaled0[0], &self.phi0);
-        let g01 = dot(&self.scaled0[0], &self.dphi0);
-        let g11 = dot(&self.scaled0[1], &self.dphi0);
-        let w0 = dot(&self.scaled0[0], &self.phi);
-        let w1 = dot(&self.scaled0[1], &self.phi);
+        let [g00, g01, w0] = dots(&self.scaled0[0], [&self.phi0, &self.dphi0, &self.phi]);
+        let [g11, w1] = dots(&self.scaled0[1], [&self.dphi0, &self.phi]);
 
         let m = self.rows.len();
         let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp);
@@ -563,18 +561,19 @@ impl System {
             gram[B_PHI0][B_DPHI0] = g01;
             gram[B_DPHI0][B_PHI0] = g01;
             gram[B_DPHI0][B_DPHI0] = g11;
+            let [s0, s1, s2, s3] = [&beam.sleeve[0], &beam.sleeve[1], &beam.sleeve[2], &beam.sleeve[3]];
             for a in 0..4 {
-                let sa = &beam.scaled[a];
-                gram[B_MID + a][B_PHI0] = dot(sa, phi0);
-                gram[B_MID + a][B_DPHI0] = dot(sa, dphi0);
-                gram[B_PHI0][B_MID + a] = gram[B_MID + a][B_PHI0];
-                gram[B_DPHI0][B_MID + a] = gram[B_MID + a][B_DPHI0];
-                for b in a..4 {
-                    let v = dot(sa, &beam.sleeve[b]);
+                // one pass over D^-1 B_a for its seven products (those with b < a are repeats)
+                let [p0, d0, gp, m0, m1, m2, m3] = dots(&beam.scaled[a], [phi0, dphi0, phi, s0, s1, s2, s3]);
+                gram[B_MID + a][B_PHI0] = p0;
+                gram[B_MID + a][B_DPHI0] = d0;
+                gram[B_PHI0][B_MID + a] = p0;
+                gram[B_DPHI0][B_MID + a] = d0;
+                for (b, v) in [m0, m1, m2, m3].into_iter().enumerate().skip(a) {
                     gram[B_MID + a][B_MID + b] = v;
                     gram[B_MID + b][B_MID + a] = v;
                 }
-                beam.g[B_MID + a] = dot(sa, phi);
+                beam.g[B_MID + a] = gp;
             }
             beam.g[B_PHI0] = w0;
             beam.g[B_DPHI0] = w1;
@@ -630,22 +629,21 @@ impl System {
             for ((d, x), di) in dinv_r.iter_mut().zip(&r[..nm]).zip(inv_d) {
                 *d = x * di;
             }
-            let mut bdr = [0.0; NB];
-            let mut bq = [0.0; NB];
-            let used = |a: usize| beam.basis.contains(&a);
-            for a in 0..NB {
-                if used(a) {
-                    let v = match a {
-                        B_PHI0 => phi0,
-                        B_DPHI0 => dphi0,
-                        _ => &beam.sleeve[a - B_MID],
-                    };
-                    bdr[a] = dot(v, dinv_r);
-                    if let Some(qh) = qhat {
-                        bq[a] = dot(v, &qh[o..o + nm]);
-                    }
-                }
-            }
+            // every basis vector against D^-1 r and against qhat, one pass each (the unused ones
+            // are never read)
+            let basis = [
+                &phi0[..],
+                &dphi0[..],
+                &beam.sleeve[0][..],
+                &beam.sleeve[1][..],
+                &beam.sleeve[2][..],
+                &beam.sleeve[3][..],
+            ];
+            let bdr: [f64; NB] = dots(dinv_r, basis);
+            let bq: [f64; NB] = match qhat {
+                Some(qh) => dots(&qh[o..o + nm], basis),
+                None => [0.0; NB],
+            };
             for k in 0..beam.ids.len() {
                 let (bk, sk) = (beam.basis[k], beam.sc[k]);
                 let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };

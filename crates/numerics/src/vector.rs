@@ -23,6 +23,23 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     dot_portable(a, b)
 }
 
+/// `[a . b[0], ..., a . b[K-1]]` in one pass over `a` (over the shortest length): the products of
+/// one vector with several others, each read once, the sums in independent registers.
+#[inline]
+pub fn dots<const K: usize>(a: &[f64], b: [&[f64]; K]) -> [f64; K] {
+    let n = b.iter().fold(a.len(), |n, v| n.min(v.len()));
+    let a = &a[..n];
+    let b = b.map(|v| &v[..n]);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+            // SAFETY: the processor has AVX2 and FMA (checked just above); every slice has length n.
+            return unsafe { dots_avx2_fma(a, b) };
+        }
+    }
+    b.map(|v| dot_portable(a, v))
+}
+
 /// Four independent accumulators (the add latency chain broken; SSE2 vectorises it in pairs).
 fn dot_portable(a: &[f64], b: &[f64]) -> f64 {
     let (ca, ra) = a.as_chunks::<4>();
@@ -71,6 +88,38 @@ unsafe fn dot_avx2_fma(a: &[f64], b: &[f64]) -> f64 {
     s
 }
 
+/// One 4-lane fused accumulator per product, blocks of 4, then the tail.
+///
+/// # Safety
+/// The processor must support AVX2 and FMA; every slice of `b` must be as long as `a`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn dots_avx2_fma<const K: usize>(a: &[f64], b: [&[f64]; K]) -> [f64; K] {
+    use std::arch::x86_64::{__m256d, _mm256_fmadd_pd, _mm256_loadu_pd, _mm256_setzero_pd, _mm256_storeu_pd};
+    let n = a.len();
+    let mut acc: [__m256d; K] = [_mm256_setzero_pd(); K];
+    let mut i = 0;
+    // SAFETY (loads): every index read is below n, the length of every slice.
+    while i + 4 <= n {
+        let x = _mm256_loadu_pd(a.as_ptr().add(i));
+        for (acc, v) in acc.iter_mut().zip(&b) {
+            *acc = _mm256_fmadd_pd(x, _mm256_loadu_pd(v.as_ptr().add(i)), *acc);
+        }
+        i += 4;
+    }
+    let mut out = [0.0f64; K];
+    for ((o, acc), v) in out.iter_mut().zip(&acc).zip(&b) {
+        let mut lanes = [0.0f64; 4];
+        _mm256_storeu_pd(lanes.as_mut_ptr(), *acc);
+        let mut s = (lanes[0] + lanes[2]) + (lanes[1] + lanes[3]);
+        for k in i..n {
+            s += a[k] * v[k];
+        }
+        *o = s;
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -115,5 +164,19 @@ mod tests {
         }
         // the shorter length is used
         assert_eq!(dot(&a[..10], &b), dot(&a[..10], &b[..10]));
+    }
+
+    #[test]
+    fn several_products_at_once_are_the_single_ones() {
+        // integer data (exact in any order) at every length, and the shortest length rule
+        for n in 0..30 {
+            let v = |m: usize, r: usize| (0..n).map(|k| ((k * m) % r) as f64 - 3.0).collect::<Vec<f64>>();
+            let (a, b, c, d) = (v(7, 11), v(5, 13), v(3, 7), v(2, 5));
+            let got = dots(&a, [&b, &c, &d]);
+            assert_eq!(got, [exact(&a, &b), exact(&a, &c), exact(&a, &d)], "n = {n}");
+        }
+        let (a, b) = (vec![1.0; 9], vec![2.0; 6]);
+        // every product over the shortest slice (6)
+        assert_eq!(dots(&a, [&a, &b]), [6.0, 12.0]);
     }
 }

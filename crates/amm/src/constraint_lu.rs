@@ -14,17 +14,19 @@
 //! ```
 //!
 //! Eliminating the sleeve blocks leaves the junction Schur complement
-//! `Z = A_JJ - sum_i A_Ji A_ii^-1 A_iJ`. A factorisation is three 4 x 4 LUs, their solves for
-//! the junction columns and the LU of Z (about 900 multiply-adds, against 1900 for the LU of the
-//! whole 18 x 18); a solve is three 4 x 4 solves, one with Z and three back-substitutions. Z is
+//! `Z = A_JJ - sum_i A_Ji A_ii^-1 A_iJ`. A factorisation is three 4 x 4 inverses (nalgebra's
+//! closed form, each checked by `A_ii A_ii^-1 = I` to 1e-9), their products with the junction
+//! columns and the LU of Z (about 900 multiply-adds, against 1900 for the LU of the
+//! whole 18 x 18); a solve is three 4 x 4 products, one solve with Z and three back-substitutions. Z is
 //! held in a 6 x 6 matrix padded with the identity, so that every size is fixed.
 //!
 //! Without pivoting across the blocks this is stable for A dominated by its symmetric positive
 //! part (the Gram matrix of the rows through the mass; the gyroscopic border of S is O(h) of it).
-//! A block pivot below [`BLOCK_PIVOT_RATIO`] of its block's largest entry hands the step to the
-//! dense LU with partial pivoting, whose own test ([`PIVOT_RATIO`]) decides rank deficiency.
+//! A sleeve block whose inverse fails its check, or a pivot of Z below [`BLOCK_PIVOT_RATIO`] of
+//! Z's largest entry, hands the step to the dense LU with partial pivoting, whose own test
+//! ([`PIVOT_RATIO`]) decides rank deficiency.
 
-use nalgebra::{DMatrix, DVector, Matrix4, Matrix6, SMatrix, Vector4, Vector6, LU, U4, U6};
+use nalgebra::{DMatrix, DVector, Matrix4, Matrix6, SMatrix, Vector4, Vector6, LU, U6};
 
 /// Rows of one beam's sleeve block (Eqs. 41-43: Fp, FR, FL, Mp).
 pub(crate) const SLEEVE_ROWS: usize = 4;
@@ -32,8 +34,11 @@ pub(crate) const SLEEVE_ROWS: usize = 4;
 pub(crate) const MAX_JUNCTION_ROWS: usize = 6;
 /// A pivot of the dense LU at or below this fraction of the largest entry of A is rank deficiency.
 pub(crate) const PIVOT_RATIO: f64 = 1e-13;
-/// A block pivot at or below this fraction of its block's largest entry: factor A densely instead.
+/// A junction pivot at or below this fraction of Z's largest entry: factor A densely instead.
 pub(crate) const BLOCK_PIVOT_RATIO: f64 = 1e-10;
+/// Largest entry of `A_ii A_ii^-1 - I` accepted for a sleeve block's inverse; above it the
+/// block is too close to singular for the closed form and A is factored densely.
+pub(crate) const INVERSE_CHECK: f64 = 1e-9;
 
 /// Factors of A for [`ConstraintLu::solve`].
 #[derive(Debug, Clone)]
@@ -47,8 +52,8 @@ pub(crate) struct ConstraintLu {
 /// The block elimination's factors.
 #[derive(Debug, Clone)]
 struct Blocks {
-    /// LU of each sleeve block A_ii.
-    sleeve: [LU<f64, U4, U4>; 3],
+    /// Inverse of each sleeve block A_ii (nalgebra's closed form for 4 x 4, checked).
+    sleeve: [Matrix4<f64>; 3],
     /// `A_ii^-1 A_iJ` (4 x 6, columns past nj zero).
     x: [SMatrix<f64, 4, 6>; 3],
     /// `A_Ji` (6 x 4, rows past nj zero).
@@ -60,6 +65,14 @@ struct Blocks {
 /// Largest |entry| of a matrix.
 fn largest<const R: usize, const C: usize>(a: &SMatrix<f64, R, C>) -> f64 {
     a.iter().fold(0.0f64, |s, v| s.max(v.abs()))
+}
+
+/// nalgebra's inverse of a sleeve block, accepted when `block * inverse` is the identity to
+/// [`INVERSE_CHECK`] (a block too close to singular for the closed form gives `None`).
+fn checked_inverse(block: &Matrix4<f64>) -> Option<Matrix4<f64>> {
+    let inverse = block.try_inverse()?;
+    let error = largest(&(block * inverse - Matrix4::identity()));
+    (error <= INVERSE_CHECK).then_some(inverse)
 }
 
 /// Every pivot (`u_diagonal`) above [`BLOCK_PIVOT_RATIO`] of the block's largest entry `scale`.
@@ -102,21 +115,15 @@ impl ConstraintLu {
                 z[(r, c)] = at(r, c);
             }
         }
-        let sleeve = [0, 1, 2].map(|i| {
-            let s = nj + SLEEVE_ROWS * i;
-            Matrix4::from_fn(|r, c| at(s + r, s + c))
-        });
-        let scales = sleeve.map(|block| largest(&block));
-        let sleeve = sleeve.map(|block| block.lu());
+        let mut sleeve = [Matrix4::<f64>::zeros(); 3];
         let mut x = [SMatrix::<f64, 4, 6>::zeros(); 3];
         let mut coupling = [SMatrix::<f64, 6, 4>::zeros(); 3];
         for i in 0..3 {
-            if !pivots_hold(sleeve[i].u().diagonal().iter().copied(), scales[i]) {
-                return None;
-            }
             let s = nj + SLEEVE_ROWS * i;
-            x[i] = SMatrix::<f64, 4, 6>::from_fn(|r, c| if c < nj { at(s + r, c) } else { 0.0 });
-            sleeve[i].solve_mut(&mut x[i]);
+            let block = Matrix4::from_fn(|r, c| at(s + r, s + c));
+            sleeve[i] = checked_inverse(&block)?;
+            let a_ij = SMatrix::<f64, 4, 6>::from_fn(|r, c| if c < nj { at(s + r, c) } else { 0.0 });
+            x[i] = sleeve[i] * a_ij;
             coupling[i] = SMatrix::<f64, 6, 4>::from_fn(|r, c| if r < nj { at(r, s + c) } else { 0.0 });
             z -= coupling[i] * x[i];
         }
@@ -170,8 +177,7 @@ impl ConstraintLu {
         }
         let y = [0, 1, 2].map(|i| {
             let s = nj + SLEEVE_ROWS * i;
-            let mut y = Vector4::from_fn(|r, _| b[s + r]);
-            f.sleeve[i].solve_mut(&mut y);
+            let y = f.sleeve[i] * Vector4::from_fn(|r, _| b[s + r]);
             rj -= f.coupling[i] * y;
             y
         });

@@ -42,15 +42,25 @@ pub(crate) struct Foreshortening {
 }
 
 impl Foreshortening {
-    /// For `modes` with geometric stiffness matrix `g2` (N x N, row-major), keeping the first
-    /// `analytic` analytic modes and every junction shape in the velocity part.
-    pub(crate) fn new(modes: &ModeSet, g2: &[f64], analytic: usize) -> Self {
+    /// For `modes` with the geometric stiffness matrix `g2` given on the modes `rows` (k x k,
+    /// row-major; `rows` must hold the kept ones), keeping the first `analytic` analytic modes
+    /// and every junction shape in the velocity part.
+    pub(crate) fn new(modes: &ModeSet, rows: &[usize], g2: &[f64], analytic: usize) -> Self {
         let n = modes.len();
         let na = modes.analytic_len();
+        let k = rows.len();
         let kept: Vec<usize> = (0..na.min(analytic)).chain(na..n).collect();
-        let g2_kept = kept
+        let at: Vec<usize> = kept
             .iter()
-            .flat_map(|&j| kept.iter().map(move |&m| g2[j * n + m]))
+            .map(|j| {
+                rows.iter()
+                    .position(|r| r == j)
+                    .expect("the kept modes are among the rows")
+            })
+            .collect();
+        let g2_kept = at
+            .iter()
+            .flat_map(|&a| at.iter().map(move |&b| g2[a * k + b]))
             .collect();
         Foreshortening {
             v: vec![0.0; kept.len()],
@@ -127,7 +137,8 @@ mod tests {
         for family in [ModeFamily::Enriched, ModeFamily::FreeFree] {
             let modes = ModeSet::new(family, 20, &p).unwrap();
             let (_, g2) = modes.axial_stiffening();
-            let mut fore = Foreshortening::new(&modes, &g2, KEPT_ANALYTIC);
+            let all: Vec<usize> = (0..modes.len()).collect();
+            let mut fore = Foreshortening::new(&modes, &all, &g2, KEPT_ANALYTIC);
             // alpha of w = x: its projections (x lies in the span of the two rigid modes)
             let shape = modes.x_phi_integral().to_vec();
             let (psi, psid, psidd) = (0.03, 2.0, -50.0);
@@ -169,7 +180,8 @@ mod tests {
         };
         let modes = ModeSet::new(settings.family, n, &exp.robot).unwrap();
         let (_, g2) = modes.axial_stiffening();
-        let fore = Foreshortening::new(&modes, &g2, KEPT_ANALYTIC);
+        let all: Vec<usize> = (0..n).collect();
+        let fore = Foreshortening::new(&modes, &all, &g2, KEPT_ANALYTIC);
         let h = crate::DEFAULT_DT;
         let mut prev: Option<Vec<f64>> = None;
         let (mut err2, mut ref2) = (0.0, 0.0);

@@ -33,23 +33,31 @@ pub(crate) struct GeometricStiffness {
 }
 
 impl GeometricStiffness {
-    /// From the N x N row-major `g1`, `g2` of `modes`, keeping its first `analytic` analytic modes
-    /// and every junction shape.
-    pub(crate) fn new(modes: &ModeSet, g1: &[f64], g2: &[f64], analytic: usize) -> Self {
-        let n = modes.len();
-        let na = modes.analytic_len();
-        let kept: Vec<usize> = (0..na.min(analytic)).chain(na..n).collect();
+    /// For `modes`, keeping its first `analytic` analytic modes and every junction shape
+    /// ([`GeometricStiffness::kept_modes`]): G1 and G2 on those modes only.
+    pub(crate) fn new(modes: &ModeSet, analytic: usize) -> Self {
+        let kept = Self::kept_modes(modes, analytic);
+        let (g1, g2) = modes.axial_stiffening_on(&kept);
         let k = kept.len();
-        let g12 = Mat::from_fn(2 * k, k, |r, c| {
-            let (g, r) = if r < k { (g1, r) } else { (g2, r - k) };
-            g[kept[r] * n + kept[c]]
-        });
+        let g12 = Mat::from_fn(2 * k, k, |r, c| if r < k { g1[r * k + c] } else { g2[(r - k) * k + c] });
         GeometricStiffness {
             kept,
             g12,
             alpha: Mat::zeros(k, 3),
             products: Mat::zeros(2 * k, 3),
         }
+    }
+
+    /// The first `analytic` analytic modes of `modes` and its junction shapes, in order.
+    pub(crate) fn kept_modes(modes: &ModeSet, analytic: usize) -> Vec<usize> {
+        let na = modes.analytic_len();
+        (0..na.min(analytic)).chain(na..modes.len()).collect()
+    }
+
+    /// G2 on the kept modes, row-major (k x k) [1/m].
+    pub(crate) fn g2(&self) -> Vec<f64> {
+        let k = self.kept.len();
+        (0..k * k).map(|e| self.g12[(k + e / k, e % k)]).collect()
     }
 
     /// The kept modes' indices.

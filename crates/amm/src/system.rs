@@ -244,11 +244,9 @@ impl System {
         let n = 3 * nb;
         let (geometric, fore) = match model {
             AmmModel::Full => {
-                let (g1, g2) = modes.axial_stiffening();
-                (
-                    Some(GeometricStiffness::new(&modes, &g1, &g2, geometric::KEPT_ANALYTIC)),
-                    Some(Foreshortening::new(&modes, &g2, KEPT_ANALYTIC)),
-                )
+                let geo = GeometricStiffness::new(&modes, geometric::KEPT_ANALYTIC);
+                let fore = Foreshortening::new(&modes, geo.kept(), &geo.g2(), KEPT_ANALYTIC);
+                (Some(geo), Some(fore))
             }
             AmmModel::Paper => (None, None),
         };
@@ -292,8 +290,7 @@ impl System {
     /// shapes) instead of [`geometric::KEPT_ANALYTIC`], for the test of that truncation.
     #[cfg(test)]
     pub(crate) fn with_geometric_kept(mut self, analytic: usize) -> Self {
-        let (g1, g2) = self.modes.axial_stiffening();
-        self.geometric = Some(GeometricStiffness::new(&self.modes, &g1, &g2, analytic));
+        self.geometric = Some(GeometricStiffness::new(&self.modes, analytic));
         self
     }
 

@@ -877,22 +877,29 @@ impl ModeSet {
     /// Returns `(G1, G2)`, row-major N x N: `G1_jm = int (L^2 - x^2)/2 phi_j' phi_m' dx` [-] and
     /// `G2_jm = int (L - x) phi_j' phi_m' dx` [1/m].
     pub fn axial_stiffening(&self) -> (Vec<f64>, Vec<f64>) {
-        let n = self.len();
+        let all: Vec<usize> = (0..self.len()).collect();
+        self.axial_stiffening_on(&all)
+    }
+
+    /// [`ModeSet::axial_stiffening`] on the modes `on` (indices, k of them): `(G1, G2)` k x k,
+    /// row-major, entry (a, b) for the modes `on[a]`, `on[b]`.
+    pub fn axial_stiffening_on(&self, on: &[usize]) -> (Vec<f64>, Vec<f64>) {
+        let n = on.len();
         let (x, w) = junction::composite_rule(junction::panels_for(self.analytic_beta_max()));
         let nq = x.len();
-        // slopes at the nodes (column q: every mode at node q), and the same columns weighted by
-        // the two axial force profiles: G = D diag(f) D^T, two matrix products
+        // slopes at the nodes (column q: the modes `on` at node q), and the same columns weighted
+        // by the two axial force profiles: G = D diag(f) D^T, two matrix products
         let mut d = Mat::<f64>::zeros(n, nq);
         let mut d1 = Mat::<f64>::zeros(n, nq);
         let mut d2 = Mat::<f64>::zeros(n, nq);
+        let mut slope = vec![0.0; self.len()];
         for (q, (&xi, &wq)) in x.iter().zip(&w).enumerate() {
             let xm = xi * self.l;
-            let slope = d
-                .col_mut(q)
-                .try_as_col_major_mut()
-                .expect("a column of a Mat is contiguous")
-                .as_slice_mut();
-            self.slopes_at(xm, slope);
+            self.slopes_at(xm, &mut slope);
+            let col = d.col_mut(q).try_as_col_major_mut().expect("contiguous").as_slice_mut();
+            for (c, &m) in col.iter_mut().zip(on) {
+                *c = slope[m];
+            }
             // dx = L dxi
             let f1 = wq * self.l * 0.5 * (self.l * self.l - xm * xm);
             let f2 = wq * self.l * (self.l - xm);

@@ -426,17 +426,14 @@ impl System {
             let (qa, qu) = (&qhat[o..o + nm], qhat[o + nm]);
             let (va, vu) = (&vhat[o..o + nm], vhat[o + nm]);
             let r = &mut self.resid[o..o + nb];
-            let mut phi_q = 0.0;
-            let mut phi_v = 0.0;
-            for j in 0..nm {
-                let pj = self.phi[j];
-                r[j] = -rho * (aw * pj + thdd * self.psi[j])
-                    - 2.0 * rho * thd * pj * vu
-                    - rho * (self.lambda_m[j] - thd * thd) * qa[j]
-                    - rho * thdd * pj * qu;
-                phi_q += pj * qa[j];
-                phi_v += pj * va[j];
+            // no reduction in the loop (it vectorises); Phi . alpha and Phi . alpha' apart
+            let c_phi = -rho * aw - 2.0 * rho * thd * vu - rho * thdd * qu;
+            let (c_psi, c_q, thd2) = (-rho * thdd, -rho, thd * thd);
+            let rows = r[..nm].iter_mut().zip(&self.phi[..nm]).zip(&self.psi[..nm]);
+            for (((rj, &pj), &sj), (&lj, &qj)) in rows.zip(self.lambda_m[..nm].iter().zip(qa)) {
+                *rj = c_phi * pj + c_psi * sj + c_q * (lj - thd2) * qj;
             }
+            let [phi_q, phi_v] = [dot(&self.phi, qa), dot(&self.phi, va)];
             r[nm] = -rho * (l * ax - thd * thd * l * l / 2.0)
                 + 2.0 * rho * thd * phi_v
                 + rho * thdd * phi_q

@@ -200,4 +200,48 @@ mod tests {
         assert_eq!(n, MAX_AUTO_MODES);
         assert!(steps < 20, "{steps}");
     }
+
+    /// A model response on `exp`'s grid (every `every`-th row): tips `(1 + e) sin(2 pi t)` with a
+    /// truncation error e = 0.3 % (53 / N)^7 (so that N = 53 is the first whose estimate, exactly
+    /// 0.3 % for a pure power law, is below 0.5 %) plus `time_error`.
+    fn model(exp: &Experiment, every: usize, n: usize, time_error: f64) -> Response {
+        let e = 0.003 * (53.0 / n as f64).powi(7) + time_error;
+        let mut r = Response::with_capacity("model", 0);
+        for t in exp.time.output_times() {
+            let w = (1.0 + e) * (2.0 * std::f64::consts::PI * t / exp.time.t_end).sin();
+            r.push(t, [w; 3], [w; 3], [0.0; 3]);
+        }
+        r.every_nth(every)
+    }
+
+    #[test]
+    fn coarse_pairs_then_one_delivered_run_or_the_fallback_when_the_coarse_step_is_too_rough() {
+        let exp = paper_case(3);
+        let every = estimate_grid(&exp, 5e-4).expect("0.5 s at 1 ms outputs gives a coarse grid");
+        assert_eq!(every, 4, "8 x 0.5 ms = 4 ms on a 1 ms output grid");
+        for (coarse_time_error, delivered_runs) in [(0.02, 1), (0.3, 3)] {
+            let mut passes = Vec::new();
+            let r = solve_to_tolerance(&exp, 0.5, Some(every), |n, pass| {
+                passes.push((n, pass));
+                Ok(match pass {
+                    Pass::Estimate { every } => model(&exp, every, n, coarse_time_error),
+                    Pass::Deliver => model(&exp, 1, n, 0.0),
+                })
+            })
+            .unwrap();
+            let delivered = passes.iter().filter(|(_, p)| *p == Pass::Deliver).count();
+            // 2 % coarse time error: the pair (46, 53) coarse, 53 delivered; 30 %: the check
+            // fails and the pair runs again at the delivered step (46, 53 delivered)
+            assert_eq!(delivered, delivered_runs, "{passes:?}");
+            assert_eq!(passes.iter().filter(|(_, p)| *p != Pass::Deliver).count(), 2);
+            assert_eq!(r.len(), exp.time.output_times().len());
+            // Richardson is exact for the power law: 0.3 % (to the EVP's trapezoidal rule)
+            let est = r.info.error_estimate_percent.unwrap();
+            assert!((est - 0.3).abs() < 0.01, "{est}");
+        }
+        // too short a span for 20 coarse rows: pairs at the delivered step
+        let mut short = paper_case(3);
+        short.time.t_end = 0.05;
+        assert_eq!(estimate_grid(&short, 5e-4), None);
+    }
 }

@@ -418,8 +418,9 @@ impl System {
             geo.multiply(qhat, nb);
         }
         for i in 0..3 {
-            let ew = st.e_w(i);
+            // Eqs. 11-12: e_x = [sin a, -cos a], e_w = [cos a, sin a], one sin/cos pair
             let ex = st.e_x(i);
+            let ew = [-ex[1], ex[0]];
             let aw = ag[0] * ew[0] + ag[1] * ew[1];
             let ax = ag[0] * ex[0] + ag[1] * ex[1];
             let o = i * nb;
@@ -471,8 +472,9 @@ impl System {
         let (nm, nb, rho, l) = (self.nm, self.nb, self.rho, self.l);
         let thd = st.theta.d1;
         for i in 0..3 {
-            let ew = st.e_w(i);
+            // Eqs. 11-12: e_x = [sin a, -cos a], e_w = [cos a, sin a], one sin/cos pair
             let ex = st.e_x(i);
+            let ew = [-ex[1], ex[0]];
             let daw = d_ag[0] * ew[0] + d_ag[1] * ew[1];
             let dax = d_ag[0] * ex[0] + d_ag[1] * ex[1];
             let o = i * nb;

@@ -30,12 +30,24 @@
 //! so the integrals are exact in closed form through the Gram matrix `int phi_k phi_l` ([`GRAM`]);
 //! for the linearised element this is the textbook consistent mass matrix.
 
+use flexstar_numerics::lanes::Real;
+
 /// 6x6 element matrix, row-major.
-pub type Mat6 = [[f64; 6]; 6];
+pub type Mat6<T = f64> = [[T; 6]; 6];
+
+/// Wrap an angle to (-pi, pi], lane by lane (the library's remainder only off the common path).
+#[inline(always)]
+fn wrap<T: Real>(a: T) -> T {
+    use std::f64::consts::PI;
+    if T::all(a.gt(T::splat(-PI)) & a.le(T::splat(PI))) {
+        a
+    } else {
+        a.map(wrap_scalar)
+    }
+}
 
 /// Wrap an angle to (-pi, pi].
-#[inline]
-fn wrap(a: f64) -> f64 {
+fn wrap_scalar(a: f64) -> f64 {
     use std::f64::consts::PI;
     if a > -PI && a <= PI {
         return a;
@@ -48,59 +60,68 @@ fn wrap(a: f64) -> f64 {
     }
 }
 
-/// `tan(i pi / 32)` and `atan` of that double, i = 0..=8 (reduction points of [`atan2`]).
-const ATAN_POINTS: [(f64, f64); 9] = [
-    (0.0, 0.0),
-    (0.09849140335716425, 0.09817477042468103),
-    (0.198912367379658, 0.19634954084936207),
-    (0.3033466836073424, 0.2945243112740431),
-    (0.41421356237309503, std::f64::consts::FRAC_PI_8),
-    (0.5345111359507916, 0.4908738521234052),
-    (0.6681786379192989, 0.5890486225480862),
-    (0.8206787908286602, 0.6872233929727672),
-    (0.9999999999999999, std::f64::consts::FRAC_PI_4),
+/// `tan(i pi / 32)`, i = 0..=8 (reduction points of [`atan2`]).
+const ATAN_TAN: [f64; 9] = [
+    0.0,
+    0.09849140335716425,
+    0.198912367379658,
+    0.3033466836073424,
+    0.41421356237309503,
+    0.5345111359507916,
+    0.6681786379192989,
+    0.8206787908286602,
+    0.9999999999999999,
+];
+/// `atan` of the doubles in [`ATAN_TAN`].
+const ATAN_VAL: [f64; 9] = [
+    0.0,
+    0.09817477042468103,
+    0.19634954084936207,
+    0.2945243112740431,
+    std::f64::consts::FRAC_PI_8,
+    0.4908738521234052,
+    0.5890486225480862,
+    0.6872233929727672,
+    std::f64::consts::FRAC_PI_4,
 ];
 
-/// `atan2(y, x)` [rad] in (-pi, pi], within 2 ulp of the C library's (unit test), about three
+/// `atan2(y, x)` [rad] in (-pi, pi], within 3 eps of the C library's (unit test), about three
 /// times faster (the element states need one per element and Newton iteration): octant
 /// reduction to `r = min / max` in [0, 1], then `atan r = atan c + atan((r - c) / (1 + r c))`
-/// with the nearest `c = tan(i pi / 32)`, `|t| < 0.07`, and the Taylor series of `atan t` to
-/// `t^17` (truncation below `1e-19`). Zero or non-finite arguments go to the library.
+/// with the nearest `c = tan(i pi / 32)` (`c = 0` near 0, where the reduction is exact),
+/// `|t| < 0.07`, and the Taylor series of `atan t` to `t^17` (truncation below `1e-19`). Zero or
+/// non-finite arguments go to the library.
 #[inline]
 pub fn atan2(y: f64, x: f64) -> f64 {
+    atan2_lanes(y, x)
+}
+
+/// [`atan2`] lane by lane, without branches on the common path (lanes with zero or non-finite
+/// arguments go to the library).
+#[inline(always)]
+fn atan2_lanes<T: Real>(y: T, x: T) -> T {
     use std::f64::consts::{FRAC_PI_2, PI};
     let (ax, ay) = (x.abs(), y.abs());
-    if !(ax.is_finite() && ay.is_finite()) || (ax == 0.0 && ay == 0.0) {
-        return y.atan2(x);
+    let regular = ax.le(T::splat(f64::MAX)) & ay.le(T::splat(f64::MAX)) & (ax.gt(T::splat(0.0)) | ay.gt(T::splat(0.0)));
+    if !T::all(regular) {
+        return y.map2(x, f64::atan2);
     }
-    let swap = ay > ax;
-    let r = if swap { ax / ay } else { ay / ax };
-    let i = (r * 8.0 + 0.5) as usize;
-    // no reduction near 0 (the common case: small relative rotations)
-    let (t, ac) = if i == 0 {
-        (r, 0.0)
-    } else {
-        let (c, ac) = ATAN_POINTS[i];
-        ((r - c) / (1.0 + r * c), ac)
-    };
+    let swap = ay.gt(ax);
+    let r = T::select(swap, ax, ay) / T::select(swap, ay, ax);
+    let i = r * 8.0 + 0.5;
+    let (c, ac) = (i.lookup(&ATAN_TAN), i.lookup(&ATAN_VAL));
+    let t = (r - c) / (r * c + 1.0);
     let u = t * t;
     // Estrin's scheme (short dependency chain) for sum_k (-1)^(k+1) u^k / (2k + 3), k = 0..7
     let (u2, u4) = (u * u, u * u * (u * u));
-    let p = (-1.0 / 3.0 + u * (1.0 / 5.0))
-        + u2 * (-1.0 / 7.0 + u * (1.0 / 9.0))
-        + u4 * ((-1.0 / 11.0 + u * (1.0 / 13.0)) + u2 * (-1.0 / 15.0 + u * (1.0 / 17.0)));
-    let mut a = ac + (t + t * u * p);
-    if swap {
-        a = FRAC_PI_2 - a;
-    }
-    if x < 0.0 {
-        a = PI - a;
-    }
-    if y.is_sign_negative() {
-        -a
-    } else {
-        a
-    }
+    let p = (u * (1.0 / 5.0) + (-1.0 / 3.0))
+        + u2 * (u * (1.0 / 9.0) + (-1.0 / 7.0))
+        + u4 * ((u * (1.0 / 13.0) + (-1.0 / 11.0)) + u2 * (u * (1.0 / 17.0) + (-1.0 / 15.0)));
+    let a = ac + (t + t * u * p);
+    let a = T::select(swap, T::splat(FRAC_PI_2) - a, a);
+    let a = T::select(x.lt(T::splat(0.0)), T::splat(PI) - a, a);
+    // a >= 0 here: the sign is y's
+    a.copysign(y)
 }
 
 /// Cubic Hermite rotation shape functions (per unit l0) and their first two derivatives in zeta.
@@ -127,82 +148,95 @@ pub struct Element {
     pub s0: f64,
 }
 
-/// Current kinematic state of one element (everything a force or interpolation needs).
+/// Current kinematic state of one element (everything a force or interpolation needs); with
+/// `T = F64x4` ([`flexstar_numerics::lanes`]) the states of four elements, one per lane, which
+/// every method below evaluates with the same arithmetic as one element (`crate::element_pass`).
 #[derive(Debug, Clone, Copy)]
-pub struct ElementState {
-    pub l0: f64,
+pub struct ElementState<T = f64> {
+    pub l0: T,
     /// Current chord length l_n [m].
-    pub ln: f64,
+    pub ln: T,
     /// cos and sin of the current chord angle beta.
-    pub c: f64,
-    pub s: f64,
+    pub c: T,
+    pub s: T,
     /// Axial elongation u = l_n - l0 [m].
-    pub u: f64,
+    pub u: T,
     /// Local end rotations th1, th2 [rad] (small in a fine mesh).
-    pub th1: f64,
-    pub th2: f64,
+    pub th1: T,
+    pub th2: T,
     /// Rigid chord rotation beta - beta0, unwrapped consistently with node a's rotation [rad].
-    pub delta: f64,
+    pub delta: T,
     /// Chord vector d = xb - xa [m].
-    pub d: [f64; 2],
+    pub d: [T; 2],
     /// Reciprocals `1 / l_n`, `1 / l0` [1/m] (divisions done once per state).
-    pub inv_ln: f64,
-    pub inv_l0: f64,
+    pub inv_ln: T,
+    pub inv_l0: T,
 }
 
 impl ElementState {
     /// Local deformations of element `el` at element DOFs `q` (`[xa, ya, phia, xb, yb, phib]`).
     #[inline]
     pub fn new(el: &Element, q: &[f64; 6]) -> Self {
+        Self::from_reference(el.l0, el.c0, el.s0, q)
+    }
+}
+
+impl<T: Real> ElementState<T> {
+    /// Local deformations at element DOFs `q` of an element of initial length `l0` [m] and
+    /// initial chord direction `[c0, s0]`.
+    #[inline(always)]
+    pub fn from_reference(l0: T, c0: T, s0: T, q: &[T; 6]) -> Self {
         let d = [q[3] - q[0], q[4] - q[1]];
         let ln = (d[0] * d[0] + d[1] * d[1]).sqrt();
-        let inv_ln = 1.0 / ln;
+        let inv_ln = T::splat(1.0) / ln;
         let (c, s) = (d[0] * inv_ln, d[1] * inv_ln);
         // rotation of the chord from its initial direction (atan2 needs no normalised chord:
         // off the chain of the square root and the division)
-        let sd = el.c0 * d[1] - el.s0 * d[0];
-        let cd = el.c0 * d[0] + el.s0 * d[1];
-        let dp = atan2(sd, cd);
+        let sd = c0 * d[1] - s0 * d[0];
+        let cd = c0 * d[0] + s0 * d[1];
+        let dp = atan2_lanes(sd, cd);
         let th1 = wrap(q[2] - dp);
         let delta = q[2] - th1;
         let th2 = wrap(q[5] - delta);
         ElementState {
-            l0: el.l0,
+            l0,
             ln,
             c,
             s,
-            u: ln - el.l0,
+            u: ln - l0,
             th1,
             th2,
             delta,
             d,
             inv_ln,
-            inv_l0: 1.0 / el.l0,
+            inv_l0: T::splat(1.0) / l0,
         }
     }
 
     /// `d beta / d q_e` = z / l_n with z = [s, -c, 0, -s, c, 0].
-    #[inline]
-    pub fn jbeta(&self) -> [f64; 6] {
+    #[inline(always)]
+    pub fn jbeta(&self) -> [T; 6] {
         let (s, c) = (self.s * self.inv_ln, self.c * self.inv_ln);
-        [s, -c, 0.0, -s, c, 0.0]
+        let zero = T::splat(0.0);
+        [s, -c, zero, -s, c, zero]
     }
 
     /// Local forces `[N, M1, M2]` (axial force [N], end moments [N m]).
-    #[inline]
-    pub fn local_forces(&self, ea: f64, ei: f64) -> [f64; 3] {
-        let k = ei * self.inv_l0;
+    #[inline(always)]
+    pub fn local_forces(&self, ea: f64, ei: f64) -> [T; 3] {
+        let k = self.inv_l0 * ei;
         [
-            ea * self.u * self.inv_l0,
-            k * (4.0 * self.th1 + 2.0 * self.th2),
-            k * (2.0 * self.th1 + 4.0 * self.th2),
+            self.u * ea * self.inv_l0,
+            k * (self.th1 * 4.0 + self.th2 * 2.0),
+            k * (self.th1 * 2.0 + self.th2 * 4.0),
         ]
     }
 
     /// Strain energy [J]: `EA u^2 / (2 l0) + EI/l0 (2 th1^2 + 2 th1 th2 + 2 th2^2)`.
-    pub fn strain_energy(&self, ea: f64, ei: f64) -> f64 {
-        0.5 * ea * self.u * self.u / self.l0
-            + ei / self.l0 * 2.0 * (self.th1 * self.th1 + self.th1 * self.th2 + self.th2 * self.th2)
+    #[inline(always)]
+    pub fn strain_energy(&self, ea: f64, ei: f64) -> T {
+        self.u * (0.5 * ea) * self.u / self.l0
+            + T::splat(ei) / self.l0 * 2.0 * (self.th1 * self.th1 + self.th1 * self.th2 + self.th2 * self.th2)
     }
 
     /// Internal force vector f = B^T [N, M1, M2] and tangent stiffness
@@ -214,29 +248,31 @@ impl ElementState {
     /// `T = EA/l0 rho rho^T + (N / l_n + 2 (k4 + k2) / l_n^2) zeta zeta^T - (M1 + M2) / l_n^2 (rho zeta^T + zeta rho^T)`,
     /// the rotation-translation coupling is `-(k4 + k2) / l_n z`, and the rotation block is
     /// `[k4, k2; k2, k4]` (`k4 = 4 EI / l0`, `k2 = 2 EI / l0`).
-    pub fn internal(&self, ea: f64, ei: f64) -> ([f64; 6], Mat6) {
+    #[inline(always)]
+    pub fn internal(&self, ea: f64, ei: f64) -> ([T; 6], Mat6<T>) {
         let (c, s) = (self.c, self.s);
         let [n, m1, m2] = self.local_forces(ea, ei);
         let f = self.internal_force(ea, ei);
         let il0 = self.inv_l0;
-        let (ka, k4, k2) = (ea * il0, 4.0 * ei * il0, 2.0 * ei * il0);
+        let (ka, k4, k2) = (il0 * ea, il0 * (4.0 * ei), il0 * (2.0 * ei));
         let iln = self.inv_ln;
-        let gz = (n + 2.0 * (k4 + k2) * iln) * iln;
+        let gz = (n + (k4 + k2) * 2.0 * iln) * iln;
         let gm = (m1 + m2) * iln * iln;
         let (rho, zeta) = ([c, s], [s, -c]);
-        let t: [[f64; 2]; 2] = std::array::from_fn(|a| {
+        let t: [[T; 2]; 2] = std::array::from_fn(|a| {
             std::array::from_fn(|b| {
                 ka * rho[a] * rho[b] + gz * zeta[a] * zeta[b] - gm * (rho[a] * zeta[b] + zeta[a] * rho[b])
             })
         });
-        let z = [s, -c, 0.0, -s, c, 0.0];
+        let zero = T::splat(0.0);
+        let z = [s, -c, zero, -s, c, zero];
         let kc = -(k4 + k2) * iln;
-        let mut k = [[0.0; 6]; 6];
+        let mut k = [[zero; 6]; 6];
         for (a, sa) in [(0, 1.0), (3, -1.0)] {
             for (b, sb) in [(0, 1.0), (3, -1.0)] {
                 for p in 0..2 {
                     for q in 0..2 {
-                        k[a + p][b + q] = sa * sb * t[p][q];
+                        k[a + p][b + q] = t[p][q] * (sa * sb);
                     }
                 }
             }
@@ -257,30 +293,31 @@ impl ElementState {
 
     /// Internal force vector `f = B^T [N, M1, M2]` alone (the first half of
     /// [`ElementState::internal`], for residual-only evaluations).
-    #[inline]
-    pub fn internal_force(&self, ea: f64, ei: f64) -> [f64; 6] {
+    #[inline(always)]
+    pub fn internal_force(&self, ea: f64, ei: f64) -> [T; 6] {
         let [n, m1, m2] = self.local_forces(ea, ei);
         let (r, b1, b2) = self.b_rows();
         std::array::from_fn(|j| n * r[j] + m1 * b1[j] + m2 * b2[j])
     }
 
     /// Rows of `B = d[u, th1, th2] / d q_e`: `r`, `b1`, `b2`.
-    #[inline]
-    fn b_rows(&self) -> ([f64; 6], [f64; 6], [f64; 6]) {
+    #[inline(always)]
+    fn b_rows(&self) -> ([T; 6], [T; 6], [T; 6]) {
         let (c, s) = (self.c, self.s);
         let (sl, cl) = (s * self.inv_ln, c * self.inv_ln);
+        let (zero, one) = (T::splat(0.0), T::splat(1.0));
         (
-            [-c, -s, 0.0, c, s, 0.0],
-            [-sl, cl, 1.0, sl, -cl, 0.0],
-            [-sl, cl, 0.0, sl, -cl, 1.0],
+            [-c, -s, zero, c, s, zero],
+            [-sl, cl, one, sl, -cl, zero],
+            [-sl, cl, zero, sl, -cl, one],
         )
     }
 
     /// Full inertia force `M(q) qdd + f_conv = int rho J^T (J qdd + r_conv) dx` [N, N m] without
     /// forming `M`, in closed form: with `J = sum_k phi_k A_k` and `r_conv = sum_k phi_k c_k`
     /// ([`ElementState::basis`]), `f = rho l0 sum_k A_k^T sum_l G_kl (A_l qdd + c_l)` ([`GRAM`]).
-    #[inline]
-    pub fn inertia_force(&self, rho: f64, qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
+    #[inline(always)]
+    pub fn inertia_force(&self, rho: f64, qd: &[T; 6], qdd: &[T; 6]) -> [T; 6] {
         let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
         let jb = self.jbeta();
         let l0 = self.l0;
@@ -289,7 +326,7 @@ impl ElementState {
         // u_k = A_k qdd + c_k (2-vectors)
         let (g2, h2) = (l0 * (qdd[2] - jq) + cv2[1], -l0 * self.th1 * jq + cv2[0]);
         let (g3, h3) = (l0 * (qdd[5] - jq) + cv3[1], -l0 * self.th2 * jq + cv3[0]);
-        let u: [[f64; 2]; 4] = [
+        let u: [[T; 2]; 4] = [
             [qdd[0], qdd[1]],
             [qdd[3], qdd[4]],
             [g2 * e2[0] + h2 * e1[0], g2 * e2[1] + h2 * e1[1]],
@@ -300,15 +337,15 @@ impl ElementState {
     }
 
     /// `rho l0 sum_k A_k^T v_k` (the transpose of the basis applied to four 2-vectors).
-    #[inline]
-    fn basis_transpose_times(&self, rho: f64, v: &[[f64; 2]; 4]) -> [f64; 6] {
+    #[inline(always)]
+    fn basis_transpose_times(&self, rho: f64, v: &[[T; 2]; 4]) -> [T; 6] {
         let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
         let jb = self.jbeta();
         let l0 = self.l0;
         let (p2, r2) = (e2[0] * v[2][0] + e2[1] * v[2][1], e1[0] * v[2][0] + e1[1] * v[2][1]);
         let (p3, r3) = (e2[0] * v[3][0] + e2[1] * v[3][1], e1[0] * v[3][0] + e1[1] * v[3][1]);
         let cj = l0 * (p2 + self.th1 * r2 + p3 + self.th2 * r3);
-        let rl = rho * l0;
+        let rl = l0 * rho;
         [
             rl * (v[0][0] - cj * jb[0]),
             rl * (v[0][1] - cj * jb[1]),
@@ -319,6 +356,109 @@ impl ElementState {
         ]
     }
 
+    /// The convective acceleration `r_conv = H1 c_2 + H2 c_3` ([`ElementState::convective`]):
+    /// returns `[c_2, c_3]`, each as `[e1 component, e2 component]`.
+    #[inline(always)]
+    fn convective_coefficients(&self, qd: &[T; 6]) -> [[T; 2]; 2] {
+        let l0 = self.l0;
+        let iln2 = self.inv_ln * self.inv_ln;
+        let dd = [qd[3] - qd[0], qd[4] - qd[1]];
+        let bd = (self.d[0] * dd[1] - self.d[1] * dd[0]) * iln2;
+        let bdd_c = bd * -2.0 * (self.d[0] * dd[0] + self.d[1] * dd[1]) * iln2;
+        let c = |th: T, rate: T| {
+            [
+                l0 * ((rate - bd) * -2.0 * bd - th * bdd_c),
+                l0 * (-bdd_c - th * bd * bd),
+            ]
+        };
+        [c(self.th1, qd[2]), c(self.th2, qd[5])]
+    }
+
+    /// Consistent mass matrix `M(q) = int rho J^T J dx = rho l0 sum_kl G_kl A_k^T A_l` [kg, kg m,
+    /// kg m^2] in closed form ([`ElementState::basis`], [`GRAM`]; exact, as the 4-point Gauss
+    /// quadrature it replaces).
+    #[inline(always)]
+    pub fn mass(&self, rho: f64) -> Mat6<T> {
+        // A_0 = P_a, A_1 = P_b (node positions), A_2 = q e_phia^T + p_2 jb^T,
+        // A_3 = q e_phib^T + p_3 jb^T with q = l0 e2, p_k = -l0 (e2 + th e1); expanded:
+        const G: [[f64; 4]; 4] = GRAM;
+        let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
+        let jb = self.jbeta();
+        let l0 = self.l0;
+        let q = [l0 * e2[0], l0 * e2[1]];
+        let p = [
+            [-l0 * (e2[0] + self.th1 * e1[0]), -l0 * (e2[1] + self.th1 * e1[1])],
+            [-l0 * (e2[0] + self.th2 * e1[0]), -l0 * (e2[1] + self.th2 * e1[1])],
+        ];
+        let dot = |a: [T; 2], b: [T; 2]| a[0] * b[0] + a[1] * b[1];
+        let (qp2, qp3) = (dot(q, p[0]), dot(q, p[1]));
+        let qq = l0 * l0;
+        let mut m = [[T::splat(0.0); 6]; 6];
+        // node positions with each other
+        for x in 0..2 {
+            m[x][x] = T::splat(G[0][0]);
+            m[x][3 + x] = T::splat(G[0][1]);
+            m[3 + x][x] = T::splat(G[1][0]);
+            m[3 + x][3 + x] = T::splat(G[1][1]);
+        }
+        // rotation shape parts with each other: sum_kl G_kl A_k^T A_l, k, l in {2, 3}
+        let rot = [2, 5];
+        let gamma = dot(p[0], p[0]) * G[2][2] + dot(p[0], p[1]) * (2.0 * G[2][3]) + dot(p[1], p[1]) * G[3][3];
+        let cr = [qp2 * G[2][2] + qp3 * G[2][3], qp2 * G[3][2] + qp3 * G[3][3]];
+        for i in 0..6 {
+            for j in 0..6 {
+                m[i][j] += gamma * jb[i] * jb[j];
+            }
+        }
+        for k in 0..2 {
+            for l in 0..2 {
+                m[rot[k]][rot[l]] += qq * G[2 + k][2 + l];
+            }
+            for j in 0..6 {
+                m[rot[k]][j] += cr[k] * jb[j];
+                m[j][rot[k]] += cr[k] * jb[j];
+            }
+        }
+        // node positions with the rotation shapes: P_n^T (G_n2 A_2 + G_n3 A_3) and transposes
+        for (n, base) in [(0, 0), (1, 3)] {
+            let (g2, g3) = (G[n][2], G[n][3]);
+            for x in 0..2 {
+                let u = p[0][x] * g2 + p[1][x] * g3;
+                let mut r = [T::splat(0.0); 6];
+                for j in 0..6 {
+                    r[j] = u * jb[j];
+                }
+                r[2] += q[x] * g2;
+                r[5] += q[x] * g3;
+                for j in 0..6 {
+                    m[base + x][j] += r[j];
+                    m[j][base + x] += r[j];
+                }
+            }
+        }
+        let rl = l0 * rho;
+        for row in m.iter_mut() {
+            for v in row.iter_mut() {
+                *v *= rl;
+            }
+        }
+        m
+    }
+
+    /// Kinetic energy [J] of the element moving with velocities `qd`: `T = 1/2 qd . M(q) qd`
+    /// (closed form: [`ElementState::inertia_force`] without its convective part).
+    #[inline(always)]
+    pub fn kinetic_energy(&self, rho: f64, qd: &[T; 6]) -> T {
+        let mqd = self.inertia_force(rho, &[T::splat(0.0); 6], qd);
+        let mut sum = qd[0] * mqd[0];
+        for j in 1..6 {
+            sum += qd[j] * mqd[j];
+        }
+        sum * 0.5
+    }
+}
+
+impl ElementState {
     /// Coefficient matrices `A_k` (2 x 6) of the Jacobian in the basis
     /// `phi = [1 - zeta, zeta, H1, H2]`: `J(zeta) = sum_k phi_k(zeta) A_k` (see
     /// [`ElementState::jacobian`]): `A_0`, `A_1` pick node a's and node b's position, and
@@ -343,24 +483,6 @@ impl ElementState {
             }
         }
         a
-    }
-
-    /// The convective acceleration `r_conv = H1 c_2 + H2 c_3` ([`ElementState::convective`]):
-    /// returns `[c_2, c_3]`, each as `[e1 component, e2 component]`.
-    #[inline]
-    fn convective_coefficients(&self, qd: &[f64; 6]) -> [[f64; 2]; 2] {
-        let l0 = self.l0;
-        let iln2 = self.inv_ln * self.inv_ln;
-        let dd = [qd[3] - qd[0], qd[4] - qd[1]];
-        let bd = (self.d[0] * dd[1] - self.d[1] * dd[0]) * iln2;
-        let bdd_c = -2.0 * bd * (self.d[0] * dd[0] + self.d[1] * dd[1]) * iln2;
-        let c = |th: f64, rate: f64| {
-            [
-                l0 * (-2.0 * (rate - bd) * bd - th * bdd_c),
-                l0 * (-bdd_c - th * bd * bd),
-            ]
-        };
-        [c(self.th1, qd[2]), c(self.th2, qd[5])]
     }
 
     /// Interpolated position `r(zeta)` [m] of the material point at `zeta` in [0, 1].
@@ -454,84 +576,6 @@ impl ElementState {
     pub fn inertia(&self, rho: f64, qd: &[f64; 6]) -> ([f64; 6], Mat6) {
         (self.inertia_force(rho, qd, &[0.0; 6]), self.mass(rho))
     }
-
-    /// Consistent mass matrix `M(q) = int rho J^T J dx = rho l0 sum_kl G_kl A_k^T A_l` [kg, kg m,
-    /// kg m^2] in closed form ([`ElementState::basis`], [`GRAM`]; exact, as the 4-point Gauss
-    /// quadrature it replaces).
-    #[inline]
-    pub fn mass(&self, rho: f64) -> Mat6 {
-        // A_0 = P_a, A_1 = P_b (node positions), A_2 = q e_phia^T + p_2 jb^T,
-        // A_3 = q e_phib^T + p_3 jb^T with q = l0 e2, p_k = -l0 (e2 + th e1); expanded:
-        const G: [[f64; 4]; 4] = GRAM;
-        let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
-        let jb = self.jbeta();
-        let l0 = self.l0;
-        let q = [l0 * e2[0], l0 * e2[1]];
-        let p = [
-            [-l0 * (e2[0] + self.th1 * e1[0]), -l0 * (e2[1] + self.th1 * e1[1])],
-            [-l0 * (e2[0] + self.th2 * e1[0]), -l0 * (e2[1] + self.th2 * e1[1])],
-        ];
-        let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
-        let (qp2, qp3) = (dot(q, p[0]), dot(q, p[1]));
-        let qq = l0 * l0;
-        let mut m = [[0.0; 6]; 6];
-        // node positions with each other
-        for x in 0..2 {
-            m[x][x] = G[0][0];
-            m[x][3 + x] = G[0][1];
-            m[3 + x][x] = G[1][0];
-            m[3 + x][3 + x] = G[1][1];
-        }
-        // rotation shape parts with each other: sum_kl G_kl A_k^T A_l, k, l in {2, 3}
-        let rot = [2, 5];
-        let gamma = G[2][2] * dot(p[0], p[0]) + 2.0 * G[2][3] * dot(p[0], p[1]) + G[3][3] * dot(p[1], p[1]);
-        let cr = [G[2][2] * qp2 + G[2][3] * qp3, G[3][2] * qp2 + G[3][3] * qp3];
-        for i in 0..6 {
-            for j in 0..6 {
-                m[i][j] += gamma * jb[i] * jb[j];
-            }
-        }
-        for k in 0..2 {
-            for l in 0..2 {
-                m[rot[k]][rot[l]] += G[2 + k][2 + l] * qq;
-            }
-            for j in 0..6 {
-                m[rot[k]][j] += cr[k] * jb[j];
-                m[j][rot[k]] += cr[k] * jb[j];
-            }
-        }
-        // node positions with the rotation shapes: P_n^T (G_n2 A_2 + G_n3 A_3) and transposes
-        for (n, base) in [(0, 0), (1, 3)] {
-            let (g2, g3) = (G[n][2], G[n][3]);
-            for x in 0..2 {
-                let u = g2 * p[0][x] + g3 * p[1][x];
-                let mut r = [0.0; 6];
-                for j in 0..6 {
-                    r[j] = u * jb[j];
-                }
-                r[2] += g2 * q[x];
-                r[5] += g3 * q[x];
-                for j in 0..6 {
-                    m[base + x][j] += r[j];
-                    m[j][base + x] += r[j];
-                }
-            }
-        }
-        let rl = rho * l0;
-        for row in m.iter_mut() {
-            for v in row.iter_mut() {
-                *v *= rl;
-            }
-        }
-        m
-    }
-
-    /// Kinetic energy [J] of the element moving with velocities `qd`: `T = 1/2 qd . M(q) qd`
-    /// (closed form: [`ElementState::inertia_force`] without its convective part).
-    pub fn kinetic_energy(&self, rho: f64, qd: &[f64; 6]) -> f64 {
-        let mqd = self.inertia_force(rho, &[0.0; 6], qd);
-        0.5 * (0..6).map(|j| qd[j] * mqd[j]).sum::<f64>()
-    }
 }
 
 /// Gram matrix `G_kl = int_0^1 phi_k phi_l dzeta` of the interpolation basis
@@ -544,11 +588,11 @@ pub const GRAM: [[f64; 4]; 4] = [
 ];
 
 /// `v_k = sum_l G_kl u_l` for four 2-vectors.
-#[inline]
-fn gram_times(u: &[[f64; 2]; 4]) -> [[f64; 2]; 4] {
+#[inline(always)]
+fn gram_times<T: Real>(u: &[[T; 2]; 4]) -> [[T; 2]; 4] {
     std::array::from_fn(|k| {
         std::array::from_fn(|c| {
-            GRAM[k][0] * u[0][c] + GRAM[k][1] * u[1][c] + GRAM[k][2] * u[2][c] + GRAM[k][3] * u[3][c]
+            u[0][c] * GRAM[k][0] + u[1][c] * GRAM[k][1] + u[2][c] * GRAM[k][2] + u[3][c] * GRAM[k][3]
         })
     })
 }

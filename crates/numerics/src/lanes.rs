@@ -1,0 +1,308 @@
+//! One number or four: the scalar type of kernels that are written once and run either on one
+//! `f64` or on four independent `f64` lanes at a time ([`F64x4`]).
+//!
+//! A kernel generic over [`Real`] and inlined into a function compiled for AVX2
+//! (`#[target_feature(enable = "avx2")]`, chosen at run time) gets every lane operation as one
+//! 256-bit instruction; compiled for baseline x86-64 it gets two 128-bit ones, on other
+//! processors what their compiler makes of four-element arrays. Every lane operation is the
+//! correctly rounded IEEE operation of its scalar counterpart (no fused multiply-add, no
+//! reassociation), so a kernel gives bit for bit the same numbers on `f64` and on each lane of
+//! `F64x4`: the lanes change the speed, never the result (unit tests below, and the FEM's element
+//! batch test).
+
+use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
+
+/// Arithmetic of a kernel's numbers: `f64`, or [`F64x4`] (lane-wise). The `f64` right-hand
+/// sides let kernels write constants as `x * 2.0`.
+pub trait Real:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + Add<f64, Output = Self>
+    + Sub<f64, Output = Self>
+    + Mul<f64, Output = Self>
+    + Div<f64, Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+{
+    /// Result of a lane-wise comparison.
+    type Mask: Copy + BitAnd<Output = Self::Mask> + BitOr<Output = Self::Mask> + Not<Output = Self::Mask>;
+    /// Lanes per value.
+    const LANES: usize;
+    /// Every lane `x`.
+    fn splat(x: f64) -> Self;
+    /// Correctly rounded square root.
+    fn sqrt(self) -> Self;
+    fn abs(self) -> Self;
+    /// `|self|` with the sign bit of `sign`.
+    fn copysign(self, sign: Self) -> Self;
+    fn gt(self, other: Self) -> Self::Mask;
+    fn le(self, other: Self) -> Self::Mask;
+    fn lt(self, other: Self) -> Self::Mask;
+    /// `a` where `mask`, `b` elsewhere.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+    /// Whether the mask holds in every lane.
+    fn all(mask: Self::Mask) -> bool;
+    /// `f` applied to every lane (for rare paths that need a library function).
+    fn map(self, f: impl Fn(f64) -> f64) -> Self;
+    /// `f(self, other)` lane by lane.
+    fn map2(self, other: Self, f: impl Fn(f64, f64) -> f64) -> Self;
+    /// `table[i]` in each lane, `i` the lane's value truncated towards zero and clamped to the
+    /// table (lane values must be finite and non-negative to mean anything).
+    fn lookup<const N: usize>(self, table: &[f64; N]) -> Self;
+}
+
+impl Real for f64 {
+    type Mask = bool;
+    const LANES: usize = 1;
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        f64::copysign(self, sign)
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> bool {
+        self > other
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> bool {
+        self <= other
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> bool {
+        self < other
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask {
+            a
+        } else {
+            b
+        }
+    }
+    #[inline(always)]
+    fn all(mask: bool) -> bool {
+        mask
+    }
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        f(self)
+    }
+    #[inline(always)]
+    fn map2(self, other: Self, f: impl Fn(f64, f64) -> f64) -> Self {
+        f(self, other)
+    }
+    #[inline(always)]
+    fn lookup<const N: usize>(self, table: &[f64; N]) -> Self {
+        table[(self as usize).min(N - 1)]
+    }
+}
+
+/// Four `f64` lanes, aligned for one 256-bit load.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(32))]
+pub struct F64x4(pub [f64; 4]);
+
+/// Lane-wise comparison result of [`F64x4`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Mask4(pub [bool; 4]);
+
+impl F64x4 {
+    /// Lane `k` of `f(k)`.
+    #[inline(always)]
+    pub fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
+        F64x4(std::array::from_fn(f))
+    }
+}
+
+macro_rules! lane_binary {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl $trait for F64x4 {
+            type Output = F64x4;
+            #[inline(always)]
+            fn $method(self, o: F64x4) -> F64x4 {
+                let (a, b) = (self.0, o.0);
+                F64x4([a[0] $op b[0], a[1] $op b[1], a[2] $op b[2], a[3] $op b[3]])
+            }
+        }
+        impl $trait<f64> for F64x4 {
+            type Output = F64x4;
+            #[inline(always)]
+            fn $method(self, o: f64) -> F64x4 {
+                let a = self.0;
+                F64x4([a[0] $op o, a[1] $op o, a[2] $op o, a[3] $op o])
+            }
+        }
+    };
+}
+lane_binary!(Add, add, +);
+lane_binary!(Sub, sub, -);
+lane_binary!(Mul, mul, *);
+lane_binary!(Div, div, /);
+
+macro_rules! lane_assign {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl $trait for F64x4 {
+            #[inline(always)]
+            fn $method(&mut self, o: F64x4) {
+                *self = *self $op o;
+            }
+        }
+    };
+}
+lane_assign!(AddAssign, add_assign, +);
+lane_assign!(SubAssign, sub_assign, -);
+lane_assign!(MulAssign, mul_assign, *);
+
+impl Neg for F64x4 {
+    type Output = F64x4;
+    #[inline(always)]
+    fn neg(self) -> F64x4 {
+        let a = self.0;
+        F64x4([-a[0], -a[1], -a[2], -a[3]])
+    }
+}
+
+macro_rules! mask_binary {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl $trait for Mask4 {
+            type Output = Mask4;
+            #[inline(always)]
+            fn $method(self, o: Mask4) -> Mask4 {
+                let (a, b) = (self.0, o.0);
+                Mask4([a[0] $op b[0], a[1] $op b[1], a[2] $op b[2], a[3] $op b[3]])
+            }
+        }
+    };
+}
+mask_binary!(BitAnd, bitand, &);
+mask_binary!(BitOr, bitor, |);
+
+impl Not for Mask4 {
+    type Output = Mask4;
+    #[inline(always)]
+    fn not(self) -> Mask4 {
+        Mask4(self.0.map(|m| !m))
+    }
+}
+
+impl Real for F64x4 {
+    type Mask = Mask4;
+    const LANES: usize = 4;
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        F64x4([x; 4])
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        F64x4(self.0.map(f64::sqrt))
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        F64x4(self.0.map(f64::abs))
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        F64x4::from_fn(|k| self.0[k].copysign(sign.0[k]))
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> Mask4 {
+        Mask4(std::array::from_fn(|k| self.0[k] > other.0[k]))
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> Mask4 {
+        Mask4(std::array::from_fn(|k| self.0[k] <= other.0[k]))
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> Mask4 {
+        Mask4(std::array::from_fn(|k| self.0[k] < other.0[k]))
+    }
+    #[inline(always)]
+    fn select(mask: Mask4, a: Self, b: Self) -> Self {
+        F64x4::from_fn(|k| if mask.0[k] { a.0[k] } else { b.0[k] })
+    }
+    #[inline(always)]
+    fn all(mask: Mask4) -> bool {
+        mask.0[0] & mask.0[1] & mask.0[2] & mask.0[3]
+    }
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        F64x4(self.0.map(f))
+    }
+    #[inline(always)]
+    fn map2(self, other: Self, f: impl Fn(f64, f64) -> f64) -> Self {
+        F64x4::from_fn(|k| f(self.0[k], other.0[k]))
+    }
+    #[inline(always)]
+    fn lookup<const N: usize>(self, table: &[f64; N]) -> Self {
+        F64x4(self.0.map(|x| table[(x as usize).min(N - 1)]))
+    }
+}
+
+/// Whether this processor runs the 256-bit lane instructions (AVX2), detected once at run time;
+/// false off x86-64. Kernels call their `#[target_feature(enable = "avx2")]` copy when it holds.
+#[inline]
+pub fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A kernel with every operation of the trait, generic over the scalar type.
+    #[inline(always)]
+    fn kernel<T: Real>(x: T, y: T) -> T {
+        let r = (x * y + 1.5) / (x.abs() + 0.25) - (y * y + 2.0).sqrt() * 3.0;
+        let big = r.gt(T::splat(0.0)) & !x.lt(T::splat(-1.0));
+        let mut s = T::select(big, r, -r).copysign(y);
+        s += T::splat(0.5);
+        s -= x;
+        s *= y / 7.0;
+        let table = [0.0, 1.0, 4.0, 9.0];
+        let s = s + (x.abs() * 2.0).lookup(&table) + if T::all(x.le(T::splat(100.0))) { 0.0 } else { 1.0 };
+        s.map2(x, f64::hypot)
+    }
+
+    #[test]
+    fn lanes_give_the_scalar_results_bit_for_bit() {
+        let xs = [0.3, -1.7, 2.9, -0.0];
+        let ys = [-0.8, 1.1, -2.2, 5.0];
+        let lanes = kernel(F64x4(xs), F64x4(ys));
+        for k in 0..4 {
+            let s = kernel(xs[k], ys[k]);
+            assert_eq!(lanes.0[k].to_bits(), s.to_bits(), "lane {k}: {} vs {s}", lanes.0[k]);
+        }
+        // and the scalar kernel is the plain arithmetic it spells (a few spot values)
+        assert_eq!((2.0f64).lookup(&[5.0, 6.0, 7.0]), 7.0);
+        assert_eq!((9.5f64).lookup(&[5.0, 6.0, 7.0]), 7.0, "clamped to the table");
+        assert_eq!(
+            F64x4([1.0, -2.0, 3.0, -4.0]).map(|v| v * 10.0),
+            F64x4([10.0, -20.0, 30.0, -40.0])
+        );
+        assert!(F64x4::all(F64x4::splat(1.0).gt(F64x4::splat(0.0))));
+        assert!(!F64x4::all(F64x4([1.0, 1.0, -1.0, 1.0]).gt(F64x4::splat(0.0))));
+    }
+}

@@ -18,6 +18,7 @@
 pub mod beam;
 mod bordered;
 pub mod element;
+mod element_pass;
 pub mod error;
 mod integrator;
 pub mod modal_solver;

@@ -44,6 +44,7 @@ use flexstar_model::RobotParams;
 
 use crate::bordered::{Bordered, Layout, SLIDER_SLOTS};
 use crate::element::{Element, ElementState};
+use crate::element_pass::{self, NodeState, Section};
 use crate::sparse::SparseLu;
 use crate::FemError;
 
@@ -397,39 +398,17 @@ impl Star {
             .ensure_pattern(q)
             .map_err(|reason| FemError::LinearSolver { t, reason })?;
         let matrix = matrix || rebuilt;
-        let (ea, ei, rho) = (self.params.ea(), self.params.ei(), self.params.rho);
         res.iter_mut().for_each(|r| *r = 0.0);
-        for (e, el) in self.elements.iter().enumerate() {
-            let qe = self.element_q(el, q);
-            let ve = self.element_q(el, v);
-            let ae = self.element_q(el, qdd);
-            let st = ElementState::new(el, &qe);
-            if !(st.ln.is_finite() && st.ln > 0.0) {
-                return Err(FemError::NonFinite {
-                    t,
-                    element: e,
-                    reason: format!("element chord length {}", st.ln),
-                });
+        let nodes = NodeState { q, v, qdd };
+        let section = self.section();
+        let vals = matrix.then_some(&mut self.vals[..]);
+        element_pass::add_forces(&self.elements, nodes, section, cf, ck, res, vals).map_err(|bad| {
+            FemError::NonFinite {
+                t,
+                element: bad.element,
+                reason: format!("element chord length {}", bad.ln),
             }
-            let d = dofs(el);
-            let fm = st.inertia_force(rho, &ve, &ae);
-            if matrix {
-                let (fi, k) = st.internal(ea, ei);
-                let m = st.mass(rho);
-                let slot = &mut self.vals[36 * e..36 * e + 36];
-                for a in 0..6 {
-                    for b in 0..6 {
-                        slot[6 * a + b] = m[a][b] + ck * k[a][b];
-                    }
-                    res[d[a]] += cf * (fm[a] + fi[a]);
-                }
-            } else {
-                let fi = st.internal_force(ea, ei);
-                for a in 0..6 {
-                    res[d[a]] += cf * (fm[a] + fi[a]);
-                }
-            }
-        }
+        })?;
         for i in 0..3 {
             let ps = self.psi(i);
             res[ps] += cf * self.params.jp * qdd[ps];
@@ -627,14 +606,16 @@ impl Star {
     /// element interpolation's, exact: [`ElementState::kinetic_energy`],
     /// [`ElementState::strain_energy`]), in one pass over the elements.
     pub fn beam_energies(&self, q: &[f64], v: &[f64]) -> (f64, f64) {
-        let (ea, ei, rho) = (self.params.ea(), self.params.ei(), self.params.rho);
-        self.elements.iter().fold((0.0, 0.0), |(t, u), el| {
-            let st = ElementState::new(el, &self.element_q(el, q));
-            (
-                t + st.kinetic_energy(rho, &self.element_q(el, v)),
-                u + st.strain_energy(ea, ei),
-            )
-        })
+        element_pass::energies(&self.elements, q, v, self.section())
+    }
+
+    /// Section constants of the beams.
+    fn section(&self) -> Section {
+        Section {
+            ea: self.params.ea(),
+            ei: self.params.ei(),
+            rho: self.params.rho,
+        }
     }
 
     /// Material positions (from G) of the nodes of one beam [m].

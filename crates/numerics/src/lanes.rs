@@ -35,6 +35,10 @@ pub trait Real:
     const LANES: usize;
     /// Every lane `x`.
     fn splat(x: f64) -> Self;
+    /// Lane `k` set to `f(k)`, `k = 0..LANES`.
+    fn from_lanes(f: impl FnMut(usize) -> f64) -> Self;
+    /// Lane `k` (`k < LANES`).
+    fn lane(self, k: usize) -> f64;
     /// Correctly rounded square root.
     fn sqrt(self) -> Self;
     fn abs(self) -> Self;
@@ -62,6 +66,14 @@ impl Real for f64 {
     #[inline(always)]
     fn splat(x: f64) -> Self {
         x
+    }
+    #[inline(always)]
+    fn from_lanes(mut f: impl FnMut(usize) -> f64) -> Self {
+        f(0)
+    }
+    #[inline(always)]
+    fn lane(self, _k: usize) -> f64 {
+        self
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -207,6 +219,14 @@ impl Real for F64x4 {
     #[inline(always)]
     fn splat(x: f64) -> Self {
         F64x4([x; 4])
+    }
+    #[inline(always)]
+    fn from_lanes(f: impl FnMut(usize) -> f64) -> Self {
+        F64x4::from_fn(f)
+    }
+    #[inline(always)]
+    fn lane(self, k: usize) -> f64 {
+        self.0[k]
     }
     #[inline(always)]
     fn sqrt(self) -> Self {

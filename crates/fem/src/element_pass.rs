@@ -1,0 +1,329 @@
+//! The element loops of the time step (issue 13): every beam element's inertia and internal
+//! forces into the residual, with its block `M + beta' K` of the Newton matrix at the first
+//! iteration of a step, and the beams' kinetic and strain energy at the output times.
+//!
+//! Four consecutive elements are evaluated at once, one per lane of
+//! [`flexstar_numerics::lanes::F64x4`], by the same [`ElementState`] methods as one element
+//! (the last `n mod 4` elements take the one-element path). The lanes' arithmetic is that of one
+//! element, operation for operation, so the results are bit for bit those of the element-by-element
+//! loop (unit test below); the sums into the residual are taken in element order, as before. The
+//! loops are compiled twice, for baseline x86-64 and for AVX2 (256-bit lanes), and the processor
+//! picks at run time ([`flexstar_numerics::lanes::has_avx2`]).
+
+use flexstar_numerics::lanes::{F64x4, Real};
+
+use crate::element::{Element, ElementState};
+
+/// Section constants of the beams: axial stiffness EA [N], bending stiffness EI [N m^2], mass
+/// per length rho [kg/m].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Section {
+    pub ea: f64,
+    pub ei: f64,
+    pub rho: f64,
+}
+
+/// Global coordinates [m, rad], velocities and accelerations of the star's nodes (first
+/// `3 n_nodes` entries used).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NodeState<'a> {
+    pub q: &'a [f64],
+    pub v: &'a [f64],
+    pub qdd: &'a [f64],
+}
+
+/// An element whose chord is not a positive finite length (a diverging iterate).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BadChord {
+    pub element: usize,
+    /// Chord length l_n [m].
+    pub ln: f64,
+}
+
+/// Elements per batch.
+const LANES: usize = 4;
+
+/// Add `cf (M(q) qdd + f_conv(q, v) + f_int(q))` of every element to `res` (global DOFs, in
+/// element order) and, with `vals`, write each element's `M + ck K` (36 values, row-major, element
+/// after element: the slot layout of `crate::star`).
+pub(crate) fn add_forces(
+    elements: &[Element],
+    nodes: NodeState,
+    sec: Section,
+    cf: f64,
+    ck: f64,
+    res: &mut [f64],
+    vals: Option<&mut [f64]>,
+) -> Result<(), BadChord> {
+    #[cfg(target_arch = "x86_64")]
+    if flexstar_numerics::lanes::has_avx2() {
+        // SAFETY: the processor has AVX2 (detected at run time just above).
+        return unsafe { add_forces_avx2(elements, nodes, sec, cf, ck, res, vals) };
+    }
+    add_forces_batched(elements, nodes, sec, cf, ck, res, vals)
+}
+
+/// Kinetic and strain energy of all elements [J] (sums in element order):
+/// [`ElementState::kinetic_energy`], [`ElementState::strain_energy`].
+pub(crate) fn energies(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
+    #[cfg(target_arch = "x86_64")]
+    if flexstar_numerics::lanes::has_avx2() {
+        // SAFETY: the processor has AVX2 (detected at run time just above).
+        return unsafe { energies_avx2(elements, q, v, sec) };
+    }
+    energies_batched(elements, q, v, sec)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn add_forces_avx2(
+    elements: &[Element],
+    nodes: NodeState,
+    sec: Section,
+    cf: f64,
+    ck: f64,
+    res: &mut [f64],
+    vals: Option<&mut [f64]>,
+) -> Result<(), BadChord> {
+    add_forces_batched(elements, nodes, sec, cf, ck, res, vals)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn energies_avx2(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
+    energies_batched(elements, q, v, sec)
+}
+
+#[inline(always)]
+fn add_forces_batched(
+    elements: &[Element],
+    nodes: NodeState,
+    sec: Section,
+    cf: f64,
+    ck: f64,
+    res: &mut [f64],
+    mut vals: Option<&mut [f64]>,
+) -> Result<(), BadChord> {
+    let full = elements.len() / LANES * LANES;
+    for start in (0..full).step_by(LANES) {
+        add_forces_of::<F64x4>(elements, start, nodes, sec, cf, ck, res, vals.as_deref_mut())?;
+    }
+    for start in full..elements.len() {
+        add_forces_of::<f64>(elements, start, nodes, sec, cf, ck, res, vals.as_deref_mut())?;
+    }
+    Ok(())
+}
+
+#[inline(always)]
+fn energies_batched(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
+    let full = elements.len() / LANES * LANES;
+    let mut sums = (0.0, 0.0);
+    for start in (0..full).step_by(LANES) {
+        energies_of::<F64x4>(elements, start, q, v, sec, &mut sums);
+    }
+    for start in full..elements.len() {
+        energies_of::<f64>(elements, start, q, v, sec, &mut sums);
+    }
+    sums
+}
+
+/// Element DOFs `[xa, ya, phia, xb, yb, phib]` of the `T::LANES` elements from `start`, one per
+/// lane, from the global vector `x`.
+#[inline(always)]
+fn gather<T: Real>(elements: &[Element], start: usize, x: &[f64]) -> [T; 6] {
+    std::array::from_fn(|c| T::from_lanes(|k| x[3 * elements[start + k].nodes[c / 3] + c % 3]))
+}
+
+/// States of the `T::LANES` elements from `start` at the global coordinates `q`.
+#[inline(always)]
+fn states<T: Real>(elements: &[Element], start: usize, q: &[f64]) -> ElementState<T> {
+    let el = |k: usize| &elements[start + k];
+    ElementState::from_reference(
+        T::from_lanes(|k| el(k).l0),
+        T::from_lanes(|k| el(k).c0),
+        T::from_lanes(|k| el(k).s0),
+        &gather(elements, start, q),
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn add_forces_of<T: Real>(
+    elements: &[Element],
+    start: usize,
+    nodes: NodeState,
+    sec: Section,
+    cf: f64,
+    ck: f64,
+    res: &mut [f64],
+    vals: Option<&mut [f64]>,
+) -> Result<(), BadChord> {
+    let st: ElementState<T> = states(elements, start, nodes.q);
+    for k in 0..T::LANES {
+        let ln = st.ln.lane(k);
+        if !(ln.is_finite() && ln > 0.0) {
+            return Err(BadChord {
+                element: start + k,
+                ln,
+            });
+        }
+    }
+    let (ve, ae) = (gather(elements, start, nodes.v), gather(elements, start, nodes.qdd));
+    let fm = st.inertia_force(sec.rho, &ve, &ae);
+    let fi = match vals {
+        Some(vals) => {
+            let (fi, kt) = st.internal(sec.ea, sec.ei);
+            let m = st.mass(sec.rho);
+            for k in 0..T::LANES {
+                let slot = &mut vals[36 * (start + k)..36 * (start + k) + 36];
+                for a in 0..6 {
+                    for b in 0..6 {
+                        slot[6 * a + b] = (m[a][b] + kt[a][b] * ck).lane(k);
+                    }
+                }
+            }
+            fi
+        }
+        None => st.internal_force(sec.ea, sec.ei),
+    };
+    let f: [T; 6] = std::array::from_fn(|a| (fm[a] + fi[a]) * cf);
+    for k in 0..T::LANES {
+        let [na, nb] = elements[start + k].nodes;
+        for a in 0..6 {
+            let node = if a < 3 { na } else { nb };
+            res[3 * node + a % 3] += f[a].lane(k);
+        }
+    }
+    Ok(())
+}
+
+#[inline(always)]
+fn energies_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], sec: Section, sums: &mut (f64, f64)) {
+    let st: ElementState<T> = states(elements, start, q);
+    let ke = st.kinetic_energy(sec.rho, &gather(elements, start, v));
+    let se = st.strain_energy(sec.ea, sec.ei);
+    for k in 0..T::LANES {
+        sums.0 += ke.lane(k);
+        sums.1 += se.lane(k);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bent, stretched, rotating chain of `n` elements (node 0 shared, as G is).
+    fn chain(n: usize) -> (Vec<Element>, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let l0 = 0.01;
+        let b0: f64 = 0.4;
+        let elements: Vec<Element> = (0..n)
+            .map(|k| Element {
+                nodes: [k, k + 1],
+                l0,
+                c0: b0.cos(),
+                s0: b0.sin(),
+            })
+            .collect();
+        let mut q = vec![0.0; 3 * (n + 1)];
+        let (mut v, mut a) = (q.clone(), q.clone());
+        for j in 0..=n {
+            let x = j as f64 * l0 * (1.0 + 1e-4 * (j as f64).sin());
+            let w = 1e-3 * (0.3 * j as f64).sin();
+            q[3 * j] = x * b0.cos() - w * b0.sin();
+            q[3 * j + 1] = x * b0.sin() + w * b0.cos();
+            // node rotations beyond +-pi too: the wrap's library path
+            q[3 * j + 2] = 0.1 * (0.2 * j as f64).cos() + if j % 5 == 3 { 2.0 * std::f64::consts::PI } else { 0.0 };
+            for c in 0..3 {
+                v[3 * j + c] = (1.7 * j as f64 + c as f64).sin();
+                a[3 * j + c] = 30.0 * (0.9 * j as f64 - c as f64).cos();
+            }
+        }
+        (elements, q, v, a)
+    }
+
+    /// The element-by-element loop the batches replace (the loop of `Star::assemble` before them).
+    fn one_by_one(elements: &[Element], nodes: NodeState, sec: Section, cf: f64, ck: f64, res: &mut [f64], vals: &mut [f64]) {
+        for (e, el) in elements.iter().enumerate() {
+            let pick = |x: &[f64]| -> [f64; 6] {
+                let (a, b) = (3 * el.nodes[0], 3 * el.nodes[1]);
+                [x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2]]
+            };
+            let st = ElementState::new(el, &pick(nodes.q));
+            let fm = st.inertia_force(sec.rho, &pick(nodes.v), &pick(nodes.qdd));
+            let (fi, k) = st.internal(sec.ea, sec.ei);
+            let m = st.mass(sec.rho);
+            let d = [0, 1, 2, 3, 4, 5].map(|a| 3 * el.nodes[a / 3] + a % 3);
+            for a in 0..6 {
+                for b in 0..6 {
+                    vals[36 * e + 6 * a + b] = m[a][b] + ck * k[a][b];
+                }
+                res[d[a]] += cf * (fm[a] + fi[a]);
+            }
+        }
+    }
+
+    #[test]
+    fn batches_give_the_element_by_element_results_bit_for_bit() {
+        let sec = Section {
+            ea: 6e6,
+            ei: 0.5,
+            rho: 0.27,
+        };
+        let (cf, ck) = (6e-8, 6e-8);
+        // 11 elements: two full batches and a remainder of three
+        let (elements, q, v, a) = chain(11);
+        let nodes = NodeState { q: &q, v: &v, qdd: &a };
+        let (mut r1, mut m1) = (vec![0.0; q.len()], vec![0.0; 36 * elements.len()]);
+        let (mut r2, mut m2) = (r1.clone(), m1.clone());
+        one_by_one(&elements, nodes, sec, cf, ck, &mut r1, &mut m1);
+        add_forces(&elements, nodes, sec, cf, ck, &mut r2, Some(&mut m2)).unwrap();
+        assert_eq!(r1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(), r2.iter().map(|x| x.to_bits()).collect::<Vec<_>>());
+        assert_eq!(m1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(), m2.iter().map(|x| x.to_bits()).collect::<Vec<_>>());
+        // the residual-only pass adds the same forces
+        let mut r3 = vec![0.0; q.len()];
+        add_forces(&elements, nodes, sec, cf, ck, &mut r3, None).unwrap();
+        assert_eq!(r1, r3);
+        // and the portable copy (baseline x86-64, or what other processors run) too
+        let mut r4 = vec![0.0; q.len()];
+        add_forces_batched(&elements, nodes, sec, cf, ck, &mut r4, None).unwrap();
+        assert_eq!(r1, r4);
+        // energies against the element-by-element sums
+        let (mut t, mut u) = (0.0, 0.0);
+        for el in &elements {
+            let pick = |x: &[f64]| -> [f64; 6] {
+                let (a, b) = (3 * el.nodes[0], 3 * el.nodes[1]);
+                [x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2]]
+            };
+            let st = ElementState::new(el, &pick(&q));
+            t += st.kinetic_energy(sec.rho, &pick(&v));
+            u += st.strain_energy(sec.ea, sec.ei);
+        }
+        assert_eq!(energies(&elements, &q, &v, sec), (t, u));
+        assert_eq!(energies_batched(&elements, &q, &v, sec), (t, u));
+        assert!(t > 0.0 && u > 0.0);
+    }
+
+    #[test]
+    fn a_collapsed_chord_is_reported_with_its_element() {
+        let sec = Section {
+            ea: 6e6,
+            ei: 0.5,
+            rho: 0.27,
+        };
+        let (elements, mut q, v, a) = chain(9);
+        // element 6 (in the second batch) collapses: node 7 onto node 6
+        q[21] = q[18];
+        q[22] = q[19];
+        let mut res = vec![0.0; q.len()];
+        let nodes = NodeState { q: &q, v: &v, qdd: &a };
+        let err = add_forces(&elements, nodes, sec, 1.0, 1.0, &mut res, None).unwrap_err();
+        assert_eq!(err, BadChord { element: 6, ln: 0.0 });
+        // and in the remainder (element 8, the one-element path)
+        let (elements, mut q, v, a) = chain(9);
+        q[27] = f64::NAN;
+        let nodes = NodeState { q: &q, v: &v, qdd: &a };
+        let err = add_forces(&elements, nodes, sec, 1.0, 1.0, &mut res, None).unwrap_err();
+        assert_eq!(err.element, 8);
+        assert!(err.ln.is_nan());
+    }
+}

@@ -183,6 +183,15 @@ impl Bordered {
     /// (first element of the window of each contact point, [sleeve][point]). `Err` names the
     /// failing pivot.
     pub fn factor(&mut self, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), String> {
+        let this = self;
+        flexstar_numerics::dispatch_avx2!(fn(this: &mut Bordered, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), String> {
+            this.factor_inline(vals, win)
+        })
+    }
+
+    /// [`Bordered::factor`], inlined into its AVX2 and baseline copies.
+    #[inline(always)]
+    fn factor_inline(&mut self, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), String> {
         let ns = self.ns;
         self.s.iter_mut().for_each(|x| *x = 0.0);
         for i in 0..3 {
@@ -207,6 +216,7 @@ impl Bordered {
 
     /// Direct problem: the slider coordinates' diagonal and their coupling with the position
     /// rows of their sleeve (`-u_i`), all within the border.
+    #[inline(always)]
     fn slider_border(&mut self, off: usize, vals: &[f64]) {
         let ns = self.ns;
         for i in 0..3 {
@@ -222,6 +232,7 @@ impl Bordered {
     }
 
     /// Band of beam i from its element blocks; the G-G part of element 0 goes to the border.
+    #[inline(always)]
     fn fill_beam(&mut self, i: usize, vals: &[f64]) {
         let ns = self.ns;
         let ne = self.lay.ne;
@@ -264,6 +275,7 @@ impl Bordered {
     /// three independent factorisations advance row by row together, so that the processor
     /// overlaps their dependency chains (each row waits on the previous one: divisions and a
     /// square root).
+    #[inline(always)]
     fn cholesky(&mut self) -> Result<(), String> {
         let n = 3 * self.lay.ne;
         let [b0, b1, b2] = &mut self.band;
@@ -289,6 +301,7 @@ impl Bordered {
     /// `E_i` (G columns from element 0, multiplier columns from the constraint rows; couplings
     /// of the multipliers with G, xi and psi go to the border), then `W_i = L_i^{-1} E_i` and
     /// `S -= W_i^T W_i`.
+    #[inline(always)]
     fn border_columns(&mut self, i: usize, vals: &[f64], win: &[[usize; 3]; 3]) {
         let ns = self.ns;
         let l = self.lay;
@@ -387,6 +400,7 @@ impl Bordered {
 
     /// LU with partial pivoting of the Schur complement, in place; the updates skip the zero
     /// entries of the pivot row (the sleeve blocks stay uncoupled until G, last).
+    #[inline(always)]
     fn lu_schur(&mut self) -> Result<(), String> {
         let ns = self.ns;
         let s = &mut self.s;
@@ -432,6 +446,7 @@ impl Bordered {
     /// chains the processor overlaps). The pad entries are zero; the last `HB` unknowns of each
     /// beam stay in registers (no reload of a value just stored), the newest one subtracted
     /// last (shortest dependency chain).
+    #[inline(always)]
     fn forward(&mut self) {
         let n = 3 * self.lay.ne;
         let [y0, y1, y2] = &mut self.y;
@@ -451,6 +466,7 @@ impl Bordered {
     }
 
     /// `y_i <- L_i^{-T} y_i` for the three beams, together as in [`Bordered::forward`].
+    #[inline(always)]
     fn backward(&mut self) {
         let n = 3 * self.lay.ne;
         let [y0, y1, y2] = &mut self.y;
@@ -477,6 +493,13 @@ impl Bordered {
 
     /// Solve `A x = rhs` in place (global ordering of the star) with the last factorisation.
     pub fn solve(&mut self, rhs: &mut [f64]) {
+        let this = self;
+        flexstar_numerics::dispatch_avx2!(fn(this: &mut Bordered, rhs: &mut [f64]) -> () { this.solve_inline(rhs) })
+    }
+
+    /// [`Bordered::solve`], inlined into its AVX2 and baseline copies.
+    #[inline(always)]
+    fn solve_inline(&mut self, rhs: &mut [f64]) {
         let n = 3 * self.lay.ne;
         let ns = self.ns;
         let mut xs = [0.0; NS_MAX];

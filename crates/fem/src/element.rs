@@ -259,12 +259,13 @@ impl<T: Real> ElementState<T> {
         let gz = (n + (k4 + k2) * 2.0 * iln) * iln;
         let gm = (m1 + m2) * iln * iln;
         let (rho, zeta) = ([c, s], [s, -c]);
-        let t: [[T; 2]; 2] = std::array::from_fn(|a| {
-            std::array::from_fn(|b| {
-                ka * rho[a] * rho[b] + gz * zeta[a] * zeta[b] - gm * (rho[a] * zeta[b] + zeta[a] * rho[b])
-            })
-        });
         let zero = T::splat(0.0);
+        let mut t = [[zero; 2]; 2];
+        for a in 0..2 {
+            for b in 0..2 {
+                t[a][b] = ka * rho[a] * rho[b] + gz * zeta[a] * zeta[b] - gm * (rho[a] * zeta[b] + zeta[a] * rho[b]);
+            }
+        }
         let z = [s, -c, zero, -s, c, zero];
         let kc = -(k4 + k2) * iln;
         let mut k = [[zero; 6]; 6];
@@ -297,7 +298,11 @@ impl<T: Real> ElementState<T> {
     pub fn internal_force(&self, ea: f64, ei: f64) -> [T; 6] {
         let [n, m1, m2] = self.local_forces(ea, ei);
         let (r, b1, b2) = self.b_rows();
-        std::array::from_fn(|j| n * r[j] + m1 * b1[j] + m2 * b2[j])
+        let mut f = r;
+        for j in 0..6 {
+            f[j] = n * r[j] + m1 * b1[j] + m2 * b2[j];
+        }
+        f
     }
 
     /// Rows of `B = d[u, th1, th2] / d q_e`: `r`, `b1`, `b2`.
@@ -590,11 +595,13 @@ pub const GRAM: [[f64; 4]; 4] = [
 /// `v_k = sum_l G_kl u_l` for four 2-vectors.
 #[inline(always)]
 fn gram_times<T: Real>(u: &[[T; 2]; 4]) -> [[T; 2]; 4] {
-    std::array::from_fn(|k| {
-        std::array::from_fn(|c| {
-            u[0][c] * GRAM[k][0] + u[1][c] * GRAM[k][1] + u[2][c] * GRAM[k][2] + u[3][c] * GRAM[k][3]
-        })
-    })
+    let mut v = *u;
+    for k in 0..4 {
+        for c in 0..2 {
+            v[k][c] = u[0][c] * GRAM[k][0] + u[1][c] * GRAM[k][1] + u[2][c] * GRAM[k][2] + u[3][c] * GRAM[k][3];
+        }
+    }
+    v
 }
 
 #[cfg(test)]

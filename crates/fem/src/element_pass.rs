@@ -8,7 +8,7 @@
 //! element, operation for operation, so the results are bit for bit those of the element-by-element
 //! loop (unit test below); the sums into the residual are taken in element order, as before. The
 //! loops are compiled twice, for baseline x86-64 and for AVX2 (256-bit lanes), and the processor
-//! picks at run time ([`flexstar_numerics::lanes::has_avx2`]).
+//! picks at run time ([`flexstar_numerics::dispatch_avx2`]).
 
 use flexstar_numerics::lanes::{F64x4, Real};
 
@@ -55,43 +55,25 @@ pub(crate) fn add_forces(
     res: &mut [f64],
     vals: Option<&mut [f64]>,
 ) -> Result<(), BadChord> {
-    #[cfg(target_arch = "x86_64")]
-    if flexstar_numerics::lanes::has_avx2() {
-        // SAFETY: the processor has AVX2 (detected at run time just above).
-        return unsafe { add_forces_avx2(elements, nodes, sec, cf, ck, res, vals) };
-    }
-    add_forces_batched(elements, nodes, sec, cf, ck, res, vals)
+    flexstar_numerics::dispatch_avx2!(fn(
+        elements: &[Element],
+        nodes: NodeState,
+        sec: Section,
+        cf: f64,
+        ck: f64,
+        res: &mut [f64],
+        vals: Option<&mut [f64]>,
+    ) -> Result<(), BadChord> {
+        add_forces_batched(elements, nodes, sec, cf, ck, res, vals)
+    })
 }
 
 /// Kinetic and strain energy of all elements [J] (sums in element order):
 /// [`ElementState::kinetic_energy`], [`ElementState::strain_energy`].
 pub(crate) fn energies(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
-    #[cfg(target_arch = "x86_64")]
-    if flexstar_numerics::lanes::has_avx2() {
-        // SAFETY: the processor has AVX2 (detected at run time just above).
-        return unsafe { energies_avx2(elements, q, v, sec) };
-    }
-    energies_batched(elements, q, v, sec)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn add_forces_avx2(
-    elements: &[Element],
-    nodes: NodeState,
-    sec: Section,
-    cf: f64,
-    ck: f64,
-    res: &mut [f64],
-    vals: Option<&mut [f64]>,
-) -> Result<(), BadChord> {
-    add_forces_batched(elements, nodes, sec, cf, ck, res, vals)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn energies_avx2(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
-    energies_batched(elements, q, v, sec)
+    flexstar_numerics::dispatch_avx2!(fn(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
+        energies_batched(elements, q, v, sec)
+    })
 }
 
 #[inline(always)]
@@ -131,7 +113,11 @@ fn energies_batched(elements: &[Element], q: &[f64], v: &[f64], sec: Section) ->
 /// lane, from the global vector `x`.
 #[inline(always)]
 fn gather<T: Real>(elements: &[Element], start: usize, x: &[f64]) -> [T; 6] {
-    std::array::from_fn(|c| T::from_lanes(|k| x[3 * elements[start + k].nodes[c / 3] + c % 3]))
+    let mut out = [T::splat(0.0); 6];
+    for c in 0..6 {
+        out[c] = T::from_lanes(|k| x[3 * elements[start + k].nodes[c / 3] + c % 3]);
+    }
+    out
 }
 
 /// States of the `T::LANES` elements from `start` at the global coordinates `q`.
@@ -162,10 +148,7 @@ fn add_forces_of<T: Real>(
     for k in 0..T::LANES {
         let ln = st.ln.lane(k);
         if !(ln.is_finite() && ln > 0.0) {
-            return Err(BadChord {
-                element: start + k,
-                ln,
-            });
+            return Err(BadChord { element: start + k, ln });
         }
     }
     let (ve, ae) = (gather(elements, start, nodes.v), gather(elements, start, nodes.qdd));
@@ -186,7 +169,10 @@ fn add_forces_of<T: Real>(
         }
         None => st.internal_force(sec.ea, sec.ei),
     };
-    let f: [T; 6] = std::array::from_fn(|a| (fm[a] + fi[a]) * cf);
+    let mut f = fm;
+    for a in 0..6 {
+        f[a] = (fm[a] + fi[a]) * cf;
+    }
     for k in 0..T::LANES {
         let [na, nb] = elements[start + k].nodes;
         for a in 0..6 {
@@ -242,7 +228,15 @@ mod tests {
     }
 
     /// The element-by-element loop the batches replace (the loop of `Star::assemble` before them).
-    fn one_by_one(elements: &[Element], nodes: NodeState, sec: Section, cf: f64, ck: f64, res: &mut [f64], vals: &mut [f64]) {
+    fn one_by_one(
+        elements: &[Element],
+        nodes: NodeState,
+        sec: Section,
+        cf: f64,
+        ck: f64,
+        res: &mut [f64],
+        vals: &mut [f64],
+    ) {
         for (e, el) in elements.iter().enumerate() {
             let pick = |x: &[f64]| -> [f64; 6] {
                 let (a, b) = (3 * el.nodes[0], 3 * el.nodes[1]);
@@ -277,8 +271,14 @@ mod tests {
         let (mut r2, mut m2) = (r1.clone(), m1.clone());
         one_by_one(&elements, nodes, sec, cf, ck, &mut r1, &mut m1);
         add_forces(&elements, nodes, sec, cf, ck, &mut r2, Some(&mut m2)).unwrap();
-        assert_eq!(r1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(), r2.iter().map(|x| x.to_bits()).collect::<Vec<_>>());
-        assert_eq!(m1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(), m2.iter().map(|x| x.to_bits()).collect::<Vec<_>>());
+        assert_eq!(
+            r1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            r2.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        );
+        assert_eq!(
+            m1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            m2.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        );
         // the residual-only pass adds the same forces
         let mut r3 = vec![0.0; q.len()];
         add_forces(&elements, nodes, sec, cf, ck, &mut r3, None).unwrap();

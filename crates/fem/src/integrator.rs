@@ -453,15 +453,92 @@ struct Workspace {
     a_part: Vec<f64>,
     qh: Vec<f64>,
     vh: Vec<f64>,
+    /// The Newton iterate: coordinates, velocities, accelerations, scaled multipliers.
+    q1: Vec<f64>,
+    v1: Vec<f64>,
+    qdd1: Vec<f64>,
     nu: Vec<f64>,
     dx: Vec<f64>,
     res: Vec<f64>,
 }
 
+/// Generalized-alpha predictor of every coordinate ([`GenAlpha::predict`]) and the first Newton
+/// iterate: constant acceleration, `q = q_hat + beta' q_dd`, `v = v_hat + gamma' q_dd`.
+#[inline(always)]
+fn predict(ga: &GenAlpha, h: f64, bp: f64, gp: f64, st: &State, ws: &mut Workspace) {
+    let n = st.q.len();
+    let (q, v, a, qdd) = (&st.q[..n], &st.v[..n], &st.a[..n], &st.qdd[..n]);
+    let (ap, qh, vh) = (&mut ws.a_part[..n], &mut ws.qh[..n], &mut ws.vh[..n]);
+    let (q1, v1, qdd1) = (&mut ws.q1[..n], &mut ws.v1[..n], &mut ws.qdd1[..n]);
+    for j in 0..n {
+        (ap[j], qh[j], vh[j]) = ga.predict(h, q[j], v[j], a[j], qdd[j]);
+        qdd1[j] = qdd[j];
+        q1[j] = qh[j] + bp * qdd[j];
+        v1[j] = vh[j] + gp * qdd[j];
+    }
+}
+
+/// Newton update of the coordinates with the increment `dx` (first `n` entries):
+/// `q += dx`, `q_dd += dx / beta'`, `v += gamma' / beta' dx`; returns the largest increment
+/// weighted by `weight` (the maximum in four interleaved partial maxima, the same number).
+#[inline(always)]
+fn update_coordinates(ws: &mut Workspace, inv_bp: f64, gp: f64) -> f64 {
+    let n = ws.q1.len();
+    let (q1, v1, qdd1) = (&mut ws.q1[..n], &mut ws.v1[..n], &mut ws.qdd1[..n]);
+    let dx = &ws.dx[..n];
+    for j in 0..n {
+        let d = dx[j];
+        q1[j] += d;
+        qdd1[j] += d * inv_bp;
+        v1[j] += gp * inv_bp * d;
+    }
+    let mut m = [0.0f64; 4];
+    let (chunks, rest) = (dx.chunks_exact(4), dx.len() / 4 * 4);
+    for (c, w) in chunks.zip(ws.weight.chunks_exact(4)) {
+        for k in 0..4 {
+            m[k] = m[k].max((c[k] * w[k]).abs());
+        }
+    }
+    let mut dq_max = m[0].max(m[1]).max(m[2].max(m[3]));
+    for j in rest..n {
+        dq_max = dq_max.max((dx[j] * ws.weight[j]).abs());
+    }
+    dq_max
+}
+
 /// One generalized-alpha step from `st` (at `t1 - h`) to `t1`; `st` holds the new state on
-/// return.
+/// return. Compiled for AVX2 and for the baseline, chosen at run time (the vector loops of the
+/// predictor and the Newton updates; the solver's parts dispatch on their own).
 #[allow(clippy::too_many_arguments)]
 fn step(
+    params: &RobotParams,
+    motion: &Motion,
+    star: &mut Star,
+    ga: &GenAlpha,
+    st: &mut State,
+    ws: &mut Workspace,
+    stats: &mut Stats,
+    t1: f64,
+    h: f64,
+) -> Result<(), FemError> {
+    flexstar_numerics::dispatch_avx2!(fn(
+        params: &RobotParams,
+        motion: &Motion,
+        star: &mut Star,
+        ga: &GenAlpha,
+        st: &mut State,
+        ws: &mut Workspace,
+        stats: &mut Stats,
+        t1: f64,
+        h: f64,
+    ) -> Result<(), FemError> {
+        step_inline(params, motion, star, ga, st, ws, stats, t1, h)
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn step_inline(
     params: &RobotParams,
     motion: &Motion,
     star: &mut Star,
@@ -476,15 +553,8 @@ fn step(
     let l = params.l;
     let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
     let fixed = motion.prescribed_pins(params, t1)?;
-    for j in 0..n_dof {
-        ws.a_part[j] = (ga.alpha_f * st.qdd[j] - ga.alpha_m * st.a[j]) / (1.0 - ga.alpha_m);
-        ws.qh[j] = st.q[j] + h * st.v[j] + h * h * ((0.5 - ga.beta) * st.a[j] + ga.beta * ws.a_part[j]);
-        ws.vh[j] = st.v[j] + h * ((1.0 - ga.gamma) * st.a[j] + ga.gamma * ws.a_part[j]);
-    }
     // predictor: constant acceleration, previous multipliers
-    let mut qdd1 = st.qdd.clone();
-    let mut q1: Vec<f64> = (0..n_dof).map(|j| ws.qh[j] + bp * qdd1[j]).collect();
-    let mut v1: Vec<f64> = (0..n_dof).map(|j| ws.vh[j] + gp * qdd1[j]).collect();
+    predict(ga, h, bp, gp, st, ws);
     for k in 0..ws.nu.len() {
         ws.nu[k] = bp * st.lam[k];
     }
@@ -499,14 +569,14 @@ fn step(
         let (pins, sliders) = match fixed {
             Some(p) => (p, None),
             None => {
-                let p = star.pins_of(&q1, &v1, &qdd1);
+                let p = star.pins_of(&ws.q1, &ws.v1, &ws.qdd1);
                 (p, motion.slider_rows(params, &p, t1, bp, gp)?)
             }
         };
         let fresh = star.assemble(
-            &q1,
-            &v1,
-            &qdd1,
+            &ws.q1,
+            &ws.v1,
+            &ws.qdd1,
             &ws.nu,
             &pins,
             sliders.as_ref(),
@@ -526,14 +596,7 @@ fn step(
             ws.dx[k] = -ws.res[k];
         }
         star.solve(&mut ws.dx);
-        let mut dq_max = 0.0f64;
-        for j in 0..n_dof {
-            let d = ws.dx[j];
-            q1[j] += d;
-            qdd1[j] += d * inv_bp;
-            v1[j] += gp * inv_bp * d;
-            dq_max = dq_max.max((d * ws.weight[j]).abs());
-        }
+        let dq_max = update_coordinates(ws, inv_bp, gp);
         let mut dl_max = 0.0f64;
         let mut l_max = 0.0f64;
         for k in 0..ws.nu.len() {
@@ -575,13 +638,14 @@ fn step(
             ),
         });
     }
+    let apq = ga.a_per_qdd();
     for j in 0..n_dof {
-        st.a[j] = ws.a_part[j] + ga.a_per_qdd() * qdd1[j];
+        st.a[j] = ws.a_part[j] + apq * ws.qdd1[j];
     }
-    st.pins = fixed.unwrap_or_else(|| star.pins_of(&q1, &v1, &qdd1));
-    st.q = q1;
-    st.v = v1;
-    st.qdd = qdd1;
+    st.pins = fixed.unwrap_or_else(|| star.pins_of(&ws.q1, &ws.v1, &ws.qdd1));
+    std::mem::swap(&mut st.q, &mut ws.q1);
+    std::mem::swap(&mut st.v, &mut ws.v1);
+    std::mem::swap(&mut st.qdd, &mut ws.qdd1);
     for k in 0..ws.nu.len() {
         st.lam[k] = ws.nu[k] / bp;
     }
@@ -631,6 +695,9 @@ pub(crate) fn integrate(
         a_part: vec![0.0; n_dof],
         qh: vec![0.0; n_dof],
         vh: vec![0.0; n_dof],
+        q1: vec![0.0; n_dof],
+        v1: vec![0.0; n_dof],
+        qdd1: vec![0.0; n_dof],
         nu: vec![0.0; 3 * ROWS],
         dx: vec![0.0; n_sys],
         res: vec![0.0; n_sys],

@@ -137,8 +137,8 @@ pub struct Mask4(pub [bool; 4]);
 impl F64x4 {
     /// Lane `k` of `f(k)`.
     #[inline(always)]
-    pub fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
-        F64x4(std::array::from_fn(f))
+    pub fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
+        F64x4([f(0), f(1), f(2), f(3)])
     }
 }
 
@@ -209,7 +209,8 @@ impl Not for Mask4 {
     type Output = Mask4;
     #[inline(always)]
     fn not(self) -> Mask4 {
-        Mask4(self.0.map(|m| !m))
+        let m = self.0;
+        Mask4([!m[0], !m[1], !m[2], !m[3]])
     }
 }
 
@@ -230,11 +231,13 @@ impl Real for F64x4 {
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
-        F64x4(self.0.map(f64::sqrt))
+        let a = self.0;
+        F64x4([a[0].sqrt(), a[1].sqrt(), a[2].sqrt(), a[3].sqrt()])
     }
     #[inline(always)]
     fn abs(self) -> Self {
-        F64x4(self.0.map(f64::abs))
+        let a = self.0;
+        F64x4([a[0].abs(), a[1].abs(), a[2].abs(), a[3].abs()])
     }
     #[inline(always)]
     fn copysign(self, sign: Self) -> Self {
@@ -242,15 +245,18 @@ impl Real for F64x4 {
     }
     #[inline(always)]
     fn gt(self, other: Self) -> Mask4 {
-        Mask4(std::array::from_fn(|k| self.0[k] > other.0[k]))
+        let (a, b) = (self.0, other.0);
+        Mask4([a[0] > b[0], a[1] > b[1], a[2] > b[2], a[3] > b[3]])
     }
     #[inline(always)]
     fn le(self, other: Self) -> Mask4 {
-        Mask4(std::array::from_fn(|k| self.0[k] <= other.0[k]))
+        let (a, b) = (self.0, other.0);
+        Mask4([a[0] <= b[0], a[1] <= b[1], a[2] <= b[2], a[3] <= b[3]])
     }
     #[inline(always)]
     fn lt(self, other: Self) -> Mask4 {
-        Mask4(std::array::from_fn(|k| self.0[k] < other.0[k]))
+        let (a, b) = (self.0, other.0);
+        Mask4([a[0] < b[0], a[1] < b[1], a[2] < b[2], a[3] < b[3]])
     }
     #[inline(always)]
     fn select(mask: Mask4, a: Self, b: Self) -> Self {
@@ -262,7 +268,8 @@ impl Real for F64x4 {
     }
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> Self {
-        F64x4(self.0.map(f))
+        let a = self.0;
+        F64x4([f(a[0]), f(a[1]), f(a[2]), f(a[3])])
     }
     #[inline(always)]
     fn map2(self, other: Self, f: impl Fn(f64, f64) -> f64) -> Self {
@@ -270,7 +277,9 @@ impl Real for F64x4 {
     }
     #[inline(always)]
     fn lookup<const N: usize>(self, table: &[f64; N]) -> Self {
-        F64x4(self.0.map(|x| table[(x as usize).min(N - 1)]))
+        let a = self.0;
+        let at = |x: f64| table[(x as usize).min(N - 1)];
+        F64x4([at(a[0]), at(a[1]), at(a[2]), at(a[3])])
     }
 }
 
@@ -286,6 +295,35 @@ pub fn has_avx2() -> bool {
     {
         false
     }
+}
+
+/// Run a function body compiled twice, for AVX2 and for the baseline of the build, choosing at
+/// run time ([`has_avx2`]): `dispatch_avx2!(fn(a: &mut [f64], x: f64) -> f64 { body })` defines
+/// both copies with the arguments given and calls one with the variables of the same names. The
+/// body's callees are compiled for AVX2 only where they are inlined into it (`#[inline(always)]`).
+/// The two copies compute the same operations (no fused multiply-add is enabled, the compiler
+/// does not reassociate), so their results are identical; only their instructions differ.
+#[macro_export]
+macro_rules! dispatch_avx2 {
+    (fn($($arg:ident : $ty:ty),* $(,)?) -> $ret:ty $body:block) => {{
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        #[allow(clippy::too_many_arguments)]
+        fn with_avx2($($arg: $ty),*) -> $ret $body
+        #[allow(clippy::too_many_arguments)]
+        #[inline(always)]
+        fn portable($($arg: $ty),*) -> $ret $body
+        #[cfg(target_arch = "x86_64")]
+        let out = if $crate::lanes::has_avx2() {
+            // SAFETY: the processor has AVX2 (detected at run time just above).
+            unsafe { with_avx2($($arg),*) }
+        } else {
+            portable($($arg),*)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let out = portable($($arg),*);
+        out
+    }};
 }
 
 #[cfg(test)]
@@ -304,6 +342,29 @@ mod tests {
         let table = [0.0, 1.0, 4.0, 9.0];
         let s = s + (x.abs() * 2.0).lookup(&table) + if T::all(x.le(T::splat(100.0))) { 0.0 } else { 1.0 };
         s.map2(x, f64::hypot)
+    }
+
+    #[test]
+    fn both_copies_of_a_dispatched_body_agree() {
+        let xs: Vec<f64> = (0..37).map(|k| (k as f64 * 0.61).sin() * 1e3).collect();
+        let scaled = |xs: &[f64], c: f64| -> Vec<f64> {
+            let mut buf = xs.to_vec();
+            let out = &mut buf[..];
+            let sum = crate::dispatch_avx2!(fn(out: &mut [f64], c: f64) -> f64 {
+                let mut sum = 0.0;
+                for x in out.iter_mut() {
+                    *x = *x * c + 1.0 / c;
+                    sum += *x;
+                }
+                sum
+            });
+            buf.push(sum);
+            buf
+        };
+        let got = scaled(&xs, 3.3);
+        let mut want: Vec<f64> = xs.iter().map(|x| x * 3.3 + 1.0 / 3.3).collect();
+        want.push(want.iter().fold(0.0, |s, x| s + x));
+        assert_eq!(got, want);
     }
 
     #[test]

@@ -407,11 +407,13 @@ impl<T: Real> ElementState<T> {
             m[3 + x][3 + x] = T::splat(G[1][1]);
         }
         // rotation shape parts with each other: sum_kl G_kl A_k^T A_l, k, l in {2, 3}
+        // (jb is zero at the rotations 2 and 5: those products are skipped)
         let rot = [2, 5];
+        let trans = [0, 1, 3, 4];
         let gamma = dot(p[0], p[0]) * G[2][2] + dot(p[0], p[1]) * (2.0 * G[2][3]) + dot(p[1], p[1]) * G[3][3];
         let cr = [qp2 * G[2][2] + qp3 * G[2][3], qp2 * G[3][2] + qp3 * G[3][3]];
-        for i in 0..6 {
-            for j in 0..6 {
+        for i in trans {
+            for j in trans {
                 m[i][j] += gamma * jb[i] * jb[j];
             }
         }
@@ -419,7 +421,7 @@ impl<T: Real> ElementState<T> {
             for l in 0..2 {
                 m[rot[k]][rot[l]] += qq * G[2 + k][2 + l];
             }
-            for j in 0..6 {
+            for j in trans {
                 m[rot[k]][j] += cr[k] * jb[j];
                 m[j][rot[k]] += cr[k] * jb[j];
             }
@@ -430,11 +432,11 @@ impl<T: Real> ElementState<T> {
             for x in 0..2 {
                 let u = p[0][x] * g2 + p[1][x] * g3;
                 let mut r = [T::splat(0.0); 6];
-                for j in 0..6 {
+                for j in trans {
                     r[j] = u * jb[j];
                 }
-                r[2] += q[x] * g2;
-                r[5] += q[x] * g3;
+                r[2] = q[x] * g2;
+                r[5] = q[x] * g3;
                 for j in 0..6 {
                     m[base + x][j] += r[j];
                     m[j][base + x] += r[j];

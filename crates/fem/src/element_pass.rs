@@ -110,14 +110,42 @@ fn energies_batched(elements: &[Element], q: &[f64], v: &[f64], sec: Section) ->
 }
 
 /// Element DOFs `[xa, ya, phia, xb, yb, phib]` of the `T::LANES` elements from `start`, one per
-/// lane, from the global vector `x`.
+/// lane, from the global vector `x` (one bounds check per node).
 #[inline(always)]
 fn gather<T: Real>(elements: &[Element], start: usize, x: &[f64]) -> [T; 6] {
+    let mut rows = [[0.0; 6]; LANES];
+    for k in 0..T::LANES {
+        let [a, b] = elements[start + k].nodes;
+        let (xa, xb) = (node_dofs(x, a), node_dofs(x, b));
+        rows[k] = [xa[0], xa[1], xa[2], xb[0], xb[1], xb[2]];
+    }
     let mut out = [T::splat(0.0); 6];
     for c in 0..6 {
-        out[c] = T::from_lanes(|k| x[3 * elements[start + k].nodes[c / 3] + c % 3]);
+        out[c] = T::from_lanes(|k| rows[k][c]);
     }
     out
+}
+
+/// `[x, y, phi]` of node `j` in the global vector `x`.
+#[inline(always)]
+fn node_dofs(x: &[f64], j: usize) -> &[f64; 3] {
+    x[3 * j..3 * j + 3].try_into().expect("three DOFs per node")
+}
+
+/// Add `f` (element DOFs, one element per lane) to the global vector `res`, lane after lane.
+#[inline(always)]
+fn scatter_add<T: Real>(elements: &[Element], start: usize, f: &[T; 6], res: &mut [f64]) {
+    for k in 0..T::LANES {
+        let [a, b] = elements[start + k].nodes;
+        for (node, off) in [(a, 0), (b, 3)] {
+            let r: &mut [f64; 3] = (&mut res[3 * node..3 * node + 3])
+                .try_into()
+                .expect("three DOFs per node");
+            for c in 0..3 {
+                r[c] += f[off + c].lane(k);
+            }
+        }
+    }
 }
 
 /// States of the `T::LANES` elements from `start` at the global coordinates `q`.
@@ -132,6 +160,11 @@ fn states<T: Real>(elements: &[Element], start: usize, q: &[f64]) -> ElementStat
     )
 }
 
+/// One batch of [`add_forces`]. The `std::hint::black_box` calls keep each lane result in memory
+/// as four consecutive doubles: that is where the compiler's straight-line vectoriser starts
+/// from. Without them the lanes' results meet only scalar scatters and most of the arithmetic
+/// stays scalar (callgrind, 300 elements: 1800 instructions per four-element batch without the
+/// matrix, 1190 with them; 2900 and 2370 with it). They change no value.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn add_forces_of<T: Real>(
@@ -152,16 +185,25 @@ fn add_forces_of<T: Real>(
         }
     }
     let (ve, ae) = (gather(elements, start, nodes.v), gather(elements, start, nodes.qdd));
-    let fm = st.inertia_force(sec.rho, &ve, &ae);
+    let fm = std::hint::black_box(st.inertia_force(sec.rho, &ve, &ae));
     let fi = match vals {
         Some(vals) => {
             let (fi, kt) = st.internal(sec.ea, sec.ei);
-            let m = st.mass(sec.rho);
+            let m = std::hint::black_box(st.mass(sec.rho));
+            let mut mk = m;
+            for a in 0..6 {
+                for b in 0..6 {
+                    mk[a][b] = m[a][b] + kt[a][b] * ck;
+                }
+            }
+            let mk = std::hint::black_box(mk);
             for k in 0..T::LANES {
-                let slot = &mut vals[36 * (start + k)..36 * (start + k) + 36];
+                let slot: &mut [f64; 36] = (&mut vals[36 * (start + k)..36 * (start + k) + 36])
+                    .try_into()
+                    .expect("36 values per element");
                 for a in 0..6 {
                     for b in 0..6 {
-                        slot[6 * a + b] = (m[a][b] + kt[a][b] * ck).lane(k);
+                        slot[6 * a + b] = mk[a][b].lane(k);
                     }
                 }
             }
@@ -173,13 +215,8 @@ fn add_forces_of<T: Real>(
     for a in 0..6 {
         f[a] = (fm[a] + fi[a]) * cf;
     }
-    for k in 0..T::LANES {
-        let [na, nb] = elements[start + k].nodes;
-        for a in 0..6 {
-            let node = if a < 3 { na } else { nb };
-            res[3 * node + a % 3] += f[a].lane(k);
-        }
-    }
+    let f = std::hint::black_box(f);
+    scatter_add(elements, start, &f, res);
     Ok(())
 }
 
@@ -187,7 +224,7 @@ fn add_forces_of<T: Real>(
 fn energies_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], sec: Section, sums: &mut (f64, f64)) {
     let st: ElementState<T> = states(elements, start, q);
     let ke = st.kinetic_energy(sec.rho, &gather(elements, start, v));
-    let se = st.strain_energy(sec.ea, sec.ei);
+    let [ke, se] = std::hint::black_box([ke, st.strain_energy(sec.ea, sec.ei)]);
     for k in 0..T::LANES {
         sums.0 += ke.lane(k);
         sums.1 += se.lane(k);

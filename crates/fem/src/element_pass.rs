@@ -43,19 +43,11 @@ pub(crate) struct BadChord {
 /// Elements per batch.
 const LANES: usize = 4;
 
-/// Add `cf (M(q) qdd + f_conv(q, v) + f_int(q))` of every element to `res` (global DOFs, in
-/// element order) and, with `vals`, write each element's `M + ck K` (36 values, row-major, element
-/// after element: the slot layout of `crate::star`).
-pub(crate) fn add_forces(
-    elements: &[Element],
-    nodes: NodeState,
-    sec: Section,
-    cf: f64,
-    ck: f64,
-    res: &mut [f64],
-    vals: Option<&mut [f64]>,
-) -> Result<(), BadChord> {
-    flexstar_numerics::dispatch_avx2!(fn(
+flexstar_numerics::dispatch_avx2! {
+    /// Add `cf (M(q) qdd + f_conv(q, v) + f_int(q))` of every element to `res` (global DOFs, in
+    /// element order) and, with `vals`, write each element's `M + ck K` (36 values, row-major,
+    /// element after element: the slot layout of `crate::star`).
+    pub(crate) fn add_forces(
         elements: &[Element],
         nodes: NodeState,
         sec: Section,
@@ -64,49 +56,32 @@ pub(crate) fn add_forces(
         res: &mut [f64],
         vals: Option<&mut [f64]>,
     ) -> Result<(), BadChord> {
-        add_forces_batched(elements, nodes, sec, cf, ck, res, vals)
-    })
+        let mut vals = vals;
+        let full = elements.len() / LANES * LANES;
+        for start in (0..full).step_by(LANES) {
+            add_forces_of::<F64x4>(elements, start, nodes, sec, cf, ck, res, vals.as_deref_mut())?;
+        }
+        for start in full..elements.len() {
+            add_forces_of::<f64>(elements, start, nodes, sec, cf, ck, res, vals.as_deref_mut())?;
+        }
+        Ok(())
+    }
 }
 
-/// Kinetic and strain energy of all elements [J] (sums in element order):
-/// [`ElementState::kinetic_energy`], [`ElementState::strain_energy`].
-pub(crate) fn energies(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
-    flexstar_numerics::dispatch_avx2!(fn(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
-        energies_batched(elements, q, v, sec)
-    })
-}
-
-#[inline(always)]
-fn add_forces_batched(
-    elements: &[Element],
-    nodes: NodeState,
-    sec: Section,
-    cf: f64,
-    ck: f64,
-    res: &mut [f64],
-    mut vals: Option<&mut [f64]>,
-) -> Result<(), BadChord> {
-    let full = elements.len() / LANES * LANES;
-    for start in (0..full).step_by(LANES) {
-        add_forces_of::<F64x4>(elements, start, nodes, sec, cf, ck, res, vals.as_deref_mut())?;
+flexstar_numerics::dispatch_avx2! {
+    /// Kinetic and strain energy of all elements [J] (sums in element order):
+    /// [`ElementState::kinetic_energy`], [`ElementState::strain_energy`].
+    pub(crate) fn energies(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
+        let full = elements.len() / LANES * LANES;
+        let mut sums = (0.0, 0.0);
+        for start in (0..full).step_by(LANES) {
+            energies_of::<F64x4>(elements, start, q, v, sec, &mut sums);
+        }
+        for start in full..elements.len() {
+            energies_of::<f64>(elements, start, q, v, sec, &mut sums);
+        }
+        sums
     }
-    for start in full..elements.len() {
-        add_forces_of::<f64>(elements, start, nodes, sec, cf, ck, res, vals.as_deref_mut())?;
-    }
-    Ok(())
-}
-
-#[inline(always)]
-fn energies_batched(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
-    let full = elements.len() / LANES * LANES;
-    let mut sums = (0.0, 0.0);
-    for start in (0..full).step_by(LANES) {
-        energies_of::<F64x4>(elements, start, q, v, sec, &mut sums);
-    }
-    for start in full..elements.len() {
-        energies_of::<f64>(elements, start, q, v, sec, &mut sums);
-    }
-    sums
 }
 
 /// Element DOFs `[xa, ya, phia, xb, yb, phib]` of the `T::LANES` elements from `start`, one per
@@ -320,10 +295,6 @@ mod tests {
         let mut r3 = vec![0.0; q.len()];
         add_forces(&elements, nodes, sec, cf, ck, &mut r3, None).unwrap();
         assert_eq!(r1, r3);
-        // and the portable copy (baseline x86-64, or what other processors run) too
-        let mut r4 = vec![0.0; q.len()];
-        add_forces_batched(&elements, nodes, sec, cf, ck, &mut r4, None).unwrap();
-        assert_eq!(r1, r4);
         // energies against the element-by-element sums
         let (mut t, mut u) = (0.0, 0.0);
         for el in &elements {
@@ -336,7 +307,6 @@ mod tests {
             u += st.strain_energy(sec.ea, sec.ei);
         }
         assert_eq!(energies(&elements, &q, &v, sec), (t, u));
-        assert_eq!(energies_batched(&elements, &q, &v, sec), (t, u));
         assert!(t > 0.0 && u > 0.0);
     }
 

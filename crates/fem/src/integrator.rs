@@ -506,22 +506,11 @@ fn update_coordinates(ws: &mut Workspace, inv_bp: f64, gp: f64) -> f64 {
     dq_max
 }
 
-/// One generalized-alpha step from `st` (at `t1 - h`) to `t1`; `st` holds the new state on
-/// return. Compiled for AVX2 and for the baseline, chosen at run time (the vector loops of the
-/// predictor and the Newton updates; the solver's parts dispatch on their own).
-#[allow(clippy::too_many_arguments)]
-fn step(
-    params: &RobotParams,
-    motion: &Motion,
-    star: &mut Star,
-    ga: &GenAlpha,
-    st: &mut State,
-    ws: &mut Workspace,
-    stats: &mut Stats,
-    t1: f64,
-    h: f64,
-) -> Result<(), FemError> {
-    flexstar_numerics::dispatch_avx2!(fn(
+flexstar_numerics::dispatch_avx2! {
+    /// One generalized-alpha step from `st` (at `t1 - h`) to `t1`; `st` holds the new state on
+    /// return. Compiled for AVX2 and for the baseline, chosen at run time (the vector loops of the
+    /// predictor and the Newton updates; the solver's parts dispatch on their own).
+    fn step(
         params: &RobotParams,
         motion: &Motion,
         star: &mut Star,
@@ -532,125 +521,109 @@ fn step(
         t1: f64,
         h: f64,
     ) -> Result<(), FemError> {
-        step_inline(params, motion, star, ga, st, ws, stats, t1, h)
-    })
-}
-
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn step_inline(
-    params: &RobotParams,
-    motion: &Motion,
-    star: &mut Star,
-    ga: &GenAlpha,
-    st: &mut State,
-    ws: &mut Workspace,
-    stats: &mut Stats,
-    t1: f64,
-    h: f64,
-) -> Result<(), FemError> {
-    let (n_dof, n_sys) = (star.n_dof, star.n_sys);
-    let l = params.l;
-    let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
-    let fixed = motion.prescribed_pins(params, t1)?;
-    // predictor: constant acceleration, previous multipliers
-    predict(ga, h, bp, gp, st, ws);
-    for k in 0..ws.nu.len() {
-        ws.nu[k] = bp * st.lam[k];
-    }
-    let inv_bp = 1.0 / bp;
-    let mut converged = false;
-    let mut last = (0.0, 0.0);
-    let mut last_err = f64::INFINITY;
-    // a fresh matrix at the first iteration of every step (see RATE_REFACTOR)
-    let mut stale = true;
-    for it in 0..MAX_ITER {
-        // the pins: prescribed, or following the iterate's sliders (direct problem)
-        let (pins, sliders) = match fixed {
-            Some(p) => (p, None),
-            None => {
-                let p = star.pins_of(&ws.q1, &ws.v1, &ws.qdd1);
-                (p, motion.slider_rows(params, &p, t1, bp, gp)?)
-            }
-        };
-        let fresh = star.assemble(
-            &ws.q1,
-            &ws.v1,
-            &ws.qdd1,
-            &ws.nu,
-            &pins,
-            sliders.as_ref(),
-            bp,
-            bp,
-            &mut ws.res,
-            t1,
-            stale,
-        )?;
-        if fresh {
-            star.factor(t1)?;
-            stats.factorisations += 1;
-            stale = false;
-        }
-        stats.newton_iterations += 1;
-        for k in 0..n_sys {
-            ws.dx[k] = -ws.res[k];
-        }
-        star.solve(&mut ws.dx);
-        let dq_max = update_coordinates(ws, inv_bp, gp);
-        let mut dl_max = 0.0f64;
-        let mut l_max = 0.0f64;
+        let (n_dof, n_sys) = (star.n_dof, star.n_sys);
+        let l = params.l;
+        let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
+        let fixed = motion.prescribed_pins(params, t1)?;
+        // predictor: constant acceleration, previous multipliers
+        predict(ga, h, bp, gp, st, ws);
         for k in 0..ws.nu.len() {
-            ws.nu[k] += ws.dx[n_dof + k];
-            dl_max = dl_max.max(ws.dx[n_dof + k].abs() / bp);
-            l_max = l_max.max(ws.nu[k].abs() / bp);
+            ws.nu[k] = bp * st.lam[k];
         }
-        if !(dq_max.is_finite() && dl_max.is_finite()) {
+        let inv_bp = 1.0 / bp;
+        let mut converged = false;
+        let mut last = (0.0, 0.0);
+        let mut last_err = f64::INFINITY;
+        // a fresh matrix at the first iteration of every step (see RATE_REFACTOR)
+        let mut stale = true;
+        for it in 0..MAX_ITER {
+            // the pins: prescribed, or following the iterate's sliders (direct problem)
+            let (pins, sliders) = match fixed {
+                Some(p) => (p, None),
+                None => {
+                    let p = star.pins_of(&ws.q1, &ws.v1, &ws.qdd1);
+                    (p, motion.slider_rows(params, &p, t1, bp, gp)?)
+                }
+            };
+            let fresh = star.assemble(
+                &ws.q1,
+                &ws.v1,
+                &ws.qdd1,
+                &ws.nu,
+                &pins,
+                sliders.as_ref(),
+                bp,
+                bp,
+                &mut ws.res,
+                t1,
+                stale,
+            )?;
+            if fresh {
+                star.factor(t1)?;
+                stats.factorisations += 1;
+                stale = false;
+            }
+            stats.newton_iterations += 1;
+            for k in 0..n_sys {
+                ws.dx[k] = -ws.res[k];
+            }
+            star.solve(&mut ws.dx);
+            let dq_max = update_coordinates(ws, inv_bp, gp);
+            let mut dl_max = 0.0f64;
+            let mut l_max = 0.0f64;
+            for k in 0..ws.nu.len() {
+                ws.nu[k] += ws.dx[n_dof + k];
+                dl_max = dl_max.max(ws.dx[n_dof + k].abs() / bp);
+                l_max = l_max.max(ws.nu[k].abs() / bp);
+            }
+            if !(dq_max.is_finite() && dl_max.is_finite()) {
+                return Err(FemError::Newton {
+                    t: t1,
+                    h,
+                    reason: "non-finite Newton increment".into(),
+                });
+            }
+            // converged: positions to 1e-11 L, multipliers to 1e-6 (1 + |lambda|) N, or, once
+            // the positions are converged, multipliers that stopped decreasing at a small
+            // level (round-off floor of very stiff runs)
+            // (a stall counts only with a fresh matrix: a reused one contracts more slowly)
+            let stalled = fresh && it > 0 && dl_max >= 0.5 * last.1 && dl_max <= 1e-4 * (1.0 + l_max);
+            last = (dq_max, dl_max);
+            // guard of the reused factorisation: increments against the tolerances
+            let err = (dq_max / (1e-11 * l)).max(dl_max / (1e-6 * (1.0 + l_max)));
+            if err > RATE_REFACTOR * last_err {
+                stale = true;
+            }
+            last_err = err;
+            if dq_max <= 1e-11 * l && (dl_max <= 1e-6 * (1.0 + l_max) || stalled) {
+                converged = true;
+                break;
+            }
+        }
+        if !converged {
             return Err(FemError::Newton {
                 t: t1,
                 h,
-                reason: "non-finite Newton increment".into(),
+                reason: format!(
+                    "no convergence in {MAX_ITER} iterations (last increments: {:.3e} m, {:.3e} N)",
+                    last.0, last.1
+                ),
             });
         }
-        // converged: positions to 1e-11 L, multipliers to 1e-6 (1 + |lambda|) N, or, once
-        // the positions are converged, multipliers that stopped decreasing at a small
-        // level (round-off floor of very stiff runs)
-        // (a stall counts only with a fresh matrix: a reused one contracts more slowly)
-        let stalled = fresh && it > 0 && dl_max >= 0.5 * last.1 && dl_max <= 1e-4 * (1.0 + l_max);
-        last = (dq_max, dl_max);
-        // guard of the reused factorisation: increments against the tolerances
-        let err = (dq_max / (1e-11 * l)).max(dl_max / (1e-6 * (1.0 + l_max)));
-        if err > RATE_REFACTOR * last_err {
-            stale = true;
+        let apq = ga.a_per_qdd();
+        for j in 0..n_dof {
+            st.a[j] = ws.a_part[j] + apq * ws.qdd1[j];
         }
-        last_err = err;
-        if dq_max <= 1e-11 * l && (dl_max <= 1e-6 * (1.0 + l_max) || stalled) {
-            converged = true;
-            break;
+        st.pins = fixed.unwrap_or_else(|| star.pins_of(&ws.q1, &ws.v1, &ws.qdd1));
+        std::mem::swap(&mut st.q, &mut ws.q1);
+        std::mem::swap(&mut st.v, &mut ws.v1);
+        std::mem::swap(&mut st.qdd, &mut ws.qdd1);
+        for k in 0..ws.nu.len() {
+            st.lam[k] = ws.nu[k] / bp;
         }
+        stats.steps += 1;
+        Ok(())
     }
-    if !converged {
-        return Err(FemError::Newton {
-            t: t1,
-            h,
-            reason: format!(
-                "no convergence in {MAX_ITER} iterations (last increments: {:.3e} m, {:.3e} N)",
-                last.0, last.1
-            ),
-        });
-    }
-    let apq = ga.a_per_qdd();
-    for j in 0..n_dof {
-        st.a[j] = ws.a_part[j] + apq * ws.qdd1[j];
-    }
-    st.pins = fixed.unwrap_or_else(|| star.pins_of(&ws.q1, &ws.v1, &ws.qdd1));
-    std::mem::swap(&mut st.q, &mut ws.q1);
-    std::mem::swap(&mut st.v, &mut ws.v1);
-    std::mem::swap(&mut st.qdd, &mut ws.qdd1);
-    for k in 0..ws.nu.len() {
-        st.lam[k] = ws.nu[k] / bp;
-    }
-    stats.steps += 1;
-    Ok(())
 }
 
 /// Integrate from the initial state to the last output time.

@@ -298,13 +298,25 @@ pub fn has_avx2() -> bool {
 }
 
 /// Run a function body compiled twice, for AVX2 and for the baseline of the build, choosing at
-/// run time ([`has_avx2`]): `dispatch_avx2!(fn(a: &mut [f64], x: f64) -> f64 { body })` defines
-/// both copies with the arguments given and calls one with the variables of the same names. The
-/// body's callees are compiled for AVX2 only where they are inlined into it (`#[inline(always)]`).
-/// The two copies compute the same operations (no fused multiply-add is enabled, the compiler
-/// does not reassociate), so their results are identical; only their instructions differ.
+/// run time ([`has_avx2`]). Two forms:
+/// - a function item, `dispatch_avx2! { /// docs\n pub fn name(a: &mut [f64], x: f64) -> f64 { body } }`,
+///   which defines `name` with both copies of its body inside;
+/// - an expression, `dispatch_avx2!(fn(a: &mut [f64], x: f64) -> f64 { body })`, which defines
+///   both copies with the arguments given and calls one with the variables of the same names.
+///
+/// The body's callees are compiled for AVX2 only where they are inlined into it
+/// (`#[inline(always)]`). The two copies compute the same operations (no fused multiply-add is
+/// enabled, the compiler does not reassociate), so their results are identical; only their
+/// instructions differ.
 #[macro_export]
 macro_rules! dispatch_avx2 {
+    ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident : $ty:ty),* $(,)?) -> $ret:ty $body:block) => {
+        $(#[$meta])*
+        #[allow(clippy::too_many_arguments)]
+        $vis fn $name($($arg: $ty),*) -> $ret {
+            $crate::dispatch_avx2!(fn($($arg: $ty),*) -> $ret $body)
+        }
+    };
     (fn($($arg:ident : $ty:ty),* $(,)?) -> $ret:ty $body:block) => {{
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx2")]

@@ -564,8 +564,8 @@ flexstar_numerics::dispatch_avx2! {
                 stale = false;
             }
             stats.newton_iterations += 1;
-            for k in 0..n_sys {
-                ws.dx[k] = -ws.res[k];
+            for (d, r) in ws.dx[..n_sys].iter_mut().zip(&ws.res[..n_sys]) {
+                *d = -r;
             }
             star.solve(&mut ws.dx);
             let dq_max = update_coordinates(ws, inv_bp, gp);
@@ -611,8 +611,8 @@ flexstar_numerics::dispatch_avx2! {
             });
         }
         let apq = ga.a_per_qdd();
-        for j in 0..n_dof {
-            st.a[j] = ws.a_part[j] + apq * ws.qdd1[j];
+        for ((a, ap), qdd) in st.a[..n_dof].iter_mut().zip(&ws.a_part[..n_dof]).zip(&ws.qdd1[..n_dof]) {
+            *a = ap + apq * qdd;
         }
         st.pins = fixed.unwrap_or_else(|| star.pins_of(&ws.q1, &ws.v1, &ws.qdd1));
         std::mem::swap(&mut st.q, &mut ws.q1);

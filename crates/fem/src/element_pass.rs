@@ -84,17 +84,37 @@ flexstar_numerics::dispatch_avx2! {
     }
 }
 
+/// First node of the `T::LANES` elements from `start` if they form a chain `n0, n0 + 1, ...`
+/// (consecutive elements of one beam: every batch but the one holding a beam's first element,
+/// whose first node is G), whose nodes' DOFs are then one contiguous run of the global vectors.
+#[inline(always)]
+fn chain<T: Real>(elements: &[Element], start: usize) -> Option<usize> {
+    let n0 = elements[start].nodes[0];
+    (0..T::LANES)
+        .all(|k| elements[start + k].nodes == [n0 + k, n0 + k + 1])
+        .then_some(n0)
+}
+
 /// Element DOFs `[xa, ya, phia, xb, yb, phib]` of the `T::LANES` elements from `start`, one per
-/// lane, from the global vector `x` (one bounds check per node).
+/// lane, from the global vector `x`: one contiguous run for a chain, else one bounds check per
+/// node.
 #[inline(always)]
 fn gather<T: Real>(elements: &[Element], start: usize, x: &[f64]) -> [T; 6] {
+    let mut out = [T::splat(0.0); 6];
+    if let Some(n0) = chain::<T>(elements, start) {
+        let run = &x[3 * n0..3 * (n0 + T::LANES + 1)];
+        for c in 0..3 {
+            out[c] = T::from_lanes(|k| run[3 * k + c]);
+            out[3 + c] = T::from_lanes(|k| run[3 * (k + 1) + c]);
+        }
+        return out;
+    }
     let mut rows = [[0.0; 6]; LANES];
     for k in 0..T::LANES {
         let [a, b] = elements[start + k].nodes;
         let (xa, xb) = (node_dofs(x, a), node_dofs(x, b));
         rows[k] = [xa[0], xa[1], xa[2], xb[0], xb[1], xb[2]];
     }
-    let mut out = [T::splat(0.0); 6];
     for c in 0..6 {
         out[c] = T::from_lanes(|k| rows[k][c]);
     }
@@ -107,9 +127,19 @@ fn node_dofs(x: &[f64], j: usize) -> &[f64; 3] {
     x[3 * j..3 * j + 3].try_into().expect("three DOFs per node")
 }
 
-/// Add `f` (element DOFs, one element per lane) to the global vector `res`, lane after lane.
+/// Add `f` (element DOFs, one element per lane) to the global vector `res`, lane after lane
+/// (node a, then node b: the order of the element-by-element loop).
 #[inline(always)]
 fn scatter_add<T: Real>(elements: &[Element], start: usize, f: &[T; 6], res: &mut [f64]) {
+    if let Some(n0) = chain::<T>(elements, start) {
+        let run = &mut res[3 * n0..3 * (n0 + T::LANES + 1)];
+        for k in 0..T::LANES {
+            for a in 0..6 {
+                run[3 * k + a] += f[a].lane(k);
+            }
+        }
+        return;
+    }
     for k in 0..T::LANES {
         let [a, b] = elements[start + k].nodes;
         for (node, off) in [(a, 0), (b, 3)] {

@@ -197,16 +197,9 @@ fn pivot_ok<T: Real>(d: T) -> T::Mask {
 
 /// `x <- L^{-1} x` on rows `from..x.len()` (padded storage) for `C` columns at once:
 /// `x[j] <- (x[j] - sum_{t<HB} L[j][j-HB+t] x[j-HB+t]) L[j][j]^{-1}`, the terms subtracted in the
-/// order t = 0..HB (the newest row last). The rows before `from` must be final (or zero); `done`
-/// sees each finished row.
+/// order t = 0..HB (the newest row last). The rows before `from` must be final (or zero).
 #[inline(always)]
-fn forward_rows<T: Real, const C: usize>(
-    band: &[[T; HB + 1]],
-    dinv: &[T],
-    x: &mut [[T; C]],
-    from: usize,
-    mut done: impl FnMut(&[T; C]),
-) {
+fn forward_rows<T: Real, const C: usize>(band: &[[T; HB + 1]], dinv: &[T], x: &mut [[T; C]], from: usize) {
     let (band, dinv) = (&band[..x.len()], &dinv[..x.len()]);
     for j in from..x.len() {
         let prev: &[[T; C]; HB] = x[j - HB..j].try_into().expect("HB rows before row j");
@@ -221,8 +214,24 @@ fn forward_rows<T: Real, const C: usize>(
             *v *= dinv[j];
         }
         x[j] = row;
-        done(&row);
     }
+}
+
+/// Upper triangle of `X^T X` (packed, see [`tri`]) of the rows `x` of `ROWS` columns, each entry
+/// summed over the rows in order.
+#[inline(always)]
+fn gram_upper<T: Real>(x: &[[T; ROWS]]) -> [T; TRI] {
+    let mut acc = [T::splat(0.0); TRI];
+    for row in x {
+        let mut k = 0;
+        for a in 0..ROWS {
+            for b in a..ROWS {
+                acc[k] += row[a] * row[b];
+                k += 1;
+            }
+        }
+    }
+    acc
 }
 
 /// `y <- L^{-T} y` on rows `HB..y.len() - HB` (padded storage, the `HB` rows after are zero):
@@ -443,16 +452,8 @@ impl Bordered {
             }
         }
         // W = L^{-1} E, multiplier columns: rows from..n, and the upper triangle of W^T W
-        let mut acc = [F64x4::splat(0.0); TRI];
-        forward_rows(&self.band, &self.dinv, w, from + HB, |row| {
-            let mut k = 0;
-            for a in 0..ROWS {
-                for b in a..ROWS {
-                    acc[k] += row[a] * row[b];
-                    k += 1;
-                }
-            }
-        });
+        forward_rows(&self.band, &self.dinv, w, from + HB);
+        let acc = gram_upper(&w[from + HB..]);
         for i in 0..BEAMS {
             // G columns: E_G lives in the rows of node 1 (the last three), from element 0
             let blk0 = Self::element_block(vals, ne, i, 0);
@@ -556,7 +557,7 @@ impl Bordered {
         beam_rows(&mut y[HB..HB + n], &mut rhs[dofs.clone()], |yj, b| {
             *yj = [beam_lanes(0.0, |i| *b[i])]
         });
-        forward_rows(&self.band, &self.dinv, &mut y[..n + HB], HB, |_| {});
+        forward_rows(&self.band, &self.dinv, &mut y[..n + HB], HB);
         let rows = self.w_from + HB..n + HB;
         let mut acc = [F64x4::splat(0.0); ROWS];
         for (wj, yj) in self.w[rows.clone()].iter().zip(&y[rows.clone()]) {
@@ -704,10 +705,8 @@ mod tests {
         let mut x: Vec<[F64x4; 3]> = (0..n + HB)
             .map(|j| std::array::from_fn(|a| beam_lanes(0.0, |i| rhs(i, j, a))))
             .collect();
-        forward_rows(&band, &dinv, &mut y[..n + HB], HB, |_| {});
-        let mut seen = 0;
-        forward_rows(&band, &dinv, &mut x, HB + 7, |_| seen += 1);
-        assert_eq!(seen, n - 7);
+        forward_rows(&band, &dinv, &mut y[..n + HB], HB);
+        forward_rows(&band, &dinv, &mut x, HB + 7);
         let mut back = y.clone();
         backward_rows(&band, &dinv, &mut back);
         for (i, mut sb) in scalar.into_iter().enumerate() {
@@ -721,10 +720,10 @@ mod tests {
                 bits(&sd.iter().map(|d| [*d]).collect::<Vec<_>>())
             );
             let mut sy: Vec<[f64; 1]> = (0..n + 2 * HB).map(|j| [rhs(i, j, 0)]).collect();
-            forward_rows(&sb, &sd, &mut sy[..n + HB], HB, |_| {});
+            forward_rows(&sb, &sd, &mut sy[..n + HB], HB);
             assert_eq!(lane_bits(&y, i), bits(&sy), "forward of beam {i}");
             let mut sx: Vec<[f64; 3]> = (0..n + HB).map(|j| std::array::from_fn(|a| rhs(i, j, a))).collect();
-            forward_rows(&sb, &sd, &mut sx, HB + 7, |_| {});
+            forward_rows(&sb, &sd, &mut sx, HB + 7);
             assert_eq!(lane_bits(&x, i), bits(&sx), "3-column forward of beam {i}");
             backward_rows(&sb, &sd, &mut sy);
             assert_eq!(lane_bits(&back, i), bits(&sy), "backward of beam {i}");

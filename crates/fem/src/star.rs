@@ -418,15 +418,19 @@ impl Star {
                     self.vals[self.off_psi + 4 * i + 1 + p] = 0.0;
                 }
             }
+            // per contact point: the element holding it, its local coordinate and the element's
+            // state (recomputed: cheaper than storing every element's state, which at 3000
+            // elements leaves the cache)
+            let points: [(usize, f64, ElementState); 3] = [0, 1, 2].map(|p| {
+                let (e, z) = self.locate(q[self.xi(i, p)]);
+                let el = &self.elements[i * self.ne + e];
+                (e, z, ElementState::new(el, &self.element_q(el, q)))
+            });
             for r in 0..ROWS {
                 let p = ROW_POINT[r];
                 let xi_idx = self.xi(i, p);
-                let (e, z) = self.locate(q[xi_idx]);
+                let (e, z, st) = points[p];
                 let ge = i * self.ne + e;
-                // the state of the element holding the contact point (recomputed: cheaper than
-                // storing every element's state, which at 3000 elements leaves the cache)
-                let el = &self.elements[ge];
-                let st = ElementState::new(el, &self.element_q(el, q));
                 let na = self.node(i, e);
                 let (phi, grad, gxi, gpsi) = self.row_terms(&st, [q[3 * na], q[3 * na + 1]], i, q[ps], pins.p[i], r, z);
                 let row = self.n_dof + ROWS * i + r;
@@ -466,7 +470,9 @@ impl Star {
                 ))
             }
         }
-        if let Some(k) = res.iter().position(|r| !r.is_finite()) {
+        // one pass without early exit (vectorised), the position only when there is one
+        let any_bad = res.iter().fold(false, |bad, r| bad | !r.is_finite());
+        if let Some(k) = any_bad.then(|| res.iter().position(|r| !r.is_finite())).flatten() {
             return Err(FemError::NonFinite {
                 t,
                 element: if k < 3 * self.n_nodes {

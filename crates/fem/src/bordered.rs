@@ -189,10 +189,16 @@ fn cholesky_row<T: Real>(band: &mut [[T; HB + 1]], dinv: &mut [T], j: usize) -> 
     d
 }
 
-/// Whether a Cholesky pivot is usable: positive and finite (in every lane).
+/// Whether a Cholesky pivot is usable: positive and finite.
 #[inline(always)]
-fn pivot_ok<T: Real>(d: T) -> T::Mask {
-    d.gt(T::splat(0.0)) & d.lt(T::splat(f64::INFINITY))
+fn pivot_ok(d: f64) -> bool {
+    d > 0.0 && d < f64::INFINITY
+}
+
+/// Whether the pivots of all three beams are usable (lane by lane, without branches).
+#[inline(always)]
+fn beam_pivots_ok(d: F64x4) -> bool {
+    (0..BEAMS).fold(true, |ok, i| ok & pivot_ok(d.0[i]))
 }
 
 /// `x <- L^{-1} x` on rows `from..x.len()` (padded storage) for `C` columns at once:
@@ -231,7 +237,15 @@ fn gram_upper<T: Real>(x: &[[T; ROWS]]) -> [T; TRI] {
             }
         }
     }
-    acc
+    keep_lanes(acc)
+}
+
+/// `x`, all of its lanes kept: a caller that reads only the beams' lanes would otherwise let
+/// the compiler drop the idle lane and regroup the remaining scalar sums into badly packed
+/// vectors (a hint on the code only, the values are unchanged).
+#[inline(always)]
+fn keep_lanes<X>(x: X) -> X {
+    std::hint::black_box(x)
 }
 
 /// `y <- L^{-T} y` on rows `HB..y.len() - HB` (padded storage, the `HB` rows after are zero):
@@ -390,7 +404,7 @@ impl Bordered {
         let n = 3 * self.lay.ne;
         for j in HB..n + HB {
             let d = cholesky_row(&mut self.band, &mut self.dinv, j);
-            if !F64x4::all(pivot_ok(d)) {
+            if !beam_pivots_ok(d) {
                 let i = (0..BEAMS).find(|&i| !pivot_ok(d.0[i])).unwrap_or(BEAMS);
                 return Err(format!(
                     "beam {} block not positive definite at row {} (pivot {:e})",
@@ -489,45 +503,47 @@ impl Bordered {
         }
     }
 
-    /// LU with partial pivoting of the Schur complement, in place; the updates skip the zero
-    /// entries of the pivot row and column (the sleeve blocks stay uncoupled until G, last).
+    /// LU with partial pivoting of the Schur complement, in place (`P S = L U`, unit `L` below
+    /// the diagonal). Only the rows with a non-zero entry in the pivot column are updated (the
+    /// sleeve blocks stay uncoupled until G, last), densely over the pivot row (an update by a
+    /// zero entry of the pivot row changes nothing).
     #[inline(always)]
     fn lu_schur(&mut self) -> Result<(), String> {
         let ns = self.ns;
         let s = &mut self.s[..ns * ns];
         for k in 0..ns {
-            let mut p = k;
+            // pivot: the first largest |s[r][k]|, r >= k; and the rows r > k to update
+            let (mut p, mut big) = (k, s[k * ns + k].abs());
+            let (mut rows, mut nr) = ([0usize; NS_MAX], 0);
             for r in k + 1..ns {
-                if s[r * ns + k].abs() > s[p * ns + k].abs() {
-                    p = r;
+                let v = s[r * ns + k];
+                if v != 0.0 {
+                    rows[nr] = r;
+                    nr += 1;
+                    if v.abs() > big {
+                        (p, big) = (r, v.abs());
+                    }
                 }
             }
             self.perm[k] = p;
             if p != k {
-                for c in 0..ns {
-                    s.swap(k * ns + c, p * ns + c);
-                }
+                let (above, from_p) = s.split_at_mut(p * ns);
+                above[k * ns..(k + 1) * ns].swap_with_slice(&mut from_p[..ns]);
             }
             let d = s[k * ns + k];
             if d == 0.0 || !d.is_finite() {
                 return Err(format!("border Schur complement singular at pivot {k} ({d:e})"));
             }
-            let mut cols = [0usize; NS_MAX];
-            let mut nc = 0;
-            for c in k + 1..ns {
-                if s[k * ns + c] != 0.0 {
-                    cols[nc] = c;
-                    nc += 1;
-                }
-            }
             let (upper, lower) = s.split_at_mut((k + 1) * ns);
-            let pivot_row = &upper[k * ns..];
-            for row in lower.chunks_exact_mut(ns) {
+            let pivot_row = &upper[k * ns + k + 1..];
+            for &r in &rows[..nr] {
+                let row = &mut lower[(r - k - 1) * ns..(r - k) * ns];
+                // (row p now holds the old row k, which may be zero in column k)
                 if row[k] != 0.0 {
                     let f = row[k] / d;
                     row[k] = f;
-                    for &c in &cols[..nc] {
-                        row[c] -= f * pivot_row[c];
+                    for (x, u) in row[k + 1..].iter_mut().zip(pivot_row) {
+                        *x -= f * u;
                     }
                 }
             }
@@ -565,6 +581,7 @@ impl Bordered {
                 acc[a] += wj[a] * yj[0];
             }
         }
+        let acc = keep_lanes(acc);
         for i in 0..BEAMS {
             for a in 0..ROWS {
                 xs[border_nu(i, a)] -= acc[a].0[i];
@@ -611,19 +628,14 @@ fn border_solve(s: &[f64], perm: &[usize], xs: &mut [f64]) {
     for (k, &p) in perm.iter().enumerate() {
         xs.swap(k, p);
     }
-    for k in 0..ns {
-        let mut v = xs[k];
-        for c in 0..k {
-            v -= s[k * ns + c] * xs[c];
-        }
-        xs[k] = v;
+    for (k, row) in s.chunks_exact(ns).enumerate() {
+        let (done, rest) = xs.split_at_mut(k);
+        rest[0] = row[..k].iter().zip(&*done).fold(rest[0], |v, (l, x)| v - l * x);
     }
-    for k in (0..ns).rev() {
-        let mut v = xs[k];
-        for c in k + 1..ns {
-            v -= s[k * ns + c] * xs[c];
-        }
-        xs[k] = v / s[k * ns + k];
+    for (k, row) in s.chunks_exact(ns).enumerate().rev() {
+        let (todo, done) = xs.split_at_mut(k + 1);
+        let v = row[k + 1..].iter().zip(&*done).fold(todo[k], |v, (u, x)| v - u * x);
+        todo[k] = v / row[k];
     }
 }
 
@@ -691,7 +703,7 @@ mod tests {
         let mut band = interleave(&scalar, idle);
         let mut dinv = vec![F64x4::splat(0.0); n + 2 * HB];
         for j in HB..n + HB {
-            assert!(F64x4::all(pivot_ok(cholesky_row(&mut band, &mut dinv, j))));
+            assert!(beam_pivots_ok(cholesky_row(&mut band, &mut dinv, j)));
         }
         // right-hand sides: one column for the substitutions, three for the multi-column forward
         let rhs = |i: usize, j: usize, a: usize| {

@@ -44,12 +44,13 @@ fn main() -> ExitCode {
     }
     let s = stats.expect("at least one run");
     println!(
-        "case {case}, {elements} elements: min of {runs} runs {best:.4} s, {} steps ({:.1} us/step), {} Newton iterations ({:.1} us/iteration), {} factorisations",
+        "case {case}, {elements} elements: min of {runs} runs {best:.4} s, {} steps ({:.1} us/step), {} Newton iterations ({:.1} us/iteration), {} factorisations, {} sparsity patterns",
         s.steps,
         1e6 * best / s.steps as f64,
         s.newton_iterations,
         1e6 * best / s.newton_iterations as f64,
-        s.factorisations
+        s.factorisations,
+        s.symbolic_factorisations
     );
     ExitCode::SUCCESS
 }

@@ -287,6 +287,22 @@ impl Star {
         if !rebuild {
             return Ok(false);
         }
+        if self.bordered.is_none() {
+            self.build_pattern();
+        } else {
+            // only the constraint rows' columns move with the windows: their slots are
+            // rewritten in place (same count), everything else stays
+            let con = self.constraint_slots();
+            self.slots[self.off_con..self.off_sl].copy_from_slice(&con);
+        }
+        self.lu = None;
+        self.symbolic_count += 1;
+        Ok(true)
+    }
+
+    /// The whole slot layout and the structured solver, at the first assembly: element blocks,
+    /// sleeve diagonals, constraint rows ([`Star::constraint_slots`]), slider rows.
+    fn build_pattern(&mut self) {
         let mut slots = Vec::new();
         for el in &self.elements {
             let d = dofs(el);
@@ -304,19 +320,7 @@ impl Star {
             }
         }
         self.off_con = slots.len();
-        for i in 0..3 {
-            for r in 0..ROWS {
-                let row = self.n_dof + ROWS * i + r;
-                let p = ROW_POINT[r];
-                let cols = self.window_cols(i, p);
-                for &c in &cols {
-                    slots.push((row, c));
-                }
-                for &c in &cols {
-                    slots.push((c, row));
-                }
-            }
-        }
+        slots.extend(self.constraint_slots());
         self.off_sl = slots.len();
         if self.direct {
             for i in 0..3 {
@@ -329,23 +333,33 @@ impl Star {
                 }
             }
         }
-        self.lu = None;
-        if self.bordered.is_none() {
-            self.bordered = Some(Bordered::new(Layout {
-                ne: self.ne,
-                n_nodes: self.n_nodes,
-                n_dof: self.n_dof,
-                off_psi: self.off_psi,
-                off_con: self.off_con,
-                ncol: self.ncol_c,
-                ww: self.ww,
-                off_sl: self.direct.then_some(self.off_sl),
-            }));
-        }
+        self.bordered = Some(Bordered::new(Layout {
+            ne: self.ne,
+            n_nodes: self.n_nodes,
+            n_dof: self.n_dof,
+            off_psi: self.off_psi,
+            off_con: self.off_con,
+            ncol: self.ncol_c,
+            ww: self.ww,
+            off_sl: self.direct.then_some(self.off_sl),
+        }));
         self.vals = vec![0.0; slots.len()];
         self.slots = slots;
-        self.symbolic_count += 1;
-        Ok(true)
+    }
+
+    /// Slots of the constraint rows in the current windows: per row its window columns
+    /// ([`Star::window_cols`]), then the transposed block.
+    fn constraint_slots(&self) -> Vec<(usize, usize)> {
+        let mut slots = Vec::with_capacity(3 * ROWS * 2 * self.ncol_c);
+        for i in 0..3 {
+            for r in 0..ROWS {
+                let row = self.n_dof + ROWS * i + r;
+                let cols = self.window_cols(i, ROW_POINT[r]);
+                slots.extend(cols.iter().map(|&c| (row, c)));
+                slots.extend(cols.iter().map(|&c| (c, row)));
+            }
+        }
+        slots
     }
 
     /// Columns of a constraint row of contact point p of sleeve i: the window's node DOFs, then

@@ -329,7 +329,9 @@ impl Bordered {
         let ns = self.ns;
         self.s.fill(0.0);
         self.fill_band(vals);
-        self.cholesky()?;
+        if !self.cholesky_fast() {
+            self.name_failing_pivot(vals)?;
+        }
         self.border_columns(vals, win);
         let l = self.lay;
         for i in 0..3 {
@@ -397,7 +399,33 @@ impl Bordered {
     }
 
     /// In-place banded Cholesky of the three beams (one lane each), with the reciprocals of the
-    /// diagonal; `Err` names the first beam (lowest row, then lowest beam) whose pivot is not
+    /// diagonal, without a test per row; whether every pivot `d` was usable (positive and
+    /// finite). That holds exactly when `L[j][j] = sqrt(d)` and `1 / L[j][j]` are finite in every
+    /// row, i.e. when the sum over the rows of `(L[j][j] + 1 / L[j][j]) 0` is zero (not NaN; the
+    /// sum of the two is below 1e162).
+    #[inline(always)]
+    fn cholesky_fast(&mut self) -> bool {
+        let n = 3 * self.lay.ne;
+        let mut nan_if_bad = F64x4::splat(0.0);
+        for j in HB..n + HB {
+            cholesky_row(&mut self.band, &mut self.dinv, j);
+            nan_if_bad += (self.band[j][HB] + self.dinv[j]) * 0.0;
+        }
+        // all four lanes (the idle one is the identity, always usable): testing only the beams'
+        // would let the compiler drop the idle lane and regroup the rows' arithmetic badly
+        nan_if_bad.0.iter().all(|&x| x == 0.0)
+    }
+
+    /// The bands and their Cholesky again, testing every row, to name the first failing pivot
+    /// (rare: the caller then falls back to the sparse LU).
+    #[cold]
+    #[inline(never)]
+    fn name_failing_pivot(&mut self, vals: &[f64]) -> Result<(), String> {
+        self.fill_band(vals);
+        self.cholesky()
+    }
+
+    /// [`Bordered::cholesky_fast`], testing every row: `Err` names the first beam (lowest row, then lowest beam) whose pivot is not
     /// positive.
     #[inline(always)]
     fn cholesky(&mut self) -> Result<(), String> {
@@ -769,9 +797,31 @@ mod tests {
             b.band[j][HB] = F64x4([4.0, 4.0, if j == HB + 7 { -1.0 } else { 4.0 }, 1.0]);
         }
         b.band[HB + 9][HB].0[1] = 0.0;
+        let good = b.band.clone();
+        assert!(!b.cholesky_fast());
+        b.band.clone_from(&good);
         assert_eq!(
             b.cholesky().unwrap_err(),
             "beam 3 block not positive definite at row 7 (pivot -1e0)"
         );
+        for (bad, pivot) in [(f64::INFINITY, "inf"), (f64::NAN, "NaN"), (-0.0, "-0e0"), (1e-320, "")] {
+            b.band.clone_from(&good);
+            for row in &mut b.band[HB..n + HB] {
+                row[HB] = F64x4::splat(4.0);
+            }
+            b.band[HB + 3][HB].0[1] = bad;
+            let want = if pivot.is_empty() {
+                Ok(())
+            } else {
+                Err(format!("beam 2 block not positive definite at row 3 (pivot {pivot})"))
+            };
+            assert_eq!(b.cholesky_fast(), want.is_ok(), "{bad:e}");
+            b.band.clone_from(&good);
+            for row in &mut b.band[HB..n + HB] {
+                row[HB] = F64x4::splat(4.0);
+            }
+            b.band[HB + 3][HB].0[1] = bad;
+            assert_eq!(b.cholesky(), want, "{bad:e}");
+        }
     }
 }

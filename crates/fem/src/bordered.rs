@@ -425,8 +425,8 @@ impl Bordered {
         self.cholesky()
     }
 
-    /// [`Bordered::cholesky_fast`], testing every row: `Err` names the first beam (lowest row, then lowest beam) whose pivot is not
-    /// positive.
+    /// [`Bordered::cholesky_fast`], testing every row: `Err` names the first beam (lowest row,
+    /// then lowest beam) whose pivot is not positive and finite.
     #[inline(always)]
     fn cholesky(&mut self) -> Result<(), String> {
         let n = 3 * self.lay.ne;

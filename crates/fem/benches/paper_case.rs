@@ -1,7 +1,7 @@
 //! Speed of the FEM on the paper's cases at the default step (issue 13: one paper case at the
 //! paper's mesh, 300 elements, in at most 0.15 s on one core; 3000 elements in at most 10 times
 //! the 300-element time). Case 2 (s = [t^2, -0.5 t^2, -0.5 t^2], 0.4 s) at 300 and 3000 elements,
-//! and case 1 (s_i = t^2, 0.5 s) at 300. Run pinned to one core:
+//! and cases 1, 3 and 4 (0.5 s each) at 300. Run pinned to one core:
 //! `taskset -c 1 cargo bench -p flexstar-fem --bench paper_case`.
 //!
 //! Direct dynamics (issue 10): case 2 at 300 elements driven by the forces of its own inverse
@@ -19,6 +19,8 @@ fn bench(c: &mut Criterion) {
     for (name, k, elements) in [
         ("case2_0.4s_300el", 2, 300),
         ("case1_0.5s_300el", 1, 300),
+        ("case3_0.5s_300el", 3, 300),
+        ("case4_0.5s_300el", 4, 300),
         ("case2_0.4s_3000el", 2, 3000),
     ] {
         let exp = catalogue::paper_case(k);

@@ -130,9 +130,26 @@ impl Real for f64 {
 #[repr(C, align(32))]
 pub struct F64x4(pub [f64; 4]);
 
-/// Lane-wise comparison result of [`F64x4`].
+/// Lane-wise comparison result of [`F64x4`]: every bit of a lane set (true) or clear (false),
+/// the form of the processor's vector comparisons, so that comparisons, selections and their
+/// combinations stay in vector registers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Mask4(pub [bool; 4]);
+#[repr(C, align(32))]
+pub struct Mask4(pub [u64; 4]);
+
+impl Mask4 {
+    /// The lane mask of `b`.
+    #[inline(always)]
+    fn bit(b: bool) -> u64 {
+        (b as u64).wrapping_neg()
+    }
+
+    /// Whether lane `k` is set.
+    #[inline(always)]
+    pub fn test(self, k: usize) -> bool {
+        self.0[k] != 0
+    }
+}
 
 impl F64x4 {
     /// Lane `k` of `f(k)`.
@@ -246,25 +263,35 @@ impl Real for F64x4 {
     #[inline(always)]
     fn gt(self, other: Self) -> Mask4 {
         let (a, b) = (self.0, other.0);
-        Mask4([a[0] > b[0], a[1] > b[1], a[2] > b[2], a[3] > b[3]])
+        let bit = Mask4::bit;
+        Mask4([bit(a[0] > b[0]), bit(a[1] > b[1]), bit(a[2] > b[2]), bit(a[3] > b[3])])
     }
     #[inline(always)]
     fn le(self, other: Self) -> Mask4 {
         let (a, b) = (self.0, other.0);
-        Mask4([a[0] <= b[0], a[1] <= b[1], a[2] <= b[2], a[3] <= b[3]])
+        let bit = Mask4::bit;
+        Mask4([
+            bit(a[0] <= b[0]),
+            bit(a[1] <= b[1]),
+            bit(a[2] <= b[2]),
+            bit(a[3] <= b[3]),
+        ])
     }
     #[inline(always)]
     fn lt(self, other: Self) -> Mask4 {
         let (a, b) = (self.0, other.0);
-        Mask4([a[0] < b[0], a[1] < b[1], a[2] < b[2], a[3] < b[3]])
+        let bit = Mask4::bit;
+        Mask4([bit(a[0] < b[0]), bit(a[1] < b[1]), bit(a[2] < b[2]), bit(a[3] < b[3])])
     }
     #[inline(always)]
     fn select(mask: Mask4, a: Self, b: Self) -> Self {
-        F64x4::from_fn(|k| if mask.0[k] { a.0[k] } else { b.0[k] })
+        // bitwise blend: a where the lane's bits are set, b where they are clear
+        let pick = |k: usize| f64::from_bits((a.0[k].to_bits() & mask.0[k]) | (b.0[k].to_bits() & !mask.0[k]));
+        F64x4([pick(0), pick(1), pick(2), pick(3)])
     }
     #[inline(always)]
     fn all(mask: Mask4) -> bool {
-        mask.0[0] & mask.0[1] & mask.0[2] & mask.0[3]
+        mask.0[0] & mask.0[1] & mask.0[2] & mask.0[3] == u64::MAX
     }
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> Self {

@@ -39,6 +39,8 @@
 
 use flexstar_numerics::lanes::{F64x4, Real};
 
+use crate::element_pass::Block;
+
 /// Half bandwidth of a beam block: node DOFs couple with the next node's 3 DOFs.
 const HB: usize = 5;
 /// Beams, one per lane of [`F64x4`] (lane 3 is idle).
@@ -149,7 +151,7 @@ fn beam_lanes(idle: f64, mut beam: impl FnMut(usize) -> f64) -> F64x4 {
 /// whose first node is m; zero at the tip): `t = 2 - c + c'` couples with DOF c' of node m + 1
 /// (the `prev`-side neighbour in tip-first order), `t = HB - c + c'` (`c' <= c`) with node m.
 #[inline(always)]
-fn band_entry(prev: &[f64; 36], next: &[f64; 36], c: usize, t: usize) -> f64 {
+fn band_entry(prev: Block, next: Block, c: usize, t: usize) -> f64 {
     if t + c >= HB {
         let cc = c + t - HB;
         prev[6 * (3 + c) + 3 + cc] + next[6 * c + cc]
@@ -308,9 +310,8 @@ impl Bordered {
 
     /// The 36 values of element k of beam i.
     #[inline(always)]
-    fn element_block(vals: &[f64], ne: usize, i: usize, k: usize) -> &[f64; 36] {
-        let at = 36 * (i * ne + k);
-        vals[at..at + 36].try_into().expect("36 values per element")
+    fn element_block(vals: &[f64], ne: usize, i: usize, k: usize) -> Block<'_> {
+        Block::of(vals, i * ne + k)
     }
 
     /// Factorise the matrix whose values are `vals` (star slot layout) with the windows `win`
@@ -370,22 +371,29 @@ impl Bordered {
     #[inline(always)]
     fn fill_band(&mut self, vals: &[f64]) {
         let (ns, ne) = (self.ns, self.lay.ne);
-        let tip = [0.0; 36];
+        let tip = Block::zero();
         let rows = &mut self.band[HB..HB + 3 * ne];
         for (node, r) in rows.chunks_exact_mut(3).enumerate() {
             let m = ne - node;
-            let prev: [&[f64; 36]; BEAMS] = std::array::from_fn(|i| Self::element_block(vals, ne, i, m - 1));
-            let next: [&[f64; 36]; BEAMS] = std::array::from_fn(|i| {
+            // explicit loops: the closures of std::array::from_fn are not always inlined here
+            let mut prev = [tip; BEAMS];
+            let mut next = [tip; BEAMS];
+            for i in 0..BEAMS {
+                prev[i] = Self::element_block(vals, ne, i, m - 1);
                 if m < ne {
-                    Self::element_block(vals, ne, i, m)
-                } else {
-                    &tip
+                    next[i] = Self::element_block(vals, ne, i, m);
                 }
-            });
+            }
             for (c, row) in r.iter_mut().enumerate() {
-                *row = std::array::from_fn(|t| {
-                    beam_lanes(if t == HB { 1.0 } else { 0.0 }, |i| band_entry(prev[i], next[i], c, t))
-                });
+                for t in 0..=HB {
+                    let idle = if t == HB { 1.0 } else { 0.0 };
+                    row[t] = F64x4([
+                        band_entry(prev[0], next[0], c, t),
+                        band_entry(prev[1], next[1], c, t),
+                        band_entry(prev[2], next[2], c, t),
+                        idle,
+                    ]);
+                }
             }
         }
         for i in 0..BEAMS {

@@ -43,10 +43,63 @@ pub(crate) struct BadChord {
 /// Elements per batch.
 const LANES: usize = 4;
 
+/// Position of entry `j = 6 a + b` of element `e`'s 6 x 6 block `M + beta' K` in the value array
+/// (the slot layout of `crate::star`): blocks stored by batches of four elements, entry by entry,
+/// the four elements' values of one entry next to each other (so that a batch writes each entry
+/// of its four lanes as one vector).
+#[inline(always)]
+pub(crate) fn block_index(e: usize, j: usize) -> usize {
+    (e / LANES) * 36 * LANES + j * LANES + e % LANES
+}
+
+/// Values taken by the element blocks of `n` elements (whole batches; the lanes past the last
+/// element are zero).
+pub(crate) fn blocks_len(n: usize) -> usize {
+    n.div_ceil(LANES) * 36 * LANES
+}
+
+/// Read access to one element's block, `block[6 a + b]` ([`block_index`]): its batch's values
+/// and its lane.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Block<'a> {
+    batch: &'a [f64; 36 * LANES],
+    lane: usize,
+}
+
+static ZERO_BATCH: [f64; 36 * LANES] = [0.0; 36 * LANES];
+
+impl<'a> Block<'a> {
+    /// The block of element `e` in the value array `vals`.
+    #[inline(always)]
+    pub fn of(vals: &'a [f64], e: usize) -> Self {
+        let at = block_index(e - e % LANES, 0);
+        Block {
+            batch: vals[at..at + 36 * LANES].try_into().expect("whole batches of blocks"),
+            lane: e % LANES,
+        }
+    }
+
+    /// A block of zeros.
+    pub fn zero() -> Block<'static> {
+        Block {
+            batch: &ZERO_BATCH,
+            lane: 0,
+        }
+    }
+}
+
+impl std::ops::Index<usize> for Block<'_> {
+    type Output = f64;
+    #[inline(always)]
+    fn index(&self, j: usize) -> &f64 {
+        &self.batch[LANES * j + self.lane]
+    }
+}
+
 flexstar_numerics::dispatch_avx2! {
     /// Add `cf (M(q) qdd + f_conv(q, v) + f_int(q))` of every element to `res` (global DOFs, in
     /// element order) and, with `vals`, write each element's `M + ck K` (36 values, row-major,
-    /// element after element: the slot layout of `crate::star`).
+    /// at [`block_index`]: the slot layout of `crate::star`).
     pub(crate) fn add_forces(
         elements: &[Element],
         nodes: NodeState,
@@ -202,13 +255,13 @@ fn add_forces_of<T: Real>(
                 }
             }
             let mk = std::hint::black_box(mk);
-            for k in 0..T::LANES {
-                let slot: &mut [f64; 36] = (&mut vals[36 * (start + k)..36 * (start + k) + 36])
-                    .try_into()
-                    .expect("36 values per element");
-                for a in 0..6 {
-                    for b in 0..6 {
-                        slot[6 * a + b] = mk[a][b].lane(k);
+            // a batch's block: 36 runs of four consecutive values (one vector store each)
+            let block = &mut vals[block_index(start, 0)..block_index(start, 35) + T::LANES];
+            let first = block_index(start, 0);
+            for a in 0..6 {
+                for b in 0..6 {
+                    for k in 0..T::LANES {
+                        block[block_index(start + k, 6 * a + b) - first] = mk[a][b].lane(k);
                     }
                 }
             }
@@ -291,7 +344,7 @@ mod tests {
             let d = [0, 1, 2, 3, 4, 5].map(|a| 3 * el.nodes[a / 3] + a % 3);
             for a in 0..6 {
                 for b in 0..6 {
-                    vals[36 * e + 6 * a + b] = m[a][b] + ck * k[a][b];
+                    vals[block_index(e, 6 * a + b)] = m[a][b] + ck * k[a][b];
                 }
                 res[d[a]] += cf * (fm[a] + fi[a]);
             }
@@ -309,7 +362,7 @@ mod tests {
         // 11 elements: two full batches and a remainder of three
         let (elements, q, v, a) = chain(11);
         let nodes = NodeState { q: &q, v: &v, qdd: &a };
-        let (mut r1, mut m1) = (vec![0.0; q.len()], vec![0.0; 36 * elements.len()]);
+        let (mut r1, mut m1) = (vec![0.0; q.len()], vec![0.0; blocks_len(elements.len())]);
         let (mut r2, mut m2) = (r1.clone(), m1.clone());
         one_by_one(&elements, nodes, sec, cf, ck, &mut r1, &mut m1);
         add_forces(&elements, nodes, sec, cf, ck, &mut r2, Some(&mut m2)).unwrap();

@@ -310,13 +310,24 @@ impl Real for F64x4 {
     }
 }
 
-/// Whether this processor runs the 256-bit lane instructions (AVX2), detected once at run time;
-/// false off x86-64. Kernels call their `#[target_feature(enable = "avx2")]` copy when it holds.
+/// Set by [`force_baseline`].
+static BASELINE_ONLY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Make every [`dispatch_avx2!`] body run its baseline copy (`true`), or choose by the processor
+/// again (`false`): the copy that processors without AVX2 (and other architectures) run, for
+/// tests that compare the two and for debugging. Process-wide.
+pub fn force_baseline(on: bool) {
+    BASELINE_ONLY.store(on, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Whether the AVX2 copies run: the processor has the 256-bit lane instructions (AVX2, detected
+/// once at run time) and [`force_baseline`] is off; false off x86-64. Kernels call their
+/// `#[target_feature(enable = "avx2")]` copy when it holds.
 #[inline]
 pub fn has_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        std::arch::is_x86_feature_detected!("avx2")
+        !BASELINE_ONLY.load(std::sync::atomic::Ordering::Relaxed) && std::arch::is_x86_feature_detected!("avx2")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {

@@ -110,12 +110,13 @@ flexstar_numerics::dispatch_avx2! {
         vals: Option<&mut [f64]>,
     ) -> Result<(), BadChord> {
         let mut vals = vals;
+        let terms = Terms { nodes, sec, cf, ck };
         let full = elements.len() / LANES * LANES;
         for start in (0..full).step_by(LANES) {
-            add_forces_of::<F64x4>(elements, start, nodes, sec, cf, ck, res, vals.as_deref_mut())?;
+            add_forces_of::<F64x4>(elements, start, &terms, res, vals.as_deref_mut())?;
         }
         for start in full..elements.len() {
-            add_forces_of::<f64>(elements, start, nodes, sec, cf, ck, res, vals.as_deref_mut())?;
+            add_forces_of::<f64>(elements, start, &terms, res, vals.as_deref_mut())?;
         }
         Ok(())
     }
@@ -149,12 +150,12 @@ fn chain<T: Real>(elements: &[Element], start: usize) -> Option<usize> {
 }
 
 /// Element DOFs `[xa, ya, phia, xb, yb, phib]` of the `T::LANES` elements from `start`, one per
-/// lane, from the global vector `x`: one contiguous run for a chain, else one bounds check per
-/// node.
+/// lane, from the global vector `x`: one contiguous run for a chain (`chain`, its first node),
+/// else one bounds check per node.
 #[inline(always)]
-fn gather<T: Real>(elements: &[Element], start: usize, x: &[f64]) -> [T; 6] {
+fn gather<T: Real>(elements: &[Element], start: usize, chain: Option<usize>, x: &[f64]) -> [T; 6] {
     let mut out = [T::splat(0.0); 6];
-    if let Some(n0) = chain::<T>(elements, start) {
+    if let Some(n0) = chain {
         let run = &x[3 * n0..3 * (n0 + T::LANES + 1)];
         for c in 0..3 {
             out[c] = T::from_lanes(|k| run[3 * k + c]);
@@ -183,8 +184,8 @@ fn node_dofs(x: &[f64], j: usize) -> &[f64; 3] {
 /// Add `f` (element DOFs, one element per lane) to the global vector `res`, lane after lane
 /// (node a, then node b: the order of the element-by-element loop).
 #[inline(always)]
-fn scatter_add<T: Real>(elements: &[Element], start: usize, f: &[T; 6], res: &mut [f64]) {
-    if let Some(n0) = chain::<T>(elements, start) {
+fn scatter_add<T: Real>(elements: &[Element], start: usize, chain: Option<usize>, f: &[T; 6], res: &mut [f64]) {
+    if let Some(n0) = chain {
         let run = &mut res[3 * n0..3 * (n0 + T::LANES + 1)];
         for k in 0..T::LANES {
             for a in 0..6 {
@@ -208,41 +209,53 @@ fn scatter_add<T: Real>(elements: &[Element], start: usize, f: &[T; 6], res: &mu
 
 /// States of the `T::LANES` elements from `start` at the global coordinates `q`.
 #[inline(always)]
-fn states<T: Real>(elements: &[Element], start: usize, q: &[f64]) -> ElementState<T> {
+fn states<T: Real>(elements: &[Element], start: usize, chain: Option<usize>, q: &[f64]) -> ElementState<T> {
     let el = |k: usize| &elements[start + k];
     ElementState::from_reference(
         T::from_lanes(|k| el(k).l0),
         T::from_lanes(|k| el(k).c0),
         T::from_lanes(|k| el(k).s0),
-        &gather(elements, start, q),
+        &gather(elements, start, chain, q),
     )
+}
+
+/// What [`add_forces`] evaluates every batch at: the nodes' state, the section, and the scales
+/// of the residual (`cf`) and of the stiffness in the matrix (`ck`).
+#[derive(Clone, Copy)]
+struct Terms<'a> {
+    nodes: NodeState<'a>,
+    sec: Section,
+    cf: f64,
+    ck: f64,
 }
 
 /// One batch of [`add_forces`]. The `std::hint::black_box` calls keep each lane result in memory
 /// as four consecutive doubles: that is where the compiler's straight-line vectoriser starts
 /// from. Without them the lanes' results meet only scalar scatters and most of the arithmetic
-/// stays scalar (callgrind, 300 elements: 1800 instructions per four-element batch without the
-/// matrix, 1190 with them; 2900 and 2370 with it). They change no value.
-#[allow(clippy::too_many_arguments)]
+/// stays scalar (callgrind, 300 elements, when they were introduced: 1800 instructions per
+/// four-element batch without the matrix, 1190 with them; 2900 and 2370 with it). They change
+/// no value.
 #[inline(always)]
 fn add_forces_of<T: Real>(
     elements: &[Element],
     start: usize,
-    nodes: NodeState,
-    sec: Section,
-    cf: f64,
-    ck: f64,
+    terms: &Terms,
     res: &mut [f64],
     vals: Option<&mut [f64]>,
 ) -> Result<(), BadChord> {
-    let st: ElementState<T> = states(elements, start, nodes.q);
+    let Terms { nodes, sec, cf, ck } = *terms;
+    let chain = chain::<T>(elements, start);
+    let st: ElementState<T> = states(elements, start, chain, nodes.q);
     for k in 0..T::LANES {
         let ln = st.ln.lane(k);
         if !(ln.is_finite() && ln > 0.0) {
             return Err(BadChord { element: start + k, ln });
         }
     }
-    let (ve, ae) = (gather(elements, start, nodes.v), gather(elements, start, nodes.qdd));
+    let (ve, ae) = (
+        gather(elements, start, chain, nodes.v),
+        gather(elements, start, chain, nodes.qdd),
+    );
     let fm = std::hint::black_box(st.inertia_force(sec.rho, &ve, &ae));
     let fi = match vals {
         Some(vals) => {
@@ -274,14 +287,15 @@ fn add_forces_of<T: Real>(
         f[a] = (fm[a] + fi[a]) * cf;
     }
     let f = std::hint::black_box(f);
-    scatter_add(elements, start, &f, res);
+    scatter_add(elements, start, chain, &f, res);
     Ok(())
 }
 
 #[inline(always)]
 fn energies_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], sec: Section, sums: &mut (f64, f64)) {
-    let st: ElementState<T> = states(elements, start, q);
-    let ke = st.kinetic_energy(sec.rho, &gather(elements, start, v));
+    let chain = chain::<T>(elements, start);
+    let st: ElementState<T> = states(elements, start, chain, q);
+    let ke = st.kinetic_energy(sec.rho, &gather(elements, start, chain, v));
     let [ke, se] = std::hint::black_box([ke, st.strain_energy(sec.ea, sec.ei)]);
     for k in 0..T::LANES {
         sums.0 += ke.lane(k);

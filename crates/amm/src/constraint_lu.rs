@@ -28,6 +28,8 @@
 
 use nalgebra::{DMatrix, DVector, Matrix4, Matrix6, SMatrix, Vector4, Vector6, LU, U6};
 
+use crate::error::RankError;
+
 /// Rows of one beam's sleeve block (Eqs. 41-43: Fp, FR, FL, Mp).
 pub(crate) const SLEEVE_ROWS: usize = 4;
 /// Largest number of junction rows (three Fix, Fw, two slope equalities).
@@ -92,7 +94,7 @@ impl ConstraintLu {
     }
 
     /// Factor A (`a`, m x m, row-major). Fails with the reason when A is rank deficient.
-    pub(crate) fn factor(&mut self, a: &[f64]) -> Result<(), String> {
+    pub(crate) fn factor(&mut self, a: &[f64]) -> Result<(), RankError> {
         self.blocks = self.block_factor(a);
         self.dense = None;
         if self.blocks.is_none() {
@@ -141,22 +143,23 @@ impl ConstraintLu {
     }
 
     /// nalgebra's LU with partial pivoting of the whole A, its rank checked.
-    fn dense_factor(&self, a: &[f64]) -> Result<LU<f64, nalgebra::Dyn, nalgebra::Dyn>, String> {
+    fn dense_factor(&self, a: &[f64]) -> Result<LU<f64, nalgebra::Dyn, nalgebra::Dyn>, RankError> {
         let m = self.m;
         for r in 0..m {
             let row = &a[r * m..(r + 1) * m];
             if row.iter().all(|v| *v == 0.0) || row.iter().any(|v| !v.is_finite()) {
-                return Err(format!("constraint row {r} has no coupling"));
+                return Err(RankError::NoCoupling { row: r });
             }
         }
         let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
         let lu = DMatrix::from_row_slice(m, m, a).lu();
         let u = lu.u();
         if let Some(k) = (0..m).find(|&k| u[(k, k)].abs().is_nan() || u[(k, k)].abs() <= PIVOT_RATIO * scale) {
-            return Err(format!(
-                "rank-deficient at elimination step {k} of {m} (pivot ratio {:e})",
-                u[(k, k)].abs() / scale
-            ));
+            return Err(RankError::RankDeficient {
+                step: k,
+                size: m,
+                ratio: u[(k, k)].abs() / scale,
+            });
         }
         Ok(lu)
     }
@@ -287,13 +290,18 @@ mod tests {
             a[r1 * m + c] = a[r0 * m + c];
         }
         let err = ConstraintLu::new(m).factor(&a).unwrap_err();
-        assert!(err.contains("rank-deficient"), "{err}");
+        assert!(
+            matches!(err, RankError::RankDeficient { size, .. } if size == m),
+            "{err}"
+        );
+        assert!(err.to_string().contains("rank-deficient"), "{err}");
         let zero_row = {
             let mut z = structured(nj, 4);
             z[2 * m..3 * m].iter_mut().for_each(|v| *v = 0.0);
             z
         };
         let err = ConstraintLu::new(m).factor(&zero_row).unwrap_err();
-        assert!(err.contains("row 2 has no coupling"), "{err}");
+        assert!(matches!(err, RankError::NoCoupling { row: 2 }), "{err}");
+        assert!(err.to_string().contains("row 2 has no coupling"), "{err}");
     }
 }

@@ -26,7 +26,7 @@ use flexstar_numerics::GenAlpha;
 use num_dual::{Dual2, HyperDual64};
 
 use crate::adaptive;
-use crate::error::AmmError;
+use crate::error::{AmmError, RankError};
 use crate::modes::ModeSet;
 use crate::record::Recorder;
 use crate::solver::{stops, validate, RHO_INF};
@@ -157,9 +157,9 @@ fn coupled_step(
         row[i] += m + kp[i] * bp + kd[i] * gp;
         row[3] = fa[i] - m * x_pred[i] - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, &sys.sleeve_axial);
     }
-    let dx = solve3(a).ok_or_else(|| AmmError::SingularConstraints {
+    let dx = solve3(a).ok_or(AmmError::SingularConstraints {
         t,
-        reason: "the sliders' equations (Eq. 33) are singular".into(),
+        source: RankError::Sliders,
     })?;
 
     qdd.copy_from_slice(&buf.qdd0);

@@ -1,7 +1,8 @@
 //! The one error type of the AMM crate: every message says where (setting key, time, mode) and why.
 
 use flexstar_kinematics::{Infeasible, KinematicsError};
-use flexstar_model::ModelError;
+use flexstar_model::{ModeFamily, ModelError};
+use flexstar_numerics::NumericsError;
 
 /// Errors of the assumed-modes solver. Input errors are raised before any work is done.
 #[derive(Debug, thiserror::Error)]
@@ -42,8 +43,22 @@ pub enum AmmError {
         hi: f64,
     },
     /// The constraint matrix lost rank: the Schur complement `C S^-1 C^T` is singular at time `t`.
-    #[error("amm: t = {t:.6} s: singular constraint system ({reason})")]
-    SingularConstraints { t: f64, reason: String },
+    #[error("amm: t = {t:.6} s: singular constraint system ({source})")]
+    SingularConstraints {
+        t: f64,
+        #[source]
+        source: RankError,
+    },
+    /// [`AmmError::SingularConstraints`] at the consistent initial accelerations: `modes` modes
+    /// of `family` per beam cannot satisfy the beam's constraints.
+    #[error("amm: t = {t:.6} s: singular constraint system ({source}; {modes} modes of the {family} family are too few for its constraints)")]
+    TooFewModes {
+        t: f64,
+        modes: usize,
+        family: ModeFamily,
+        #[source]
+        source: RankError,
+    },
     /// The actuator law could not be evaluated at time `t` (a direct run).
     #[error("amm: t = {t:.6} s: drive: {source}")]
     Drive {
@@ -63,4 +78,22 @@ impl AmmError {
             reason: reason.into(),
         }
     }
+}
+
+/// Why a constraint system of the AMM has no unique solution ([`AmmError::SingularConstraints`]).
+#[derive(Debug, Clone, Copy, thiserror::Error)]
+pub enum RankError {
+    /// Row `row` (0-based) of the constraint matrix `A = C S^-1 C^T` is zero or not finite.
+    #[error("constraint row {row} has no coupling")]
+    NoCoupling { row: usize },
+    /// The LU of the `size` x `size` matrix met a pivot below the rank threshold at `step`
+    /// (`ratio`: the pivot against the largest entry).
+    #[error("rank-deficient at elimination step {step} of {size} (pivot ratio {ratio:e})")]
+    RankDeficient { step: usize, size: usize, ratio: f64 },
+    /// The 3 x 3 system of the sliders' equations (Eq. 33) of a direct run is singular.
+    #[error("the sliders' equations (Eq. 33) are singular")]
+    Sliders,
+    /// The constrained eigenproblem of a pose (dependent constraint rows, an eigensolver failure).
+    #[error(transparent)]
+    Modes(#[from] NumericsError),
 }

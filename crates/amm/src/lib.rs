@@ -31,6 +31,6 @@ pub mod solver;
 mod system;
 
 pub use direct::{solve_direct, DIRECT_COLUMNS};
-pub use error::AmmError;
+pub use error::{AmmError, RankError};
 pub use modes::{ModeSet, MAX_MODES};
 pub use solver::{parse_family, solve, tolerance_step, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS, TOLERANCE_DT};

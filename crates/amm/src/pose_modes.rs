@@ -27,6 +27,7 @@ use flexstar_numerics::eigen::{constrained_modes, rigid_shift};
 use crate::error::AmmError;
 use crate::modes::ModeSet;
 use crate::system::{Row, System};
+use flexstar_numerics::NumericsError;
 
 /// Default modes per beam of the modal analysis (enriched family): the first six frequencies of
 /// the paper's robot at the centre pose change by less than 0.06 % from 60 to 80 (0.5 % from 40 to
@@ -225,7 +226,10 @@ struct Projected {
 impl Projected {
     fn new(sys: &PoseSystem) -> Result<Self, AmmError> {
         let (n, r) = (sys.n, sys.rows);
-        let fail = |reason: String| AmmError::SingularConstraints { t: 0.0, reason };
+        let fail = |e: NumericsError| AmmError::SingularConstraints {
+            t: 0.0,
+            source: e.into(),
+        };
         let inv_sqrt_m: Vec<f64> = (0..n).map(|j| 1.0 / sys.m[j * n + j].sqrt()).collect();
         let d: Vec<f64> = (0..n).map(|j| sys.k[j * n + j] / sys.m[j * n + j]).collect();
         let q = row_space_basis(n, r, |row, j| sys.c[row * n + j] * inv_sqrt_m[j]).map_err(fail)?;
@@ -240,7 +244,12 @@ impl Projected {
         matmul(a.as_mut(), Accum::Add, dq.as_ref(), q.transpose(), -1.0, Par::Seq);
         matmul(a.as_mut(), Accum::Add, qg.as_ref(), q.transpose(), 1.0, Par::Seq);
         let a = Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
-        let w = eigenvalues_seq(&a).map_err(|e| fail(format!("symmetric eigensolver failed ({e:?})")))?;
+        let w = eigenvalues_seq(&a).map_err(|cause| {
+            fail(NumericsError::Eigensolver {
+                what: "symmetric eigensolver",
+                cause,
+            })
+        })?;
         Ok(Projected {
             n,
             r,
@@ -336,7 +345,7 @@ fn eigenvalues_seq(a: &Mat<f64>) -> Result<Vec<f64>, faer::linalg::evd::EvdError
 
 /// Orthonormal basis (n x r, columns) of the rows of the r x n matrix `c(row, j)`: modified
 /// Gram-Schmidt applied twice; fails when a row is (numerically) a combination of the others.
-fn row_space_basis(n: usize, r: usize, c: impl Fn(usize, usize) -> f64) -> Result<Mat<f64>, String> {
+fn row_space_basis(n: usize, r: usize, c: impl Fn(usize, usize) -> f64) -> Result<Mat<f64>, NumericsError> {
     let mut q = Mat::from_fn(n, r, |j, row| c(row, j));
     let scale = (0..r).map(|k| q.col(k).norm_l2()).fold(0.0, f64::max);
     for k in 0..r {
@@ -351,10 +360,11 @@ fn row_space_basis(n: usize, r: usize, c: impl Fn(usize, usize) -> f64) -> Resul
         }
         let norm = q.col(k).norm_l2();
         if norm.is_nan() || norm <= 1e-11 * scale {
-            return Err(format!(
-                "constraint row {} of {r} is a combination of the others (residual norm {norm:e})",
-                k + 1
-            ));
+            return Err(NumericsError::DependentRow {
+                row: k + 1,
+                rows: r,
+                norm,
+            });
         }
         for i in 0..n {
             q[(i, k)] /= norm;
@@ -399,7 +409,10 @@ fn solve_modes(system: PoseSystem, count: usize) -> Result<PoseModes, AmmError> 
         count + rigid,
         rigid_shift(system.sliders == Sliders::Free),
     )
-    .map_err(|reason| AmmError::SingularConstraints { t: 0.0, reason })?;
+    .map_err(|e| AmmError::SingularConstraints {
+        t: 0.0,
+        source: e.into(),
+    })?;
     Ok(PoseModes::new(out.omega2, out.shapes, rigid, system))
 }
 

@@ -262,12 +262,11 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     // consistent initial accelerations: M qdd = f + C^T lambda, C qdd = 0 (q = q' = 0)
     let mut st = kin(0.0)?;
     sys.solve(&st, 0.0, 0.0, &q, &v, &mut qdd).map_err(|e| match e {
-        AmmError::SingularConstraints { t, reason } => AmmError::SingularConstraints {
+        AmmError::SingularConstraints { t, source } => AmmError::TooFewModes {
             t,
-            reason: format!(
-                "{reason}; {} modes of the {} family are too few for its constraints",
-                nm, settings.family
-            ),
+            modes: nm,
+            family: settings.family,
+            source,
         },
         other => other,
     })?;

@@ -604,7 +604,7 @@ impl System {
         }
         self.lu
             .factor(&self.a)
-            .map_err(|reason| AmmError::SingularConstraints { t: st.t, reason })
+            .map_err(|source| AmmError::SingularConstraints { t: st.t, source })
     }
 
     /// Solve the prepared step for the forcing in the workspace ([`System::forcing`] or

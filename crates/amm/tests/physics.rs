@@ -372,7 +372,7 @@ fn bad_input_is_rejected_before_any_work() {
     }
     // too few modes for the twelve sleeve constraints: a clear error, not a panic
     match solve(&exp, &settings(ModeFamily::PinnedFree, 2, None)).unwrap_err() {
-        AmmError::SingularConstraints { t, reason } => assert!(t == 0.0 && reason.contains("too few"), "{reason}"),
+        e @ AmmError::TooFewModes { t, modes: 2, .. } => assert!(t == 0.0 && e.to_string().contains("too few"), "{e}"),
         other => panic!("{other}"),
     }
 }

@@ -176,7 +176,7 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<(), RunError> {
         for run in spec.amm.iter().chain(&spec.extra) {
             run.settings
                 .validate(exp.time.dt_out)
-                .map_err(|e| input(format!("AMM {}: {}", run.label, strip_file(&e.to_string()))))?;
+                .map_err(|e| input(format!("AMM {}: {}", run.label, e.detail())))?;
         }
         for (k, run) in spec.amm.iter().enumerate() {
             if spec.amm[..k].iter().any(|r| r.label == run.label) {
@@ -187,11 +187,6 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<(), RunError> {
             .map_err(|e| input(e.to_string()))?;
     }
     Ok(())
-}
-
-/// A model error raised without a file starts with ": "; drop it (the caller names the file).
-fn strip_file(msg: &str) -> &str {
-    msg.strip_prefix(": ").unwrap_or(msg)
 }
 
 enum Job {

@@ -77,7 +77,7 @@ pub fn law_for(exp: &Experiment) -> Result<Option<Box<dyn ActuatorLaw>>, DriveEr
 pub enum DriveError {
     /// A force table that cannot be used (row and reason).
     #[error("force table: {0}")]
-    Table(String),
+    Table(#[from] flexstar_model::SampleError),
     /// The servo reference cannot be evaluated at time `t`.
     #[error("servo reference at t = {t} s: {reason}")]
     Reference { t: f64, reason: String },

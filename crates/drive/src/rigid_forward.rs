@@ -13,7 +13,7 @@
 //! translating mass is in `mpp_mpa`, as in Eq. 33. Integrated by the classical fourth-order
 //! Runge-Kutta scheme at a fixed step.
 
-use flexstar_kinematics::{check_configuration, direct_kinematics};
+use flexstar_kinematics::{check_configuration, direct_kinematics, Violation};
 use flexstar_model::RobotParams;
 use nalgebra::{Matrix3, Vector3};
 use num_dual::{Dual2, DualSVec64};
@@ -37,8 +37,11 @@ pub struct RigidSample {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ForwardError {
     /// The motion reached a limit of the feasible range.
+    #[error("rigid forward dynamics: infeasible at t = {t:.6} s: {violation}")]
+    Infeasible { t: f64, violation: Violation },
+    /// The rigid accelerations could not be computed at time `t`.
     #[error("rigid forward dynamics: infeasible at t = {t:.6} s: {reason}")]
-    Infeasible { t: f64, reason: String },
+    Singular { t: f64, reason: Singular },
     /// The drive could not be evaluated.
     #[error("rigid forward dynamics: {0}")]
     Drive(#[from] DriveError),
@@ -47,27 +50,35 @@ pub enum ForwardError {
     Input(String),
 }
 
+/// Why [`rigid_acceleration`] has no answer at a state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum Singular {
+    /// The sliders' positions have no Fermat point (Eqs. 4-10).
+    #[error("no Fermat point")]
+    NoFermatPoint,
+    /// The mass matrix of the virtual-power equations is not positive definite.
+    #[error("the rigid mass matrix is not positive definite")]
+    MassMatrix,
+}
+
 /// Accelerations `s''` [m/s^2] of the rigid robot at state (`s`, `v`) under forces `fa` [N].
-pub fn rigid_acceleration(params: &RobotParams, s: [f64; 3], v: [f64; 3], fa: [f64; 3]) -> Result<[f64; 3], String> {
+pub fn rigid_acceleration(params: &RobotParams, s: [f64; 3], v: [f64; 3], fa: [f64; 3]) -> Result<[f64; 3], Singular> {
     let (jg, jth) = jacobians(params, s)?;
     let (kg, kth) = quadratic_terms(params, s, v)?;
     let m = params.star_mass();
     let j = params.star_inertia() + 3.0 * params.jp;
     let mass = Matrix3::identity() * params.mpp_mpa + jg.transpose() * jg * m + jth * jth.transpose() * j;
     let rhs = Vector3::from(fa) - jg.transpose() * kg * m - jth * (kth * j);
-    let a = mass
-        .cholesky()
-        .ok_or("the rigid mass matrix is not positive definite")?
-        .solve(&rhs);
+    let a = mass.cholesky().ok_or(Singular::MassMatrix)?.solve(&rhs);
     Ok([a[0], a[1], a[2]])
 }
 
 type Jacobians = (nalgebra::Matrix2x3<f64>, Vector3<f64>);
 
 /// `J_G = dG/ds` (2 x 3) and `j_th = dtheta/ds` at `s`.
-fn jacobians(params: &RobotParams, s: [f64; 3]) -> Result<Jacobians, String> {
+fn jacobians(params: &RobotParams, s: [f64; 3]) -> Result<Jacobians, Singular> {
     let sd: [DualSVec64<3>; 3] = [0, 1, 2].map(|k| DualSVec64::from_re(s[k]).derivative(k));
-    let pose = direct_kinematics(params.d, sd).ok_or("no Fermat point")?;
+    let pose = direct_kinematics(params.d, sd).ok_or(Singular::NoFermatPoint)?;
     let grad = |x: &DualSVec64<3>| {
         let e = x.eps.unwrap_generic(nalgebra::Const::<3>, nalgebra::Const::<1>);
         Vector3::new(e[0], e[1], e[2])
@@ -78,9 +89,9 @@ fn jacobians(params: &RobotParams, s: [f64; 3]) -> Result<Jacobians, String> {
 }
 
 /// `s'^T H s'` for G (2-vector) and theta: the accelerations at `s'' = 0`.
-fn quadratic_terms(params: &RobotParams, s: [f64; 3], v: [f64; 3]) -> Result<(nalgebra::Vector2<f64>, f64), String> {
+fn quadratic_terms(params: &RobotParams, s: [f64; 3], v: [f64; 3]) -> Result<(nalgebra::Vector2<f64>, f64), Singular> {
     let sd: [Dual2<f64>; 3] = [0, 1, 2].map(|k| Dual2::new(s[k], v[k], 0.0));
-    let pose = direct_kinematics(params.d, sd).ok_or("no Fermat point")?;
+    let pose = direct_kinematics(params.d, sd).ok_or(Singular::NoFermatPoint)?;
     Ok((nalgebra::Vector2::new(pose.g[0].v2, pose.g[1].v2), pose.theta.v2))
 }
 
@@ -118,10 +129,7 @@ pub fn rigid_forward_dynamics(
         for j in 0..sub {
             let t = k as f64 * dt_out + j as f64 * h;
             x = rk4_step(params, law, t, x, h)?;
-            check_configuration(params, x.s).map_err(|v| ForwardError::Infeasible {
-                t: t + h,
-                reason: v.to_string(),
-            })?;
+            check_configuration(params, x.s).map_err(|violation| ForwardError::Infeasible { t: t + h, violation })?;
         }
         let t = (k + 1) as f64 * dt_out;
         out.push(RigidSample {
@@ -142,7 +150,7 @@ struct State {
 
 fn rate(params: &RobotParams, law: &dyn ActuatorLaw, t: f64, x: State) -> Result<State, ForwardError> {
     let fa = law.force(t, x.s, x.v)?;
-    let a = rigid_acceleration(params, x.s, x.v, fa).map_err(|reason| ForwardError::Infeasible { t, reason })?;
+    let a = rigid_acceleration(params, x.s, x.v, fa).map_err(|reason| ForwardError::Singular { t, reason })?;
     Ok(State { s: x.v, v: a })
 }
 
@@ -247,9 +255,9 @@ mod tests {
         };
         let err = rigid_forward_dynamics(&params, [0.0; 3], [0.0; 3], &push, 2.0, 0.01, 1e-3).unwrap_err();
         match err {
-            ForwardError::Infeasible { t, reason } => {
+            ForwardError::Infeasible { t, violation } => {
                 assert!(t > 0.0 && t < 2.0, "t = {t}");
-                assert!(!reason.is_empty());
+                assert!(!violation.to_string().is_empty());
             }
             other => panic!("expected an infeasible stop, got {other}"),
         }

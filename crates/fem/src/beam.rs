@@ -7,7 +7,7 @@ use nalgebra::{DMatrix, DVector};
 use flexstar_model::RobotParams;
 
 use crate::element::{Element, ElementState};
-use crate::FemError;
+use crate::{FemError, NewtonFailure};
 
 /// Boundary conditions of a single beam for the frequency check.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -177,7 +177,7 @@ pub fn end_moment_static(
             let dq = k.lu().solve(&r).ok_or_else(|| FemError::Newton {
                 t: 0.0,
                 h: 0.0,
-                reason: "singular stiffness".into(),
+                reason: NewtonFailure::SingularStiffness,
             })?;
             for j in 0..n {
                 q[j] += dq[j];
@@ -191,7 +191,7 @@ pub fn end_moment_static(
             return Err(FemError::Newton {
                 t: 0.0,
                 h: 0.0,
-                reason: format!("static Newton did not converge at load step {step}"),
+                reason: NewtonFailure::StaticNoConvergence { step },
             });
         }
     }

@@ -40,6 +40,7 @@
 use flexstar_numerics::lanes::{F64x4, Real};
 
 use crate::element_pass::Block;
+use crate::error::PivotError;
 
 /// Half bandwidth of a beam block: node DOFs couple with the next node's 3 DOFs.
 const HB: usize = 5;
@@ -317,16 +318,16 @@ impl Bordered {
     /// Factorise the matrix whose values are `vals` (star slot layout) with the windows `win`
     /// (first element of the window of each contact point, [sleeve][point]). `Err` names the
     /// failing pivot.
-    pub fn factor(&mut self, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), String> {
+    pub fn factor(&mut self, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), PivotError> {
         let this = self;
-        flexstar_numerics::dispatch_avx2!(fn(this: &mut Bordered, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), String> {
+        flexstar_numerics::dispatch_avx2!(fn(this: &mut Bordered, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), PivotError> {
             this.factor_inline(vals, win)
         })
     }
 
     /// [`Bordered::factor`], inlined into its AVX2 and baseline copies.
     #[inline(always)]
-    fn factor_inline(&mut self, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), String> {
+    fn factor_inline(&mut self, vals: &[f64], win: &[[usize; 3]; 3]) -> Result<(), PivotError> {
         let ns = self.ns;
         self.s.fill(0.0);
         self.fill_band(vals);
@@ -428,7 +429,7 @@ impl Bordered {
     /// (rare: the caller then falls back to the sparse LU).
     #[cold]
     #[inline(never)]
-    fn name_failing_pivot(&mut self, vals: &[f64]) -> Result<(), String> {
+    fn name_failing_pivot(&mut self, vals: &[f64]) -> Result<(), PivotError> {
         self.fill_band(vals);
         self.cholesky()
     }
@@ -436,18 +437,17 @@ impl Bordered {
     /// [`Bordered::cholesky_fast`], testing every row: `Err` names the first beam (lowest row,
     /// then lowest beam) whose pivot is not positive and finite.
     #[inline(always)]
-    fn cholesky(&mut self) -> Result<(), String> {
+    fn cholesky(&mut self) -> Result<(), PivotError> {
         let n = 3 * self.lay.ne;
         for j in HB..n + HB {
             let d = cholesky_row(&mut self.band, &mut self.dinv, j);
             if !beam_pivots_ok(d) {
                 let i = (0..BEAMS).find(|&i| !pivot_ok(d.0[i])).unwrap_or(BEAMS);
-                return Err(format!(
-                    "beam {} block not positive definite at row {} (pivot {:e})",
-                    i + 1,
-                    j - HB,
-                    d.0[i]
-                ));
+                return Err(PivotError::BeamBlock {
+                    beam: i + 1,
+                    row: j - HB,
+                    pivot: d.0[i],
+                });
             }
         }
         Ok(())
@@ -544,7 +544,7 @@ impl Bordered {
     /// sleeve blocks stay uncoupled until G, last), densely over the pivot row (an update by a
     /// zero entry of the pivot row changes nothing).
     #[inline(always)]
-    fn lu_schur(&mut self) -> Result<(), String> {
+    fn lu_schur(&mut self) -> Result<(), PivotError> {
         let ns = self.ns;
         let s = &mut self.s[..ns * ns];
         for k in 0..ns {
@@ -568,7 +568,7 @@ impl Bordered {
             }
             let d = s[k * ns + k];
             if d == 0.0 || !d.is_finite() {
-                return Err(format!("border Schur complement singular at pivot {k} ({d:e})"));
+                return Err(PivotError::Schur { index: k, pivot: d });
             }
             let (upper, lower) = s.split_at_mut((k + 1) * ns);
             let pivot_row = &upper[k * ns + k + 1..];
@@ -808,8 +808,17 @@ mod tests {
         let good = b.band.clone();
         assert!(!b.cholesky_fast());
         b.band.clone_from(&good);
+        let err = b.cholesky().unwrap_err();
         assert_eq!(
-            b.cholesky().unwrap_err(),
+            err,
+            PivotError::BeamBlock {
+                beam: 3,
+                row: 7,
+                pivot: -1.0
+            }
+        );
+        assert_eq!(
+            err.to_string(),
             "beam 3 block not positive definite at row 7 (pivot -1e0)"
         );
         for (bad, pivot) in [(f64::INFINITY, "inf"), (f64::NAN, "NaN"), (-0.0, "-0e0"), (1e-320, "")] {
@@ -829,7 +838,7 @@ mod tests {
                 row[HB] = F64x4::splat(4.0);
             }
             b.band[HB + 3][HB].0[1] = bad;
-            assert_eq!(b.cholesky(), want, "{bad:e}");
+            assert_eq!(b.cholesky().map_err(|e| e.to_string()), want, "{bad:e}");
         }
     }
 }

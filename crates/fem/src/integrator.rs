@@ -19,8 +19,9 @@ use flexstar_model::geometry::slider_direction;
 use flexstar_model::{RobotParams, Trajectory};
 use flexstar_numerics::GenAlpha;
 
+use crate::error::PivotError;
 use crate::star::{InitialState, Pins, SliderRows, Star, ROWS};
-use crate::FemError;
+use crate::{FemError, NewtonFailure};
 
 /// Newton iterations allowed per step.
 const MAX_ITER: usize = 30;
@@ -81,7 +82,7 @@ pub(crate) struct Snapshot {
 }
 
 /// Work counters.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Stats {
     /// Time steps taken.
     pub steps: usize,
@@ -97,6 +98,18 @@ pub struct Stats {
     /// reused by the step's later iterations while the increments contract by a factor 10 or
     /// better, refactorised otherwise (docs/fem.md section 3).
     pub factorisations: usize,
+    /// Why the structured solver last failed, and when (`None` without a fallback).
+    pub last_fallback: Option<Fallback>,
+}
+
+/// A fallback from the structured solver to the sparse LU: the Newton time `t` [s] and the
+/// failing pivot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fallback {
+    /// Time of the step whose factorisation fell back [s].
+    pub t: f64,
+    /// The pivot that failed.
+    pub reason: PivotError,
 }
 
 /// Everything a run produces.
@@ -184,10 +197,7 @@ impl Motion<'_> {
     /// The actuator law at the sliders' state of `pins`.
     fn law_forces(law: &dyn ActuatorLaw, pins: &Pins, t: f64) -> Result<[f64; 3], FemError> {
         law.force(t, pins.s.map(|s| s[0]), pins.s.map(|s| s[1]))
-            .map_err(|e| FemError::Drive {
-                t,
-                reason: e.to_string(),
-            })
+            .map_err(|source| FemError::Drive { t, source })
     }
 
     /// The sliders' rows at one iterate of the direct problem (`bp = beta'`, `gp = gamma'`, both
@@ -230,10 +240,7 @@ impl Motion<'_> {
         if let Motion::Prescribed(_) = self {
             return Ok(());
         }
-        check_configuration(params, pins.s.map(|s| s[0])).map_err(|v| FemError::Infeasible {
-            t,
-            reason: v.to_string(),
-        })
+        check_configuration(params, pins.s.map(|s| s[0])).map_err(|violation| FemError::Infeasible { t, violation })
     }
 }
 
@@ -580,7 +587,7 @@ flexstar_numerics::dispatch_avx2! {
                 return Err(FemError::Newton {
                     t: t1,
                     h,
-                    reason: "non-finite Newton increment".into(),
+                    reason: NewtonFailure::NonFiniteIncrement,
                 });
             }
             // converged: positions to 1e-11 L, multipliers to 1e-6 (1 + |lambda|) N, or, once
@@ -604,10 +611,11 @@ flexstar_numerics::dispatch_avx2! {
             return Err(FemError::Newton {
                 t: t1,
                 h,
-                reason: format!(
-                    "no convergence in {MAX_ITER} iterations (last increments: {:.3e} m, {:.3e} N)",
-                    last.0, last.1
-                ),
+                reason: NewtonFailure::NoConvergence {
+                    iterations: MAX_ITER,
+                    dq: last.0,
+                    dl: last.1,
+                },
             });
         }
         let apq = ga.a_per_qdd();
@@ -698,6 +706,7 @@ pub(crate) fn integrate(
     }
     stats.symbolic_factorisations = star.symbolic_count;
     stats.sparse_fallbacks = star.sparse_fallbacks;
+    stats.last_fallback = star.last_fallback;
     Ok(History {
         samples: rec.samples,
         snapshots: rec.snapshots,

@@ -22,6 +22,7 @@ use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, MatRef, Par, Side};
 use flexstar_numerics::eigen::ConstrainedModes;
 
+use crate::error::LinearError;
 use crate::sparse::SparseLu;
 
 /// Relative change of the requested Ritz values `omega^2 + sigma` in one iteration below which
@@ -57,7 +58,7 @@ fn block_size(count: usize, free: usize) -> usize {
 
 /// M-orthonormalise the columns of `y` in place (modified Gram-Schmidt, two passes); returns R
 /// (p x p upper triangular) with `Y_in = Q R`, `Q^T M Q = I`.
-fn m_orthonormalise(m: &Triplets, y: &mut [Vec<f64>]) -> Result<Mat<f64>, String> {
+fn m_orthonormalise(m: &Triplets, y: &mut [Vec<f64>]) -> Result<Mat<f64>, LinearError> {
     let p = y.len();
     let n = y.first().map_or(0, Vec::len);
     let mut r = Mat::<f64>::zeros(p, p);
@@ -75,9 +76,7 @@ fn m_orthonormalise(m: &Triplets, y: &mut [Vec<f64>]) -> Result<Mat<f64>, String
         mul(m, &y[j], &mut mj);
         let norm2: f64 = mj.iter().zip(&y[j]).map(|(a, b)| a * b).sum();
         if norm2.is_nan() || norm2 <= 0.0 {
-            return Err(format!(
-                "subspace vector {j} has no mass (M-norm^2 {norm2:e}): a massless mode"
-            ));
+            return Err(LinearError::Massless { vector: j, norm2 });
         }
         let norm = norm2.sqrt();
         r[(j, j)] = norm;
@@ -117,9 +116,9 @@ pub fn sparse_constrained_modes(
     rows: usize,
     count: usize,
     shift: f64,
-) -> Result<ConstrainedModes, String> {
+) -> Result<ConstrainedModes, LinearError> {
     if rows >= n || shift.is_nan() || shift < 0.0 {
-        return Err(format!("{rows} constraint rows for {n} coordinates, shift {shift:e}"));
+        return Err(LinearError::ModalSizes { rows, n, shift });
     }
     let free = n - rows;
     let count = count.min(free);
@@ -141,7 +140,7 @@ pub fn sparse_constrained_modes(
         let y = apply(&mut lu, &bordered, &mx, n, np, p);
         let mut y: Vec<Vec<f64>> = y.chunks_exact(np).map(|c| c[..n].to_vec()).collect();
         if y.iter().flatten().any(|v| !v.is_finite()) {
-            return Err("the bordered system K + sigma M with the constraints is singular".into());
+            return Err(LinearError::BorderedNonFinite);
         }
         let r = m_orthonormalise(m, &mut y)?;
         let q = Mat::from_fn(n, p, |i, j| y[j][i]);
@@ -151,9 +150,7 @@ pub fn sparse_constrained_modes(
         // projected stiffness Q^T A Q (p x p), symmetrised
         let kr = &aq_t * &q;
         let kr = Mat::from_fn(p, p, |i, j| 0.5 * (kr[(i, j)] + kr[(j, i)]));
-        let eig = kr
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|e| format!("projected eigenproblem failed ({e:?})"))?;
+        let eig = kr.self_adjoint_eigen(Side::Lower).map_err(LinearError::Projected)?;
         let theta: Vec<f64> = (0..p).map(|j| eig.S()[j]).collect();
         let xm = &q * eig.U();
         for (j, xj) in x.chunks_exact_mut(n).enumerate() {
@@ -186,7 +183,7 @@ pub fn sparse_constrained_modes(
             });
         }
     }
-    Err(format!("subspace iteration did not converge in {MAX_ITER} iterations"))
+    Err(LinearError::NoConvergence { iterations: MAX_ITER })
 }
 
 /// `Y = Op X` for the p columns of `M X` (`mx`, n x p column-major): the bordered solve with one
@@ -218,13 +215,16 @@ fn scaled_system(
     c: &Triplets,
     rows: usize,
     shift: f64,
-) -> Result<(Vec<f64>, Triplets, Triplets), String> {
+) -> Result<(Vec<f64>, Triplets, Triplets), LinearError> {
     let mut diag = vec![0.0; n];
     for &(r, col, v) in m.iter().chain(k).chain(c) {
         if !v.is_finite() || col >= n || r >= n {
-            return Err(format!(
-                "entry ({r}, {col}) = {v:e}: non-finite or outside {n} coordinates"
-            ));
+            return Err(LinearError::ModalEntry {
+                row: r,
+                col,
+                value: v,
+                n,
+            });
         }
     }
     for &(r, col, v) in m {
@@ -240,12 +240,12 @@ fn scaled_system(
     let mut row_norm = vec![0.0; rows];
     for &(r, col, v) in c {
         if r >= rows {
-            return Err(format!("constraint entry in row {r} of {rows}"));
+            return Err(LinearError::ConstraintRowOutside { row: r, rows });
         }
         row_norm[r] += (v * d[col]).powi(2);
     }
     if let Some(r) = row_norm.iter().position(|v| *v == 0.0) {
-        return Err(format!("constraint row {} is empty", r + 1));
+        return Err(LinearError::EmptyConstraintRow { row: r + 1 });
     }
     let mut bordered = Triplets::with_capacity(k.len() + m.len() + 2 * c.len());
     bordered.extend(k.iter().map(|&(r, col, v)| (r, col, v * d[r] * d[col])));
@@ -259,12 +259,12 @@ fn scaled_system(
 }
 
 /// Sparse LU of a square matrix of size `size` given as triplets.
-fn bordered_lu(size: usize, a: &Triplets) -> Result<SparseLu, String> {
+fn bordered_lu(size: usize, a: &Triplets) -> Result<SparseLu, LinearError> {
     let slots: Vec<(usize, usize)> = a.iter().map(|&(r, col, _)| (r, col)).collect();
     let vals: Vec<f64> = a.iter().map(|t| t.2).collect();
     let mut lu = SparseLu::new(size, &slots)?;
     lu.factor(&vals)
-        .map_err(|e| format!("the bordered system is singular ({e}): a mechanism or dependent constraints"))?;
+        .map_err(|e| LinearError::BorderedSingular { source: Box::new(e) })?;
     Ok(lu)
 }
 

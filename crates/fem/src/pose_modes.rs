@@ -255,7 +255,7 @@ pub fn pose_modes(
         count + rigid,
         rigid_shift(sliders == Sliders::Free),
     )
-    .map_err(|reason| FemError::LinearSolver { t: 0.0, reason })?;
+    .map_err(|source| FemError::LinearSolver { t: 0.0, source })?;
     Ok(finish(sparse, out, rigid))
 }
 
@@ -280,7 +280,10 @@ pub fn pose_modes_dense(
         count + rigid,
         rigid_shift(sliders == Sliders::Free),
     )
-    .map_err(|reason| FemError::LinearSolver { t: 0.0, reason })?;
+    .map_err(|e| FemError::LinearSolver {
+        t: 0.0,
+        source: e.into(),
+    })?;
     Ok(finish(sparse, out, rigid))
 }
 

@@ -80,12 +80,8 @@ pub fn solve_with_stats(
     // of the requested motion only (the FEM's equations never use the rigid kinematics)
     check_trajectory(params, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))
         .map_err(|e| FemError::Input(e.to_string()))?;
-    let rigid = |t: f64| {
-        RigidState::at(params, &exp.trajectory, t).map_err(|e| FemError::PostProcessing {
-            t,
-            reason: e.to_string(),
-        })
-    };
+    let rigid =
+        |t: f64| RigidState::at(params, &exp.trajectory, t).map_err(|source| FemError::PostProcessing { t, source });
     let r0 = rigid(0.0)?;
     let (t_out, snaps) = times(exp, settings);
     let motion = Motion::Prescribed(&exp.trajectory);
@@ -158,10 +154,7 @@ pub fn solve_direct_with_stats(
 
     // post-processing with the rigid kinematics of the simulated sliders
     let frame = |t: f64, s: [f64; 3]| {
-        let pose = direct_kinematics(params.d, s).ok_or_else(|| FemError::PostProcessing {
-            t,
-            reason: format!("no rigid configuration for the simulated sliders s = {s:?} m"),
-        })?;
+        let pose = direct_kinematics(params.d, s).ok_or(FemError::NoRigidConfiguration { t, s })?;
         Ok(Frame {
             g: pose.g,
             theta: pose.theta,

@@ -7,6 +7,8 @@ use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{MatMut, Par};
 
+use crate::error::LinearError;
+
 /// A square sparse matrix given as a fixed list of (row, col) slots (duplicates are summed),
 /// with its LU factorisation.
 pub struct SparseLu {
@@ -24,11 +26,11 @@ pub struct SparseLu {
 
 impl SparseLu {
     /// Build the pattern of an `n x n` matrix from its slots, and its symbolic factorisation.
-    pub fn new(n: usize, slots: &[(usize, usize)]) -> Result<Self, String> {
+    pub fn new(n: usize, slots: &[(usize, usize)]) -> Result<Self, LinearError> {
         let mut cols: Vec<Vec<usize>> = vec![Vec::new(); n];
         for &(r, c) in slots {
             if r >= n || c >= n {
-                return Err(format!("slot ({r}, {c}) outside a {n} x {n} matrix"));
+                return Err(LinearError::SlotOutside { row: r, col: c, n });
             }
             cols[c].push(r);
         }
@@ -50,7 +52,8 @@ impl SparseLu {
             .collect();
         let nnz = row_idx.len();
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        let lu_symbolic = factorize_symbolic_lu(symbolic.as_ref(), Default::default()).map_err(|e| format!("{e:?}"))?;
+        let lu_symbolic =
+            factorize_symbolic_lu(symbolic.as_ref(), Default::default()).map_err(LinearError::Symbolic)?;
         let factor_mem = MemBuffer::new(lu_symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()));
         let solve_mem = MemBuffer::new(lu_symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
         Ok(SparseLu {
@@ -68,14 +71,14 @@ impl SparseLu {
 
     /// Numeric factorisation of the matrix whose slot values are `slot_values` (same order as
     /// the slots given to [`SparseLu::new`]).
-    pub fn factor(&mut self, slot_values: &[f64]) -> Result<(), String> {
+    pub fn factor(&mut self, slot_values: &[f64]) -> Result<(), LinearError> {
         debug_assert_eq!(slot_values.len(), self.map.len());
         self.values.iter_mut().for_each(|v| *v = 0.0);
         for (k, &v) in slot_values.iter().enumerate() {
             self.values[self.map[k]] += v;
         }
         if let Some(bad) = self.values.iter().position(|v| !v.is_finite()) {
-            return Err(format!("non-finite matrix entry at value index {bad}"));
+            return Err(LinearError::NonFiniteEntry { index: bad });
         }
         let mat = SparseColMatRef::new(self.symbolic.as_ref(), &self.values);
         self.factored = false;
@@ -87,7 +90,7 @@ impl SparseLu {
                 MemStack::new(&mut self.factor_mem),
                 Default::default(),
             )
-            .map_err(|e| format!("{e:?}"))?;
+            .map_err(LinearError::Numeric)?;
         self.factored = true;
         Ok(())
     }

@@ -45,6 +45,7 @@ use flexstar_model::RobotParams;
 use crate::bordered::{Bordered, Layout, SLIDER_SLOTS};
 use crate::element::{Element, ElementState};
 use crate::element_pass::{self, NodeState, Section};
+use crate::integrator::Fallback;
 use crate::sparse::SparseLu;
 use crate::FemError;
 
@@ -122,6 +123,8 @@ pub(crate) struct Star {
     use_sparse: bool,
     /// Factorisations that fell back to the sparse LU.
     pub sparse_fallbacks: usize,
+    /// The last fallback's time and failing pivot.
+    pub last_fallback: Option<Fallback>,
     slots: Vec<(usize, usize)>,
     pub vals: Vec<f64>,
     /// Offsets of the slot groups.
@@ -213,6 +216,7 @@ impl Star {
             lu: None,
             use_sparse: false,
             sparse_fallbacks: 0,
+            last_fallback: None,
             slots: Vec::new(),
             vals: Vec::new(),
             off_psi: 0,
@@ -272,7 +276,7 @@ impl Star {
     /// Rebuild the pattern (slot layout of the constraint rows) if a contact point left its
     /// window; the sparse LU's symbolic factorisation is then redone on demand. Returns whether
     /// the pattern was rebuilt.
-    fn ensure_pattern(&mut self, q: &[f64]) -> Result<bool, String> {
+    fn ensure_pattern(&mut self, q: &[f64]) -> bool {
         let mut rebuild = self.bordered.is_none();
         for i in 0..3 {
             for p in 0..3 {
@@ -285,7 +289,7 @@ impl Star {
             }
         }
         if !rebuild {
-            return Ok(false);
+            return false;
         }
         if self.bordered.is_none() {
             self.build_pattern();
@@ -297,7 +301,7 @@ impl Star {
         }
         self.lu = None;
         self.symbolic_count += 1;
-        Ok(true)
+        true
     }
 
     /// The whole slot layout and the structured solver, at the first assembly: element blocks,
@@ -411,9 +415,7 @@ impl Star {
         t: f64,
         matrix: bool,
     ) -> Result<bool, FemError> {
-        let rebuilt = self
-            .ensure_pattern(q)
-            .map_err(|reason| FemError::LinearSolver { t, reason })?;
+        let rebuilt = self.ensure_pattern(q);
         let matrix = matrix || rebuilt;
         res.iter_mut().for_each(|r| *r = 0.0);
         let nodes = NodeState { q, v, qdd };
@@ -572,18 +574,22 @@ impl Star {
     /// where the structured one fails (its error then only explains the fallback).
     pub fn factor(&mut self, t: f64) -> Result<(), FemError> {
         let bordered = self.bordered.as_mut().expect("assemble before factor");
-        self.use_sparse = bordered.factor(&self.vals, &self.win).is_err();
-        if !self.use_sparse {
-            return Ok(());
-        }
+        let reason = match bordered.factor(&self.vals, &self.win) {
+            Ok(()) => {
+                self.use_sparse = false;
+                return Ok(());
+            }
+            Err(reason) => reason,
+        };
+        self.use_sparse = true;
         self.sparse_fallbacks += 1;
+        self.last_fallback = Some(Fallback { t, reason });
+        let failed = |source| FemError::LinearSolver { t, source };
         if self.lu.is_none() {
-            self.lu =
-                Some(SparseLu::new(self.n_sys, &self.slots).map_err(|reason| FemError::LinearSolver { t, reason })?);
+            self.lu = Some(SparseLu::new(self.n_sys, &self.slots).map_err(failed)?);
         }
         let lu = self.lu.as_mut().expect("sparse LU built above");
-        lu.factor(&self.vals)
-            .map_err(|reason| FemError::LinearSolver { t, reason })
+        lu.factor(&self.vals).map_err(failed)
     }
 
     /// Solve with the last factorisation, in place.

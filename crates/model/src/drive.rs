@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::ModelError;
+use crate::error::{ModelError, SampleError};
 
 /// Which drive (`drive.kind`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -60,23 +60,26 @@ pub struct ForceSamples {
 impl ForceSamples {
     /// Check samples: as many rows as times, at least two, finite values, strictly increasing
     /// times. The error names the (1-based) row and the reason.
-    pub fn check(t: &[f64], fa: &[[f64; 3]]) -> Result<(), String> {
+    pub fn check(t: &[f64], fa: &[[f64; 3]]) -> Result<(), SampleError> {
         if t.len() != fa.len() {
-            return Err(format!("{} times but {} force rows", t.len(), fa.len()));
+            return Err(SampleError::Lengths {
+                times: t.len(),
+                rows: fa.len(),
+            });
         }
         if t.len() < 2 {
-            return Err(format!("need at least two samples, got {}", t.len()));
+            return Err(SampleError::TooFew(t.len()));
         }
         for (k, (tk, f)) in t.iter().zip(fa).enumerate() {
             if !tk.is_finite() || f.iter().any(|v| !v.is_finite()) {
-                return Err(format!("row {}: non-finite value", k + 1));
+                return Err(SampleError::NonFinite { row: k + 1 });
             }
             if k > 0 && *tk <= t[k - 1] {
-                return Err(format!(
-                    "row {}: time {tk} s does not increase (previous {} s)",
-                    k + 1,
-                    t[k - 1]
-                ));
+                return Err(SampleError::NotIncreasing {
+                    row: k + 1,
+                    t: *tk,
+                    previous: t[k - 1],
+                });
             }
         }
         Ok(())
@@ -84,12 +87,10 @@ impl ForceSamples {
 
     /// Check that samples starting at `first` and ending at `last` cover `[t0, t1]` [s], with a
     /// relative slack of 1e-9 for times written with fewer digits than the solver keeps.
-    pub fn check_covers(first: f64, last: f64, t0: f64, t1: f64) -> Result<(), String> {
+    pub fn check_covers(first: f64, last: f64, t0: f64, t1: f64) -> Result<(), SampleError> {
         let slack = 1e-9 * t1.abs().max(1.0);
         if first > t0 + slack || last < t1 - slack {
-            return Err(format!(
-                "samples span [{first}, {last}] s but the run needs [{t0}, {t1}] s"
-            ));
+            return Err(SampleError::Span { first, last, t0, t1 });
         }
         Ok(())
     }
@@ -137,7 +138,7 @@ impl ForceSamples {
             t.push(num(0)?);
             fa.push([num(idx[0])?, num(idx[1])?, num(idx[2])?]);
         }
-        Self::check(&t, &fa).map_err(bad)?;
+        Self::check(&t, &fa).map_err(|e| bad(e.to_string()))?;
         Ok(ForceSamples { t, fa })
     }
 }

@@ -36,6 +36,17 @@ impl ModelError {
         }
     }
 
+    /// The message without the file, for a caller that names the file itself: key and reason of
+    /// an [`ModelError::Invalid`], the message of a [`ModelError::Parse`], the whole message
+    /// otherwise.
+    pub fn detail(&self) -> String {
+        match self {
+            ModelError::Invalid { key, reason, .. } => format!("key `{key}`: {reason}"),
+            ModelError::Parse { message, .. } => message.clone(),
+            other => other.to_string(),
+        }
+    }
+
     /// Attach the file name to an error raised before it was known.
     pub fn in_file(self, path: &std::path::Path) -> Self {
         match self {
@@ -47,4 +58,24 @@ impl ModelError {
             other => other,
         }
     }
+}
+
+/// Why a table of force samples (`[drive] file`, a force table) cannot be used; rows are 1-based.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SampleError {
+    /// Times and force rows differ in number.
+    #[error("{times} times but {rows} force rows")]
+    Lengths { times: usize, rows: usize },
+    /// Fewer than two samples.
+    #[error("need at least two samples, got {0}")]
+    TooFew(usize),
+    /// A NaN or infinite time or force in row `row`.
+    #[error("row {row}: non-finite value")]
+    NonFinite { row: usize },
+    /// The time of row `row` [s] is not above the previous one.
+    #[error("row {row}: time {t} s does not increase (previous {previous} s)")]
+    NotIncreasing { row: usize, t: f64, previous: f64 },
+    /// The samples span `[first, last]` [s] but the run needs `[t0, t1]` [s].
+    #[error("samples span [{first}, {last}] s but the run needs [{t0}, {t1}] s")]
+    Span { first: f64, last: f64, t0: f64, t1: f64 },
 }

@@ -22,7 +22,7 @@ pub mod validity;
 
 pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, ModeFamily, TimeSpan};
 pub use drive::{DriveKind, DriveSettings, Feedforward, ForceSamples};
-pub use error::ModelError;
+pub use error::{ModelError, SampleError};
 pub use params::RobotParams;
 pub use response::{BeamShape, Column, Response, RunInfo, StarShape};
 pub use rest_pose::{RestPose, Sliders};

@@ -13,6 +13,8 @@
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Mat, Par, Side};
 
+use crate::NumericsError;
+
 /// Modes of the star at a pose, from either solver (`S`: the solver's assembled system).
 #[derive(Debug, Clone)]
 pub struct PoseModes<S> {
@@ -114,7 +116,7 @@ impl Reflector {
 
 /// Householder QR of `C^T` (`c`: r x n, row-major): the reflectors, and the number of rows
 /// kept. Fails when a row is (numerically) a combination of the others.
-fn null_space_reflectors(n: usize, c: &[f64], rows: usize) -> Result<Vec<Reflector>, String> {
+fn null_space_reflectors(n: usize, c: &[f64], rows: usize) -> Result<Vec<Reflector>, NumericsError> {
     // columns of C^T = rows of C
     let mut cols: Vec<Vec<f64>> = c.chunks_exact(n).map(|r| r.to_vec()).collect();
     let scale = cols
@@ -126,10 +128,7 @@ fn null_space_reflectors(n: usize, c: &[f64], rows: usize) -> Result<Vec<Reflect
         let x = &cols[j][j..];
         let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
         if norm.is_nan() || norm <= 1e-11 * scale {
-            return Err(format!(
-                "constraint row {} of {rows} is a combination of the others (residual norm {norm:e})",
-                j + 1
-            ));
+            return Err(NumericsError::DependentRow { row: j + 1, rows, norm });
         }
         let alpha = if x[0] > 0.0 { -norm } else { norm };
         let mut v = x.to_vec();
@@ -156,7 +155,7 @@ fn null_space_reflectors(n: usize, c: &[f64], rows: usize) -> Result<Vec<Reflect
 /// `L_M^-1 K L_M^-T` loses them when M is ill-conditioned, as a FEM mass matrix with rotational
 /// degrees of freedom is). Coordinates are scaled by `1/sqrt(M_ii)` (Jacobi) first.
 ///
-/// Errors (as text, the caller adds context): dependent constraint rows, `K + sigma M` not
+/// Errors ([`NumericsError`], the caller adds when and where): dependent constraint rows, `K + sigma M` not
 /// positive definite on the constrained motions, an eigensolver failure, non-finite input.
 pub fn constrained_modes(
     n: usize,
@@ -166,17 +165,18 @@ pub fn constrained_modes(
     rows: usize,
     count: usize,
     shift: f64,
-) -> Result<ConstrainedModes, String> {
+) -> Result<ConstrainedModes, NumericsError> {
     if m.len() != n * n || k.len() != n * n || c.len() != rows * n || rows >= n {
-        return Err(format!(
-            "inconsistent sizes: n = {n}, M {}, K {}, C {} with {rows} rows",
-            m.len(),
-            k.len(),
-            c.len()
-        ));
+        return Err(NumericsError::Sizes {
+            n,
+            m: m.len(),
+            k: k.len(),
+            c: c.len(),
+            rows,
+        });
     }
     if m.iter().chain(k).chain(c).any(|v| !v.is_finite()) || shift.is_nan() || shift < 0.0 {
-        return Err("non-finite entry in M, K or C, or a negative shift".into());
+        return Err(NumericsError::NonFinite);
     }
     // Jacobi scaling q = D q~ (massless coordinates keep scale 1)
     let d: Vec<f64> = (0..n)
@@ -201,9 +201,9 @@ pub fn constrained_modes(
     let mr = mq.as_ref().submatrix(rows, rows, p, p).to_owned();
     let kr = kq.as_ref().submatrix(rows, rows, p, p);
     let ks = Mat::from_fn(p, p, |i, j| kr[(i, j)] + shift * mr[(i, j)]);
-    let llt = ks.llt(Side::Lower).map_err(|e| {
-        format!("K + {shift:e} M is not positive definite on the constrained motions ({e:?}): a mechanism, or too small a shift")
-    })?;
+    let llt = ks
+        .llt(Side::Lower)
+        .map_err(|source| NumericsError::NotPositiveDefinite { shift, source })?;
     let l = llt.L();
     // S = L^-1 Mr L^-T
     let mut s = mr;
@@ -213,7 +213,10 @@ pub fn constrained_modes(
     let sym = Mat::from_fn(p, p, |i, j| 0.5 * (st[(i, j)] + st[(j, i)]));
     let eig = sym
         .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| format!("symmetric eigensolver failed ({e:?})"))?;
+        .map_err(|cause| NumericsError::Eigensolver {
+            what: "symmetric eigensolver",
+            cause,
+        })?;
     let count = count.min(p);
     // largest mu first
     let order: Vec<usize> = (0..count).map(|j| p - 1 - j).collect();
@@ -291,6 +294,10 @@ mod tests {
         let k = m;
         let c = [1.0, 1.0, 0.0, 2.0, 2.0, 0.0];
         let err = constrained_modes(n, &m, &k, &c, 2, 1, 0.0).unwrap_err();
-        assert!(err.contains("combination"), "{err}");
+        assert!(
+            matches!(err, NumericsError::DependentRow { row: 2, rows: 2, .. }),
+            "{err}"
+        );
+        assert!(err.to_string().contains("combination"), "{err}");
     }
 }

@@ -7,10 +7,12 @@
 //! FEM's element kernels.
 
 pub mod eigen;
+pub mod error;
 pub mod gen_alpha;
 pub mod lanes;
 pub mod measures;
 pub mod quadrature;
 pub mod vector;
 
+pub use error::NumericsError;
 pub use gen_alpha::GenAlpha;

@@ -218,24 +218,37 @@ fn finish_table(results: &std::path::Path, mine: &[&Case], solvers: &[Solver]) -
 }
 
 /// A solver's outcome: the response or why there is none, and the wall time [s].
-type Solved = (Result<Response, String>, f64);
+type Solved = (Result<Response, Failure>, f64);
+
+/// Why a case has no response for a solver: its status in the table.
+#[derive(Debug, thiserror::Error)]
+enum Failure {
+    /// The case's experiment could not be built from the study's values.
+    #[error("invalid: {0}")]
+    Invalid(String),
+    /// The solver stopped with an error.
+    #[error("failed: {0}")]
+    Solver(#[from] flexstar_compare::runs::SolveError),
+    /// The solver panicked (its message, if it had one).
+    #[error("failed: the solver panicked: {0}")]
+    Panicked(String),
+}
 
 fn solve(exp: &Experiment, solver: Solver) -> Solved {
     let started = Instant::now();
     let result = catch_unwind(AssertUnwindSafe(|| match solver {
-        Solver::Amm => flexstar_compare::runs::solve_amm(exp, &exp.amm).map_err(|e| e.to_string()),
-        Solver::Fem => flexstar_compare::runs::solve_fem(exp, &exp.fem, None).map_err(|e| e.to_string()),
+        Solver::Amm => flexstar_compare::runs::solve_amm(exp, &exp.amm),
+        Solver::Fem => flexstar_compare::runs::solve_fem(exp, &exp.fem, None),
     }));
     let result = match result {
-        Ok(Ok(r)) => Ok(r),
-        Ok(Err(e)) => Err(format!("failed: {e}")),
-        Err(panic) => Err(format!(
-            "failed: the solver panicked: {}",
+        Ok(r) => r.map_err(Failure::from),
+        Err(panic) => Err(Failure::Panicked(
             panic
                 .downcast_ref::<String>()
                 .map(String::as_str)
                 .or_else(|| panic.downcast_ref::<&str>().copied())
                 .unwrap_or("(no message)")
+                .to_string(),
         )),
     };
     (result, started.elapsed().as_secs_f64())
@@ -251,7 +264,7 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
         .map(|&s| {
             let out = match &exp {
                 Ok(e) => solve(e, s),
-                Err(reason) => (Err(format!("invalid: {reason}")), 0.0),
+                Err(reason) => (Err(Failure::Invalid(reason.clone())), 0.0),
             };
             (s, out)
         })
@@ -295,7 +308,8 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
                     row.modes = r.info.modes;
                     row.error_estimate_percent = r.info.error_estimate_percent;
                 }
-                Err(reason) => row.status = reason.replace(['\n', '\r'], " "),
+                // one line per row of the table
+                Err(failure) => row.status = failure.to_string().replace(['\n', '\r'], " "),
             }
             row
         })

@@ -337,7 +337,11 @@ fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[0] + a[1] * b[1]
 }
 
+/// An output angle wrapped by [`flexstar_numerics::angle::wrap`], first shifted by pi and back:
+/// the shift rounds the angle as the output's earlier formula `(a + pi) mod 2 pi - pi` did, so
+/// that the written columns stay bit for bit those of earlier versions (the two differ only by
+/// that rounding, at most half an ulp of pi, and at -pi, which the wrap sends to pi).
 fn wrap(a: f64) -> f64 {
     use std::f64::consts::PI;
-    (a + PI).rem_euclid(2.0 * PI) - PI
+    flexstar_numerics::angle::wrap((a + PI) - PI)
 }

@@ -182,6 +182,15 @@ pub struct DriveSettings {
     pub samples: Option<ForceSamples>,
 }
 
+/// Servo gains from a closed-loop bandwidth `f_bw` [Hz] and damping ratio `zeta` for a slider of
+/// mass `m` [kg] treated as a free mass: `kp = m (2 pi f_bw)^2` [N/m], `kd = 2 zeta m (2 pi f_bw)`
+/// [N s/m] (poles of `m s'' + kd s' + kp s = 0` at natural frequency `2 pi f_bw`, damping
+/// `zeta`). The one place of this formula.
+pub fn gains_from_bandwidth(m: f64, f_bw: f64, zeta: f64) -> (f64, f64) {
+    let wn = 2.0 * std::f64::consts::PI * f_bw;
+    (m * wn * wn, 2.0 * zeta * m * wn)
+}
+
 /// Servo gains resolved from `kp`, `kd` or from `bandwidth_hz`, `damping_ratio`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ServoGains {
@@ -338,11 +347,8 @@ impl DriveSettings {
             }),
             (None, None, Some(f), Some(z)) => {
                 let (f, z) = (positive("bandwidth_hz", f)?, positive("damping_ratio", z)?);
-                let wn = 2.0 * std::f64::consts::PI * f;
-                Ok(ServoGains {
-                    kp: m * wn * wn,
-                    kd: 2.0 * z * m * wn,
-                })
+                let (kp, kd) = gains_from_bandwidth(m, f, z);
+                Ok(ServoGains { kp, kd })
             }
             (Some(_), Some(_), _, _) => Err(ModelError::invalid(
                 "drive.bandwidth_hz",

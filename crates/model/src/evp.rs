@@ -13,7 +13,7 @@
 //!   tip peak of the same case) has no EVP ("n/a") and leaves the mean.
 
 use crate::Response;
-use flexstar_numerics::measures::max_abs;
+use flexstar_numerics::measures::{evp_of_error, max_abs};
 
 /// Relative size below which a reference response counts as zero (G in case 1 by symmetry, tip C
 /// in case 4): 1 % of the largest tip peak of the same FEM run.
@@ -40,8 +40,6 @@ impl Point {
         }
     }
 }
-
-pub use flexstar_numerics::measures::{evp, integral_abs};
 
 /// Norm of the elastic displacement vector of G from its three projections w_iG [m].
 pub fn g_norm(w: [f64; 3]) -> f64 {
@@ -114,8 +112,7 @@ pub fn point_evps(test: &Response, reference: &Response) -> Result<PointEvps, Co
             return None;
         }
         let err = error_history(test, reference, p);
-        let den = integral_abs(t, &reference_h);
-        (den > 0.0).then(|| integral_abs(t, &err) / den * 100.0)
+        evp_of_error(t, &err, &reference_h)
     });
     let used: Vec<f64> = points.iter().flatten().copied().collect();
     let mean = (!used.is_empty()).then(|| used.iter().sum::<f64>() / used.len() as f64);

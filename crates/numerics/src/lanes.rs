@@ -335,6 +335,20 @@ pub fn has_avx2() -> bool {
     }
 }
 
+/// [`has_avx2`] and the processor also has FMA (detected once at run time): the choice of the
+/// fused kernels of [`crate::vector`], so that [`force_baseline`] covers them too.
+#[inline]
+pub fn has_avx2_fma() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        has_avx2() && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// Run a function body compiled twice, for AVX2 and for the baseline of the build, choosing at
 /// run time ([`has_avx2`]). Two forms:
 /// - a function item, `dispatch_avx2! { /// docs\n pub fn name(a: &mut [f64], x: f64) -> f64 { body } }`,

@@ -6,6 +6,7 @@
 //! processor's fused multiply-add where it has one, and the one-or-four-lanes number type of the
 //! FEM's element kernels.
 
+pub mod angle;
 pub mod eigen;
 pub mod error;
 pub mod gen_alpha;

@@ -14,8 +14,16 @@ pub fn integral_abs(t: &[f64], f: &[f64]) -> f64 {
 /// reference integral vanishes.
 pub fn evp(t: &[f64], test: &[f64], reference: &[f64]) -> Option<f64> {
     let diff: Vec<f64> = test.iter().zip(reference).map(|(a, b)| a - b).collect();
+    evp_of_error(t, &diff, reference)
+}
+
+/// Eq. 45 from the error history itself: `int |error| dt / int |reference| dt * 100` [%], for a
+/// caller whose error is not a plain difference (the norm of G's displacement difference,
+/// `flexstar_model::evp`); `None` when the reference integral vanishes. The one implementation of
+/// the ratio.
+pub fn evp_of_error(t: &[f64], error: &[f64], reference: &[f64]) -> Option<f64> {
     let den = integral_abs(t, reference);
-    (den > 0.0).then(|| integral_abs(t, &diff) / den * 100.0)
+    (den > 0.0).then(|| integral_abs(t, error) / den * 100.0)
 }
 
 /// Largest |v|.

@@ -7,6 +7,12 @@
 //! round differently (the fused one rounds once per product-sum), so results agree to a few ulps
 //! of the sum of |products|, not bit for bit, across processors; on one processor they are
 //! reproducible.
+//!
+//! The choice is [`crate::lanes::has_avx2_fma`], so [`crate::lanes::force_baseline`] selects the
+//! portable loop here too. The kernels are not bodies of `dispatch_avx2!`: that macro compiles
+//! one portable body twice and lets the compiler vectorise it for AVX2, which never fuses a
+//! multiply with an add (no FMA target feature, and Rust does not contract `a * b + c`); the
+//! fused sums need the explicit FMA intrinsics below.
 
 /// `sum_k a[k] b[k]` over the shorter length.
 #[inline]
@@ -15,8 +21,8 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     let (a, b) = (&a[..n], &b[..n]);
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-            // SAFETY: the processor has AVX2 and FMA (checked just above), and a, b have length n.
+        if crate::lanes::has_avx2_fma() {
+            // SAFETY: the processor has AVX2 and FMA (has_avx2_fma, just above), and a, b have length n.
             return unsafe { dot_avx2_fma(a, b) };
         }
     }
@@ -32,8 +38,8 @@ pub fn dots<const K: usize>(a: &[f64], b: [&[f64]; K]) -> [f64; K] {
     let b = b.map(|v| &v[..n]);
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-            // SAFETY: the processor has AVX2 and FMA (checked just above); every slice has length n.
+        if crate::lanes::has_avx2_fma() {
+            // SAFETY: the processor has AVX2 and FMA (has_avx2_fma, just above); every slice has length n.
             return unsafe { dots_avx2_fma(a, b) };
         }
     }

@@ -15,7 +15,6 @@
 
 #![allow(clippy::needless_range_loop)] // index loops over DOFs read like the equations
 
-pub mod beam;
 mod bordered;
 pub mod element;
 mod element_pass;

@@ -1,6 +1,10 @@
 //! Single-beam self-checks of the co-rotational element against outside references.
 
-use flexstar_fem::beam::{bending_frequencies, end_moment_static, BeamSupport};
+// the single-beam models are test code: they live in the test tree (issue 25 item 4)
+#[path = "support/beam.rs"]
+mod beam;
+
+use beam::{bending_frequencies, end_moment_static, BeamSupport};
 use flexstar_model::RobotParams;
 
 /// beta L of the first four bending modes (Blevins 1979, Formulas for Natural Frequency and Mode

@@ -1,13 +1,13 @@
 //! One straight beam of the star's cross-section and length, meshed with the co-rotational
-//! element of [`crate::element`]: the element's self-checks (natural frequencies of the
+//! element of [`flexstar_fem::element`]: the element's self-checks (natural frequencies of the
 //! linearised element, large-rotation statics). The star model uses the very same element code.
 
 use nalgebra::{DMatrix, DVector};
 
 use flexstar_model::RobotParams;
 
-use crate::element::{Element, ElementState};
-use crate::{FemError, NewtonFailure};
+use flexstar_fem::element::{Element, ElementState};
+use flexstar_fem::{FemError, NewtonFailure};
 
 /// Boundary conditions of a single beam for the frequency check.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

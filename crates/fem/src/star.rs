@@ -771,4 +771,93 @@ mod tests {
         // indefinite, the banded Cholesky refuses it and the sparse LU solves instead
         assert!(solve_and_check(1e-4, false), "expected the fallback");
     }
+
+    /// The constraint Jacobian of [`Star::row_terms`] (the rows' element gradients, contact
+    /// coordinate and sleeve-rotation derivatives, assembled as [`Star::assemble`] does) against
+    /// central differences of the constraint residual [`Star::constraints`] (Eq. 21), column by
+    /// column over every coordinate, at three states of paper case 3 (rigid poses at t = 0.1, 0.3,
+    /// 0.5 s, the nodes displaced by up to 2 mm and 0.02 rad, the sleeves turned): two
+    /// independent codes (values against derivatives).
+    ///
+    /// Tolerance: with the step `h = 1e-6` (metres or radians) the central difference errs by
+    /// `h^2 |d3 Phi| / 6 + eps |Phi| / h`; the rows are positions of order 0.5 m and angles of
+    /// order 1 rad, cubic in the element's local coordinate, so their third derivatives are of
+    /// order 1 / h_el^2 ~ 1e4 at 40 elements per beam: a truncation below ~2e-9, a round-off
+    /// ~2e-16 / 1e-6 ~ 2e-10. `1e-6 (1 + |J|)` holds both with margin, while a wrong or missing
+    /// derivative (entries of order 1e-3 to 1) is far above it.
+    #[test]
+    fn row_terms_match_central_differences_of_the_constraints() {
+        let exp = flexstar_model::catalogue::paper_case(3);
+        let params = exp.robot;
+        let ne = 40;
+        let h = 1e-6;
+        let mut checked = 0;
+        for (n, &t) in [0.1, 0.3, 0.5].iter().enumerate() {
+            let r = flexstar_kinematics::RigidState::at(&params, &exp.trajectory, t).unwrap();
+            let init = InitialState {
+                g: [r.g[0].v, r.g[1].v],
+                g_dot: [0.0; 2],
+                theta: r.theta.v,
+                theta_dot: 0.0,
+                xp: r.xp.map(|x| x.v),
+                xp_dot: [0.0; 3],
+            };
+            let pins = Pins::new(&params, r.s.map(|s| [s.v, s.d1, s.d2]));
+            let (star, mut q, _) = Star::new(&params, ne, &init, None).unwrap();
+            for (j, x) in q.iter_mut().enumerate().take(3 * star.n_nodes) {
+                let amp = if j % 3 == 2 { 0.02 } else { 2e-3 };
+                *x += amp * (0.7 * j as f64 + n as f64).sin();
+            }
+            for i in 0..3 {
+                q[star.psi(i)] += 0.01 * (i as f64 + 1.0);
+                // contact points well inside their elements (the Jacobian jumps at nodes)
+                for p in 0..3 {
+                    let (_, z) = star.locate(q[star.xi(i, p)]);
+                    if !(0.05..=0.95).contains(&z) {
+                        q[star.xi(i, p)] += 0.3 * star.h;
+                    }
+                }
+            }
+            // analytic Jacobian: 3 ROWS rows, n_dof columns
+            let nd = star.n_dof;
+            let mut jac = vec![vec![0.0; nd]; 3 * ROWS];
+            for i in 0..3 {
+                let ps = star.psi(i);
+                for r in 0..ROWS {
+                    let p = ROW_POINT[r];
+                    let (e, z) = star.locate(q[star.xi(i, p)]);
+                    let el = &star.elements[i * star.ne + e];
+                    let st = ElementState::new(el, &star.element_q(el, &q));
+                    let na = star.node(i, e);
+                    let (_, grad, gxi, gpsi) =
+                        star.row_terms(&st, [q[3 * na], q[3 * na + 1]], i, q[ps], pins.p[i], r, z);
+                    let row = &mut jac[ROWS * i + r];
+                    for (a, &d) in dofs(el).iter().enumerate() {
+                        row[d] += grad[a];
+                    }
+                    row[star.xi(i, p)] += gxi;
+                    row[ps] += gpsi;
+                }
+            }
+            for c in 0..nd {
+                let (mut qp, mut qm) = (q.clone(), q.clone());
+                qp[c] += h;
+                qm[c] -= h;
+                let (fp, fm) = (star.constraints(&qp, &pins), star.constraints(&qm, &pins));
+                for k in 0..3 * ROWS {
+                    let fd = (fp[k] - fm[k]) / (2.0 * h);
+                    let an = jac[k][c];
+                    assert!(
+                        (fd - an).abs() <= 1e-6 * (1.0 + an.abs()),
+                        "t = {t} s, row {k}, column {c}: analytic {an:e}, central difference {fd:e}"
+                    );
+                    if an.abs() > 1e-3 {
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        // every row has its 6 element entries, the contact coordinate and psi, at three states
+        assert!(checked >= 3 * 3 * ROWS * 6, "only {checked} entries above 1e-3");
+    }
 }

@@ -5,12 +5,13 @@
 //! `cargo run --release -p flexstar-compare --example servo_study -- OUT_DIR`
 //! (markdown tables on stdout, figures in OUT_DIR).
 
-use flexstar_compare::figures::{figure_tips, Figure, Panel, Run, Series, Style, FAMILY_COLORS, FEM_STYLE};
+use flexstar_compare::figures::{figure_tips, Run};
 use flexstar_drive::Servo;
 use flexstar_model::catalogue::paper_case;
 use flexstar_model::evp::point_evps;
 use flexstar_model::rest_pose::{RestPose, Sliders};
 use flexstar_model::{AmmSettings, Experiment, ModeFamily, Response};
+use flexstar_plot::{Figure, Panel, Series, Style, FAMILY_COLORS, FEM_STYLE};
 use rayon::prelude::*;
 
 const BANDWIDTHS: [f64; 8] = [2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 1000.0];

@@ -11,11 +11,11 @@ use flexstar_model::output::write_string_atomically;
 use flexstar_model::{small_deflection_check, Experiment, ModeFamily, Provenance, Response, ValidityExceeded};
 use serde::Serialize;
 
-use crate::figures::{
-    figure_forces, figure_star, figure_tips, figure_w_g, Figure, Run, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE,
-};
+use flexstar_plot::{Figure, RenderedFigure, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE};
+
+use crate::figures::{figure_forces, figure_star, figure_tips, figure_w_g, Run};
 use crate::runs::CaseResults;
-use crate::table::{opt_number, TableRow};
+use crate::table::{csv_text, opt_number, TableRow};
 use crate::Error;
 
 /// Header of `compare.csv` (issue 14 contract).
@@ -123,21 +123,19 @@ pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>,
 /// `compare.csv`: one row per AMM run, `model` = its file stem, EVPs in %, `n/a` where the FEM
 /// reference is negligible.
 pub fn compare_csv(row: &TableRow) -> String {
-    let mut s = format!("{COMPARE_CSV_HEADER}\n");
-    for e in &row.families {
+    let records = row.families.iter().map(|e| {
         let p = e.evp.points;
-        let _ = writeln!(
-            s,
-            "amm-{},{},{},{},{},{}",
-            e.label,
+        vec![
+            format!("amm-{}", e.label),
             opt_number(p[0]),
             opt_number(p[1]),
             opt_number(p[2]),
             opt_number(p[3]),
-            opt_number(e.evp.mean)
-        );
-    }
-    s
+            opt_number(e.evp.mean),
+        ]
+    });
+    let header: Vec<&str> = COMPARE_CSV_HEADER.split(',').collect();
+    csv_text(&header, records)
 }
 
 fn pct(v: Option<f64>) -> String {
@@ -145,7 +143,13 @@ fn pct(v: Option<f64>) -> String {
 }
 
 /// `compare.md`: what was run, the EVPs, the behaviour of G, the figures.
-pub fn compare_markdown(exp: &Experiment, case: &CaseResults, row: &TableRow, figures: &[Figure]) -> String {
+pub fn compare_markdown(
+    exp: &Experiment,
+    case: &CaseResults,
+    row: &TableRow,
+    warnings: &[ValidityWarning],
+    figures: &[RenderedFigure],
+) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# {}: AMM against FEM\n", exp.name);
     if !exp.description.is_empty() {
@@ -195,10 +199,9 @@ pub fn compare_markdown(exp: &Experiment, case: &CaseResults, row: &TableRow, fi
         m.w_g_rel,
         m.slope_rel.map(|v| format!("{v:.3e}")).unwrap_or_else(|| "n/a".into())
     );
-    let warnings = validity_warnings(exp, case);
     if !warnings.is_empty() {
         let _ = writeln!(s, "## Model validity\n");
-        for w in &warnings {
+        for w in warnings {
             let _ = writeln!(s, "- {} {}", w.run, w.exceeded);
         }
         let _ = writeln!(s);
@@ -269,9 +272,18 @@ pub fn compare_json(exp: &Experiment, case: &CaseResults, row: &TableRow, prov: 
     serde_json::to_string_pretty(&doc).expect("plain data serialises") + "\n"
 }
 
-/// Write every output of one case into `dir` (see the module docs); returns the figures (empty
-/// when `figures` is false) for a combined report. `report`: the HTML of this case's own report,
-/// built by the caller from the figures (so that `verify` and `compare` share the page layout).
+/// What [`write_case`] wrote that its callers show again, each computed once: the figures as
+/// drawn (the reports embed the SVG written to disk), the small-deflection warnings and the text
+/// of `compare.csv` (printed by the CLI).
+#[derive(Debug, Clone)]
+pub struct WrittenCase {
+    /// Empty when the figures were not asked for.
+    pub figures: Vec<RenderedFigure>,
+    pub warnings: Vec<ValidityWarning>,
+    pub compare_csv: String,
+}
+
+/// Write every output of one case into `dir` (see the module docs).
 pub fn write_case(
     dir: &Path,
     exp: &Experiment,
@@ -279,21 +291,28 @@ pub fn write_case(
     row: &TableRow,
     prov: &Provenance,
     figures: bool,
-) -> Result<Vec<Figure>, Error> {
+) -> Result<WrittenCase, Error> {
     for (stem, r) in runs_of(case) {
         r.write_csv(&dir.join(format!("{stem}.csv")))?;
         r.write_shapes_csv(&dir.join(format!("{stem}-shapes.csv")))?;
         r.write_sidecar(&dir.join(format!("{stem}.json")), exp, prov)?;
     }
-    let figs = if figures { case_figures(exp, case)? } else { Vec::new() };
+    let drawn = if figures { case_figures(exp, case)? } else { Vec::new() };
     let figdir = dir.join("figures");
-    for f in &figs {
-        f.write(&figdir)?;
-    }
-    write_string_atomically(&dir.join("compare.csv"), &compare_csv(row))?;
-    write_string_atomically(&dir.join("compare.md"), &compare_markdown(exp, case, row, &figs))?;
+    let figs = drawn.iter().map(|f| f.write(&figdir)).collect::<Result<Vec<_>, _>>()?;
+    let csv = compare_csv(row);
+    let warnings = validity_warnings(exp, case);
+    write_string_atomically(&dir.join("compare.csv"), &csv)?;
+    write_string_atomically(
+        &dir.join("compare.md"),
+        &compare_markdown(exp, case, row, &warnings, &figs),
+    )?;
     write_string_atomically(&dir.join("compare.json"), &compare_json(exp, case, row, prov))?;
-    Ok(figs)
+    Ok(WrittenCase {
+        figures: figs,
+        warnings,
+        compare_csv: csv,
+    })
 }
 
 /// A step for display: four significant digits (`1.667e-4`); files keep the exact value.

@@ -2,14 +2,14 @@
 //! asked) and the FEM on any experiment, written to `DIR/<name>/`: the runs' CSVs and sidecars,
 //! `compare.md`, `compare.csv`, `compare.json`, the figure set and `report.html`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use flexstar_model::output::{ensure_writable_dir, write_string_atomically};
 use flexstar_model::{AmmSettings, Experiment, ModeFamily, Provenance};
 
-use crate::case_output::{validity_warnings, write_case, ValidityWarning};
-use crate::report::{html_report, ReportCase, ReportInput};
+use crate::case_output::{write_case, ValidityWarning};
+use crate::report::case_report;
 use crate::runs::{preflight, run_cases, AmmRun, CaseSpec, ProgressFn};
 use crate::table::{TableI, TableRow};
 use crate::Error;
@@ -39,6 +39,8 @@ pub struct CompareOutcome {
     pub row: TableRow,
     /// Runs that leave the small-deflection range of the AMM.
     pub warnings: Vec<ValidityWarning>,
+    /// The text of `compare.csv` as written (header and one row per AMM run).
+    pub compare_csv: String,
     /// Wall time of the solves and of the whole command [s].
     pub solve_seconds: f64,
     pub total_seconds: f64,
@@ -88,34 +90,23 @@ pub fn run_compare(opts: &CompareOptions, progress: Option<ProgressFn>) -> Resul
         extra: Vec::new(),
         exp,
     };
-    preflight(std::slice::from_ref(&spec))?;
+    let checked = preflight(std::slice::from_ref(&spec))?;
     let dir = opts.out.join(&spec.exp.name);
     ensure_writable_dir(&opts.out)?;
     ensure_writable_dir(&dir)?;
-    let cases = run_cases(std::slice::from_ref(&spec), progress)?;
+    let cases = run_cases(checked, progress)?;
     let solve_seconds = start.elapsed().as_secs_f64();
     let case = &cases[0];
     let table = TableI::compute(&cases, false)?;
     let row = &table.rows[0];
-    let figs = write_case(&dir, &spec.exp, case, row, &opts.provenance, opts.figures)?;
+    let written = write_case(&dir, &spec.exp, case, row, &opts.provenance, opts.figures)?;
     if opts.figures {
-        let html = html_report(&ReportInput {
-            title: format!("flexstar compare: {}", spec.exp.name),
-            provenance: &opts.provenance,
-            table: None,
-            checks: None,
-            cases: vec![ReportCase {
-                exp: &spec.exp,
-                case,
-                row,
-                figures: &figs,
-                dir: Path::new(""),
-            }],
-        })?;
+        let html = case_report(&spec.exp, case, row, &written, &opts.provenance);
         write_string_atomically(&dir.join("report.html"), &html)?;
     }
     Ok(CompareOutcome {
-        warnings: validity_warnings(&spec.exp, case),
+        warnings: written.warnings,
+        compare_csv: written.compare_csv,
         dir,
         row: row.clone(),
         solve_seconds,

@@ -8,8 +8,9 @@
 
 use flexstar_model::{Experiment, Response};
 
-use crate::figures::{figure_forces, figure_tips, Figure, Panel, Run, Series, FAMILY_COLORS, RIGID_STYLE};
-use crate::figures::{Style, FEM_STYLE};
+use flexstar_plot::{Figure, Panel, Series, Style, FAMILY_COLORS, FEM_STYLE, RIGID_STYLE};
+
+use crate::figures::{figure_forces, figure_tips, Run};
 
 /// The response's column `name`, or an empty vector (a figure then shows nothing for it).
 fn column(r: &Response, name: &str) -> Vec<f64> {

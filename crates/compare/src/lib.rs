@@ -3,9 +3,9 @@
 //! Judging the AMM against the FEM reference (paper, section 9): the error variance parameter
 //! ([`evp`], Eq. 45), the behaviour of G and the correctness of each mode family
 //! ([`behaviour`]), the regenerated Table I ([`table`]) beside the paper's ([`paper`]), figures
-//! ([`figures`]) and the HTML report ([`report`]). [`runs`] runs the solvers of an experiment
-//! (the FEM and a list of AMM runs); [`compare`] does that for any experiment file and writes its
-//! outputs ([`case_output`]); [`verify`] is compare over the paper's four cases plus Table I and
+//! ([`figures`], drawn with `flexstar-plot`) and the HTML report ([`report`]). [`runs`] runs the
+//! solvers of an experiment (the FEM and a list of AMM runs); [`compare`] does that for any
+//! experiment file and writes its outputs ([`case_output`]); [`verify`] is compare over the paper's four cases plus Table I and
 //! the checks of [`thresholds`]. The EVP decisions the paper leaves open are written up in
 //! `docs/validation.md`, every output column in `docs/outputs.md`.
 
@@ -41,7 +41,7 @@ pub enum Error {
     #[error(transparent)]
     Compare(#[from] evp::CompareError),
     #[error(transparent)]
-    Figure(#[from] figures::FigureError),
+    Figure(#[from] flexstar_plot::FigureError),
     #[error("{file}: rigid kinematics: {source}")]
     Kinematics {
         file: String,

@@ -10,11 +10,11 @@ use std::path::Path;
 use flexstar_model::{small_deflection_check, Experiment, Provenance};
 
 use crate::behaviour::Behaviour;
-use crate::case_output::{runs_of, validity_warnings};
-use crate::figures::{Figure, FigureError};
+use crate::case_output::{runs_of, ValidityWarning, WrittenCase};
 use crate::runs::CaseResults;
 use crate::table::{TableI, TableRow};
 use crate::thresholds::Check;
+use flexstar_plot::RenderedFigure;
 
 /// Minimal Markdown-to-HTML for the documents flexstar itself writes: `#` headings, pipe tables
 /// and paragraphs; `**bold**` and `*italic*` inside cells and paragraphs.
@@ -100,7 +100,10 @@ pub struct ReportCase<'a> {
     pub exp: &'a Experiment,
     pub case: &'a CaseResults,
     pub row: &'a TableRow,
-    pub figures: &'a [Figure],
+    /// The case's figures as written to disk (embedded from the same SVG).
+    pub figures: &'a [RenderedFigure],
+    /// The runs outside the AMM's small-deflection range (`write_case`'s).
+    pub warnings: &'a [ValidityWarning],
     /// Directory of the case's files relative to the report (`""` beside it).
     pub dir: &'a Path,
 }
@@ -149,9 +152,34 @@ fn pct(v: Option<f64>) -> String {
     v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "n/a".into())
 }
 
+/// The report of one experiment alone (`DIR/<name>/report.html` of `compare` and `verify`),
+/// from what [`write_case`](crate::case_output::write_case) wrote.
+pub fn case_report(
+    exp: &Experiment,
+    case: &CaseResults,
+    row: &TableRow,
+    written: &WrittenCase,
+    provenance: &Provenance,
+) -> String {
+    html_report(&ReportInput {
+        title: format!("flexstar compare: {}", exp.name),
+        provenance,
+        table: None,
+        checks: None,
+        cases: vec![ReportCase {
+            exp,
+            case,
+            row,
+            figures: &written.figures,
+            warnings: &written.warnings,
+            dir: Path::new(""),
+        }],
+    })
+}
+
 /// The report: summary, contents, (verify) the checks and Table I, per experiment the runs with
 /// their metadata, the EVPs, the behaviour of G and the figures with captions, and how to read it.
-pub fn html_report(input: &ReportInput) -> Result<String, FigureError> {
+pub fn html_report(input: &ReportInput) -> String {
     let mut h = String::new();
     let _ = writeln!(
         h,
@@ -208,11 +236,11 @@ pub fn html_report(input: &ReportInput) -> Result<String, FigureError> {
         h.push_str("</p></section>\n");
     }
     for c in &input.cases {
-        case_html(&mut h, c)?;
+        case_html(&mut h, c);
     }
     method_html(&mut h);
     h.push_str("</body></html>\n");
-    Ok(h)
+    h
 }
 
 fn checks_html(h: &mut String, checks: &[Check]) {
@@ -234,7 +262,16 @@ fn checks_html(h: &mut String, checks: &[Check]) {
     h.push_str("</table></section>\n");
 }
 
-fn case_html(h: &mut String, c: &ReportCase) -> Result<(), FigureError> {
+fn case_html(h: &mut String, c: &ReportCase) {
+    case_summary_html(h, c);
+    runs_html(h, c);
+    evps_html(h, c);
+    figures_html(h, c);
+    h.push_str("</section>\n");
+}
+
+/// The section's heading, what was run, the behaviour of G, the closest run and the warnings.
+fn case_summary_html(h: &mut String, c: &ReportCase) {
     let (exp, row) = (c.exp, c.row);
     let _ = writeln!(h, "<section id=\"{0}\"><h2>{0}</h2>", escape(&exp.name));
     if !exp.description.is_empty() {
@@ -257,14 +294,18 @@ fn case_html(h: &mut String, c: &ReportCase) -> Result<(), FigureError> {
             None => "No run has an EVP (the FEM response is negligible everywhere).".into(),
         }
     );
-    let warnings = validity_warnings(exp, c.case);
-    if !warnings.is_empty() {
+    if !c.warnings.is_empty() {
         h.push_str("<div class=\"warn\"><b>Outside the AMM's small-deflection range.</b><ul>");
-        for w in &warnings {
+        for w in c.warnings {
             let _ = write!(h, "<li>{}: {}</li>", escape(&w.run), escape(&w.exceeded.to_string()));
         }
         h.push_str("</ul></div>\n");
     }
+}
+
+/// The runs and their metadata.
+fn runs_html(h: &mut String, c: &ReportCase) {
+    let exp = c.exp;
     // runs and their metadata
     h.push_str("<h3>Runs</h3>\n<table><tr><th>run</th><th>solver</th><th>family</th><th>model</th><th>N</th><th>elements</th><th>dt [s]</th><th>wall time [s]</th><th>small deflection</th><th>files</th></tr>\n");
     for (stem, r) in runs_of(c.case) {
@@ -292,6 +333,11 @@ fn case_html(h: &mut String, c: &ReportCase) -> Result<(), FigureError> {
         );
     }
     h.push_str("</table>\n");
+}
+
+/// The EVPs of every run against the FEM.
+fn evps_html(h: &mut String, c: &ReportCase) {
+    let row = c.row;
     // EVPs
     h.push_str("<h3>EVP against the FEM (%)</h3>\n<table><tr><th>run</th><th>A</th><th>B</th><th>C</th><th>G</th><th>mean</th><th>correct at G</th></tr>\n");
     for e in &row.families {
@@ -316,20 +362,22 @@ fn case_html(h: &mut String, c: &ReportCase) -> Result<(), FigureError> {
         file_link(c.dir, "compare.csv"),
         file_link(c.dir, "compare.json")
     );
+}
+
+/// The figures with their captions and links to their files.
+fn figures_html(h: &mut String, c: &ReportCase) {
     for f in c.figures {
         let _ = writeln!(
             h,
             "<figure id=\"{}\">{}<figcaption><b>{}.</b> {} ({}, {})</figcaption></figure>",
             escape(&f.name),
-            strip_xml_decl(&f.to_svg_string()?),
+            f.svg_element(),
             escape(&f.title),
             escape(&f.caption),
             file_link(&c.dir.join("figures"), &format!("{}.svg", f.name)),
             file_link(&c.dir.join("figures"), &format!("{}.png", f.name)),
         );
     }
-    h.push_str("</section>\n");
-    Ok(())
 }
 
 fn behaviour_sentence(b: Behaviour) -> &'static str {
@@ -380,13 +428,6 @@ tip and G responses, which the EVPs use, are converged.</li>\n\
 /// A step for display: four significant digits (`1.667e-4`); files keep the exact value.
 fn short(v: f64) -> String {
     format!("{v:.3e}")
-}
-
-fn strip_xml_decl(svg: &str) -> &str {
-    match svg.find("<svg") {
-        Some(i) => &svg[i..],
-        None => svg,
-    }
 }
 
 #[cfg(test)]

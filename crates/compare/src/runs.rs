@@ -162,10 +162,24 @@ pub struct Progress {
 /// Callback receiving [`Progress`]; called from worker threads.
 pub type ProgressFn<'a> = &'a (dyn Fn(Progress) + Sync);
 
+/// Experiments that passed [`preflight`]: the only input [`run_cases`] takes, so that the checks
+/// run once per batch.
+#[derive(Debug, Clone, Copy)]
+pub struct Checked<'a> {
+    specs: &'a [CaseSpec],
+}
+
+impl<'a> Checked<'a> {
+    /// The checked experiments, in the order given to [`preflight`].
+    pub fn specs(&self) -> &'a [CaseSpec] {
+        self.specs
+    }
+}
+
 /// Everything that can be checked before the work, for every experiment and run: the settings
 /// of each AMM run (keys named relative to the experiment file), unique labels, and the
 /// feasibility of the trajectory over the whole span.
-pub fn preflight(specs: &[CaseSpec]) -> Result<(), RunError> {
+pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
     for spec in specs {
         let exp = &spec.exp;
         let file = exp.source.display().to_string();
@@ -186,7 +200,7 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<(), RunError> {
         check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))
             .map_err(|e| input(e.to_string()))?;
     }
-    Ok(())
+    Ok(Checked { specs })
 }
 
 enum Job {
@@ -261,10 +275,10 @@ fn run_error(file: String, label: &str, e: SolveError) -> RunError {
     }
 }
 
-/// Run every FEM and AMM run of `specs` in parallel, after [`preflight`]. Results come back in
-/// the order of `specs`.
-pub fn run_cases(specs: &[CaseSpec], progress: Option<ProgressFn>) -> Result<Vec<CaseResults>, RunError> {
-    preflight(specs)?;
+/// Run every FEM and AMM run of the experiments that passed [`preflight`], in parallel. Results
+/// come back in the order of the specs.
+pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<CaseResults>, RunError> {
+    let specs = checked.specs();
     // AMM runs first: they are short, and a failing one stops the batch early
     let mut jobs = Vec::new();
     for (k, s) in specs.iter().enumerate() {

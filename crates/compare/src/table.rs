@@ -165,6 +165,126 @@ pub fn opt_number(v: Option<f64>) -> String {
         .unwrap_or_else(|| "n/a".into())
 }
 
+/// One case's line of the summary table: ours beside the paper's values; a paper-specific finding
+/// becomes a numbered note (pushed to `notes`).
+fn summary_row(s: &mut String, row: &TableRow, labels: &[String], notes: &mut Vec<(String, &'static str)>) {
+    let note = row.paper.and_then(|_| crate::paper::finding(&row.case));
+    let marker = match note {
+        Some(n) => {
+            notes.push((row.case.clone(), n));
+            format!(" [note {}]", notes.len())
+        }
+        None => String::new(),
+    };
+    let paper_b = row
+        .paper
+        .map(|p| format!(" ({})", p.behaviour.name()))
+        .unwrap_or_default();
+    let _ = write!(
+        s,
+        "| {} ({}) | {}{}{} |",
+        row.case,
+        row.description,
+        row.behaviour.name(),
+        paper_b,
+        marker
+    );
+    for l in labels {
+        let ours = row
+            .run(l)
+            .map(|e| {
+                format!(
+                    "{} {}{}",
+                    pct(e.evp.mean),
+                    mark(e.correct),
+                    if e.most_accurate { ", **best**" } else { "" }
+                )
+            })
+            .unwrap_or_else(|| "-".into());
+        let paper = match (row.paper, row.run(l).and_then(|e| family_index(e.family))) {
+            (Some(p), Some(k)) => match p.evp[k] {
+                Some(v) => format!(" ({v:.2} {})", mark(p.correct[k])),
+                None => format!(" (no EVP, {})", mark(p.correct[k])),
+            },
+            _ => String::new(),
+        };
+        let _ = write!(s, " {ours}{paper} |");
+    }
+    let best = row.most_accurate.clone().unwrap_or_else(|| "-".into());
+    let paper_best = row
+        .paper
+        .map(|p| format!(" ({})", p.most_accurate.name()))
+        .unwrap_or_default();
+    let _ = writeln!(s, " {best}{paper_best} |");
+}
+
+/// Header of `table1.csv` (columns in `docs/outputs.md`).
+pub const TABLE_CSV_HEADER: [&str; 16] = [
+    "case",
+    "model",
+    "family",
+    "modes",
+    "behaviour",
+    "evp_A",
+    "evp_B",
+    "evp_C",
+    "evp_G",
+    "evp_mean",
+    "correct",
+    "most_accurate",
+    "paper_behaviour",
+    "paper_evp_mean",
+    "paper_correct",
+    "paper_most_accurate",
+];
+
+/// One line of `table1.csv`: the run `e` of the case `row`, with the paper's values where the
+/// paper has the family.
+fn csv_record(row: &TableRow, e: &FamilyEntry) -> Vec<String> {
+    let k = family_index(e.family);
+    let paper = match (row.paper, k) {
+        (Some(p), Some(k)) => [
+            p.behaviour.name().to_string(),
+            opt_number(p.evp[k]),
+            p.correct[k].to_string(),
+            (p.most_accurate == e.family).to_string(),
+        ],
+        _ => Default::default(),
+    };
+    let p = e.evp.points;
+    let mut record = vec![
+        row.case.clone(),
+        e.label.clone(),
+        e.family.to_string(),
+        e.modes.or(e.modes_used).map(|n| n.to_string()).unwrap_or_default(),
+        row.behaviour.name().to_string(),
+        opt_number(p[0]),
+        opt_number(p[1]),
+        opt_number(p[2]),
+        opt_number(p[3]),
+        opt_number(e.evp.mean),
+        e.correct.to_string(),
+        e.most_accurate.to_string(),
+    ];
+    record.extend(paper);
+    record
+}
+
+/// A CSV document (the `csv` crate: a field with a comma, quote or line break is quoted).
+pub fn csv_text<R, F>(header: &[&str], records: R) -> String
+where
+    R: IntoIterator<Item = Vec<F>>,
+    F: AsRef<[u8]>,
+{
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(header).expect("CSV into memory");
+    for r in records {
+        w.write_record(&r).expect("CSV into memory: records of equal length");
+    }
+    let bytes = w.into_inner().expect("CSV into memory");
+    String::from_utf8(bytes).expect("CSV of UTF-8 fields is UTF-8")
+}
+
 fn mark(ok: bool) -> &'static str {
     if ok {
         "correct"
@@ -204,6 +324,16 @@ impl TableI {
         let mut s = String::new();
         let labels = self.labels();
         let with_paper = self.rows.iter().any(|r| r.paper.is_some());
+        self.summary_intro(&mut s, with_paper);
+        self.summary_table(&mut s, &labels, with_paper);
+        self.per_point_markdown(&mut s);
+        self.junction_markdown(&mut s);
+        self.n_study_markdown(&mut s);
+        s
+    }
+
+    /// The heading and the paragraph saying how to read the summary table.
+    fn summary_intro(&self, s: &mut String, with_paper: bool) {
         let _ = writeln!(s, "## Table I (regenerated)\n");
         let _ = write!(
             s,
@@ -227,70 +357,31 @@ impl TableI {
             );
         }
         let _ = writeln!(s, "\n");
+    }
+
+    /// The summary table, one row per case, and the paper-specific notes under it.
+    fn summary_table(&self, s: &mut String, labels: &[String], with_paper: bool) {
         let _ = write!(
             s,
             "| case | behaviour of G{} |",
             if with_paper { " (paper)" } else { "" }
         );
-        for l in &labels {
+        for l in labels {
             let _ = write!(s, " {l} |");
         }
         let _ = writeln!(s, " most accurate{} |", if with_paper { " (paper)" } else { "" });
         let _ = writeln!(s, "|---|---|{}---|", "---|".repeat(labels.len()));
         let mut notes = Vec::new();
         for row in &self.rows {
-            let note = row.paper.and_then(|_| crate::paper::finding(&row.case));
-            let marker = match note {
-                Some(n) => {
-                    notes.push((row.case.clone(), n));
-                    format!(" [note {}]", notes.len())
-                }
-                None => String::new(),
-            };
-            let paper_b = row
-                .paper
-                .map(|p| format!(" ({})", p.behaviour.name()))
-                .unwrap_or_default();
-            let _ = write!(
-                s,
-                "| {} ({}) | {}{}{} |",
-                row.case,
-                row.description,
-                row.behaviour.name(),
-                paper_b,
-                marker
-            );
-            for l in &labels {
-                let ours = row
-                    .run(l)
-                    .map(|e| {
-                        format!(
-                            "{} {}{}",
-                            pct(e.evp.mean),
-                            mark(e.correct),
-                            if e.most_accurate { ", **best**" } else { "" }
-                        )
-                    })
-                    .unwrap_or_else(|| "-".into());
-                let paper = match (row.paper, row.run(l).and_then(|e| family_index(e.family))) {
-                    (Some(p), Some(k)) => match p.evp[k] {
-                        Some(v) => format!(" ({v:.2} {})", mark(p.correct[k])),
-                        None => format!(" (no EVP, {})", mark(p.correct[k])),
-                    },
-                    _ => String::new(),
-                };
-                let _ = write!(s, " {ours}{paper} |");
-            }
-            let best = row.most_accurate.clone().unwrap_or_else(|| "-".into());
-            let paper_best = row
-                .paper
-                .map(|p| format!(" ({})", p.most_accurate.name()))
-                .unwrap_or_default();
-            let _ = writeln!(s, " {best}{paper_best} |");
+            summary_row(s, row, labels, &mut notes);
         }
         for (k, (case, n)) in notes.iter().enumerate() {
             let _ = writeln!(s, "\n**Note {} ({case}).** {n}", k + 1);
         }
+    }
+
+    /// The EVP at every point of every run.
+    fn per_point_markdown(&self, s: &mut String) {
         let _ = writeln!(s, "\n### EVP per point (%)\n");
         let _ = writeln!(s, "| case | run | N | A | B | C | G | mean |");
         let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
@@ -311,6 +402,10 @@ impl TableI {
                 );
             }
         }
+    }
+
+    /// The junction measures behind the behaviour of G.
+    fn junction_markdown(&self, s: &mut String) {
         let _ = writeln!(s, "\n### Junction measures (FEM)\n");
         let _ = writeln!(
             s,
@@ -335,8 +430,6 @@ impl TableI {
                 row.behaviour.name()
             );
         }
-        self.n_study_markdown(&mut s);
-        s
     }
 
     fn n_study_markdown(&self, s: &mut String) {
@@ -380,47 +473,83 @@ impl TableI {
     /// CSV, one line per case and run; numbers in the shortest exact form, `n/a` where Table I
     /// has it, empty paper columns where the paper has no entry.
     pub fn to_csv(&self) -> String {
-        let mut s = String::from("case,model,family,modes,behaviour,evp_A,evp_B,evp_C,evp_G,evp_mean,correct,most_accurate,paper_behaviour,paper_evp_mean,paper_correct,paper_most_accurate\n");
-        for row in &self.rows {
-            for e in &row.families {
-                let k = family_index(e.family);
-                let (pb, pe, pc, pm) = match (row.paper, k) {
-                    (Some(p), Some(k)) => (
-                        p.behaviour.name().to_string(),
-                        opt_number(p.evp[k]),
-                        p.correct[k].to_string(),
-                        (p.most_accurate == e.family).to_string(),
-                    ),
-                    _ => ("".into(), "".into(), "".into(), "".into()),
-                };
-                let p = e.evp.points;
-                let _ = writeln!(
-                    s,
-                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                    row.case,
-                    e.label,
-                    e.family,
-                    e.modes.or(e.modes_used).map(|n| n.to_string()).unwrap_or_default(),
-                    row.behaviour.name(),
-                    opt_number(p[0]),
-                    opt_number(p[1]),
-                    opt_number(p[2]),
-                    opt_number(p[3]),
-                    opt_number(e.evp.mean),
-                    e.correct,
-                    e.most_accurate,
-                    pb,
-                    pe,
-                    pc,
-                    pm
-                );
-            }
-        }
-        s
+        let rows = self
+            .rows
+            .iter()
+            .flat_map(|row| row.families.iter().map(move |e| csv_record(row, e)));
+        csv_text(&TABLE_CSV_HEADER, rows)
     }
 
     /// JSON of the whole table.
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("table serialises")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(case: &str, label: &str) -> TableRow {
+        TableRow {
+            case: case.into(),
+            description: String::new(),
+            behaviour: Behaviour::General,
+            measures: JunctionMeasures {
+                w_g_rel: 0.1,
+                slope_rel: None,
+            },
+            modes: 4,
+            families: vec![FamilyEntry {
+                label: label.into(),
+                family: ModeFamily::FreeFree,
+                modes: Some(4),
+                modes_used: Some(4),
+                error_estimate: None,
+                evp: PointEvps {
+                    points: [Some(1.5), None, Some(2.0), Some(0.25)],
+                    mean: Some(1.25),
+                },
+                correct: true,
+                most_accurate: true,
+            }],
+            most_accurate: Some(label.into()),
+            n_study: Vec::new(),
+            paper: None,
+        }
+    }
+
+    /// A case name with a comma and a quote comes back whole through an independent CSV reader
+    /// (the `csv` crate's), every other field as written.
+    #[test]
+    fn awkward_case_names_round_trip() {
+        let name = "brisk, \"fast\" case";
+        let table = TableI {
+            rows: vec![row(name, "free-free")],
+        };
+        let text = table.to_csv();
+        let mut reader = csv::Reader::from_reader(text.as_bytes());
+        let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+        assert_eq!(header, TABLE_CSV_HEADER);
+        let records: Vec<csv::StringRecord> = reader.records().collect::<Result<_, _>>().unwrap();
+        assert_eq!(records.len(), 1);
+        let r = &records[0];
+        assert_eq!(r.len(), TABLE_CSV_HEADER.len());
+        assert_eq!(&r[0], name);
+        assert_eq!(&r[1], "free-free");
+        assert_eq!(&r[5..10], ["1.5", "n/a", "2", "0.25", "1.25"]);
+    }
+
+    /// An ordinary name is written plainly, one line per run, `\n` line ends.
+    #[test]
+    fn ordinary_names_are_not_quoted() {
+        let table = TableI {
+            rows: vec![row("case1", "free-free")],
+        };
+        let line = table.to_csv().lines().nth(1).unwrap().to_string();
+        assert_eq!(
+            line,
+            "case1,free-free,free-free,4,general,1.5,n/a,2,0.25,1.25,true,true,,,,"
+        );
     }
 }

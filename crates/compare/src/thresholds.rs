@@ -11,7 +11,7 @@ use flexstar_model::ModeFamily;
 use serde::Deserialize;
 
 use crate::behaviour::Behaviour;
-use crate::table::TableI;
+use crate::table::{TableI, TableRow};
 
 /// Expectations for one case.
 #[derive(Debug, Clone, Deserialize)]
@@ -144,105 +144,139 @@ impl Thresholds {
     pub fn check(&self, table: &TableI) -> Vec<Check> {
         let mut out = Vec::new();
         for (name, exp) in &self.case {
-            let mut push = |what: String, value: String, bound: String, ok: bool| {
-                out.push(Check {
-                    case: name.clone(),
-                    what,
-                    value,
-                    bound,
-                    ok,
-                })
+            let mut c = CaseChecks {
+                case: name,
+                out: &mut out,
             };
             let Some(row) = table.rows.iter().find(|r| &r.case == name) else {
-                push("case".into(), "not run".into(), "in the table".into(), false);
+                c.push("case".into(), "not run".into(), "in the table".into(), false);
                 continue;
             };
-            push(
-                "behaviour of G".into(),
-                row.behaviour.name().into(),
-                exp.behaviour.name().into(),
-                row.behaviour == exp.behaviour,
-            );
-            for (families, want) in [(&exp.correct, true), (&exp.incorrect, false)] {
-                for f in families {
-                    let value = row.family(*f).map(|e| verdict(e.correct)).unwrap_or("not run");
-                    push(
-                        format!("verdict of {f}"),
-                        value.into(),
-                        verdict(want).into(),
-                        value == verdict(want),
-                    );
-                }
-            }
-            let mean = |f: ModeFamily| row.family(f).and_then(|e| e.evp.mean);
-            let best = row.most_accurate_family();
-            let value = match best {
-                Some(b) => format!("{b} ({})", fmt(mean(b))),
-                None => "none (no run has an EVP)".into(),
-            };
-            let ok = match best {
-                Some(b) if b == exp.most_accurate => true,
-                Some(b) if Some(b) == exp.tie_with => {
-                    matches!((mean(b), mean(exp.most_accurate)), (Some(a), Some(e)) if (a - e).abs() <= exp.tie_points)
-                }
-                _ => false,
-            };
-            let bound = match exp.tie_with {
-                Some(t) => format!(
-                    "{} ({}), or {t} within {} EVP points of it",
-                    exp.most_accurate,
-                    fmt(mean(exp.most_accurate)),
-                    exp.tie_points
-                ),
-                None => exp.most_accurate.to_string(),
-            };
-            push("most accurate family".into(), value, bound, ok);
-            let mut bands: Vec<_> = exp.evp.iter().collect();
-            bands.sort_by_key(|(f, _)| ModeFamily::ALL.iter().position(|g| g == *f));
-            for (f, band) in bands {
-                let v = mean(*f);
-                push(
-                    format!("mean EVP of {f}"),
-                    fmt(v),
-                    format!("[{}, {}] %", band[0], band[1]),
-                    matches!(v, Some(v) if v >= band[0] && v <= band[1]),
-                );
-            }
+            check_verdicts(&mut c, exp, row);
+            check_most_accurate(&mut c, exp, row);
+            check_bands(&mut c, exp, row);
             if let Some(acc) = &self.accurate {
-                let run = row.run(&acc.label);
-                let mean = run.and_then(|e| e.evp.mean);
-                push(
-                    format!("mean EVP of the accurate model ({})", acc.label),
-                    fmt(mean),
-                    format!("<= {} %", acc.mean_max),
-                    matches!(mean, Some(v) if v <= acc.mean_max),
-                );
-                let worst = run.map(|e| e.evp.points.iter().flatten().fold(0.0f64, |a, b| a.max(*b)));
-                push(
-                    format!("largest point EVP of the accurate model ({})", acc.label),
-                    fmt(worst),
-                    format!("<= {} %", acc.point_max),
-                    matches!(worst, Some(v) if v <= acc.point_max),
-                );
-                if let Some(max) = acc.estimate_ratio_max {
-                    let estimate = run.and_then(|e| e.error_estimate);
-                    let ratio = match (estimate, mean) {
-                        (Some(e), Some(m)) if e > 0.0 && m > 0.0 => Some(e / m),
-                        _ => None,
-                    };
-                    push(
-                        format!("error estimate / mean EVP of the accurate model ({})", acc.label),
-                        match (estimate, ratio) {
-                            (Some(e), Some(r)) => format!("{e:.2} % / {} = {r:.2}", fmt(mean)),
-                            _ => "n/a".into(),
-                        },
-                        format!("in [1/{max}, {max}]"),
-                        matches!(ratio, Some(r) if r <= max && r >= 1.0 / max),
-                    );
-                }
+                check_accurate(&mut c, acc, row);
             }
         }
         out
+    }
+}
+
+/// The checks of one case, collected in the order they are made.
+struct CaseChecks<'a> {
+    case: &'a str,
+    out: &'a mut Vec<Check>,
+}
+
+impl CaseChecks<'_> {
+    fn push(&mut self, what: String, value: String, bound: String, ok: bool) {
+        self.out.push(Check {
+            case: self.case.to_string(),
+            what,
+            value,
+            bound,
+            ok,
+        });
+    }
+}
+
+/// The behaviour of G and the verdict of every family the thresholds name.
+fn check_verdicts(c: &mut CaseChecks, exp: &CaseThresholds, row: &TableRow) {
+    c.push(
+        "behaviour of G".into(),
+        row.behaviour.name().into(),
+        exp.behaviour.name().into(),
+        row.behaviour == exp.behaviour,
+    );
+    for (families, want) in [(&exp.correct, true), (&exp.incorrect, false)] {
+        for f in families {
+            let value = row.family(*f).map(|e| verdict(e.correct)).unwrap_or("not run");
+            c.push(
+                format!("verdict of {f}"),
+                value.into(),
+                verdict(want).into(),
+                value == verdict(want),
+            );
+        }
+    }
+}
+
+/// The most accurate family, or a tie with the expected one within the allowed EVP points.
+fn check_most_accurate(c: &mut CaseChecks, exp: &CaseThresholds, row: &TableRow) {
+    let mean = |f: ModeFamily| row.family(f).and_then(|e| e.evp.mean);
+    let best = row.most_accurate_family();
+    let value = match best {
+        Some(b) => format!("{b} ({})", fmt(mean(b))),
+        None => "none (no run has an EVP)".into(),
+    };
+    let ok = match best {
+        Some(b) if b == exp.most_accurate => true,
+        Some(b) if Some(b) == exp.tie_with => {
+            matches!((mean(b), mean(exp.most_accurate)), (Some(a), Some(e)) if (a - e).abs() <= exp.tie_points)
+        }
+        _ => false,
+    };
+    let bound = match exp.tie_with {
+        Some(t) => format!(
+            "{} ({}), or {t} within {} EVP points of it",
+            exp.most_accurate,
+            fmt(mean(exp.most_accurate)),
+            exp.tie_points
+        ),
+        None => exp.most_accurate.to_string(),
+    };
+    c.push("most accurate family".into(), value, bound, ok);
+}
+
+/// Every family's mean EVP inside its band.
+fn check_bands(c: &mut CaseChecks, exp: &CaseThresholds, row: &TableRow) {
+    let mean = |f: ModeFamily| row.family(f).and_then(|e| e.evp.mean);
+    let mut bands: Vec<_> = exp.evp.iter().collect();
+    bands.sort_by_key(|(f, _)| ModeFamily::ALL.iter().position(|g| g == *f));
+    for (f, band) in bands {
+        let v = mean(*f);
+        c.push(
+            format!("mean EVP of {f}"),
+            fmt(v),
+            format!("[{}, {}] %", band[0], band[1]),
+            matches!(v, Some(v) if v >= band[0] && v <= band[1]),
+        );
+    }
+}
+
+/// The accurate model's mean and largest point EVP, and its error estimate against its EVP.
+fn check_accurate(c: &mut CaseChecks, acc: &AccurateBounds, row: &TableRow) {
+    let run = row.run(&acc.label);
+    let mean = run.and_then(|e| e.evp.mean);
+    c.push(
+        format!("mean EVP of the accurate model ({})", acc.label),
+        fmt(mean),
+        format!("<= {} %", acc.mean_max),
+        matches!(mean, Some(v) if v <= acc.mean_max),
+    );
+    let worst = run.map(|e| e.evp.points.iter().flatten().fold(0.0f64, |a, b| a.max(*b)));
+    c.push(
+        format!("largest point EVP of the accurate model ({})", acc.label),
+        fmt(worst),
+        format!("<= {} %", acc.point_max),
+        matches!(worst, Some(v) if v <= acc.point_max),
+    );
+    if let Some(max) = acc.estimate_ratio_max {
+        let estimate = run.and_then(|e| e.error_estimate);
+        let ratio = match (estimate, mean) {
+            (Some(e), Some(m)) if e > 0.0 && m > 0.0 => Some(e / m),
+            _ => None,
+        };
+        c.push(
+            format!("error estimate / mean EVP of the accurate model ({})", acc.label),
+            match (estimate, ratio) {
+                (Some(e), Some(r)) => format!("{e:.2} % / {} = {r:.2}", fmt(mean)),
+                _ => "n/a".into(),
+            },
+            format!("in [1/{max}, {max}]"),
+            matches!(ratio, Some(r) if r <= max && r >= 1.0 / max),
+        );
     }
 }
 

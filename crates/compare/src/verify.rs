@@ -14,10 +14,9 @@ use flexstar_model::{Experiment, ModeFamily, Provenance};
 use rayon::prelude::*;
 
 use crate::builtin::paper_experiments;
-use crate::case_output::{validity_warnings, write_case, ValidityWarning};
-use crate::figures::Figure;
-use crate::report::{html_report, ReportCase, ReportInput};
-use crate::runs::{preflight, run_cases, AmmRun, CaseSpec, ProgressFn};
+use crate::case_output::{write_case, ValidityWarning, WrittenCase};
+use crate::report::{case_report, html_report, ReportCase, ReportInput};
+use crate::runs::{preflight, run_cases, AmmRun, CaseResults, CaseSpec, ProgressFn};
 use crate::table::TableI;
 use crate::thresholds::{Check, Thresholds};
 use crate::Error;
@@ -94,91 +93,26 @@ pub fn run_verify(opts: &VerifyOptions, progress: Option<ProgressFn>) -> Result<
         Some(p) => Thresholds::load(p)?,
         None => Thresholds::builtin()?,
     };
-    let paper = opts.configs.is_none();
-    let exps: Vec<Experiment> = match &opts.configs {
-        Some(files) => files.iter().map(|c| Experiment::load(c)).collect::<Result<_, _>>()?,
-        None => paper_experiments(),
-    };
-    let n_study: &[usize] = if opts.n_study { &thresholds.n_study } else { &[] };
-    let specs: Vec<CaseSpec> = exps
-        .into_iter()
-        .map(|e| verify_spec(e, thresholds.modes, n_study))
-        .collect();
-    preflight(&specs)?;
+    let specs = load_specs(opts, &thresholds)?;
+    let checked = preflight(&specs)?;
     ensure_writable_dir(&opts.out)?;
     for s in &specs {
         ensure_writable_dir(&opts.out.join(&s.exp.name))?;
     }
-    let cases = run_cases(&specs, progress)?;
+    let cases = run_cases(checked, progress)?;
     let solve_seconds = start.elapsed().as_secs_f64();
-    let table = TableI::compute(&cases, paper)?;
+    let table = TableI::compute(&cases, opts.configs.is_none())?;
     let checks = thresholds.check(&table);
     let failures = checks.iter().filter(|c| !c.ok).map(|c| c.to_string()).collect();
-
-    // per case: what compare writes
-    let per_case: Vec<Vec<Figure>> = specs
-        .par_iter()
-        .zip(cases.par_iter())
-        .zip(table.rows.par_iter())
-        .map(|((s, c), row)| {
-            let dir = opts.out.join(&s.exp.name);
-            let figs = write_case(&dir, &s.exp, c, row, &opts.provenance, opts.figures)?;
-            if opts.figures {
-                let html = html_report(&ReportInput {
-                    title: format!("flexstar compare: {}", s.exp.name),
-                    provenance: &opts.provenance,
-                    table: None,
-                    checks: None,
-                    cases: vec![ReportCase {
-                        exp: &s.exp,
-                        case: c,
-                        row,
-                        figures: &figs,
-                        dir: Path::new(""),
-                    }],
-                })?;
-                write_string_atomically(&dir.join("report.html"), &html)?;
-            }
-            Ok(figs)
-        })
-        .collect::<Result<_, Error>>()?;
-
-    let out = &opts.out;
-    write_string_atomically(&out.join("table1.md"), &table.to_markdown())?;
-    write_string_atomically(&out.join("table1.csv"), &table.to_csv())?;
-    write_string_atomically(&out.join("table1.json"), &table.to_json())?;
-    write_string_atomically(&out.join("checks.txt"), &checks_text(&checks))?;
-    if opts.figures {
-        let html = html_report(&ReportInput {
-            title: if paper {
-                "flexstar verify: the paper's four cases, AMM against FEM".into()
-            } else {
-                "flexstar verify".into()
-            },
-            provenance: &opts.provenance,
-            table: Some(&table),
-            checks: Some(&checks),
-            cases: specs
-                .iter()
-                .zip(&cases)
-                .zip(&table.rows)
-                .zip(&per_case)
-                .map(|(((s, c), row), figs)| ReportCase {
-                    exp: &s.exp,
-                    case: c,
-                    row,
-                    figures: figs,
-                    dir: Path::new(&s.exp.name),
-                })
-                .collect(),
-        })?;
-        write_string_atomically(&out.join("report.html"), &html)?;
-    }
-    let warnings = specs
-        .iter()
-        .zip(&cases)
-        .flat_map(|(s, c)| validity_warnings(&s.exp, c))
-        .collect();
+    let verified = Verified {
+        specs: &specs,
+        cases: &cases,
+        table: &table,
+        checks: &checks,
+    };
+    let per_case = write_cases(opts, &verified)?;
+    write_summary(opts, &verified, &per_case)?;
+    let warnings = per_case.into_iter().flat_map(|w| w.warnings).collect();
     Ok(VerifyOutcome {
         table,
         checks,
@@ -187,6 +121,84 @@ pub fn run_verify(opts: &VerifyOptions, progress: Option<ProgressFn>) -> Result<
         solve_seconds,
         total_seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The cases to verify: the experiment files given, or the paper's four built-in cases, each
+/// with the runs of [`verify_spec`].
+fn load_specs(opts: &VerifyOptions, thresholds: &Thresholds) -> Result<Vec<CaseSpec>, Error> {
+    let exps: Vec<Experiment> = match &opts.configs {
+        Some(files) => files.iter().map(|c| Experiment::load(c)).collect::<Result<_, _>>()?,
+        None => paper_experiments(),
+    };
+    let n_study: &[usize] = if opts.n_study { &thresholds.n_study } else { &[] };
+    Ok(exps
+        .into_iter()
+        .map(|e| verify_spec(e, thresholds.modes, n_study))
+        .collect())
+}
+
+/// What a verify run computed, handed to the writers.
+struct Verified<'a> {
+    specs: &'a [CaseSpec],
+    cases: &'a [CaseResults],
+    table: &'a TableI,
+    checks: &'a [Check],
+}
+
+/// Per case, in parallel: what compare writes, and the case's own report.
+fn write_cases(opts: &VerifyOptions, v: &Verified) -> Result<Vec<WrittenCase>, Error> {
+    v.specs
+        .par_iter()
+        .zip(v.cases.par_iter())
+        .zip(v.table.rows.par_iter())
+        .map(|((s, c), row)| {
+            let dir = opts.out.join(&s.exp.name);
+            let written = write_case(&dir, &s.exp, c, row, &opts.provenance, opts.figures)?;
+            if opts.figures {
+                let html = case_report(&s.exp, c, row, &written, &opts.provenance);
+                write_string_atomically(&dir.join("report.html"), &html)?;
+            }
+            Ok(written)
+        })
+        .collect()
+}
+
+/// Table I, the checks and (with figures) the report of all cases, in `opts.out`.
+fn write_summary(opts: &VerifyOptions, v: &Verified, per_case: &[WrittenCase]) -> Result<(), Error> {
+    let out = &opts.out;
+    write_string_atomically(&out.join("table1.md"), &v.table.to_markdown())?;
+    write_string_atomically(&out.join("table1.csv"), &v.table.to_csv())?;
+    write_string_atomically(&out.join("table1.json"), &v.table.to_json())?;
+    write_string_atomically(&out.join("checks.txt"), &checks_text(v.checks))?;
+    if opts.figures {
+        let html = html_report(&ReportInput {
+            title: if opts.configs.is_none() {
+                "flexstar verify: the paper's four cases, AMM against FEM".into()
+            } else {
+                "flexstar verify".into()
+            },
+            provenance: &opts.provenance,
+            table: Some(v.table),
+            checks: Some(v.checks),
+            cases: v
+                .specs
+                .iter()
+                .zip(v.cases)
+                .zip(&v.table.rows)
+                .zip(per_case)
+                .map(|(((s, c), row), written)| ReportCase {
+                    exp: &s.exp,
+                    case: c,
+                    row,
+                    figures: &written.figures,
+                    warnings: &written.warnings,
+                    dir: Path::new(&s.exp.name),
+                })
+                .collect(),
+        });
+        write_string_atomically(&out.join("report.html"), &html)?;
+    }
+    Ok(())
 }
 
 /// `checks.txt`: one line per check, `PASS` or `FAIL`, the value found and the bound, then a

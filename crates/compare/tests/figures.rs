@@ -1,8 +1,9 @@
 //! Figures are drawn from responses into SVG and PNG files that are complete documents.
 
-use flexstar_compare::figures::{figure_star, figure_tips, Run, Style, FAMILY_COLORS, FEM_STYLE};
+use flexstar_compare::figures::{figure_star, figure_tips, Run};
 use flexstar_kinematics::RigidState;
 use flexstar_model::{BeamShape, Response, RobotParams, StarShape, Trajectory};
+use flexstar_plot::{Style, FAMILY_COLORS, FEM_STYLE};
 
 fn synthetic(label: &str, amp: f64, p: &RobotParams, tr: &Trajectory) -> Response {
     let mut r = Response::with_capacity(label, 101);

@@ -9,11 +9,11 @@
 //! defaults (the paper's families are for the time-domain comparison, not for modes).
 
 use flexstar_amm::pose_modes::{PoseModel, DEFAULT_MODAL_MODES};
-use flexstar_compare::figures::{Figure, Panel, Series, Style};
 use flexstar_modal::plots::PATH_COLORS;
 use flexstar_modal::pose::pose_at_time;
 use flexstar_model::output::{fmt_number, write_atomically};
 use flexstar_model::{AmmSettings, Sliders};
+use flexstar_plot::{Figure, Panel, Series, Style};
 
 const STEP: f64 = 0.005;
 

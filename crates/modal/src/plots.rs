@@ -1,12 +1,12 @@
-//! Figures of the modal analyses (plotters, SVG and PNG, through the drawing kit shared with
-//! `flexstar_compare::figures`): the first mode shapes at a pose (AMM over FEM over the rigid
+//! Figures of the modal analyses (plotters, SVG and PNG, through the drawing kit of
+//! `flexstar-plot`): the first mode shapes at a pose (AMM over FEM over the rigid
 //! star) and the heat map of a frequency map with the workspace boundary and the paper's paths.
 
-use flexstar_compare::figures::{
-    colormap, draw_legend, tick, Drawing, Figure, GridFigure, Panel, Series, Style, FEM_STYLE, RIGID_STYLE,
-};
 use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::RestPose;
+use flexstar_plot::{
+    colormap, draw_legend, tick, Drawing, Figure, GridFigure, Panel, Series, Style, FEM_STYLE, RIGID_STYLE,
+};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -73,7 +73,7 @@ fn padded(lo: f64, hi: f64) -> (f64, f64) {
 impl Scatter {
     /// The plot as an SVG document.
     pub fn to_svg(&self) -> Result<String, StudyError> {
-        flexstar_compare::figures::register_font();
+        flexstar_plot::register_font();
         let e = err(&self.title);
         let all = self.sets.iter().flat_map(|s| s.points.iter());
         let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
@@ -137,13 +137,33 @@ impl Scatter {
     }
 }
 
-pub use flexstar_compare::figures::colormap;
+pub use flexstar_plot::colormap;
 
 impl Heat {
+    /// Each cell's value as text at its centre, white on the dark end of the colour map.
+    fn cell_labels(&self, lo: f64, span: f64) -> Vec<Text<'static, (f64, f64), String>> {
+        let mut out = Vec::new();
+        for (iy, row) in self.values.iter().enumerate() {
+            for (ix, v) in row.iter().enumerate() {
+                if let Some(v) = *v {
+                    let dark = (v - lo) / span < 0.6;
+                    let style = TextStyle::from(("sans-serif", 10).into_font())
+                        .color(if dark { &WHITE } else { &BLACK })
+                        .pos(plotters::style::text_anchor::Pos::new(
+                            plotters::style::text_anchor::HPos::Center,
+                            plotters::style::text_anchor::VPos::Center,
+                        ));
+                    out.push(Text::new(tick(&v), (ix as f64 + 0.5, iy as f64 + 0.5), style));
+                }
+            }
+        }
+        out
+    }
+
     /// The heat map as an SVG document; cells without a value are grey, and each cell is labelled
     /// with its value when the grid has at most 12 x 12 cells.
     pub fn to_svg(&self) -> Result<String, StudyError> {
-        flexstar_compare::figures::register_font();
+        flexstar_plot::register_font();
         let e = err(&self.title);
         let (nx, ny) = (self.x_levels.len(), self.y_levels.len());
         let finite = self
@@ -209,25 +229,10 @@ impl Heat {
                 }))
                 .map_err(|x| e(x.to_string()))?;
             if nx <= 12 && ny <= 12 {
-                for iy in 0..ny {
-                    for ix in 0..nx {
-                        if let Some(v) = self.values[iy][ix] {
-                            let dark = (v - lo) / span < 0.6;
-                            let style = TextStyle::from(("sans-serif", 10).into_font())
-                                .color(if dark { &WHITE } else { &BLACK })
-                                .pos(plotters::style::text_anchor::Pos::new(
-                                    plotters::style::text_anchor::HPos::Center,
-                                    plotters::style::text_anchor::VPos::Center,
-                                ));
-                            chart
-                                .draw_series(std::iter::once(Text::new(
-                                    tick(&v),
-                                    (ix as f64 + 0.5, iy as f64 + 0.5),
-                                    style,
-                                )))
-                                .map_err(|x| e(x.to_string()))?;
-                        }
-                    }
+                for label in self.cell_labels(lo, span) {
+                    chart
+                        .draw_series(std::iter::once(label))
+                        .map_err(|x| e(x.to_string()))?;
                 }
             }
             root.present().map_err(|x| e(x.to_string()))?;

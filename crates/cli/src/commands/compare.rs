@@ -44,10 +44,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     reporter.finish();
     let outcome = outcome?;
     super::print_warnings(&outcome.warnings);
-    println!(
-        "{}",
-        std::fs::read_to_string(outcome.dir.join("compare.csv"))?.trim_end()
-    );
+    println!("{}", outcome.compare_csv.trim_end());
     eprintln!(
         "compare: solves {:.2} s, total {:.2} s; behaviour of G: {}; closest to the FEM: {}; outputs in {}",
         outcome.solve_seconds,

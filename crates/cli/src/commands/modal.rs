@@ -4,12 +4,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use flexstar_compare::figures::write_svg_png;
 use flexstar_modal::analysis::{modal, write_modal_csv};
 use flexstar_modal::freqmap::{check_grid, freqmap, write_freqmap_csv, Axis, Solver};
 use flexstar_modal::plots::{mode_shapes_figure, paper_paths, FreqMapFigure};
 use flexstar_modal::pose::{parse_pose, pose_at_time, pose_from_task};
 use flexstar_model::{Experiment, RestPose, Sliders};
+use flexstar_plot::write_svg_png;
 
 use crate::progress::Reporter;
 

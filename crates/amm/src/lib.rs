@@ -33,4 +33,7 @@ mod system;
 pub use direct::{solve_direct, DIRECT_COLUMNS};
 pub use error::{AmmError, RankError};
 pub use modes::{ModeSet, MAX_MODES};
-pub use solver::{parse_family, solve, tolerance_step, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS, TOLERANCE_DT};
+pub use solver::{
+    parse_family, solve, solve_with_stats, tolerance_step, Stats, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS,
+    TOLERANCE_DT,
+};

@@ -168,16 +168,69 @@ pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 /// it is raised until the estimated truncation EVP is below the tolerance (`adaptive` module),
 /// and `info.modes` / `info.error_estimate_percent` report the N used and the estimate.
 pub fn solve(exp: &Experiment, settings: &AmmSettings) -> Result<Response, AmmError> {
-    match settings.mode_count() {
-        ModeCount::Fixed(n) => integrate(exp, settings, n, true, |_, _| {}),
-        ModeCount::Tolerance(tol) => solve_to_tolerance(exp, settings, tol),
+    solve_with_stats(exp, settings).map(|(r, _)| r)
+}
+
+/// Work counters of an AMM run ([`solve_with_stats`]). Every integration run solves the
+/// constrained system once for the initial accelerations and once per time step, each solve one
+/// factorisation of the step matrix (the constraints move with t) and one substitution.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Modes per beam N of the delivered run.
+    pub modes: usize,
+    /// N of every integration run, in the order run: for the automatic N the estimate's runs
+    /// (at the coarse step, or the delivered one) and the delivered run last; one entry for a
+    /// fixed N.
+    pub modes_tried: Vec<usize>,
+    /// Time steps of the delivered run.
+    pub steps: usize,
+    /// Time steps of all runs.
+    pub total_steps: usize,
+    /// Linear solves (= factorisations of the step matrix) of all runs: `total_steps` plus one
+    /// per run.
+    pub solves: usize,
+}
+
+impl Stats {
+    /// The counters of the runs `(N, steps)` in the order run, the delivered one last.
+    fn from_runs(runs: &[(usize, usize)]) -> Self {
+        let total_steps = runs.iter().map(|r| r.1).sum();
+        let (modes, steps) = runs.last().copied().unwrap_or_default();
+        Stats {
+            modes,
+            modes_tried: runs.iter().map(|r| r.0).collect(),
+            steps,
+            total_steps,
+            solves: total_steps + runs.len(),
+        }
     }
+}
+
+/// [`solve`], also returning the work counters (steps, solves, the N used and those tried).
+pub fn solve_with_stats(exp: &Experiment, settings: &AmmSettings) -> Result<(Response, Stats), AmmError> {
+    let mut runs = Vec::new();
+    let resp = match settings.mode_count() {
+        ModeCount::Fixed(n) => {
+            let mut steps = 0;
+            let r = integrate(exp, settings, n, true, |_, _| steps += 1)?;
+            runs.push((n, steps));
+            r
+        }
+        ModeCount::Tolerance(tol) => solve_to_tolerance(exp, settings, tol, &mut runs)?,
+    };
+    Ok((resp, Stats::from_runs(&runs)))
 }
 
 /// [`solve`] with N chosen for the tolerance `tol` [%] (`adaptive` module): the estimate's pairs
 /// at the coarse step on the coarse output grid, the chosen N at the delivered step `h`. The
-/// system of the last N is built once and reused by its runs at both steps.
-fn solve_to_tolerance(exp: &Experiment, settings: &AmmSettings, tol: f64) -> Result<Response, AmmError> {
+/// system of the last N is built once and reused by its runs at both steps. `runs` receives
+/// `(N, steps)` of every integration run, in order.
+fn solve_to_tolerance(
+    exp: &Experiment,
+    settings: &AmmSettings,
+    tol: f64,
+    runs: &mut Vec<(usize, usize)>,
+) -> Result<Response, AmmError> {
     // every input error before any work, at the first N; the trajectory is scanned once here
     let h = validate(exp, settings, adaptive::first_modes(exp), true)?;
     let every = adaptive::estimate_grid(exp, h);
@@ -193,8 +246,9 @@ fn solve_to_tolerance(exp: &Experiment, settings: &AmmSettings, tol: f64) -> Res
                 sys
             }
         };
-        match pass {
-            Pass::Deliver => integrate_system(exp, settings, sys, h, started, |_, _| {}),
+        let mut steps = 0;
+        let resp = match pass {
+            Pass::Deliver => integrate_system(exp, settings, sys, h, started, |_, _| steps += 1),
             Pass::Estimate { every } => {
                 let mut coarse = exp.clone();
                 coarse.time.dt_out = every as f64 * exp.time.dt_out;
@@ -204,9 +258,11 @@ fn solve_to_tolerance(exp: &Experiment, settings: &AmmSettings, tol: f64) -> Res
                     snapshots: Vec::new(),
                     ..settings.clone()
                 };
-                integrate_system(&coarse, &pair_settings, sys, step, started, |_, _| {})
+                integrate_system(&coarse, &pair_settings, sys, step, started, |_, _| steps += 1)
             }
-        }
+        };
+        runs.push((n, steps));
+        resp
     })
 }
 

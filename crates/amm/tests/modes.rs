@@ -1,7 +1,8 @@
 //! Mode families (Eq. 34-1) against outside references: textbook roots beta*L (Blevins, "Formulas
 //! for natural frequency and mode shape", table 8-1; the slide-free roots are the roots of
 //! tan(bL) = -tanh(bL)), their exponentially small distance to the asymptotes, orthonormality and
-//! stiffness orthogonality by an independent Gauss-Legendre quadrature, the closed-form integrals
+//! stiffness orthogonality by an independent quadrature (Clenshaw-Curtis, not the crate's
+//! Gauss-Legendre), the closed-form integrals
 //! Phi_j and Psi_j, and the frequency formula.
 
 use flexstar_amm::{parse_family, AmmError, ModeSet};
@@ -15,36 +16,36 @@ const ALL: [ModeFamily; 4] = [
     ModeFamily::ClampedFree,
 ];
 
-/// n-point Gauss-Legendre nodes and weights on [-1, 1] by Newton's method on P_n (own rule,
-/// independent of the crate's quadrature).
-fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let (mut x, mut w) = (vec![0.0; n], vec![0.0; n]);
-    for i in 0..n {
-        let mut z = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 0.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
+/// Points per panel of the composite rule, minus one (even).
+const CC_ORDER: usize = 20;
+
+/// Nodes and weights of the (n + 1)-point Clenshaw-Curtis rule on [-1, 1], n even: the nodes
+/// `cos(k pi / n)`, the weights those of integrating the interpolating Chebyshev series term by
+/// term (Clenshaw & Curtis 1960; Trefethen, "Spectral Methods in MATLAB", 2000, chapter 12).
+/// Exact for polynomials of degree n. A different rule from the crate's Gauss-Legendre
+/// (`flexstar_numerics::quadrature`), so that the checks below do not share its errors.
+fn clenshaw_curtis(n: usize) -> (Vec<f64>, Vec<f64>) {
+    assert!(n >= 2 && n % 2 == 0);
+    let nf = n as f64;
+    let end = 1.0 / (nf * nf - 1.0);
+    (0..=n)
+        .map(|k| {
+            let theta = PI * k as f64 / nf;
+            if k == 0 || k == n {
+                return (theta.cos(), end);
             }
-            dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let dz = p1 / dp;
-            z -= dz;
-            if dz.abs() < 1e-16 {
-                break;
-            }
-        }
-        x[i] = z;
-        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-    }
-    (x, w)
+            let series: f64 = (1..n / 2)
+                .map(|j| 2.0 * (2.0 * j as f64 * theta).cos() / (4.0 * (j * j) as f64 - 1.0))
+                .sum();
+            (theta.cos(), 2.0 / nf * (1.0 - series - (nf * theta).cos() * end))
+        })
+        .unzip()
 }
 
-/// Composite 20-point rule on [0, L] with panels no wider than one radian of the highest mode.
+/// Composite Clenshaw-Curtis rule on [0, L] with panels no wider than one radian of the highest
+/// mode.
 fn nodes(l: f64, beta_max: f64) -> Vec<(f64, f64)> {
-    let (x, w) = gauss_legendre(20);
+    let (x, w) = clenshaw_curtis(CC_ORDER);
     let panels = ((beta_max * l).ceil() as usize).max(4);
     let h = l / panels as f64;
     (0..panels)
@@ -59,11 +60,19 @@ fn nodes(l: f64, beta_max: f64) -> Vec<(f64, f64)> {
 }
 
 #[test]
-fn gauss_legendre_rule_is_exact_for_degree_39() {
-    let (x, w) = gauss_legendre(20);
-    let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(38)).sum();
-    assert!((got - 2.0 / 39.0).abs() < 1e-14, "{got}");
-    assert!((w.iter().sum::<f64>() - 2.0).abs() < 1e-14);
+fn clenshaw_curtis_is_exact_to_degree_n_and_matches_closed_forms() {
+    let (x, w) = clenshaw_curtis(CC_ORDER);
+    for deg in 0..=CC_ORDER {
+        let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(deg as i32)).sum();
+        let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
+        assert!((got - exact).abs() < 1e-14, "degree {deg}: {got} vs {exact}");
+    }
+    // the composite rule on oscillating and growing integrands (beta = 20 over [0, 0.5])
+    let q = nodes(0.5, 20.0);
+    let cos: f64 = q.iter().map(|(x, w)| w * (40.0 * x).cos()).sum();
+    assert!((cos - 20f64.sin() / 40.0).abs() < 1e-14, "{cos}");
+    let cosh: f64 = q.iter().map(|(x, w)| w * (20.0 * x).cosh()).sum();
+    assert!((cosh / (10f64.sinh() / 20.0) - 1.0).abs() < 1e-13, "{cosh}");
 }
 
 #[test]

@@ -34,6 +34,9 @@ fn baseline_and_avx2_copies_give_the_same_run() {
     force_baseline(false);
     let (chosen, s1) = solve_with_stats(&exp, &settings, None).expect("run with the processor's copy");
     force_baseline(true);
+    // the switch the dispatched bodies read (the counters of numerics' own test show that they
+    // obey it): every body below runs its baseline copy
+    assert!(!flexstar_numerics::lanes::has_avx2());
     let (baseline, s2) = solve_with_stats(&exp, &settings, None).expect("run with the baseline copy");
     force_baseline(false);
     assert_eq!(s1, s2, "work counters");

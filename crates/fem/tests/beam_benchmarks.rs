@@ -20,9 +20,10 @@ fn check(support: BeamSupport, beta_l: [f64; 4]) {
     for (k, (w, bl)) in got.iter().zip(beta_l).enumerate() {
         let exact = bl * bl * scale;
         let rel = (w - exact).abs() / exact;
-        // beta L is tabulated to 7 digits: 5e-7 relative in beta L, 1e-6 in omega.
+        // beta L is tabulated to 7 digits: 5e-7 relative in beta L, 1e-6 in omega; the
+        // discretisation error at 100 cubic elements is below that (measured 5e-8 to 3.5e-7)
         assert!(
-            rel < 1e-4,
+            rel < 1e-6,
             "{support:?} mode {}: {w} rad/s vs {exact} rad/s (rel {rel:.2e})",
             k + 1
         );

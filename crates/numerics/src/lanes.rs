@@ -349,6 +349,27 @@ pub fn has_avx2_fma() -> bool {
     }
 }
 
+/// Which copy of a [`dispatch_avx2!`] body runs (`avx2`: the AVX2 one), called by the macro: it
+/// counts them in this crate's own unit tests, so that they can check which copy ran, and is an
+/// empty function in every other build.
+#[doc(hidden)]
+#[inline(always)]
+pub fn note_copy(avx2: bool) {
+    #[cfg(test)]
+    COPIES_RUN.with(|c| {
+        let (a, b) = c.get();
+        c.set(if avx2 { (a + 1, b) } else { (a, b + 1) });
+    });
+    #[cfg(not(test))]
+    let _ = avx2;
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Dispatched bodies run on this thread: (AVX2 copies, baseline copies).
+    static COPIES_RUN: std::cell::Cell<(usize, usize)> = const { std::cell::Cell::new((0, 0)) };
+}
+
 /// Run a function body compiled twice, for AVX2 and for the baseline of the build, choosing at
 /// run time ([`has_avx2`]). Two forms:
 /// - a function item, `dispatch_avx2! { /// docs\n pub fn name(a: &mut [f64], x: f64) -> f64 { body } }`,
@@ -379,13 +400,18 @@ macro_rules! dispatch_avx2 {
         fn portable($($arg: $ty),*) -> $ret $body
         #[cfg(target_arch = "x86_64")]
         let out = if $crate::lanes::has_avx2() {
+            $crate::lanes::note_copy(true);
             // SAFETY: the processor has AVX2 (detected at run time just above).
             unsafe { with_avx2($($arg),*) }
         } else {
+            $crate::lanes::note_copy(false);
             portable($($arg),*)
         };
         #[cfg(not(target_arch = "x86_64"))]
-        let out = portable($($arg),*);
+        let out = {
+            $crate::lanes::note_copy(false);
+            portable($($arg),*)
+        };
         out
     }};
 }
@@ -425,10 +451,29 @@ mod tests {
             buf.push(sum);
             buf
         };
-        let got = scaled(&xs, 3.3);
         let mut want: Vec<f64> = xs.iter().map(|x| x * 3.3 + 1.0 / 3.3).collect();
         want.push(want.iter().fold(0.0, |s, x| s + x));
-        assert_eq!(got, want);
+        let copies = || COPIES_RUN.with(|c| c.get());
+        // the processor's copy: AVX2 where the processor has it (the counters say which ran)
+        force_baseline(false);
+        let (a0, b0) = copies();
+        let chosen = scaled(&xs, 3.3);
+        let (a1, b1) = copies();
+        let avx2 = has_avx2();
+        assert_eq!((a1 - a0, b1 - b0), if avx2 { (1, 0) } else { (0, 1) });
+        // the baseline copy, forced (process-wide; no other test here dispatches)
+        force_baseline(true);
+        assert!(!has_avx2());
+        let baseline = scaled(&xs, 3.3);
+        force_baseline(false);
+        let (a2, b2) = copies();
+        assert_eq!((a2 - a1, b2 - b1), (0, 1), "force_baseline must run the baseline copy");
+        if !avx2 {
+            eprintln!("no AVX2 on this processor: the baseline copy ran both times");
+        }
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&chosen), bits(&want));
+        assert_eq!(bits(&baseline), bits(&want));
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! returns the outcome; errors are an [`ApiError`] that tells bad input (file, key, reason), an
 //! infeasible motion (time, reason) and a solver failure apart.
 
+pub mod document;
 mod error;
 mod figures;
 pub mod kinematics;
@@ -16,6 +17,7 @@ pub mod study;
 
 use std::path::{Path, PathBuf};
 
+pub use document::ExperimentDoc;
 pub use error::{ApiError, Result};
 pub use flexstar_model::{Experiment, Provenance};
 pub use run::{Forces, Prepared, RunOutcome, RunSettings, Solver};

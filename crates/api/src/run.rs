@@ -163,6 +163,8 @@ fn forces_drive(f: &Forces) -> Result<(DriveSettings, String)> {
             ForceSamples::check(&s.t, &s.fa).map_err(|reason| ApiError::config("forces", None, reason))?;
             let drive = DriveSettings {
                 kind: DriveKind::Forces,
+                // no file: the samples were given in memory (the sidecar records this name)
+                file: Some(PathBuf::from("<forces array>")),
                 samples: Some(s.clone()),
                 ..DriveSettings::default()
             };
@@ -334,4 +336,21 @@ pub fn run_to_dir(
     let mut outcome = run(&p, progress)?;
     write_run(&mut outcome, &dir, p.figures)?;
     Ok(outcome)
+}
+
+/// Every column of a response by name, in the order of its CSV (`t` first, the fixed columns,
+/// then the extra ones): what fronts hand out as arrays.
+pub fn columns(r: &Response) -> Vec<(String, &[f64])> {
+    let fixed: Vec<&[f64]> = std::iter::once(r.t.as_slice())
+        .chain(r.w_g.iter().map(Vec::as_slice))
+        .chain(r.w_tip.iter().map(Vec::as_slice))
+        .chain(r.fa.iter().map(Vec::as_slice))
+        .collect();
+    let mut out: Vec<(String, &[f64])> = flexstar_model::response::RESPONSE_HEADER
+        .iter()
+        .map(|s| s.to_string())
+        .zip(fixed)
+        .collect();
+    out.extend(r.extra.iter().map(|c| (c.name.clone(), c.values.as_slice())));
+    out
 }

@@ -3,6 +3,7 @@
 //! conversion of arguments, results and errors. Solves release the GIL.
 
 mod convert;
+mod reports;
 
 use std::path::{Path, PathBuf};
 
@@ -313,6 +314,9 @@ fn _flexstar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(modal, m)?)?;
     m.add_function(wrap_pyfunction!(linearize, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(reports::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(reports::verify, m)?)?;
+    m.add_function(wrap_pyfunction!(reports::freqmap, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -128,3 +128,21 @@ def test_study(root, tmp_path):
     for lp in (0.02, 0.04):
         row = df[np.isclose(df["robot.Lp"], lp)]
         assert len(row) == 1
+
+
+def test_freqmap_equals_modal(root):
+    """A map point's frequencies equal modal's AMM ones at that pose (sliders locked)."""
+    pd = pytest.importorskip("pandas")
+    exp = flexstar.Experiment.load(root / "configs/case1.toml")
+    df = flexstar.freqmap(exp, gx=(-0.02, 0.02, 2), gy=(-0.02, 0.02, 2), modes=2)
+    assert isinstance(df, pd.DataFrame) and len(df) == 4
+    row = df.iloc[0]
+    m = flexstar.modal(exp, pose=(row["Gx"], row["Gy"], 0.0), modes=2)
+    np.testing.assert_allclose([row["f1"], row["f2"]], m["amm_hz"][:2], rtol=1e-9)
+
+
+def test_compare_writes_the_cli_table(root, tmp_path):
+    res = flexstar.compare(root / "configs/case3.toml", tmp_path, figures=False)
+    assert pathlib.Path(res["compare_csv"]).exists()
+    report = (pathlib.Path(res["dir"]) / "compare.json").read_text()
+    assert res["behaviour"] in report, "the behaviour of G is the one compare.json reports"

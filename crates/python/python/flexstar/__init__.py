@@ -31,6 +31,9 @@ __all__ = [
     "modal",
     "linearize",
     "sweep",
+    "compare",
+    "verify",
+    "freqmap",
 ]
 __version__ = _flexstar.__version__
 
@@ -251,3 +254,45 @@ def sweep(study: "os.PathLike[str] | str", out: "os.PathLike[str] | str", jobs: 
 
     path = _flexstar.sweep(os.fspath(study), os.fspath(out), jobs)
     return pd.read_csv(path)
+
+
+def compare(
+    config: "os.PathLike[str] | str",
+    out: "os.PathLike[str] | str" = "out",
+    families: Sequence[str] = (),
+    modes: Optional[int] = None,
+    figures: bool = False,
+) -> Dict[str, Any]:
+    """Compare the AMM with the FEM on an experiment file (as ``flexstar compare``): writes
+    ``out/<name>/``; returns the folder, compare.csv, the behaviour of G and the closest family."""
+    _check_count("modes", modes)
+    return _flexstar.compare(os.fspath(config), os.fspath(out), list(families), modes, figures)
+
+
+def verify(out: "os.PathLike[str] | str" = "out/verify", figures: bool = False, n_study: bool = False) -> Dict[str, Any]:
+    """Reproduce and check Table I (as ``flexstar verify``): the table as Markdown, the number of
+    checks and the failed ones."""
+    return _flexstar.verify(os.fspath(out), figures, n_study)
+
+
+def freqmap(
+    exp: Experiment,
+    gx: Sequence[float],
+    gy: Sequence[float],
+    theta: float = 0.0,
+    modes: int = 6,
+    solver: str = "amm",
+) -> "Any":
+    """The first ``modes`` frequencies (sliders locked) over a grid ``gx``, ``gy`` = (min, max, n)
+    [m] at ``theta`` [rad]: a DataFrame (Gx, Gy, theta, f1..fK [Hz], reason) when pandas is
+    installed, else the dict of lists."""
+    d = _flexstar.freqmap(exp._inner, tuple(gx), tuple(gy), theta, modes, solver)
+    try:
+        import pandas as pd
+    except ImportError:
+        return d
+    df = pd.DataFrame({"Gx": d["Gx"], "Gy": d["Gy"], "theta": d["theta"]})
+    for k in range(modes):
+        df[f"f{k + 1}"] = [f[k] if f is not None else float("nan") for f in d["f_hz"]]
+    df["reason"] = d["reason"]
+    return df

@@ -254,17 +254,21 @@ impl Response {
         })
     }
 
-    /// Write the sidecar JSON of a run (`<csv name>.json`), whole or not at all:
+    /// The sidecar document of a run (what [`Response::write_sidecar`] writes):
     /// `flexstar_version`, `commit` (when known), `date` (UTC, of the run), the `label`, every field
     /// of [`RunInfo`], `small_deflection` (the check of [`small_deflection_check`]: `null` when the
     /// run stays in range, else the first time, the quantity, its value and the bound) and the
-    /// resolved `experiment`. Fields are listed in `docs/outputs.md`.
-    pub fn write_sidecar(
+    /// resolved `experiment`. Fields are listed in `docs/outputs.md`; `path` only names errors.
+    pub fn sidecar(
         &self,
         path: &Path,
         experiment: &crate::Experiment,
         provenance: &Provenance,
-    ) -> Result<(), ModelError> {
+    ) -> Result<serde_json::Value, ModelError> {
+        let fail = |e: serde_json::Error| ModelError::Write {
+            file: path.to_path_buf(),
+            reason: e.to_string(),
+        };
         let mut doc = serde_json::Map::new();
         doc.insert("flexstar_version".into(), provenance.version.clone().into());
         doc.insert(
@@ -277,29 +281,24 @@ impl Response {
         );
         doc.insert("date".into(), provenance.date.clone().into());
         doc.insert("label".into(), self.label.clone().into());
-        let info = serde_json::to_value(&self.info).map_err(|e| ModelError::Write {
-            file: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
-        if let serde_json::Value::Object(fields) = info {
+        if let serde_json::Value::Object(fields) = serde_json::to_value(&self.info).map_err(fail)? {
             doc.extend(fields);
         }
-        let validity =
-            serde_json::to_value(small_deflection_check(self, experiment.robot.l)).map_err(|e| ModelError::Write {
-                file: path.to_path_buf(),
-                reason: e.to_string(),
-            })?;
+        let validity = serde_json::to_value(small_deflection_check(self, experiment.robot.l)).map_err(fail)?;
         doc.insert("small_deflection".into(), validity);
-        let exp = serde_json::to_value(experiment).map_err(|e| ModelError::Write {
-            file: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
-        doc.insert("experiment".into(), exp);
-        let text = serde_json::to_string_pretty(&serde_json::Value::Object(doc)).map_err(|e| ModelError::Write {
-            file: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
-        crate::output::write_string_atomically(path, &(text + "\n"))
+        doc.insert("experiment".into(), serde_json::to_value(experiment).map_err(fail)?);
+        Ok(serde_json::Value::Object(doc))
+    }
+
+    /// Write the sidecar JSON of a run (`<csv name>.json`, the document of
+    /// [`Response::sidecar`]), whole or not at all.
+    pub fn write_sidecar(
+        &self,
+        path: &Path,
+        experiment: &crate::Experiment,
+        provenance: &Provenance,
+    ) -> Result<(), ModelError> {
+        write_sidecar_value(path, &self.sidecar(path, experiment, provenance)?)
     }
 
     /// Write the deformed-star snapshots as CSV (`t,beam,x,w,X,Y`), whole or not at all.
@@ -362,4 +361,13 @@ mod tests {
         assert_eq!(c.extra[0].values, vec![0.0, -4.0, -8.0, -11.0]);
         assert_eq!(r.every_nth(1), r);
     }
+}
+
+/// Write a sidecar document as pretty JSON with a final newline, whole or not at all.
+pub fn write_sidecar_value(path: &Path, doc: &serde_json::Value) -> Result<(), ModelError> {
+    let text = serde_json::to_string_pretty(doc).map_err(|e| ModelError::Write {
+        file: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    crate::output::write_string_atomically(path, &(text + "\n"))
 }

@@ -2,8 +2,6 @@
 
 use std::path::PathBuf;
 
-use flexstar_kinematics::table::{kinematics_table, write_kinematics_csv};
-
 /// Rigid kinematics of an experiment (Eqs. 1-12): G, theta, xp_i and their derivatives.
 #[derive(clap::Args)]
 pub struct Args {
@@ -16,10 +14,8 @@ pub struct Args {
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let exp = super::load(&args.config)?;
-    let states = kinematics_table(&exp).map_err(|e| anyhow::anyhow!("{}: {e}", args.config.display()))?;
-    let dir = super::case_dir(&args.out, &exp)?;
-    let path = dir.join("kinematics.csv");
-    write_kinematics_csv(&path, &states)?;
+    let states = flexstar_api::kinematics::table(&exp, &args.config.display().to_string())?;
+    let path = flexstar_api::kinematics::write(&args.out, &exp, &states)?;
     let last = states.last().expect("output times are never empty");
     eprintln!(
         "{}: {} rows to {} (t_end = {} s: G = ({:.5}, {:.5}) m, theta = {:.5} rad, xp = {:.4}/{:.4}/{:.4} m)",

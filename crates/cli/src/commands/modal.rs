@@ -1,15 +1,11 @@
 //! `flexstar modal`, `flexstar freqmap` and `flexstar linearize` (issue 11): modes at a pose,
 //! frequency maps and linear models (thin layer over `flexstar_modal`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
-use flexstar_modal::analysis::{modal, write_modal_csv};
-use flexstar_modal::freqmap::{check_grid, freqmap, write_freqmap_csv, Axis, Solver};
-use flexstar_modal::plots::{mode_shapes_figure, paper_paths, FreqMapFigure};
-use flexstar_modal::pose::{parse_pose, pose_at_time, pose_from_task};
-use flexstar_model::{Experiment, RestPose, Sliders};
-use flexstar_plot::write_svg_png;
+use flexstar_api::modal::{FreqmapSettings, MapSolver, PoseSpec};
+use flexstar_model::{Experiment, Sliders};
 
 use crate::progress::Reporter;
 
@@ -26,17 +22,17 @@ pub struct PoseArgs {
 }
 
 impl PoseArgs {
-    /// The rest pose, checked against the workspace (the error names the limit).
-    fn resolve(&self, exp: &Experiment) -> anyhow::Result<RestPose> {
-        let pose = match (&self.at, &self.pose) {
-            (Some(t), _) => pose_at_time(exp, *t)?,
+    /// Where the pose comes from (`--pose` parsed; the error names the flag).
+    fn spec(&self, config: &std::path::Path) -> anyhow::Result<PoseSpec> {
+        match (&self.at, &self.pose) {
+            (Some(t), _) => Ok(PoseSpec::At(*t)),
             (None, Some(p)) => {
-                let [gx, gy, th] = parse_pose(p)?;
-                pose_from_task(&exp.robot, gx, gy, th).map_err(|e| anyhow::anyhow!("--pose {p}: {e}"))?
+                let pose =
+                    flexstar_modal::pose::parse_pose(p).map_err(|e| anyhow::anyhow!("{}: {e}", config.display()))?;
+                Ok(PoseSpec::Task { pose, text: p.clone() })
             }
             (None, None) => anyhow::bail!("give --at T or --pose GX,GY,THETA"),
-        };
-        Ok(pose)
+        }
     }
 }
 
@@ -111,43 +107,27 @@ pub struct LinearizeArgs {
     out: PathBuf,
 }
 
-/// Warn when the experiment asks for another AMM family than the enriched one: the paper's
-/// families are meant for the time-domain comparison and miss the modes badly at some poses
-/// (case 4's end pose with pinned-free: f1 79 % above the FEM's).
-fn warn_family(config: &Path, exp: &Experiment) {
-    if exp.amm.family != flexstar_model::ModeFamily::Enriched {
-        eprintln!(
-            "note: {}: [amm] family = {} is for the time-domain runs; the modes use the accurate basis (enriched, N = {})",
-            config.display(),
-            exp.amm.family,
-            flexstar_modal::analysis::amm_modes_per_beam(exp)
-        );
+/// Load the experiment and print the note about the modes' basis.
+fn load(config: &std::path::Path) -> anyhow::Result<(Experiment, String)> {
+    let exp = super::load(config)?;
+    let source = config.display().to_string();
+    if let Some(note) = flexstar_api::modal::family_note(&source, &exp) {
+        eprintln!("{note}");
     }
-}
-
-/// Errors of the modal library prefixed with the experiment file.
-fn in_file(config: &Path) -> impl Fn(flexstar_modal::ModalError) -> anyhow::Error + '_ {
-    move |e| anyhow::anyhow!("{}: {e}", config.display())
+    Ok((exp, source))
 }
 
 pub fn run_modal(args: ModalArgs) -> anyhow::Result<()> {
-    let exp = super::load(&args.config)?;
-    warn_family(&args.config, &exp);
-    flexstar_modal::check_k(args.k)?;
-    let pose = args
-        .pose
-        .resolve(&exp)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", args.config.display()))?;
+    let (exp, source) = load(&args.config)?;
     let sliders = match args.sliders {
         SlidersArg::Locked => Sliders::Locked,
         SlidersArg::Free => Sliders::Free,
     };
-    let dir = super::case_dir(&args.out, &exp)?;
+    flexstar_api::modal::check_k(args.k)?;
+    let spec = args.pose.spec(&args.config)?;
     let start = Instant::now();
-    let m = modal(&exp, &pose, sliders, args.k).map_err(in_file(&args.config))?;
-    let figure = mode_shapes_figure("modal-shapes", &m, &pose, exp.robot.l);
-    write_modal_csv(&dir.join("modal.csv"), &m)?;
-    write_svg_png(&figure, &dir)?;
+    let o = flexstar_api::modal::modal(&exp, &source, &spec, sliders, args.k, Some(&args.out))?;
+    let pose = &o.pose;
     eprintln!(
         "{}: pose G = ({:.5}, {:.5}) m, theta = {:.5} rad, s = {:.5}/{:.5}/{:.5} m, sliders {} ({:.2} s)",
         exp.name,
@@ -160,32 +140,29 @@ pub fn run_modal(args: ModalArgs) -> anyhow::Result<()> {
         sliders.name(),
         start.elapsed().as_secs_f64()
     );
-    for (mode, a, f, rel) in m.rows() {
+    for (mode, a, f, rel) in o.modal.rows() {
         eprintln!(
             "  mode {mode:>2}: AMM {a:>10.4} Hz  FEM {f:>10.4} Hz  {:>+8.3} %",
             100.0 * rel
         );
     }
+    let dir = args.out.join(&exp.name);
     eprintln!("{}: modal.csv, modal-shapes.svg/.png in {}", exp.name, dir.display());
     Ok(())
 }
 
 pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
-    let exp = super::load(&args.config)?;
-    warn_family(&args.config, &exp);
-    let gx = Axis::parse("--gx", &args.gx)?;
-    let gy = Axis::parse("--gy", &args.gy)?;
-    check_grid(&gx, &gy)?;
-    flexstar_modal::check_k(args.k)?;
-    if !args.theta.is_finite() {
-        anyhow::bail!("--theta {}: must be a finite angle in rad", args.theta);
-    }
-    let solver = match args.solver {
-        SolverArg::Amm => Solver::Amm,
-        SolverArg::Fem => Solver::Fem,
+    let (exp, source) = load(&args.config)?;
+    let settings = FreqmapSettings {
+        gx: flexstar_api::modal::parse_axis("--gx", &args.gx)?,
+        gy: flexstar_api::modal::parse_axis("--gy", &args.gy)?,
+        theta: args.theta,
+        k: args.k,
+        solver: match args.solver {
+            SolverArg::Amm => MapSolver::Amm,
+            SolverArg::Fem => MapSolver::Fem,
+        },
     };
-    let paths = paper_paths()?;
-    let dir = super::case_dir(&args.out, &exp)?;
     let start = Instant::now();
     let reporter = Reporter::new("freqmap");
     let tick = |done: usize, total: usize| {
@@ -196,54 +173,32 @@ pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
             elapsed: start.elapsed().as_secs_f64(),
         })
     };
-    let points = freqmap(&exp, &gx, &gy, args.theta, args.k, solver, tick);
+    let figure = flexstar_api::modal::freqmap(&exp, &source, settings, Some(&args.out), tick);
     reporter.finish();
-    let points = points.map_err(in_file(&args.config))?;
-    let feasible = points.iter().filter(|p| p.result.is_ok()).count();
-    let figure = FreqMapFigure {
-        name: "freqmap".into(),
-        title: format!(
-            "{}: first frequencies over the workspace, theta = {} rad, sliders locked ({})",
-            exp.name,
-            args.theta,
-            if matches!(solver, Solver::Amm) { "AMM" } else { "FEM" }
-        ),
-        gx,
-        gy,
-        points,
-        shown: args.k.min(2),
-        paths,
-    };
-    write_freqmap_csv(&dir, &figure.points, args.k)?;
-    write_svg_png(&figure, &dir)?;
+    let figure = figure?;
+    let feasible = figure.points.iter().filter(|p| p.result.is_ok()).count();
     eprintln!(
         "{}: {} poses ({feasible} feasible) in {:.2} s; freqmap.csv, freqmap-infeasible.csv, freqmap.svg/.png in {}",
         exp.name,
         figure.points.len(),
         start.elapsed().as_secs_f64(),
-        dir.display()
+        args.out.join(&exp.name).display()
     );
     Ok(())
 }
 
 pub fn run_linearize(args: LinearizeArgs) -> anyhow::Result<()> {
-    let exp = super::load(&args.config)?;
-    warn_family(&args.config, &exp);
-    let pose = args
-        .pose
-        .resolve(&exp)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", args.config.display()))?;
-    let dir = super::case_dir(&args.out, &exp)?;
-    let ss = flexstar_modal::linear::linearize(&exp, &pose).map_err(in_file(&args.config))?;
-    flexstar_modal::linear::write_linear(&dir, &exp, &ss).map_err(in_file(&args.config))?;
+    let (exp, source) = load(&args.config)?;
+    let spec = args.pose.spec(&args.config)?;
+    let ss = flexstar_api::modal::linearize(&exp, &source, &spec, Some(&args.out))?;
     eprintln!(
         "{}: {} states, 3 inputs, 9 outputs about G = ({:.5}, {:.5}) m, theta = {:.5} rad; A.mtx .. D.mtx, M.mtx, K.mtx, Phi_q.mtx, statespace.json in {}",
         exp.name,
         ss.a.rows(),
-        pose.g[0],
-        pose.g[1],
-        pose.theta,
-        dir.join("linear").display()
+        ss.pose.g[0],
+        ss.pose.g[1],
+        ss.pose.theta,
+        args.out.join(&exp.name).join("linear").display()
     );
     Ok(())
 }

@@ -23,8 +23,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(c) => super::load(c)?.robot,
         None => RobotParams::paper(),
     };
-    let set = flexstar_amm::ModeSet::new(args.family, args.n, &params)?;
-    let (bl, f) = (set.beta_l(), set.frequencies_hz());
+    let (bl, f) = flexstar_api::modes::mode_table(args.family, args.n, &params)?;
     println!(
         "# {} modes, L = {} m, EI = {} N m^2, rho = {} kg/m",
         args.family,

@@ -1,0 +1,42 @@
+//! One library entry point for both fronts of flexstar, the command line and the Python package:
+//! what each command does beyond parsing its arguments (loading and checking the experiment, the
+//! drive dispatch, the feasibility preflight, the solver call, the sidecar, the files written).
+//! A front parses its arguments into the typed settings here, calls one function and prints or
+//! returns the outcome; errors are an [`ApiError`] that tells bad input (file, key, reason), an
+//! infeasible motion (time, reason) and a solver failure apart.
+
+pub mod document;
+mod error;
+mod figures;
+pub mod kinematics;
+pub mod modal;
+pub mod modes;
+pub mod run;
+mod solver_errors;
+pub mod study;
+
+use std::path::{Path, PathBuf};
+
+pub use document::ExperimentDoc;
+pub use error::{ApiError, Result};
+pub use flexstar_model::{Experiment, Provenance};
+pub use run::{Forces, Prepared, RunOutcome, RunSettings, Solver};
+
+/// Load and validate an experiment file (errors name the file, the key and the reason).
+pub fn load(config: &Path) -> Result<Experiment> {
+    Ok(Experiment::load(config)?)
+}
+
+/// `DIR/<name>/`, created and checked writable (before any work is done).
+pub fn case_dir(out: &Path, exp: &Experiment) -> Result<PathBuf> {
+    let dir = out.join(&exp.name);
+    flexstar_model::output::ensure_writable_dir(out)?;
+    flexstar_model::output::ensure_writable_dir(&dir)?;
+    Ok(dir)
+}
+
+/// This library's version, the commit it was built from (when known) and now: the provenance
+/// fields of every sidecar.
+pub fn provenance() -> Provenance {
+    Provenance::now(option_env!("FLEXSTAR_GIT_COMMIT"))
+}

@@ -1,0 +1,356 @@
+//! `run`: one solver on one experiment (the CLI's `flexstar run`, Python's `flexstar.run`):
+//! the settings applied over the experiment, the feasibility preflight, the drive dispatch
+//! (prescribed motion or direct problem), the solve, the sidecar and the run's files.
+
+use std::path::{Path, PathBuf};
+
+use flexstar_model::config::check_step;
+use flexstar_model::{AmmModel, DriveKind, DriveSettings, Experiment, ForceSamples, ModeFamily, Response};
+
+use crate::solver_errors::{from_amm, from_fem};
+use crate::{ApiError, Result};
+
+/// Which model solves the experiment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Solver {
+    /// The paper's constrained assumed-modes method.
+    Amm,
+    /// The independent finite-element reference.
+    Fem,
+}
+
+/// Actuator forces that replace the experiment's `[drive]` (the direct problem).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Forces {
+    /// A CSV whose header starts with `t` and names `Fa1, Fa2, Fa3` (`--forces FILE`).
+    File(PathBuf),
+    /// Samples `Fa_i(t)` [N] at increasing times [s] (Python's `forces=` array).
+    Samples(ForceSamples),
+}
+
+/// What a run may change over its experiment (every field optional, as the CLI's flags).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSettings {
+    pub solver: Solver,
+    /// AMM mode family (overrides `[amm] family`).
+    pub family: Option<ModeFamily>,
+    /// AMM modes per beam N, rigid ones included (overrides `[amm] modes` and `tol`).
+    pub modes: Option<usize>,
+    /// AMM equations (overrides `[amm] model`).
+    pub model: Option<AmmModel>,
+    /// AMM error tolerance [%] (overrides `[amm] tol` and `modes`).
+    pub tol: Option<f64>,
+    /// FEM elements in the whole star (overrides `[fem] elements`).
+    pub elements: Option<usize>,
+    /// Integration step [s] (overrides `[amm] dt` or `[fem] dt`).
+    pub dt: Option<f64>,
+    /// Actuator forces replacing the `[drive]`.
+    pub forces: Option<Forces>,
+    /// Also draw the figures in `DIR/<name>/figures/`.
+    pub figures: bool,
+}
+
+impl RunSettings {
+    /// The experiment as it is: no override.
+    pub fn new(solver: Solver) -> Self {
+        RunSettings {
+            solver,
+            family: None,
+            modes: None,
+            model: None,
+            tol: None,
+            elements: None,
+            dt: None,
+            forces: None,
+            figures: false,
+        }
+    }
+}
+
+/// An experiment with a run's settings applied and checked: ready to solve.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// The resolved experiment (what the sidecar records).
+    pub exp: Experiment,
+    pub solver: Solver,
+    /// The file stem of the run: `amm-<family>`, `fem`, `amm-<family>-direct`, `fem-direct`.
+    pub stem: String,
+    /// The direct problem (forces or servo)?
+    pub direct: bool,
+    /// Notes for the user (e.g. forces replacing the `[drive]`).
+    pub notes: Vec<String>,
+    /// Where the experiment came from, first in every message (a file name, `<dict>`).
+    pub source: String,
+    figures: bool,
+}
+
+impl Prepared {
+    /// One line that says what will be solved (`case3: AMM, Tolerance(0.2), enriched`).
+    pub fn describe(&self) -> String {
+        match self.solver {
+            Solver::Amm => format!(
+                "{}: AMM, {:?}, {}",
+                self.exp.name,
+                self.exp.amm.mode_count(),
+                self.exp.amm.family
+            ),
+            Solver::Fem => format!("{}: FEM, {} elements", self.exp.name, self.exp.fem.elements),
+        }
+    }
+}
+
+/// The outcome of a run: the response, its sidecar document and the files written (if any).
+#[derive(Debug, Clone)]
+pub struct RunOutcome {
+    pub response: Response,
+    /// The sidecar JSON as written next to the CSV (provenance, run info, validity, experiment).
+    pub meta: serde_json::Value,
+    /// The file stem (`amm-enriched`, `fem-direct`, ...).
+    pub stem: String,
+    /// The resolved experiment.
+    pub exp: Experiment,
+    /// The small-deflection warning (`None` when the run stays in range).
+    pub warning: Option<String>,
+    /// Files written, in order (empty until [`write_run`]).
+    pub files: Vec<PathBuf>,
+    /// The main CSV (set by [`write_run`]).
+    pub csv: Option<PathBuf>,
+}
+
+/// Apply `settings` to `exp` (from `source`) and check everything before any work: the step,
+/// the feasibility scan of the motion (a forces-driven run: its start), the flags that do not
+/// apply to the solver, the resolved experiment.
+pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Result<Prepared> {
+    let mut notes = Vec::new();
+    if let Some(f) = &settings.forces {
+        let (drive, what) = forces_drive(f)?;
+        if exp.drive.is_direct() {
+            notes.push(format!("note: {what} replaces the [drive] of {source}"));
+        }
+        exp.drive = drive;
+    }
+    if let Some(dt) = settings.dt {
+        check_step("--dt", dt, exp.time.dt_out).map_err(|e| ApiError::model_in(source, Path::new(source), e))?;
+    }
+    preflight(&exp, source)?;
+    let direct = exp.drive.is_direct();
+    let stem = match settings.solver {
+        Solver::Amm => apply_amm(&mut exp, source, settings)?,
+        Solver::Fem => apply_fem(&mut exp, source, settings)?,
+    };
+    exp.validate()
+        .map_err(|e| ApiError::model_in(format!("{source} with the command-line flags"), Path::new(source), e))?;
+    let stem = if direct { format!("{stem}-direct") } else { stem };
+    Ok(Prepared {
+        exp,
+        solver: settings.solver,
+        stem,
+        direct,
+        notes,
+        source: source.to_string(),
+        figures: settings.figures,
+    })
+}
+
+/// The `[drive]` of a forces override and how to name it in a note.
+fn forces_drive(f: &Forces) -> Result<(DriveSettings, String)> {
+    match f {
+        Forces::File(path) => Ok((
+            DriveSettings::forces_file(path)?,
+            format!("--forces {}", path.display()),
+        )),
+        Forces::Samples(s) => {
+            ForceSamples::check(&s.t, &s.fa).map_err(|reason| ApiError::config("forces", None, reason.to_string()))?;
+            let drive = DriveSettings {
+                kind: DriveKind::Forces,
+                // no file: the samples were given in memory (the sidecar records this name)
+                file: Some(PathBuf::from("<forces array>")),
+                samples: Some(s.clone()),
+                ..DriveSettings::default()
+            };
+            Ok((drive, "forces".to_string()))
+        }
+    }
+}
+
+/// The feasibility scan of both solvers, here too so that nothing is created for a motion that
+/// is refused (a forces-driven run: its start only; its motion is checked as it goes).
+fn preflight(exp: &Experiment, source: &str) -> Result<()> {
+    let servo = exp.drive.kind == DriveKind::Servo;
+    if exp.drive.is_direct() && !servo {
+        let s0 = exp
+            .trajectory
+            .s(&exp.robot, 0.0)
+            .map_err(|e| ApiError::infeasible(source, 0.0, e))?;
+        flexstar_kinematics::check_configuration(&exp.robot, s0).map_err(|violation| {
+            ApiError::infeasible(source, 0.0, flexstar_kinematics::Infeasible { t: 0.0, violation })
+        })
+    } else {
+        let step = exp.time.dt_out.min(1e-3);
+        flexstar_kinematics::check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, step)
+            .map_err(|e| ApiError::infeasible(source, e.t, e))
+    }
+}
+
+/// The AMM's settings over `[amm]`; the stem `amm-<family>`.
+fn apply_amm(exp: &mut Experiment, source: &str, s: &RunSettings) -> Result<String> {
+    if s.elements.is_some() {
+        return Err(ApiError::config(
+            source,
+            None,
+            "--elements applies to --solver fem only",
+        ));
+    }
+    if let Some(f) = s.family {
+        exp.amm.family = f;
+    }
+    if let Some(n) = s.modes {
+        exp.amm.modes = Some(n);
+        exp.amm.tol = None;
+    }
+    if let Some(p) = s.tol {
+        exp.amm.tol = Some(p);
+        exp.amm.modes = None;
+    }
+    if let Some(m) = s.model {
+        exp.amm.model = m;
+    }
+    if s.dt.is_some() {
+        exp.amm.dt = s.dt;
+    }
+    Ok(format!("amm-{}", exp.amm.family))
+}
+
+/// The FEM's settings over `[fem]`; the stem `fem`.
+fn apply_fem(exp: &mut Experiment, source: &str, s: &RunSettings) -> Result<String> {
+    if s.family.is_some() || s.modes.is_some() || s.model.is_some() || s.tol.is_some() {
+        return Err(ApiError::config(
+            source,
+            None,
+            "--family, --modes, --model and --tol apply to --solver amm only",
+        ));
+    }
+    if let Some(n) = s.elements {
+        exp.fem.elements = n;
+    }
+    if s.dt.is_some() {
+        exp.fem.dt = s.dt;
+    }
+    Ok("fem".to_string())
+}
+
+/// The actuator law of a direct run's drive.
+fn law_of(p: &Prepared) -> Result<Box<dyn flexstar_drive::ActuatorLaw>> {
+    flexstar_drive::law_for(&p.exp)
+        .map_err(|e| ApiError::config(&p.source, Some("drive"), e.to_string()))?
+        .ok_or_else(|| ApiError::config(&p.source, None, "the drive is a motion, not a direct problem"))
+}
+
+/// Solve a prepared run; `progress` gets the fraction done of an FEM run (0..1). A servo run's
+/// response gets its tracking errors `e1..e3`.
+pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Response> {
+    let law = if p.direct { Some(law_of(p)?) } else { None };
+    let exp = &p.exp;
+    let mut r = match (p.solver, &law) {
+        (Solver::Amm, Some(law)) => {
+            flexstar_amm::solve_direct(exp, &exp.amm, law.as_ref()).map_err(|e| from_amm(&p.source, e))?
+        }
+        (Solver::Amm, None) => flexstar_amm::solve(exp, &exp.amm).map_err(|e| from_amm(&p.source, e))?,
+        (Solver::Fem, Some(law)) => {
+            flexstar_fem::solve_direct(exp, &exp.fem, law.as_ref(), progress).map_err(|e| from_fem(&p.source, e))?
+        }
+        (Solver::Fem, None) => flexstar_fem::solve(exp, &exp.fem, progress).map_err(|e| from_fem(&p.source, e))?,
+    };
+    if p.direct && exp.drive.kind == DriveKind::Servo {
+        flexstar_drive::add_tracking_errors(&mut r, exp).map_err(|e| ApiError::solver(&p.source, e))?;
+    }
+    Ok(r)
+}
+
+/// Solve a prepared run and build its outcome (sidecar document, validity warning); nothing is
+/// written.
+pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunOutcome> {
+    let response = solve(p, progress)?;
+    let meta = response.sidecar(Path::new(&format!("{}.json", p.stem)), &p.exp, &crate::provenance())?;
+    let warning = flexstar_model::small_deflection_check(&response, p.exp.robot.l)
+        .map(|v| format!("{}: {} {v}", p.source, p.stem));
+    Ok(RunOutcome {
+        response,
+        meta,
+        stem: p.stem.clone(),
+        exp: p.exp.clone(),
+        warning,
+        files: Vec::new(),
+        csv: None,
+    })
+}
+
+/// Columns a direct run's file puts right after the fixed ones (issue 10 contract).
+fn direct_columns(servo: bool) -> Vec<&'static str> {
+    let mut v = vec!["Gx", "Gy", "theta"];
+    if servo {
+        v.extend(["e1", "e2", "e3"]);
+    }
+    v
+}
+
+/// Write a run's files in `dir` (already `DIR/<name>/`): `<stem>.csv` (a direct run: the
+/// sliders first, then the fixed columns, the pose, a servo's errors), `<stem>-shapes.csv`,
+/// `<stem>.json` (the outcome's sidecar) and with `figures` the figures in `dir/figures/`.
+pub fn write_run(out: &mut RunOutcome, dir: &Path, figures: bool) -> Result<()> {
+    let (r, exp, stem) = (&out.response, &out.exp, &out.stem);
+    let direct = exp.drive.is_direct();
+    let csv = dir.join(format!("{stem}.csv"));
+    if direct {
+        let servo = exp.drive.kind == DriveKind::Servo;
+        r.write_csv_ordered(&csv, &["s1", "s2", "s3"], &direct_columns(servo))?;
+    } else {
+        r.write_csv(&csv)?;
+    }
+    let shapes = dir.join(format!("{stem}-shapes.csv"));
+    r.write_shapes_csv(&shapes)?;
+    let json = dir.join(format!("{stem}.json"));
+    flexstar_model::response::write_sidecar_value(&json, &out.meta)?;
+    out.files.extend([csv.clone(), shapes, json]);
+    if figures {
+        let figs = crate::figures::run_figures(exp, stem, r, direct, dir)?;
+        out.files.extend(figs);
+    }
+    out.csv = Some(csv);
+    Ok(())
+}
+
+/// The whole `flexstar run`: prepare, create `out/<name>/` (checked writable before any work),
+/// solve, write. `on_prepared` sees the prepared run before the solve (the CLI prints notes).
+pub fn run_to_dir(
+    exp: Experiment,
+    source: &str,
+    settings: &RunSettings,
+    out: &Path,
+    on_prepared: impl FnOnce(&Prepared),
+    progress: Option<&(dyn Fn(f64) + Sync)>,
+) -> Result<RunOutcome> {
+    let p = prepare(exp, source, settings)?;
+    let dir = crate::case_dir(out, &p.exp)?;
+    on_prepared(&p);
+    let mut outcome = run(&p, progress)?;
+    write_run(&mut outcome, &dir, p.figures)?;
+    Ok(outcome)
+}
+
+/// Every column of a response by name, in the order of its CSV (`t` first, the fixed columns,
+/// then the extra ones): what fronts hand out as arrays.
+pub fn columns(r: &Response) -> Vec<(String, &[f64])> {
+    let fixed: Vec<&[f64]> = std::iter::once(r.t.as_slice())
+        .chain(r.w_g.iter().map(Vec::as_slice))
+        .chain(r.w_tip.iter().map(Vec::as_slice))
+        .chain(r.fa.iter().map(Vec::as_slice))
+        .collect();
+    let mut out: Vec<(String, &[f64])> = flexstar_model::response::RESPONSE_HEADER
+        .iter()
+        .map(|s| s.to_string())
+        .zip(fixed)
+        .collect();
+    out.extend(r.extra.iter().map(|c| (c.name.clone(), c.values.as_slice())));
+    out
+}

@@ -1,0 +1,298 @@
+"""flexstar: the vibration of the flexible 3-PRP star-triangle robot (AMM and FEM) from Python.
+
+Every function calls the same Rust library as the ``flexstar`` command line (``flexstar-api``);
+this package adds no physics, only conversions. Units are SI (m, s, N, rad, Hz).
+
+    import flexstar
+    exp = flexstar.Experiment.load("configs/case3.toml")
+    run = flexstar.run(exp, solver="amm")
+    run["w1tip"].max()
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, List, Mapping, Optional, Sequence
+
+import numpy as np
+
+from . import _flexstar
+from ._flexstar import ConfigError, InfeasibleMotion, SolverError
+
+__all__ = [
+    "ConfigError",
+    "InfeasibleMotion",
+    "SolverError",
+    "Experiment",
+    "Run",
+    "LinearModel",
+    "run",
+    "modal",
+    "linearize",
+    "sweep",
+    "compare",
+    "verify",
+    "freqmap",
+]
+__version__ = _flexstar.__version__
+
+
+class Experiment:
+    """A checked experiment (robot, time span, trajectory or drive, solver settings).
+
+    Build with :meth:`load`, :meth:`from_toml` or :meth:`from_dict`; every value is checked by
+    the library's experiment loader (errors are :class:`ConfigError` naming file, key, reason).
+    """
+
+    def __init__(self, inner: Any) -> None:
+        self._inner = inner
+
+    @classmethod
+    def load(cls, path: "os.PathLike[str] | str") -> "Experiment":
+        """Read and check an experiment file (TOML)."""
+        return cls(_flexstar._Experiment.load(os.fspath(path)))
+
+    @classmethod
+    def from_toml(cls, text: str, source: str = "<toml>") -> "Experiment":
+        """Parse and check TOML text; ``source`` names it in messages."""
+        if not isinstance(text, str):
+            raise ConfigError(f"text: expected a str of TOML, got {type(text).__name__}")
+        return cls(_flexstar._Experiment.from_toml(text, source))
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], source: str = "<dict>") -> "Experiment":
+        """Build from a dict shaped like the TOML file (sections as nested dicts)."""
+        return cls(_flexstar._Experiment.from_json(_to_json("d", d), source))
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The experiment's document as a dict (``from_dict(exp.to_dict())`` gives it back)."""
+        return json.loads(self._inner.to_json())
+
+    def with_values(self, values: Mapping[str, Any]) -> "Experiment":
+        """A copy with values at the dotted keys of sweeps (``{"robot.Lp": 0.04, "amm.tol": 0.2}``),
+        checked the same way as the cases of a sweep."""
+        if not isinstance(values, Mapping):
+            raise ConfigError(f"values: expected a dict of dotted keys, got {type(values).__name__}")
+        return Experiment(self._inner.with_values_json(_to_json("values", dict(values))))
+
+    @property
+    def name(self) -> str:
+        """The experiment's name (its output folder)."""
+        return self._inner.name
+
+    @property
+    def source(self) -> str:
+        """Where the experiment was read from."""
+        return self._inner.source
+
+    def __repr__(self) -> str:
+        return f"Experiment({self.name!r}, source={self.source!r})"
+
+
+def _to_json(arg: str, value: Any) -> str:
+    try:
+        return json.dumps(value, allow_nan=False)
+    except (TypeError, ValueError) as e:
+        raise ConfigError(f"{arg}: {e}") from None
+
+
+class Run:
+    """A solver's output: every column (``t`` included) as a numpy array.
+
+    ``run["w1tip"]``, ``run.columns``, ``run.meta`` (the sidecar JSON as a dict),
+    ``run.to_pandas()``, ``run.save(dir)`` (the CLI's files, in ``dir/<name>/``).
+    """
+
+    def __init__(self, inner: Any) -> None:
+        self._inner = inner
+        self.columns: List[str] = list(inner.columns())
+        self._cache: Dict[str, np.ndarray] = {}
+        self._meta: Optional[Dict[str, Any]] = None
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self._cache:
+            self._cache[name] = self._inner.column(name)
+        return self._cache[name]
+
+    def __contains__(self, name: str) -> bool:
+        return name in self.columns
+
+    def __len__(self) -> int:
+        return len(self["t"])
+
+    @property
+    def meta(self) -> Dict[str, Any]:
+        """The sidecar document (provenance, resolved settings, validity, experiment)."""
+        if self._meta is None:
+            self._meta = json.loads(self._inner.meta_json())
+        return self._meta
+
+    @property
+    def stem(self) -> str:
+        """The file stem of the run (``amm-enriched``, ``fem-direct``, ...)."""
+        return self._inner.stem
+
+    @property
+    def warning(self) -> Optional[str]:
+        """The small-deflection warning, ``None`` when the run stays in range."""
+        return self._inner.warning
+
+    def to_pandas(self) -> "Any":
+        """The columns as a pandas DataFrame (needs pandas)."""
+        import pandas as pd
+
+        return pd.DataFrame({c: self[c] for c in self.columns})
+
+    def save(self, out: "os.PathLike[str] | str", figures: bool = False) -> List[str]:
+        """Write the CLI's files (``<stem>.csv``, ``-shapes.csv``, ``.json``) into ``out/<name>/``."""
+        return list(self._inner.save(os.fspath(out), figures))
+
+    def __repr__(self) -> str:
+        return f"Run({self.stem!r}, {len(self)} rows, columns={self.columns})"
+
+
+def _forces_array(forces: Any) -> np.ndarray:
+    if hasattr(forces, "columns") and hasattr(forces, "to_numpy"):
+        missing = [c for c in ("t", "Fa1", "Fa2", "Fa3") if c not in forces.columns]
+        if missing:
+            raise ConfigError(f"forces: the DataFrame has no column(s) {', '.join(missing)}")
+        forces = forces[["t", "Fa1", "Fa2", "Fa3"]].to_numpy()
+    try:
+        a = np.ascontiguousarray(forces, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ConfigError(f"forces: not an array of numbers: {e}") from None
+    if a.ndim != 2:
+        raise ConfigError(f"forces: expected a 2-D array (n, 4) of t, Fa1, Fa2, Fa3, got {a.ndim} dimension(s)")
+    return a
+
+
+def _check_count(arg: str, v: Any) -> None:
+    if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1):
+        raise ConfigError(f"{arg}: expected a positive whole number, got {v!r}")
+
+
+def _check_float(arg: str, v: Any) -> None:
+    if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer))):
+        raise ConfigError(f"{arg}: expected a number, got {v!r}")
+
+
+def run(
+    exp: Experiment,
+    solver: str = "amm",
+    *,
+    family: Optional[str] = None,
+    modes: Optional[int] = None,
+    model: Optional[str] = None,
+    tol: Optional[float] = None,
+    elements: Optional[int] = None,
+    dt: Optional[float] = None,
+    forces: Any = None,
+) -> Run:
+    """Run ``solver`` ("amm" or "fem") on ``exp`` with the CLI's overrides (``family``, ``modes``,
+    ``model``, ``tol`` [%], ``elements``, ``dt`` [s]). ``forces``: a (n, 4) array or a DataFrame
+    with columns t, Fa1, Fa2, Fa3 [s, N] drives the sliders (the direct problem). The GIL is
+    released during the solve. Nothing is written (see :meth:`Run.save`)."""
+    if not isinstance(exp, Experiment):
+        raise ConfigError(f"exp: expected a flexstar.Experiment, got {type(exp).__name__}")
+    for arg, v in (("modes", modes), ("elements", elements)):
+        _check_count(arg, v)
+    for arg, v in (("tol", tol), ("dt", dt)):
+        _check_float(arg, v)
+    f = None if forces is None else _forces_array(forces)
+    return Run(
+        _flexstar.run(exp._inner, solver, family, modes, model, tol, elements, dt, f)
+    )
+
+
+def modal(
+    exp: Experiment,
+    at: Optional[float] = None,
+    pose: Optional[Sequence[float]] = None,
+    sliders: str = "locked",
+    modes: int = 6,
+) -> Dict[str, Any]:
+    """Modes at a pose (``at`` = time of the trajectory [s], or ``pose`` = (Gx, Gy, theta)),
+    AMM and FEM side by side: ``{"mode", "amm_hz", "fem_hz", "rigid", "pose"}``; with
+    ``sliders="free"`` the three rigid modes (0 Hz) come first."""
+    return _flexstar.modal(exp._inner, at, None if pose is None else tuple(pose), sliders, modes)
+
+
+class LinearModel:
+    """x' = A x + B u, y = C x + D u about a pose, sliders free (inputs Fa1..Fa3 [N],
+    outputs s1..s3, w1_tip..w3_tip, w1G..w3G [m])."""
+
+    def __init__(self, d: Dict[str, Any]) -> None:
+        self.A: np.ndarray = d["A"]
+        self.B: np.ndarray = d["B"]
+        self.C: np.ndarray = d["C"]
+        self.D: np.ndarray = d["D"]
+        self.inputs: List[str] = d["inputs"]
+        self.outputs: List[str] = d["outputs"]
+        n = self.A.shape[0] // 2
+        self.states: List[str] = [f"eta{k + 1}" for k in range(n)] + [f"deta{k + 1}" for k in range(n)]
+        self.modal_frequencies_hz: np.ndarray = d["modal_frequencies_hz"]
+        self.rigid: int = d["rigid"]
+        self.pose: Dict[str, Any] = d["pose"]
+
+    def to_control(self) -> "Any":
+        """A python-control ``StateSpace`` (needs the ``control`` package)."""
+        import control
+
+        return control.ss(self.A, self.B, self.C, self.D, inputs=self.inputs, outputs=self.outputs, states=self.states)
+
+
+def linearize(exp: Experiment, at: Optional[float] = None, pose: Optional[Sequence[float]] = None) -> LinearModel:
+    """The linear state-space model about a pose (see :class:`LinearModel`)."""
+    return LinearModel(_flexstar.linearize(exp._inner, at, None if pose is None else tuple(pose)))
+
+
+def sweep(study: "os.PathLike[str] | str", out: "os.PathLike[str] | str", jobs: Optional[int] = None) -> "Any":
+    """Run a design study file (as ``flexstar sweep``) into ``out/<name>/``; returns results.csv
+    as a pandas DataFrame (needs pandas)."""
+    import pandas as pd
+
+    path = _flexstar.sweep(os.fspath(study), os.fspath(out), jobs)
+    return pd.read_csv(path)
+
+
+def compare(
+    config: "os.PathLike[str] | str",
+    out: "os.PathLike[str] | str" = "out",
+    families: Sequence[str] = (),
+    modes: Optional[int] = None,
+    figures: bool = False,
+) -> Dict[str, Any]:
+    """Compare the AMM with the FEM on an experiment file (as ``flexstar compare``): writes
+    ``out/<name>/``; returns the folder, compare.csv, the behaviour of G and the closest family."""
+    _check_count("modes", modes)
+    return _flexstar.compare(os.fspath(config), os.fspath(out), list(families), modes, figures)
+
+
+def verify(out: "os.PathLike[str] | str" = "out/verify", figures: bool = False, n_study: bool = False) -> Dict[str, Any]:
+    """Reproduce and check Table I (as ``flexstar verify``): the table as Markdown, the number of
+    checks and the failed ones."""
+    return _flexstar.verify(os.fspath(out), figures, n_study)
+
+
+def freqmap(
+    exp: Experiment,
+    gx: Sequence[float],
+    gy: Sequence[float],
+    theta: float = 0.0,
+    modes: int = 6,
+    solver: str = "amm",
+) -> "Any":
+    """The first ``modes`` frequencies (sliders locked) over a grid ``gx``, ``gy`` = (min, max, n)
+    [m] at ``theta`` [rad]: a DataFrame (Gx, Gy, theta, f1..fK [Hz], reason) when pandas is
+    installed, else the dict of lists."""
+    d = _flexstar.freqmap(exp._inner, tuple(gx), tuple(gy), theta, modes, solver)
+    try:
+        import pandas as pd
+    except ImportError:
+        return d
+    df = pd.DataFrame({"Gx": d["Gx"], "Gy": d["Gy"], "theta": d["theta"]})
+    for k in range(modes):
+        df[f"f{k + 1}"] = [f[k] if f is not None else float("nan") for f in d["f_hz"]]
+    df["reason"] = d["reason"]
+    return df

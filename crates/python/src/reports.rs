@@ -1,0 +1,118 @@
+//! `compare`, `verify` and `freqmap`: the library's commands that write reports, with their
+//! main numbers returned as dicts.
+
+use std::path::PathBuf;
+
+use flexstar_api::study::{run_compare, run_verify, CompareOptions, VerifyOptions};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::{convert, py_err, ConfigError, PyExperiment, SolverError};
+
+/// Compare the AMM with the FEM on an experiment file (as `flexstar compare`): writes
+/// `out/<name>/`; returns `{"dir", "behaviour", "most_accurate", "compare_csv"}`.
+#[pyfunction]
+#[pyo3(signature = (config, out, families = Vec::new(), modes = None, figures = false))]
+pub fn compare<'py>(
+    py: Python<'py>,
+    config: PathBuf,
+    out: PathBuf,
+    families: Vec<String>,
+    modes: Option<usize>,
+    figures: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let families = families
+        .iter()
+        .map(|f| convert::parse("families", f))
+        .collect::<PyResult<Vec<_>>>()?;
+    let opts = CompareOptions {
+        config,
+        families,
+        modes,
+        out,
+        figures,
+        provenance: flexstar_api::provenance(),
+    };
+    let o = py
+        .detach(|| run_compare(&opts, None))
+        .map_err(|e| SolverError::new_err(e.to_string()))?;
+    let d = PyDict::new(py);
+    d.set_item("dir", o.dir.display().to_string())?;
+    d.set_item("compare_csv", o.dir.join("compare.csv").display().to_string())?;
+    d.set_item("behaviour", o.row.behaviour.name())?;
+    d.set_item("most_accurate", o.row.most_accurate.clone())?;
+    Ok(d)
+}
+
+/// Reproduce and check Table I (as `flexstar verify`): returns `{"table_md", "checks",
+/// "failures"}`; the files go to `out`.
+#[pyfunction]
+#[pyo3(signature = (out, figures = false, n_study = false))]
+pub fn verify<'py>(py: Python<'py>, out: PathBuf, figures: bool, n_study: bool) -> PyResult<Bound<'py, PyDict>> {
+    let opts = VerifyOptions {
+        configs: None,
+        thresholds: None,
+        out,
+        figures,
+        n_study,
+        provenance: flexstar_api::provenance(),
+    };
+    let o = py
+        .detach(|| run_verify(&opts, None))
+        .map_err(|e| SolverError::new_err(e.to_string()))?;
+    let d = PyDict::new(py);
+    d.set_item("table_md", o.table.to_markdown())?;
+    d.set_item("checks", o.checks.len())?;
+    d.set_item("failures", o.failures.clone())?;
+    Ok(d)
+}
+
+/// The first `modes` frequencies (sliders locked) over a grid of poses: `gx`, `gy` as
+/// `(min, max, n)` [m], `theta` [rad]; returns `{"Gx", "Gy", "theta", "f_hz", "reason"}` lists
+/// (`f_hz` None and `reason` given for an infeasible pose).
+#[pyfunction]
+#[pyo3(signature = (exp, gx, gy, theta = 0.0, modes = 6, solver = "amm"))]
+pub fn freqmap<'py>(
+    py: Python<'py>,
+    exp: &PyExperiment,
+    gx: (f64, f64, usize),
+    gy: (f64, f64, usize),
+    theta: f64,
+    modes: usize,
+    solver: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let axis =
+        |flag: &str, (a, b, n): (f64, f64, usize)| flexstar_api::modal::parse_axis(flag, &format!("{a}:{b}:{n}"));
+    let solver = match convert::solver(solver)? {
+        flexstar_api::Solver::Amm => flexstar_api::modal::MapSolver::Amm,
+        flexstar_api::Solver::Fem => flexstar_api::modal::MapSolver::Fem,
+    };
+    let s = flexstar_api::modal::FreqmapSettings {
+        gx: axis("gx", gx).map_err(py_err)?,
+        gy: axis("gy", gy).map_err(py_err)?,
+        theta,
+        k: modes,
+        solver,
+    };
+    let doc = &exp.inner;
+    let source = doc.source.display().to_string();
+    let fig = py
+        .detach(|| flexstar_api::modal::freqmap(&doc.exp, &source, s, None, |_, _| {}))
+        .map_err(py_err)?;
+    if fig.points.is_empty() {
+        return Err(ConfigError::new_err("gx, gy: empty grid"));
+    }
+    let d = PyDict::new(py);
+    d.set_item("Gx", fig.points.iter().map(|p| p.gx).collect::<Vec<_>>())?;
+    d.set_item("Gy", fig.points.iter().map(|p| p.gy).collect::<Vec<_>>())?;
+    d.set_item("theta", fig.points.iter().map(|p| p.theta).collect::<Vec<_>>())?;
+    d.set_item(
+        "f_hz",
+        fig.points.iter().map(|p| p.result.clone().ok()).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "reason",
+        fig.points.iter().map(|p| p.result.clone().err()).collect::<Vec<_>>(),
+    )?;
+    Ok(d)
+}

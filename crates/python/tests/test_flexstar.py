@@ -1,0 +1,148 @@
+"""The Python package against the CLI (the same library): files equal to the last digit, every
+exception type, nothing written on bad input, a study, the linear model's poles."""
+
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+import flexstar
+
+
+def cli_run(cli, root, tmp, *args):
+    subprocess.run([cli, "run", *args, "--out", str(tmp)], cwd=root, check=True, capture_output=True)
+
+
+@pytest.mark.parametrize("solver", ["amm", "fem"])
+def test_files_equal_cli(cli, root, tmp_path, solver):
+    exp = flexstar.Experiment.load(root / "configs/case3.toml")
+    run = flexstar.run(exp, solver=solver)
+    run.save(tmp_path / "py")
+    cli_run(cli, root, tmp_path / "cli", "configs/case3.toml", "--solver", solver)
+    stem = run.stem
+    for suffix in (".csv", "-shapes.csv"):
+        a = (tmp_path / "py/case3" / f"{stem}{suffix}").read_bytes()
+        b = (tmp_path / "cli/case3" / f"{stem}{suffix}").read_bytes()
+        assert a == b, f"{stem}{suffix} differs from the CLI's"
+    import json
+
+    cli_meta = json.loads((tmp_path / "cli/case3" / f"{stem}.json").read_text())
+    for k in ("date", "wall_s", "commit"):
+        cli_meta.pop(k, None)
+        run.meta.pop(k, None)
+    assert run.meta == cli_meta
+    header = (tmp_path / "cli/case3" / f"{stem}.csv").read_text().splitlines()[0].split(",")
+    assert run.columns == header
+
+
+def test_forces_array_equals_cli_forces_file(cli, root, tmp_path):
+    """Direct dynamics: forces= an array equals --forces FILE of the same samples."""
+    exp = flexstar.Experiment.load(root / "configs/case3.toml")
+    inverse = flexstar.run(exp, solver="amm")
+    csv = pathlib.Path(inverse.save(tmp_path / "inv")[0])
+    forces = np.column_stack([inverse[c] for c in ("t", "Fa1", "Fa2", "Fa3")])
+    direct = flexstar.run(exp, solver="amm", forces=forces)
+    direct.save(tmp_path / "py")
+    cli_run(cli, root, tmp_path / "cli", "configs/case3.toml", "--solver", "amm", "--forces", str(csv))
+    name = f"{direct.stem}.csv"
+    assert (tmp_path / "py/case3" / name).read_bytes() == (tmp_path / "cli/case3" / name).read_bytes()
+
+
+def test_roundtrip_dict_and_with_values(root):
+    exp = flexstar.Experiment.load(root / "configs/case3.toml")
+    again = flexstar.Experiment.from_dict(exp.to_dict(), source=str(root / "configs/case3.toml"))
+    assert np.array_equal(flexstar.run(exp)["w1tip"], flexstar.run(again)["w1tip"])
+    lp = exp.with_values({"robot.Lp": 0.04})
+    assert lp.to_dict()["robot"]["Lp"] == 0.04
+    assert exp.to_dict()["robot"].get("Lp") != 0.04
+
+
+@pytest.mark.parametrize(
+    "call, key",
+    [
+        (lambda e: e.with_values({"robot.nope": 1.0}), "robot.nope"),
+        (lambda e: e.with_values({"robot.Lp": -1.0}), "robot.Lp"),
+        (lambda e: flexstar.run(e, solver="fem", elements=7), "fem.elements"),
+        (lambda e: flexstar.run(e, solver="xyz"), None),
+        (lambda e: flexstar.run(e, tol=float("nan")), None),
+        (lambda e: flexstar.run(e, modes=-1), None),
+        (lambda e: flexstar.run(e, forces=np.zeros((3, 3))), None),
+        (lambda e: flexstar.run(e, forces=np.array([[0.0, 0, 0, 0], [0.0, 1, 1, 1]])), None),
+        (lambda e: flexstar.modal(e, at=99.0), None),
+    ],
+)
+def test_config_errors(root, tmp_path, monkeypatch, call, key):
+    monkeypatch.chdir(tmp_path)
+    exp = flexstar.Experiment.load(root / "configs/case3.toml")
+    with pytest.raises(flexstar.ConfigError) as info:
+        call(exp)
+    assert isinstance(info.value, ValueError)
+    if key is not None:
+        assert info.value.key == key and key in str(info.value)
+    assert list(tmp_path.iterdir()) == [], "nothing is written on bad input"
+
+
+def test_config_error_names_file_and_line():
+    with pytest.raises(flexstar.ConfigError, match="unknown field `x`"):
+        flexstar.Experiment.from_toml("x = 1")
+
+
+def test_infeasible_motion(root):
+    exp = flexstar.Experiment.load(root / "configs/case3.toml")
+    with pytest.raises(flexstar.InfeasibleMotion, match="outside the workspace"):
+        flexstar.linearize(exp, pose=(0.9, 0.9, 0.0))
+    fast = exp.with_values({"trajectory.s1": [0.0, 0.0, 100.0]})
+    with pytest.raises(flexstar.InfeasibleMotion) as info:
+        flexstar.run(fast)
+    assert 0.0 <= info.value.t <= 0.5
+
+
+def test_solver_error_on_unwritable_output(root):
+    run = flexstar.run(flexstar.Experiment.load(root / "configs/case3.toml"))
+    with pytest.raises(flexstar.SolverError):
+        run.save("/proc/flexstar-cannot-write")
+
+
+def test_poles_equal_free_modal_frequencies(root):
+    """The linear model's poles (an eigenvalue problem of A) equal `modal`'s free-slider
+    frequencies (the AMM's generalized eigenproblem), rigid modes at 0 Hz included."""
+    exp = flexstar.Experiment.load(root / "configs/case3.toml")
+    lin = flexstar.linearize(exp, at=0.3)
+    m = flexstar.modal(exp, at=0.3, sliders="free", modes=6)
+    poles = np.linalg.eigvals(lin.A)
+    f = np.sort(np.abs(poles.imag)) / (2 * np.pi)
+    elastic = f[::2][m["rigid"]:][:6]
+    np.testing.assert_allclose(elastic, m["amm_hz"][m["rigid"]:], rtol=1e-8)
+
+
+def test_study(root, tmp_path):
+    study = tmp_path / "lp.toml"
+    study.write_text(
+        f'name = "lp"\nbase = "{root / "configs/case3.toml"}"\nsolvers = ["amm"]\n\n'
+        '[[vary]]\nkey = "robot.Lp"\nvalues = [0.02, 0.03, 0.04]\n'
+    )
+    df = flexstar.sweep(study, tmp_path / "out", jobs=2)
+    assert len(df) == 3
+    # every row equals a single run of the same case
+    for lp in (0.02, 0.04):
+        row = df[np.isclose(df["robot.Lp"], lp)]
+        assert len(row) == 1
+
+
+def test_freqmap_equals_modal(root):
+    """A map point's frequencies equal modal's AMM ones at that pose (sliders locked)."""
+    pd = pytest.importorskip("pandas")
+    exp = flexstar.Experiment.load(root / "configs/case1.toml")
+    df = flexstar.freqmap(exp, gx=(-0.02, 0.02, 2), gy=(-0.02, 0.02, 2), modes=2)
+    assert isinstance(df, pd.DataFrame) and len(df) == 4
+    row = df.iloc[0]
+    m = flexstar.modal(exp, pose=(row["Gx"], row["Gy"], 0.0), modes=2)
+    np.testing.assert_allclose([row["f1"], row["f2"]], m["amm_hz"][:2], rtol=1e-9)
+
+
+def test_compare_writes_the_cli_table(root, tmp_path):
+    res = flexstar.compare(root / "configs/case3.toml", tmp_path, figures=False)
+    assert pathlib.Path(res["compare_csv"]).exists()
+    report = (pathlib.Path(res["dir"]) / "compare.json").read_text()
+    assert res["behaviour"] in report, "the behaviour of G is the one compare.json reports"

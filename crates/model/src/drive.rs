@@ -103,6 +103,10 @@ impl ForceSamples {
             key: key.to_string(),
             reason,
         };
+        // a solver output of flexstar's own: its folder recovered from an interrupted writer first
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            crate::run_set::recover(dir)?;
+        }
         let mut rd = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .from_path(path)

@@ -6,7 +6,7 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use crate::error::StudyError;
-use crate::shard::{meta_file, results_file, Meta};
+use crate::shard::{meta_file, results_file, write_pair, Meta};
 use crate::table::Table;
 
 /// What a merge found and wrote.
@@ -54,6 +54,7 @@ pub fn merge(dir: &Path) -> Result<MergeReport, StudyError> {
         dir: dir.to_path_buf(),
         reason,
     };
+    flexstar_model::run_set::recover(dir)?;
     let entries = std::fs::read_dir(dir).map_err(|source| StudyError::Read {
         file: dir.to_path_buf(),
         source,
@@ -162,16 +163,15 @@ fn join(dir: &Path, n: usize, shards: &[(usize, Meta, Table, PathBuf)]) -> Resul
     let mut ids: Vec<(usize, String)> = index.into_iter().map(|(id, i)| (i, id)).collect();
     ids.sort();
     report.rows = rows.len();
-    Table {
+    let table = Table {
         header: t0.header.clone(),
         rows,
-    }
-    .write(&report.results)?;
-    Meta {
+    };
+    let meta = Meta {
         shard: None,
         cases: ids.into_iter().map(|(_, id)| id).collect(),
         ..m0.clone()
-    }
-    .write(&meta_file(&report.results))?;
+    };
+    write_pair(&report.results, &table, &meta)?;
     Ok(report)
 }

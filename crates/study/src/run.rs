@@ -17,7 +17,7 @@ use crate::error::StudyError;
 use crate::metrics::{mean_evp, motion_end, peaks, residual_tip};
 use crate::patch::value_text;
 use crate::sample::Case;
-use crate::shard::{meta_file, results_file, Meta, Shard};
+use crate::shard::{meta_file, results_file, write_pair, Meta, Shard};
 use crate::spec::{Sampling, Solver, Study};
 use crate::table::{header, records_bytes, Row, Table, OK};
 
@@ -154,13 +154,15 @@ fn prepare_table(
     header: &[String],
 ) -> Result<HashSet<(String, String)>, StudyError> {
     let meta_path = meta_file(results);
+    if let Some(dir) = results.parent() {
+        flexstar_model::run_set::recover(dir)?;
+    }
     if !results.exists() {
-        Table {
+        let empty = Table {
             header: header.to_vec(),
             rows: Vec::new(),
-        }
-        .write(results)?;
-        meta.write(&meta_path)?;
+        };
+        write_pair(results, &empty, meta)?;
         return Ok(HashSet::new());
     }
     let other = |reason: String| StudyError::Results {

@@ -219,16 +219,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let mut response = response;
     let csv = dir.join(format!("{file}.csv"));
-    if direct {
-        if servo {
-            flexstar_drive::add_tracking_errors(&mut response, &exp).map_err(|e| anyhow!("{cfg}: {e}"))?;
-        }
-        response.write_csv_ordered(&csv, &["s1", "s2", "s3"], &direct_columns(servo))?;
-    } else {
-        response.write_csv(&csv)?;
+    if servo && direct {
+        flexstar_drive::add_tracking_errors(&mut response, &exp).map_err(|e| anyhow!("{cfg}: {e}"))?;
     }
-    response.write_shapes_csv(&dir.join(format!("{file}-shapes.csv")))?;
-    response.write_sidecar(&dir.join(format!("{file}.json")), &exp, &super::provenance())?;
+    // the run's three files are published together (a kill or a full disk keeps the old set)
+    let after = direct_columns(servo);
+    let order = direct.then_some((&["s1", "s2", "s3"][..], &after[..]));
+    let mut set = flexstar_model::run_set::RunSet::begin(&dir)?;
+    response.stage_run(&mut set, &file, order, &exp, &super::provenance())?;
+    set.commit()?;
     if args.figures {
         write_figures(&exp, &file, &response, direct, &dir)?;
     }

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use flexstar_model::config::check_step;
+use flexstar_model::run_set::RunSet;
 use flexstar_model::{AmmModel, DriveKind, DriveSettings, Experiment, ForceSamples, ModeFamily, Response};
 
 use crate::solver_errors::{from_amm, from_fem};
@@ -294,23 +295,37 @@ fn direct_columns(servo: bool) -> Vec<&'static str> {
     v
 }
 
+/// The sidecar document as the file's text (pretty JSON and a final newline).
+fn sidecar_text(path: &Path, meta: &serde_json::Value) -> Result<String> {
+    let text = serde_json::to_string_pretty(meta).map_err(|e| flexstar_model::ModelError::Write {
+        file: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    Ok(text + "\n")
+}
+
 /// Write a run's files in `dir` (already `DIR/<name>/`): `<stem>.csv` (a direct run: the
 /// sliders first, then the fixed columns, the pose, a servo's errors), `<stem>-shapes.csv`,
 /// `<stem>.json` (the outcome's sidecar) and with `figures` the figures in `dir/figures/`.
+/// The CSV files and the sidecar are one run set ([`RunSet`]): published together.
 pub fn write_run(out: &mut RunOutcome, dir: &Path, figures: bool) -> Result<()> {
     let (r, exp, stem) = (&out.response, &out.exp, &out.stem);
     let direct = exp.drive.is_direct();
     let csv = dir.join(format!("{stem}.csv"));
+    // the run's three files are published together: a kill or a full disk keeps the old set
+    let mut set = RunSet::begin(dir)?;
+    let csv_name = format!("{stem}.csv");
     if direct {
         let servo = exp.drive.kind == DriveKind::Servo;
-        r.write_csv_ordered(&csv, &["s1", "s2", "s3"], &direct_columns(servo))?;
+        r.stage_csv_ordered(&mut set, &csv_name, &["s1", "s2", "s3"], &direct_columns(servo))?;
     } else {
-        r.write_csv(&csv)?;
+        r.stage_csv(&mut set, &csv_name)?;
     }
     let shapes = dir.join(format!("{stem}-shapes.csv"));
-    r.write_shapes_csv(&shapes)?;
+    r.stage_shapes_csv(&mut set, &format!("{stem}-shapes.csv"))?;
     let json = dir.join(format!("{stem}.json"));
-    flexstar_model::response::write_sidecar_value(&json, &out.meta)?;
+    set.text(&format!("{stem}.json"), &sidecar_text(&json, &out.meta)?)?;
+    set.commit()?;
     out.files.extend([csv.clone(), shapes, json]);
     if figures {
         let figs = crate::figures::run_figures(exp, stem, r, direct, dir)?;

@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
-use flexstar_model::output::write_string_atomically;
+use flexstar_model::run_set::RunSet;
 use flexstar_model::{small_deflection_check, Experiment, ModeFamily, Provenance, Response, ValidityExceeded};
 use serde::Serialize;
 
@@ -292,22 +292,20 @@ pub fn write_case(
     prov: &Provenance,
     figures: bool,
 ) -> Result<WrittenCase, Error> {
-    for (stem, r) in runs_of(case) {
-        r.write_csv(&dir.join(format!("{stem}.csv")))?;
-        r.write_shapes_csv(&dir.join(format!("{stem}-shapes.csv")))?;
-        r.write_sidecar(&dir.join(format!("{stem}.json")), exp, prov)?;
-    }
     let drawn = if figures { case_figures(exp, case)? } else { Vec::new() };
     let figdir = dir.join("figures");
     let figs = drawn.iter().map(|f| f.write(&figdir)).collect::<Result<Vec<_>, _>>()?;
     let csv = compare_csv(row);
     let warnings = validity_warnings(exp, case);
-    write_string_atomically(&dir.join("compare.csv"), &csv)?;
-    write_string_atomically(
-        &dir.join("compare.md"),
-        &compare_markdown(exp, case, row, &warnings, &figs),
-    )?;
-    write_string_atomically(&dir.join("compare.json"), &compare_json(exp, case, row, prov))?;
+    // every run's files and the EVP files are published together (issue 24)
+    let mut set = RunSet::begin(dir)?;
+    for (stem, r) in runs_of(case) {
+        r.stage_run(&mut set, &stem, None, exp, prov)?;
+    }
+    set.text("compare.csv", &csv)?;
+    set.text("compare.md", &compare_markdown(exp, case, row, &warnings, &figs))?;
+    set.text("compare.json", &compare_json(exp, case, row, prov))?;
+    set.commit()?;
     Ok(WrittenCase {
         figures: figs,
         warnings,

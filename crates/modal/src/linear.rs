@@ -162,7 +162,8 @@ pub fn dense(rows: usize, cols: usize, v: &[f64]) -> CsMat<f64> {
 }
 
 /// Write `dir/linear/`: A, B, C, D, statespace.json, and the FEM's M, K, Phi_q at the pose
-/// (sliders free). Everything is computed before the first file is written.
+/// (sliders free). Everything is computed before the first file is written, and the files are
+/// published as one set ([`flexstar_model::run_set::RunSet`]).
 pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(), ModalError> {
     let fem = flexstar_fem::pose_modes::pose_system(&exp.robot, &ss.pose, Sliders::Free, exp.fem.elements)?;
     let (fm, fk, fc) = (
@@ -180,7 +181,8 @@ pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(),
         "files": {"A": "A.mtx", "B": "B.mtx", "C": "C.mtx", "D": "D.mtx", "fem_mass": "M.mtx", "fem_stiffness": "K.mtx", "fem_constraint_jacobian": "Phi_q.mtx"},
         "fem": {"coordinates": fem.n, "constraints": fem.rows, "elements": exp.fem.elements},
     });
-    let lin = dir.join("linear");
+    // the seven matrices and the JSON are published together (issue 24)
+    let mut set = flexstar_model::run_set::RunSet::begin(&dir.join("linear"))?;
     for (name, m) in [
         ("A", &ss.a),
         ("B", &ss.b),
@@ -190,11 +192,15 @@ pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(),
         ("K", &fk),
         ("Phi_q", &fc),
     ] {
-        write_mtx(&lin.join(format!("{name}.mtx")), m)?;
+        set.file(&format!("{name}.mtx"), |w| {
+            sprs::io::write_matrix_market_to_bufwrite(w, m)?;
+            Ok(())
+        })?;
     }
-    flexstar_model::output::write_string_atomically(
-        &lin.join("statespace.json"),
+    set.text(
+        "statespace.json",
         &serde_json::to_string_pretty(&json).expect("json of plain values"),
     )?;
+    set.commit()?;
     Ok(())
 }

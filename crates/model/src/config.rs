@@ -345,6 +345,13 @@ impl Experiment {
         Ok(exp)
     }
 
+    /// Every file besides the experiment file itself that this experiment reads (today the
+    /// forces table of a `[drive]` of kind `forces`), resolved against [`Experiment::source`]:
+    /// what a fingerprint of the experiment must cover besides its text.
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        self.drive.file_path(&self.source).into_iter().collect()
+    }
+
     /// Check every value (keys named relative to the file).
     pub fn validate(&self) -> Result<(), ModelError> {
         let name_ok = !self.name.is_empty()

@@ -104,6 +104,10 @@ impl ForceSamples {
             key: key.to_string(),
             reason,
         };
+        // a solver output of flexstar's own: its folder recovered from an interrupted writer first
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            crate::run_set::recover(dir)?;
+        }
         let mut rd = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .from_path(path)
@@ -242,15 +246,20 @@ impl DriveSettings {
         v
     }
 
+    /// The forces file of a forces drive, resolved against the experiment file `config`.
+    pub fn file_path(&self, config: &Path) -> Option<PathBuf> {
+        let f = self.file.as_ref().filter(|_| self.kind == DriveKind::Forces)?;
+        let dir = config.parent().unwrap_or_else(|| Path::new(""));
+        Some(if f.is_absolute() { f.clone() } else { dir.join(f) })
+    }
+
     /// Read the forces file (path relative to the experiment file `config`); a no-op for other
     /// drives. Errors name the experiment file, `drive.file` and the forces file.
     pub fn read_file(&mut self, config: &Path) -> Result<(), ModelError> {
         if self.kind != DriveKind::Forces {
             return Ok(());
         }
-        if let Some(f) = &self.file {
-            let dir = config.parent().unwrap_or_else(|| Path::new(""));
-            let path = if f.is_absolute() { f.clone() } else { dir.join(f) };
+        if let Some(path) = self.file_path(config) {
             let samples = ForceSamples::read_csv(&path, "drive.file").map_err(|e| match e {
                 ModelError::Invalid { key, reason, .. } => ModelError::Invalid {
                     file: config.to_path_buf(),

@@ -17,6 +17,7 @@ pub mod output;
 pub mod params;
 pub mod response;
 pub mod rest_pose;
+pub mod run_set;
 pub mod trajectory;
 pub mod validity;
 

@@ -6,12 +6,16 @@ use std::io::Write;
 use std::path::Path;
 
 use crate::error::ModelError;
+use crate::run_set::RunSet;
 
-/// A temporary file in `dir`, created with mode `0666` less the process umask (as `File::create`
-/// would), so that the result it becomes has normal permissions.
+/// A temporary file `dir/.flexstar-<pid>-XXXXXX<suffix>`, created with mode `0666` less the
+/// process umask (as `File::create` would), so that the result it becomes has normal permissions.
+/// The process id in the name lets a later writer remove the temporaries of a killed one
+/// ([`crate::run_set::recover`]).
 pub fn temp_file_in(dir: &Path, suffix: &str) -> std::io::Result<tempfile::NamedTempFile> {
     let mut b = tempfile::Builder::new();
-    b.prefix(".flexstar-").suffix(suffix);
+    let prefix = format!(".flexstar-{}-", std::process::id());
+    b.prefix(&prefix).suffix(suffix);
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
@@ -41,6 +45,36 @@ where
     Ok(())
 }
 
+/// Where one result file goes: alone (written atomically) or staged into a [`RunSet`] under a
+/// file name of its folder.
+pub enum Dest<'a> {
+    /// A file of its own, written by [`write_atomically`].
+    File(&'a Path),
+    /// File `name` of a set, published with the others by [`RunSet::commit`].
+    Set(&'a mut RunSet, &'a str),
+}
+
+impl Dest<'_> {
+    /// The path the file has once written.
+    pub fn path(&self) -> std::path::PathBuf {
+        match self {
+            Dest::File(p) => p.to_path_buf(),
+            Dest::Set(set, name) => set.path(name),
+        }
+    }
+
+    /// Write (or stage) the file through `fill`.
+    pub fn write<F>(self, fill: F) -> Result<(), ModelError>
+    where
+        F: FnOnce(&mut dyn Write) -> Result<(), Box<dyn std::error::Error + Send + Sync>>,
+    {
+        match self {
+            Dest::File(p) => write_atomically(p, fill),
+            Dest::Set(set, name) => set.file(name, fill).map(|_| ()),
+        }
+    }
+}
+
 fn parent_dir(path: &Path) -> std::path::PathBuf {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -58,7 +92,8 @@ pub fn write_string_atomically(path: &Path, text: &str) -> Result<(), ModelError
 
 /// Create the directory `dir` (and its parents) and check that a file can be written in it, so
 /// that a run fails before any work instead of after it (e.g. `--out` names an existing file, or
-/// a read-only place). The probe file is removed again.
+/// a read-only place). The probe file is removed again, and the folder is recovered from an
+/// interrupted writer ([`crate::run_set::recover`]).
 pub fn ensure_writable_dir(dir: &Path) -> Result<(), ModelError> {
     let err = |reason: String| ModelError::Write {
         file: dir.to_path_buf(),
@@ -69,7 +104,7 @@ pub fn ensure_writable_dir(dir: &Path) -> Result<(), ModelError> {
     }
     std::fs::create_dir_all(dir).map_err(|e| err(format!("cannot create the output directory: {e}")))?;
     temp_file_in(dir, ".probe").map_err(|e| err(format!("the output directory is not writable: {e}")))?;
-    Ok(())
+    crate::run_set::recover(dir)
 }
 
 /// A number as written into result files: the shortest decimal that parses back to exactly the

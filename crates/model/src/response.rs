@@ -8,7 +8,8 @@
 use std::path::Path;
 
 use crate::error::ModelError;
-use crate::output::{fmt_number, write_atomically};
+use crate::output::{fmt_number, Dest};
+use crate::run_set::RunSet;
 pub use crate::validity::{small_deflection_check, Provenance, ValidityExceeded};
 
 /// Fixed leading CSV columns of every solver result (issue contract).
@@ -175,6 +176,15 @@ impl Response {
 
     /// Write the response as CSV, whole or not at all.
     pub fn write_csv(&self, path: &Path) -> Result<(), ModelError> {
+        self.emit_csv(Dest::File(path))
+    }
+
+    /// [`Response::write_csv`] into file `name` of a run set.
+    pub fn stage_csv(&self, set: &mut RunSet, name: &str) -> Result<(), ModelError> {
+        self.emit_csv(Dest::Set(set, name))
+    }
+
+    fn check_columns(&self, path: &Path) -> Result<(), ModelError> {
         for c in &self.extra {
             if c.values.len() != self.len() {
                 return Err(ModelError::Write {
@@ -183,7 +193,12 @@ impl Response {
                 });
             }
         }
-        write_atomically(path, |w| {
+        Ok(())
+    }
+
+    fn emit_csv(&self, dest: Dest<'_>) -> Result<(), ModelError> {
+        self.check_columns(&dest.path())?;
+        dest.write(|w| {
             let mut out = csv::Writer::from_writer(w);
             out.write_record(self.header())?;
             let mut row = Vec::with_capacity(10 + self.extra.len());
@@ -207,6 +222,23 @@ impl Response {
     /// `leading = [s1, s2, s3]`, `after = [Gx, Gy, theta, (e1, e2, e3)]`. A named column that is
     /// missing is an error.
     pub fn write_csv_ordered(&self, path: &Path, leading: &[&str], after: &[&str]) -> Result<(), ModelError> {
+        self.emit_csv_ordered(Dest::File(path), leading, after)
+    }
+
+    /// [`Response::write_csv_ordered`] into file `name` of a run set.
+    pub fn stage_csv_ordered(
+        &self,
+        set: &mut RunSet,
+        name: &str,
+        leading: &[&str],
+        after: &[&str],
+    ) -> Result<(), ModelError> {
+        self.emit_csv_ordered(Dest::Set(set, name), leading, after)
+    }
+
+    fn emit_csv_ordered(&self, dest: Dest<'_>, leading: &[&str], after: &[&str]) -> Result<(), ModelError> {
+        let path = dest.path();
+        let path = path.as_path();
         let find = |name: &str| {
             self.extra
                 .iter()
@@ -221,21 +253,14 @@ impl Response {
         let rest: Vec<usize> = (0..self.extra.len())
             .filter(|k| !lead.contains(k) && !mid.contains(k))
             .collect();
-        for c in &self.extra {
-            if c.values.len() != self.len() {
-                return Err(ModelError::Write {
-                    file: path.to_path_buf(),
-                    reason: format!("column {} has {} rows, expected {}", c.name, c.values.len(), self.len()),
-                });
-            }
-        }
+        self.check_columns(path)?;
         let name = |k: &usize| self.extra[*k].name.clone();
         let mut header = vec!["t".to_string()];
         header.extend(lead.iter().map(name));
         header.extend(RESPONSE_HEADER[1..].iter().map(|s| s.to_string()));
         header.extend(mid.iter().map(name));
         header.extend(rest.iter().map(name));
-        write_atomically(path, |w| {
+        dest.write(|w| {
             let mut out = csv::Writer::from_writer(w);
             out.write_record(&header)?;
             let mut row = Vec::with_capacity(header.len());
@@ -301,9 +326,57 @@ impl Response {
         write_sidecar_value(path, &self.sidecar(path, experiment, provenance)?)
     }
 
+    /// [`Response::write_sidecar`] into file `name` of a run set (published with the run's other
+    /// files by [`RunSet::commit`]).
+    pub fn stage_sidecar(
+        &self,
+        set: &mut RunSet,
+        name: &str,
+        experiment: &crate::Experiment,
+        provenance: &Provenance,
+    ) -> Result<(), ModelError> {
+        let path = set.path(name);
+        let doc = self.sidecar(&path, experiment, provenance)?;
+        let text = serde_json::to_string_pretty(&doc).map_err(|e| ModelError::Write {
+            file: path.clone(),
+            reason: e.to_string(),
+        })?;
+        set.text(name, &(text + "\n"))?;
+        Ok(())
+    }
+
     /// Write the deformed-star snapshots as CSV (`t,beam,x,w,X,Y`), whole or not at all.
     pub fn write_shapes_csv(&self, path: &Path) -> Result<(), ModelError> {
-        write_atomically(path, |w| {
+        self.emit_shapes_csv(Dest::File(path))
+    }
+
+    /// [`Response::write_shapes_csv`] into file `name` of a run set.
+    pub fn stage_shapes_csv(&self, set: &mut RunSet, name: &str) -> Result<(), ModelError> {
+        self.emit_shapes_csv(Dest::Set(set, name))
+    }
+
+    /// Stage the three files of run `stem` (`<stem>.csv`, `<stem>-shapes.csv`, `<stem>.json`)
+    /// into `set`; `order`: the `(leading, after)` columns of [`Response::write_csv_ordered`]
+    /// (a direct run's file), `None` for the plain order of [`Response::write_csv`].
+    pub fn stage_run(
+        &self,
+        set: &mut RunSet,
+        stem: &str,
+        order: Option<(&[&str], &[&str])>,
+        experiment: &crate::Experiment,
+        provenance: &Provenance,
+    ) -> Result<(), ModelError> {
+        let csv = format!("{stem}.csv");
+        match order {
+            Some((leading, after)) => self.stage_csv_ordered(set, &csv, leading, after)?,
+            None => self.stage_csv(set, &csv)?,
+        }
+        self.stage_shapes_csv(set, &format!("{stem}-shapes.csv"))?;
+        self.stage_sidecar(set, &format!("{stem}.json"), experiment, provenance)
+    }
+
+    fn emit_shapes_csv(&self, dest: Dest<'_>) -> Result<(), ModelError> {
+        dest.write(|w| {
             let mut out = csv::Writer::from_writer(w);
             out.write_record(["t", "beam", "x", "w", "X", "Y"])?;
             for s in &self.shapes {

@@ -6,7 +6,7 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use crate::error::StudyError;
-use crate::shard::{meta_file, results_file, Meta};
+use crate::shard::{meta_file, results_file, write_pair, Meta};
 use crate::table::Table;
 
 /// What a merge found and wrote.
@@ -47,13 +47,16 @@ fn shard_of(name: &str) -> Option<(usize, usize)> {
 
 /// Merge the shards found in `dir` (a study's results folder, `<out>/<name>`) into
 /// `dir/results.csv` and its sidecar. Nothing is written when the shards belong to different
-/// studies (hash of the study and base files) or splits; missing and duplicated cases are
-/// reported, and the rows present are still written.
+/// studies (hash of the study and base files) or splits, or when a `results.csv` already there is
+/// of another study; the rows of such a `results.csv` of the same study that no shard holds are
+/// kept (a whole-study rerun that filled gaps). Missing and duplicated cases are reported, and
+/// the rows present are still written.
 pub fn merge(dir: &Path) -> Result<MergeReport, StudyError> {
     let refuse = |reason: String| StudyError::Merge {
         dir: dir.to_path_buf(),
         reason,
     };
+    flexstar_model::run_set::recover(dir)?;
     let entries = std::fs::read_dir(dir).map_err(|source| StudyError::Read {
         file: dir.to_path_buf(),
         source,
@@ -110,24 +113,59 @@ pub fn merge(dir: &Path) -> Result<MergeReport, StudyError> {
             )));
         }
     }
-    join(dir, n, &shards)
+    let existing = existing_results(dir, m0, t0)?;
+    join(dir, n, &shards, existing)
 }
 
-fn join(dir: &Path, n: usize, shards: &[(usize, Meta, Table, PathBuf)]) -> Result<MergeReport, StudyError> {
+/// The `results.csv` already in `dir`, if any: it must be of the same study (hash and name) and
+/// header as the shards, else the merge is refused (nothing is written).
+fn existing_results(dir: &Path, m0: &Meta, t0: &Table) -> Result<Option<(Meta, Table)>, StudyError> {
+    let path = results_file(dir, None);
+    if !path.exists() {
+        return Ok(None);
+    }
+    let refuse = |reason: String| StudyError::Results {
+        file: path.clone(),
+        reason,
+    };
+    let meta_path = meta_file(&path);
+    if !meta_path.exists() {
+        return Err(refuse(format!(
+            "exists without its sidecar {}: cannot tell which study wrote it (move it away to merge here)",
+            meta_path.display()
+        )));
+    }
+    let meta = Meta::read(&meta_path)?;
+    if meta.hash != m0.hash || meta.study != m0.study || meta.shard.is_some() {
+        return Err(refuse(format!(
+            "was written by another study (study {}, hash {}, shard {:?}; the shards: study {}, hash {}): \
+             move it away or merge the shards in another folder",
+            meta.study, meta.hash, meta.shard, m0.study, m0.hash
+        )));
+    }
+    let table = Table::read(&path)?;
+    if table.header != t0.header {
+        return Err(refuse("its header is not the shards' one".into()));
+    }
+    Ok(Some((meta, table)))
+}
+
+type Shards = [(usize, Meta, Table, PathBuf)];
+
+fn join(dir: &Path, n: usize, shards: &Shards, existing: Option<(Meta, Table)>) -> Result<MergeReport, StudyError> {
     let (_, m0, t0, _) = &shards[0];
     let solver_col = t0.column("solver").unwrap_or(0);
-    let present: HashSet<usize> = shards.iter().map(|s| s.0).collect();
-    let missing_shards: Vec<usize> = (1..=n).filter(|k| !present.contains(k)).collect();
-    let per_shard = |k: usize| (m0.total_cases + n - k) / n;
     let mut report = MergeReport {
         results: results_file(dir, None),
         shards: n,
-        missing_in_missing_shards: missing_shards.iter().map(|&k| per_shard(k)).sum(),
-        missing_shards,
         ..MergeReport::default()
     };
-    // global index of each expected case: the j-th case of shard K is case j N + K - 1
+    // global index of each expected case: the j-th case of shard K is case j N + K - 1; a whole
+    // study's earlier results.csv lists every case in order
     let mut index: HashMap<String, usize> = HashMap::new();
+    if let Some((meta, _)) = existing.as_ref().filter(|(m, _)| m.cases.len() == m.total_cases) {
+        index.extend(meta.cases.iter().enumerate().map(|(i, id)| (id.clone(), i)));
+    }
     for (k, meta, _, _) in shards {
         for (j, id) in meta.cases.iter().enumerate() {
             index.insert(id.clone(), j * n + k - 1);
@@ -148,30 +186,53 @@ fn join(dir: &Path, n: usize, shards: &[(usize, Meta, Table, PathBuf)]) -> Resul
             }
         }
     }
-    for (_, meta, _, _) in shards {
-        for id in &meta.cases {
-            for s in &m0.solvers {
-                if !seen.contains(&(id.clone(), s.clone())) {
-                    report.missing.push((id.clone(), s.clone()));
-                }
+    // rows of the earlier results.csv that no shard holds are kept (a shard's row wins)
+    let mut earlier_ids: Vec<String> = Vec::new();
+    if let Some((meta, table)) = &existing {
+        earlier_ids.clone_from(&meta.cases);
+        for r in &table.rows {
+            if seen.insert((r[0].clone(), r[solver_col].clone())) {
+                rows.push(r.clone());
+            }
+        }
+    }
+    let present: HashSet<usize> = shards.iter().map(|s| s.0).collect();
+    let whole_earlier = existing.as_ref().is_some_and(|(m, _)| m.cases.len() == m.total_cases);
+    let mut expected: Vec<&String> = shards.iter().flat_map(|s| &s.1.cases).collect();
+    for k in (1..=n).filter(|k| !present.contains(k)) {
+        if whole_earlier {
+            // the cases of a missing shard are known from the whole study's table
+            expected.extend(earlier_ids.iter().skip(k - 1).step_by(n));
+        } else {
+            report.missing_shards.push(k);
+            report.missing_in_missing_shards += (m0.total_cases + n - k) / n;
+        }
+    }
+    for id in expected {
+        for s in &m0.solvers {
+            if !seen.contains(&(id.clone(), s.clone())) {
+                report.missing.push((id.clone(), s.clone()));
             }
         }
     }
     let rank = |s: &str| m0.solvers.iter().position(|x| x == s).unwrap_or(usize::MAX);
     rows.sort_by_key(|r| (index.get(&r[0]).copied().unwrap_or(usize::MAX), rank(&r[solver_col])));
+    for id in earlier_ids {
+        let next = index.len();
+        index.entry(id).or_insert(usize::MAX / 2 + next);
+    }
     let mut ids: Vec<(usize, String)> = index.into_iter().map(|(id, i)| (i, id)).collect();
     ids.sort();
     report.rows = rows.len();
-    Table {
+    let table = Table {
         header: t0.header.clone(),
         rows,
-    }
-    .write(&report.results)?;
-    Meta {
+    };
+    let meta = Meta {
         shard: None,
         cases: ids.into_iter().map(|(_, id)| id).collect(),
         ..m0.clone()
-    }
-    .write(&meta_file(&report.results))?;
+    };
+    write_pair(&report.results, &table, &meta)?;
     Ok(report)
 }

@@ -17,7 +17,7 @@ use crate::error::StudyError;
 use crate::metrics::{mean_evp, motion_end, peaks, residual_tip};
 use crate::patch::value_text;
 use crate::sample::Case;
-use crate::shard::{meta_file, results_file, Meta, Shard};
+use crate::shard::{meta_file, results_file, write_pair, Meta, Shard};
 use crate::spec::{Sampling, Solver, Study};
 use crate::table::{header, records_bytes, Row, Table, OK};
 
@@ -59,18 +59,15 @@ pub fn run_study(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<RunOutcome, StudyError> {
     let started = Instant::now();
-    let all = study.cases();
-    let mine: Vec<&Case> = all
-        .iter()
-        .filter(|c| opts.shard.is_none_or(|s| s.holds(c.index)))
-        .collect();
+    // the worker threads first: a --jobs the system refuses writes nothing
+    let pool = opts.jobs.map(|n| worker_pool(study, n)).transpose()?;
+    let mine: Vec<Case> = study.shard_cases(opts.shard).collect();
     let dir = opts.out.join(&study.name);
     let results = results_file(&dir, opts.shard);
-    let meta = meta_of(study, all.len(), &mine, opts.shard);
+    let meta = meta_of(study, study.case_count(), &mine, opts.shard);
     let done = prepare_table(&results, &meta, &header(&study.keys()))?;
     let todo: Vec<&Case> = mine
         .iter()
-        .copied()
         .filter(|c| {
             !study
                 .solvers
@@ -99,12 +96,8 @@ pub fn run_study(
             Ok::<(), StudyError>(())
         })
     };
-    match opts.jobs {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| StudyError::invalid(&study.file, "--jobs", e.to_string()))?
-            .install(work)?,
+    match pool {
+        Some(pool) => pool.install(work)?,
         None => work()?,
     }
     drop(file);
@@ -121,6 +114,21 @@ pub fn run_study(
     })
 }
 
+/// Most worker threads `--jobs` may ask for.
+pub const MAX_JOBS: usize = 1024;
+
+/// The thread pool of `--jobs n` (1..=[`MAX_JOBS`]).
+fn worker_pool(study: &Study, n: usize) -> Result<rayon::ThreadPool, StudyError> {
+    let bad = |reason: String| StudyError::invalid(&study.file, "--jobs", reason);
+    if n == 0 || n > MAX_JOBS {
+        return Err(bad(format!("{n}: give 1 to {MAX_JOBS} worker threads")));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map_err(|e| bad(format!("{n} worker threads: {e}")))
+}
+
 fn write_error(file: &std::path::Path, reason: String) -> StudyError {
     StudyError::Write(flexstar_model::ModelError::Write {
         file: file.to_path_buf(),
@@ -128,7 +136,7 @@ fn write_error(file: &std::path::Path, reason: String) -> StudyError {
     })
 }
 
-fn meta_of(study: &Study, total: usize, mine: &[&Case], shard: Option<Shard>) -> Meta {
+fn meta_of(study: &Study, total: usize, mine: &[Case], shard: Option<Shard>) -> Meta {
     Meta {
         study: study.name.clone(),
         hash: study.hash.clone(),
@@ -154,13 +162,15 @@ fn prepare_table(
     header: &[String],
 ) -> Result<HashSet<(String, String)>, StudyError> {
     let meta_path = meta_file(results);
+    if let Some(dir) = results.parent() {
+        flexstar_model::run_set::recover(dir)?;
+    }
     if !results.exists() {
-        Table {
+        let empty = Table {
             header: header.to_vec(),
             rows: Vec::new(),
-        }
-        .write(results)?;
-        meta.write(&meta_path)?;
+        };
+        write_pair(results, &empty, meta)?;
         return Ok(HashSet::new());
     }
     let other = |reason: String| StudyError::Results {
@@ -196,7 +206,7 @@ fn prepare_table(
 
 /// Rewrite the table in the study's case order (solvers in the study's order), keeping the last
 /// row of any (run_id, solver) pair written twice.
-fn finish_table(results: &std::path::Path, mine: &[&Case], solvers: &[Solver]) -> Result<Table, StudyError> {
+fn finish_table(results: &std::path::Path, mine: &[Case], solvers: &[Solver]) -> Result<Table, StudyError> {
     let mut table = Table::read(results)?;
     let solver_col = table.column("solver").unwrap_or(0);
     let order: HashMap<&str, usize> = mine.iter().map(|c| (c.run_id.as_str(), c.index)).collect();

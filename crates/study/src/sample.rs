@@ -3,6 +3,7 @@
 
 use crate::hash::hex64;
 use crate::patch::value_text;
+use crate::shard::Shard;
 use crate::spec::{Levels, Sampling, Study, Vary};
 
 /// One point of the study: a value for each varied key, in the study's order.
@@ -69,13 +70,9 @@ impl Vary {
                 .map(|p| toml::Value::Float(tidy(p)))
                 .collect(),
         };
-        let mut out: Vec<toml::Value> = Vec::with_capacity(raw.len());
-        for v in raw {
-            if !out.contains(&v) {
-                out.push(v);
-            }
-        }
-        out
+        // duplicates by their text in the table (1 and 1.0 are one level: one run id)
+        let mut seen = std::collections::HashSet::with_capacity(raw.len());
+        raw.into_iter().filter(|v| seen.insert(value_text(v))).collect()
     }
 
     /// The values the key check patches in: every listed value; the two bounds of a range.
@@ -167,11 +164,57 @@ pub fn full_factorial(vary: &[Vary]) -> Vec<Vec<toml::Value>> {
     })
 }
 
+/// The `index`-th point of the full factorial of `levels` (the first key varying slowest).
+fn grid_point(levels: &[Vec<toml::Value>], mut index: usize) -> Vec<toml::Value> {
+    let mut values = vec![toml::Value::Boolean(false); levels.len()];
+    for (v, l) in values.iter_mut().zip(levels).rev() {
+        *v = l[index % l.len()].clone();
+        index /= l.len();
+    }
+    values
+}
+
 impl Study {
+    /// Number of cases of the study.
+    pub fn case_count(&self) -> usize {
+        match self.sampling {
+            Sampling::Grid => self.vary.iter().map(|v| v.grid_values().len()).product(),
+            Sampling::Lhs { .. } => self.cases().len(),
+        }
+    }
+
+    /// The cases of one shard (`None`: of the whole study) in the study's order. For a grid they
+    /// are made one at a time from their index, so that a shard of a study of [`MAX_CASES`]
+    /// cases costs the memory of its own cases only; a Latin hypercube is drawn whole first
+    /// (its strata are permutations of all samples).
+    ///
+    /// [`MAX_CASES`]: crate::spec::MAX_CASES
+    pub fn shard_cases(&self, shard: Option<Shard>) -> Box<dyn Iterator<Item = Case> + '_> {
+        let Sampling::Grid = self.sampling else {
+            return Box::new(
+                self.cases()
+                    .into_iter()
+                    .filter(move |c| shard.is_none_or(|s| s.holds(c.index))),
+            );
+        };
+        let levels: Vec<Vec<toml::Value>> = self.vary.iter().map(Vary::grid_values).collect();
+        let total: usize = levels.iter().map(Vec::len).product();
+        let (first, step) = shard.map_or((0, 1), |s| (s.k - 1, s.n));
+        let keys = self.keys();
+        Box::new((first..total).step_by(step).map(move |index| {
+            let values = grid_point(&levels, index);
+            Case {
+                index,
+                run_id: run_id(&keys, &values),
+                values,
+            }
+        }))
+    }
+
     /// The study's cases in order, each once (a repeated point keeps its first position).
     pub fn cases(&self) -> Vec<Case> {
         let points = match self.sampling {
-            Sampling::Grid => full_factorial(&self.vary),
+            Sampling::Grid => return self.shard_cases(None).collect(),
             Sampling::Lhs { samples, seed } => latin_hypercube(&self.vary, samples, seed),
         };
         let keys = self.keys();

@@ -57,6 +57,18 @@ pub fn meta_file(results: &Path) -> PathBuf {
     results.with_extension("meta.json")
 }
 
+/// Publish a results table and its sidecar together (a kill or a full disk between the two
+/// leaves the old pair): both in the table's folder.
+pub fn write_pair(results: &Path, table: &crate::table::Table, meta: &Meta) -> Result<(), StudyError> {
+    let dir = results.parent().unwrap_or(Path::new("."));
+    let name = |p: &Path| p.file_name().and_then(|s| s.to_str()).unwrap_or_default().to_string();
+    let mut set = flexstar_model::run_set::RunSet::begin(dir)?;
+    table.stage(&mut set, &name(results))?;
+    meta.stage(&mut set, &name(&meta_file(results)))?;
+    set.commit()?;
+    Ok(())
+}
+
 /// The sidecar JSON beside every results table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Meta {
@@ -95,12 +107,18 @@ impl Meta {
 
     /// Write a sidecar, whole or not at all.
     pub fn write(&self, path: &Path) -> Result<(), StudyError> {
-        let text = serde_json::to_string_pretty(self).map_err(|e| StudyError::Results {
-            file: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
-        flexstar_model::output::write_string_atomically(path, &(text + "\n"))?;
+        flexstar_model::output::write_string_atomically(path, &self.text())?;
         Ok(())
+    }
+
+    /// Stage the sidecar as file `name` of a run set (published with its table).
+    pub fn stage(&self, set: &mut flexstar_model::run_set::RunSet, name: &str) -> Result<(), StudyError> {
+        set.text(name, &self.text())?;
+        Ok(())
+    }
+
+    fn text(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a sidecar of plain data serialises") + "\n"
     }
 }
 

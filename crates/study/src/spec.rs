@@ -92,8 +92,8 @@ pub struct Study {
     pub solvers: Vec<Solver>,
     pub vary: Vec<Vary>,
     pub sampling: Sampling,
-    /// FNV-1a hash of the study file and the base file (bytes): shards and resumed tables must
-    /// carry the same one.
+    /// FNV-1a hash of the study file, the base file and every file a case reads (bytes):
+    /// shards and resumed tables must carry the same one.
     pub hash: String,
 }
 
@@ -167,11 +167,12 @@ impl Study {
             solvers: solvers(path, &raw.solvers)?,
             vary: raw.vary.into_iter().map(|v| vary(path, v)).collect::<Result<_, _>>()?,
             sampling: sampling(path, raw.sampling.as_deref(), raw.samples, raw.seed)?,
-            hash: hex64(format!("{text}\0{base_text}").as_bytes()),
+            hash: String::new(),
         };
         study.check_shape()?;
         study.check_keys()?;
-        Ok(study)
+        let hash = study.fingerprint(&text, &base_text);
+        Ok(Study { hash, ..study })
     }
 
     /// The varied keys in the study's order (the columns after `run_id`).
@@ -237,6 +238,27 @@ impl Study {
         Ok(())
     }
 
+    /// The study's hash: FNV-1a of the study file, the base file and the contents of every file
+    /// a case reads (the base's forces table, and those a varied key names), in path order. A
+    /// study without such files keeps the hash of the two texts alone.
+    fn fingerprint(&self, text: &str, base_text: &str) -> String {
+        let mut files: std::collections::BTreeSet<PathBuf> = self.base_experiment.input_files().into_iter().collect();
+        for v in &self.vary {
+            for value in v.probe_values() {
+                if let Ok(exp) = self.experiment_with(std::slice::from_ref(&v.key), std::slice::from_ref(&value)) {
+                    files.extend(exp.input_files());
+                }
+            }
+        }
+        let mut bytes = format!("{text}\0{base_text}").into_bytes();
+        for f in files {
+            bytes.push(0);
+            // an unreadable file fails its cases; its absence is part of the fingerprint
+            bytes.extend(std::fs::read(&f).unwrap_or_default());
+        }
+        hex64(&bytes)
+    }
+
     fn vary_error(&self, key: &str, reason: impl Into<String>) -> StudyError {
         StudyError::VaryKey {
             file: self.file.clone(),
@@ -249,7 +271,11 @@ impl Study {
     /// and validated by the experiment loader. Errors (a bad value, an infeasible motion) are
     /// returned as text for the case's `status`.
     pub fn experiment(&self, values: &[toml::Value]) -> Result<Experiment, String> {
-        let doc = patch::case_document(&self.base, &self.keys(), values)?;
+        self.experiment_with(&self.keys(), values)
+    }
+
+    fn experiment_with(&self, keys: &[String], values: &[toml::Value]) -> Result<Experiment, String> {
+        let doc = patch::case_document(&self.base, keys, values)?;
         let text = toml::to_string(&doc).map_err(|e| e.to_string())?;
         Experiment::from_toml_str(&text, &self.base_file).map_err(|e| e.to_string())
     }

@@ -272,3 +272,29 @@ fn interrupted_study_resumes_and_ends_with_the_same_table() {
     let msg = run_study(&other, &opts, &|_, _| {}).unwrap_err().to_string();
     assert!(msg.contains("another study"), "{msg}");
 }
+
+/// Issue 24, item 2: the study hash covers the forces tables a case reads, by content: the base's
+/// table and each table a varied key names; a study that reads no table keeps the hash of its
+/// two texts (FNV-1a of `study \0 base`, as before), so that existing results still resume.
+#[test]
+fn the_hash_covers_every_file_a_case_reads() {
+    let forces = |fa: f64| format!("t,Fa1,Fa2,Fa3\n0,{fa},0,0\n0.1,{fa},0,0\n");
+    let base = format!("{BASE}[drive]\nkind = \"forces\"\nfile = \"f1.csv\"\n");
+    let text = study_text("[[vary]]\nkey = \"drive.file\"\nvalues = [\"f1.csv\", \"f2.csv\"]\n");
+    let (d, p) = setup(&text);
+    std::fs::write(d.path().join("base.toml"), &base).unwrap();
+    std::fs::write(d.path().join("f1.csv"), forces(0.0)).unwrap();
+    std::fs::write(d.path().join("f2.csv"), forces(0.5)).unwrap();
+    let h0 = Study::load(&p).unwrap().hash;
+    assert_eq!(Study::load(&p).unwrap().hash, h0, "the same files, the same hash");
+    std::fs::write(d.path().join("f2.csv"), forces(0.6)).unwrap();
+    let h2 = Study::load(&p).unwrap().hash;
+    assert_ne!(h2, h0, "a varied key's table edited");
+    std::fs::write(d.path().join("f1.csv"), forces(0.1)).unwrap();
+    assert_ne!(Study::load(&p).unwrap().hash, h2, "the base's table edited");
+
+    let plain = study_text("[[vary]]\nkey = \"robot.E\"\nvalues = [150e9, 200e9]\n");
+    let (_d, p) = setup(&plain);
+    let fnv = flexstar_study::hash::hex64(format!("{plain}\0{BASE}").as_bytes());
+    assert_eq!(Study::load(&p).unwrap().hash, fnv);
+}

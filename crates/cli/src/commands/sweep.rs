@@ -60,7 +60,7 @@ fn sweep(
         anyhow::bail!("--jobs must be at least 1");
     }
     let study = Study::load(path)?;
-    let cases = study.cases().len();
+    let cases = study.case_count();
     eprintln!(
         "{}: {cases} cases x {} solver(s){}",
         study.name,

@@ -25,7 +25,7 @@ const CC_ORDER: usize = 20;
 /// Exact for polynomials of degree n. A different rule from the crate's Gauss-Legendre
 /// (`flexstar_numerics::quadrature`), so that the checks below do not share its errors.
 fn clenshaw_curtis(n: usize) -> (Vec<f64>, Vec<f64>) {
-    assert!(n >= 2 && n % 2 == 0);
+    assert!(n >= 2 && n.is_multiple_of(2));
     let nf = n as f64;
     let end = 1.0 / (nf * nf - 1.0);
     (0..=n)

@@ -174,7 +174,7 @@ pub fn end_moment_static(
                 k[(d, d)] = 1.0;
                 r[d] = 0.0;
             }
-            let dq = k.lu().solve(&r).ok_or_else(|| FemError::Newton {
+            let dq = k.lu().solve(&r).ok_or(FemError::Newton {
                 t: 0.0,
                 h: 0.0,
                 reason: NewtonFailure::SingularStiffness,

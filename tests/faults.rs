@@ -6,25 +6,13 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+mod common;
+
 /// 30 ms (old) or 40 ms (new) of case 3 with 5 free-free modes: same file names, other contents.
 fn config(t_end: f64) -> String {
-    format!(
-        r#"
-name = "unit"
-[time]
-t_end = {t_end}
-dt_out = 0.005
-[trajectory]
-kind = "polynomial"
-s1 = [0.0, 0.0, 1.0]
-s2 = [0.0]
-s3 = [0.0, 0.0, 0.5]
-[amm]
-family = "free-free"
-model = "paper"
-modes = 5
-"#
-    )
+    let text = common::TINY.replace("name = \"tiny\"", "name = \"unit\"");
+    assert!(text.contains("t_end = 0.03"));
+    text.replace("t_end = 0.03", &format!("t_end = {t_end}"))
 }
 
 const STEMS: [&str; 3] = ["amm-free-free.csv", "amm-free-free-shapes.csv", "amm-free-free.json"];

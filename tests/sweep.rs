@@ -8,22 +8,7 @@ use std::process::Command;
 mod common;
 use common::{flexstar, stderr};
 
-/// 30 ms of case 3 with 5 free-free modes: a fast case.
-const BASE: &str = r#"
-name = "tiny"
-[time]
-t_end = 0.03
-dt_out = 0.005
-[trajectory]
-kind = "polynomial"
-s1 = [0.0, 0.0, 1.0]
-s2 = [0.0]
-s3 = [0.0, 0.0, 0.5]
-[amm]
-family = "free-free"
-model = "paper"
-modes = 5
-"#;
+const BASE: &str = common::TINY;
 
 const STUDY: &str = r#"
 name = "shards"

@@ -106,21 +106,7 @@ replace() { # replace() FROM TO FILE: fail when FROM is not in FILE (the page ch
 W=$T/work
 mkdir -p "$W/target/release" "$W/configs/studies"
 ln -s "$BIN" "$W/target/release/flexstar"
-cat >"$W/configs/studies/base.toml" <<'EOF'
-name = "tiny"
-[time]
-t_end = 0.03
-dt_out = 0.005
-[trajectory]
-kind = "polynomial"
-s1 = [0.0, 0.0, 1.0]
-s2 = [0.0]
-s3 = [0.0, 0.0, 0.5]
-[amm]
-family = "free-free"
-model = "paper"
-modes = 5
-EOF
+cp "$ROOT/tests/data/tiny.toml" "$W/configs/studies/base.toml"
 cat >"$W/configs/studies/ci.toml" <<'EOF'
 name = "ci"
 base = "base.toml"

@@ -174,6 +174,14 @@ pub const PAPER_MODES: usize = 25;
 /// estimated EVP of the truncation is below it.
 pub const DEFAULT_TOL_PERCENT: f64 = 0.5;
 
+/// Smallest error tolerance [%] the automatic N accepts (issue 24). The estimator of
+/// `flexstar_amm::adaptive` resolves a truncation EVP only down to what N = 200
+/// (`MAX_AUTO_MODES`) reaches: from about 1 % at its first N (46 for the paper's robot,
+/// `2 L / Lp + 12`) the error falls like `N^-p` with p = 6.1-7.6 measured between N = 46 and 53,
+/// so at N = 200 it is `1 % x (46 / 200)^p` = 3e-5 % (p = 7) to 1.3e-4 % (p = 6.1). A tolerance
+/// below 1e-3 % would run every N up to 200 and then fail; it is refused before any run.
+pub const MIN_TOL_PERCENT: f64 = 1e-3;
+
 /// How the number of modes per beam is chosen (see [`AmmSettings::mode_count`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ModeCount {
@@ -259,6 +267,16 @@ impl AmmSettings {
                     format!("the tolerance must be a positive percentage, got {p}"),
                 ));
             }
+            if p < MIN_TOL_PERCENT {
+                return Err(ModelError::invalid(
+                    "amm.tol",
+                    format!(
+                        "the tolerance {p} % is below what the error estimate resolves \
+                         ({MIN_TOL_PERCENT} %: the truncation error reached with the most modes, \
+                         N = 200); give tol >= {MIN_TOL_PERCENT}, or a fixed modes"
+                    ),
+                ));
+            }
             if self.modes.is_some() {
                 return Err(ModelError::invalid(
                     "amm.tol",
@@ -337,7 +355,7 @@ impl Experiment {
     pub fn from_toml_str(text: &str, path: &Path) -> Result<Self, ModelError> {
         let mut exp: Experiment = toml::from_str(text).map_err(|e| ModelError::Parse {
             file: path.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
+            message: parse_message(text, e),
         })?;
         exp.source = path.to_path_buf();
         exp.drive.read_file(path)?;
@@ -372,6 +390,18 @@ impl Experiment {
         self.robot.validate()?;
         self.time.validate()?;
         self.trajectory.validate(&self.robot)?;
+        if let Trajectory::Quintic { t0, t1, .. } = self.trajectory {
+            if t0 >= self.time.t_end {
+                return Err(ModelError::invalid(
+                    "trajectory.t0",
+                    format!(
+                        "the quintic starts at t0 = {t0} s (ends at t1 = {t1} s), at or after \
+                         time.t_end = {} s: nothing would move; lower t0 or raise t_end",
+                        self.time.t_end
+                    ),
+                ));
+            }
+        }
         self.amm.validate(self.time.dt_out)?;
         self.drive.validate(self.time.t_end, self.robot.mpp_mpa)?;
         if self.fem.elements < 3 || !self.fem.elements.is_multiple_of(3) || self.fem.elements > 30_000 {
@@ -410,6 +440,55 @@ impl Experiment {
         }
         Ok(())
     }
+}
+
+/// The message of a TOML error; an unknown key is reported together with every other unknown key
+/// of the file, in file order (serde stops at the first, in the table's key order).
+fn parse_message(text: &str, first: toml::de::Error) -> String {
+    let render = |e: &toml::de::Error| e.to_string().trim_end().to_string();
+    if !first.message().starts_with("unknown field") {
+        return render(&first);
+    }
+    let Ok(mut doc) = toml::de::DeTable::parse(text) else {
+        return render(&first);
+    };
+    let mut unknown = Vec::new();
+    let mut err = first;
+    // each pass removes the key just reported and parses again, until no unknown key is left
+    while let Some(span) = err.span().filter(|_| err.message().starts_with("unknown field")) {
+        if unknown.len() >= 64 || !remove_key(doc.get_mut(), &span) {
+            break;
+        }
+        err.set_input(Some(text));
+        unknown.push((span.start, render(&err)));
+        match Experiment::deserialize(toml::de::Deserializer::from(doc.clone())) {
+            Ok(_) => break,
+            Err(next) => err = next,
+        }
+    }
+    if unknown.len() <= 1 {
+        return unknown.pop().map(|(_, m)| m).unwrap_or_default();
+    }
+    unknown.sort_by_key(|(start, _)| *start);
+    let n = unknown.len();
+    let all: Vec<String> = unknown.into_iter().map(|(_, m)| m).collect();
+    format!("{n} unknown keys, in file order:\n{}", all.join("\n"))
+}
+
+/// Remove the entry whose key spans `span` from a parsed TOML table (searched recursively).
+fn remove_key(table: &mut toml::de::DeTable<'_>, span: &std::ops::Range<usize>) -> bool {
+    if let Some(key) = table.keys().find(|k| k.span() == *span).cloned() {
+        table.remove(&key);
+        return true;
+    }
+    table.iter_mut().any(|(_, v)| match v.get_mut() {
+        toml::de::DeValue::Table(t) => remove_key(t, span),
+        toml::de::DeValue::Array(a) => a.iter_mut().any(|item| match item.get_mut() {
+            toml::de::DeValue::Table(t) => remove_key(t, span),
+            _ => false,
+        }),
+        _ => false,
+    })
 }
 
 /// A solver step must be positive and not larger than the output interval.
@@ -465,6 +544,85 @@ s3 = [0.0, 0.0, 1.0]
             .unwrap_err()
             .to_string();
         assert!(err.contains("s4"), "{err}");
+    }
+
+    /// The line the TOML parser's message points at (`TOML parse error at line N, ...`).
+    fn error_line(err: &str) -> usize {
+        let at = err.find("at line ").expect(err) + "at line ".len();
+        err[at..].split(',').next().unwrap().parse().unwrap()
+    }
+
+    #[test]
+    fn wrong_type_in_trajectory_points_at_the_key() {
+        // CASE1 line 6 is `[trajectory]`, line 8 is `s1 = ...`
+        let text = CASE1.replace("s1 = [0.0, 0.0, 1.0]", "s1 = [\"a\"]");
+        let err = Experiment::from_toml_str(&text, Path::new("t.toml"))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(error_line(&err), 8, "{err}");
+        assert!(err.contains("t.toml") && err.contains("s1 = [\"a\"]"), "{err}");
+        let quintic = "name = \"q\"\n[time]\nt_end = 0.5\n[trajectory]\nkind = \"quintic\"\nfrom = 3\n\
+                       to = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\nt0 = 0.0\nt1 = 0.2\n";
+        let err = Experiment::from_toml_str(quintic, Path::new("q.toml"))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(error_line(&err), 6, "{err}");
+        assert!(err.contains("from = 3"), "{err}");
+        // a key of the other kind, and a missing key, are named
+        let text = CASE1.replace("kind = \"polynomial\"", "kind = \"polynomial\"\nt0 = 0.1");
+        let err = Experiment::from_toml_str(&text, Path::new("t.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("trajectory.t0") && err.contains("polynomial"), "{err}");
+        let text = CASE1.replace("s3 = [0.0, 0.0, 1.0]", "");
+        let err = Experiment::from_toml_str(&text, Path::new("t.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("trajectory.s3"), "{err}");
+    }
+
+    #[test]
+    fn every_unknown_key_is_named_in_file_order() {
+        let text = CASE1.replace("[time]", "[robot]\nzz = 1\naa = 2\n[time]\nqq = 3");
+        let err = Experiment::from_toml_str(&text, Path::new("u.toml"))
+            .unwrap_err()
+            .to_string();
+        let at = |k: &str| {
+            err.find(&format!("`{k}`"))
+                .unwrap_or_else(|| panic!("{k} missing: {err}"))
+        };
+        assert!(err.contains("3 unknown keys") && err.contains("u.toml"), "{err}");
+        assert!(at("zz") < at("aa") && at("aa") < at("qq"), "{err}");
+    }
+
+    #[test]
+    fn quintic_after_t_end_is_refused_with_the_times() {
+        let text = "name = \"q\"\n[time]\nt_end = 0.5\n[trajectory]\nkind = \"quintic\"\n\
+                    from = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\nto = { Gx = 0.01, Gy = 0.0, theta = 0.0 }\n\
+                    t0 = 0.6\nt1 = 0.8\n";
+        let err = Experiment::from_toml_str(text, Path::new("q.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("trajectory.t0") && err.contains("0.6") && err.contains("0.8") && err.contains("t_end = 0.5"),
+            "{err}"
+        );
+        // one that starts before t_end and ends after it is a valid (truncated) motion
+        let text = text.replace("t0 = 0.6", "t0 = 0.4");
+        assert!(Experiment::from_toml_str(&text, Path::new("q.toml")).is_ok());
+    }
+
+    #[test]
+    fn tolerance_below_the_estimate_floor_is_refused() {
+        for (tol, ok) in [("1e-9", false), ("0.0009", false), ("0.001", true), ("0.5", true)] {
+            let text = CASE1.replace("[trajectory]", &format!("[amm]\ntol = {tol}\n[trajectory]"));
+            let r = Experiment::from_toml_str(&text, Path::new("e.toml"));
+            assert_eq!(r.is_ok(), ok, "tol = {tol}: {r:?}");
+            if let Err(e) = r {
+                let e = e.to_string();
+                assert!(e.contains("amm.tol") && e.contains("0.001"), "{e}");
+            }
+        }
     }
 
     #[test]

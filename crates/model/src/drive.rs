@@ -356,6 +356,15 @@ impl DriveSettings {
             }),
             (None, None, Some(f), Some(z)) => {
                 let (f, z) = (positive("bandwidth_hz", f)?, positive("damping_ratio", z)?);
+                if !(m.is_finite() && m > 0.0) {
+                    return Err(ModelError::invalid(
+                        "drive.bandwidth_hz",
+                        format!(
+                            "the gains from bandwidth_hz scale with the slider mass robot.mpp_mpa = {m} kg, \
+                             which would give kp = kd = 0: give a positive robot.mpp_mpa, or kp and kd"
+                        ),
+                    ));
+                }
                 let (kp, kd) = gains_from_bandwidth(m, f, z);
                 Ok(ServoGains { kp, kd })
             }
@@ -426,6 +435,28 @@ s3 = [0.0, 0.0, 0.5]
         .unwrap();
         assert_eq!(e.drive.servo_gains(0.2).unwrap().kp, 100.0);
         assert!(!load("", Path::new("e.toml")).unwrap().drive.is_direct());
+    }
+
+    #[test]
+    fn bandwidth_with_a_massless_slider_is_refused() {
+        // kp = m (2 pi f)^2 is zero for m = 0: refused, naming both keys, instead of a servo that
+        // does nothing; kp and kd given directly stay accepted with m = 0.
+        let text = format!(
+            "{}[drive]\nkind = \"servo\"\nbandwidth_hz = 10.0\ndamping_ratio = 0.7\n",
+            BASE.replace("[time]", "[robot]\nmpp_mpa = 0.0\n[time]")
+        );
+        let e = Experiment::from_toml_str(&text, Path::new("m0.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("m0.toml") && e.contains("drive.bandwidth_hz") && e.contains("robot.mpp_mpa"),
+            "{e}"
+        );
+        let text = format!(
+            "{}[drive]\nkind = \"servo\"\nkp = 10.0\nkd = 1.0\n",
+            BASE.replace("[time]", "[robot]\nmpp_mpa = 0.0\n[time]")
+        );
+        assert!(Experiment::from_toml_str(&text, Path::new("m0.toml")).is_ok());
     }
 
     #[test]

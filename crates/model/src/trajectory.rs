@@ -22,14 +22,95 @@ pub struct Pose {
 }
 
 /// The prescribed motion of the three actuated prismatic joints.
+///
+/// Read through [`TrajectoryTable`] (a plain table, so that a wrong type is reported at its key
+/// rather than at the `[trajectory]` header); written tagged by `kind`, the same shape.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(tag = "kind", rename_all = "kebab-case", try_from = "TrajectoryTable")]
 pub enum Trajectory {
     /// `s_i(t) = sum_k c_ik t^k` [m], coefficients in increasing powers of t (section 8).
     Polynomial { s1: Vec<f64>, s2: Vec<f64>, s3: Vec<f64> },
     /// Rest-to-rest quintic from pose `from` at `t0` to pose `to` at `t1` (zero velocity and
     /// acceleration at both ends), holding still outside `[t0, t1]`.
     Quintic { from: Pose, to: Pose, t0: f64, t1: f64 },
+}
+
+/// The kinds of [`Trajectory`], as the `kind` key names them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TrajectoryKind {
+    Polynomial,
+    Quintic,
+}
+
+/// The `[trajectory]` table as written: every key of every kind, checked against `kind` when
+/// converted into a [`Trajectory`].
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrajectoryTable {
+    kind: TrajectoryKind,
+    s1: Option<Vec<f64>>,
+    s2: Option<Vec<f64>>,
+    s3: Option<Vec<f64>>,
+    from: Option<Pose>,
+    to: Option<Pose>,
+    t0: Option<f64>,
+    t1: Option<f64>,
+}
+
+impl TryFrom<TrajectoryTable> for Trajectory {
+    type Error = String;
+    fn try_from(t: TrajectoryTable) -> Result<Self, String> {
+        let (name, own, foreign): (_, &[&str], _) = match t.kind {
+            TrajectoryKind::Polynomial => ("polynomial", &["s1", "s2", "s3"], t.quintic_keys()),
+            TrajectoryKind::Quintic => ("quintic", &["from", "to", "t0", "t1"], t.polynomial_keys()),
+        };
+        if let Some(key) = foreign.first() {
+            return Err(format!(
+                "key `trajectory.{key}` does not belong to kind = \"{name}\" (its keys: {})",
+                own.join(", ")
+            ));
+        }
+        let missing = |key: &str| format!("kind = \"{name}\" needs key `trajectory.{key}`");
+        Ok(match t.kind {
+            TrajectoryKind::Polynomial => Trajectory::Polynomial {
+                s1: t.s1.ok_or_else(|| missing("s1"))?,
+                s2: t.s2.ok_or_else(|| missing("s2"))?,
+                s3: t.s3.ok_or_else(|| missing("s3"))?,
+            },
+            TrajectoryKind::Quintic => Trajectory::Quintic {
+                from: t.from.ok_or_else(|| missing("from"))?,
+                to: t.to.ok_or_else(|| missing("to"))?,
+                t0: t.t0.ok_or_else(|| missing("t0"))?,
+                t1: t.t1.ok_or_else(|| missing("t1"))?,
+            },
+        })
+    }
+}
+
+impl TrajectoryTable {
+    fn polynomial_keys(&self) -> Vec<&'static str> {
+        [
+            ("s1", self.s1.is_some()),
+            ("s2", self.s2.is_some()),
+            ("s3", self.s3.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(k, present)| present.then_some(k))
+        .collect()
+    }
+
+    fn quintic_keys(&self) -> Vec<&'static str> {
+        [
+            ("from", self.from.is_some()),
+            ("to", self.to.is_some()),
+            ("t0", self.t0.is_some()),
+            ("t1", self.t1.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(k, present)| present.then_some(k))
+        .collect()
+    }
 }
 
 /// Value, first and second time derivative of one scalar.

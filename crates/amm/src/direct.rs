@@ -321,6 +321,9 @@ fn integrate_direct(
             }
         }
         record(&mut rec, &sys, &w[1], t1, &q, s, sd, sdd)?;
+        if flexstar_model::cancel::cancelled() {
+            return Err(AmmError::Cancelled { t: t1 });
+        }
     }
 
     let mut resp = rec.finish(format!("amm-{}-direct", settings.family.name()));

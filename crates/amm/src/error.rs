@@ -69,6 +69,9 @@ pub enum AmmError {
     /// The solution stopped being finite at time `t`.
     #[error("amm: t = {t:.6} s: the solution is no longer finite (step {dt:e} s)")]
     NonFinite { t: f64, dt: f64 },
+    /// The run was stopped on request ([`flexstar_model::cancel`]) at output time `t` [s].
+    #[error("amm: cancelled at t = {t} s")]
+    Cancelled { t: f64 },
 }
 
 impl AmmError {

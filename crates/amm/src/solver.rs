@@ -363,6 +363,9 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
             observe(&sys, &q);
         }
         record(&st, &w[1], &q, &sys.lam, &sys.sleeve_axial);
+        if flexstar_model::cancel::cancelled() {
+            return Err(AmmError::Cancelled { t: t1 });
+        }
     }
 
     let mut resp = rec.finish(format!("amm-{}", settings.family.name()));

@@ -3,7 +3,6 @@
 
 use std::path::{Path, PathBuf};
 
-use flexstar_plot::write_svg_png;
 use flexstar_modal::analysis::{amm_modes_per_beam, write_modal_csv, Modal};
 use flexstar_modal::freqmap::{check_grid, write_freqmap_csv, Axis};
 use flexstar_modal::linear::StateSpace;
@@ -11,6 +10,7 @@ use flexstar_modal::plots::{mode_shapes_figure, paper_paths, FreqMapFigure};
 use flexstar_modal::pose::{pose_at_time, pose_from_task};
 use flexstar_modal::ModalError;
 use flexstar_model::{Experiment, ModeFamily, RestPose, Sliders};
+use flexstar_plot::write_svg_png;
 
 pub use flexstar_modal::freqmap::{MapPoint, Solver as MapSolver};
 

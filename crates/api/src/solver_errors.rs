@@ -13,6 +13,10 @@ pub fn from_amm(file: &str, e: AmmError) -> ApiError {
         AmmError::DirectInfeasible { t, .. } => ApiError::infeasible(file, *t, &e),
         AmmError::InvalidSetting { key, reason } => ApiError::config_text(file, Some(key), reason, message),
         AmmError::UnknownFamily(_) => ApiError::config_text(file, Some("amm.family"), &e.to_string(), message),
+        AmmError::Cancelled { t } => ApiError::Cancelled {
+            file: file.to_string(),
+            t: *t,
+        },
         AmmError::Model(m) => ApiError::config_text(file, None, &m.to_string(), message),
         _ => ApiError::Solver { message },
     }
@@ -23,6 +27,10 @@ pub fn from_fem(file: &str, e: FemError) -> ApiError {
     let message = format!("{file}: {e}");
     match &e {
         FemError::Input(reason) => ApiError::config_text(file, None, reason, message),
+        FemError::Cancelled { t } => ApiError::Cancelled {
+            file: file.to_string(),
+            t: *t,
+        },
         FemError::MeshTooCoarse { .. } => ApiError::config_text(file, Some("fem.elements"), &e.to_string(), message),
         FemError::Infeasible { t, .. }
         | FemError::SleeveOffBeam { t, .. }

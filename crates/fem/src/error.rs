@@ -44,6 +44,9 @@ pub enum FemError {
         #[source]
         source: LinearError,
     },
+    /// The run was stopped on request ([`flexstar_model::cancel`]) at output time `t` [s].
+    #[error("cancelled at t = {t} s")]
+    Cancelled { t: f64 },
     /// A sleeve contact point left the beam: its material coordinate is outside (0, L).
     #[error(
         "sleeve {sleeve} slid off beam {sleeve} at t = {t} s: the {point} contact point is at material coordinate {xi:.5} m, outside (0, L = {l} m)"

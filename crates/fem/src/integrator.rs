@@ -703,6 +703,9 @@ pub(crate) fn integrate(
         if let Some(cb) = progress {
             cb((t / t_end).min(1.0));
         }
+        if flexstar_model::cancel::cancelled() {
+            return Err(FemError::Cancelled { t });
+        }
     }
     stats.symbolic_factorisations = star.symbolic_count;
     stats.sparse_fallbacks = star.sparse_fallbacks;

@@ -260,3 +260,15 @@ fn progress_reaches_one_and_rows_match_output_times() {
         ["t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3"]
     );
 }
+
+#[test]
+fn a_set_cancel_token_stops_the_run_at_the_first_output_time() {
+    let exp = experiment(RobotParams::paper(), Trajectory::quadratic([1.0, -0.5, -0.5]), 0.02);
+    let token = flexstar_model::Cancel::new();
+    token.cancel();
+    let r = flexstar_model::cancel::with_cancel(Some(&token), || solve(&exp, &coarse(), None));
+    match r {
+        Err(FemError::Cancelled { t }) => assert_eq!(t, exp.time.dt_out),
+        other => panic!("expected Cancelled, got {:?}", other.map(|r| r.t.len())),
+    }
+}

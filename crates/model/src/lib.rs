@@ -7,6 +7,7 @@
 //! Conventions (frames, signs, units) are written once, in `docs/conventions.md`; the items here
 //! follow them. All quantities are SI: metres, seconds, kilograms, newtons, radians.
 
+pub mod cancel;
 pub mod catalogue;
 pub mod config;
 pub mod drive;
@@ -21,6 +22,7 @@ pub mod run_set;
 pub mod trajectory;
 pub mod validity;
 
+pub use cancel::Cancel;
 pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, ModeFamily, TimeSpan};
 pub use drive::{DriveKind, DriveSettings, Feedforward, ForceSamples};
 pub use error::{ModelError, SampleError};

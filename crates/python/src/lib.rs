@@ -3,6 +3,7 @@
 //! conversion of arguments, results and errors. Solves release the GIL.
 
 mod convert;
+mod interrupt;
 mod reports;
 
 use std::path::{Path, PathBuf};
@@ -185,7 +186,7 @@ impl PyRun {
 
 /// Solve an experiment (see `flexstar.run`).
 #[pyfunction]
-#[pyo3(signature = (exp, solver, family = None, modes = None, model = None, tol = None, elements = None, dt = None, forces = None))]
+#[pyo3(signature = (exp, solver, family = None, modes = None, model = None, tol = None, elements = None, dt = None, forces = None, progress = false))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -198,6 +199,7 @@ fn run(
     elements: Option<usize>,
     dt: Option<f64>,
     forces: Option<PyReadonlyArray2<'_, f64>>,
+    progress: bool,
 ) -> PyResult<PyRun> {
     let mut s = RunSettings::new(convert::solver(solver)?);
     s.family = family.map(|f| convert::parse("family", f)).transpose()?;
@@ -209,12 +211,11 @@ fn run(
     s.forces = forces.map(|f| convert::forces(f.as_array())).transpose()?;
     let doc = exp.inner.clone();
     let source = doc.source.display().to_string();
-    let outcome = py
-        .detach(|| {
-            let p = flexstar_api::run::prepare(doc.exp, &source, &s)?;
-            flexstar_api::run::run(&p, None)
-        })
-        .map_err(py_err)?;
+    let outcome = interrupt::interruptible(py, "flexstar.run", progress, |report| {
+        let p = flexstar_api::run::prepare(doc.exp, &source, &s)?;
+        flexstar_api::run::run(&p, Some(report))
+    })?
+    .map_err(py_err)?;
     Ok(PyRun { inner: outcome })
 }
 
@@ -287,18 +288,19 @@ fn linearize<'py>(
 
 /// Run a design study file into `out` (see `flexstar.sweep`); returns the results CSV path.
 #[pyfunction]
-#[pyo3(signature = (study, out, jobs = None))]
-fn sweep(py: Python<'_>, study: PathBuf, out: PathBuf, jobs: Option<usize>) -> PyResult<String> {
+#[pyo3(signature = (study, out, jobs = None, progress = false))]
+fn sweep(py: Python<'_>, study: PathBuf, out: PathBuf, jobs: Option<usize>, progress: bool) -> PyResult<String> {
     if jobs == Some(0) {
         return Err(ConfigError::new_err("jobs: must be at least 1"));
     }
-    let r = py.detach(|| -> Result<PathBuf, String> {
+    let r = interrupt::interruptible(py, "flexstar.sweep", progress, |report| -> Result<PathBuf, String> {
         let st = flexstar_api::study::Study::load(&study).map_err(|e| e.to_string())?;
         let opts = flexstar_api::study::SweepOptions { out, jobs, shard: None };
-        Ok(flexstar_api::study::run_study(&st, &opts, &|_, _| {})
+        let cases = |done: usize, total: usize| report(done as f64 / total.max(1) as f64);
+        Ok(flexstar_api::study::run_study(&st, &opts, &cases)
             .map_err(|e| e.to_string())?
             .results)
-    });
+    })?;
     r.map(|p| p.display().to_string()).map_err(ConfigError::new_err)
 }
 

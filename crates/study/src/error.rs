@@ -8,6 +8,14 @@ use flexstar_model::ModelError;
 /// of the study: it becomes a row whose `status` says why.
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
+    /// The study was stopped on request ([`flexstar_model::cancel`]) between cases; the rows of
+    /// the cases finished are in `results` (a rerun resumes).
+    #[error("{results}: cancelled after {done} of {total} cases")]
+    Cancelled {
+        results: PathBuf,
+        done: usize,
+        total: usize,
+    },
     /// A file could not be read.
     #[error("{file}: cannot read: {source}")]
     Read {

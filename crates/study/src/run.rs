@@ -82,8 +82,18 @@ pub fn run_study(
         .map_err(|e| write_error(&results, e.to_string()))?;
     let file = Mutex::new(file);
     let finished = AtomicUsize::new(0);
+    // a stop on request is polled between cases (the worker threads do not share the caller's)
+    let cancel = flexstar_model::cancel::current();
     let work = || {
         todo.par_iter().try_for_each(|case| {
+            if cancel.as_ref().is_some_and(flexstar_model::Cancel::is_cancelled) {
+                let done = finished.load(Ordering::Relaxed);
+                return Err(StudyError::Cancelled {
+                    results: results.clone(),
+                    done,
+                    total: todo.len(),
+                });
+            }
             let rows: Vec<Vec<String>> = run_case(study, case).iter().map(Row::record).collect();
             let bytes = records_bytes(&rows).map_err(|e| write_error(&results, e.to_string()))?;
             {

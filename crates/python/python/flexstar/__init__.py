@@ -188,11 +188,13 @@ def run(
     elements: Optional[int] = None,
     dt: Optional[float] = None,
     forces: Any = None,
+    progress: bool = False,
 ) -> Run:
     """Run ``solver`` ("amm" or "fem") on ``exp`` with the CLI's overrides (``family``, ``modes``,
     ``model``, ``tol`` [%], ``elements``, ``dt`` [s]). ``forces``: a (n, 4) array or a DataFrame
     with columns t, Fa1, Fa2, Fa3 [s, N] drives the sliders (the direct problem). The GIL is
-    released during the solve. Nothing is written (see :meth:`Run.save`)."""
+    released during the solve; Ctrl-C stops it within a second (``KeyboardInterrupt``);
+    ``progress=True`` prints a line a second on stderr. Nothing is written (see :meth:`Run.save`)."""
     if not isinstance(exp, Experiment):
         raise ConfigError(f"exp: expected a flexstar.Experiment, got {type(exp).__name__}")
     for arg, v in (("modes", modes), ("elements", elements)):
@@ -201,7 +203,7 @@ def run(
         _check_float(arg, v)
     f = None if forces is None else _forces_array(forces)
     return Run(
-        _flexstar.run(exp._inner, solver, family, modes, model, tol, elements, dt, f)
+        _flexstar.run(exp._inner, solver, family, modes, model, tol, elements, dt, f, bool(progress))
     )
 
 
@@ -247,12 +249,15 @@ def linearize(exp: Experiment, at: Optional[float] = None, pose: Optional[Sequen
     return LinearModel(_flexstar.linearize(exp._inner, at, None if pose is None else tuple(pose)))
 
 
-def sweep(study: "os.PathLike[str] | str", out: "os.PathLike[str] | str", jobs: Optional[int] = None) -> "Any":
+def sweep(
+    study: "os.PathLike[str] | str", out: "os.PathLike[str] | str", jobs: Optional[int] = None, progress: bool = False
+) -> "Any":
     """Run a design study file (as ``flexstar sweep``) into ``out/<name>/``; returns results.csv
-    as a pandas DataFrame (needs pandas)."""
+    as a pandas DataFrame (needs pandas). Ctrl-C stops it between cases (``KeyboardInterrupt``; the
+    rows done stay, a rerun resumes); ``progress=True`` prints the share of cases done on stderr."""
     import pandas as pd
 
-    path = _flexstar.sweep(os.fspath(study), os.fspath(out), jobs)
+    path = _flexstar.sweep(os.fspath(study), os.fspath(out), jobs, bool(progress))
     return pd.read_csv(path)
 
 

@@ -88,7 +88,7 @@ flexstar_numerics::dispatch_avx2! {
         t1: f64,
         h: f64,
     ) -> Result<(), FemError> {
-        let (n_dof, n_sys) = (star.n_dof, star.n_sys);
+        let n_dof = star.n_dof;
         let l = params.l;
         let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
         let fixed = motion.prescribed_pins(params, t1)?;
@@ -112,37 +112,12 @@ flexstar_numerics::dispatch_avx2! {
                     (p, motion.slider_rows(params, &p, t1, bp, gp)?)
                 }
             };
-            let fresh = star.assemble(
-                &ws.q1,
-                &ws.v1,
-                &ws.qdd1,
-                &ws.nu,
-                &pins,
-                sliders.as_ref(),
-                bp,
-                bp,
-                &mut ws.res,
-                t1,
-                stale,
-            )?;
+            let fresh = newton_increment(star, ws, &pins, sliders.as_ref(), bp, t1, stale, stats)?;
             if fresh {
-                star.factor(t1)?;
-                stats.factorisations += 1;
                 stale = false;
             }
-            stats.newton_iterations += 1;
-            for (d, r) in ws.dx[..n_sys].iter_mut().zip(&ws.res[..n_sys]) {
-                *d = -r;
-            }
-            star.solve(&mut ws.dx);
             let dq_max = update_coordinates(ws, inv_bp, gp);
-            let mut dl_max = 0.0f64;
-            let mut l_max = 0.0f64;
-            for k in 0..ws.nu.len() {
-                ws.nu[k] += ws.dx[n_dof + k];
-                dl_max = dl_max.max(ws.dx[n_dof + k].abs() / bp);
-                l_max = l_max.max(ws.nu[k].abs() / bp);
-            }
+            let (dl_max, l_max) = update_multipliers(ws, n_dof, bp);
             if !(dq_max.is_finite() && dl_max.is_finite()) {
                 return Err(FemError::Newton {
                     t: t1,
@@ -178,18 +153,80 @@ flexstar_numerics::dispatch_avx2! {
                 },
             });
         }
-        let apq = ga.a_per_qdd();
-        for ((a, ap), qdd) in st.a[..n_dof].iter_mut().zip(&ws.a_part[..n_dof]).zip(&ws.qdd1[..n_dof]) {
-            *a = ap + apq * qdd;
-        }
-        st.pins = fixed.unwrap_or_else(|| star.pins_of(&ws.q1, &ws.v1, &ws.qdd1));
-        std::mem::swap(&mut st.q, &mut ws.q1);
-        std::mem::swap(&mut st.v, &mut ws.v1);
-        std::mem::swap(&mut st.qdd, &mut ws.qdd1);
-        for k in 0..ws.nu.len() {
-            st.lam[k] = ws.nu[k] / bp;
-        }
+        accept(ga, star, st, ws, fixed, bp);
         stats.steps += 1;
         Ok(())
+    }
+}
+
+/// Assemble the residual (and, when `stale`, the matrix, then factorise it) at the Newton
+/// iterate and solve for the increment `dx = -A^{-1} res`; whether the matrix was fresh.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn newton_increment(
+    star: &mut Star,
+    ws: &mut Workspace,
+    pins: &Pins,
+    sliders: Option<&SliderRows>,
+    bp: f64,
+    t1: f64,
+    stale: bool,
+    stats: &mut Stats,
+) -> Result<bool, FemError> {
+    let n_sys = star.n_sys;
+    let fresh = star.assemble(
+        &ws.q1,
+        &ws.v1,
+        &ws.qdd1,
+        &ws.nu,
+        pins,
+        sliders,
+        bp,
+        bp,
+        &mut ws.res,
+        t1,
+        stale,
+    )?;
+    if fresh {
+        star.factor(t1)?;
+        stats.factorisations += 1;
+    }
+    stats.newton_iterations += 1;
+    for (d, r) in ws.dx[..n_sys].iter_mut().zip(&ws.res[..n_sys]) {
+        *d = -r;
+    }
+    star.solve(&mut ws.dx);
+    Ok(fresh)
+}
+
+/// `nu += dnu` from the increment; the largest multiplier increment and multiplier, both
+/// divided by `beta'` (hence in N).
+#[inline(always)]
+fn update_multipliers(ws: &mut Workspace, n_dof: usize, bp: f64) -> (f64, f64) {
+    let mut dl_max = 0.0f64;
+    let mut l_max = 0.0f64;
+    for k in 0..ws.nu.len() {
+        ws.nu[k] += ws.dx[n_dof + k];
+        dl_max = dl_max.max(ws.dx[n_dof + k].abs() / bp);
+        l_max = l_max.max(ws.nu[k].abs() / bp);
+    }
+    (dl_max, l_max)
+}
+
+/// The converged iterate becomes the state: accelerations `a = a_part + (a/q_dd) q_dd`, the
+/// pins, coordinates, velocities, and the multipliers `lambda = nu / beta'`.
+#[inline(always)]
+fn accept(ga: &GenAlpha, star: &Star, st: &mut State, ws: &mut Workspace, fixed: Option<Pins>, bp: f64) {
+    let n_dof = star.n_dof;
+    let apq = ga.a_per_qdd();
+    for ((a, ap), qdd) in st.a[..n_dof].iter_mut().zip(&ws.a_part[..n_dof]).zip(&ws.qdd1[..n_dof]) {
+        *a = ap + apq * qdd;
+    }
+    st.pins = fixed.unwrap_or_else(|| star.pins_of(&ws.q1, &ws.v1, &ws.qdd1));
+    std::mem::swap(&mut st.q, &mut ws.q1);
+    std::mem::swap(&mut st.v, &mut ws.v1);
+    std::mem::swap(&mut st.qdd, &mut ws.qdd1);
+    for k in 0..ws.nu.len() {
+        st.lam[k] = ws.nu[k] / bp;
     }
 }

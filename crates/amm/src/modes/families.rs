@@ -199,3 +199,91 @@ impl Shape {
         }
     }
 }
+
+/// The inputs of [`ModeSet::new`]: `1 <= n <= MAX_MODES` (`n >= 4` for the enriched family)
+/// and positive finite EI, rho and L; the error names the key.
+pub(super) fn check_inputs(family: ModeFamily, n: usize, params: &RobotParams) -> Result<(), AmmError> {
+    if n == 0 || n > MAX_MODES {
+        return Err(AmmError::invalid(
+            "amm.modes",
+            format!("need 1 <= modes <= {MAX_MODES}, got {n}"),
+        ));
+    }
+    for (key, v) in [
+        ("robot.E * robot.I", params.ei()),
+        ("robot.rho", params.rho),
+        ("robot.L", params.l),
+    ] {
+        if !v.is_finite() || v <= 0.0 {
+            return Err(AmmError::invalid(
+                key,
+                format!("must be a positive finite number, got {v}"),
+            ));
+        }
+    }
+    if family == ModeFamily::Enriched && n < 4 {
+        return Err(AmmError::invalid(
+            "amm.modes",
+            format!("the enriched family needs N >= 4 (two rigid modes, at least two elastic modes or junction shapes), got {n}"),
+        ));
+    }
+    Ok(())
+}
+
+/// The first `n_analytic` shapes of `family` on the unit interval: its rigid modes, then the
+/// elastic ones in the order of their roots.
+pub(super) fn analytic_shapes(family: ModeFamily, n_analytic: usize) -> Result<Vec<Shape>, AmmError> {
+    let mut shapes = Vec::with_capacity(n_analytic);
+    for &(a, b) in rigid_modes(family).iter().take(n_analytic) {
+        shapes.push(Shape::Rigid { a, b });
+    }
+    let orders = orders_at_g(family);
+    let mut k = 1;
+    while shapes.len() < n_analytic {
+        shapes.push(elastic_shape(elastic_root(family, k)?, orders));
+        k += 1;
+    }
+    Ok(shapes)
+}
+
+/// The elastic mode of root `bl = beta L` in the stable basis: the null vector of the boundary
+/// conditions at G (derivative `orders`) and of the free tip, scaled to unit norm on the unit
+/// interval and a positive tip value.
+fn elastic_shape(bl: f64, orders: [usize; 2]) -> Shape {
+    let a = [
+        basis_row(bl, 0.0, orders[0]),
+        basis_row(bl, 0.0, orders[1]),
+        basis_row(bl, 1.0, 2),
+        basis_row(bl, 1.0, 3),
+    ];
+    let mut c = null_vector(a);
+    let g = gram(bl);
+    let mut norm2 = 0.0;
+    for p in 0..4 {
+        for q in 0..4 {
+            norm2 += c[p] * g[p][q] * c[q];
+        }
+    }
+    let e = (-bl).exp();
+    let tip = c[0] * bl.cos() + c[1] * bl.sin() + c[2] * e + c[3];
+    let scale = tip.signum() / norm2.sqrt();
+    for v in &mut c {
+        *v *= scale;
+    }
+    Shape::Elastic { bl, c, e }
+}
+
+impl Shape {
+    /// `(beta L, int_0^1 Phi dxi, int_0^1 xi Phi dxi)`; for elastic modes from the ODE and the
+    /// free tip: `int Phi = -Phi'''(0)/b^4`, `int xi Phi = Phi''(0)/b^4`.
+    pub(super) fn unit_integrals(&self) -> (f64, f64, f64) {
+        match *self {
+            Shape::Rigid { a, b } => (0.0, a + 0.5 * b, 0.5 * a + b / 3.0),
+            Shape::Elastic { bl, .. } => {
+                let v = self.eval(0.0);
+                let b4 = bl.powi(4);
+                (bl, -v[3] / b4, v[2] / b4)
+            }
+        }
+    }
+}

@@ -76,82 +76,20 @@ impl ModeSet {
     ///
     /// Errors: `n = 0` or `n > MAX_MODES`, non-positive EI, rho or L.
     pub fn new(family: ModeFamily, n: usize, params: &RobotParams) -> Result<Self, AmmError> {
-        if n == 0 || n > MAX_MODES {
-            return Err(AmmError::invalid(
-                "amm.modes",
-                format!("need 1 <= modes <= {MAX_MODES}, got {n}"),
-            ));
-        }
-        for (key, v) in [
-            ("robot.E * robot.I", params.ei()),
-            ("robot.rho", params.rho),
-            ("robot.L", params.l),
-        ] {
-            if !v.is_finite() || v <= 0.0 {
-                return Err(AmmError::invalid(
-                    key,
-                    format!("must be a positive finite number, got {v}"),
-                ));
-            }
-        }
+        check_inputs(family, n, params)?;
         let enriched = family == ModeFamily::Enriched;
-        if enriched && n < 4 {
-            return Err(AmmError::invalid(
-                "amm.modes",
-                format!("the enriched family needs N >= 4 (two rigid modes, at least two elastic modes or junction shapes), got {n}"),
-            ));
-        }
         // the enriched family: N - 2 free-free modes, then two junction shapes
         let n_analytic = if enriched { n - 2 } else { n };
         let l = params.l;
         let rigid = rigid_modes(family);
-        let mut shapes = Vec::with_capacity(n_analytic);
-        for &(a, b) in rigid.iter().take(n_analytic) {
-            shapes.push(Shape::Rigid { a, b });
-        }
-        let orders = orders_at_g(family);
-        let mut k = 1;
-        while shapes.len() < n_analytic {
-            let bl = elastic_root(family, k)?;
-            let a = [
-                basis_row(bl, 0.0, orders[0]),
-                basis_row(bl, 0.0, orders[1]),
-                basis_row(bl, 1.0, 2),
-                basis_row(bl, 1.0, 3),
-            ];
-            let mut c = null_vector(a);
-            let g = gram(bl);
-            let mut norm2 = 0.0;
-            for p in 0..4 {
-                for q in 0..4 {
-                    norm2 += c[p] * g[p][q] * c[q];
-                }
-            }
-            let e = (-bl).exp();
-            let tip = c[0] * bl.cos() + c[1] * bl.sin() + c[2] * e + c[3];
-            let scale = tip.signum() / norm2.sqrt();
-            for v in &mut c {
-                *v *= scale;
-            }
-            shapes.push(Shape::Elastic { bl, c, e });
-            k += 1;
-        }
+        let shapes = analytic_shapes(family, n_analytic)?;
         let ei_over_rho = params.ei() / params.rho;
         let sqrt_l = l.sqrt();
         let mut lambda = Vec::with_capacity(n);
         let mut phi_int = Vec::with_capacity(n);
         let mut psi_int = Vec::with_capacity(n);
         for s in &shapes {
-            // int_0^1 Phi dxi and int_0^1 xi Phi dxi; for elastic modes from the ODE and the free
-            // tip: int Phi = -Phi'''(0)/b^4, int xi Phi = Phi''(0)/b^4.
-            let (bl, i0, i1) = match *s {
-                Shape::Rigid { a, b } => (0.0, a + 0.5 * b, 0.5 * a + b / 3.0),
-                Shape::Elastic { bl, .. } => {
-                    let v = s.eval(0.0);
-                    let b4 = bl.powi(4);
-                    (bl, -v[3] / b4, v[2] / b4)
-                }
-            };
+            let (bl, i0, i1) = s.unit_integrals();
             lambda.push(ei_over_rho * (bl / l).powi(4));
             phi_int.push(sqrt_l * i0);
             psi_int.push(sqrt_l * l * i1);

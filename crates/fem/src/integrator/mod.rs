@@ -20,7 +20,7 @@ use flexstar_model::{RobotParams, Trajectory};
 use flexstar_numerics::GenAlpha;
 
 use crate::error::PivotError;
-use crate::star::{InitialState, Pins, SliderRows, Star, ROWS};
+use crate::star::{Factors, InitialState, Iterate, Pins, SliderRows, Star, ROWS};
 use crate::{FemError, NewtonFailure};
 
 mod motion;
@@ -122,14 +122,15 @@ fn initial_state(
     let lam0 = vec![0.0; 3 * ROWS];
     let sl0 = motion.slider_rows(params, &pins0, 0.0, 0.0, 0.0)?;
     star.assemble(
-        &q,
-        &v,
-        &zeros,
-        &lam0,
-        &pins0,
-        sl0.as_ref(),
-        1.0,
-        0.0,
+        Iterate {
+            q: &q,
+            v: &v,
+            qdd: &zeros,
+            lam: &lam0,
+            pins: &pins0,
+            sliders: sl0.as_ref(),
+        },
+        Factors { cf: 1.0, ck: 0.0 },
         &mut res,
         0.0,
         true,

@@ -175,14 +175,15 @@ fn newton_increment(
 ) -> Result<bool, FemError> {
     let n_sys = star.n_sys;
     let fresh = star.assemble(
-        &ws.q1,
-        &ws.v1,
-        &ws.qdd1,
-        &ws.nu,
-        pins,
-        sliders,
-        bp,
-        bp,
+        Iterate {
+            q: &ws.q1,
+            v: &ws.v1,
+            qdd: &ws.qdd1,
+            lam: &ws.nu,
+            pins,
+            sliders,
+        },
+        Factors { cf: bp, ck: bp },
         &mut ws.res,
         t1,
         stale,

@@ -268,19 +268,7 @@ impl Bordered {
         forward_rows(&self.band, &self.dinv, w, from + HB);
         let acc = gram_upper(&w[from + HB..]);
         for i in 0..BEAMS {
-            // G columns: E_G lives in the rows of node 1 (the last three), from element 0
-            let blk0 = Self::element_block(vals, ne, i, 0);
-            let mut wg = [[0.0; 3]; 3];
-            for c in 0..3 {
-                let j = n - 3 + c + HB;
-                for g in 0..3 {
-                    let mut v = blk0[6 * (3 + c) + g];
-                    for m in 0..c {
-                        v -= self.band[j][HB - (c - m)].0[i] * wg[m][g];
-                    }
-                    wg[c][g] = v * self.dinv[j].0[i];
-                }
-            }
+            let wg = self.g_columns(vals, i);
             self.wg[i] = wg;
             // S -= W^T W
             for a in 0..ROWS {
@@ -300,6 +288,26 @@ impl Bordered {
                 }
             }
         }
+    }
+
+    /// G columns of `W_i = L_i^{-1} E_i`: `E_G` lives in the rows of node 1 (the last three),
+    /// from element 0, so only the last three rows of `L_i` take part.
+    #[inline(always)]
+    fn g_columns(&self, vals: &[f64], i: usize) -> [[f64; 3]; 3] {
+        let (ne, n) = (self.lay.ne, 3 * self.lay.ne);
+        let blk0 = Self::element_block(vals, ne, i, 0);
+        let mut wg = [[0.0; 3]; 3];
+        for c in 0..3 {
+            let j = n - 3 + c + HB;
+            for g in 0..3 {
+                let mut v = blk0[6 * (3 + c) + g];
+                for m in 0..c {
+                    v -= self.band[j][HB - (c - m)].0[i] * wg[m][g];
+                }
+                wg[c][g] = v * self.dinv[j].0[i];
+            }
+        }
+        wg
     }
 
     /// LU with partial pivoting of the Schur complement, in place (`P S = L U`, unit `L` below

@@ -136,28 +136,7 @@ fn initial_state(
         true,
     )?;
     let mut rhs: Vec<f64> = res.iter().map(|r| -r).collect();
-    let vmax = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let mut conv = [0.0; 3 * ROWS];
-    if vmax > 0.0 {
-        // d^2/dtau^2 Phi(q + tau v) at tau = 0 by central differences (convective part; in the
-        // direct problem the pins move with q, linearly, and add nothing)
-        let tau = 1e-4 * l / vmax.max(1e-3);
-        let qp: Vec<f64> = q.iter().zip(&v).map(|(a, b)| a + tau * b).collect();
-        let qm: Vec<f64> = q.iter().zip(&v).map(|(a, b)| a - tau * b).collect();
-        let fp = star.constraints(&qp, &pins_of(star, &qp)?);
-        let fm = star.constraints(&qm, &pins_of(star, &qm)?);
-        for k in 0..conv.len() {
-            conv[k] = (fp[k] - 2.0 * phi0[k] + fm[k]) / (tau * tau);
-        }
-    }
-    for i in 0..3 {
-        let u = slider_direction(i);
-        for r in 0..6 {
-            // Phi contains -P(t): its second derivative contributes -s'' u (prescribed s only;
-            // the direct problem's s'' is an unknown, zero in pins0)
-            conv[ROWS * i + r] -= pins0.s[i][2] * u[r % 2];
-        }
-    }
+    let conv = convective_accelerations(star, &q, &v, &phi0, &pins0, l, pins_of)?;
     for k in 0..conv.len() {
         rhs[n_dof + k] = -conv[k];
     }
@@ -177,6 +156,43 @@ fn initial_state(
         lam,
         pins,
     })
+}
+
+/// `Phi_dd` of the constraints at t = 0 with zero accelerations (the right-hand side of
+/// [`initial_state`]'s multiplier rows): the convective part `d^2/dtau^2 Phi(q + tau v)` by
+/// central differences, and `-s'' u` of the prescribed sliders.
+fn convective_accelerations(
+    star: &Star,
+    q: &[f64],
+    v: &[f64],
+    phi0: &[f64],
+    pins0: &Pins,
+    l: f64,
+    pins_of: impl Fn(&Star, &[f64]) -> Result<Pins, FemError>,
+) -> Result<[f64; 3 * ROWS], FemError> {
+    let vmax = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut conv = [0.0; 3 * ROWS];
+    if vmax > 0.0 {
+        // d^2/dtau^2 Phi(q + tau v) at tau = 0 by central differences (convective part; in the
+        // direct problem the pins move with q, linearly, and add nothing)
+        let tau = 1e-4 * l / vmax.max(1e-3);
+        let qp: Vec<f64> = q.iter().zip(v).map(|(a, b)| a + tau * b).collect();
+        let qm: Vec<f64> = q.iter().zip(v).map(|(a, b)| a - tau * b).collect();
+        let fp = star.constraints(&qp, &pins_of(star, &qp)?);
+        let fm = star.constraints(&qm, &pins_of(star, &qm)?);
+        for k in 0..conv.len() {
+            conv[k] = (fp[k] - 2.0 * phi0[k] + fm[k]) / (tau * tau);
+        }
+    }
+    for i in 0..3 {
+        let u = slider_direction(i);
+        for r in 0..6 {
+            // Phi contains -P(t): its second derivative contributes -s'' u (prescribed s only;
+            // the direct problem's s'' is an unknown, zero in pins0)
+            conv[ROWS * i + r] -= pins0.s[i][2] * u[r % 2];
+        }
+    }
+    Ok(conv)
 }
 
 /// The sleeves must stay on their beams: every contact point inside (0, L).

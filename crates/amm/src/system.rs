@@ -149,6 +149,99 @@ fn negligible(v: &[f64], scale: &[f64]) -> bool {
     v.iter().zip(scale).all(|(x, s)| x.abs() <= 1e-9 * s)
 }
 
+/// Values `phi_m(0)`, slopes `phi_m'(0)` at G and tip values `phi_m(L)` of every mode.
+fn end_values(modes: &ModeSet, l: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let nm = modes.len();
+    let mut phi0 = vec![0.0; nm];
+    let mut dphi0 = vec![0.0; nm];
+    let mut phil = vec![0.0; nm];
+    for m in 0..nm {
+        let e0 = modes.eval(m, 0.0);
+        phi0[m] = e0[0];
+        dphi0[m] = e0[1];
+        phil[m] = modes.eval(m, l)[0];
+    }
+    (phi0, dphi0, phil)
+}
+
+/// The constraint rows kept for a family whose modes have (`has_w0`) a non-zero value at G and
+/// (`has_slope0`) a non-zero slope there.
+fn constraint_rows(has_w0: bool, has_slope0: bool) -> Vec<Row> {
+    let mut rows = vec![Row::Fix(0), Row::Fix(1), Row::Fix(2)];
+    if has_w0 {
+        rows.push(Row::Fw);
+    }
+    if has_slope0 {
+        rows.push(Row::M1G);
+        rows.push(Row::M3G);
+    }
+    for i in 0..3 {
+        rows.extend([Row::Fp(i), Row::FR(i), Row::FL(i), Row::Mp(i)]);
+    }
+    rows
+}
+
+/// Block of constraint row `row` on beam b: (basis vector, its factor, u coefficient, thp
+/// coefficient), `None` where the block is zero; `hp` is half the sleeve length [m].
+fn row_entry(row: Row, b: usize, has_w0: bool, hp: f64) -> Option<(usize, f64, f64, f64)> {
+    match row {
+        Row::Fix(i) if b == i => Some((NONE, 0.0, 1.0, 0.0)),
+        Row::Fix(i) if has_w0 => Some((
+            B_PHI0,
+            if b == (i + 1) % 3 { 1.0 / SQRT3 } else { -1.0 / SQRT3 },
+            0.0,
+            0.0,
+        )),
+        Row::Fix(_) => None,
+        Row::Fw => Some((B_PHI0, 1.0, 0.0, 0.0)),
+        Row::M1G | Row::M3G => {
+            let first = if row == Row::M1G { 0 } else { 2 };
+            match b {
+                1 => Some((B_DPHI0, -1.0, 0.0, 0.0)),
+                _ if b == first => Some((B_DPHI0, 1.0, 0.0, 0.0)),
+                _ => None,
+            }
+        }
+        Row::Fp(i) if b == i => Some((B_MID, 1.0, 0.0, 0.0)),
+        Row::FR(i) if b == i => Some((B_RIGHT, 1.0, 0.0, -hp)),
+        Row::FL(i) if b == i => Some((B_LEFT, 1.0, 0.0, hp)),
+        Row::Mp(i) if b == i => Some((B_MSLOPE, 1.0, 0.0, 1.0)),
+        Row::Fp(_) | Row::FR(_) | Row::FL(_) | Row::Mp(_) => None,
+    }
+}
+
+/// The rows of each beam: which constraint rows touch it and how ([`row_entry`]), with the
+/// workspaces for `nm` modes (`n_bent` analytic modes for the full model's sleeve bending).
+fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize, n_bent: usize) -> [BeamRows; 3] {
+    let mut beams: [BeamRows; 3] = std::array::from_fn(|_| BeamRows {
+        ids: Vec::new(),
+        basis: Vec::new(),
+        sc: Vec::new(),
+        cu: Vec::new(),
+        gu: Vec::new(),
+        ct: Vec::new(),
+        sleeve: std::array::from_fn(|_| vec![0.0; nm]),
+        scaled: std::array::from_fn(|_| vec![0.0; nm]),
+        gram: [[0.0; NB]; NB],
+        bent: SleeveBending::new(n_bent),
+        g: [0.0; NB],
+    });
+    for (k, row) in rows.iter().enumerate() {
+        for (b, beam) in beams.iter_mut().enumerate() {
+            let entry = row_entry(*row, b, has_w0, hp);
+            if let Some((basis, sc, cu, ct)) = entry {
+                beam.ids.push(k);
+                beam.basis.push(basis);
+                beam.sc.push(sc);
+                beam.cu.push(cu);
+                beam.gu.push(cu);
+                beam.ct.push(ct);
+            }
+        }
+    }
+    beams
+}
+
 impl System {
     /// Build the system for `modes`, keeping the constraint rows that do not vanish identically
     /// for the family (pinned-free: no `Fw`; slide-free: no slope equalities; clamped-free: neither).
@@ -158,87 +251,21 @@ impl System {
         let l = params.l;
         let sl = 1.0 / l.sqrt();
         let bl = modes.beta_l();
-        let mut phi0 = vec![0.0; nm];
-        let mut dphi0 = vec![0.0; nm];
-        let mut phil = vec![0.0; nm];
-        for m in 0..nm {
-            let e0 = modes.eval(m, 0.0);
-            phi0[m] = e0[0];
-            dphi0[m] = e0[1];
-            phil[m] = modes.eval(m, l)[0];
-        }
+        let (phi0, dphi0, phil) = end_values(&modes, l);
         // a non-zero value is O(1/sqrt L), a non-zero slope O(max(1, beta L) / L^1.5)
         let val_scale = vec![sl; nm];
         let slope_scale: Vec<f64> = bl.iter().map(|b| b.max(1.0) * sl / l).collect();
         let has_w0 = !negligible(&phi0, &val_scale);
         let has_slope0 = !negligible(&dphi0, &slope_scale);
 
-        let mut rows = vec![Row::Fix(0), Row::Fix(1), Row::Fix(2)];
-        if has_w0 {
-            rows.push(Row::Fw);
-        }
-        if has_slope0 {
-            rows.push(Row::M1G);
-            rows.push(Row::M3G);
-        }
-        for i in 0..3 {
-            rows.extend([Row::Fp(i), Row::FR(i), Row::FL(i), Row::Mp(i)]);
-        }
+        let rows = constraint_rows(has_w0, has_slope0);
         let hp = 0.5 * params.lp;
-        let mut beams: [BeamRows; 3] = std::array::from_fn(|_| BeamRows {
-            ids: Vec::new(),
-            basis: Vec::new(),
-            sc: Vec::new(),
-            cu: Vec::new(),
-            gu: Vec::new(),
-            ct: Vec::new(),
-            sleeve: std::array::from_fn(|_| vec![0.0; nm]),
-            scaled: std::array::from_fn(|_| vec![0.0; nm]),
-            gram: [[0.0; NB]; NB],
-            bent: SleeveBending::new(if model == AmmModel::Full {
-                modes.analytic_len()
-            } else {
-                0
-            }),
-            g: [0.0; NB],
-        });
-        for (k, row) in rows.iter().enumerate() {
-            for (b, beam) in beams.iter_mut().enumerate() {
-                // (basis vector, its factor, u coefficient, thp coefficient); None: block is zero
-                let entry = match *row {
-                    Row::Fix(i) if b == i => Some((NONE, 0.0, 1.0, 0.0)),
-                    Row::Fix(i) if has_w0 => Some((
-                        B_PHI0,
-                        if b == (i + 1) % 3 { 1.0 / SQRT3 } else { -1.0 / SQRT3 },
-                        0.0,
-                        0.0,
-                    )),
-                    Row::Fix(_) => None,
-                    Row::Fw => Some((B_PHI0, 1.0, 0.0, 0.0)),
-                    Row::M1G | Row::M3G => {
-                        let first = if *row == Row::M1G { 0 } else { 2 };
-                        match b {
-                            1 => Some((B_DPHI0, -1.0, 0.0, 0.0)),
-                            _ if b == first => Some((B_DPHI0, 1.0, 0.0, 0.0)),
-                            _ => None,
-                        }
-                    }
-                    Row::Fp(i) if b == i => Some((B_MID, 1.0, 0.0, 0.0)),
-                    Row::FR(i) if b == i => Some((B_RIGHT, 1.0, 0.0, -hp)),
-                    Row::FL(i) if b == i => Some((B_LEFT, 1.0, 0.0, hp)),
-                    Row::Mp(i) if b == i => Some((B_MSLOPE, 1.0, 0.0, 1.0)),
-                    Row::Fp(_) | Row::FR(_) | Row::FL(_) | Row::Mp(_) => None,
-                };
-                if let Some((basis, sc, cu, ct)) = entry {
-                    beam.ids.push(k);
-                    beam.basis.push(basis);
-                    beam.sc.push(sc);
-                    beam.cu.push(cu);
-                    beam.gu.push(cu);
-                    beam.ct.push(ct);
-                }
-            }
-        }
+        let n_bent = if model == AmmModel::Full {
+            modes.analytic_len()
+        } else {
+            0
+        };
+        let beams = beam_rows(&rows, has_w0, hp, nm, n_bent);
         debug_assert!(beams.iter().all(|b| b.ids.len() <= MAX_BEAM_ROWS));
         let m = rows.len();
         let n = 3 * nb;

@@ -8,7 +8,7 @@ use flexstar_kinematics::{check_trajectory, direct_kinematics, RigidState};
 use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::{BeamShape, Experiment, FemSettings, Response, RobotParams, RunInfo, StarShape};
 
-use crate::integrator::{integrate, History, Motion, RunSettings, Stats};
+use crate::integrator::{integrate, History, Motion, RunSettings, Snapshot, Stats};
 use crate::star::InitialState;
 use crate::FemError;
 
@@ -311,26 +311,36 @@ fn post_process(
     lead.extend(extra);
     resp.set_extra(&names, lead);
     for snap in &hist.snapshots {
-        let r = frame(snap.t, snap.s)?;
-        let g = r.g;
-        let beams = [0, 1, 2].map(|i| {
-            let (ex, ew) = (e_x(i, r.theta), e_w(i, r.theta));
-            let pos = snap.beams[i].clone();
-            let w = hist
-                .node_x
-                .iter()
-                .zip(&pos)
-                .map(|(x, p)| dot([p[0] - g[0] - x * ex[0], p[1] - g[1] - x * ex[1]], ew))
-                .collect();
-            BeamShape {
-                x: hist.node_x.clone(),
-                w,
-                pos,
-            }
-        });
-        resp.shapes.push(StarShape { t: snap.t, beams });
+        resp.shapes.push(star_shape(hist, snap, frame)?);
     }
     Ok(resp)
+}
+
+/// The deformed star of snapshot `snap`: per beam the node positions and their deflections `w`
+/// [m] from the rigid beam of the frame at the snapshot's slider positions.
+fn star_shape(
+    hist: &History,
+    snap: &Snapshot,
+    frame: &dyn Fn(f64, [f64; 3]) -> Result<Frame, FemError>,
+) -> Result<StarShape, FemError> {
+    let r = frame(snap.t, snap.s)?;
+    let g = r.g;
+    let beams = [0, 1, 2].map(|i| {
+        let (ex, ew) = (e_x(i, r.theta), e_w(i, r.theta));
+        let pos = snap.beams[i].clone();
+        let w = hist
+            .node_x
+            .iter()
+            .zip(&pos)
+            .map(|(x, p)| dot([p[0] - g[0] - x * ex[0], p[1] - g[1] - x * ex[1]], ew))
+            .collect();
+        BeamShape {
+            x: hist.node_x.clone(),
+            w,
+            pos,
+        }
+    });
+    Ok(StarShape { t: snap.t, beams })
 }
 
 fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {

@@ -100,6 +100,27 @@ pub(crate) struct SliderRows {
     pub diag: [f64; 3],
 }
 
+/// The Newton iterate at which [`Star::assemble`] evaluates the residual and the matrix:
+/// coordinates, velocities, accelerations and (scaled) multipliers in the star's global
+/// ordering, the pins of the same iterate and, in the direct problem, the sliders' rows.
+#[derive(Clone, Copy)]
+pub(crate) struct Iterate<'a> {
+    pub q: &'a [f64],
+    pub v: &'a [f64],
+    pub qdd: &'a [f64],
+    pub lam: &'a [f64],
+    pub pins: &'a Pins,
+    pub sliders: Option<&'a SliderRows>,
+}
+
+/// Factors of [`Star::assemble`]: `cf` on the dynamic part of the residual, `ck` on the
+/// stiffness in the matrix `M + ck K`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Factors {
+    pub cf: f64,
+    pub ck: f64,
+}
+
 /// The assembled model with its sparse iteration matrix.
 pub(crate) struct Star {
     pub params: RobotParams,
@@ -292,21 +313,23 @@ impl Star {
     /// With `matrix == false` only the residual is evaluated (for a modified Newton iteration with
     /// the last factorisation, `crate::integrator`), unless the pattern had to be rebuilt. Returns
     /// whether the matrix was assembled (and must be factorised before the next solve).
-    #[allow(clippy::too_many_arguments)]
     pub fn assemble(
         &mut self,
-        q: &[f64],
-        v: &[f64],
-        qdd: &[f64],
-        lam: &[f64],
-        pins: &Pins,
-        sliders: Option<&SliderRows>,
-        cf: f64,
-        ck: f64,
+        it: Iterate,
+        fac: Factors,
         res: &mut [f64],
         t: f64,
         matrix: bool,
     ) -> Result<bool, FemError> {
+        let Iterate {
+            q,
+            v,
+            qdd,
+            lam,
+            sliders,
+            ..
+        } = it;
+        let Factors { cf, ck } = fac;
         let rebuilt = self.ensure_pattern(q);
         let matrix = matrix || rebuilt;
         res.iter_mut().for_each(|r| *r = 0.0);
@@ -321,56 +344,7 @@ impl Star {
             }
         })?;
         for i in 0..3 {
-            let ps = self.psi(i);
-            res[ps] += cf * self.params.jp * qdd[ps];
-            if matrix {
-                self.vals[self.off_psi + 4 * i] = self.params.jp;
-                for p in 0..3 {
-                    self.vals[self.off_psi + 4 * i + 1 + p] = 0.0;
-                }
-            }
-            // per contact point: the element holding it, its local coordinate and the element's
-            // state (recomputed: cheaper than storing every element's state, which at 3000
-            // elements leaves the cache)
-            let points: [(usize, f64, ElementState); 3] = [0, 1, 2].map(|p| {
-                let (e, z) = self.locate(q[self.xi(i, p)]);
-                let el = &self.elements[i * self.ne + e];
-                (e, z, ElementState::new(el, &self.element_q(el, q)))
-            });
-            for r in 0..ROWS {
-                let p = ROW_POINT[r];
-                let xi_idx = self.xi(i, p);
-                let (e, z, st) = points[p];
-                let ge = i * self.ne + e;
-                let na = self.node(i, e);
-                let (phi, grad, gxi, gpsi) = self.row_terms(&st, [q[3 * na], q[3 * na + 1]], i, q[ps], pins.p[i], r, z);
-                let row = self.n_dof + ROWS * i + r;
-                let l = lam[ROWS * i + r];
-                res[row] = phi;
-                let d = dofs(&self.elements[ge]);
-                for a in 0..6 {
-                    res[d[a]] += grad[a] * l;
-                }
-                res[xi_idx] += gxi * l;
-                res[ps] += gpsi * l;
-                if !matrix {
-                    continue;
-                }
-                // matrix slots: row block then transposed block
-                let base = self.off_con + (ROWS * i + r) * 2 * self.ncol_c;
-                let lo = self.win[i][p];
-                let nc = self.ncol_c;
-                self.vals[base..base + 2 * nc].iter_mut().for_each(|x| *x = 0.0);
-                let c0 = 3 * (e - lo);
-                for a in 0..6 {
-                    self.vals[base + c0 + a] = grad[a];
-                    self.vals[base + nc + c0 + a] = grad[a];
-                }
-                self.vals[base + nc - 2] = gxi;
-                self.vals[base + 2 * nc - 2] = gxi;
-                self.vals[base + nc - 1] = gpsi;
-                self.vals[base + 2 * nc - 1] = gpsi;
-            }
+            self.sleeve_rows(i, &it, cf, res, matrix);
         }
         match (self.direct, sliders) {
             (true, Some(sl)) => self.assemble_sliders(sl, qdd, lam, cf, res, matrix),
@@ -381,6 +355,71 @@ impl Star {
                 ))
             }
         }
+        self.check_residual(res, t)?;
+        Ok(matrix)
+    }
+
+    /// The sleeve part of [`Star::assemble`] for sleeve i: the rotation's inertia, then per
+    /// constraint row its value, its gradient times the multiplier into the residual and, with
+    /// `matrix`, its slots (row block, then transposed block).
+    #[inline]
+    fn sleeve_rows(&mut self, i: usize, it: &Iterate, cf: f64, res: &mut [f64], matrix: bool) {
+        let Iterate { q, qdd, lam, pins, .. } = *it;
+        let ps = self.psi(i);
+        res[ps] += cf * self.params.jp * qdd[ps];
+        if matrix {
+            self.vals[self.off_psi + 4 * i] = self.params.jp;
+            for p in 0..3 {
+                self.vals[self.off_psi + 4 * i + 1 + p] = 0.0;
+            }
+        }
+        // per contact point: the element holding it, its local coordinate and the element's
+        // state (recomputed: cheaper than storing every element's state, which at 3000
+        // elements leaves the cache)
+        let points: [(usize, f64, ElementState); 3] = [0, 1, 2].map(|p| {
+            let (e, z) = self.locate(q[self.xi(i, p)]);
+            let el = &self.elements[i * self.ne + e];
+            (e, z, ElementState::new(el, &self.element_q(el, q)))
+        });
+        for r in 0..ROWS {
+            let p = ROW_POINT[r];
+            let xi_idx = self.xi(i, p);
+            let (e, z, st) = points[p];
+            let ge = i * self.ne + e;
+            let na = self.node(i, e);
+            let (phi, grad, gxi, gpsi) = self.row_terms(&st, [q[3 * na], q[3 * na + 1]], i, q[ps], pins.p[i], r, z);
+            let row = self.n_dof + ROWS * i + r;
+            let l = lam[ROWS * i + r];
+            res[row] = phi;
+            let d = dofs(&self.elements[ge]);
+            for a in 0..6 {
+                res[d[a]] += grad[a] * l;
+            }
+            res[xi_idx] += gxi * l;
+            res[ps] += gpsi * l;
+            if !matrix {
+                continue;
+            }
+            // matrix slots: row block then transposed block
+            let base = self.off_con + (ROWS * i + r) * 2 * self.ncol_c;
+            let lo = self.win[i][p];
+            let nc = self.ncol_c;
+            self.vals[base..base + 2 * nc].iter_mut().for_each(|x| *x = 0.0);
+            let c0 = 3 * (e - lo);
+            for a in 0..6 {
+                self.vals[base + c0 + a] = grad[a];
+                self.vals[base + nc + c0 + a] = grad[a];
+            }
+            self.vals[base + nc - 2] = gxi;
+            self.vals[base + 2 * nc - 2] = gxi;
+            self.vals[base + nc - 1] = gpsi;
+            self.vals[base + 2 * nc - 1] = gpsi;
+        }
+    }
+
+    /// A residual with a non-finite entry is an error naming the row (and the element of a DOF row).
+    #[inline]
+    fn check_residual(&self, res: &[f64], t: f64) -> Result<(), FemError> {
         // one pass without early exit (vectorised), the position only when there is one
         let any_bad = res.iter().fold(false, |bad, r| bad | !r.is_finite());
         if let Some(k) = any_bad.then(|| res.iter().position(|r| !r.is_finite())).flatten() {
@@ -394,7 +433,7 @@ impl Star {
                 reason: format!("residual row {k}"),
             });
         }
-        Ok(matrix)
+        Ok(())
     }
 
     /// Value, element gradient, contact-coordinate derivative and sleeve-rotation derivative of
@@ -599,8 +638,21 @@ mod tests {
             diag: [0.2 + bp * 7.9e6 + 3e-4 * 1.8e3; 3],
         };
         let sl = direct.then_some(&rows);
-        star.assemble(&q, &v, &qdd, &lam, &pins, sl, bp, bp, &mut res, 0.0, true)
-            .unwrap();
+        star.assemble(
+            Iterate {
+                q: &q,
+                v: &v,
+                qdd: &qdd,
+                lam: &lam,
+                pins: &pins,
+                sliders: sl,
+            },
+            Factors { cf: bp, ck: bp },
+            &mut res,
+            0.0,
+            true,
+        )
+        .unwrap();
         assert_eq!(star.win[0][1], 0, "the test wants a window that holds G");
         let b: Vec<f64> = (0..star.n_sys).map(|k| (k as f64 * 1.3).sin()).collect();
         let mut x = b.clone();

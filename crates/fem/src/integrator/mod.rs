@@ -1,0 +1,299 @@
+//! Index-3 generalized-alpha time integration of the constrained star (Arnold & Bruls 2007,
+//! Multibody Syst. Dyn. 18:185), with the equations of motion scaled by `beta'` and the
+//! multipliers carried as `nu = beta' lambda` (Bottasso, Bauchau & Cardona 2007, SIAM J. Sci.
+//! Comput. 29:397), so that the iteration matrix
+//!
+//! ```text
+//! [ M + beta' K    Phi_q^T ] [ dq  ]     [ beta' (M q_dd + f_conv + f_int) + Phi_q^T nu ]
+//! [ Phi_q          0       ] [ dnu ] = - [ Phi(q, t)                                     ]
+//! ```
+//!
+//! has entries of comparable size whatever the step. `q_{n+1} = q_hat + beta' q_dd`,
+//! `v_{n+1} = v_hat + gamma' q_dd` with the coefficients of [`flexstar_numerics::GenAlpha`]; the
+//! equations hold exactly at `t_{n+1}` (positions, multipliers), so the pin forces and hence Fa
+//! come out at the output times with second-order accuracy.
+
+use flexstar_drive::ActuatorLaw;
+use flexstar_kinematics::feasibility::check_configuration;
+use flexstar_model::geometry::slider_direction;
+use flexstar_model::{RobotParams, Trajectory};
+use flexstar_numerics::GenAlpha;
+
+use crate::error::PivotError;
+use crate::star::{Factors, InitialState, Iterate, Pins, SliderRows, Star, ROWS};
+use crate::{FemError, NewtonFailure};
+
+mod motion;
+mod recorder;
+mod step;
+
+pub(crate) use motion::Motion;
+use motion::{pins_at, power};
+use recorder::{event_times, Recorder};
+pub(crate) use recorder::{Sample, Snapshot};
+use step::{step, Workspace};
+
+/// Numerical settings of one run.
+#[derive(Debug, Clone)]
+pub(crate) struct RunSettings {
+    /// Elements per beam.
+    pub ne: usize,
+    /// Largest time step [s].
+    pub dt: f64,
+    pub rho_inf: f64,
+}
+
+/// Work counters.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Stats {
+    /// Time steps taken.
+    pub steps: usize,
+    /// Newton iterations (residual evaluations and solves) in all.
+    pub newton_iterations: usize,
+    /// Sparsity patterns built (one at the start, a new one when a sleeve's contact point leaves
+    /// its window of elements); the sparse LU fallback redoes its symbolic factorisation on these.
+    pub symbolic_factorisations: usize,
+    /// Factorisations that fell back from the structured solver (banded beam blocks and a dense
+    /// border, `docs/fem.md` section 3) to the general sparse LU (0 in the paper cases).
+    pub sparse_fallbacks: usize,
+    /// Numeric factorisations of the Newton matrix: one at the first iteration of each step,
+    /// reused by the step's later iterations while the increments contract by a factor 10 or
+    /// better, refactorised otherwise (docs/fem.md section 3).
+    pub factorisations: usize,
+    /// Why the structured solver last failed, and when (`None` without a fallback).
+    pub last_fallback: Option<Fallback>,
+}
+
+/// A fallback from the structured solver to the sparse LU: the Newton time `t` [s] and the
+/// failing pivot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fallback {
+    /// Time of the step whose factorisation fell back [s].
+    pub t: f64,
+    /// The pivot that failed.
+    pub reason: PivotError,
+}
+
+/// Everything a run produces.
+pub(crate) struct History {
+    pub samples: Vec<Sample>,
+    pub snapshots: Vec<Snapshot>,
+    pub node_x: Vec<f64>,
+    pub stats: Stats,
+}
+
+/// The integration state at one time: coordinates, velocities, algorithmic accelerations
+/// `q_dd`, the generalized-alpha acceleration variable `a`, multipliers, and the pins.
+struct State {
+    q: Vec<f64>,
+    v: Vec<f64>,
+    qdd: Vec<f64>,
+    a: Vec<f64>,
+    lam: Vec<f64>,
+    pins: Pins,
+}
+
+/// Consistent accelerations and multipliers at t = 0:
+/// `[M Phi_q^T; Phi_q 0] [q_dd; lambda] = [-f_conv - f_int; -Phi_dd_conv]` (with the sliders'
+/// rows `m s'' - u . F = Fa` in the direct problem).
+fn initial_state(
+    params: &RobotParams,
+    motion: &Motion,
+    star: &mut Star,
+    q: Vec<f64>,
+    v: Vec<f64>,
+) -> Result<State, FemError> {
+    let (n_dof, n_sys) = (star.n_dof, star.n_sys);
+    let l = params.l;
+    let zeros = vec![0.0; n_dof];
+    let pins_of = |star: &Star, q: &[f64]| match motion {
+        Motion::Prescribed(traj) => pins_at(params, traj, 0.0),
+        Motion::Driven { .. } => Ok(star.pins_of(q, &v, &zeros)),
+    };
+    let pins0 = pins_of(star, &q)?;
+    let phi0 = star.constraints(&q, &pins0);
+    let worst = phi0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if worst > 1e-9 * l {
+        return Err(FemError::Input(format!(
+            "the initial pose does not pass through the pins (largest constraint residual {worst:.3e})"
+        )));
+    }
+    let mut res = vec![0.0; n_sys];
+    let lam0 = vec![0.0; 3 * ROWS];
+    let sl0 = motion.slider_rows(params, &pins0, 0.0, 0.0, 0.0)?;
+    star.assemble(
+        Iterate {
+            q: &q,
+            v: &v,
+            qdd: &zeros,
+            lam: &lam0,
+            pins: &pins0,
+            sliders: sl0.as_ref(),
+        },
+        Factors { cf: 1.0, ck: 0.0 },
+        &mut res,
+        0.0,
+        true,
+    )?;
+    let mut rhs: Vec<f64> = res.iter().map(|r| -r).collect();
+    let conv = convective_accelerations(star, &q, &v, &phi0, &pins0, l, pins_of)?;
+    for k in 0..conv.len() {
+        rhs[n_dof + k] = -conv[k];
+    }
+    star.factor(0.0)?;
+    star.solve(&mut rhs);
+    let qdd = rhs[..n_dof].to_vec();
+    let lam = rhs[n_dof..].to_vec();
+    let pins = match motion {
+        Motion::Prescribed(_) => pins0,
+        Motion::Driven { .. } => star.pins_of(&q, &v, &qdd),
+    };
+    Ok(State {
+        a: qdd.clone(),
+        q,
+        v,
+        qdd,
+        lam,
+        pins,
+    })
+}
+
+/// `Phi_dd` of the constraints at t = 0 with zero accelerations (the right-hand side of
+/// [`initial_state`]'s multiplier rows): the convective part `d^2/dtau^2 Phi(q + tau v)` by
+/// central differences, and `-s'' u` of the prescribed sliders.
+fn convective_accelerations(
+    star: &Star,
+    q: &[f64],
+    v: &[f64],
+    phi0: &[f64],
+    pins0: &Pins,
+    l: f64,
+    pins_of: impl Fn(&Star, &[f64]) -> Result<Pins, FemError>,
+) -> Result<[f64; 3 * ROWS], FemError> {
+    let vmax = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut conv = [0.0; 3 * ROWS];
+    if vmax > 0.0 {
+        // d^2/dtau^2 Phi(q + tau v) at tau = 0 by central differences (convective part; in the
+        // direct problem the pins move with q, linearly, and add nothing)
+        let tau = 1e-4 * l / vmax.max(1e-3);
+        let qp: Vec<f64> = q.iter().zip(v).map(|(a, b)| a + tau * b).collect();
+        let qm: Vec<f64> = q.iter().zip(v).map(|(a, b)| a - tau * b).collect();
+        let fp = star.constraints(&qp, &pins_of(star, &qp)?);
+        let fm = star.constraints(&qm, &pins_of(star, &qm)?);
+        for k in 0..conv.len() {
+            conv[k] = (fp[k] - 2.0 * phi0[k] + fm[k]) / (tau * tau);
+        }
+    }
+    for i in 0..3 {
+        let u = slider_direction(i);
+        for r in 0..6 {
+            // Phi contains -P(t): its second derivative contributes -s'' u (prescribed s only;
+            // the direct problem's s'' is an unknown, zero in pins0)
+            conv[ROWS * i + r] -= pins0.s[i][2] * u[r % 2];
+        }
+    }
+    Ok(conv)
+}
+
+/// The sleeves must stay on their beams: every contact point inside (0, L).
+fn check_sleeves(star: &Star, q: &[f64], l: f64, t: f64) -> Result<(), FemError> {
+    for i in 0..3 {
+        for (p, name) in [(0, "centre"), (1, "left edge"), (2, "right edge")] {
+            let xi = q[star.xi(i, p)];
+            if !(xi > 0.0 && xi < l) {
+                return Err(FemError::SleeveOffBeam {
+                    t,
+                    sleeve: i + 1,
+                    point: name,
+                    xi,
+                    l,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Integrate from the initial state to the last output time.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn integrate(
+    params: &RobotParams,
+    motion: &Motion,
+    t_out: &[f64],
+    snap_times: &[f64],
+    init: &InitialState,
+    run: &RunSettings,
+    progress: Option<&(dyn Fn(f64) + Sync)>,
+) -> Result<History, FemError> {
+    if !(run.dt.is_finite() && run.dt > 0.0) {
+        return Err(FemError::Input(format!(
+            "the time step must be positive, got {}",
+            run.dt
+        )));
+    }
+    if t_out.is_empty() || t_out[0] != 0.0 {
+        return Err(FemError::Input("output times must start at t = 0".into()));
+    }
+    let (mut star, q, v) = Star::new(params, run.ne, init, motion.slider_unknowns())?;
+    let (n_dof, n_sys) = (star.n_dof, star.n_sys);
+    let l = params.l;
+    let mut st = initial_state(params, motion, &mut star, q, v)?;
+    motion.check_feasible(params, &st.pins, 0.0)?;
+
+    let t_end = *t_out.last().unwrap_or(&0.0);
+    let events = event_times(t_out, snap_times);
+    let ga = GenAlpha::new(run.rho_inf);
+    let mut rec = Recorder::new(t_out, snap_times);
+    let mut stats = Stats::default();
+    let (fa0, pf0) = motion.forces(params, &st.pins, &st.lam, 0.0)?;
+    let mut pow_prev = power(&fa0, &st.pins);
+    let mut work = 0.0;
+    rec.record(params, &star, &st, fa0, pf0, 0.0, 0.0);
+
+    let rot = |j: usize| j < 3 * star.n_nodes && j % 3 == 2 || (j >= 3 * star.n_nodes && j < 3 * star.n_nodes + 3);
+    let mut ws = Workspace {
+        weight: (0..n_dof).map(|j| if rot(j) { star.h } else { 1.0 }).collect(),
+        a_part: vec![0.0; n_dof],
+        qh: vec![0.0; n_dof],
+        vh: vec![0.0; n_dof],
+        q1: vec![0.0; n_dof],
+        v1: vec![0.0; n_dof],
+        qdd1: vec![0.0; n_dof],
+        nu: vec![0.0; 3 * ROWS],
+        dx: vec![0.0; n_sys],
+        res: vec![0.0; n_sys],
+    };
+    let mut t = 0.0;
+    for w in events.windows(2) {
+        let (ta, tb) = (w[0], w[1]);
+        let n_sub = ((tb - ta) / run.dt - 1e-9).ceil().max(1.0) as usize;
+        let h = (tb - ta) / n_sub as f64;
+        for sub in 1..=n_sub {
+            let t1 = if sub == n_sub { tb } else { ta + h * sub as f64 };
+            step(params, motion, &mut star, &ga, &mut st, &mut ws, &mut stats, t1, h)?;
+            t = t1;
+            check_sleeves(&star, &st.q, l, t)?;
+            motion.check_feasible(params, &st.pins, t)?;
+            let (fa, pf) = motion.forces(params, &st.pins, &st.lam, t)?;
+            let pw = power(&fa, &st.pins);
+            work += 0.5 * h * (pow_prev + pw);
+            pow_prev = pw;
+            rec.record(params, &star, &st, fa, pf, t, work);
+        }
+        if let Some(cb) = progress {
+            cb((t / t_end).min(1.0));
+        }
+        if flexstar_model::cancel::cancelled() {
+            return Err(FemError::Cancelled { t });
+        }
+    }
+    stats.symbolic_factorisations = star.symbolic_count;
+    stats.sparse_fallbacks = star.sparse_fallbacks;
+    stats.last_fallback = star.last_fallback;
+    Ok(History {
+        samples: rec.samples,
+        snapshots: rec.snapshots,
+        node_x: star.node_x(),
+        stats,
+    })
+}

@@ -1,0 +1,128 @@
+//! The prescribed motion of the sliders or the actuator law, and the forces and power at the
+//! pins.
+
+use super::*;
+
+pub(super) fn pins_at(params: &RobotParams, traj: &Trajectory, t: f64) -> Result<Pins, FemError> {
+    let j = traj
+        .jets(params, t)
+        .map_err(|source| FemError::Trajectory { t, source })?;
+    Ok(Pins::new(params, j.map(|x| [x.v, x.d1, x.d2])))
+}
+
+/// Force `F_i = lambda_c + lambda_l + lambda_r` the beam exerts on sleeve i, hence on its pin
+/// and slider [N], fixed frame.
+pub(super) fn pin_forces(lam: &[f64]) -> [[f64; 2]; 3] {
+    [0, 1, 2].map(|i| {
+        let l = &lam[ROWS * i..ROWS * i + ROWS];
+        [l[0] + l[2] + l[4], l[1] + l[3] + l[5]]
+    })
+}
+
+/// Driving force (Eq. 33): `Fa_i = (mpp + mpa) s_i'' - F_i . u_i`, F_i the force of the beam on
+/// sleeve i (the sleeve is translationally massless: F_i passes through the pin to the slider).
+pub(super) fn driving_forces(params: &RobotParams, pins: &Pins, lam: &[f64]) -> ([f64; 3], [[f64; 2]; 3]) {
+    let f = pin_forces(lam);
+    let fa = [0, 1, 2].map(|i| {
+        let u = slider_direction(i);
+        params.mpp_mpa * pins.s[i][2] - (f[i][0] * u[0] + f[i][1] * u[1])
+    });
+    (fa, f)
+}
+
+pub(super) fn power(fa: &[f64; 3], pins: &Pins) -> f64 {
+    (0..3).map(|i| fa[i] * pins.s[i][1]).sum()
+}
+
+/// What moves the sliders.
+pub(crate) enum Motion<'a> {
+    /// Inverse problem: `s_i(t)` prescribed by the trajectory, `Fa_i` from Eq. 33.
+    Prescribed(&'a Trajectory),
+    /// Direct problem: each slider a body of mass `mpp + mpa` on its rail pushed along `+u_i` by
+    /// the law's `Fa_i(t, s_i, s_i')`, starting at `s0` [m] with speeds `v0` [m/s].
+    Driven {
+        law: &'a dyn ActuatorLaw,
+        s0: [f64; 3],
+        v0: [f64; 3],
+    },
+}
+
+impl Motion<'_> {
+    /// `[s_i, s_i']` at t = 0 of the slider unknowns (direct problem only).
+    pub(super) fn slider_unknowns(&self) -> Option<[[f64; 2]; 3]> {
+        match self {
+            Motion::Prescribed(_) => None,
+            Motion::Driven { s0, v0, .. } => Some([0, 1, 2].map(|i| [s0[i], v0[i]])),
+        }
+    }
+
+    /// Prescribed pins at time `t` (inverse problem), `None` in the direct problem, where the
+    /// pins follow the Newton iterate. Checks that the prescribed sliders stay on their sides.
+    pub(super) fn prescribed_pins(&self, params: &RobotParams, t: f64) -> Result<Option<Pins>, FemError> {
+        let Motion::Prescribed(traj) = self else {
+            return Ok(None);
+        };
+        let pins = pins_at(params, traj, t)?;
+        let limit = params.half_side();
+        for i in 0..3 {
+            if pins.s[i][0].abs() >= limit {
+                return Err(FemError::SliderOffBase {
+                    t,
+                    slider: i + 1,
+                    s: pins.s[i][0],
+                    limit,
+                });
+            }
+        }
+        Ok(Some(pins))
+    }
+
+    /// The actuator law at the sliders' state of `pins`.
+    pub(super) fn law_forces(law: &dyn ActuatorLaw, pins: &Pins, t: f64) -> Result<[f64; 3], FemError> {
+        law.force(t, pins.s.map(|s| s[0]), pins.s.map(|s| s[1]))
+            .map_err(|source| FemError::Drive { t, source })
+    }
+
+    /// The sliders' rows at one iterate of the direct problem (`bp = beta'`, `gp = gamma'`, both
+    /// zero for the initial accelerations); `None` in the inverse problem.
+    pub(super) fn slider_rows(
+        &self,
+        params: &RobotParams,
+        pins: &Pins,
+        t: f64,
+        bp: f64,
+        gp: f64,
+    ) -> Result<Option<SliderRows>, FemError> {
+        let Motion::Driven { law, .. } = self else {
+            return Ok(None);
+        };
+        let (kp, kd) = (law.stiffness(), law.damping());
+        Ok(Some(SliderRows {
+            fa: Self::law_forces(*law, pins, t)?,
+            diag: [0, 1, 2].map(|i| params.mpp_mpa + bp * kp[i] + gp * kd[i]),
+        }))
+    }
+
+    /// `Fa` [N] and the pin forces at a converged state: Eq. 33 (inverse), the law (direct).
+    pub(super) fn forces(
+        &self,
+        params: &RobotParams,
+        pins: &Pins,
+        lam: &[f64],
+        t: f64,
+    ) -> Result<([f64; 3], [[f64; 2]; 3]), FemError> {
+        match self {
+            Motion::Prescribed(_) => Ok(driving_forces(params, pins, lam)),
+            Motion::Driven { law, .. } => Ok((Self::law_forces(*law, pins, t)?, pin_forces(lam))),
+        }
+    }
+
+    /// Direct problem: the simulated configuration must stay feasible (the limits of
+    /// `flexstar_kinematics::feasibility`, applied to the simulated s: a check, not an equation).
+    pub(super) fn check_feasible(&self, params: &RobotParams, pins: &Pins, t: f64) -> Result<(), FemError> {
+        if let Motion::Prescribed(_) = self {
+            return Ok(());
+        }
+        check_configuration(params, pins.s.map(|s| s[0])).map_err(|violation| FemError::Infeasible { t, violation })
+    }
+}

@@ -20,7 +20,7 @@
 //! the per-step change of s'' times the step (`docs/amm.md` section 10).
 
 use flexstar_drive::ActuatorLaw;
-use flexstar_kinematics::{check_configuration, direct_kinematics, RigidState};
+use flexstar_kinematics::{check_configuration, direct_kinematics, CheckedMotion, RigidState};
 use flexstar_model::{AmmSettings, DriveKind, Experiment, ModeCount, Response, RobotParams};
 use flexstar_numerics::GenAlpha;
 use num_dual::{Dual2, HyperDual64};
@@ -29,7 +29,7 @@ use crate::adaptive;
 use crate::error::{AmmError, RankError};
 use crate::modes::ModeSet;
 use crate::record::Recorder;
-use crate::solver::{stops, validate, RHO_INF};
+use crate::solver::{snapshot_times, stops, validate, Stop, RHO_INF};
 use crate::system::System;
 
 /// Columns a direct run writes first among its extra columns: the sliders `s_i` [m] and `s_i'`
@@ -48,14 +48,31 @@ pub const DIRECT_COLUMNS: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "G
 /// (it is the reference); otherwise only its start. The configuration reached is checked at every
 /// step: leaving the feasible range stops the run with the time (to one step) and the reason.
 pub fn solve_direct(exp: &Experiment, settings: &AmmSettings, law: &dyn ActuatorLaw) -> Result<Response, AmmError> {
-    let scan = exp.drive.kind == DriveKind::Servo;
+    solve_direct_scanned(exp, settings, law, exp.drive.kind == DriveKind::Servo)
+}
+
+/// [`solve_direct`] of a servo's reference whose feasibility the caller checked once for all its
+/// runs (see [`crate::solve_checked`]).
+pub fn solve_direct_checked(
+    exp: &Experiment,
+    settings: &AmmSettings,
+    law: &dyn ActuatorLaw,
+    checked: &CheckedMotion,
+) -> Result<Response, AmmError> {
+    let scan = exp.drive.kind == DriveKind::Servo && !crate::solver::covers(checked, exp);
+    solve_direct_scanned(exp, settings, law, scan)
+}
+
+/// [`solve_direct`]; `scan`: check the reference over the whole span (else its start only).
+fn solve_direct_scanned(exp: &Experiment, settings: &AmmSettings, law: &dyn ActuatorLaw, scan: bool) -> Result<Response, AmmError> {
     match settings.mode_count() {
-        ModeCount::Fixed(n) => integrate_direct(exp, settings, law, n),
+        ModeCount::Fixed(n) => integrate_direct(exp, settings, law, n, scan),
         ModeCount::Tolerance(tol) => {
             validate(exp, settings, adaptive::first_modes(exp), scan)?;
             // the pairs at the delivered step: the coarse-step estimate (`adaptive`) is measured
             // on inverse runs only, and a servo's loop may not tolerate the coarse step
-            adaptive::solve_to_tolerance(exp, tol, None, |n, _| integrate_direct(exp, settings, law, n))
+            // (the reference was scanned once just above: not again per N)
+            adaptive::solve_to_tolerance(exp, tol, None, |n, _| integrate_direct(exp, settings, law, n, false))
         }
     }
 }
@@ -108,6 +125,19 @@ struct Coupled {
     dqdd: [Vec<f64>; 3],
     dlam: [Vec<f64>; 3],
     qnew: Vec<f64>,
+}
+
+impl Coupled {
+    /// Buffers for `n` coordinates and `n_lam` multipliers.
+    fn new(n: usize, n_lam: usize) -> Self {
+        Coupled {
+            qdd0: vec![0.0; n],
+            lam0: vec![0.0; n_lam],
+            dqdd: std::array::from_fn(|_| vec![0.0; n]),
+            dlam: std::array::from_fn(|_| vec![0.0; n_lam]),
+            qnew: vec![0.0; n],
+        }
+    }
 }
 
 /// One coupled step (module docs): returns s'' and writes q'' and `sys.lam`. `shat`, `sdhat`:
@@ -203,15 +233,16 @@ fn solve3(mut a: [[f64; 4]; 3]) -> Option<[f64; 3]> {
     Some(x)
 }
 
-/// [`solve_direct`] at N = `n_modes`.
+/// [`solve_direct`] at N = `n_modes`: the system and recorder set up, the consistent start, then
+/// generalized-alpha substeps between consecutive stops (output times and snapshots).
 fn integrate_direct(
     exp: &Experiment,
     settings: &AmmSettings,
     law: &dyn ActuatorLaw,
     n_modes: usize,
+    scan: bool,
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
-    let scan = exp.drive.kind == DriveKind::Servo;
     let dt_max = validate(exp, settings, n_modes, scan)?;
     let params = &exp.robot;
     let modes = ModeSet::new(settings.family, n_modes, params)?;
@@ -219,126 +250,192 @@ fn integrate_direct(
     let n = sys.dim();
 
     let out_times = exp.time.output_times();
-    let mut snaps: Vec<f64> = settings.snapshots.clone();
-    snaps.push(exp.time.t_end);
-    snaps.sort_by(|a, b| a.total_cmp(b));
-    snaps.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * exp.time.dt_out);
+    let snaps = snapshot_times(exp, settings);
     let stops = stops(&out_times, &snaps, 1e-9 * exp.time.dt_out);
-    let mut rec = Recorder::new(&sys, settings, params, out_times.len(), &snaps);
-    let mut cols: Vec<Vec<f64>> = (0..DIRECT_COLUMNS.len())
-        .map(|_| Vec::with_capacity(out_times.len()))
-        .collect();
-    let mut buf = Coupled {
-        qdd0: vec![0.0; n],
-        lam0: vec![0.0; sys.lam.len()],
-        dqdd: std::array::from_fn(|_| vec![0.0; n]),
-        dlam: std::array::from_fn(|_| vec![0.0; sys.lam.len()]),
-        qnew: vec![0.0; n],
+    let mut out = DirectOutput {
+        rec: Recorder::new(&sys, settings, params, out_times.len(), &snaps),
+        cols: (0..DIRECT_COLUMNS.len())
+            .map(|_| Vec::with_capacity(out_times.len()))
+            .collect(),
     };
+    let mut buf = Coupled::new(n, sys.lam.len());
+    let mut ctx = StepContext { sys: &mut sys, buf: &mut buf, law, params };
+
+    let mut state = initial_state(exp, &mut ctx, &out.rec, n)?;
+    out.record(&ctx, &stops[0], 0.0, &state)?;
 
     let ga = GenAlpha::new(RHO_INF);
-    let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut scratch = Predictors::new(n);
+    for w in stops.windows(2) {
+        let (t0, t1) = (w[0].t, w[1].t);
+        let nsub = (((t1 - t0) / dt_max) - 1e-9).ceil().max(1.0) as usize;
+        let h = (t1 - t0) / nsub as f64;
+        for k in 1..=nsub {
+            let t = if k == nsub { t1 } else { t0 + k as f64 * h };
+            substep(&mut ctx, &out.rec, &ga, h, t, &mut state, &mut scratch)?;
+        }
+        out.record(&ctx, &w[1], t1, &state)?;
+        if flexstar_model::cancel::cancelled() {
+            return Err(AmmError::Cancelled { t: t1 });
+        }
+    }
+    Ok(out.finish(settings, n_modes, dt_max, started))
+}
 
-    // initial state: s, s' of the trajectory at t = 0, the star at rest elastically; consistent
-    // accelerations of both (bp = gp = 0: the step is linear, the solve exact)
-    let jets = exp.trajectory.jets(params, 0.0)?;
-    let (mut s, mut sd) = (jets.map(|j| j.v), jets.map(|j| j.d1));
-    let mut sdd = coupled_step(
-        &mut sys,
-        &rec,
-        &mut buf,
-        law,
-        params,
+/// What every coupled step of one run borrows: the system, the step buffers, the actuator law
+/// and the robot.
+struct StepContext<'a> {
+    sys: &'a mut System,
+    buf: &'a mut Coupled,
+    law: &'a dyn ActuatorLaw,
+    params: &'a RobotParams,
+}
+
+/// The state of a direct run at a step: elastic coordinates q [-], their rates and the
+/// generalized-alpha acceleration-like variable `acc`, q''; the sliders s [m], s' [m/s], s''
+/// [m/s^2] and their `sacc`.
+struct DirectState {
+    q: Vec<f64>,
+    v: Vec<f64>,
+    acc: Vec<f64>,
+    qdd: Vec<f64>,
+    s: [f64; 3],
+    sd: [f64; 3],
+    sdd: [f64; 3],
+    sacc: [f64; 3],
+}
+
+/// The predictors of one step (elastic part), kept between steps to avoid allocation.
+struct Predictors {
+    qhat: Vec<f64>,
+    vhat: Vec<f64>,
+    a_part: Vec<f64>,
+}
+
+impl Predictors {
+    fn new(n: usize) -> Self {
+        Predictors { qhat: vec![0.0; n], vhat: vec![0.0; n], a_part: vec![0.0; n] }
+    }
+}
+
+/// The initial state: s, s' of the trajectory at t = 0, the star at rest elastically; consistent
+/// accelerations of both (bp = gp = 0: the step is linear, the solve exact).
+fn initial_state(exp: &Experiment, ctx: &mut StepContext, rec: &Recorder, n: usize) -> Result<DirectState, AmmError> {
+    let (q, v) = (vec![0.0; n], vec![0.0; n]);
+    let mut qdd = vec![0.0; n];
+    let jets = exp.trajectory.jets(ctx.params, 0.0)?;
+    let (s, sd) = (jets.map(|j| j.v), jets.map(|j| j.d1));
+    let sdd = coupled_step(
+        ctx.sys,
+        rec,
+        ctx.buf,
+        ctx.law,
+        ctx.params,
         0.0,
         (0.0, 0.0),
         (s, sd, jets.map(|j| j.d2)),
         (&q, &v),
         &mut qdd,
     )?;
-    acc.copy_from_slice(&qdd);
-    let mut sacc = sdd;
+    let acc = qdd.clone();
+    Ok(DirectState { q, v, acc, qdd, s, sd, sdd, sacc: sdd })
+}
 
-    let mut record = |rec: &mut Recorder, sys: &System, stop, t: f64, q: &[f64], s, sd, sdd| -> Result<(), AmmError> {
-        check_configuration(params, s).map_err(|violation| AmmError::DirectInfeasible { t, violation })?;
-        let st = rigid_at(params, s, sd, sdd, t)?;
-        let fa = law.force(t, s, sd).map_err(|source| AmmError::Drive { t, source })?;
-        rec.record(&st, stop, q, &sys.lam, &sys.sleeve_axial, Some(fa));
+/// One generalized-alpha substep of length `h` ending at `t`: predict q and s, solve the coupled
+/// step, correct; a non-finite state stops the run with the time and the step.
+fn substep(
+    ctx: &mut StepContext,
+    rec: &Recorder,
+    ga: &GenAlpha,
+    h: f64,
+    t: f64,
+    x: &mut DirectState,
+    p: &mut Predictors,
+) -> Result<(), AmmError> {
+    let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
+    let apq = ga.a_per_qdd();
+    let predict = |x: f64, xd: f64, xa: f64, xdd: f64| ga.predict(h, x, xd, xa, xdd);
+    let n = x.q.len();
+    for i in 0..n {
+        (p.a_part[i], p.qhat[i], p.vhat[i]) = predict(x.q[i], x.v[i], x.acc[i], x.qdd[i]);
+    }
+    let mut sa_part = [0.0; 3];
+    let (mut shat, mut sdhat) = ([0.0; 3], [0.0; 3]);
+    for i in 0..3 {
+        (sa_part[i], shat[i], sdhat[i]) = predict(x.s[i], x.sd[i], x.sacc[i], x.sdd[i]);
+    }
+    x.sdd = coupled_step(
+        ctx.sys,
+        rec,
+        ctx.buf,
+        ctx.law,
+        ctx.params,
+        t,
+        (bp, gp),
+        (shat, sdhat, x.sdd),
+        (&p.qhat, &p.vhat),
+        &mut x.qdd,
+    )?;
+    let mut norm = 0.0;
+    for i in 0..n {
+        x.q[i] = p.qhat[i] + bp * x.qdd[i];
+        x.v[i] = p.vhat[i] + gp * x.qdd[i];
+        x.acc[i] = p.a_part[i] + apq * x.qdd[i];
+        norm += x.q[i].abs();
+    }
+    for i in 0..3 {
+        x.s[i] = shat[i] + bp * x.sdd[i];
+        x.sd[i] = sdhat[i] + gp * x.sdd[i];
+        x.sacc[i] = sa_part[i] + apq * x.sdd[i];
+        norm += x.s[i].abs() + x.sd[i].abs();
+    }
+    if !norm.is_finite() {
+        return Err(AmmError::NonFinite { t, dt: h });
+    }
+    Ok(())
+}
+
+/// The recorder of a direct run and its [`DIRECT_COLUMNS`] at the output times.
+struct DirectOutput {
+    rec: Recorder,
+    cols: Vec<Vec<f64>>,
+}
+
+impl DirectOutput {
+    /// Record the state at a stop: the configuration reached is checked (leaving the feasible
+    /// range stops the run with the time and the reason), the law's forces evaluated.
+    fn record(&mut self, ctx: &StepContext, stop: &Stop, t: f64, x: &DirectState) -> Result<(), AmmError> {
+        let (s, sd, sdd) = (x.s, x.sd, x.sdd);
+        check_configuration(ctx.params, s).map_err(|violation| AmmError::DirectInfeasible { t, violation })?;
+        let st = rigid_at(ctx.params, s, sd, sdd, t)?;
+        let fa = ctx.law.force(t, s, sd).map_err(|source| AmmError::Drive { t, source })?;
+        self.rec.record(&st, stop, &x.q, &ctx.sys.lam, &ctx.sys.sleeve_axial, Some(fa));
         if stop.output.is_some() {
             let vals = [s[0], s[1], s[2], sd[0], sd[1], sd[2], st.g[0].v, st.g[1].v, st.theta.v];
-            for (c, x) in cols.iter_mut().zip(vals) {
-                c.push(x);
+            for (c, v) in self.cols.iter_mut().zip(vals) {
+                c.push(v);
             }
         }
         Ok(())
-    };
-    record(&mut rec, &sys, &stops[0], 0.0, &q, s, sd, sdd)?;
-
-    for w in stops.windows(2) {
-        let (t0, t1) = (w[0].t, w[1].t);
-        let nsub = (((t1 - t0) / dt_max) - 1e-9).ceil().max(1.0) as usize;
-        let h = (t1 - t0) / nsub as f64;
-        let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
-        let apq = ga.a_per_qdd();
-        let predict = |x: f64, xd: f64, xa: f64, xdd: f64| ga.predict(h, x, xd, xa, xdd);
-        for k in 1..=nsub {
-            let t = if k == nsub { t1 } else { t0 + k as f64 * h };
-            for i in 0..n {
-                (a_part[i], qhat[i], vhat[i]) = predict(q[i], v[i], acc[i], qdd[i]);
-            }
-            let mut sa_part = [0.0; 3];
-            let (mut shat, mut sdhat) = ([0.0; 3], [0.0; 3]);
-            for i in 0..3 {
-                (sa_part[i], shat[i], sdhat[i]) = predict(s[i], sd[i], sacc[i], sdd[i]);
-            }
-            sdd = coupled_step(
-                &mut sys,
-                &rec,
-                &mut buf,
-                law,
-                params,
-                t,
-                (bp, gp),
-                (shat, sdhat, sdd),
-                (&qhat, &vhat),
-                &mut qdd,
-            )?;
-            let mut norm = 0.0;
-            for i in 0..n {
-                q[i] = qhat[i] + bp * qdd[i];
-                v[i] = vhat[i] + gp * qdd[i];
-                acc[i] = a_part[i] + apq * qdd[i];
-                norm += q[i].abs();
-            }
-            for i in 0..3 {
-                s[i] = shat[i] + bp * sdd[i];
-                sd[i] = sdhat[i] + gp * sdd[i];
-                sacc[i] = sa_part[i] + apq * sdd[i];
-                norm += s[i].abs() + sd[i].abs();
-            }
-            if !norm.is_finite() {
-                return Err(AmmError::NonFinite { t, dt: h });
-            }
-        }
-        record(&mut rec, &sys, &w[1], t1, &q, s, sd, sdd)?;
-        if flexstar_model::cancel::cancelled() {
-            return Err(AmmError::Cancelled { t: t1 });
-        }
     }
 
-    let mut resp = rec.finish(format!("amm-{}-direct", settings.family.name()));
-    let mut extra: Vec<flexstar_model::Column> = DIRECT_COLUMNS
-        .iter()
-        .zip(cols)
-        .map(|(name, values)| flexstar_model::Column {
-            name: name.to_string(),
-            values,
-        })
-        .collect();
-    extra.append(&mut resp.extra);
-    resp.extra = extra;
-    resp.info = crate::solver::run_info("amm-direct", settings, n_modes, dt_max, started);
-    Ok(resp)
+    /// The response labelled `amm-<family>-direct`: [`DIRECT_COLUMNS`] first among the extra
+    /// columns, the run's info.
+    fn finish(self, settings: &AmmSettings, n_modes: usize, dt_max: f64, started: std::time::Instant) -> Response {
+        let mut resp = self.rec.finish(format!("amm-{}-direct", settings.family.name()));
+        let mut extra: Vec<flexstar_model::Column> = DIRECT_COLUMNS
+            .iter()
+            .zip(self.cols)
+            .map(|(name, values)| flexstar_model::Column {
+                name: name.to_string(),
+                values,
+            })
+            .collect();
+        extra.append(&mut resp.extra);
+        resp.extra = extra;
+        resp.info = crate::solver::run_info("amm-direct", settings, n_modes, dt_max, started);
+        resp
+    }
 }
 
 #[cfg(test)]

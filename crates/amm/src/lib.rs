@@ -30,10 +30,10 @@ mod record;
 pub mod solver;
 mod system;
 
-pub use direct::{solve_direct, DIRECT_COLUMNS};
+pub use direct::{solve_direct, solve_direct_checked, DIRECT_COLUMNS};
 pub use error::{AmmError, RankError};
 pub use modes::{ModeSet, MAX_MODES};
 pub use solver::{
-    parse_family, solve, solve_with_stats, tolerance_step, Stats, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS,
+    parse_family, solve, solve_checked, solve_with_stats, tolerance_step, Stats, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS,
     TOLERANCE_DT,
 };

@@ -9,7 +9,7 @@
 //! drift). The system is linear, so each step is one linear solve (see the private `system` module and `docs/amm.md`).
 //! Initial accelerations are consistent: `M q''(0) = f(0) + C^T lambda(0)`, `C q''(0) = 0`.
 
-use flexstar_kinematics::{check_configuration, check_trajectory, Infeasible, RigidState};
+use flexstar_kinematics::{check_configuration, check_trajectory, preflight_step, CheckedMotion, Infeasible, RigidState};
 use flexstar_model::config::check_step;
 use flexstar_model::{AmmSettings, Experiment, ModeCount, ModeFamily, Response, RobotParams, RunInfo};
 use flexstar_numerics::GenAlpha;
@@ -111,7 +111,7 @@ pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, s
         ));
     }
     if scan {
-        check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))?;
+        check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, preflight_step(exp.time.dt_out))?;
     } else {
         let s0 = exp.trajectory.s(&exp.robot, 0.0)?;
         check_configuration(&exp.robot, s0).map_err(|violation| Infeasible { t: 0.0, violation })?;
@@ -208,15 +208,32 @@ impl Stats {
 
 /// [`solve`], also returning the work counters (steps, solves, the N used and those tried).
 pub fn solve_with_stats(exp: &Experiment, settings: &AmmSettings) -> Result<(Response, Stats), AmmError> {
+    solve_scanned(exp, settings, true)
+}
+
+/// [`solve`] of a motion whose feasibility the caller checked once for all its runs (the
+/// preflight of `compare`, `verify`, `run`): the trajectory is scanned here only when `checked`
+/// does not cover this experiment's robot, trajectory and span.
+pub fn solve_checked(exp: &Experiment, settings: &AmmSettings, checked: &CheckedMotion) -> Result<Response, AmmError> {
+    solve_scanned(exp, settings, !covers(checked, exp)).map(|(r, _)| r)
+}
+
+/// Does `checked` cover the scan a run of `exp` would make?
+pub(crate) fn covers(checked: &CheckedMotion, exp: &Experiment) -> bool {
+    checked.covers(&exp.robot, &exp.trajectory, exp.time.t_end, preflight_step(exp.time.dt_out))
+}
+
+/// [`solve_with_stats`]; `scan`: check the trajectory's feasibility over the whole span first.
+fn solve_scanned(exp: &Experiment, settings: &AmmSettings, scan: bool) -> Result<(Response, Stats), AmmError> {
     let mut runs = Vec::new();
     let resp = match settings.mode_count() {
         ModeCount::Fixed(n) => {
             let mut steps = 0;
-            let r = integrate(exp, settings, n, true, |_, _| steps += 1)?;
+            let r = integrate(exp, settings, n, scan, |_, _| steps += 1)?;
             runs.push((n, steps));
             r
         }
-        ModeCount::Tolerance(tol) => solve_to_tolerance(exp, settings, tol, &mut runs)?,
+        ModeCount::Tolerance(tol) => solve_to_tolerance(exp, settings, tol, scan, &mut runs)?,
     };
     Ok((resp, Stats::from_runs(&runs)))
 }
@@ -229,10 +246,12 @@ fn solve_to_tolerance(
     exp: &Experiment,
     settings: &AmmSettings,
     tol: f64,
+    scan: bool,
     runs: &mut Vec<(usize, usize)>,
 ) -> Result<Response, AmmError> {
     // every input error before any work, at the first N; the trajectory is scanned once here
-    let h = validate(exp, settings, adaptive::first_modes(exp), true)?;
+    // (unless the caller has)
+    let h = validate(exp, settings, adaptive::first_modes(exp), scan)?;
     let every = adaptive::estimate_grid(exp, h);
     let mut built: Option<(usize, System)> = None;
     adaptive::solve_to_tolerance(exp, tol, every, |n, pass| {
@@ -288,6 +307,16 @@ pub(crate) fn integrate<F: FnMut(&System, &[f64])>(
     integrate_system(exp, settings, sys, dt_max, started, observe)
 }
 
+/// The snapshot times of the shapes file: the requested ones and `t_end`, sorted, duplicates
+/// (within 1e-9 of the output step) merged.
+pub(crate) fn snapshot_times(exp: &Experiment, settings: &AmmSettings) -> Vec<f64> {
+    let mut snaps: Vec<f64> = settings.snapshots.clone();
+    snaps.push(exp.time.t_end);
+    snaps.sort_by(|a, b| a.total_cmp(b));
+    snaps.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * exp.time.dt_out);
+    snaps
+}
+
 /// [`integrate`] with the system `sys` built (fresh, not yet stepped) and the inputs validated:
 /// steps of at most `dt_max` [s]; the reported wall time counts from `started`.
 pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
@@ -303,12 +332,8 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let (nm, n) = (sys.nm, sys.dim());
 
     let out_times = exp.time.output_times();
-    let mut snaps: Vec<f64> = settings.snapshots.clone();
-    snaps.push(exp.time.t_end);
-    snaps.sort_by(|a, b| a.total_cmp(b));
-    snaps.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * exp.time.dt_out);
+    let snaps = snapshot_times(exp, settings);
     let stops = stops(&out_times, &snaps, 1e-9 * exp.time.dt_out);
-
     let mut rec = Recorder::new(&sys, settings, params, out_times.len(), &snaps);
     let ga = GenAlpha::new(RHO_INF);
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);

@@ -95,6 +95,71 @@ struct BeamRows {
     g: [f64; NB],
 }
 
+impl BeamRows {
+    /// The Gram matrix `B D^-1 B^T` of this beam's six vectors and `g = B D^-1 Phi` (see
+    /// [`System::prepare`]): the junction entries `[g00, g01, g11]` and `[w0, w1]` are shared by
+    /// the beams, the sleeve vectors are scaled by `inv_d` here.
+    fn fill_gram(&mut self, [g00, g01, g11]: [f64; 3], [w0, w1]: [f64; 2], inv_d: &[f64], [phi0, dphi0, phi]: [&[f64]; 3]) {
+        for (sv, v) in self.scaled.iter_mut().zip(&self.sleeve) {
+            for ((s, x), d) in sv.iter_mut().zip(v).zip(inv_d) {
+                *s = x * d;
+            }
+        }
+        let gram = &mut self.gram;
+        gram[B_PHI0][B_PHI0] = g00;
+        gram[B_PHI0][B_DPHI0] = g01;
+        gram[B_DPHI0][B_PHI0] = g01;
+        gram[B_DPHI0][B_DPHI0] = g11;
+        let [s0, s1, s2, s3] = [&self.sleeve[0], &self.sleeve[1], &self.sleeve[2], &self.sleeve[3]];
+        for a in 0..4 {
+            // one pass over D^-1 B_a for its seven products (those with b < a are repeats)
+            let [p0, d0, gp, m0, m1, m2, m3] = dots(&self.scaled[a], [phi0, dphi0, phi, s0, s1, s2, s3]);
+            gram[B_MID + a][B_PHI0] = p0;
+            gram[B_MID + a][B_DPHI0] = d0;
+            gram[B_PHI0][B_MID + a] = p0;
+            gram[B_DPHI0][B_MID + a] = d0;
+            for (b, v) in [m0, m1, m2, m3].into_iter().enumerate().skip(a) {
+                gram[B_MID + a][B_MID + b] = v;
+                gram[B_MID + b][B_MID + a] = v;
+            }
+            self.g[B_MID + a] = gp;
+        }
+        self.g[B_PHI0] = w0;
+        self.g[B_DPHI0] = w1;
+    }
+
+    /// Add this beam's block of the Schur complement to `a_mat` (m x m, row-major):
+    /// `A_ks = (cu_k - p g_k)(cu_s + p g_s) / sigma + ct_k ct_s / Jp + sc_k sc_s gram[b_k][b_s]`,
+    /// with the rows without an alpha part (basis NONE) given g = 0 and a zero Gram row.
+    fn add_block(&self, a_mat: &mut [f64], m: usize, p: f64, inv_sigma: f64, inv_jp: f64) {
+        let mb = self.ids.len();
+        let mut left = [0.0; MAX_BEAM_ROWS];
+        let mut right = [0.0; MAX_BEAM_ROWS];
+        let mut gram_rows = [[0.0; MAX_BEAM_ROWS]; NB];
+        for k in 0..mb {
+            let (bk, sk) = (self.basis[k], self.sc[k]);
+            let gk = if bk == NONE { 0.0 } else { sk * self.g[bk] };
+            left[k] = (self.cu[k] - p * gk) * inv_sigma;
+            right[k] = self.cu[k] + p * gk;
+            if bk != NONE {
+                for (a, row) in gram_rows.iter_mut().enumerate() {
+                    row[k] = sk * self.gram[a][bk];
+                }
+            }
+        }
+        for k in 0..mb {
+            let (bk, sk) = (self.basis[k], self.sc[k]);
+            let ctk = self.ct[k] * inv_jp;
+            let a_row = &mut a_mat[self.ids[k] * m..(self.ids[k] + 1) * m];
+            let zero = [0.0; MAX_BEAM_ROWS];
+            let gram_k = if bk == NONE { &zero } else { &gram_rows[bk] };
+            for s in 0..mb {
+                a_row[self.ids[s]] += left[k] * right[s] + ctk * self.ct[s] + sk * gram_k[s];
+            }
+        }
+    }
+}
+
 /// Workspace of the constrained system: everything sized once, nothing allocated per step.
 #[derive(Debug, Clone)]
 pub(crate) struct System {
@@ -573,61 +638,8 @@ impl System {
             &self.phi,
         );
         for beam in beams.iter_mut() {
-            // sleeve vectors scaled by D^-1, the Gram matrix and g = B D^-1 Phi
-            for (sv, v) in beam.scaled.iter_mut().zip(&beam.sleeve) {
-                for ((s, x), d) in sv.iter_mut().zip(v).zip(inv_d) {
-                    *s = x * d;
-                }
-            }
-            let gram = &mut beam.gram;
-            gram[B_PHI0][B_PHI0] = g00;
-            gram[B_PHI0][B_DPHI0] = g01;
-            gram[B_DPHI0][B_PHI0] = g01;
-            gram[B_DPHI0][B_DPHI0] = g11;
-            let [s0, s1, s2, s3] = [&beam.sleeve[0], &beam.sleeve[1], &beam.sleeve[2], &beam.sleeve[3]];
-            for a in 0..4 {
-                // one pass over D^-1 B_a for its seven products (those with b < a are repeats)
-                let [p0, d0, gp, m0, m1, m2, m3] = dots(&beam.scaled[a], [phi0, dphi0, phi, s0, s1, s2, s3]);
-                gram[B_MID + a][B_PHI0] = p0;
-                gram[B_MID + a][B_DPHI0] = d0;
-                gram[B_PHI0][B_MID + a] = p0;
-                gram[B_DPHI0][B_MID + a] = d0;
-                for (b, v) in [m0, m1, m2, m3].into_iter().enumerate().skip(a) {
-                    gram[B_MID + a][B_MID + b] = v;
-                    gram[B_MID + b][B_MID + a] = v;
-                }
-                beam.g[B_MID + a] = gp;
-            }
-            beam.g[B_PHI0] = w0;
-            beam.g[B_DPHI0] = w1;
-
-            // A_ks = (cu_k - p g_k)(cu_s + p g_s) / sigma + ct_k ct_s / Jp + sc_k sc_s gram[b_k][b_s],
-            // with the rows without an alpha part (basis NONE) given g = 0 and a zero Gram row
-            let mb = beam.ids.len();
-            let mut left = [0.0; MAX_BEAM_ROWS];
-            let mut right = [0.0; MAX_BEAM_ROWS];
-            let mut gram_rows = [[0.0; MAX_BEAM_ROWS]; NB];
-            for k in 0..mb {
-                let (bk, sk) = (beam.basis[k], beam.sc[k]);
-                let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };
-                left[k] = (beam.cu[k] - p * gk) * inv_sigma;
-                right[k] = beam.cu[k] + p * gk;
-                if bk != NONE {
-                    for (a, row) in gram_rows.iter_mut().enumerate() {
-                        row[k] = sk * beam.gram[a][bk];
-                    }
-                }
-            }
-            for k in 0..mb {
-                let (bk, sk) = (beam.basis[k], beam.sc[k]);
-                let ctk = beam.ct[k] * inv_jp;
-                let a_row = &mut a_mat[beam.ids[k] * m..(beam.ids[k] + 1) * m];
-                let zero = [0.0; MAX_BEAM_ROWS];
-                let gram_k = if bk == NONE { &zero } else { &gram_rows[bk] };
-                for s in 0..mb {
-                    a_row[beam.ids[s]] += left[k] * right[s] + ctk * beam.ct[s] + sk * gram_k[s];
-                }
-            }
+            beam.fill_gram([g00, g01, g11], [w0, w1], inv_d, [phi0, dphi0, phi]);
+            beam.add_block(a_mat, m, p, inv_sigma, inv_jp);
         }
         self.lu
             .factor(&self.a)

@@ -1,6 +1,10 @@
 //! Direct dynamics of the AMM (issue 10) against independent references: the inverse run it must
 //! invert (round trip), and the prescribed-motion run a very stiff servo must reproduce.
 
+#[path = "../../../tests/support/rigid_forward.rs"]
+#[allow(dead_code)]
+mod rigid_forward;
+
 mod common;
 
 use common::paper_case;
@@ -196,7 +200,8 @@ fn stiff_limit_matches_the_rigid_forward_dynamics() {
     // Fermat-point Jacobians, RK4 at 1e-4 s; no AMM code). Paper model, free-free modes: the
     // family whose rigid modes let G move freely (docs/amm.md section 4). Measured: 5.5e-8 to
     // 1.1e-7 m over travels of 0.16-0.25 m.
-    use flexstar_drive::{rigid_forward_dynamics, RigidInverseForces};
+    use flexstar_drive::RigidInverseForces;
+    use rigid_forward::rigid_forward_dynamics;
     for k in 1..=4 {
         let mut exp = paper_case(k);
         exp.robot.i *= 1e4;

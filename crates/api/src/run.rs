@@ -4,6 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
+use flexstar_kinematics::CheckedMotion;
+
 use flexstar_model::config::check_step;
 use flexstar_model::run_set::RunSet;
 use flexstar_model::{AmmModel, DriveKind, DriveSettings, Experiment, ForceSamples, ModeFamily, Response};
@@ -83,6 +85,9 @@ pub struct Prepared {
     /// Where the experiment came from, first in every message (a file name, `<dict>`).
     pub source: String,
     figures: bool,
+    /// The preflight's proof that the motion (a servo's reference) is feasible over the span,
+    /// handed to the solver so that it does not scan it again; `None` for a forces-driven run.
+    checked: Option<CheckedMotion>,
 }
 
 impl Prepared {
@@ -133,7 +138,7 @@ pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Res
     if let Some(dt) = settings.dt {
         check_step("--dt", dt, exp.time.dt_out).map_err(|e| ApiError::model_in(source, Path::new(source), e))?;
     }
-    preflight(&exp, source)?;
+    let checked = preflight(&exp, source)?;
     let direct = exp.drive.is_direct();
     let stem = match settings.solver {
         Solver::Amm => apply_amm(&mut exp, source, settings)?,
@@ -150,6 +155,7 @@ pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Res
         notes,
         source: source.to_string(),
         figures: settings.figures,
+        checked,
     })
 }
 
@@ -176,7 +182,7 @@ fn forces_drive(f: &Forces) -> Result<(DriveSettings, String)> {
 
 /// The feasibility scan of both solvers, here too so that nothing is created for a motion that
 /// is refused (a forces-driven run: its start only; its motion is checked as it goes).
-fn preflight(exp: &Experiment, source: &str) -> Result<()> {
+fn preflight(exp: &Experiment, source: &str) -> Result<Option<CheckedMotion>> {
     let servo = exp.drive.kind == DriveKind::Servo;
     if exp.drive.is_direct() && !servo {
         let s0 = exp
@@ -185,10 +191,12 @@ fn preflight(exp: &Experiment, source: &str) -> Result<()> {
             .map_err(|e| ApiError::infeasible(source, 0.0, e))?;
         flexstar_kinematics::check_configuration(&exp.robot, s0).map_err(|violation| {
             ApiError::infeasible(source, 0.0, flexstar_kinematics::Infeasible { t: 0.0, violation })
-        })
+        })?;
+        Ok(None)
     } else {
-        let step = exp.time.dt_out.min(1e-3);
-        flexstar_kinematics::check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, step)
+        let step = flexstar_kinematics::preflight_step(exp.time.dt_out);
+        flexstar_kinematics::check_motion(&exp.robot, &exp.trajectory, exp.time.t_end, step)
+            .map(Some)
             .map_err(|e| ApiError::infeasible(source, e.t, e))
     }
 }
@@ -252,15 +260,26 @@ fn law_of(p: &Prepared) -> Result<Box<dyn flexstar_drive::ActuatorLaw>> {
 pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Response> {
     let law = if p.direct { Some(law_of(p)?) } else { None };
     let exp = &p.exp;
+    let checked = p.checked.as_ref();
     let mut r = match (p.solver, &law) {
-        (Solver::Amm, Some(law)) => {
-            flexstar_amm::solve_direct(exp, &exp.amm, law.as_ref()).map_err(|e| from_amm(&p.source, e))?
+        (Solver::Amm, Some(law)) => match checked {
+            Some(c) => flexstar_amm::solve_direct_checked(exp, &exp.amm, law.as_ref(), c),
+            None => flexstar_amm::solve_direct(exp, &exp.amm, law.as_ref()),
         }
-        (Solver::Amm, None) => flexstar_amm::solve(exp, &exp.amm).map_err(|e| from_amm(&p.source, e))?,
+        .map_err(|e| from_amm(&p.source, e))?,
+        (Solver::Amm, None) => match checked {
+            Some(c) => flexstar_amm::solve_checked(exp, &exp.amm, c),
+            None => flexstar_amm::solve(exp, &exp.amm),
+        }
+        .map_err(|e| from_amm(&p.source, e))?,
         (Solver::Fem, Some(law)) => {
             flexstar_fem::solve_direct(exp, &exp.fem, law.as_ref(), progress).map_err(|e| from_fem(&p.source, e))?
         }
-        (Solver::Fem, None) => flexstar_fem::solve(exp, &exp.fem, progress).map_err(|e| from_fem(&p.source, e))?,
+        (Solver::Fem, None) => match checked {
+            Some(c) => flexstar_fem::solve_checked(exp, &exp.fem, c, progress),
+            None => flexstar_fem::solve(exp, &exp.fem, progress),
+        }
+        .map_err(|e| from_fem(&p.source, e))?,
     };
     if p.direct && exp.drive.kind == DriveKind::Servo {
         flexstar_drive::add_tracking_errors(&mut r, exp).map_err(|e| ApiError::solver(&p.source, e))?;

@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
-use flexstar_kinematics::check_trajectory;
+use flexstar_kinematics::{check_motion, preflight_step, CheckedMotion};
 use flexstar_model::{AmmSettings, Experiment, ModeFamily, Response};
 use rayon::prelude::*;
 
@@ -111,11 +111,18 @@ pub enum SolveError {
 /// The AMM run of `exp` with `settings`, for the experiment's drive: the inverse problem (motion
 /// prescribed, `flexstar_amm::solve`) or the direct one (forces or a servo,
 /// `flexstar_amm::solve_direct`; a servo's run gains the tracking errors `e1..e3`).
-pub fn solve_amm(exp: &Experiment, settings: &AmmSettings) -> Result<Response, SolveError> {
-    match flexstar_drive::law_for(exp)? {
-        None => Ok(flexstar_amm::solve(exp, settings)?),
-        Some(law) => {
-            let mut r = flexstar_amm::solve_direct(exp, settings, law.as_ref())?;
+///
+/// `checked`: the preflight's proof that the motion is feasible (the solver then does not scan it
+/// again); `None`: the solver scans it.
+pub fn solve_amm(exp: &Experiment, settings: &AmmSettings, checked: Option<&CheckedMotion>) -> Result<Response, SolveError> {
+    match (flexstar_drive::law_for(exp)?, checked) {
+        (None, None) => Ok(flexstar_amm::solve(exp, settings)?),
+        (None, Some(c)) => Ok(flexstar_amm::solve_checked(exp, settings, c)?),
+        (Some(law), checked) => {
+            let mut r = match checked {
+                None => flexstar_amm::solve_direct(exp, settings, law.as_ref())?,
+                Some(c) => flexstar_amm::solve_direct_checked(exp, settings, law.as_ref(), c)?,
+            };
             add_servo_columns(exp, &mut r)?;
             Ok(r)
         }
@@ -126,11 +133,13 @@ pub fn solve_amm(exp: &Experiment, settings: &AmmSettings) -> Result<Response, S
 pub fn solve_fem(
     exp: &Experiment,
     settings: &flexstar_model::FemSettings,
+    checked: Option<&CheckedMotion>,
     progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> Result<Response, SolveError> {
-    match flexstar_drive::law_for(exp)? {
-        None => Ok(flexstar_fem::solve(exp, settings, progress)?),
-        Some(law) => {
+    match (flexstar_drive::law_for(exp)?, checked) {
+        (None, None) => Ok(flexstar_fem::solve(exp, settings, progress)?),
+        (None, Some(c)) => Ok(flexstar_fem::solve_checked(exp, settings, c, progress)?),
+        (Some(law), _) => {
             let mut r = flexstar_fem::solve_direct(exp, settings, law.as_ref(), progress)?;
             add_servo_columns(exp, &mut r)?;
             Ok(r)
@@ -164,9 +173,11 @@ pub type ProgressFn<'a> = &'a (dyn Fn(Progress) + Sync);
 
 /// Experiments that passed [`preflight`]: the only input [`run_cases`] takes, so that the checks
 /// run once per batch.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Checked<'a> {
     specs: &'a [CaseSpec],
+    /// Per spec: the proof of its feasibility scan, handed to the solvers.
+    motions: Vec<CheckedMotion>,
 }
 
 impl<'a> Checked<'a> {
@@ -180,6 +191,7 @@ impl<'a> Checked<'a> {
 /// of each AMM run (keys named relative to the experiment file), unique labels, and the
 /// feasibility of the trajectory over the whole span.
 pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
+    let mut motions = Vec::with_capacity(specs.len());
     for spec in specs {
         let exp = &spec.exp;
         let file = exp.source.display().to_string();
@@ -197,10 +209,11 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
                 return Err(input(format!("two AMM runs labelled {}", run.label)));
             }
         }
-        check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))
+        let motion = check_motion(&exp.robot, &exp.trajectory, exp.time.t_end, preflight_step(exp.time.dt_out))
             .map_err(|e| input(e.to_string()))?;
+        motions.push(motion);
     }
-    Ok(Checked { specs })
+    Ok(Checked { specs, motions })
 }
 
 enum Job {
@@ -309,14 +322,16 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
                 Job::Fem(k) => {
                     let exp = &specs[k].exp;
                     let tick = |f: f64| tracker.set(j, f, false);
-                    solve_fem(exp, &exp.fem, Some(&tick)).map_err(|e| run_error(file(k), "fem", e))
+                    solve_fem(exp, &exp.fem, Some(&checked.motions[k]), Some(&tick))
+                        .map_err(|e| run_error(file(k), "fem", e))
                 }
                 Job::Amm(k, i) | Job::Extra(k, i) => {
                     let run = match job {
                         Job::Amm(..) => &specs[k].amm[i],
                         _ => &specs[k].extra[i],
                     };
-                    solve_amm(&specs[k].exp, &run.settings).map_err(|e| run_error(file(k), &run.label, e))
+                    solve_amm(&specs[k].exp, &run.settings, Some(&checked.motions[k]))
+                        .map_err(|e| run_error(file(k), &run.label, e))
                 }
             }?;
             tracker.set(j, 1.0, true);

@@ -28,14 +28,8 @@ pub trait ActuatorLaw: Send + Sync {
 }
 
 mod laws;
-/// The rigid-body forward dynamics, a reference for tests only: behind the `reference-models`
-/// feature, which the crates whose tests use it enable in their dev-dependencies.
-#[cfg(any(test, feature = "reference-models"))]
-pub mod rigid_forward;
 
 pub use laws::{ForcePolynomials, ForceTable, ReferencePoint, RigidInverseForces, Servo};
-#[cfg(any(test, feature = "reference-models"))]
-pub use rigid_forward::{rigid_forward_dynamics, RigidSample};
 
 use flexstar_model::{DriveKind, Experiment, Feedforward};
 

@@ -175,16 +175,34 @@ pub fn pose_triplets(
     let (star, q, _) = Star::new(params, ne, &init, None)?;
     let nd = star.n_dof;
     let n = nd + if sliders == Sliders::Free { 3 } else { 0 };
-    let mut m = Triplets::with_capacity(36 * star.elements.len() + 6);
-    let mut k = Triplets::with_capacity(36 * star.elements.len());
-    let (ea, ei, rho) = (params.ea(), params.ei(), params.rho);
-    let zero = [0.0; 6];
     let states: Vec<ElementState> = star
         .elements
         .iter()
         .map(|el| ElementState::new(el, &element_q(el.nodes, &q)))
         .collect();
-    for (el, st) in star.elements.iter().zip(&states) {
+    let (mut m, k) = element_triplets(params, &star, &states);
+    let rows = 3 * ROWS;
+    let c = constraint_triplets(params, &star, &states, &q, pose, sliders, &mut m);
+    Ok(SparsePoseSystem {
+        n,
+        ne,
+        m,
+        k,
+        c,
+        rows,
+        sliders,
+        theta: pose.theta,
+        h: star.h,
+    })
+}
+
+/// The elements' mass and tangent stiffness at the pose (unstressed: the rest pose), as triplets.
+fn element_triplets(params: &RobotParams, star: &Star, states: &[ElementState]) -> (Triplets, Triplets) {
+    let mut m = Triplets::with_capacity(36 * star.elements.len() + 6);
+    let mut k = Triplets::with_capacity(36 * star.elements.len());
+    let (ea, ei, rho) = (params.ea(), params.ei(), params.rho);
+    let zero = [0.0; 6];
+    for (el, st) in star.elements.iter().zip(states) {
         let d = dofs(el.nodes);
         let (_, ke) = st.internal(ea, ei);
         let (_, me) = st.inertia(rho, &zero);
@@ -195,8 +213,22 @@ pub fn pose_triplets(
             }
         }
     }
-    let rows = 3 * ROWS;
-    let mut c = Triplets::with_capacity(rows * 9);
+    (m, k)
+}
+
+/// The sleeves' rows Phi_q at the pose (with the slider columns when the sliders are free), and
+/// the sleeves' rotational inertia Jp and the sliders' mass mpp + mpa added to `m`.
+fn constraint_triplets(
+    params: &RobotParams,
+    star: &Star,
+    states: &[ElementState],
+    q: &[f64],
+    pose: &RestPose,
+    sliders: Sliders,
+    m: &mut Triplets,
+) -> Triplets {
+    let nd = star.n_dof;
+    let mut c = Triplets::with_capacity(3 * ROWS * 9);
     let pins = pose.s.map(|_| [0.0; 2]);
     for i in 0..3 {
         let ps = star.psi(i);
@@ -222,17 +254,7 @@ pub fn pose_triplets(
             }
         }
     }
-    Ok(SparsePoseSystem {
-        n,
-        ne,
-        m,
-        k,
-        c,
-        rows,
-        sliders,
-        theta: pose.theta,
-        h: star.h,
-    })
+    c
 }
 
 /// The first `count` modes (after the rigid ones when the sliders are free) of the star at `pose`:

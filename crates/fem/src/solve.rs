@@ -4,7 +4,7 @@
 //! `docs/conventions.md`).
 
 use flexstar_drive::ActuatorLaw;
-use flexstar_kinematics::{check_trajectory, direct_kinematics, RigidState};
+use flexstar_kinematics::{check_trajectory, direct_kinematics, preflight_step, CheckedMotion, RigidState};
 use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::{BeamShape, Experiment, FemSettings, Response, RobotParams, RunInfo, StarShape};
 
@@ -73,13 +73,37 @@ pub fn solve_with_stats(
     settings: &FemSettings,
     progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> Result<(Response, Stats), FemError> {
+    solve_scanned(exp, settings, None, progress)
+}
+
+/// [`solve`] of a motion whose feasibility the caller checked once for all its runs (the
+/// preflight of `compare`, `verify`, `run`): the trajectory is scanned here only when `checked`
+/// does not cover this experiment's robot, trajectory and span.
+pub fn solve_checked(
+    exp: &Experiment,
+    settings: &FemSettings,
+    checked: &CheckedMotion,
+    progress: Option<&(dyn Fn(f64) + Sync)>,
+) -> Result<Response, FemError> {
+    solve_scanned(exp, settings, Some(checked), progress).map(|(r, _)| r)
+}
+
+/// [`solve_with_stats`], the feasibility scan skipped when `checked` covers the run.
+fn solve_scanned(
+    exp: &Experiment,
+    settings: &FemSettings,
+    checked: Option<&CheckedMotion>,
+    progress: Option<&(dyn Fn(f64) + Sync)>,
+) -> Result<(Response, Stats), FemError> {
     let started = std::time::Instant::now();
     let params = &exp.robot;
     let run = validate(exp, settings)?;
     // the same feasibility scan as the AMM and the kinematics, before any work: a pre-flight check
     // of the requested motion only (the FEM's equations never use the rigid kinematics)
-    check_trajectory(params, &exp.trajectory, exp.time.t_end, exp.time.dt_out.min(1e-3))
-        .map_err(|e| FemError::Input(e.to_string()))?;
+    let step = preflight_step(exp.time.dt_out);
+    if !checked.is_some_and(|c| c.covers(params, &exp.trajectory, exp.time.t_end, step)) {
+        check_trajectory(params, &exp.trajectory, exp.time.t_end, step).map_err(|e| FemError::Input(e.to_string()))?;
+    }
     let rigid =
         |t: f64| RigidState::at(params, &exp.trajectory, t).map_err(|source| FemError::PostProcessing { t, source });
     let r0 = rigid(0.0)?;

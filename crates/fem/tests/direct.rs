@@ -10,8 +10,13 @@
 
 #![allow(clippy::needless_range_loop)]
 
+#[path = "../../../tests/support/rigid_forward.rs"]
+#[allow(dead_code)]
+mod rigid_forward;
+
+use rigid_forward::rigid_forward_dynamics;
 use flexstar_drive::{
-    rigid_forward_dynamics, ActuatorLaw, DriveError, ForcePolynomials, ForceTable, RigidInverseForces, Servo,
+    ActuatorLaw, DriveError, ForcePolynomials, ForceTable, RigidInverseForces, Servo,
 };
 use flexstar_fem::{solve, solve_direct, solve_direct_with_stats, solve_with_stats, FemError};
 use flexstar_model::evp::point_evps;

@@ -143,6 +143,42 @@ pub fn check_trajectory(params: &RobotParams, traj: &Trajectory, t_end: f64, sca
     Ok(())
 }
 
+/// The scan step of the preflight every solver and command uses: the output step, at most 1 ms.
+pub fn preflight_step(dt_out: f64) -> f64 {
+    dt_out.min(1e-3)
+}
+
+/// A motion that [`check_motion`] found feasible over `[0, t_end]`: the proof a solver takes in
+/// place of its own scan (issue 25 item 7: the preflight runs once). It holds what was checked
+/// (robot, trajectory, span, scan step), so that a solver can tell whether it covers the run it
+/// is given; it can only be made by the check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckedMotion {
+    params: RobotParams,
+    trajectory: Trajectory,
+    t_end: f64,
+    scan_step: f64,
+}
+
+impl CheckedMotion {
+    /// Does this check cover a run of `traj` on `params` over `[0, t_end]` scanned at
+    /// `scan_step` or coarser (same robot and trajectory, a span and a step no larger)?
+    pub fn covers(&self, params: &RobotParams, traj: &Trajectory, t_end: f64, scan_step: f64) -> bool {
+        self.params == *params && self.trajectory == *traj && t_end <= self.t_end && self.scan_step <= scan_step
+    }
+}
+
+/// [`check_trajectory`], returning the proof of the check on success.
+pub fn check_motion(params: &RobotParams, traj: &Trajectory, t_end: f64, scan_step: f64) -> Result<CheckedMotion, Infeasible> {
+    check_trajectory(params, traj, t_end, scan_step)?;
+    Ok(CheckedMotion {
+        params: *params,
+        trajectory: traj.clone(),
+        t_end,
+        scan_step,
+    })
+}
+
 /// Is `s` (at rest) inside the feasible range? Used by property tests and samplers.
 pub fn is_feasible_configuration(params: &RobotParams, s: [f64; 3]) -> bool {
     check_configuration(params, s).is_ok()

@@ -2,6 +2,10 @@
 //! modal analysis (eigenvalues of A), the rigid robot's mass matrix from the drive crate's
 //! forward dynamics (the rigid modes' residue of B and C).
 
+#[path = "../../../tests/support/rigid_forward.rs"]
+#[allow(dead_code)]
+mod rigid_forward;
+
 use flexstar_modal::linear::{linearize, StateSpace, ELASTIC_MODES};
 use flexstar_modal::pose::pose_from_task;
 use flexstar_model::{Experiment, Sliders};
@@ -67,7 +71,7 @@ fn eigenvalues_of_a_are_the_free_slider_frequencies_of_amm_and_fem() {
 /// actuator forces as a rigid body, `s'' = M_r^-1 Fa`. In modal form
 /// `s(p) = sum_j C_s,j B_j Fa / (p^2 + omega_j^2)`, so the residue of the three 0 Hz modes in
 /// `p^2 s / Fa` is `sum_{j rigid} C[s, j] B[nr + j, :]`; the reference `M_r^-1` comes from
-/// `flexstar_drive::rigid_forward::rigid_acceleration` (virtual power with the exact Fermat-point
+/// `rigid_forward::rigid_acceleration` (tests/support) (virtual power with the exact Fermat-point
 /// Jacobians, no modes) with zero velocity, one unit force at a time.
 #[test]
 fn rigid_residue_is_the_inverse_rigid_mass_matrix() {
@@ -80,7 +84,7 @@ fn rigid_residue_is_the_inverse_rigid_mass_matrix() {
     for k in 0..3 {
         let mut fa = [0.0; 3];
         fa[k] = 1.0;
-        let reference = flexstar_drive::rigid_forward::rigid_acceleration(&exp.robot, ss.pose.s, [0.0; 3], fa).unwrap();
+        let reference = rigid_forward::rigid_acceleration(&exp.robot, ss.pose.s, [0.0; 3], fa).unwrap();
         for (i, r) in reference.iter().enumerate() {
             let residue: f64 = (0..3).map(|j| c[[i, j]] * b[[nr + j, k]]).sum();
             scale = scale.max(r.abs());

@@ -11,7 +11,7 @@
 //! factor of the shifted stiffness (see [`constrained_modes`]) and solved densely with faer.
 
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
-use faer::{Mat, Par, Side};
+use faer::{Mat, MatRef, Par, Side};
 
 use crate::NumericsError;
 
@@ -166,18 +166,7 @@ pub fn constrained_modes(
     count: usize,
     shift: f64,
 ) -> Result<ConstrainedModes, NumericsError> {
-    if m.len() != n * n || k.len() != n * n || c.len() != rows * n || rows >= n {
-        return Err(NumericsError::Sizes {
-            n,
-            m: m.len(),
-            k: k.len(),
-            c: c.len(),
-            rows,
-        });
-    }
-    if m.iter().chain(k).chain(c).any(|v| !v.is_finite()) || shift.is_nan() || shift < 0.0 {
-        return Err(NumericsError::NonFinite);
-    }
+    check_inputs(n, m, k, c, rows, shift)?;
     // Jacobi scaling q = D q~ (massless coordinates keep scale 1)
     let d: Vec<f64> = (0..n)
         .map(|i| {
@@ -205,30 +194,16 @@ pub fn constrained_modes(
         .llt(Side::Lower)
         .map_err(|source| NumericsError::NotPositiveDefinite { shift, source })?;
     let l = llt.L();
-    // S = L^-1 Mr L^-T
-    let mut s = mr;
-    solve_lower_triangular_in_place(l, s.as_mut(), Par::Seq);
-    let mut st = s.transpose().to_owned();
-    solve_lower_triangular_in_place(l, st.as_mut(), Par::Seq);
-    let sym = Mat::from_fn(p, p, |i, j| 0.5 * (st[(i, j)] + st[(j, i)]));
-    let eig = sym
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|cause| NumericsError::Eigensolver {
-            what: "symmetric eigensolver",
-            cause,
-        })?;
-    let count = count.min(p);
-    // largest mu first
-    let order: Vec<usize> = (0..count).map(|j| p - 1 - j).collect();
-    let omega2: Vec<f64> = order.iter().map(|&j| 1.0 / eig.S()[j] - shift).collect();
+    let (mu, z) = inverse_form_modes(l, mr, count.min(p))?;
+    let omega2: Vec<f64> = mu.iter().map(|&mu| 1.0 / mu - shift).collect();
     // shapes: x_r = L^-T z / sqrt(mu) (mass-normalised), x = D Q [0; x_r]
-    let mut y = Mat::from_fn(p, count, |r, j| eig.U()[(r, order[j])]);
+    let mut y = z;
     solve_upper_triangular_in_place(l.transpose(), y.as_mut(), Par::Seq);
-    let shapes = order
+    let shapes = mu
         .iter()
         .enumerate()
-        .map(|(j, &jj)| {
-            let scale = 1.0 / eig.S()[jj].sqrt();
+        .map(|(j, &mu)| {
+            let scale = 1.0 / mu.sqrt();
             let mut x = vec![0.0; n];
             for (r, xr) in x[rows..].iter_mut().enumerate() {
                 *xr = y[(r, j)] * scale;
@@ -245,6 +220,45 @@ pub fn constrained_modes(
         shapes,
         rank: rows,
     })
+}
+
+/// The sizes and finiteness of [`constrained_modes`]' input.
+fn check_inputs(n: usize, m: &[f64], k: &[f64], c: &[f64], rows: usize, shift: f64) -> Result<(), NumericsError> {
+    if m.len() != n * n || k.len() != n * n || c.len() != rows * n || rows >= n {
+        return Err(NumericsError::Sizes {
+            n,
+            m: m.len(),
+            k: k.len(),
+            c: c.len(),
+            rows,
+        });
+    }
+    if m.iter().chain(k).chain(c).any(|v| !v.is_finite()) || shift.is_nan() || shift < 0.0 {
+        return Err(NumericsError::NonFinite);
+    }
+    Ok(())
+}
+
+/// The `count` largest eigenvalues mu (largest first) and their eigenvectors z (columns) of the
+/// inverse form `S = L^-1 Mr L^-T` (symmetrised), with `L` the Cholesky factor of `K + sigma M`.
+fn inverse_form_modes(l: MatRef<'_, f64>, mr: Mat<f64>, count: usize) -> Result<(Vec<f64>, Mat<f64>), NumericsError> {
+    let p = mr.nrows();
+    let mut s = mr;
+    solve_lower_triangular_in_place(l, s.as_mut(), Par::Seq);
+    let mut st = s.transpose().to_owned();
+    solve_lower_triangular_in_place(l, st.as_mut(), Par::Seq);
+    let sym = Mat::from_fn(p, p, |i, j| 0.5 * (st[(i, j)] + st[(j, i)]));
+    let eig = sym
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|cause| NumericsError::Eigensolver {
+            what: "symmetric eigensolver",
+            cause,
+        })?;
+    // largest mu first
+    let order: Vec<usize> = (0..count).map(|j| p - 1 - j).collect();
+    let mu = order.iter().map(|&j| eig.S()[j]).collect();
+    let z = Mat::from_fn(p, count, |r, j| eig.U()[(r, order[j])]);
+    Ok((mu, z))
 }
 
 #[cfg(test)]

@@ -152,18 +152,11 @@ fn existing_results(dir: &Path, m0: &Meta, t0: &Table) -> Result<Option<(Meta, T
 
 type Shards = [(usize, Meta, Table, PathBuf)];
 
-fn join(dir: &Path, n: usize, shards: &Shards, existing: Option<(Meta, Table)>) -> Result<MergeReport, StudyError> {
-    let (_, m0, t0, _) = &shards[0];
-    let solver_col = t0.column("solver").unwrap_or(0);
-    let mut report = MergeReport {
-        results: results_file(dir, None),
-        shards: n,
-        ..MergeReport::default()
-    };
-    // global index of each expected case: the j-th case of shard K is case j N + K - 1; a whole
-    // study's earlier results.csv lists every case in order
+/// Global index of each expected case: the j-th case of shard K is case j N + K - 1; a whole
+/// study's earlier results.csv lists every case in order.
+fn case_index(n: usize, shards: &Shards, existing: Option<&(Meta, Table)>) -> HashMap<String, usize> {
     let mut index: HashMap<String, usize> = HashMap::new();
-    if let Some((meta, _)) = existing.as_ref().filter(|(m, _)| m.cases.len() == m.total_cases) {
+    if let Some((meta, _)) = existing.filter(|(m, _)| m.cases.len() == m.total_cases) {
         index.extend(meta.cases.iter().enumerate().map(|(i, id)| (id.clone(), i)));
     }
     for (k, meta, _, _) in shards {
@@ -171,6 +164,16 @@ fn join(dir: &Path, n: usize, shards: &Shards, existing: Option<(Meta, Table)>) 
             index.insert(id.clone(), j * n + k - 1);
         }
     }
+    index
+}
+
+/// The shards' rows, each (case, solver) once; rows of cases a shard does not own and repeated
+/// rows go to the report. Returns the rows and the (case, solver) pairs seen.
+fn shard_rows(
+    shards: &Shards,
+    solver_col: usize,
+    report: &mut MergeReport,
+) -> (Vec<Vec<String>>, HashSet<(String, String)>) {
     let mut seen: HashSet<(String, String)> = HashSet::new();
     let mut rows: Vec<Vec<String>> = Vec::new();
     for (_, meta, table, _) in shards {
@@ -186,6 +189,19 @@ fn join(dir: &Path, n: usize, shards: &Shards, existing: Option<(Meta, Table)>) 
             }
         }
     }
+    (rows, seen)
+}
+
+fn join(dir: &Path, n: usize, shards: &Shards, existing: Option<(Meta, Table)>) -> Result<MergeReport, StudyError> {
+    let (_, m0, t0, _) = &shards[0];
+    let solver_col = t0.column("solver").unwrap_or(0);
+    let mut report = MergeReport {
+        results: results_file(dir, None),
+        shards: n,
+        ..MergeReport::default()
+    };
+    let mut index = case_index(n, shards, existing.as_ref());
+    let (mut rows, mut seen) = shard_rows(shards, solver_col, &mut report);
     // rows of the earlier results.csv that no shard holds are kept (a shard's row wins)
     let mut earlier_ids: Vec<String> = Vec::new();
     if let Some((meta, table)) = &existing {

@@ -257,8 +257,9 @@ enum Failure {
 fn solve(exp: &Experiment, solver: Solver) -> Solved {
     let started = Instant::now();
     let result = catch_unwind(AssertUnwindSafe(|| match solver {
-        Solver::Amm => flexstar_compare::runs::solve_amm(exp, &exp.amm),
-        Solver::Fem => flexstar_compare::runs::solve_fem(exp, &exp.fem, None),
+        // each solver scans the case's motion itself: a case's solvers may run in different shards
+        Solver::Amm => flexstar_compare::runs::solve_amm(exp, &exp.amm, None),
+        Solver::Fem => flexstar_compare::runs::solve_fem(exp, &exp.fem, None, None),
     }));
     let result = match result {
         Ok(r) => r.map_err(Failure::from),

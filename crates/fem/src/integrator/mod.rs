@@ -235,7 +235,6 @@ pub(crate) fn integrate(
         return Err(FemError::Input("output times must start at t = 0".into()));
     }
     let (mut star, q, v) = Star::new(params, run.ne, init, motion.slider_unknowns())?;
-    let (n_dof, n_sys) = (star.n_dof, star.n_sys);
     let l = params.l;
     let mut st = initial_state(params, motion, &mut star, q, v)?;
     motion.check_feasible(params, &st.pins, 0.0)?;
@@ -250,19 +249,7 @@ pub(crate) fn integrate(
     let mut work = 0.0;
     rec.record(params, &star, &st, fa0, pf0, 0.0, 0.0);
 
-    let rot = |j: usize| j < 3 * star.n_nodes && j % 3 == 2 || (j >= 3 * star.n_nodes && j < 3 * star.n_nodes + 3);
-    let mut ws = Workspace {
-        weight: (0..n_dof).map(|j| if rot(j) { star.h } else { 1.0 }).collect(),
-        a_part: vec![0.0; n_dof],
-        qh: vec![0.0; n_dof],
-        vh: vec![0.0; n_dof],
-        q1: vec![0.0; n_dof],
-        v1: vec![0.0; n_dof],
-        qdd1: vec![0.0; n_dof],
-        nu: vec![0.0; 3 * ROWS],
-        dx: vec![0.0; n_sys],
-        res: vec![0.0; n_sys],
-    };
+    let mut ws = Workspace::new(&star);
     let mut t = 0.0;
     for w in events.windows(2) {
         let (ta, tb) = (w[0], w[1]);

@@ -29,6 +29,27 @@ pub(super) struct Workspace {
     pub(super) res: Vec<f64>,
 }
 
+impl Workspace {
+    /// The work vectors of `star`'s system, zeroed; the weights: the element length h [m] for
+    /// rotations (node rotations and the three sleeve rotations), 1 for lengths.
+    pub(super) fn new(star: &Star) -> Self {
+        let (n_dof, n_sys) = (star.n_dof, star.n_sys);
+        let rot = |j: usize| j < 3 * star.n_nodes && j % 3 == 2 || (j >= 3 * star.n_nodes && j < 3 * star.n_nodes + 3);
+        Workspace {
+            weight: (0..n_dof).map(|j| if rot(j) { star.h } else { 1.0 }).collect(),
+            a_part: vec![0.0; n_dof],
+            qh: vec![0.0; n_dof],
+            vh: vec![0.0; n_dof],
+            q1: vec![0.0; n_dof],
+            v1: vec![0.0; n_dof],
+            qdd1: vec![0.0; n_dof],
+            nu: vec![0.0; 3 * ROWS],
+            dx: vec![0.0; n_sys],
+            res: vec![0.0; n_sys],
+        }
+    }
+}
+
 /// Generalized-alpha predictor of every coordinate ([`GenAlpha::predict`]) and the first Newton
 /// iterate: constant acceleration, `q = q_hat + beta' q_dd`, `v = v_hat + gamma' q_dd`.
 #[inline(always)]

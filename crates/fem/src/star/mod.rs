@@ -164,6 +164,75 @@ pub(crate) struct Star {
     off_sl: usize,
 }
 
+/// A sleeve must span at least two elements (its three contact points on distinct elements).
+fn check_mesh(params: &RobotParams, ne: usize, h: f64) -> Result<(), FemError> {
+    if params.lp < 2.0 * h * (1.0 - 1e-12) {
+        let needed = (2.0 * params.l / params.lp).ceil() as usize;
+        return Err(FemError::MeshTooCoarse {
+            per_beam: ne,
+            h,
+            lp: params.lp,
+            needed,
+        });
+    }
+    Ok(())
+}
+
+/// The elements of the three beams (`ne` each, length `h` [m], straight along `e_x(i, theta)`)
+/// and the nodes' initial positions and velocities of the rigid star (written into `q`, `v`);
+/// returns the elements and the beams' initial angles gamma0_i [rad].
+fn initial_beams(ne: usize, h: f64, init: &InitialState, q: &mut [f64], v: &mut [f64]) -> (Vec<Element>, [f64; 3]) {
+    let mut gamma0 = [0.0; 3];
+    let mut elements = Vec::with_capacity(3 * ne);
+    let perp = |r: [f64; 2]| [-(r[1]), r[0]];
+    for i in 0..3 {
+        let ex = e_x(i, init.theta);
+        gamma0[i] = ex[1].atan2(ex[0]);
+        for k in 0..ne {
+            elements.push(Element {
+                nodes: [node(ne, i, k), node(ne, i, k + 1)],
+                l0: h,
+                c0: ex[0],
+                s0: ex[1],
+            });
+        }
+        for k in 0..=ne {
+            let j = node(ne, i, k);
+            let rel = [k as f64 * h * ex[0], k as f64 * h * ex[1]];
+            q[3 * j] = init.g[0] + rel[0];
+            q[3 * j + 1] = init.g[1] + rel[1];
+            let w = perp(rel);
+            v[3 * j] = init.g_dot[0] + init.theta_dot * w[0];
+            v[3 * j + 1] = init.g_dot[1] + init.theta_dot * w[1];
+            v[3 * j + 2] = init.theta_dot;
+        }
+    }
+    (elements, gamma0)
+}
+
+/// The sleeves' initial coordinates (from `psi0`: three rotations, then the three contact points
+/// of each sleeve at xp_i and xp_i -+ Lp/2) and, in the direct problem, the sliders'.
+fn initial_sleeves(
+    params: &RobotParams,
+    psi0: usize,
+    init: &InitialState,
+    sliders: Option<[[f64; 2]; 3]>,
+    q: &mut [f64],
+    v: &mut [f64],
+) {
+    for i in 0..3 {
+        v[psi0 + i] = init.theta_dot;
+        for (p, off) in [0.0, -0.5 * params.lp, 0.5 * params.lp].iter().enumerate() {
+            q[psi0 + 3 + 3 * i + p] = init.xp[i] + off;
+            v[psi0 + 3 + 3 * i + p] = init.xp_dot[i];
+        }
+        if let Some(sl) = sliders {
+            q[psi0 + 12 + i] = sl[i][0];
+            v[psi0 + 12 + i] = sl[i][1];
+        }
+    }
+}
+
 impl Star {
     /// Mesh the star with `ne` elements per beam around the initial pose. With `sliders`
     /// (`[s_i, s_i']` [m, m/s] at t = 0) the slider coordinates are unknowns too (direct problem).
@@ -174,57 +243,14 @@ impl Star {
         sliders: Option<[[f64; 2]; 3]>,
     ) -> Result<(Self, Vec<f64>, Vec<f64>), FemError> {
         let h = params.l / ne as f64;
-        if params.lp < 2.0 * h * (1.0 - 1e-12) {
-            let needed = (2.0 * params.l / params.lp).ceil() as usize;
-            return Err(FemError::MeshTooCoarse {
-                per_beam: ne,
-                h,
-                lp: params.lp,
-                needed,
-            });
-        }
+        check_mesh(params, ne, h)?;
         let n_nodes = 1 + 3 * ne;
         let n_dof = 3 * n_nodes + 12 + if sliders.is_some() { 3 } else { 0 };
         let n_sys = n_dof + 3 * ROWS;
         let mut q = vec![0.0; n_dof];
         let mut v = vec![0.0; n_dof];
-        let mut gamma0 = [0.0; 3];
-        let mut elements = Vec::with_capacity(3 * ne);
-        let perp = |r: [f64; 2]| [-(r[1]), r[0]];
-        for i in 0..3 {
-            let ex = e_x(i, init.theta);
-            gamma0[i] = ex[1].atan2(ex[0]);
-            for k in 0..ne {
-                elements.push(Element {
-                    nodes: [node(ne, i, k), node(ne, i, k + 1)],
-                    l0: h,
-                    c0: ex[0],
-                    s0: ex[1],
-                });
-            }
-            for k in 0..=ne {
-                let j = node(ne, i, k);
-                let rel = [k as f64 * h * ex[0], k as f64 * h * ex[1]];
-                q[3 * j] = init.g[0] + rel[0];
-                q[3 * j + 1] = init.g[1] + rel[1];
-                let w = perp(rel);
-                v[3 * j] = init.g_dot[0] + init.theta_dot * w[0];
-                v[3 * j + 1] = init.g_dot[1] + init.theta_dot * w[1];
-                v[3 * j + 2] = init.theta_dot;
-            }
-        }
-        let psi0 = 3 * n_nodes;
-        for i in 0..3 {
-            v[psi0 + i] = init.theta_dot;
-            for (p, off) in [0.0, -0.5 * params.lp, 0.5 * params.lp].iter().enumerate() {
-                q[psi0 + 3 + 3 * i + p] = init.xp[i] + off;
-                v[psi0 + 3 + 3 * i + p] = init.xp_dot[i];
-            }
-            if let Some(sl) = sliders {
-                q[psi0 + 12 + i] = sl[i][0];
-                v[psi0 + 12 + i] = sl[i][1];
-            }
-        }
+        let (elements, gamma0) = initial_beams(ne, h, init, &mut q, &mut v);
+        initial_sleeves(params, 3 * n_nodes, init, sliders, &mut q, &mut v);
         let star = Star {
             params: *params,
             ne,

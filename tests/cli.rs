@@ -627,7 +627,7 @@ fn sidecars_give_every_column_its_unit_and_the_values_used() {
     ] {
         let mut args = vec!["run", cfg.as_str(), "--solver", solver, "--out", out_s];
         if solver == "fem" {
-            args.extend(["--elements", "36"]);
+            args.extend(["--elements", "108"]);
         }
         let o = flexstar(&args);
         assert!(o.status.success(), "{stem}: {}", stderr(&o));
@@ -650,7 +650,7 @@ fn sidecars_give_every_column_its_unit_and_the_values_used() {
             assert!(exp["amm"]["tol"].is_null(), "{stem}: a fixed N uses no tolerance");
         } else {
             assert_eq!(exp["fem"]["dt"].as_f64(), doc["dt"].as_f64(), "{stem}");
-            assert_eq!(exp["fem"]["elements"], 36, "{stem}");
+            assert_eq!(exp["fem"]["elements"], 108, "{stem}");
             assert_eq!(exp["fem"]["rho_inf"].as_f64(), Some(0.7), "{stem}");
         }
     }
@@ -664,7 +664,7 @@ fn compare_of_a_servo_experiment_shows_the_servo_and_its_tracking() {
         dir.path(),
         "servo.toml",
         &format!(
-            "{}\n[fem]\nelements = 36\n[drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n",
+            "{}\n[fem]\nelements = 108\n[drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n",
             common::TINY
         ),
     );

@@ -59,7 +59,10 @@ fn kinematics_rates_and_forces_are_consistent(case: &str, rows: &[Vec<f64>]) {
         let sd2: f64 = (14..17).map(|c| rows[k][c] * rows[k][c]).sum();
         0.5 * m * (vx * vx + vy * vy) + 0.5 * j * rows[k][12] * rows[k][12] + 0.5 * m_s * sd2
     };
-    let scale_f = rows.iter().flat_map(|r| r[20..23].iter()).fold(0.0f64, |a, v| a.max(v.abs()));
+    let scale_f = rows
+        .iter()
+        .flat_map(|r| r[20..23].iter())
+        .fold(0.0f64, |a, v| a.max(v.abs()));
     let scale_p = rows
         .iter()
         .map(|r| (0..3).map(|i| (r[20 + i] * r[14 + i]).abs()).sum::<f64>())
@@ -68,8 +71,16 @@ fn kinematics_rates_and_forces_are_consistent(case: &str, rows: &[Vec<f64>]) {
     for k in 2..rows.len() - 2 {
         for i in 0..3 {
             let (sd, sdd) = (rows[k][14 + i], rows[k][17 + i]);
-            assert!((sd - d(k, 1 + i)).abs() < 1e-6 * (1.0 + sd.abs()), "{case} row {k}: sd{} {sd}", i + 1);
-            assert!((sdd - d(k, 14 + i)).abs() < 1e-6 * (1.0 + sdd.abs()), "{case} row {k}: sdd{}", i + 1);
+            assert!(
+                (sd - d(k, 1 + i)).abs() < 1e-6 * (1.0 + sd.abs()),
+                "{case} row {k}: sd{} {sd}",
+                i + 1
+            );
+            assert!(
+                (sdd - d(k, 14 + i)).abs() < 1e-6 * (1.0 + sdd.abs()),
+                "{case} row {k}: sdd{}",
+                i + 1
+            );
         }
         let power: f64 = (0..3).map(|i| rows[k][20 + i] * rows[k][14 + i]).sum();
         let dtdt = (energy(k + 1) - energy(k - 1)) / (2.0 * h);
@@ -402,6 +413,10 @@ fn compare_writes_its_outputs_for_any_experiment() {
     ] {
         assert!(case.join(f).exists(), "{f} missing");
     }
+    // a prescribed motion: the dashed force curve is its rigid-body inverse dynamics; no servo
+    let md = std::fs::read_to_string(case.join("compare.md")).unwrap();
+    assert!(md.contains("Actuator forces against the rigid-body inverse dynamics"), "{md}");
+    assert!(!md.contains("## Servo") && !case.join("figures/case1-sliders.svg").exists());
     let sidecar = std::fs::read_to_string(case.join("fem.json")).unwrap();
     for key in [
         "\"flexstar_version\"",
@@ -605,12 +620,18 @@ fn sidecars_give_every_column_its_unit_and_the_values_used() {
     let servo = write(
         dir.path(),
         "servo.toml",
-        &format!("{}\n[drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n", common::TINY),
+        &format!(
+            "{}\n[drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n",
+            common::TINY
+        ),
     );
     let unit = |name: &str| -> Option<&'static str> {
         let units: &[(&[&str], &str)] = &[
             (&["t"], "s"),
-            (&["Fa1", "Fa2", "Fa3", "Fix1", "Fw", "Fp2", "FLp3", "FRp1", "Fn1", "Fn3"], "N"),
+            (
+                &["Fa1", "Fa2", "Fa3", "Fix1", "Fw", "Fp2", "FLp3", "FRp1", "Fn1", "Fn3"],
+                "N",
+            ),
             (&["M1G", "M3G", "Mp2"], "N m"),
             (&["w1G", "w3tip", "s2", "Gx", "dGy", "xp1", "u3", "e1", "e3"], "m"),
             (&["theta", "thp1", "slopeG"], "rad"),
@@ -632,7 +653,9 @@ fn sidecars_give_every_column_its_unit_and_the_values_used() {
         let o = flexstar(&args);
         assert!(o.status.success(), "{stem}: {}", stderr(&o));
         let (header, doc) = csv_and_sidecar(&out.join("tiny"), stem);
-        let units = doc["column_units"].as_object().unwrap_or_else(|| panic!("{stem}: {doc}"));
+        let units = doc["column_units"]
+            .as_object()
+            .unwrap_or_else(|| panic!("{stem}: {doc}"));
         assert_eq!(units.len(), header.len(), "{stem}: {units:?} for {header:?}");
         for c in &header {
             let u = units.get(c).and_then(|u| u.as_str());
@@ -672,12 +695,21 @@ fn compare_of_a_servo_experiment_shows_the_servo_and_its_tracking() {
     assert!(o.status.success(), "{}", stderr(&o));
     let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
     // the table first (as compare.csv), then the servo
-    assert!(stdout.starts_with("model,evp_A,evp_B,evp_C,evp_G,evp_mean\n"), "{stdout}");
+    assert!(
+        stdout.starts_with("model,evp_A,evp_B,evp_C,evp_G,evp_mean\n"),
+        "{stdout}"
+    );
     // kp = m (2 pi f)^2 = 0.2 kg (2 pi 20 Hz)^2 = 3158.3 N/m
-    assert!(stdout.contains("servo: bandwidth 20 Hz, damping ratio 0.7, so kp = 3.1583e3 N/m"), "{stdout}");
+    assert!(
+        stdout.contains("servo: bandwidth 20 Hz, damping ratio 0.7, so kp = 3.1583e3 N/m"),
+        "{stdout}"
+    );
     let case = out.join("tiny");
     let md = std::fs::read_to_string(case.join("compare.md")).unwrap();
-    assert!(md.contains("## Servo") && md.contains("| fem |") && md.contains("| amm-free-free |"), "{md}");
+    assert!(
+        md.contains("## Servo") && md.contains("| fem |") && md.contains("| amm-free-free |"),
+        "{md}"
+    );
     // the tracking error against the reference s1 = t^2, s2 = 0, s3 = t^2 / 2, from the FEM's file
     let text = std::fs::read_to_string(case.join("fem.csv")).unwrap();
     let mut lines = text.lines();
@@ -694,12 +726,43 @@ fn compare_of_a_servo_experiment_shows_the_servo_and_its_tracking() {
             n += 1.0;
         }
     }
-    let want = format!("tracking error fem: max {:.4} mm, RMS {:.4} mm", max * 1e3, (sum2 / n).sqrt() * 1e3);
+    let want = format!(
+        "tracking error fem: max {:.4} mm, RMS {:.4} mm",
+        max * 1e3,
+        (sum2 / n).sqrt() * 1e3
+    );
     assert!(stdout.contains(&want), "{want} not in {stdout}");
     assert!(stdout.contains("tracking error amm-free-free: max "), "{stdout}");
     // the reference drawn in the sliders figure; the forces caption says what the dashed line is
     assert!(case.join("figures/tiny-sliders.svg").exists());
-    assert!(md.contains("rigid-body inverse dynamics of its reference motion"), "{md}");
+    assert!(
+        md.contains("rigid-body inverse dynamics of its reference motion"),
+        "{md}"
+    );
     let html = std::fs::read_to_string(case.join("report.html")).unwrap();
-    assert!(html.contains("<h3>Servo</h3>") && html.contains("tiny-sliders"), "servo missing in the report");
+    assert!(
+        html.contains("<h3>Servo</h3>") && html.contains("tiny-sliders"),
+        "servo missing in the report"
+    );
+}
+
+#[test]
+fn compare_of_a_forces_drive_says_what_its_force_figure_draws() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = write(
+        dir.path(),
+        "forces.toml",
+        &format!(
+            "{}\n[fem]\nelements = 108\n[drive]\nkind = \"forces\"\nFa1 = [0.0]\nFa2 = [0.0]\nFa3 = [0.0]\n",
+            common::TINY
+        ),
+    );
+    let o = flexstar(&["compare", &cfg, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(!stdout.contains("servo"), "{stdout}");
+    let md = std::fs::read_to_string(out.join("tiny/compare.md")).unwrap();
+    assert!(md.contains("The forces the [drive] prescribes"), "{md}");
+    assert!(!md.contains("Actuator forces against the rigid-body inverse dynamics"), "{md}");
 }

@@ -138,7 +138,10 @@ mod tests {
         let mut r = Response::with_capacity("x", 2);
         r.push(0.0, [0.0; 3], [0.0; 3], [0.0; 3]);
         r.push(1.0, [0.0; 3], [0.0; 3], [0.0; 3]);
-        r.set_extra(&["e1", "e2", "e3"], vec![vec![3e-3, 0.0], vec![0.0, -4e-3], vec![0.0, 0.0]]);
+        r.set_extra(
+            &["e1", "e2", "e3"],
+            vec![vec![3e-3, 0.0], vec![0.0, -4e-3], vec![0.0, 0.0]],
+        );
         let (max, rms) = tracking_error(&r);
         assert_eq!(max, 4e-3);
         assert!((rms - (25e-6f64 / 6.0).sqrt()).abs() < 1e-15);

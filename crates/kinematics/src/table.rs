@@ -101,7 +101,10 @@ mod tests {
     #[test]
     fn every_column_has_a_unit_and_the_forces_are_the_rigid_inverse_dynamics() {
         for name in KINEMATICS_HEADER {
-            assert!(flexstar_model::response::column_unit(name).is_some(), "{name} has no unit");
+            assert!(
+                flexstar_model::response::column_unit(name).is_some(),
+                "{name} has no unit"
+            );
         }
         let exp = paper_case(3);
         let st = RigidState::at(&exp.robot, &exp.trajectory, 0.25).unwrap();
@@ -114,6 +117,9 @@ mod tests {
             assert_eq!(col(&format!("sdd{}", i + 1)), st.s[i].d2);
         }
         // today's columns keep their place
-        assert_eq!(KINEMATICS_HEADER[..14].join(","), "t,s1,s2,s3,Gx,Gy,theta,xp1,xp2,xp3,aGx,aGy,thetadot,thetaddot");
+        assert_eq!(
+            KINEMATICS_HEADER[..14].join(","),
+            "t,s1,s2,s3,Gx,Gy,theta,xp1,xp2,xp3,aGx,aGy,thetadot,thetaddot"
+        );
     }
 }

@@ -573,18 +573,27 @@ mod tests {
                 .map(|(_, u)| u.as_str())
                 .collect();
             assert!(!docs.is_empty(), "{name} is not in docs/outputs.md");
-            assert!(docs.iter().all(|u| u == unit), "{name}: {unit} here, {docs:?} in docs/outputs.md");
+            assert!(
+                docs.iter().all(|u| u == unit),
+                "{name}: {unit} here, {docs:?} in docs/outputs.md"
+            );
         }
         // and every documented result column is in the table (the files' fields are not columns)
         for (name, unit) in &documented {
-            assert!(column_unit(name).is_some(), "{name} [{unit}] documented but not in COLUMN_UNITS");
+            assert!(
+                column_unit(name).is_some(),
+                "{name} [{unit}] documented but not in COLUMN_UNITS"
+            );
         }
         let names: Vec<&str> = COLUMN_UNITS.iter().map(|(n, _)| *n).collect();
         let mut unique = names.clone();
         unique.sort();
         unique.dedup();
         assert_eq!(unique.len(), names.len(), "a column listed twice");
-        assert_eq!(column_units(&["t", "nope"]), serde_json::json!({"t": "s", "nope": null}));
+        assert_eq!(
+            column_units(&["t", "nope"]),
+            serde_json::json!({"t": "s", "nope": null})
+        );
     }
 
     #[test]
@@ -643,7 +652,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let doc = r.sidecar(Path::new("fem.json"), &exp, &prov).unwrap();
         let want = sidecar_text(Path::new("fem.json"), &doc).unwrap();
-        assert_eq!(want, serde_json::to_string_pretty(&doc).unwrap() + "\n", "pretty JSON, final newline");
+        assert_eq!(
+            want,
+            serde_json::to_string_pretty(&doc).unwrap() + "\n",
+            "pretty JSON, final newline"
+        );
         let mut set = RunSet::begin(dir.path()).unwrap();
         r.stage_sidecar(&mut set, "staged.json", &exp, &prov).unwrap();
         set.commit().unwrap();

@@ -415,7 +415,10 @@ fn compare_writes_its_outputs_for_any_experiment() {
     }
     // a prescribed motion: the dashed force curve is its rigid-body inverse dynamics; no servo
     let md = std::fs::read_to_string(case.join("compare.md")).unwrap();
-    assert!(md.contains("Actuator forces against the rigid-body inverse dynamics"), "{md}");
+    assert!(
+        md.contains("Actuator forces against the rigid-body inverse dynamics"),
+        "{md}"
+    );
     assert!(!md.contains("## Servo") && !case.join("figures/case1-sliders.svg").exists());
     let sidecar = std::fs::read_to_string(case.join("fem.json")).unwrap();
     for key in [
@@ -764,5 +767,8 @@ fn compare_of_a_forces_drive_says_what_its_force_figure_draws() {
     assert!(!stdout.contains("servo"), "{stdout}");
     let md = std::fs::read_to_string(out.join("tiny/compare.md")).unwrap();
     assert!(md.contains("The forces the [drive] prescribes"), "{md}");
-    assert!(!md.contains("Actuator forces against the rigid-body inverse dynamics"), "{md}");
+    assert!(
+        !md.contains("Actuator forces against the rigid-body inverse dynamics"),
+        "{md}"
+    );
 }

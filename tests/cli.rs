@@ -30,7 +30,8 @@ fn kinematics_writes_the_contracted_table() {
         let mut lines = text.lines();
         assert_eq!(
             lines.next().unwrap(),
-            "t,s1,s2,s3,Gx,Gy,theta,xp1,xp2,xp3,aGx,aGy,thetadot,thetaddot"
+            "t,s1,s2,s3,Gx,Gy,theta,xp1,xp2,xp3,aGx,aGy,thetadot,thetaddot,\
+             sd1,sd2,sd3,sdd1,sdd2,sdd3,Fa1,Fa2,Fa3"
         );
         let rows: Vec<Vec<f64>> = lines
             .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
@@ -39,7 +40,54 @@ fn kinematics_writes_the_contracted_table() {
         let t_end = if case == "case2" { 0.4 } else { 0.5 };
         assert_eq!(rows.len(), (t_end / 0.001f64).round() as usize + 1);
         assert!((rows.last().unwrap()[0] - t_end).abs() < 1e-12);
-        assert!(rows.iter().all(|r| r.len() == 14));
+        assert!(rows.iter().all(|r| r.len() == 23));
+        kinematics_rates_and_forces_are_consistent(case, &rows);
+    }
+}
+
+/// The slider rates of `kinematics.csv` against central differences of its own columns, and the
+/// rigid driving forces against the power balance of the rigid robot (paper parameters):
+/// `sum Fa_i sd_i = dT/dt`, T = 1/2 m |v_G|^2 + 1/2 (rho L^3 + 3 Jp) theta'^2 + 1/2 (mpp+mpa)
+/// sum sd_i^2, with v_G and dT/dt differenced from the file's rows (an independent check of Fa).
+fn kinematics_rates_and_forces_are_consistent(case: &str, rows: &[Vec<f64>]) {
+    let (rho, l, jp, m_s) = (0.234, 0.5, 2e-4, 0.2);
+    let (m, j) = (3.0 * rho * l, rho * l * l * l + 3.0 * jp);
+    let h = rows[1][0] - rows[0][0];
+    let d = |k: usize, c: usize| (rows[k + 1][c] - rows[k - 1][c]) / (2.0 * h);
+    let energy = |k: usize| {
+        let (vx, vy) = (d(k, 4), d(k, 5));
+        let sd2: f64 = (14..17).map(|c| rows[k][c] * rows[k][c]).sum();
+        0.5 * m * (vx * vx + vy * vy) + 0.5 * j * rows[k][12] * rows[k][12] + 0.5 * m_s * sd2
+    };
+    let scale_f = rows
+        .iter()
+        .flat_map(|r| r[20..23].iter())
+        .fold(0.0f64, |a, v| a.max(v.abs()));
+    let scale_p = rows
+        .iter()
+        .map(|r| (0..3).map(|i| (r[20 + i] * r[14 + i]).abs()).sum::<f64>())
+        .fold(0.0f64, f64::max);
+    assert!(scale_f > 0.0, "{case}: the rigid forces are all zero");
+    for k in 2..rows.len() - 2 {
+        for i in 0..3 {
+            let (sd, sdd) = (rows[k][14 + i], rows[k][17 + i]);
+            assert!(
+                (sd - d(k, 1 + i)).abs() < 1e-6 * (1.0 + sd.abs()),
+                "{case} row {k}: sd{} {sd}",
+                i + 1
+            );
+            assert!(
+                (sdd - d(k, 14 + i)).abs() < 1e-6 * (1.0 + sdd.abs()),
+                "{case} row {k}: sdd{}",
+                i + 1
+            );
+        }
+        let power: f64 = (0..3).map(|i| rows[k][20 + i] * rows[k][14 + i]).sum();
+        let dtdt = (energy(k + 1) - energy(k - 1)) / (2.0 * h);
+        assert!(
+            (power - dtdt).abs() < 1e-3 * scale_p.max(1e-9),
+            "{case} row {k}: power of the rigid forces {power} W, dT/dt {dtdt} W"
+        );
     }
 }
 
@@ -365,6 +413,13 @@ fn compare_writes_its_outputs_for_any_experiment() {
     ] {
         assert!(case.join(f).exists(), "{f} missing");
     }
+    // a prescribed motion: the dashed force curve is its rigid-body inverse dynamics; no servo
+    let md = std::fs::read_to_string(case.join("compare.md")).unwrap();
+    assert!(
+        md.contains("Actuator forces against the rigid-body inverse dynamics"),
+        "{md}"
+    );
+    assert!(!md.contains("## Servo") && !case.join("figures/case1-sliders.svg").exists());
     let sidecar = std::fs::read_to_string(case.join("fem.json")).unwrap();
     for key in [
         "\"flexstar_version\"",
@@ -547,4 +602,173 @@ fn a_servo_run_with_figures_draws_sliders_tracking_tips_and_forces() {
             );
         }
     }
+}
+
+/// The header of a CSV file and its sidecar JSON.
+fn csv_and_sidecar(dir: &Path, stem: &str) -> (Vec<String>, serde_json::Value) {
+    let csv = std::fs::read_to_string(dir.join(format!("{stem}.csv"))).unwrap();
+    let header = csv.lines().next().unwrap().split(',').map(str::to_string).collect();
+    let json = std::fs::read_to_string(dir.join(format!("{stem}.json"))).unwrap();
+    (header, serde_json::from_str(&json).unwrap())
+}
+
+#[test]
+fn sidecars_give_every_column_its_unit_and_the_values_used() {
+    // issue 24: AMM and FEM, inverse and direct (a servo); units as in docs/outputs.md
+    // (flexstar_model's table is checked against the page in its own tests)
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let inverse = write(dir.path(), "tiny.toml", common::TINY);
+    let servo = write(
+        dir.path(),
+        "servo.toml",
+        &format!(
+            "{}\n[drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n",
+            common::TINY
+        ),
+    );
+    let unit = |name: &str| -> Option<&'static str> {
+        let units: &[(&[&str], &str)] = &[
+            (&["t"], "s"),
+            (
+                &["Fa1", "Fa2", "Fa3", "Fix1", "Fw", "Fp2", "FLp3", "FRp1", "Fn1", "Fn3"],
+                "N",
+            ),
+            (&["M1G", "M3G", "Mp2"], "N m"),
+            (&["w1G", "w3tip", "s2", "Gx", "dGy", "xp1", "u3", "e1", "e3"], "m"),
+            (&["theta", "thp1", "slopeG"], "rad"),
+            (&["sd1", "sd3"], "m/s"),
+            (&["Ek_star", "U", "W"], "J"),
+        ];
+        units.iter().find(|(names, _)| names.contains(&name)).map(|(_, u)| *u)
+    };
+    for (cfg, solver, stem) in [
+        (&inverse, "amm", "amm-free-free"),
+        (&inverse, "fem", "fem"),
+        (&servo, "amm", "amm-free-free-direct"),
+        (&servo, "fem", "fem-direct"),
+    ] {
+        let mut args = vec!["run", cfg.as_str(), "--solver", solver, "--out", out_s];
+        if solver == "fem" {
+            args.extend(["--elements", "108"]);
+        }
+        let o = flexstar(&args);
+        assert!(o.status.success(), "{stem}: {}", stderr(&o));
+        let (header, doc) = csv_and_sidecar(&out.join("tiny"), stem);
+        let units = doc["column_units"]
+            .as_object()
+            .unwrap_or_else(|| panic!("{stem}: {doc}"));
+        assert_eq!(units.len(), header.len(), "{stem}: {units:?} for {header:?}");
+        for c in &header {
+            let u = units.get(c).and_then(|u| u.as_str());
+            assert!(u.is_some(), "{stem}: column {c} has no unit");
+            if let Some(want) = unit(c) {
+                assert_eq!(u, Some(want), "{stem}: {c}");
+            }
+        }
+        // the resolved experiment: the values used, where the file left a default
+        let exp = &doc["experiment"];
+        assert!(exp["robot"]["EA"].as_f64().unwrap() > 0.0, "{stem}: {exp}");
+        if solver == "amm" {
+            assert_eq!(exp["amm"]["dt"].as_f64(), doc["dt"].as_f64(), "{stem}");
+            assert_eq!(exp["amm"]["modes"], 5, "{stem}");
+            assert!(exp["amm"]["tol"].is_null(), "{stem}: a fixed N uses no tolerance");
+        } else {
+            assert_eq!(exp["fem"]["dt"].as_f64(), doc["dt"].as_f64(), "{stem}");
+            assert_eq!(exp["fem"]["elements"], 108, "{stem}");
+            assert_eq!(exp["fem"]["rho_inf"].as_f64(), Some(0.7), "{stem}");
+        }
+    }
+}
+
+#[test]
+fn compare_of_a_servo_experiment_shows_the_servo_and_its_tracking() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = write(
+        dir.path(),
+        "servo.toml",
+        &format!(
+            "{}\n[fem]\nelements = 108\n[drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n",
+            common::TINY
+        ),
+    );
+    let o = flexstar(&["compare", &cfg, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    // the table first (as compare.csv), then the servo
+    assert!(
+        stdout.starts_with("model,evp_A,evp_B,evp_C,evp_G,evp_mean\n"),
+        "{stdout}"
+    );
+    // kp = m (2 pi f)^2 = 0.2 kg (2 pi 20 Hz)^2 = 3158.3 N/m
+    assert!(
+        stdout.contains("servo: bandwidth 20 Hz, damping ratio 0.7, so kp = 3.1583e3 N/m"),
+        "{stdout}"
+    );
+    let case = out.join("tiny");
+    let md = std::fs::read_to_string(case.join("compare.md")).unwrap();
+    assert!(
+        md.contains("## Servo") && md.contains("| fem |") && md.contains("| amm-free-free |"),
+        "{md}"
+    );
+    // the tracking error against the reference s1 = t^2, s2 = 0, s3 = t^2 / 2, from the FEM's file
+    let text = std::fs::read_to_string(case.join("fem.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| header.iter().position(|c| *c == n).unwrap();
+    let (mut max, mut sum2, mut n) = (0.0f64, 0.0, 0.0);
+    for l in lines {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        let t = v[col("t")];
+        for (i, s_ref) in [t * t, 0.0, 0.5 * t * t].into_iter().enumerate() {
+            let e = s_ref - v[col(&format!("s{}", i + 1))];
+            max = max.max(e.abs());
+            sum2 += e * e;
+            n += 1.0;
+        }
+    }
+    let want = format!(
+        "tracking error fem: max {:.4} mm, RMS {:.4} mm",
+        max * 1e3,
+        (sum2 / n).sqrt() * 1e3
+    );
+    assert!(stdout.contains(&want), "{want} not in {stdout}");
+    assert!(stdout.contains("tracking error amm-free-free: max "), "{stdout}");
+    // the reference drawn in the sliders figure; the forces caption says what the dashed line is
+    assert!(case.join("figures/tiny-sliders.svg").exists());
+    assert!(
+        md.contains("rigid-body inverse dynamics of its reference motion"),
+        "{md}"
+    );
+    let html = std::fs::read_to_string(case.join("report.html")).unwrap();
+    assert!(
+        html.contains("<h3>Servo</h3>") && html.contains("tiny-sliders"),
+        "servo missing in the report"
+    );
+}
+
+#[test]
+fn compare_of_a_forces_drive_says_what_its_force_figure_draws() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = write(
+        dir.path(),
+        "forces.toml",
+        &format!(
+            "{}\n[fem]\nelements = 108\n[drive]\nkind = \"forces\"\nFa1 = [0.0]\nFa2 = [0.0]\nFa3 = [0.0]\n",
+            common::TINY
+        ),
+    );
+    let o = flexstar(&["compare", &cfg, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(!stdout.contains("servo"), "{stdout}");
+    let md = std::fs::read_to_string(out.join("tiny/compare.md")).unwrap();
+    assert!(md.contains("The forces the [drive] prescribes"), "{md}");
+    assert!(
+        !md.contains("Actuator forces against the rigid-body inverse dynamics"),
+        "{md}"
+    );
 }

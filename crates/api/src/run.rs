@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use flexstar_kinematics::CheckedMotion;
 
 use flexstar_model::config::check_step;
+use flexstar_model::response::sidecar_text;
 use flexstar_model::run_set::RunSet;
 use flexstar_model::{AmmModel, DriveKind, DriveSettings, Experiment, ForceSamples, ModeFamily, Response};
 
@@ -312,15 +313,6 @@ fn direct_columns(servo: bool) -> Vec<&'static str> {
         v.extend(["e1", "e2", "e3"]);
     }
     v
-}
-
-/// The sidecar document as the file's text (pretty JSON and a final newline).
-fn sidecar_text(path: &Path, meta: &serde_json::Value) -> Result<String> {
-    let text = serde_json::to_string_pretty(meta).map_err(|e| flexstar_model::ModelError::Write {
-        file: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
-    Ok(text + "\n")
 }
 
 /// Write a run's files in `dir` (already `DIR/<name>/`): `<stem>.csv` (a direct run: the

@@ -8,13 +8,16 @@ use std::path::Path;
 
 use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
 use flexstar_model::run_set::RunSet;
-use flexstar_model::{small_deflection_check, Experiment, ModeFamily, Provenance, Response, ValidityExceeded};
+use flexstar_model::{
+    small_deflection_check, DriveKind, Experiment, Feedforward, ModeFamily, Provenance, Response, ValidityExceeded,
+};
 use serde::Serialize;
 
 use flexstar_plot::{Figure, RenderedFigure, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE};
 
-use crate::figures::{figure_forces, figure_star, figure_tips, figure_w_g, Run};
+use crate::figures::{figure_forces, figure_sliders, figure_star, figure_tips, figure_w_g, Run};
 use crate::runs::CaseResults;
+use crate::servo::servo_summary;
 use crate::table::{csv_text, opt_number, TableRow};
 use crate::Error;
 
@@ -116,8 +119,45 @@ pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>,
     if let Some(f) = figure_star(&exp.name, &runs, &last, magnify) {
         figs.push(f);
     }
-    figs.push(figure_forces(&exp.name, &runs, Some((t, &rigid))));
+    let mut forces = figure_forces(&exp.name, &runs, Some((t, &rigid)));
+    if let Some(caption) = direct_forces_caption(exp) {
+        forces.caption = caption;
+    }
+    figs.push(forces);
+    if exp.drive.kind == DriveKind::Servo {
+        let reference: Vec<[f64; 3]> = t
+            .iter()
+            .map(|&ti| kin(ti).map(|s| s.s.map(|si| si.v)))
+            .collect::<Result<_, _>>()?;
+        figs.push(figure_sliders(&exp.name, &runs, t, &reference));
+    }
     Ok(figs)
+}
+
+/// The caption of the forces figure of a direct experiment (`None`: the motion is prescribed and
+/// the dashed curve is the rigid-body inverse dynamics of that motion, as `figure_forces` says).
+fn direct_forces_caption(exp: &Experiment) -> Option<String> {
+    let servo = match exp.drive.kind {
+        DriveKind::Motion => return None,
+        DriveKind::Servo => true,
+        DriveKind::Forces => false,
+    };
+    let what = if servo {
+        let ff = match exp.drive.feedforward.unwrap_or_default() {
+            Feedforward::Rigid => "the servo's rigid feedforward: the rest is what its PD loop added",
+            Feedforward::None => "the servo has no feedforward: every newton here comes from its PD loop",
+        };
+        format!(
+            "What the servo pushed in every run, against the rigid-body inverse dynamics of its reference \
+                motion, the [trajectory] (grey dashed; {ff})."
+        )
+    } else {
+        "The forces the [drive] prescribes, the same in every run (the sliders move as they make them), \
+            against the rigid-body inverse dynamics of the [trajectory] (grey dashed), the motion those forces \
+            were meant to produce."
+            .to_string()
+    };
+    Some(what)
 }
 
 /// `compare.csv`: one row per AMM run, `model` = its file stem, EVPs in %, `n/a` where the FEM
@@ -164,6 +204,9 @@ pub fn compare_markdown(
     );
     let _ = writeln!(s, "## Runs\n");
     let _ = writeln!(s, "{}", runs_markdown(case));
+    if let Some(servo) = servo_summary(exp, case) {
+        s.push_str(&servo.markdown());
+    }
     let _ = writeln!(s, "## EVP (Eq. 45), % of the FEM response\n");
     let _ = writeln!(
         s,

@@ -11,6 +11,7 @@ use flexstar_model::{AmmSettings, Experiment, ModeFamily, Provenance};
 use crate::case_output::{write_case, ValidityWarning};
 use crate::report::case_report;
 use crate::runs::{preflight, run_cases, AmmRun, CaseSpec, ProgressFn};
+use crate::servo::{servo_summary, ServoSummary};
 use crate::table::{TableI, TableRow};
 use crate::Error;
 
@@ -41,6 +42,8 @@ pub struct CompareOutcome {
     pub warnings: Vec<ValidityWarning>,
     /// The text of `compare.csv` as written (header and one row per AMM run).
     pub compare_csv: String,
+    /// The servo and each run's tracking error, for an experiment driven by a servo.
+    pub servo: Option<ServoSummary>,
     /// Wall time of the solves and of the whole command [s].
     pub solve_seconds: f64,
     pub total_seconds: f64,
@@ -105,6 +108,7 @@ pub fn run_compare(opts: &CompareOptions, progress: Option<ProgressFn>) -> Resul
         write_string_atomically(&dir.join("report.html"), &html)?;
     }
     Ok(CompareOutcome {
+        servo: servo_summary(&spec.exp, case),
         warnings: written.warnings,
         compare_csv: written.compare_csv,
         dir,

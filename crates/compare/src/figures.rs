@@ -94,6 +94,30 @@ pub fn figure_forces(case: &str, runs: &[Run], rigid: Option<(&[f64], &[[f64; 3]
     }
 }
 
+/// The slider positions s_i [mm] of direct runs (their columns `s1..s3`) over the reference
+/// motion `reference` (the servo's `[trajectory]` at the times `t`), dashed.
+pub fn figure_sliders(case: &str, runs: &[Run], t: &[f64], reference: &[[f64; 3]]) -> Figure {
+    let mut panels = per_beam(runs, "slider", "s_i [mm]", |r, i| {
+        scaled(r.column(&format!("s{}", i + 1)).unwrap_or(&[]), 1e3)
+    });
+    for (i, p) in panels.iter_mut().enumerate() {
+        p.series.push(Series {
+            label: "reference".into(),
+            x: t.to_vec(),
+            y: reference.iter().map(|s| s[i] * 1e3).collect(),
+            style: RIGID_STYLE,
+        });
+    }
+    Figure {
+        name: format!("{case}-sliders"),
+        title: format!("{case}: slider positions s_i against the servo's reference"),
+        caption: "Where the servo took each slider in every run, against the ideal motion it was asked to follow \
+            (the [trajectory], grey dashed). The gap is the tracking error of compare.md's servo table."
+            .into(),
+        panels,
+    }
+}
+
 /// The deformed star at its last snapshot: (a) elastic deflection w_i(x) of each beam [mm];
 /// (b) absolute shape with the elastic part magnified by `magnify`, over the rigid star
 /// (`rigid`: the rigid kinematics at the snapshot time, post-processing only).

@@ -12,6 +12,7 @@ use flexstar_model::{small_deflection_check, Experiment, Provenance};
 use crate::behaviour::Behaviour;
 use crate::case_output::{runs_of, ValidityWarning, WrittenCase};
 use crate::runs::CaseResults;
+use crate::servo::servo_summary;
 use crate::table::{TableI, TableRow};
 use crate::thresholds::Check;
 use flexstar_plot::RenderedFigure;
@@ -265,6 +266,7 @@ fn checks_html(h: &mut String, checks: &[Check]) {
 fn case_html(h: &mut String, c: &ReportCase) {
     case_summary_html(h, c);
     runs_html(h, c);
+    servo_html(h, c);
     evps_html(h, c);
     figures_html(h, c);
     h.push_str("</section>\n");
@@ -333,6 +335,15 @@ fn runs_html(h: &mut String, c: &ReportCase) {
         );
     }
     h.push_str("</table>\n");
+}
+
+/// For a servo experiment: the gains and each run's tracking error (`crate::servo`).
+fn servo_html(h: &mut String, c: &ReportCase) {
+    let Some(servo) = servo_summary(c.exp, c.case) else {
+        return;
+    };
+    h.push_str("<h3>Servo</h3>\n");
+    h.push_str(&markdown_to_html(servo.markdown().trim_start_matches("## Servo\n\n")));
 }
 
 /// The EVPs of every run against the FEM.

@@ -15,7 +15,7 @@ use crate::FemError;
 /// Default integration step [s], from the convergence study in `docs/fem.md`.
 pub const DEFAULT_DT: f64 = 5e-4;
 /// Default spectral radius at infinity of the generalized-alpha scheme (docs/fem.md).
-pub const DEFAULT_RHO_INF: f64 = 0.7;
+pub const DEFAULT_RHO_INF: f64 = flexstar_model::config::FEM_DEFAULT_RHO_INF;
 
 /// Names of the extra columns of every run (see [`solve`]).
 const EXTRA: [&str; 17] = [

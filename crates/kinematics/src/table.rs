@@ -3,14 +3,17 @@
 use std::path::Path;
 
 use flexstar_model::output::{fmt_number, write_atomically};
-use flexstar_model::Experiment;
+use flexstar_model::{Experiment, RobotParams};
 
 use crate::feasibility::check_trajectory;
+use crate::inverse_dynamics::rigid_inverse_dynamics;
 use crate::state::RigidState;
 use crate::KinematicsError;
 
-/// Column header of `kinematics.csv` (issue contract).
-pub const KINEMATICS_HEADER: [&str; 14] = [
+/// Column header of `kinematics.csv` (issue contract): the pose and its derivatives, then the
+/// slider velocities `sd_i` [m/s] and accelerations `sdd_i` [m/s^2] and the rigid driving forces
+/// `Fa_i` [N] of [`rigid_inverse_dynamics`] (issue 24). Units: `flexstar_model::response::COLUMN_UNITS`.
+pub const KINEMATICS_HEADER: [&str; 23] = [
     "t",
     "s1",
     "s2",
@@ -25,6 +28,15 @@ pub const KINEMATICS_HEADER: [&str; 14] = [
     "aGy",
     "thetadot",
     "thetaddot",
+    "sd1",
+    "sd2",
+    "sd3",
+    "sdd1",
+    "sdd2",
+    "sdd3",
+    "Fa1",
+    "Fa2",
+    "Fa3",
 ];
 
 /// Rigid states at the experiment's output times, after checking feasibility over the span.
@@ -37,8 +49,9 @@ pub fn kinematics_table(exp: &Experiment) -> Result<Vec<RigidState>, KinematicsE
         .collect()
 }
 
-/// One CSV row in the order of [`KINEMATICS_HEADER`].
-pub fn row(st: &RigidState) -> [f64; 14] {
+/// One CSV row in the order of [`KINEMATICS_HEADER`] for the robot `params`.
+pub fn row(params: &RobotParams, st: &RigidState) -> [f64; 23] {
+    let fa = rigid_inverse_dynamics(params, st).fa;
     [
         st.t,
         st.s[0].v,
@@ -54,19 +67,59 @@ pub fn row(st: &RigidState) -> [f64; 14] {
         st.g[1].d2,
         st.theta.d1,
         st.theta.d2,
+        st.s[0].d1,
+        st.s[1].d1,
+        st.s[2].d1,
+        st.s[0].d2,
+        st.s[1].d2,
+        st.s[2].d2,
+        fa[0],
+        fa[1],
+        fa[2],
     ]
 }
 
-/// Write the table as CSV, whole or not at all.
-pub fn write_kinematics_csv(path: &Path, states: &[RigidState]) -> Result<(), KinematicsError> {
+/// Write the table of the robot `params` as CSV, whole or not at all.
+pub fn write_kinematics_csv(path: &Path, params: &RobotParams, states: &[RigidState]) -> Result<(), KinematicsError> {
     write_atomically(path, |w| {
         let mut out = csv::Writer::from_writer(w);
         out.write_record(KINEMATICS_HEADER)?;
         for st in states {
-            out.write_record(row(st).iter().map(|v| fmt_number(*v)))?;
+            out.write_record(row(params, st).iter().map(|v| fmt_number(*v)))?;
         }
         out.flush()?;
         Ok(())
     })
     .map_err(KinematicsError::Write)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flexstar_model::catalogue::paper_case;
+
+    #[test]
+    fn every_column_has_a_unit_and_the_forces_are_the_rigid_inverse_dynamics() {
+        for name in KINEMATICS_HEADER {
+            assert!(
+                flexstar_model::response::column_unit(name).is_some(),
+                "{name} has no unit"
+            );
+        }
+        let exp = paper_case(3);
+        let st = RigidState::at(&exp.robot, &exp.trajectory, 0.25).unwrap();
+        let r = row(&exp.robot, &st);
+        let col = |name: &str| r[KINEMATICS_HEADER.iter().position(|c| *c == name).unwrap()];
+        let f = rigid_inverse_dynamics(&exp.robot, &st);
+        for i in 0..3 {
+            assert_eq!(col(&format!("Fa{}", i + 1)), f.fa[i]);
+            assert_eq!(col(&format!("sd{}", i + 1)), st.s[i].d1);
+            assert_eq!(col(&format!("sdd{}", i + 1)), st.s[i].d2);
+        }
+        // today's columns keep their place
+        assert_eq!(
+            KINEMATICS_HEADER[..14].join(","),
+            "t,s1,s2,s3,Gx,Gy,theta,xp1,xp2,xp3,aGx,aGy,thetadot,thetaddot"
+        );
+    }
 }

@@ -291,6 +291,10 @@ impl AmmSettings {
     }
 }
 
+/// The FEM's default spectral radius at infinity of its generalized-alpha scheme (`[fem] rho_inf`
+/// left out); `flexstar_fem::DEFAULT_RHO_INF` is this value.
+pub const FEM_DEFAULT_RHO_INF: f64 = 0.7;
+
 /// `[fem]` section: settings of the finite-element reference. Command-line flags override them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

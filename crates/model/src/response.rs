@@ -15,6 +15,102 @@ pub use crate::validity::{small_deflection_check, Provenance, ValidityExceeded};
 /// Fixed leading CSV columns of every solver result (issue contract).
 pub const RESPONSE_HEADER: [&str; 10] = ["t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3"];
 
+/// Unit of every column of every CSV flexstar writes for a run or a motion (SI; `docs/outputs.md`
+/// lists the same): the solver results (fixed columns, the AMM's and the FEM's extra columns), a
+/// direct run's file and `kinematics.csv`. The sidecar's `column_units` is drawn from here.
+pub const COLUMN_UNITS: &[(&str, &str)] = &[
+    ("t", "s"),
+    // fixed columns of every solver result
+    ("w1G", "m"),
+    ("w2G", "m"),
+    ("w3G", "m"),
+    ("w1tip", "m"),
+    ("w2tip", "m"),
+    ("w3tip", "m"),
+    ("Fa1", "N"),
+    ("Fa2", "N"),
+    ("Fa3", "N"),
+    // the AMM's multipliers and coordinates
+    ("Fix1", "N"),
+    ("Fix2", "N"),
+    ("Fix3", "N"),
+    ("M1G", "N m"),
+    ("M2G", "N m"),
+    ("M3G", "N m"),
+    ("Fw", "N"),
+    ("Fp1", "N"),
+    ("Fp2", "N"),
+    ("Fp3", "N"),
+    ("FLp1", "N"),
+    ("FLp2", "N"),
+    ("FLp3", "N"),
+    ("FRp1", "N"),
+    ("FRp2", "N"),
+    ("FRp3", "N"),
+    ("Mp1", "N m"),
+    ("Mp2", "N m"),
+    ("Mp3", "N m"),
+    ("thp1", "rad"),
+    ("thp2", "rad"),
+    ("thp3", "rad"),
+    ("u1", "m"),
+    ("u2", "m"),
+    ("u3", "m"),
+    // the FEM's columns (thp1..3 as above)
+    ("xp1", "m"),
+    ("xp2", "m"),
+    ("xp3", "m"),
+    ("Fn1", "N"),
+    ("Fn2", "N"),
+    ("Fn3", "N"),
+    ("dGx", "m"),
+    ("dGy", "m"),
+    ("Ek_star", "J"),
+    ("Ek_sleeves", "J"),
+    ("Ek_sliders", "J"),
+    ("U", "J"),
+    ("W", "J"),
+    ("slopeG", "rad"),
+    // a direct run's columns and kinematics.csv (xp1..3, Fa1..3 as above)
+    ("s1", "m"),
+    ("s2", "m"),
+    ("s3", "m"),
+    ("sd1", "m/s"),
+    ("sd2", "m/s"),
+    ("sd3", "m/s"),
+    ("sdd1", "m/s^2"),
+    ("sdd2", "m/s^2"),
+    ("sdd3", "m/s^2"),
+    ("Gx", "m"),
+    ("Gy", "m"),
+    ("theta", "rad"),
+    ("e1", "m"),
+    ("e2", "m"),
+    ("e3", "m"),
+    ("aGx", "m/s^2"),
+    ("aGy", "m/s^2"),
+    ("thetadot", "rad/s"),
+    ("thetaddot", "rad/s^2"),
+];
+
+/// The unit of column `name` in [`COLUMN_UNITS`], `None` for a name flexstar does not write.
+pub fn column_unit(name: &str) -> Option<&'static str> {
+    COLUMN_UNITS.iter().find(|(n, _)| *n == name).map(|(_, u)| *u)
+}
+
+/// `{column: unit}` for the columns `names` (the sidecar's `column_units`); a column without an
+/// entry in [`COLUMN_UNITS`] gets `null` (the tests keep the table complete).
+pub fn column_units<S: AsRef<str>>(names: &[S]) -> serde_json::Value {
+    let map = names
+        .iter()
+        .map(|n| {
+            let unit = column_unit(n.as_ref()).map_or(serde_json::Value::Null, |u| u.into());
+            (n.as_ref().to_string(), unit)
+        })
+        .collect::<serde_json::Map<_, _>>();
+    serde_json::Value::Object(map)
+}
+
 /// A named extra output column (multipliers, sleeve rotations, ...), one value per output time.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Column {
@@ -279,11 +375,42 @@ impl Response {
         })
     }
 
+    /// The experiment as this run used it: `experiment` with the values the run took written in
+    /// where the file left a default (`null`): the robot's `EA`; for an AMM run the family,
+    /// equations, N used, the tolerance N was chosen for (automatic N) and the step of `[amm]`;
+    /// for an FEM run the elements, step and `rho_inf` of `[fem]`. The other solver's section is
+    /// kept as written (this run used none of it).
+    pub fn resolved_experiment(&self, experiment: &crate::Experiment) -> crate::Experiment {
+        let mut exp = experiment.clone();
+        let info = &self.info;
+        exp.robot.ea = Some(exp.robot.ea());
+        if info.solver.starts_with("amm") {
+            let amm = &mut exp.amm;
+            if let Some(f) = info.family.as_deref().and_then(|f| f.parse().ok()) {
+                amm.family = f;
+            }
+            if let Some(m) = info.model.as_deref().and_then(|m| m.parse().ok()) {
+                amm.model = m;
+            }
+            amm.modes = info.modes.or(amm.modes);
+            amm.tol = info.tol_percent;
+            amm.dt = Some(info.dt);
+        } else if info.solver.starts_with("fem") {
+            let fem = &mut exp.fem;
+            fem.elements = info.elements.unwrap_or(fem.elements);
+            fem.dt = Some(info.dt);
+            fem.rho_inf = Some(fem.rho_inf.unwrap_or(crate::config::FEM_DEFAULT_RHO_INF));
+        }
+        exp
+    }
+
     /// The sidecar document of a run (what [`Response::write_sidecar`] writes):
     /// `flexstar_version`, `commit` (when known), `date` (UTC, of the run), the `label`, every field
     /// of [`RunInfo`], `small_deflection` (the check of [`small_deflection_check`]: `null` when the
-    /// run stays in range, else the first time, the quantity, its value and the bound) and the
-    /// resolved `experiment`. Fields are listed in `docs/outputs.md`; `path` only names errors.
+    /// run stays in range, else the first time, the quantity, its value and the bound),
+    /// `column_units` (`{column: unit}` for every column of the run's CSV, [`COLUMN_UNITS`]) and
+    /// the resolved `experiment` ([`Response::resolved_experiment`]). Fields are listed in
+    /// `docs/outputs.md`; `path` only names errors.
     pub fn sidecar(
         &self,
         path: &Path,
@@ -311,7 +438,9 @@ impl Response {
         }
         let validity = serde_json::to_value(small_deflection_check(self, experiment.robot.l)).map_err(fail)?;
         doc.insert("small_deflection".into(), validity);
-        doc.insert("experiment".into(), serde_json::to_value(experiment).map_err(fail)?);
+        doc.insert("column_units".into(), column_units(&self.header()));
+        let resolved = self.resolved_experiment(experiment);
+        doc.insert("experiment".into(), serde_json::to_value(&resolved).map_err(fail)?);
         Ok(serde_json::Value::Object(doc))
     }
 
@@ -337,11 +466,7 @@ impl Response {
     ) -> Result<(), ModelError> {
         let path = set.path(name);
         let doc = self.sidecar(&path, experiment, provenance)?;
-        let text = serde_json::to_string_pretty(&doc).map_err(|e| ModelError::Write {
-            file: path.clone(),
-            reason: e.to_string(),
-        })?;
-        set.text(name, &(text + "\n"))?;
+        set.text(name, &sidecar_text(&path, &doc)?)?;
         Ok(())
     }
 
@@ -404,6 +529,144 @@ mod tests {
     use super::*;
     use crate::config::TimeSpan;
 
+    /// `(column, unit)` of every row of the `| column | unit | meaning |` tables of
+    /// `docs/outputs.md` but the deformed star's (`-shapes.csv`, not a run's table); the names in
+    /// backticks, `Fix1..3` read as Fix1, Fix2, Fix3.
+    fn documented_units() -> Vec<(String, String)> {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/outputs.md");
+        let text = std::fs::read_to_string(path).expect("docs/outputs.md");
+        let mut out = Vec::new();
+        let (mut columns, mut shapes) = (false, false);
+        for line in text.lines() {
+            if line.starts_with("## ") {
+                shapes = line.contains("-shapes.csv");
+            }
+            if !line.starts_with('|') {
+                columns = false;
+                continue;
+            }
+            if line.starts_with("| column | unit |") {
+                columns = true;
+            }
+            if !columns || shapes || !line.starts_with("| `") {
+                continue;
+            }
+            let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+            let (names, unit) = (cells[1], cells[2]);
+            for name in names.split('`').skip(1).step_by(2) {
+                match name.strip_suffix("1..3") {
+                    Some(stem) => out.extend((1..=3).map(|i| (format!("{stem}{i}"), unit.to_string()))),
+                    None => out.push((name.to_string(), unit.to_string())),
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn every_column_unit_is_the_one_documented() {
+        let documented = documented_units();
+        for (name, unit) in COLUMN_UNITS {
+            let docs: Vec<&str> = documented
+                .iter()
+                .filter(|(n, _)| n == name)
+                .map(|(_, u)| u.as_str())
+                .collect();
+            assert!(!docs.is_empty(), "{name} is not in docs/outputs.md");
+            assert!(
+                docs.iter().all(|u| u == unit),
+                "{name}: {unit} here, {docs:?} in docs/outputs.md"
+            );
+        }
+        // and every documented result column is in the table (the files' fields are not columns)
+        for (name, unit) in &documented {
+            assert!(
+                column_unit(name).is_some(),
+                "{name} [{unit}] documented but not in COLUMN_UNITS"
+            );
+        }
+        let names: Vec<&str> = COLUMN_UNITS.iter().map(|(n, _)| *n).collect();
+        let mut unique = names.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), names.len(), "a column listed twice");
+        assert_eq!(
+            column_units(&["t", "nope"]),
+            serde_json::json!({"t": "s", "nope": null})
+        );
+    }
+
+    #[test]
+    fn the_resolved_experiment_has_the_values_used() {
+        let exp = crate::catalogue::paper_case(1);
+        assert!(exp.amm.dt.is_none() && exp.fem.dt.is_none() && exp.robot.ea.is_none());
+        let mut r = Response::with_capacity("amm-free-free", 0);
+        r.info = RunInfo {
+            solver: "amm".into(),
+            family: Some("free-free".into()),
+            model: Some("paper".into()),
+            modes: Some(51),
+            tol_percent: Some(0.5),
+            dt: 1e-4,
+            ..RunInfo::default()
+        };
+        let a = r.resolved_experiment(&exp);
+        assert_eq!(a.amm.family, crate::ModeFamily::FreeFree);
+        assert_eq!(a.amm.model, crate::AmmModel::Paper);
+        assert_eq!((a.amm.modes, a.amm.tol, a.amm.dt), (Some(51), Some(0.5), Some(1e-4)));
+        assert_eq!(a.robot.ea, Some(exp.robot.ea()));
+        assert_eq!(a.fem, exp.fem, "the FEM's section is the FEM's");
+        r.info = RunInfo {
+            solver: "fem-direct".into(),
+            elements: Some(108),
+            dt: 2e-4,
+            ..RunInfo::default()
+        };
+        let f = r.resolved_experiment(&exp);
+        assert_eq!((f.fem.elements, f.fem.dt, f.fem.rho_inf), (108, Some(2e-4), Some(0.7)));
+        assert_eq!(f.amm, exp.amm);
+        // the sidecar writes it, and no null is left in the section of the run's solver
+        let prov = Provenance {
+            version: "0".into(),
+            commit: None,
+            date: "d".into(),
+        };
+        let doc = r.sidecar(Path::new("fem.json"), &exp, &prov).unwrap();
+        let fem = doc["experiment"]["fem"].as_object().unwrap();
+        assert!(fem.values().all(|v| !v.is_null()), "{fem:?}");
+        assert_eq!(doc["experiment"]["robot"]["EA"], serde_json::json!(exp.robot.ea()));
+        assert_eq!(doc["column_units"]["w1tip"], "m");
+    }
+
+    #[test]
+    fn every_sidecar_writer_writes_the_text_of_sidecar_text() {
+        let exp = crate::catalogue::paper_case(2);
+        let mut r = Response::with_capacity("fem", 1);
+        r.push(0.0, [1e-3, 0.0, -0.0], [0.5; 3], [2.0; 3]);
+        r.info.solver = "fem".into();
+        let prov = Provenance {
+            version: "0.1.0".into(),
+            commit: Some("abc".into()),
+            date: "2026-01-01T00:00:00Z".into(),
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let doc = r.sidecar(Path::new("fem.json"), &exp, &prov).unwrap();
+        let want = sidecar_text(Path::new("fem.json"), &doc).unwrap();
+        assert_eq!(
+            want,
+            serde_json::to_string_pretty(&doc).unwrap() + "\n",
+            "pretty JSON, final newline"
+        );
+        let mut set = RunSet::begin(dir.path()).unwrap();
+        r.stage_sidecar(&mut set, "staged.json", &exp, &prov).unwrap();
+        set.commit().unwrap();
+        r.write_sidecar(&dir.path().join("written.json"), &exp, &prov).unwrap();
+        write_sidecar_value(&dir.path().join("value.json"), &doc).unwrap();
+        for f in ["staged.json", "written.json", "value.json"] {
+            assert_eq!(std::fs::read_to_string(dir.path().join(f)).unwrap(), want, "{f}");
+        }
+    }
+
     #[test]
     fn every_nth_lands_on_the_coarser_output_grid() {
         // a span that is not a multiple of either interval: both grids end at t_end
@@ -436,11 +699,17 @@ mod tests {
     }
 }
 
-/// Write a sidecar document as pretty JSON with a final newline, whole or not at all.
-pub fn write_sidecar_value(path: &Path, doc: &serde_json::Value) -> Result<(), ModelError> {
+/// The text of a sidecar file: the document as pretty JSON with a final newline (the one place
+/// of this format; `path` only names errors).
+pub fn sidecar_text(path: &Path, doc: &serde_json::Value) -> Result<String, ModelError> {
     let text = serde_json::to_string_pretty(doc).map_err(|e| ModelError::Write {
         file: path.to_path_buf(),
         reason: e.to_string(),
     })?;
-    crate::output::write_string_atomically(path, &(text + "\n"))
+    Ok(text + "\n")
+}
+
+/// Write a sidecar document ([`sidecar_text`]), whole or not at all.
+pub fn write_sidecar_value(path: &Path, doc: &serde_json::Value) -> Result<(), ModelError> {
+    crate::output::write_string_atomically(path, &sidecar_text(path, doc)?)
 }

@@ -45,6 +45,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let outcome = outcome?;
     super::print_warnings(&outcome.warnings);
     println!("{}", outcome.compare_csv.trim_end());
+    if let Some(servo) = &outcome.servo {
+        // after the CSV and a blank line, so that the table above still reads as compare.csv
+        println!("\n{}", servo.gains_line());
+        for line in servo.tracking_lines() {
+            println!("{line}");
+        }
+    }
     eprintln!(
         "compare: solves {:.2} s, total {:.2} s; behaviour of G: {}; closest to the FEM: {}; outputs in {}",
         outcome.solve_seconds,

@@ -206,31 +206,13 @@ fn coupled_step(
     Ok([0, 1, 2].map(|i| x_pred[i] + dx[i]))
 }
 
-/// Gaussian elimination with partial pivoting of a 3 x 3 system given as augmented rows.
-fn solve3(mut a: [[f64; 4]; 3]) -> Option<[f64; 3]> {
-    for k in 0..3 {
-        let p = (k..3).max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))?;
-        a.swap(k, p);
-        if a[k][k].abs() < 1e-300 || !a[k][k].is_finite() {
-            return None;
-        }
-        let pivot = a[k];
-        for row in a.iter_mut().skip(k + 1) {
-            let f = row[k] / pivot[k];
-            for (x, p) in row.iter_mut().zip(pivot).skip(k) {
-                *x -= f * p;
-            }
-        }
-    }
-    let mut x = [0.0; 3];
-    for k in (0..3).rev() {
-        let mut v = a[k][3];
-        for c in k + 1..3 {
-            v -= a[k][c] * x[c];
-        }
-        x[k] = v / a[k][k];
-    }
-    Some(x)
+/// The 3 x 3 system given as augmented rows, by nalgebra's LU with partial pivoting; `None` when
+/// it is singular or the solution is not finite.
+fn solve3(a: [[f64; 4]; 3]) -> Option<[f64; 3]> {
+    let m = nalgebra::Matrix3::from_fn(|i, j| a[i][j]);
+    let b = nalgebra::Vector3::from_fn(|i, _| a[i][3]);
+    let x = m.lu().solve(&b)?;
+    x.iter().all(|v| v.is_finite()).then(|| [x[0], x[1], x[2]])
 }
 
 /// [`solve_direct`] at N = `n_modes`: the system and recorder set up, the consistent start, then

@@ -370,6 +370,15 @@ fn bad_input_is_rejected_before_any_work() {
         }
         other => panic!("{other}"),
     }
+    // the preflight's proof of the feasible 0.4 s motion does not cover the run to 0.5 s: the
+    // solver scans it itself and refuses it the same way
+    let short = paper_case(2);
+    let step = flexstar_kinematics::preflight_step(short.time.dt_out);
+    let proof = flexstar_kinematics::check_motion(&short.robot, &short.trajectory, short.time.t_end, step).unwrap();
+    match flexstar_amm::solve_checked(&long, &settings(ModeFamily::SlideFree, 25, None), &proof).unwrap_err() {
+        AmmError::Infeasible(inf) => assert!(inf.t > 0.4 && inf.t < 0.5, "{inf}"),
+        other => panic!("{other}"),
+    }
     // too few modes for the twelve sleeve constraints: a clear error, not a panic
     match solve(&exp, &settings(ModeFamily::PinnedFree, 2, None)).unwrap_err() {
         e @ AmmError::TooFewModes { t, modes: 2, .. } => assert!(t == 0.0 && e.to_string().contains("too few"), "{e}"),

@@ -13,6 +13,7 @@
 //! and for slider i (mass mpp + mpa along u_i), Eq. 33 with `e_wi . u_i = cos(theta)`:
 //! `Fa_i = (mpp + mpa) s_i'' + f_i e_wi . u_i`.
 
+use nalgebra::{Matrix3, Vector3};
 use flexstar_model::geometry::slider_direction;
 use flexstar_model::RobotParams;
 
@@ -43,14 +44,15 @@ pub fn rigid_inverse_dynamics(params: &RobotParams, state: &RigidState) -> Rigid
     RigidForces { fa, normal }
 }
 
-/// Cramer's rule for a 3x3 system given as augmented rows (the matrix is well conditioned
-/// whenever the Fermat point exists: the e_wi are 120 degrees apart).
+/// Cramer's rule for a 3x3 system given as augmented rows, on nalgebra's determinant (the
+/// matrix is well conditioned whenever the Fermat point exists: the e_wi are 120 degrees apart).
 fn solve3(r: [[f64; 4]; 3]) -> [f64; 3] {
-    let det = |c: [usize; 3]| {
-        r[0][c[0]] * (r[1][c[1]] * r[2][c[2]] - r[1][c[2]] * r[2][c[1]])
-            - r[0][c[1]] * (r[1][c[0]] * r[2][c[2]] - r[1][c[2]] * r[2][c[0]])
-            + r[0][c[2]] * (r[1][c[0]] * r[2][c[1]] - r[1][c[1]] * r[2][c[0]])
-    };
-    let d = det([0, 1, 2]);
-    [det([3, 1, 2]) / d, det([0, 3, 2]) / d, det([0, 1, 3]) / d]
+    let a = Matrix3::from_fn(|i, j| r[i][j]);
+    let b = Vector3::from_fn(|i, _| r[i][3]);
+    let d = a.determinant();
+    [0, 1, 2].map(|c| {
+        let mut with_b = a;
+        with_b.set_column(c, &b);
+        with_b.determinant() / d
+    })
 }

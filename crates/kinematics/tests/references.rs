@@ -266,3 +266,37 @@ fn slider_force_direction_is_cos_theta() {
         assert!((q[0] - st.p[i][0]).abs() < 1e-15);
     }
 }
+
+/// The preflight's proof (`check_motion`) covers exactly what it checked: the same robot and
+/// trajectory, a span and a scan step no finer; a faster version of a motion that leaves the
+/// feasible range is not covered by the proof of the slow one, and the check itself refuses it
+/// at the time `check_trajectory` names.
+#[test]
+fn a_checked_motion_covers_only_what_was_checked() {
+    use flexstar_kinematics::{check_motion, check_trajectory, preflight_step};
+    use flexstar_model::Trajectory;
+    let exp = flexstar_model::catalogue::paper_case(3);
+    let (p, traj, t_end) = (exp.robot, exp.trajectory.clone(), exp.time.t_end);
+    let step = preflight_step(exp.time.dt_out);
+    let proof = check_motion(&p, &traj, t_end, step).expect("case 3 is feasible");
+    assert!(proof.covers(&p, &traj, t_end, step));
+    assert!(proof.covers(&p, &traj, 0.5 * t_end, 2.0 * step), "a shorter span, a coarser scan");
+    assert!(!proof.covers(&p, &traj, 2.0 * t_end, step), "a longer span is not covered");
+    assert!(!proof.covers(&p, &traj, t_end, 0.5 * step), "a finer scan is not covered");
+    let mut other = p;
+    other.lp *= 1.5;
+    assert!(!proof.covers(&other, &traj, t_end, step), "another robot");
+    // the same polynomial ten times faster leaves the range: not covered, and refused
+    let fast = match &traj {
+        Trajectory::Polynomial { s1, s2, s3 } => {
+            let scale = |c: &Vec<f64>| c.iter().enumerate().map(|(k, v)| v * 10f64.powi(k as i32)).collect();
+            Trajectory::Polynomial { s1: scale(s1), s2: scale(s2), s3: scale(s3) }
+        }
+        other => panic!("case 3 is a polynomial motion, got {other:?}"),
+    };
+    assert!(!proof.covers(&p, &fast, t_end, step));
+    let refused = check_motion(&p, &fast, t_end, step).expect_err("ten times faster leaves the range");
+    let reference = check_trajectory(&p, &fast, t_end, step).expect_err("the same check");
+    assert_eq!(refused.t, reference.t);
+    assert!(refused.t > 0.0 && refused.t < t_end);
+}

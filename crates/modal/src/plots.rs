@@ -196,6 +196,14 @@ pub struct MapPath {
     pub style: Style,
 }
 
+/// Colours of the paper's four cases' paths (the `f1_paths` example's figure).
+pub const PATH_COLORS: [RGBColor; 4] = [
+    RGBColor(214, 39, 40),
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(227, 119, 194),
+];
+
 /// Colour of the experiment's path over a frequency map.
 pub const PATH_COLOR: RGBColor = RGBColor(214, 39, 40);
 

@@ -472,6 +472,19 @@ mod tests {
     }
 
     #[test]
+    fn the_map_shows_the_experiments_own_path() {
+        let mut exp = flexstar_model::catalogue::paper_case(3);
+        let path = trajectory_path(&exp).expect("a motion has a path");
+        assert_eq!(path.label, "G(t) of case3, t = 0 .. 0.5 s");
+        // one point per output time, from G(0) (independent: the rigid kinematics at t = 0)
+        assert_eq!(path.points.len(), exp.time.output_times().len());
+        let g0 = flexstar_kinematics::RigidState::at(&exp.robot, &exp.trajectory, 0.0).unwrap();
+        assert_eq!(path.points[0], (g0.g[0].v, g0.g[1].v));
+        exp.drive.kind = flexstar_model::DriveKind::Forces;
+        assert!(trajectory_path(&exp).is_none(), "a forces drive has no prescribed path");
+    }
+
+    #[test]
     fn paths_are_cut_where_they_leave_the_map() {
         let p = [(0.0, 0.0), (0.5, 0.0), (2.0, 0.0), (0.2, 0.1)];
         let c = clipped(&p, (-1.0, 1.0), (-1.0, 1.0));

@@ -174,19 +174,28 @@ fn run_writes_the_contracted_solver_tables() {
     let cfg = short_case1(dir.path(), "0.05");
     let out = dir.path().join("out");
     let out_s = out.to_str().unwrap();
-    for (args, file) in [
+    // stderr says what is solved in words (`N = 12`, `tol = 2 %`), not in Debug forms (issue 24)
+    for (args, file, said) in [
         (
             vec!["--solver", "amm", "--family", "slide-free", "--modes", "12"],
             "amm-slide-free.csv",
+            "case1: AMM, N = 12, slide-free",
         ),
-        (vec!["--solver", "amm"], "amm-pinned-free.csv"), // family from the config's [amm] section
-        (vec!["--solver", "fem", "--elements", "108"], "fem.csv"),
+        // family from the config's [amm] section
+        (vec!["--solver", "amm"], "amm-pinned-free.csv", "case1: AMM, N = 25, pinned-free"),
+        (
+            vec!["--solver", "amm", "--family", "enriched", "--tol", "2"],
+            "amm-enriched.csv",
+            "case1: AMM, tol = 2 %, enriched",
+        ),
+        (vec!["--solver", "fem", "--elements", "108"], "fem.csv", "case1: FEM, 108 elements"),
     ] {
         let mut all = vec!["run", cfg.as_str()];
         all.extend(args.iter().copied());
         all.extend(["--out", out_s]);
         let o = flexstar(&all);
         assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(said), "{args:?}: {}", stderr(&o));
         let text = std::fs::read_to_string(out.join("case1").join(file)).unwrap();
         let header = text.lines().next().unwrap();
         assert!(
@@ -203,15 +212,31 @@ fn run_refuses_bad_settings_before_any_work() {
     let cfg = short_case1(dir.path(), "0.05");
     let out = dir.path().join("out");
     let out_s = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    // a flag's error names the flag first, with no empty file or key parts (issue 24)
+    let cases: [(&[&str], &str); 10] = [
         (&["--solver", "amm", "--family", "hinged-free"], "hinged-free"),
-        (&["--solver", "amm", "--modes", "0"], "amm.modes"),
-        (&["--solver", "amm", "--modes", "100000"], "amm.modes"),
+        (&["--solver", "amm", "--modes", "0"], "error: --modes: need 1 <= modes <= 400, got 0"),
+        (&["--solver", "amm", "--modes", "100000"], "error: --modes: need 1 <= modes <= 400"),
         (
             &["--solver", "amm", "--dt", "0.01"],
-            "short.toml: key `--dt`: the step 0.01 s is larger than the output interval",
+            "error: --dt: the step 0.01 s is larger than the output interval",
         ),
-        (&["--solver", "fem", "--elements", "301"], "fem.elements"),
+        (&["--solver", "fem", "--dt=-1"], "error: --dt: the step must be positive, got -1"),
+        (&["--solver", "fem", "--elements", "301"], "error: --elements: need a multiple of 3"),
+        (
+            &["--solver", "amm", "--tol=-0.5"],
+            "error: --tol: the tolerance must be a positive percentage, got -0.5",
+        ),
+        (&["--solver", "amm", "--tol", "1e-9"], "error: --tol: the tolerance 0.000000001 % is below"),
+        (
+            &["--solver", "amm", "--family", "enriched", "--modes", "2"],
+            "error: --modes: the enriched family needs N >= 4",
+        ),
+        // the file refuses `modes` with `tol`; so do the flags, in the same words
+        (
+            &["--solver", "amm", "--modes", "10", "--tol", "0.5"],
+            "error: --modes, --tol: give either --modes (a fixed N) or --tol (N chosen to meet the tolerance), not both",
+        ),
     ];
     for (args, needle) in cases {
         let mut all = vec!["run", cfg.as_str()];
@@ -220,6 +245,7 @@ fn run_refuses_bad_settings_before_any_work() {
         let o = flexstar(&all);
         assert!(!o.status.success(), "{args:?} accepted");
         assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains(": : ") && !stderr(&o).contains("key ``"), "{}", stderr(&o));
         assert!(!out.join("case1").exists() || std::fs::read_dir(out.join("case1")).unwrap().count() == 0);
     }
     // a trajectory that leaves the feasible range: refused with the time, nothing written
@@ -345,6 +371,15 @@ fn modes_lists_textbook_roots() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("4.7300407") && text.contains("7.8532046"), "{text}");
+    // the parameters read as a person writes them (E I = 0.5 N m^2, not 0.49999999999999994)
+    assert!(
+        text.starts_with("# free-free modes, L = 0.5 m, EI = 0.5 N m^2, rho = 0.234 kg/m\n"),
+        "{text}"
+    );
+    // a bad N names the flag, not an empty file
+    let o = flexstar(&["modes", "--family", "enriched", "-n", "1"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("error: --modes: the enriched family needs N >= 4"), "{}", stderr(&o));
 }
 
 #[test]

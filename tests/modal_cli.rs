@@ -73,7 +73,8 @@ fn modal_writes_the_contracted_table_and_shapes() {
             p.display()
         );
     }
-    // free sliders: three rigid modes at 0 Hz first, then K elastic ones
+    // free sliders: three rigid modes at 0 Hz first, then K elastic ones (other settings into
+    // the same folder: --force replaces the table)
     let o = flexstar(&[
         "modal",
         &cfg,
@@ -83,6 +84,7 @@ fn modal_writes_the_contracted_table_and_shapes() {
         "free",
         "--modes",
         "2",
+        "--force",
         "--out",
         out.to_str().unwrap(),
     ]);
@@ -91,6 +93,138 @@ fn modal_writes_the_contracted_table_and_shapes() {
     assert_eq!(r.len(), 5);
     assert!(r[..3].iter().all(|x| num(&x[1]) == 0.0 && num(&x[2]) == 0.0));
     assert!(r[3..].iter().all(|x| num(&x[1]) > 1.0 && num(&x[3]).abs() < 0.015));
+}
+
+/// The sidecar JSON as a value.
+fn json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
+/// modal.json and freqmap.json beside their tables: provenance, solver(s), pose or grid,
+/// sliders, K, the resolved experiment. A rerun with other settings is refused naming the file
+/// and what differs, and leaves the files as they were; an identical rerun and `--force`
+/// replace them (issue 24).
+#[test]
+fn modal_and_freqmap_sidecars_guard_the_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_config(dir.path());
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let case = out.join("small");
+    let modal = |extra: &[&str]| {
+        let mut args = vec!["modal", &cfg, "--modes", "3", "--out", out_s];
+        args.extend(extra);
+        flexstar(&args)
+    };
+    let o = modal(&["--pose", "0.03,-0.02,0.1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m = json(&case.join("modal.json"));
+    assert_eq!(m["command"], "modal");
+    assert_eq!(m["table"], "modal.csv");
+    assert_eq!(m["K"], 3);
+    assert_eq!(m["sliders"], "locked");
+    assert_eq!(m["pose"]["task"], serde_json::json!([0.03, -0.02, 0.1]));
+    // G of the rest pose, from the sliders by the direct kinematics: the pose asked for
+    let g: Vec<f64> = m["pose"]["G"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert!((g[0] - 0.03).abs() < 1e-12 && (g[1] + 0.02).abs() < 1e-12, "{g:?}");
+    assert_eq!(m["pose"]["s"].as_array().map(Vec::len), Some(3));
+    assert_eq!(m["solvers"][0]["solver"], "amm");
+    assert_eq!(m["solvers"][0]["modes_per_beam"], 40);
+    assert_eq!(m["solvers"][1]["elements"], 102);
+    assert_eq!(m["experiment"]["name"], "small");
+    assert_eq!(m["flexstar_version"], env!("CARGO_PKG_VERSION"));
+    assert!(m["date"].as_str().is_some_and(|d| d.ends_with('Z')), "{m}");
+    // the same settings again: replaced
+    let o = modal(&["--pose", "0.03,-0.02,0.1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let before = std::fs::read(case.join("modal.csv")).unwrap();
+    let meta = std::fs::read(case.join("modal.json")).unwrap();
+    for (extra, needle) in [
+        (vec!["--pose", "0,0,0"], "pose: "),
+        (vec!["--pose", "0.03,-0.02,0.1", "--sliders", "free"], "sliders: \"locked\" -> \"free\""),
+        (vec!["--at", "0.25"], "pose: "),
+    ] {
+        let o = modal(&extra);
+        assert!(!o.status.success(), "{extra:?} replaced the table");
+        let e = stderr(&o);
+        assert!(e.contains("modal.csv") && e.contains("other settings") && e.contains(needle), "{e}");
+        assert!(e.contains("--force"), "{e}");
+        assert_eq!(std::fs::read(case.join("modal.csv")).unwrap(), before, "{extra:?}");
+        assert_eq!(std::fs::read(case.join("modal.json")).unwrap(), meta, "{extra:?}");
+    }
+    let o = modal(&["--pose", "0,0,0", "--force"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(json(&case.join("modal.json"))["pose"]["task"], serde_json::json!([0.0, 0.0, 0.0]));
+    // the map: the grid, solver, sliders, K
+    let map = |extra: &[&str]| {
+        let mut args = vec!["freqmap", &cfg, "--gy", "-0.1:0.1:3", "--modes", "2", "--out", out_s];
+        args.extend(extra);
+        flexstar(&args)
+    };
+    let o = map(&["--gx", "-0.1:0.1:3"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let f = json(&case.join("freqmap.json"));
+    assert_eq!(f["command"], "freqmap");
+    assert_eq!(f["grid"]["Gx"], serde_json::json!({ "min": -0.1, "max": 0.1, "n": 3 }));
+    assert_eq!(f["grid"]["theta"], 0.0);
+    assert_eq!((f["K"].clone(), f["sliders"].clone()), (2.into(), "locked".into()));
+    assert_eq!(f["solver"]["solver"], "amm");
+    assert_eq!(f["experiment"]["name"], "small");
+    let before = std::fs::read(case.join("freqmap.csv")).unwrap();
+    for (extra, needle) in [
+        (vec!["--gx", "-0.1:0.1:5"], "grid: "),
+        (vec!["--gx", "-0.1:0.1:3", "--solver", "fem"], "solver: "),
+        (vec!["--gx", "-0.1:0.1:3", "--theta", "0.1"], "grid: "),
+    ] {
+        let o = map(&extra);
+        assert!(!o.status.success(), "{extra:?} replaced the map");
+        let e = stderr(&o);
+        assert!(e.contains("freqmap.csv") && e.contains(needle), "{e}");
+        assert_eq!(std::fs::read(case.join("freqmap.csv")).unwrap(), before, "{extra:?}");
+    }
+    let o = map(&["--gx", "-0.1:0.1:3"]);
+    assert!(o.status.success(), "identical rerun: {}", stderr(&o));
+    let o = map(&["--gx", "-0.1:0.1:5", "--force"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(rows(&case.join("freqmap.csv")).1.len(), 15);
+    // a table without its sidecar (an older flexstar): its settings cannot be told, refused
+    std::fs::remove_file(case.join("freqmap.json")).unwrap();
+    let o = map(&["--gx", "-0.1:0.1:5"]);
+    assert!(!o.status.success() && stderr(&o).contains("freqmap.json"), "{}", stderr(&o));
+}
+
+/// `freqmap --sliders free`: f1 is the first elastic frequency, equal to what `modal --sliders
+/// free` reports there (its mode 4, after the three rigid ones); the map is drawn over the
+/// experiment's own path G(t), not the paper's four; `modal` prints no negative zero.
+#[test]
+fn freqmap_with_free_sliders_and_the_experiments_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_config(dir.path());
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let case = out.join("small");
+    let grid = ["--gx", "-0.05:0.05:3", "--gy", "-0.05:0.05:3", "--modes", "2", "--out", out_s];
+    let mut args = vec!["freqmap", cfg.as_str(), "--sliders", "free"];
+    args.extend(grid);
+    let o = flexstar(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (header, map) = rows(&case.join("freqmap.csv"));
+    assert_eq!(header, "Gx,Gy,theta,feasible,f1_hz,f2_hz");
+    let centre = &map[4];
+    assert_eq!((num(&centre[0]), num(&centre[1])), (0.0, 0.0));
+    let svg = std::fs::read_to_string(case.join("freqmap.svg")).unwrap();
+    assert!(svg.contains("G(t) of small") && svg.contains("sliders free"), "no path of the experiment");
+    assert!(!svg.contains("case 1"), "the paper's paths are drawn");
+    let o = flexstar(&["modal", &cfg, "--pose", "0,0,0", "--sliders", "free", "--modes", "2", "--out", out_s]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(!e.contains("-0.00000") && !e.contains(" -0.000 %"), "a negative zero: {e}");
+    let (_, m) = rows(&case.join("modal.csv"));
+    for k in 0..2 {
+        let (map, full) = (num(&centre[4 + k]), num(&m[3 + k][1]));
+        assert!(map > 1.0 && (map / full - 1.0).abs() < 1e-7, "f{}: {map} vs {full}", k + 1);
+    }
 }
 
 /// freqmap.csv with the exact header, infeasible poses marked with the reason in the sidecar;

@@ -49,6 +49,27 @@ impl ApiError {
         }
     }
 
+    /// Bad value of a command-line flag (or a Python keyword): `--tol: the tolerance must be a
+    /// positive percentage, got -1`. The flag stands in the error's `file`; there is no key.
+    pub fn flag(flag: &str, reason: impl Into<String>) -> Self {
+        let reason = reason.into();
+        ApiError::Config {
+            file: flag.to_string(),
+            key: None,
+            message: format!("{flag}: {reason}"),
+            reason,
+        }
+    }
+
+    /// A model error raised by the value of `flag`: its reason after the flag ([`ApiError::flag`]);
+    /// other model errors as [`ApiError::from_model`].
+    pub fn from_flag(flag: &str, e: ModelError) -> Self {
+        match e {
+            ModelError::Invalid { reason, .. } => Self::flag(flag, reason),
+            other => Self::from_model(other),
+        }
+    }
+
     /// A config error whose text is given whole (the library's own wording kept).
     pub fn config_text(file: impl std::fmt::Display, key: Option<&str>, reason: &str, message: String) -> Self {
         ApiError::Config {

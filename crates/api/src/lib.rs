@@ -12,6 +12,7 @@ pub mod kinematics;
 pub mod modal;
 pub mod modes;
 pub mod run;
+pub mod sidecar;
 mod solver_errors;
 pub mod study;
 

@@ -4,16 +4,20 @@
 use std::path::{Path, PathBuf};
 
 use flexstar_modal::analysis::{amm_modes_per_beam, write_modal_csv, Modal};
-use flexstar_modal::freqmap::{check_grid, write_freqmap_csv, Axis};
+use flexstar_modal::freqmap::{check_grid, stage_freqmap_csv, Axis, Grid};
 use flexstar_modal::linear::StateSpace;
-use flexstar_modal::plots::{mode_shapes_figure, paper_paths, FreqMapFigure};
+use flexstar_modal::plots::{mode_shapes_figure, trajectory_path, FreqMapFigure};
 use flexstar_modal::pose::{pose_at_time, pose_from_task};
 use flexstar_modal::ModalError;
+use flexstar_model::output::{fmt_display, fmt_fixed, Dest};
+use flexstar_model::run_set::RunSet;
 use flexstar_model::{Experiment, ModeFamily, RestPose, Sliders};
 use flexstar_plot::write_svg_png;
+use serde_json::{json, Map, Value};
 
 pub use flexstar_modal::freqmap::{MapPoint, Solver as MapSolver};
 
+use crate::sidecar::TableSidecar;
 use crate::solver_errors::{from_amm, from_fem};
 use crate::{ApiError, Result};
 
@@ -88,8 +92,43 @@ pub struct ModalOutcome {
     pub files: Vec<PathBuf>,
 }
 
+/// The pose of a sidecar: how it was given (`at` [s] or `task` `[Gx, Gy, theta]`), then the rest
+/// pose it gives: sliders `s` [m], `G` [m], `theta` [rad].
+fn pose_json(spec: &PoseSpec, pose: &RestPose) -> Value {
+    let mut v = match spec {
+        PoseSpec::At(t) => json!({ "at": t }),
+        PoseSpec::Task { pose, .. } => json!({ "task": pose }),
+    };
+    v["s"] = json!(pose.s);
+    v["G"] = json!(pose.g);
+    v["theta"] = json!(pose.theta);
+    v
+}
+
+/// The AMM's basis and the FEM's mesh of the modal analyses of `exp`.
+fn amm_json(exp: &Experiment) -> Value {
+    let (family, n) = flexstar_modal::analysis::amm_basis(exp);
+    json!({ "solver": "amm", "family": family.to_string(), "modes_per_beam": n })
+}
+
+fn fem_json(exp: &Experiment) -> Value {
+    json!({ "solver": "fem", "elements": exp.fem.elements })
+}
+
+/// The settings of `modal`, as its sidecar records and a rerun compares them.
+fn modal_settings(exp: &Experiment, spec: &PoseSpec, pose: &RestPose, sliders: Sliders, k: usize) -> Map<String, Value> {
+    let mut m = Map::new();
+    m.insert("solvers".into(), json!([amm_json(exp), fem_json(exp)]));
+    m.insert("pose".into(), pose_json(spec, pose));
+    m.insert("sliders".into(), sliders.name().into());
+    m.insert("K".into(), k.into());
+    m
+}
+
 /// Modes at a pose from the AMM and the FEM, `k` elastic modes; with `out` writes
-/// `out/<name>/modal.csv` and `modal-shapes.svg/.png` (the folder checked before any work).
+/// `out/<name>/modal.csv` and its sidecar `modal.json` (published together), then
+/// `modal-shapes.svg/.png`. The folder is checked before any work, and a `modal.csv` written with
+/// other settings (solvers, pose, sliders, K) is kept (an error says what differs) unless `force`.
 pub fn modal(
     exp: &Experiment,
     source: &str,
@@ -97,30 +136,78 @@ pub fn modal(
     sliders: Sliders,
     k: usize,
     out: Option<&Path>,
+    force: bool,
 ) -> Result<ModalOutcome> {
     check_k(k)?;
     let pose = resolve_pose(exp, source, spec)?;
+    let sidecar = TableSidecar {
+        command: "modal",
+        csv: "modal.csv",
+        settings: modal_settings(exp, spec, &pose, sliders, k),
+        experiment: exp,
+    };
     let dir = out.map(|o| crate::case_dir(o, exp)).transpose()?;
+    if let Some(dir) = &dir {
+        sidecar.check_rerun(dir, force)?;
+    }
     let m =
         flexstar_modal::analysis::modal(exp, &pose, sliders, k).map_err(|e| from_modal(Some(source), f64::NAN, e))?;
     let mut files = Vec::new();
     if let Some(dir) = dir {
+        let mut set = RunSet::begin(&dir)?;
+        write_modal_csv(Dest::Set(&mut set, "modal.csv"), &m).map_err(|e| from_modal(None, f64::NAN, e))?;
+        sidecar.stage(&mut set)?;
+        set.commit()?;
         let figure = mode_shapes_figure("modal-shapes", &m, &pose, exp.robot.l);
-        let csv = dir.join("modal.csv");
-        write_modal_csv(&csv, &m).map_err(|e| from_modal(None, f64::NAN, e))?;
         write_svg_png(&figure, &dir)?;
-        files.extend([csv, dir.join("modal-shapes.svg"), dir.join("modal-shapes.png")]);
+        files.extend(["modal.csv", "modal.json", "modal-shapes.svg", "modal-shapes.png"].map(|f| dir.join(f)));
     }
     Ok(ModalOutcome { pose, modal: m, files })
 }
 
-/// A frequency map's grid: `gx`, `gy` [m] at orientation `theta` [rad], `k` frequencies.
+/// The pose and the sliders as `modal` reports them, five decimals and no `-0.00000`:
+/// `pose G = (0.03000, -0.02000) m, theta = 0.10000 rad, s = .../.../... m, sliders locked`.
+pub fn pose_text(pose: &RestPose, sliders: Sliders) -> String {
+    let f = |v: f64| fmt_fixed(v, 5);
+    format!(
+        "pose G = ({}, {}) m, theta = {} rad, s = {}/{}/{} m, sliders {}",
+        f(pose.g[0]),
+        f(pose.g[1]),
+        f(pose.theta),
+        f(pose.s[0]),
+        f(pose.s[1]),
+        f(pose.s[2]),
+        sliders.name()
+    )
+}
+
+/// One line per mode of a modal analysis: `mode  1: AMM   123.4567 Hz  FEM   123.4000 Hz    +0.046 %`
+/// (no negative zeros).
+pub fn mode_lines(m: &Modal) -> Vec<String> {
+    m.rows()
+        .into_iter()
+        .map(|(mode, a, f, rel)| {
+            let pct = fmt_fixed(100.0 * rel, 3);
+            let pct = if pct.starts_with('-') { pct } else { format!("+{pct}") };
+            format!(
+                "mode {mode:>2}: AMM {:>10} Hz  FEM {:>10} Hz  {pct:>8} %",
+                fmt_fixed(a, 4),
+                fmt_fixed(f, 4)
+            )
+        })
+        .collect()
+}
+
+/// A frequency map's grid: `gx`, `gy` [m] at orientation `theta` [rad], `k` frequencies, the
+/// sliders held as `sliders`; `force` replaces a map written with other settings.
 pub struct FreqmapSettings {
     pub gx: Axis,
     pub gy: Axis,
     pub theta: f64,
     pub k: usize,
     pub solver: MapSolver,
+    pub sliders: Sliders,
+    pub force: bool,
 }
 
 /// Parse a grid axis `MIN:MAX:N` (`flag` names it in errors).
@@ -128,9 +215,26 @@ pub fn parse_axis(flag: &str, text: &str) -> Result<Axis> {
     Axis::parse(flag, text).map_err(|e| from_modal(None, f64::NAN, e))
 }
 
-/// The first `k` frequencies (sliders locked) over the grid, in parallel (`tick(done, total)`
-/// from the workers); with `out` writes `out/<name>/freqmap.csv`, `freqmap-infeasible.csv` and
-/// the heat map `freqmap.svg/.png`. The figure holds the points.
+/// The settings of `freqmap`, as its sidecar records and a rerun compares them.
+fn freqmap_settings(exp: &Experiment, s: &FreqmapSettings) -> Map<String, Value> {
+    let axis = |a: &Axis| json!({ "min": a.min, "max": a.max, "n": a.n });
+    let solver = match s.solver {
+        MapSolver::Amm => amm_json(exp),
+        MapSolver::Fem => fem_json(exp),
+    };
+    let mut m = Map::new();
+    m.insert("solver".into(), solver);
+    m.insert("grid".into(), json!({ "Gx": axis(&s.gx), "Gy": axis(&s.gy), "theta": s.theta }));
+    m.insert("sliders".into(), s.sliders.name().into());
+    m.insert("K".into(), s.k.into());
+    m
+}
+
+/// The first `k` elastic frequencies over the grid, in parallel (`tick(done, total)` from the
+/// workers); with `out` writes `out/<name>/freqmap.csv`, `freqmap-infeasible.csv` and the sidecar
+/// `freqmap.json` (published together), then the heat map `freqmap.svg/.png` with the
+/// experiment's path G(t) over it. A `freqmap.csv` written with other settings (solver, grid,
+/// sliders, K) is kept (an error says what differs) unless `s.force`. The figure holds the points.
 pub fn freqmap<P>(
     exp: &Experiment,
     source: &str,
@@ -148,32 +252,55 @@ where
         let message = format!("--theta {}: {reason}", s.theta);
         return Err(ApiError::config_text("--theta", None, reason, message));
     }
-    let paths = paper_paths().map_err(|e| from_modal(None, f64::NAN, e))?;
-    let dir = out.map(|o| crate::case_dir(o, exp)).transpose()?;
-    let points = flexstar_modal::freqmap::freqmap(exp, &s.gx, &s.gy, s.theta, s.k, s.solver, tick)
-        .map_err(|e| from_modal(Some(source), f64::NAN, e))?;
-    let solver = if matches!(s.solver, MapSolver::Amm) {
-        "AMM"
-    } else {
-        "FEM"
+    let sidecar = TableSidecar {
+        command: "freqmap",
+        csv: "freqmap.csv",
+        settings: freqmap_settings(exp, &s),
+        experiment: exp,
     };
-    let figure = FreqMapFigure {
+    let dir = out.map(|o| crate::case_dir(o, exp)).transpose()?;
+    if let Some(dir) = &dir {
+        sidecar.check_rerun(dir, s.force)?;
+    }
+    let grid = Grid {
+        gx: s.gx,
+        gy: s.gy,
+        theta: s.theta,
+        sliders: s.sliders,
+    };
+    let points = flexstar_modal::freqmap::freqmap(exp, &grid, s.k, s.solver, tick)
+        .map_err(|e| from_modal(Some(source), f64::NAN, e))?;
+    let figure = freqmap_figure(exp, &s, points);
+    if let Some(dir) = dir {
+        let mut set = RunSet::begin(&dir)?;
+        stage_freqmap_csv(&mut set, &figure.points, s.k).map_err(|e| from_modal(None, f64::NAN, e))?;
+        sidecar.stage(&mut set)?;
+        set.commit()?;
+        write_svg_png(&figure, &dir)?;
+    }
+    Ok(figure)
+}
+
+/// The heat map of a frequency map, the experiment's path G(t) over it.
+fn freqmap_figure(exp: &Experiment, s: &FreqmapSettings, points: Vec<MapPoint>) -> FreqMapFigure {
+    let solver = match s.solver {
+        MapSolver::Amm => "AMM",
+        MapSolver::Fem => "FEM",
+    };
+    FreqMapFigure {
         name: "freqmap".into(),
         title: format!(
-            "{}: first frequencies over the workspace, theta = {} rad, sliders locked ({solver})",
-            exp.name, s.theta
+            "{}: first frequencies over the workspace, theta = {} rad, sliders {} ({solver})",
+            exp.name,
+            fmt_display(s.theta),
+            s.sliders.name()
         ),
         gx: s.gx,
         gy: s.gy,
         points,
         shown: s.k.min(2),
-        paths,
-    };
-    if let Some(dir) = dir {
-        write_freqmap_csv(&dir, &figure.points, s.k).map_err(|e| from_modal(None, f64::NAN, e))?;
-        write_svg_png(&figure, &dir)?;
+        paths: trajectory_path(exp).into_iter().collect(),
     }
-    Ok(figure)
 }
 
 /// The linear state-space model about a pose, sliders free (3 inputs Fa1..Fa3 [N], 9 outputs);
@@ -186,4 +313,23 @@ pub fn linearize(exp: &Experiment, source: &str, spec: &PoseSpec, out: Option<&P
         flexstar_modal::linear::write_linear(&dir, exp, &ss).map_err(|e| from_modal(Some(source), f64::NAN, e))?;
     }
     Ok(ss)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pose_is_reported_without_negative_zeros() {
+        let pose = RestPose {
+            s: [-0.0, -1e-9, 0.123456789],
+            g: [-2e-7, -0.03],
+            theta: -0.0,
+            xp: [0.1; 3],
+        };
+        assert_eq!(
+            pose_text(&pose, Sliders::Free),
+            "pose G = (0.00000, -0.03000) m, theta = 0.00000 rad, s = 0.00000/0.00000/0.12346 m, sliders free"
+        );
+    }
 }

@@ -89,14 +89,28 @@ pub struct Prepared {
     /// The preflight's proof that the motion (a servo's reference) is feasible over the span,
     /// handed to the solver so that it does not scan it again; `None` for a forces-driven run.
     checked: Option<CheckedMotion>,
+    /// The experiment keys a flag set, with the flag (`amm.modes`, `--modes`): a solver's refusal
+    /// of such a value is the flag's error.
+    flags: Vec<(&'static str, &'static str)>,
 }
 
 impl Prepared {
-    /// One line that says what will be solved (`case3: AMM, Tolerance(0.2), enriched`).
+    /// An AMM error of this run: a refused setting that a flag gave is the flag's error
+    /// (`--modes: the enriched family needs N >= 4 ...`), else as [`from_amm`].
+    fn amm_error(&self, e: flexstar_amm::AmmError) -> ApiError {
+        if let flexstar_amm::AmmError::InvalidSetting { key, reason } = &e {
+            if let Some((_, flag)) = self.flags.iter().find(|(k, _)| k == key) {
+                return ApiError::flag(flag, reason.clone());
+            }
+        }
+        from_amm(&self.source, e)
+    }
+
+    /// One line that says what will be solved (`case3: AMM, tol = 0.2 %, enriched`).
     pub fn describe(&self) -> String {
         match self.solver {
             Solver::Amm => format!(
-                "{}: AMM, {:?}, {}",
+                "{}: AMM, {}, {}",
                 self.exp.name,
                 self.exp.amm.mode_count(),
                 self.exp.amm.family
@@ -137,7 +151,7 @@ pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Res
         exp.drive = drive;
     }
     if let Some(dt) = settings.dt {
-        check_step("--dt", dt, exp.time.dt_out).map_err(|e| ApiError::model_in(source, Path::new(source), e))?;
+        check_step("--dt", dt, exp.time.dt_out).map_err(|e| ApiError::from_flag("--dt", e))?;
     }
     let checked = preflight(&exp, source)?;
     let direct = exp.drive.is_direct();
@@ -145,8 +159,16 @@ pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Res
         Solver::Amm => apply_amm(&mut exp, source, settings)?,
         Solver::Fem => apply_fem(&mut exp, source, settings)?,
     };
-    exp.validate()
-        .map_err(|e| ApiError::model_in(format!("{source} with the command-line flags"), Path::new(source), e))?;
+    exp.validate().map_err(|e| {
+        let flag = match &e {
+            flexstar_model::ModelError::Invalid { key, .. } => flag_of(key, settings),
+            _ => None,
+        };
+        match flag {
+            Some(flag) => ApiError::from_flag(flag, e),
+            None => ApiError::model_in(format!("{source} with the command-line flags"), Path::new(source), e),
+        }
+    })?;
     let stem = if direct { format!("{stem}-direct") } else { stem };
     Ok(Prepared {
         exp,
@@ -157,7 +179,26 @@ pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Res
         source: source.to_string(),
         figures: settings.figures,
         checked,
+        flags: FLAG_KEYS
+            .iter()
+            .filter_map(|k| flag_of(k, settings).map(|f| (*k, f)))
+            .collect(),
     })
+}
+
+/// The experiment keys the flags of [`RunSettings`] set (see [`flag_of`]).
+const FLAG_KEYS: [&str; 5] = ["amm.modes", "amm.tol", "amm.dt", "fem.dt", "fem.elements"];
+
+/// The flag of `settings` that set the experiment key `key` (`amm.tol` from `--tol`), if one did:
+/// an invalid value is then the flag's error, not the file's.
+fn flag_of(key: &str, settings: &RunSettings) -> Option<&'static str> {
+    match key {
+        "amm.modes" if settings.modes.is_some() => Some("--modes"),
+        "amm.tol" if settings.tol.is_some() => Some("--tol"),
+        "amm.dt" | "fem.dt" if settings.dt.is_some() => Some("--dt"),
+        "fem.elements" if settings.elements.is_some() => Some("--elements"),
+        _ => None,
+    }
 }
 
 /// The `[drive]` of a forces override and how to name it in a note.
@@ -210,6 +251,11 @@ fn apply_amm(exp: &mut Experiment, source: &str, s: &RunSettings) -> Result<Stri
             None,
             "--elements applies to --solver fem only",
         ));
+    }
+    if s.modes.is_some() && s.tol.is_some() {
+        // the file's refusal of `modes` with `tol`, in the flags' words
+        let reason = flexstar_model::config::modes_with_tol_reason("--modes", "--tol");
+        return Err(ApiError::flag("--modes, --tol", reason));
     }
     if let Some(f) = s.family {
         exp.amm.family = f;
@@ -267,12 +313,12 @@ pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Re
             Some(c) => flexstar_amm::solve_direct_checked(exp, &exp.amm, law.as_ref(), c),
             None => flexstar_amm::solve_direct(exp, &exp.amm, law.as_ref()),
         }
-        .map_err(|e| from_amm(&p.source, e))?,
+        .map_err(|e| p.amm_error(e))?,
         (Solver::Amm, None) => match checked {
             Some(c) => flexstar_amm::solve_checked(exp, &exp.amm, c),
             None => flexstar_amm::solve(exp, &exp.amm),
         }
-        .map_err(|e| from_amm(&p.source, e))?,
+        .map_err(|e| p.amm_error(e))?,
         (Solver::Fem, Some(law)) => {
             flexstar_fem::solve_direct(exp, &exp.fem, law.as_ref(), progress).map_err(|e| from_fem(&p.source, e))?
         }

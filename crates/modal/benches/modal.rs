@@ -8,7 +8,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexstar_amm::pose_modes::{pose_modes, PoseModel, DEFAULT_MODAL_MODES};
-use flexstar_modal::freqmap::{freqmap, Axis, Solver};
+use flexstar_modal::freqmap::{freqmap, Axis, Grid, Solver};
 use flexstar_modal::pose::pose_from_task;
 use flexstar_model::{Experiment, ModeFamily, Sliders};
 
@@ -48,10 +48,16 @@ fn one_pose(c: &mut Criterion) {
 fn map_21x21(c: &mut Criterion) {
     let exp = paper_robot();
     let axis = Axis::parse("--gx", "-0.15:0.15:21").expect("axis");
+    let grid = Grid {
+        gx: axis,
+        gy: axis,
+        theta: 0.0,
+        sliders: Sliders::Locked,
+    };
     let mut group = c.benchmark_group("amm_freqmap");
     group.sample_size(10);
     group.bench_function("21x21_n60", |b| {
-        b.iter(|| freqmap(&exp, &axis, &axis, 0.0, 6, Solver::Amm, |_, _| {}).expect("map"))
+        b.iter(|| freqmap(&exp, &grid, 6, Solver::Amm, |_, _| {}).expect("map"))
     });
     group.finish();
 }

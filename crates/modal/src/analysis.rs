@@ -1,9 +1,7 @@
 //! Modes at one pose from both solvers, side by side (`modal.csv`).
 
-use std::path::Path;
-
 use flexstar_amm::pose_modes::DEFAULT_MODAL_MODES;
-use flexstar_model::output::{fmt_number, write_atomically};
+use flexstar_model::output::{fmt_number, Dest};
 use flexstar_model::ModeFamily;
 use flexstar_model::{Experiment, RestPose, Sliders};
 
@@ -71,9 +69,9 @@ pub fn modal(exp: &Experiment, pose: &RestPose, sliders: Sliders, k: usize) -> R
     Ok(Modal { amm, fem, k })
 }
 
-/// Write `modal.csv` (whole or not at all).
-pub fn write_modal_csv(path: &Path, modal: &Modal) -> Result<(), ModalError> {
-    write_atomically(path, |w| {
+/// Write `modal.csv` (whole or not at all) to `dest`: a file of its own or a file of a run set.
+pub fn write_modal_csv(dest: Dest<'_>, modal: &Modal) -> Result<(), ModalError> {
+    dest.write(|w| {
         writeln!(w, "{MODAL_HEADER}")?;
         for (m, a, f, r) in modal.rows() {
             writeln!(w, "{m},{},{},{}", fmt_number(a), fmt_number(f), fmt_number(r))?;

@@ -1,10 +1,10 @@
 //! Frequency maps: the first K frequencies over a grid of task-space poses (`freqmap.csv`).
 
-use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use flexstar_amm::pose_modes::PoseModel;
-use flexstar_model::output::{fmt_number, write_atomically};
+use flexstar_model::output::fmt_number;
+use flexstar_model::run_set::RunSet;
 use flexstar_model::{Experiment, Sliders};
 use rayon::prelude::*;
 
@@ -76,13 +76,23 @@ pub fn check_grid(gx: &Axis, gy: &Axis) -> Result<(), ModalError> {
     Ok(())
 }
 
-/// The first `k` frequencies (sliders locked) over the grid, in parallel; `progress(done, total)`
-/// is called from the worker threads. Infeasible poses are kept with the reason.
+/// The poses of a frequency map: the grid of G, the star's orientation and how the sliders are
+/// held at every point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grid {
+    pub gx: Axis,
+    pub gy: Axis,
+    /// Orientation of the star at every point [rad].
+    pub theta: f64,
+    pub sliders: Sliders,
+}
+
+/// The first `k` elastic frequencies over the grid, in parallel (with free sliders the three
+/// rigid modes at 0 Hz are left out: f1 is the first elastic one); `progress(done, total)` is
+/// called from the worker threads. Infeasible poses are kept with the reason.
 pub fn freqmap<P>(
     exp: &Experiment,
-    gx: &Axis,
-    gy: &Axis,
-    theta: f64,
+    grid: &Grid,
     k: usize,
     solver: Solver,
     progress: P,
@@ -90,6 +100,7 @@ pub fn freqmap<P>(
 where
     P: Fn(usize, usize) + Sync,
 {
+    let (gx, gy, theta) = (&grid.gx, &grid.gy, grid.theta);
     crate::check_k(k)?;
     check_grid(gx, gy)?;
     let total = gx.n * gy.n;
@@ -107,7 +118,7 @@ where
         .into_par_iter()
         .map(|idx| {
             let (x, y) = (gx.at(idx % gx.n), gy.at(idx / gx.n));
-            let result = point(exp, amm.as_ref(), x, y, theta, k);
+            let result = point(exp, amm.as_ref(), (x, y, theta), grid.sliders, k);
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             MapPoint {
                 gx: x,
@@ -120,35 +131,35 @@ where
     Ok(points)
 }
 
-/// The first `k` frequencies at one grid point: by the AMM when `amm` is given, else the FEM.
+/// The first `k` elastic frequencies at the pose `(gx, gy, theta)`: by the AMM when `amm` is
+/// given, else the FEM; the rigid modes of free sliders (0 Hz) left out.
 fn point(
     exp: &Experiment,
     amm: Option<&PoseModel>,
-    gx: f64,
-    gy: f64,
-    theta: f64,
+    (gx, gy, theta): (f64, f64, f64),
+    sliders: Sliders,
     k: usize,
 ) -> Result<Vec<f64>, String> {
     let pose = pose_from_task(&exp.robot, gx, gy, theta).map_err(|e| e.to_string())?;
     let f = match amm {
         // eigenvalues only (no shapes): a third of the cost of `modes_at`, equal to 1e-7
-        Some(model) => model
-            .frequencies_at(&pose, Sliders::Locked, k)
-            .map_err(|e| e.to_string())?,
+        Some(model) => model.frequencies_at(&pose, sliders, k).map_err(|e| e.to_string())?,
         None => {
-            flexstar_fem::pose_modes::pose_modes(&exp.robot, &pose, Sliders::Locked, exp.fem.elements, k)
+            flexstar_fem::pose_modes::pose_modes(&exp.robot, &pose, sliders, exp.fem.elements, k)
                 .map_err(|e| e.to_string())?
                 .freq_hz
         }
     };
-    Ok(f)
+    let rigid = if sliders == Sliders::Free { 3 } else { 0 };
+    Ok(f.into_iter().skip(rigid).collect())
 }
 
-/// Write `freqmap.csv`: header `Gx,Gy,theta,feasible,f1_hz,...,fK_hz`; an infeasible pose has
-/// `feasible = false` and its frequency fields empty, the reason in the sidecar
-/// `freqmap-infeasible.csv` (`Gx,Gy,theta,reason`).
-pub fn write_freqmap_csv(dir: &Path, points: &[MapPoint], k: usize) -> Result<(), ModalError> {
-    write_atomically(&dir.join("freqmap.csv"), |w| {
+/// Stage `freqmap.csv` into `set` (published with the map's other files by [`RunSet::commit`]):
+/// header `Gx,Gy,theta,feasible,f1_hz,...,fK_hz`; an infeasible pose has `feasible = false` and
+/// its frequency fields empty, the reason in `freqmap-infeasible.csv` (`Gx,Gy,theta,reason`),
+/// staged too.
+pub fn stage_freqmap_csv(set: &mut RunSet, points: &[MapPoint], k: usize) -> Result<(), ModalError> {
+    set.file("freqmap.csv", |w| {
         let cols: Vec<String> = (1..=k).map(|j| format!("f{j}_hz")).collect();
         writeln!(w, "Gx,Gy,theta,feasible,{}", cols.join(","))?;
         for p in points {
@@ -163,7 +174,7 @@ pub fn write_freqmap_csv(dir: &Path, points: &[MapPoint], k: usize) -> Result<()
         }
         Ok(())
     })?;
-    write_atomically(&dir.join("freqmap-infeasible.csv"), |w| {
+    set.file("freqmap-infeasible.csv", |w| {
         writeln!(w, "Gx,Gy,theta,reason")?;
         for p in points {
             if let Err(reason) = &p.result {

@@ -1,6 +1,6 @@
 //! Figures of the modal analyses (plotters, SVG and PNG, through the drawing kit of
 //! `flexstar-plot`): the first mode shapes at a pose (AMM over FEM over the rigid
-//! star) and the heat map of a frequency map with the workspace boundary and the paper's paths.
+//! star) and the heat map of a frequency map with the workspace boundary and the experiment's path.
 
 use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::RestPose;
@@ -177,7 +177,7 @@ pub struct MapPath {
     pub style: Style,
 }
 
-/// Colours of the paper's four cases' paths.
+/// Colours of the paper's four cases' paths (the `f1_paths` example's figure).
 pub const PATH_COLORS: [RGBColor; 4] = [
     RGBColor(214, 39, 40),
     RGBColor(31, 119, 180),
@@ -185,25 +185,36 @@ pub const PATH_COLORS: [RGBColor; 4] = [
     RGBColor(227, 119, 194),
 ];
 
-/// G(t) of the paper's four cases (rigid kinematics of `flexstar_model::catalogue::paper_case`),
-/// one path each in [`PATH_COLORS`]. The paths' theta(t) varies; the map is at one theta.
-pub fn paper_paths() -> Result<Vec<MapPath>, crate::ModalError> {
-    (1..=4)
-        .map(|k| {
-            let exp = flexstar_model::catalogue::paper_case(k);
-            let states = flexstar_kinematics::table::kinematics_table(&exp)
-                .map_err(|e| crate::ModalError::Infeasible(format!("paper case {k}: {e}")))?;
-            Ok(MapPath {
-                label: format!("case {k}"),
-                points: states.iter().map(|s| (s.g[0].v, s.g[1].v)).collect(),
-                style: Style {
-                    color: PATH_COLORS[k - 1],
-                    width: 3,
-                    dashed: false,
-                },
-            })
-        })
-        .collect()
+/// Colour of the experiment's path over a frequency map.
+pub const PATH_COLOR: RGBColor = RGBColor(214, 39, 40);
+
+/// G(t) of the experiment over `[0, t_end]` at its output times (rigid kinematics), the path
+/// drawn over its frequency map; `None` when the experiment has no prescribed path (a forces
+/// drive: the motion is what the solver finds) or its trajectory leaves the feasible range. A
+/// servo's path is its reference. The path's theta(t) varies; the map is at one theta.
+pub fn trajectory_path(exp: &flexstar_model::Experiment) -> Option<MapPath> {
+    if exp.drive.kind == flexstar_model::DriveKind::Forces {
+        return None;
+    }
+    let states = flexstar_kinematics::table::kinematics_table(exp).ok()?;
+    let what = if exp.drive.kind == flexstar_model::DriveKind::Servo {
+        "reference G(t)"
+    } else {
+        "G(t)"
+    };
+    Some(MapPath {
+        label: format!(
+            "{what} of {}, t = 0 .. {} s",
+            exp.name,
+            flexstar_model::output::fmt_display(exp.time.t_end)
+        ),
+        points: states.iter().map(|s| (s.g[0].v, s.g[1].v)).collect(),
+        style: Style {
+            color: PATH_COLOR,
+            width: 3,
+            dashed: false,
+        },
+    })
 }
 
 /// The heat map of the first `shown` frequencies of a map (one panel each, own colour scale),
@@ -428,6 +439,19 @@ impl Drawing for FreqMapFigure {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_map_shows_the_experiments_own_path() {
+        let mut exp = flexstar_model::catalogue::paper_case(3);
+        let path = trajectory_path(&exp).expect("a motion has a path");
+        assert_eq!(path.label, "G(t) of case3, t = 0 .. 0.5 s");
+        // one point per output time, from G(0) (independent: the rigid kinematics at t = 0)
+        assert_eq!(path.points.len(), exp.time.output_times().len());
+        let g0 = flexstar_kinematics::RigidState::at(&exp.robot, &exp.trajectory, 0.0).unwrap();
+        assert_eq!(path.points[0], (g0.g[0].v, g0.g[1].v));
+        exp.drive.kind = flexstar_model::DriveKind::Forces;
+        assert!(trajectory_path(&exp).is_none(), "a forces drive has no prescribed path");
+    }
 
     #[test]
     fn paths_are_cut_where_they_leave_the_map() {

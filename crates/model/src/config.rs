@@ -191,6 +191,22 @@ pub enum ModeCount {
     Tolerance(f64),
 }
 
+impl std::fmt::Display for ModeCount {
+    /// `N = 25` or `tol = 0.5 %` (the number as [`crate::output::fmt_display`] writes it).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ModeCount::Fixed(n) => write!(f, "N = {n}"),
+            ModeCount::Tolerance(p) => write!(f, "tol = {} %", crate::output::fmt_display(*p)),
+        }
+    }
+}
+
+/// The refusal of a fixed N together with a tolerance, with the two settings named as the caller
+/// spells them (`modes`/`tol` in a file, `--modes`/`--tol` on the command line).
+pub fn modes_with_tol_reason(modes: &str, tol: &str) -> String {
+    format!("give either {modes} (a fixed N) or {tol} (N chosen to meet the tolerance), not both")
+}
+
 /// `[amm]` section: settings of the assumed-modes solver. Command-line flags override them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -278,10 +294,7 @@ impl AmmSettings {
                 ));
             }
             if self.modes.is_some() {
-                return Err(ModelError::invalid(
-                    "amm.tol",
-                    "give either modes (a fixed N) or tol (N chosen to meet the tolerance), not both",
-                ));
+                return Err(ModelError::invalid("amm.tol", modes_with_tol_reason("modes", "tol")));
             }
         }
         if let Some(dt) = self.dt {
@@ -532,6 +545,8 @@ s3 = [0.0, 0.0, 1.0]
         assert_eq!(e.amm.family, ModeFamily::Enriched);
         assert_eq!(e.amm.model, AmmModel::Full);
         assert_eq!(e.amm.mode_count(), ModeCount::Tolerance(DEFAULT_TOL_PERCENT));
+        assert_eq!(e.amm.mode_count().to_string(), "tol = 0.5 %");
+        assert_eq!(ModeCount::Fixed(25).to_string(), "N = 25");
         assert_eq!(e.fem.elements, 300);
         assert_eq!(e.time.output_times().len(), 501);
     }

@@ -127,6 +127,27 @@ pub fn fmt_number(v: f64) -> String {
     }
 }
 
+/// A number as shown to a person (stderr, titles, reports): rounded to 12 significant digits,
+/// then as [`fmt_number`] (so `0.49999999999999994` reads `0.5`, `-0.0` reads `0`). Files keep
+/// [`fmt_number`], which reads back exactly.
+pub fn fmt_display(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return fmt_number(v);
+    }
+    let rounded: f64 = format!("{v:.11e}").parse().unwrap_or(v);
+    fmt_number(rounded)
+}
+
+/// `v` with `digits` decimals as shown to a person, without the sign of a value that rounds to
+/// zero (`-0.000001` with 5 decimals reads `0.00000`, not `-0.00000`).
+pub fn fmt_fixed(v: f64, digits: usize) -> String {
+    let text = format!("{v:.digits$}");
+    match text.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+        _ => text,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -183,6 +204,25 @@ mod tests {
                 x = 1e-150;
             }
         }
+    }
+
+    #[test]
+    fn numbers_for_people_are_rounded_and_have_no_negative_zero() {
+        // the paper robot's EI: E I computed in floating point (issue 24)
+        assert_eq!(fmt_display(0.49999999999999994), "0.5");
+        assert_eq!(fmt_display(0.1 + 0.2), "0.3");
+        assert_eq!(fmt_display(-0.0), "0");
+        assert_eq!(fmt_display(2.1e11), "2.1e11");
+        assert_eq!(fmt_display(1.5e-7), "1.5e-7");
+        assert_eq!(fmt_display(0.234), "0.234");
+        assert_eq!(fmt_display(123.456789012345), "123.456789012");
+        assert_eq!(fmt_display(f64::NAN), "NaN");
+        assert_eq!(fmt_fixed(-0.0, 5), "0.00000");
+        assert_eq!(fmt_fixed(-0.000004, 5), "0.00000");
+        assert_eq!(fmt_fixed(-0.000006, 5), "-0.00001");
+        assert_eq!(fmt_fixed(-1.5, 2), "-1.50");
+        assert_eq!(fmt_fixed(-0.4, 0), "0");
+        assert_eq!(fmt_fixed(0.123456, 3), "0.123");
     }
 
     #[test]

@@ -421,17 +421,7 @@ impl Response {
             file: path.to_path_buf(),
             reason: e.to_string(),
         };
-        let mut doc = serde_json::Map::new();
-        doc.insert("flexstar_version".into(), provenance.version.clone().into());
-        doc.insert(
-            "commit".into(),
-            provenance
-                .commit
-                .clone()
-                .map(Into::into)
-                .unwrap_or(serde_json::Value::Null),
-        );
-        doc.insert("date".into(), provenance.date.clone().into());
+        let mut doc = provenance.fields();
         doc.insert("label".into(), self.label.clone().into());
         if let serde_json::Value::Object(fields) = serde_json::to_value(&self.info).map_err(fail)? {
             doc.extend(fields);

@@ -108,6 +108,17 @@ impl Provenance {
             date: utc_date_time(secs),
         }
     }
+
+    /// The first fields of every sidecar: `flexstar_version`, `commit` (`null` when unknown) and
+    /// `date`.
+    pub fn fields(&self) -> serde_json::Map<String, serde_json::Value> {
+        let mut doc = serde_json::Map::new();
+        doc.insert("flexstar_version".into(), self.version.clone().into());
+        let commit = self.commit.clone().map(Into::into).unwrap_or(serde_json::Value::Null);
+        doc.insert("commit".into(), commit);
+        doc.insert("date".into(), self.date.clone().into());
+        doc
+    }
 }
 
 /// `YYYY-MM-DDTHH:MM:SSZ` for seconds since 1970-01-01 UTC (proleptic Gregorian calendar; days to

@@ -235,7 +235,7 @@ fn modal<'py>(
     let doc = &exp.inner;
     let source = doc.source.display().to_string();
     let o = py
-        .detach(|| flexstar_api::modal::modal(&doc.exp, &source, &spec, sliders, modes, None))
+        .detach(|| flexstar_api::modal::modal(&doc.exp, &source, &spec, sliders, modes, None, false))
         .map_err(py_err)?;
     let d = PyDict::new(py);
     let rows = o.modal.rows();

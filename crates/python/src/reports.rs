@@ -67,11 +67,12 @@ pub fn verify<'py>(py: Python<'py>, out: PathBuf, figures: bool, n_study: bool) 
     Ok(d)
 }
 
-/// The first `modes` frequencies (sliders locked) over a grid of poses: `gx`, `gy` as
-/// `(min, max, n)` [m], `theta` [rad]; returns `{"Gx", "Gy", "theta", "f_hz", "reason"}` lists
-/// (`f_hz` None and `reason` given for an infeasible pose).
+/// The first `modes` elastic frequencies over a grid of poses: `gx`, `gy` as `(min, max, n)`
+/// [m], `theta` [rad], the sliders `locked` or `free`; returns `{"Gx", "Gy", "theta", "f_hz",
+/// "reason"}` lists (`f_hz` None and `reason` given for an infeasible pose).
 #[pyfunction]
-#[pyo3(signature = (exp, gx, gy, theta = 0.0, modes = 6, solver = "amm"))]
+#[pyo3(signature = (exp, gx, gy, theta = 0.0, modes = 6, solver = "amm", sliders = "locked"))]
+#[allow(clippy::too_many_arguments)]
 pub fn freqmap<'py>(
     py: Python<'py>,
     exp: &PyExperiment,
@@ -80,6 +81,7 @@ pub fn freqmap<'py>(
     theta: f64,
     modes: usize,
     solver: &str,
+    sliders: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let axis =
         |flag: &str, (a, b, n): (f64, f64, usize)| flexstar_api::modal::parse_axis(flag, &format!("{a}:{b}:{n}"));
@@ -93,6 +95,9 @@ pub fn freqmap<'py>(
         theta,
         k: modes,
         solver,
+        sliders: convert::sliders(sliders)?,
+        // nothing is written from Python, so nothing can be replaced
+        force: false,
     };
     let doc = &exp.inner;
     let source = doc.source.display().to_string();

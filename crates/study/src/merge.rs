@@ -99,11 +99,11 @@ pub fn merge(dir: &Path) -> Result<MergeReport, StudyError> {
             )));
         }
         if meta.shard != Some([*k, n]) {
-            return Err(refuse(format!(
-                "{}: its sidecar says shard {:?}",
-                path.display(),
-                meta.shard
-            )));
+            let says = match meta.shard {
+                Some([a, b]) => format!("shard {a}/{b}"),
+                None => "the whole study (no shard)".to_string(),
+            };
+            return Err(refuse(format!("{}: its sidecar says {says}", path.display())));
         }
         if table.header != t0.header {
             return Err(refuse(format!(
@@ -138,9 +138,13 @@ fn existing_results(dir: &Path, m0: &Meta, t0: &Table) -> Result<Option<(Meta, T
     let meta = Meta::read(&meta_path)?;
     if meta.hash != m0.hash || meta.study != m0.study || meta.shard.is_some() {
         return Err(refuse(format!(
-            "was written by another study (study {}, hash {}, shard {:?}; the shards: study {}, hash {}): \
+            "was written by another study (study {}, hash {}{}; the shards: study {}, hash {}): \
              move it away or merge the shards in another folder",
-            meta.study, meta.hash, meta.shard, m0.study, m0.hash
+            meta.study,
+            meta.hash,
+            meta.shard_text(),
+            m0.study,
+            m0.hash
         )));
     }
     let table = Table::read(&path)?;

@@ -196,9 +196,12 @@ fn prepare_table(
     let old = Meta::read(&meta_path)?;
     if old.hash != meta.hash || old.shard != meta.shard {
         return Err(other(format!(
-            "was written by another study or split (hash {}, shard {:?}; this run: hash {}, shard {:?}): \
+            "was written by another study or split (hash {}{}; this run: hash {}{}): \
              give another --out or move it away",
-            old.hash, old.shard, meta.hash, meta.shard
+            old.hash,
+            old.shard_text(),
+            meta.hash,
+            meta.shard_text()
         )));
     }
     let text_len = std::fs::metadata(results).map(|m| m.len()).unwrap_or(0);

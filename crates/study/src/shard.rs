@@ -120,11 +120,27 @@ impl Meta {
     fn text(&self) -> String {
         serde_json::to_string_pretty(self).expect("a sidecar of plain data serialises") + "\n"
     }
+
+    /// `, shard K/N` for a slice, nothing for the whole study (for messages).
+    pub fn shard_text(&self) -> String {
+        shard_text(self.shard)
+    }
+}
+
+/// `, shard K/N` for a slice `[K, N]`, nothing for the whole study (`None`): what messages show.
+pub fn shard_text(shard: Option<[usize; 2]>) -> String {
+    shard.map(|[k, n]| format!(", shard {k}/{n}")).unwrap_or_default()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shards_are_shown_as_k_of_n_and_a_whole_study_as_nothing() {
+        assert_eq!(shard_text(Some([2, 4])), ", shard 2/4");
+        assert_eq!(shard_text(None), "");
+    }
 
     #[test]
     fn shards_partition_the_cases() {

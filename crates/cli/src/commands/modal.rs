@@ -45,6 +45,15 @@ pub enum SlidersArg {
     Free,
 }
 
+impl SlidersArg {
+    fn sliders(self) -> Sliders {
+        match self {
+            SlidersArg::Locked => Sliders::Locked,
+            SlidersArg::Free => Sliders::Free,
+        }
+    }
+}
+
 /// Which solver computes a frequency map (`--solver`).
 #[derive(Clone, Copy, clap::ValueEnum)]
 pub enum SolverArg {
@@ -65,6 +74,9 @@ pub struct ModalArgs {
     /// How the sliders are held
     #[arg(long, value_enum, default_value = "locked")]
     sliders: SlidersArg,
+    /// Replace a modal.csv that other settings (pose, sliders, K, solvers) wrote in DIR/<name>/
+    #[arg(long)]
+    force: bool,
     /// Output directory
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -90,6 +102,12 @@ pub struct FreqmapArgs {
     /// Solver of the map
     #[arg(long, value_enum, default_value = "amm")]
     solver: SolverArg,
+    /// How the sliders are held (free: f1 is the first elastic frequency, the rigid modes left out)
+    #[arg(long, value_enum, default_value = "locked")]
+    sliders: SlidersArg,
+    /// Replace a freqmap.csv that other settings (grid, theta, sliders, K, solver) wrote in DIR/<name>/
+    #[arg(long)]
+    force: bool,
     /// Output directory
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -119,35 +137,22 @@ fn load(config: &std::path::Path) -> anyhow::Result<(Experiment, String)> {
 
 pub fn run_modal(args: ModalArgs) -> anyhow::Result<()> {
     let (exp, source) = load(&args.config)?;
-    let sliders = match args.sliders {
-        SlidersArg::Locked => Sliders::Locked,
-        SlidersArg::Free => Sliders::Free,
-    };
+    let sliders = args.sliders.sliders();
     flexstar_api::modal::check_k(args.k)?;
     let spec = args.pose.spec(&args.config)?;
     let start = Instant::now();
-    let o = flexstar_api::modal::modal(&exp, &source, &spec, sliders, args.k, Some(&args.out))?;
-    let pose = &o.pose;
+    let o = flexstar_api::modal::modal(&exp, &source, &spec, sliders, args.k, Some(&args.out), args.force)?;
     eprintln!(
-        "{}: pose G = ({:.5}, {:.5}) m, theta = {:.5} rad, s = {:.5}/{:.5}/{:.5} m, sliders {} ({:.2} s)",
+        "{}: {} ({:.2} s)",
         exp.name,
-        pose.g[0],
-        pose.g[1],
-        pose.theta,
-        pose.s[0],
-        pose.s[1],
-        pose.s[2],
-        sliders.name(),
+        flexstar_api::modal::pose_text(&o.pose, sliders),
         start.elapsed().as_secs_f64()
     );
-    for (mode, a, f, rel) in o.modal.rows() {
-        eprintln!(
-            "  mode {mode:>2}: AMM {a:>10.4} Hz  FEM {f:>10.4} Hz  {:>+8.3} %",
-            100.0 * rel
-        );
+    for line in flexstar_api::modal::mode_lines(&o.modal) {
+        eprintln!("  {line}");
     }
     let dir = args.out.join(&exp.name);
-    eprintln!("{}: modal.csv, modal-shapes.svg/.png in {}", exp.name, dir.display());
+    eprintln!("{}: modal.csv, modal.json, modal-shapes.svg/.png in {}", exp.name, dir.display());
     Ok(())
 }
 
@@ -162,6 +167,8 @@ pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
             SolverArg::Amm => MapSolver::Amm,
             SolverArg::Fem => MapSolver::Fem,
         },
+        sliders: args.sliders.sliders(),
+        force: args.force,
     };
     let start = Instant::now();
     let reporter = Reporter::new("freqmap");
@@ -178,7 +185,7 @@ pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
     let figure = figure?;
     let feasible = figure.points.iter().filter(|p| p.result.is_ok()).count();
     eprintln!(
-        "{}: {} poses ({feasible} feasible) in {:.2} s; freqmap.csv, freqmap-infeasible.csv, freqmap.svg/.png in {}",
+        "{}: {} poses ({feasible} feasible) in {:.2} s; freqmap.csv, freqmap-infeasible.csv, freqmap.json, freqmap.svg/.png in {}",
         exp.name,
         figure.points.len(),
         start.elapsed().as_secs_f64(),

@@ -24,13 +24,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => RobotParams::paper(),
     };
     let (bl, f) = flexstar_api::modes::mode_table(args.family, args.n, &params)?;
-    println!(
-        "# {} modes, L = {} m, EI = {} N m^2, rho = {} kg/m",
-        args.family,
-        params.l,
-        params.ei(),
-        params.rho
-    );
+    println!("{}", flexstar_api::modes::header(args.family, &params));
     println!("{:>4} {:>18} {:>16}", "mode", "beta*L", "f [Hz]");
     for k in 0..bl.len() {
         println!("{:>4} {:>18.12} {:>16.6}", k + 1, bl[k], f[k]);

@@ -287,11 +287,13 @@ def freqmap(
     theta: float = 0.0,
     modes: int = 6,
     solver: str = "amm",
+    sliders: str = "locked",
 ) -> "Any":
-    """The first ``modes`` frequencies (sliders locked) over a grid ``gx``, ``gy`` = (min, max, n)
-    [m] at ``theta`` [rad]: a DataFrame (Gx, Gy, theta, f1..fK [Hz], reason) when pandas is
-    installed, else the dict of lists."""
-    d = _flexstar.freqmap(exp._inner, tuple(gx), tuple(gy), theta, modes, solver)
+    """The first ``modes`` elastic frequencies over a grid ``gx``, ``gy`` = (min, max, n) [m] at
+    ``theta`` [rad], the sliders ``"locked"`` or ``"free"`` (then the three rigid modes at 0 Hz
+    are left out): a DataFrame (Gx, Gy, theta, f1..fK [Hz], reason) when pandas is installed,
+    else the dict of lists."""
+    d = _flexstar.freqmap(exp._inner, tuple(gx), tuple(gy), theta, modes, solver, sliders)
     try:
         import pandas as pd
     except ImportError:

@@ -66,8 +66,7 @@ impl Holding {
     pub fn servo_of(exp: &Experiment) -> Result<Holding, ModalError> {
         if exp.drive.kind != DriveKind::Servo {
             return Err(ModalError::Input(format!(
-                "--loop closed needs a servo drive ([drive] kind = \"servo\"); the drive of {} is kind = \"{}\"",
-                exp.source.display(),
+                "--loop closed needs a servo drive ([drive] kind = \"servo\"); this experiment's drive is kind = \"{}\"",
                 drive_kind_name(exp.drive.kind)
             )));
         }

@@ -193,8 +193,11 @@ pub enum LoopKind {
 /// [`ELASTIC_MODES`]: flexstar_modal::linear::ELASTIC_MODES
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct LinearizeOptions {
+    /// Elastic modes K (`--modes`).
     pub modes: Option<usize>,
+    /// How the sliders are held (`--sliders`).
     pub sliders: Option<Sliders>,
+    /// Servo loop (`--loop`).
     pub loop_kind: Option<LoopKind>,
 }
 

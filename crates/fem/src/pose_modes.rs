@@ -173,6 +173,7 @@ pub struct Coordinate {
     pub node: Option<usize>,
     /// Beam (0-based) of a node other than G, of a sleeve's coordinate or slider.
     pub beam: Option<usize>,
+    /// What the coordinate is.
     pub dof: Dof,
     /// Material position along the beam from G [m]: the node's, the sleeve centre's (psi) or the
     /// contact point's rest value; none for a slider.

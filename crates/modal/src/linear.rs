@@ -97,6 +97,7 @@ fn drive_kind_name(k: DriveKind) -> &'static str {
 pub struct LinearSettings {
     /// Elastic modes K (1..=[`crate::MAX_K`]).
     pub modes: usize,
+    /// How the sliders are held.
     pub holding: Holding,
 }
 
@@ -113,7 +114,9 @@ impl Default for LinearSettings {
 /// A named signal or state with its unit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Signal {
+    /// Name (as the run CSVs' columns where the same quantity appears there).
     pub name: String,
+    /// SI unit.
     pub unit: &'static str,
 }
 
@@ -130,11 +133,14 @@ pub struct StateSpace {
     /// The modal analysis behind it (sliders free for the free and servo models, else locked).
     pub modes: PoseModes,
     pub pose: RestPose,
+    /// The settings it was built with.
     pub settings: LinearSettings,
     /// States in order: `eta1..etaN` [m kg^0.5] (modal amplitudes of the mass-normalised
     /// shapes, mode k = row k of `modal_frequencies_hz`), then their rates `etad1..etadN`.
     pub states: Vec<Signal>,
+    /// Inputs in the order of B's columns (module docs).
     pub inputs: Vec<Signal>,
+    /// Outputs in the order of C's rows (module docs).
     pub outputs: Vec<Signal>,
 }
 

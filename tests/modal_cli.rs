@@ -371,6 +371,130 @@ fn linearize_writes_the_state_space_files() {
     }
 }
 
+/// Size (rows, columns) of a Matrix Market file.
+fn mtx_size(path: &Path) -> (usize, usize) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let size: Vec<usize> = text
+        .lines()
+        .find(|l| !l.starts_with('%'))
+        .unwrap()
+        .split_whitespace()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    (size[0], size[1])
+}
+
+fn names(json: &serde_json::Value, key: &str) -> Vec<String> {
+    json[key]
+        .as_array()
+        .unwrap_or_else(|| panic!("{key} is not a list"))
+        .iter()
+        .map(|v| v["name"].as_str().unwrap().to_string())
+        .collect()
+}
+
+/// Run `linearize` with `extra` flags; returns linear/ and statespace.json.
+fn linearize_with(cfg: &str, name: &str, out: &Path, extra: &[&str]) -> (PathBuf, serde_json::Value) {
+    let mut args = vec!["linearize", cfg, "--pose", "0.03,-0.02,0.1", "--out", out.to_str().unwrap()];
+    args.extend(extra);
+    let o = flexstar(&args);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    let lin = out.join(name).join("linear");
+    let json = std::fs::read_to_string(lin.join("statespace.json")).unwrap();
+    (lin, serde_json::from_str(&json).unwrap())
+}
+
+/// Issue 24: `--modes K` and `--sliders locked|free` set the model's size and inputs; the JSON
+/// names every state, input and output in the order of the matrices (outputs as the run CSVs'
+/// columns: `w1tip`, not `w1_tip`); `fem-coordinates.csv` has one row per row of M.mtx, with the
+/// slider coordinates last when the sliders are free and none when they are locked.
+#[test]
+fn linearize_settings_set_the_model_and_name_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_config(dir.path());
+    let out = dir.path().join("out");
+    let (lin, json) = linearize_with(&cfg, "small", &out, &["--modes", "5", "--sliders", "locked"]);
+    assert_eq!(mtx_size(&lin.join("A.mtx")), (10, 10));
+    assert_eq!(mtx_size(&lin.join("B.mtx")), (10, 3));
+    assert_eq!(mtx_size(&lin.join("C.mtx")), (6, 10));
+    assert_eq!(mtx_size(&lin.join("D.mtx")), (6, 3));
+    let states = names(&json, "states");
+    assert_eq!(states.len(), 10);
+    assert_eq!((states[0].as_str(), states[4].as_str(), states[5].as_str()), ("eta1", "eta5", "etad1"));
+    assert_eq!(names(&json, "inputs"), ["sdd1", "sdd2", "sdd3"]);
+    assert_eq!(names(&json, "outputs"), ["w1tip", "w2tip", "w3tip", "w1G", "w2G", "w3G"]);
+    assert_eq!((json["sliders"].as_str(), json["loop"].as_str()), (Some("locked"), Some("open")));
+    let check_coordinates = |lin: &Path, sliders_free: bool| {
+        let (header, rows) = rows(&lin.join("fem-coordinates.csv"));
+        assert_eq!(header, "index,node,beam,dof,x_m");
+        let (n, _) = mtx_size(&lin.join("M.mtx"));
+        assert_eq!(rows.len(), n);
+        assert_eq!(mtx_size(&lin.join("Phi_q.mtx")).1, n);
+        for (k, r) in rows.iter().enumerate() {
+            assert_eq!(num(&r[0]) as usize, k + 1, "1-based index = the Matrix Market row");
+        }
+        assert_eq!(rows[0][1..4], ["0", "", "ux"], "G first");
+        let sliders: Vec<&Vec<String>> = rows.iter().filter(|r| r[3] == "slider").collect();
+        if sliders_free {
+            assert_eq!(sliders.len(), 3);
+            assert_eq!(rows[n - 1][2..4], ["3", "slider"]);
+        } else {
+            assert!(sliders.is_empty());
+        }
+        // 102 elements: 103 nodes of 3 coordinates, then the sleeves' 12
+        assert_eq!(rows.iter().filter(|r| r[3] == "theta").count(), 103);
+        assert_eq!(rows.iter().filter(|r| r[3] == "psi").count(), 3);
+    };
+    check_coordinates(&lin, false);
+    let (lin, json) = linearize_with(&cfg, "small", &out, &["--modes", "4"]);
+    assert_eq!(mtx_size(&lin.join("A.mtx")), (14, 14));
+    assert_eq!(names(&json, "inputs"), ["Fa1", "Fa2", "Fa3"]);
+    let outputs = names(&json, "outputs");
+    assert_eq!(outputs, ["s1", "s2", "s3", "w1tip", "w2tip", "w3tip", "w1G", "w2G", "w3G"]);
+    assert!(!std::fs::read_to_string(lin.join("statespace.json")).unwrap().contains("w1_tip"));
+    assert_eq!(names(&json, "states").len(), 14);
+    check_coordinates(&lin, true);
+}
+
+/// A servo experiment: the loop is closed by default (inputs the references, their rates and the
+/// feedforward forces; outputs with the tracking errors; the gains in the JSON), `--loop open`
+/// gives the force-input model; `--loop closed` is refused without a servo or with locked sliders.
+#[test]
+fn linearize_closes_the_servo_loop_of_a_servo_experiment() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = "name = \"servo\"\n[time]\nt_end = 0.5\n[trajectory]\nkind = \"polynomial\"\n\
+                s1 = [0.0, 0.0, 1.0]\ns2 = [0.0]\ns3 = [0.0, 0.0, 0.5]\n[amm]\nfamily = \"enriched\"\nmodes = 40\n[fem]\nelements = 102\n\
+                [drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n";
+    let cfg = dir.path().join("servo.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let cfg = cfg.to_string_lossy().into_owned();
+    let out = dir.path().join("out");
+    let (lin, json) = linearize_with(&cfg, "servo", &out, &["--modes", "4"]);
+    assert_eq!(json["loop"].as_str(), Some("closed"));
+    let kp = json["servo"]["kp"].as_f64().unwrap();
+    let want = 0.2 * (2.0 * std::f64::consts::PI * 20.0f64).powi(2);
+    assert!((kp / want - 1.0).abs() < 1e-12, "kp {kp} vs {want}");
+    assert_eq!(names(&json, "inputs").len(), 9);
+    assert_eq!(names(&json, "outputs")[9..], ["e1", "e2", "e3"]);
+    assert_eq!(mtx_size(&lin.join("D.mtx")), (12, 9));
+    let (_, json) = linearize_with(&cfg, "servo", &out, &["--modes", "4", "--loop", "open"]);
+    assert_eq!(names(&json, "inputs"), ["Fa1", "Fa2", "Fa3"]);
+    let out2 = dir.path().join("out2");
+    let small = small_config(dir.path());
+    for (c, extra, needle) in [
+        (&small, vec!["--loop", "closed"], "servo"),
+        (&cfg, vec!["--loop", "closed", "--sliders", "locked"], "--sliders locked"),
+        (&cfg, vec!["--modes", "0"], "--modes"),
+    ] {
+        let mut args = vec!["linearize", c.as_str(), "--at", "0.1", "--out", out2.to_str().unwrap()];
+        args.extend(extra);
+        let o = flexstar(&args);
+        assert!(!o.status.success(), "{args:?} accepted");
+        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+        assert!(files_in(&out2).is_empty(), "{args:?} wrote {:?}", files_in(&out2));
+    }
+}
+
 /// Bad input: non-zero exit, the reason on stderr, no file written.
 #[test]
 fn bad_input_is_refused_before_any_output() {

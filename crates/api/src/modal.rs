@@ -5,13 +5,13 @@ use std::path::{Path, PathBuf};
 
 use flexstar_modal::analysis::{amm_modes_per_beam, write_modal_csv, Modal};
 use flexstar_modal::freqmap::{check_grid, stage_freqmap_csv, Axis, Grid};
-use flexstar_modal::linear::StateSpace;
+use flexstar_modal::linear::{Holding, LinearSettings, StateSpace};
 use flexstar_modal::plots::{mode_shapes_figure, trajectory_path, FreqMapFigure};
 use flexstar_modal::pose::{pose_at_time, pose_from_task};
 use flexstar_modal::ModalError;
 use flexstar_model::output::{fmt_display, fmt_fixed, Dest};
 use flexstar_model::run_set::RunSet;
-use flexstar_model::{Experiment, ModeFamily, RestPose, Sliders};
+use flexstar_model::{DriveKind, Experiment, ModeFamily, RestPose, Sliders};
 use flexstar_plot::write_svg_png;
 use serde_json::{json, Map, Value};
 
@@ -303,12 +303,70 @@ fn freqmap_figure(exp: &Experiment, s: &FreqmapSettings, points: Vec<MapPoint>) 
     }
 }
 
-/// The linear state-space model about a pose, sliders free (3 inputs Fa1..Fa3 [N], 9 outputs);
-/// with `out` writes `out/<name>/linear/` (Matrix Market A..D, M, K, Phi_q, statespace.json).
-pub fn linearize(exp: &Experiment, source: &str, spec: &PoseSpec, out: Option<&Path>) -> Result<StateSpace> {
+/// Whether the servo loop is closed in the linear model (`--loop`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoopKind {
+    /// Open loop: the actuator forces (sliders free) or the slider accelerations (locked) are
+    /// the inputs.
+    Open,
+    /// The experiment's PD servo closes the loop around the sliders (`[drive] kind = "servo"`).
+    Closed,
+}
+
+/// The settings of `linearize` as given; `None` takes the default: [`ELASTIC_MODES`] elastic
+/// modes, sliders free, the loop closed when the experiment's drive is a servo (and the sliders
+/// free), else open.
+///
+/// [`ELASTIC_MODES`]: flexstar_modal::linear::ELASTIC_MODES
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LinearizeOptions {
+    /// Elastic modes K (`--modes`).
+    pub modes: Option<usize>,
+    /// How the sliders are held (`--sliders`).
+    pub sliders: Option<Sliders>,
+    /// Servo loop (`--loop`).
+    pub loop_kind: Option<LoopKind>,
+}
+
+/// The model's settings from `opts` and the experiment (defaults: [`LinearizeOptions`]); a closed
+/// loop without a servo drive or with locked sliders is refused, naming the flags.
+pub fn linear_settings(exp: &Experiment, source: &str, opts: &LinearizeOptions) -> Result<LinearSettings> {
+    let modes = opts.modes.unwrap_or(flexstar_modal::linear::ELASTIC_MODES);
+    check_k(modes)?;
+    let sliders = opts.sliders.unwrap_or(Sliders::Free);
+    let servo = exp.drive.kind == DriveKind::Servo;
+    let closed = match opts.loop_kind {
+        Some(LoopKind::Closed) => true,
+        Some(LoopKind::Open) => false,
+        None => servo && sliders == Sliders::Free,
+    };
+    let holding = match (closed, sliders) {
+        (true, Sliders::Locked) => {
+            let reason = "--loop closed: the servo acts on free sliders; --sliders locked leaves no loop to close (give --loop open or --sliders free)";
+            return Err(from_modal(Some(source), f64::NAN, ModalError::Input(reason.into())));
+        }
+        (true, Sliders::Free) => Holding::servo_of(exp).map_err(|e| from_modal(Some(source), f64::NAN, e))?,
+        (false, Sliders::Free) => Holding::Free,
+        (false, Sliders::Locked) => Holding::Locked,
+    };
+    Ok(LinearSettings { modes, holding })
+}
+
+/// The linear state-space model about a pose with the settings of `opts` ([`linear_settings`];
+/// states, inputs and outputs in `flexstar_modal::linear`); with `out` writes `out/<name>/linear/`
+/// (Matrix Market A..D, M, K, Phi_q, fem-coordinates.csv, statespace.json).
+pub fn linearize(
+    exp: &Experiment,
+    source: &str,
+    spec: &PoseSpec,
+    opts: &LinearizeOptions,
+    out: Option<&Path>,
+) -> Result<StateSpace> {
+    let settings = linear_settings(exp, source, opts)?;
     let pose = resolve_pose(exp, source, spec)?;
     let dir = out.map(|o| crate::case_dir(o, exp)).transpose()?;
-    let ss = flexstar_modal::linear::linearize(exp, &pose).map_err(|e| from_modal(Some(source), f64::NAN, e))?;
+    let ss = flexstar_modal::linear::linearize_with(exp, &pose, &settings)
+        .map_err(|e| from_modal(Some(source), f64::NAN, e))?;
     if let Some(dir) = dir {
         flexstar_modal::linear::write_linear(&dir, exp, &ss).map_err(|e| from_modal(Some(source), f64::NAN, e))?;
     }

@@ -84,6 +84,100 @@ macro_rules! coordinate_helpers {
 
 impl PoseSystem {
     coordinate_helpers!();
+
+    /// What each coordinate is, in the order of the rows and columns of M, K and Phi_q (see
+    /// [`Coordinate`]); `xp` [m] are the sleeves' rest positions on their beams and `lp` [m] the
+    /// sleeve length (the contact coordinates' rest values).
+    pub fn coordinates(&self, xp: [f64; 3], lp: f64) -> Vec<Coordinate> {
+        let n_nodes = 1 + 3 * self.ne;
+        let mut out = Vec::with_capacity(self.n);
+        let mut push = |node, beam, dof, x| {
+            out.push(Coordinate {
+                index: out.len(),
+                node,
+                beam,
+                dof,
+                x,
+            })
+        };
+        for j in 0..n_nodes {
+            // node 0 is G (shared by the three beams); beam i's node k is 1 + i ne + k - 1
+            let (beam, x) = match j {
+                0 => (None, 0.0),
+                _ => (Some((j - 1) / self.ne), ((j - 1) % self.ne + 1) as f64 * self.h),
+            };
+            for dof in [Dof::Ux, Dof::Uy, Dof::Theta] {
+                push(Some(j), beam, dof, Some(x));
+            }
+        }
+        for (i, x) in xp.iter().enumerate() {
+            push(None, Some(i), Dof::Psi, Some(*x));
+        }
+        for (i, x) in xp.iter().enumerate() {
+            for (dof, off) in [(Dof::XiC, 0.0), (Dof::XiL, -0.5 * lp), (Dof::XiR, 0.5 * lp)] {
+                push(None, Some(i), dof, Some(x + off));
+            }
+        }
+        if self.sliders == Sliders::Free {
+            for i in 0..3 {
+                push(None, Some(i), Dof::Slider, None);
+            }
+        }
+        out
+    }
+}
+
+/// The kind of one FEM coordinate (all increments from the rest pose, fixed XY frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dof {
+    /// Node displacement along X [m].
+    Ux,
+    /// Node displacement along Y [m].
+    Uy,
+    /// Node cross-section rotation [rad].
+    Theta,
+    /// Rotation of sleeve i [rad].
+    Psi,
+    /// Contact coordinate of sleeve i's centre on its beam [m] (massless).
+    XiC,
+    /// Contact coordinate of sleeve i's left edge [m].
+    XiL,
+    /// Contact coordinate of sleeve i's right edge [m].
+    XiR,
+    /// Slider i along `+u_i` [m] (free sliders only).
+    Slider,
+}
+
+impl Dof {
+    /// The name in `fem-coordinates.csv`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Dof::Ux => "ux",
+            Dof::Uy => "uy",
+            Dof::Theta => "theta",
+            Dof::Psi => "psi",
+            Dof::XiC => "xi_c",
+            Dof::XiL => "xi_l",
+            Dof::XiR => "xi_r",
+            Dof::Slider => "slider",
+        }
+    }
+}
+
+/// One coordinate of the linearised FEM ([`PoseSystem::coordinates`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coordinate {
+    /// Row and column in M, K (0-based; columns of Phi_q).
+    pub index: usize,
+    /// Global node (0 = G) of a node coordinate.
+    pub node: Option<usize>,
+    /// Beam (0-based) of a node other than G, of a sleeve's coordinate or slider.
+    pub beam: Option<usize>,
+    /// What the coordinate is.
+    pub dof: Dof,
+    /// Material position along the beam from G [m]: the node's, the sleeve centre's (psi) or the
+    /// contact point's rest value; none for a slider.
+    pub x: Option<f64>,
 }
 
 /// Modes of the star at a pose; `system` is sparse ([`SparsePoseSystem::to_dense`] gives the
@@ -327,6 +421,53 @@ fn dofs(nodes: [usize; 2]) -> [usize; 6] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `PoseSystem::coordinates` against the assembled matrices: one entry per coordinate, the
+    /// sleeves' rotational inertia Jp on the psi rows, the slider mass on the slider rows, and a
+    /// unit translation along X or Y of every ux (uy) coordinate carries the beams' mass 3 rho L
+    /// (a rigid translation: the contact coordinates and sleeves have no translational mass); the
+    /// node positions are those of the mesh (k h along beam i).
+    #[test]
+    fn coordinates_describe_the_rows_of_m() {
+        let p = RobotParams::paper();
+        let pose = RestPose {
+            s: [0.0; 3],
+            g: [0.0; 2],
+            theta: 0.3,
+            xp: [0.16, 0.21, 0.18],
+        };
+        for sliders in [Sliders::Locked, Sliders::Free] {
+            let sys = pose_system(&p, &pose, sliders, 102).unwrap();
+            let coords = sys.coordinates(pose.xp, p.lp);
+            assert_eq!(coords.len(), sys.n);
+            let n = sys.n;
+            for (k, c) in coords.iter().enumerate() {
+                assert_eq!(c.index, k);
+                let mkk = sys.m[k * n + k];
+                match c.dof {
+                    Dof::Psi => assert_eq!(mkk, p.jp),
+                    Dof::Slider => {
+                        assert_eq!(mkk, p.mpp_mpa);
+                        assert_eq!(sys.slider_index(c.beam.unwrap()), Some(k));
+                    }
+                    Dof::XiC | Dof::XiL | Dof::XiR => assert_eq!(mkk, 0.0),
+                    Dof::Ux => {
+                        let (i, node) = (c.beam, c.node.unwrap());
+                        let kk = ((c.x.unwrap() / sys.h).round()) as usize;
+                        assert_eq!(sys.node(i.unwrap_or(0), kk), node, "{c:?}");
+                        assert_eq!(k, 3 * node);
+                    }
+                    _ => {}
+                }
+            }
+            for dof in [Dof::Ux, Dof::Uy] {
+                let r: Vec<f64> = coords.iter().map(|c| f64::from(u8::from(c.dof == dof))).collect();
+                let mass: f64 = (0..n).map(|a| (0..n).map(|b| r[a] * sys.m[a * n + b] * r[b]).sum::<f64>()).sum();
+                let beams = 3.0 * p.rho * p.l;
+                assert!((mass / beams - 1.0).abs() < 1e-12, "{dof:?}: {mass} vs {beams}");
+            }
+        }
+    }
 
     /// The sparse subspace iteration reproduces the dense null-space solution: omega^2 within
     /// 1e-7 relative to the first elastic one, and every sparse shape lies in the span of the dense

@@ -7,7 +7,7 @@
 //!   checked against the feasible range (the limit is named);
 //! - [`analysis`]: modes at a pose from the AMM and the FEM side by side (`modal.csv`);
 //! - [`freqmap`]: the first K frequencies over a grid of poses, in parallel (`freqmap.csv`);
-//! - [`linear`]: the state-space model (A, B, C, D) with free sliders, Matrix Market files
+//! - [`linear`]: the state-space model (A, B, C, D), sliders free, locked or servo-held, Matrix Market files
 //!   (sprs) and `statespace.json`;
 //! - [`plots`]: mode shapes and frequency heat maps (SVG, PNG).
 //!

@@ -1,46 +1,128 @@
-//! Linear state-space model of the small motion about a pose with free sliders (issue 11):
+//! Linear state-space model of the small motion about a pose (issue 11, settings of issue 24):
 //!
 //! ```text
 //! x' = A x + B u,   y = C x + D u
 //! ```
-//! built from the AMM's modes at the pose (sliders free, [`flexstar_amm::pose_modes`]) in modal
-//! coordinates: `x = [eta; eta']` with `q = Phi eta` (mass-normalised shapes, the three rigid modes
-//! first, then [`ELASTIC_MODES`] elastic ones), so `A = [[0, I], [-Omega^2, 0]]`,
-//! `B = [0; Phi^T F]`, `C = [H Phi, 0]`, `D = 0`.
-//! Inputs: the actuator forces Fa_1..Fa_3 [N] on the sliders along `+u_i` (Eq. 33).
-//! Outputs (docs/conventions.md): s_1..s_3 [m] (from the pose), the tip deflections
-//! `w_i(L)` [m] and `w_iG` [m], both relative to the rigid star the sliders hold (the rigid
-//! kinematics' Jacobian at the pose removes the rigid part).
+//! built from the AMM's modes at the pose ([`flexstar_amm::pose_modes`]) in modal coordinates:
+//! `x = [eta; eta']` with `q = Phi eta` (mass-normalised shapes; with free sliders the three
+//! rigid modes first, then K elastic ones, [`ELASTIC_MODES`] by default), so
+//! `A = [[0, I], [-Omega^2, 0]]`, `B = [0; Phi^T F]`, `C = [H Phi, 0]`. How the sliders are held
+//! ([`Holding`]) sets the inputs:
+//!
+//! - **free** (open loop): inputs the actuator forces `Fa1..Fa3` [N] on the sliders along `+u_i`
+//!   (Eq. 33); outputs `s1..s3` [m] (from the pose), the tip deflections `w1tip..w3tip` and
+//!   `w1G..w3G` [m], both relative to the rigid star the sliders hold (the rigid kinematics'
+//!   Jacobian at the pose removes the rigid part);
+//! - **locked**: the revolute points move with the sliders' prescribed motion, so the states are
+//!   the elastic modes of the locked star (no rigid modes, no slider states) and the inputs are the
+//!   slider accelerations `sdd1..sdd3` [m/s^2] (base excitation): with `q = q_rel + R s`, where
+//!   `R = dq/ds` is the rigid motion the sliders impose (from the sliders-free rigid modes),
+//!   `eta'' + Omega^2 eta = -Phi^T M R s''`. Outputs `w1tip..w3tip`, `w1G..w3G` [m] (relative to
+//!   the rigid star, i.e. `H Phi eta`);
+//! - **servo** (closed loop, sliders free): the PD servo `Fa = ff + kp (s_ref - s) + kd (s_ref' - s')`
+//!   closes the loop around the slider coordinates `s = S eta` (S: the shapes' slider rows):
+//!   `A = [[0, I], [-Omega^2 - kp S^T S, -kd S^T S]]`, inputs `s1ref..s3ref` [m],
+//!   `sd1ref..sd3ref` [m/s] and the feedforward forces `ff1..ff3` [N] (`B = [0; kp S^T, kd S^T,
+//!   S^T]`); outputs those of the free model and the tracking errors `e1..e3 = s_ref - s` [m]
+//!   (`D` = 1 from `s_iref`).
 
 use std::path::Path;
 
-use flexstar_amm::pose_modes::PoseModes;
+use flexstar_amm::pose_modes::{PoseModes, PoseSystem};
 use flexstar_kinematics::RigidState;
 use flexstar_model::output::write_atomically;
-use flexstar_model::{Experiment, RestPose, Sliders};
+use flexstar_model::{DriveKind, Experiment, RestPose, Sliders};
 use num_dual::Dual2;
 use sprs::{CsMat, TriMat};
 
 use crate::analysis::amm_modes_per_beam;
 use crate::ModalError;
 
-/// Elastic modes kept in the state-space model (after the three rigid ones).
+/// Elastic modes kept in the state-space model by default (after the three rigid ones when the
+/// sliders are free).
 pub const ELASTIC_MODES: usize = 20;
 
-/// Names and units of the inputs.
-pub const INPUTS: [(&str, &str); 3] = [("Fa1", "N"), ("Fa2", "N"), ("Fa3", "N")];
-/// Names and units of the outputs.
-pub const OUTPUTS: [(&str, &str); 9] = [
-    ("s1", "m"),
-    ("s2", "m"),
-    ("s3", "m"),
-    ("w1_tip", "m"),
-    ("w2_tip", "m"),
-    ("w3_tip", "m"),
-    ("w1G", "m"),
-    ("w2G", "m"),
-    ("w3G", "m"),
-];
+/// How the sliders of the linear model are held.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Holding {
+    /// Free on their rails (mass `mpp_mpa`), pushed by the actuator forces (open loop).
+    Free,
+    /// Revolute points moved by the prescribed slider motion (inputs: slider accelerations).
+    Locked,
+    /// Free, held by the experiment's PD servo with gains `kp` [N/m], `kd` [N s/m] (closed loop).
+    Servo { kp: f64, kd: f64 },
+}
+
+impl Holding {
+    /// How the AMM's sliders are held for the modes.
+    pub fn sliders(&self) -> Sliders {
+        match self {
+            Holding::Locked => Sliders::Locked,
+            Holding::Free | Holding::Servo { .. } => Sliders::Free,
+        }
+    }
+
+    /// The servo of an experiment, closed around free sliders; errors name the `[drive]` key.
+    pub fn servo_of(exp: &Experiment) -> Result<Holding, ModalError> {
+        if exp.drive.kind != DriveKind::Servo {
+            return Err(ModalError::Input(format!(
+                "--loop closed needs a servo drive ([drive] kind = \"servo\"); this experiment's drive is kind = \"{}\"",
+                drive_kind_name(exp.drive.kind)
+            )));
+        }
+        let g = exp.drive.servo_gains(exp.robot.mpp_mpa)?;
+        Ok(Holding::Servo { kp: g.kp, kd: g.kd })
+    }
+
+    /// The name in `statespace.json` and in messages: `free`, `locked`, `servo`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Holding::Free => "free",
+            Holding::Locked => "locked",
+            Holding::Servo { .. } => "servo",
+        }
+    }
+}
+
+fn drive_kind_name(k: DriveKind) -> &'static str {
+    match k {
+        DriveKind::Motion => "motion",
+        DriveKind::Forces => "forces",
+        DriveKind::Servo => "servo",
+    }
+}
+
+/// What the linear model keeps: K elastic modes and how the sliders are held.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearSettings {
+    /// Elastic modes K (1..=[`crate::MAX_K`]).
+    pub modes: usize,
+    /// How the sliders are held.
+    pub holding: Holding,
+}
+
+impl Default for LinearSettings {
+    /// [`ELASTIC_MODES`] elastic modes, sliders free, open loop (the model of issue 11).
+    fn default() -> Self {
+        LinearSettings {
+            modes: ELASTIC_MODES,
+            holding: Holding::Free,
+        }
+    }
+}
+
+/// A named signal or state with its unit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Signal {
+    /// Name (as the run CSVs' columns where the same quantity appears there).
+    pub name: String,
+    /// SI unit.
+    pub unit: &'static str,
+}
+
+fn signals(names: &[&str], unit: &'static str) -> Vec<Signal> {
+    names.iter().map(|n| Signal { name: (*n).into(), unit }).collect()
+}
 
 /// The state-space model and what it was built from.
 pub struct StateSpace {
@@ -48,9 +130,18 @@ pub struct StateSpace {
     pub b: CsMat<f64>,
     pub c: CsMat<f64>,
     pub d: CsMat<f64>,
-    /// The modal analysis (sliders free) behind it.
+    /// The modal analysis behind it (sliders free for the free and servo models, else locked).
     pub modes: PoseModes,
     pub pose: RestPose,
+    /// The settings it was built with.
+    pub settings: LinearSettings,
+    /// States in order: `eta1..etaN` [m kg^0.5] (modal amplitudes of the mass-normalised
+    /// shapes, mode k = row k of `modal_frequencies_hz`), then their rates `etad1..etadN`.
+    pub states: Vec<Signal>,
+    /// Inputs in the order of B's columns (module docs).
+    pub inputs: Vec<Signal>,
+    /// Outputs in the order of C's rows (module docs).
+    pub outputs: Vec<Signal>,
 }
 
 /// Derivatives of the rigid star (G [m], theta [rad]) with respect to s_j at the pose.
@@ -79,57 +170,183 @@ fn dense_to_cs(rows: usize, cols: usize, f: impl Fn(usize, usize) -> f64) -> CsM
     t.to_csr()
 }
 
-/// The linear model about `pose` (sliders free).
-pub fn linearize(exp: &Experiment, pose: &RestPose) -> Result<StateSpace, ModalError> {
+/// Rows `h` (on the AMM coordinates, `h . q`) of the tip deflections `w_i(L)` then of `w_iG`,
+/// relative to the rigid star: with free sliders the rigid part the slider displacements carry
+/// (the rigid kinematics' Jacobian, projected on `e_wi`, lever L at the tip) is removed; with
+/// locked sliders the rigid star does not move.
+fn deflection_rows(exp: &Experiment, pose: &RestPose, sys: &PoseSystem) -> Result<Vec<Vec<f64>>, ModalError> {
+    let jac = match sys.sliders {
+        Sliders::Free => Some(rigid_jacobian(exp, pose)?),
+        Sliders::Locked => None,
+    };
+    let l = exp.robot.l;
+    let mut h = Vec::with_capacity(6);
+    for (x, lever) in [(l, l), (0.0, 0.0)] {
+        for i in 0..3 {
+            let mut row = sys.deflection_row(i, x);
+            if let Some(jac) = &jac {
+                let ew = flexstar_model::geometry::e_w(i, pose.theta);
+                for (j, ((jx, jy), jt)) in jac[0].iter().zip(&jac[1]).zip(&jac[2]).enumerate() {
+                    if let Some(s_j) = sys.slider_index(j) {
+                        row[s_j] -= jx * ew[0] + jy * ew[1] + lever * jt;
+                    }
+                }
+            }
+            h.push(row);
+        }
+    }
+    Ok(h)
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>()
+}
+
+/// The slider rows `S[i][k]` = slider i's displacement in shape k (free sliders).
+fn slider_rows(modes: &PoseModes) -> [Vec<f64>; 3] {
+    let sys = &modes.system;
+    [0, 1, 2].map(|i| match sys.slider_index(i) {
+        Some(si) => modes.shapes.iter().map(|p| p[si]).collect(),
+        None => vec![0.0; modes.shapes.len()],
+    })
+}
+
+/// Inverse of a 3 x 3 matrix (cofactors); `None` when it is singular to round-off.
+fn inverse3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+    let c = |r: usize, k: usize| {
+        let (r1, r2, k1, k2) = ((r + 1) % 3, (r + 2) % 3, (k + 1) % 3, (k + 2) % 3);
+        m[r1][k1] * m[r2][k2] - m[r1][k2] * m[r2][k1]
+    };
+    let det: f64 = (0..3).map(|k| m[0][k] * c(0, k)).sum();
+    let scale = m.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
+    if !(det.abs() > 1e-12 * scale.powi(3)) {
+        return None;
+    }
+    // inverse = adjugate / det, adj[k][r] = cofactor(r, k)
+    Some([0, 1, 2].map(|k| [0, 1, 2].map(|r| c(r, k) / det)))
+}
+
+/// Locked sliders' base excitation: the columns `M R_j` (on the locked coordinates), where
+/// `R_j = dq/ds_j` is the rigid motion of the star when slider j moves, from the three rigid
+/// modes of the sliders-free system (their beam part times the inverse of their slider part).
+fn base_excitation(exp: &Experiment, pose: &RestPose, locked: &PoseSystem) -> Result<Vec<[f64; 3]>, ModalError> {
+    let (family, nm) = crate::analysis::amm_basis(exp);
+    let free = flexstar_amm::pose_modes::pose_modes(&exp.robot, pose, Sliders::Free, family, nm, 1)?;
+    let rigid = &free.shapes[..free.rigid];
+    let mut s = [[0.0; 3]; 3];
+    for (i, row) in s.iter_mut().enumerate() {
+        let si = free.system.slider_index(i).unwrap_or(0);
+        for (r, shape) in rigid.iter().enumerate().take(3) {
+            row[r] = shape[si];
+        }
+    }
+    let s_inv = inverse3(&s).ok_or_else(|| {
+        ModalError::Infeasible("the sliders do not determine the star's rigid motion at this pose".into())
+    })?;
+    let n = locked.n;
+    let r: Vec<[f64; 3]> = (0..n)
+        .map(|b| [0, 1, 2].map(|j| (0..3).map(|k| rigid[k][b] * s_inv[k][j]).sum::<f64>()))
+        .collect();
+    Ok((0..n)
+        .map(|a| [0, 1, 2].map(|j| (0..n).map(|b| locked.m[a * n + b] * r[b][j]).sum::<f64>()))
+        .collect())
+}
+
+/// The AMM's modes at the pose for `settings` (K checked, enough modes in the basis).
+fn amm_modes(exp: &Experiment, pose: &RestPose, settings: &LinearSettings) -> Result<PoseModes, ModalError> {
+    crate::check_k(settings.modes)?;
+    let (family, nm) = crate::analysis::amm_basis(exp);
     let modes = flexstar_amm::pose_modes::pose_modes(
         &exp.robot,
         pose,
-        Sliders::Free,
-        crate::analysis::amm_basis(exp).0,
-        amm_modes_per_beam(exp),
-        ELASTIC_MODES,
+        settings.holding.sliders(),
+        family,
+        nm,
+        settings.modes,
     )?;
-    let sys = &modes.system;
-    let nr = modes.shapes.len();
-    let jac = rigid_jacobian(exp, pose)?;
-    let l = exp.robot.l;
-    // output rows H (9 x n) on the AMM coordinates
-    let mut h = vec![vec![0.0; sys.n]; 9];
-    for i in 0..3 {
-        let si = sys.slider_index(i).expect("sliders free");
-        h[i][si] = 1.0;
-        let ew = flexstar_model::geometry::e_w(i, pose.theta);
-        for (row, x, lever) in [(3 + i, l, l), (6 + i, 0.0, 0.0)] {
-            let dr = sys.deflection_row(i, x);
-            for (hv, v) in h[row].iter_mut().zip(dr) {
-                *hv += v;
-            }
-            for (j, ((jx, jy), jt)) in jac[0].iter().zip(&jac[1]).zip(&jac[2]).enumerate() {
-                let s_j = sys.slider_index(j).expect("sliders free");
-                h[row][s_j] -= jx * ew[0] + jy * ew[1] + lever * jt;
-            }
-        }
+    if modes.shapes.len() < modes.rigid + settings.modes {
+        return Err(ModalError::Input(format!(
+            "--modes {}: the AMM with N = {} modes per beam has only {} modes",
+            settings.modes,
+            amm_modes_per_beam(exp),
+            modes.shapes.len() - modes.rigid
+        )));
     }
+    Ok(modes)
+}
+
+/// The model's matrices on the modal coordinates: `omega2` (nr), the loop's stiffness and
+/// damping on the modes (`kp S^T S`, `kd S^T S`; none in open loop), `bm` (nr x nu, the lower
+/// block of B), `cq` (ny x nr, the left block of C) and D (ny x nu, dense).
+struct Blocks {
+    omega2: Vec<f64>,
+    feedback: Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)>,
+    bm: Vec<Vec<f64>>,
+    cq: Vec<Vec<f64>>,
+    d: Vec<Vec<f64>>,
+}
+
+impl Blocks {
+    fn matrices(&self) -> [CsMat<f64>; 4] {
+        let nr = self.omega2.len();
+        let n = 2 * nr;
+        let (nu, ny) = (self.d.first().map_or(0, Vec::len), self.cq.len());
+        let a = dense_to_cs(n, n, |r, c| {
+            if r < nr {
+                f64::from(u8::from(c == r + nr))
+            } else if let Some((k, d)) = &self.feedback {
+                let (k, d) = (&k[r - nr], &d[r - nr]);
+                let diag = if c == r - nr { -self.omega2[c] } else { 0.0 };
+                if c < nr {
+                    diag - k[c]
+                } else {
+                    -d[c - nr]
+                }
+            } else if c == r - nr {
+                -self.omega2[c]
+            } else {
+                0.0
+            }
+        });
+        let b = dense_to_cs(n, nu, |r, c| if r < nr { 0.0 } else { self.bm[r - nr][c] });
+        let c = dense_to_cs(ny, n, |r, c| if c < nr { self.cq[r][c] } else { 0.0 });
+        let d = dense_to_cs(ny, nu, |r, c| self.d[r][c]);
+        [a, b, c, d]
+    }
+}
+
+/// The linear model about `pose` with free sliders, [`ELASTIC_MODES`] elastic modes, open loop
+/// (the model of issue 11; [`linearize_with`] takes other settings).
+pub fn linearize(exp: &Experiment, pose: &RestPose) -> Result<StateSpace, ModalError> {
+    linearize_with(exp, pose, &LinearSettings::default())
+}
+
+/// The linear model about `pose` with K elastic modes and the sliders held as `settings` says
+/// (module docs: states, inputs and outputs of each case).
+pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettings) -> Result<StateSpace, ModalError> {
+    let modes = amm_modes(exp, pose, settings)?;
     let phi = &modes.shapes;
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-    let hphi: Vec<Vec<f64>> = h.iter().map(|r| phi.iter().map(|p| dot(r, p)).collect()).collect();
-    let phit_f: Vec<[f64; 3]> = phi
+    let deflections: Vec<Vec<f64>> = deflection_rows(exp, pose, &modes.system)?
         .iter()
-        .map(|p| [0, 1, 2].map(|i| p[sys.slider_index(i).expect("sliders free")]))
+        .map(|r| phi.iter().map(|p| dot(r, p)).collect())
         .collect();
-    let n = 2 * nr;
-    let a = dense_to_cs(n, n, |r, c| {
-        if r < nr {
-            f64::from(u8::from(c == r + nr))
-        } else if c == r - nr {
-            -modes.omega2[c]
-        } else {
-            0.0
-        }
-    });
-    let b = dense_to_cs(n, 3, |r, c| if r < nr { 0.0 } else { phit_f[r - nr][c] });
-    let c = dense_to_cs(9, n, |r, c| if c < nr { hphi[r][c] } else { 0.0 });
-    let d = TriMat::new((9, 3)).to_csr();
+    let (blocks, inputs, outputs) = match settings.holding {
+        Holding::Locked => locked_model(exp, pose, &modes, deflections)?,
+        Holding::Free => free_model(&modes, deflections),
+        Holding::Servo { kp, kd } => servo_model(&modes, deflections, kp, kd),
+    };
+    let [a, b, c, d] = blocks.matrices();
+    let nr = phi.len();
+    let mut states: Vec<Signal> = (1..=nr)
+        .map(|k| Signal {
+            name: format!("eta{k}"),
+            unit: "m kg^0.5",
+        })
+        .collect();
+    states.extend((1..=nr).map(|k| Signal {
+        name: format!("etad{k}"),
+        unit: "m kg^0.5/s",
+    }));
     Ok(StateSpace {
         a,
         b,
@@ -137,7 +354,92 @@ pub fn linearize(exp: &Experiment, pose: &RestPose) -> Result<StateSpace, ModalE
         d,
         modes,
         pose: *pose,
+        settings: *settings,
+        states,
+        inputs,
+        outputs,
     })
+}
+
+/// Blocks, inputs and outputs of one model.
+type Model = (Blocks, Vec<Signal>, Vec<Signal>);
+
+fn zeros(rows: usize, cols: usize) -> Vec<Vec<f64>> {
+    vec![vec![0.0; cols]; rows]
+}
+
+/// Locked sliders: inputs the slider accelerations, `B = -Phi^T M R` (module docs).
+fn locked_model(exp: &Experiment, pose: &RestPose, modes: &PoseModes, deflections: Vec<Vec<f64>>) -> Result<Model, ModalError> {
+    let sys = &modes.system;
+    let mr = base_excitation(exp, pose, sys)?;
+    let bm = modes
+        .shapes
+        .iter()
+        .map(|p| (0..3).map(|j| -(0..sys.n).map(|a| p[a] * mr[a][j]).sum::<f64>()).collect())
+        .collect();
+    let blocks = Blocks {
+        omega2: modes.omega2.clone(),
+        feedback: None,
+        bm,
+        cq: deflections,
+        d: zeros(6, 3),
+    };
+    Ok((blocks, signals(&["sdd1", "sdd2", "sdd3"], "m/s^2"), deflection_signals()))
+}
+
+/// Free sliders, open loop: inputs Fa, `B = [0; S^T]`, outputs the sliders then the deflections.
+fn free_model(modes: &PoseModes, deflections: Vec<Vec<f64>>) -> Model {
+    let s = slider_rows(modes);
+    let nr = modes.shapes.len();
+    let mut cq: Vec<Vec<f64>> = s.to_vec();
+    cq.extend(deflections);
+    let mut outputs = signals(&["s1", "s2", "s3"], "m");
+    outputs.extend(deflection_signals());
+    let bm = (0..nr).map(|k| s.iter().map(|row| row[k]).collect()).collect();
+    let blocks = Blocks {
+        omega2: modes.omega2.clone(),
+        feedback: None,
+        bm,
+        cq,
+        d: zeros(9, 3),
+    };
+    (blocks, signals(&["Fa1", "Fa2", "Fa3"], "N"), outputs)
+}
+
+/// The free model with the PD servo closed around the sliders (module docs): inputs the
+/// references, their rates and the feedforward forces; the tracking errors appended as outputs.
+fn servo_model(modes: &PoseModes, deflections: Vec<Vec<f64>>, kp: f64, kd: f64) -> Model {
+    let (mut blocks, _, mut outputs) = free_model(modes, deflections);
+    let s = slider_rows(modes);
+    let nr = modes.shapes.len();
+    let sts: Vec<Vec<f64>> = (0..nr)
+        .map(|k| (0..nr).map(|j| s.iter().map(|row| row[k] * row[j]).sum::<f64>()).collect())
+        .collect();
+    let scaled = |g: f64| -> Vec<Vec<f64>> { sts.iter().map(|r| r.iter().map(|v| g * v).collect()).collect() };
+    blocks.feedback = Some((scaled(kp), scaled(kd)));
+    blocks.bm = blocks
+        .bm
+        .iter()
+        .map(|r| {
+            let ref_pos = r.iter().map(|v| kp * v);
+            let ref_rate = r.iter().map(|v| kd * v);
+            ref_pos.chain(ref_rate).chain(r.iter().copied()).collect()
+        })
+        .collect();
+    blocks.d = zeros(12, 9);
+    for (i, row) in s.iter().enumerate() {
+        blocks.cq.push(row.iter().map(|v| -v).collect());
+        blocks.d[9 + i][i] = 1.0;
+    }
+    outputs.extend(signals(&["e1", "e2", "e3"], "m"));
+    let mut inputs = signals(&["s1ref", "s2ref", "s3ref"], "m");
+    inputs.extend(signals(&["sd1ref", "sd2ref", "sd3ref"], "m/s"));
+    inputs.extend(signals(&["ff1", "ff2", "ff3"], "N"));
+    (blocks, inputs, outputs)
+}
+
+fn deflection_signals() -> Vec<Signal> {
+    signals(&["w1tip", "w2tip", "w3tip", "w1G", "w2G", "w3G"], "m")
 }
 
 /// Write one sparse matrix as a Matrix Market file (sprs; whole or not at all).
@@ -161,27 +463,82 @@ pub fn dense(rows: usize, cols: usize, v: &[f64]) -> CsMat<f64> {
     dense_to_cs(rows, cols, |r, c| v[r * cols + c])
 }
 
-/// Write `dir/linear/`: A, B, C, D, statespace.json, and the FEM's M, K, Phi_q at the pose
-/// (sliders free). Everything is computed before the first file is written, and the files are
-/// published as one set ([`flexstar_model::run_set::RunSet`]).
+/// Header of `linear/fem-coordinates.csv` (one row per FEM coordinate, in the order of the rows
+/// and columns of `M.mtx`, `K.mtx` and the columns of `Phi_q.mtx`).
+pub const FEM_COORDINATES_HEADER: &str = "index,node,beam,dof,x_m";
+
+/// The text of `fem-coordinates.csv`: `index` 1-based (the row/column number in the Matrix
+/// Market files), `node` the FEM node (0 = G; empty for a sleeve's or slider's coordinate), `beam`
+/// 1..3 (empty for G), `dof` ux|uy|theta|psi|xi_c|xi_l|xi_r|slider, `x_m` the position along
+/// the beam from G [m] (empty for a slider).
+pub fn fem_coordinates_csv(coords: &[flexstar_fem::pose_modes::Coordinate]) -> String {
+    let opt = |v: Option<usize>| v.map_or(String::new(), |v| v.to_string());
+    let mut text = format!("{FEM_COORDINATES_HEADER}\n");
+    for c in coords {
+        let x = c.x.map_or(String::new(), flexstar_model::output::fmt_number);
+        text.push_str(&format!(
+            "{},{},{},{},{x}\n",
+            c.index + 1,
+            opt(c.node),
+            opt(c.beam.map(|b| b + 1)),
+            c.dof.name()
+        ));
+    }
+    text
+}
+
+fn named(list: &[Signal]) -> Vec<serde_json::Value> {
+    list.iter()
+        .map(|s| serde_json::json!({"name": s.name, "unit": s.unit}))
+        .collect()
+}
+
+/// `statespace.json`: the model's settings, its states, inputs and outputs (names and units, in
+/// the order of A, B, C, D), the pose, the modal frequencies and the files.
+fn statespace_json(exp: &Experiment, ss: &StateSpace, fem: &flexstar_fem::pose_modes::PoseSystem) -> serde_json::Value {
+    let h = ss.settings.holding;
+    let description = match h {
+        Holding::Free => "sliders free, open loop (inputs: actuator forces)",
+        Holding::Locked => "sliders locked, revolute points moved by the prescribed slider motion (inputs: slider accelerations)",
+        Holding::Servo { .. } => "sliders free, PD servo loop closed (inputs: reference positions and rates, feedforward forces)",
+    };
+    let servo = match h {
+        Holding::Servo { kp, kd } => serde_json::json!({"kp": kp, "kd": kd}),
+        _ => serde_json::Value::Null,
+    };
+    serde_json::json!({
+        "description": format!("continuous-time state-space model x' = A x + B u, y = C x + D u of the small motion about the pose, {description} (flexstar, AMM modal coordinates: x = [eta; eta'], rigid modes first when the sliders are free)"),
+        "sliders": h.sliders().name(),
+        "loop": if matches!(h, Holding::Servo { .. }) { "closed" } else { "open" },
+        "servo": servo,
+        "elastic_modes": ss.settings.modes,
+        "rigid_modes": ss.modes.rigid,
+        "n_states": ss.a.rows(),
+        "states": named(&ss.states),
+        "inputs": named(&ss.inputs),
+        "outputs": named(&ss.outputs),
+        "pose": {"Gx": ss.pose.g[0], "Gy": ss.pose.g[1], "theta": ss.pose.theta, "s": ss.pose.s, "xp": ss.pose.xp},
+        "modal_frequencies_hz": ss.modes.freq_hz,
+        "files": {"A": "A.mtx", "B": "B.mtx", "C": "C.mtx", "D": "D.mtx", "fem_mass": "M.mtx", "fem_stiffness": "K.mtx", "fem_constraint_jacobian": "Phi_q.mtx", "fem_coordinates": "fem-coordinates.csv"},
+        "fem": {"coordinates": fem.n, "constraints": fem.rows, "elements": exp.fem.elements, "sliders": fem.sliders.name()},
+    })
+}
+
+/// Write `dir/linear/`: A, B, C, D, statespace.json, the FEM's M, K, Phi_q at the pose (sliders
+/// held as the model's) and `fem-coordinates.csv` (what their rows are). Everything is computed
+/// before the first file is written, and the files are published as one set
+/// ([`flexstar_model::run_set::RunSet`]).
 pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(), ModalError> {
-    let fem = flexstar_fem::pose_modes::pose_system(&exp.robot, &ss.pose, Sliders::Free, exp.fem.elements)?;
+    let sliders = ss.settings.holding.sliders();
+    let fem = flexstar_fem::pose_modes::pose_system(&exp.robot, &ss.pose, sliders, exp.fem.elements)?;
     let (fm, fk, fc) = (
         dense(fem.n, fem.n, &fem.m),
         dense(fem.n, fem.n, &fem.k),
         dense(fem.rows, fem.n, &fem.c),
     );
-    let json = serde_json::json!({
-        "description": "continuous-time state-space model x' = A x + B u, y = C x + D u of the small motion about the pose, sliders free (flexstar, AMM modal coordinates: x = [eta; eta'], rigid modes first)",
-        "states": ss.a.rows(),
-        "inputs": INPUTS.iter().map(|(n, u)| serde_json::json!({"name": n, "unit": u})).collect::<Vec<_>>(),
-        "outputs": OUTPUTS.iter().map(|(n, u)| serde_json::json!({"name": n, "unit": u})).collect::<Vec<_>>(),
-        "pose": {"Gx": ss.pose.g[0], "Gy": ss.pose.g[1], "theta": ss.pose.theta, "s": ss.pose.s, "xp": ss.pose.xp},
-        "modal_frequencies_hz": ss.modes.freq_hz,
-        "files": {"A": "A.mtx", "B": "B.mtx", "C": "C.mtx", "D": "D.mtx", "fem_mass": "M.mtx", "fem_stiffness": "K.mtx", "fem_constraint_jacobian": "Phi_q.mtx"},
-        "fem": {"coordinates": fem.n, "constraints": fem.rows, "elements": exp.fem.elements},
-    });
-    // the seven matrices and the JSON are published together (issue 24)
+    let coordinates = fem_coordinates_csv(&fem.coordinates(ss.pose.xp, exp.robot.lp));
+    let json = statespace_json(exp, ss, &fem);
+    // the seven matrices, the coordinates and the JSON are published together (issue 24)
     let mut set = flexstar_model::run_set::RunSet::begin(&dir.join("linear"))?;
     for (name, m) in [
         ("A", &ss.a),
@@ -197,6 +554,7 @@ pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(),
             Ok(())
         })?;
     }
+    set.text("fem-coordinates.csv", &coordinates)?;
     set.text(
         "statespace.json",
         &serde_json::to_string_pretty(&json).expect("json of plain values"),

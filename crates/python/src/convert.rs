@@ -81,6 +81,19 @@ pub fn sliders(s: &str) -> PyResult<Sliders> {
     }
 }
 
+/// `loop="open" | "closed"` (None: the default of `flexstar linearize`).
+pub fn loop_kind(s: Option<&str>) -> PyResult<Option<flexstar_api::modal::LoopKind>> {
+    use flexstar_api::modal::LoopKind;
+    match s {
+        None => Ok(None),
+        Some("open") => Ok(Some(LoopKind::Open)),
+        Some("closed") => Ok(Some(LoopKind::Closed)),
+        Some(other) => Err(ConfigError::new_err(format!(
+            "loop: expected \"open\" or \"closed\", got {other:?}"
+        ))),
+    }
+}
+
 /// A rest pose as a dict (SI units).
 pub fn pose_dict<'py>(py: Python<'py>, p: &RestPose) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);

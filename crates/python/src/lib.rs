@@ -247,39 +247,46 @@ fn modal<'py>(
     Ok(d)
 }
 
-/// The linear state-space model about a pose, sliders free (see `flexstar.linearize`).
+/// The linear state-space model about a pose (see `flexstar.linearize`): the matrices, the names
+/// of the states, inputs and outputs (in the matrices' order) and the settings used.
 #[pyfunction]
-#[pyo3(signature = (exp, at = None, pose = None))]
+#[pyo3(signature = (exp, at = None, pose = None, modes = flexstar_modal::linear::ELASTIC_MODES, sliders = "free", r#loop = None))]
 fn linearize<'py>(
     py: Python<'py>,
     exp: &PyExperiment,
     at: Option<f64>,
     pose: Option<[f64; 3]>,
+    modes: usize,
+    sliders: &str,
+    r#loop: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let spec = convert::pose_spec(at, pose)?;
+    let opts = flexstar_api::modal::LinearizeOptions {
+        modes: Some(modes),
+        sliders: Some(convert::sliders(sliders)?),
+        loop_kind: convert::loop_kind(r#loop)?,
+    };
     let doc = &exp.inner;
     let source = doc.source.display().to_string();
     let ss = py
-        .detach(|| flexstar_api::modal::linearize(&doc.exp, &source, &spec, None))
+        .detach(|| flexstar_api::modal::linearize(&doc.exp, &source, &spec, &opts, None))
         .map_err(py_err)?;
     let d = PyDict::new(py);
     for (name, m) in [("A", &ss.a), ("B", &ss.b), ("C", &ss.c), ("D", &ss.d)] {
         d.set_item(name, convert::dense(py, m)?)?;
     }
-    d.set_item(
-        "inputs",
-        flexstar_modal::linear::INPUTS
-            .iter()
-            .map(|(n, _)| *n)
-            .collect::<Vec<_>>(),
-    )?;
-    d.set_item(
-        "outputs",
-        flexstar_modal::linear::OUTPUTS
-            .iter()
-            .map(|(n, _)| *n)
-            .collect::<Vec<_>>(),
-    )?;
+    let names = |v: &[flexstar_modal::linear::Signal]| v.iter().map(|s| s.name.clone()).collect::<Vec<_>>();
+    let units = |v: &[flexstar_modal::linear::Signal]| v.iter().map(|s| s.unit).collect::<Vec<_>>();
+    d.set_item("states", names(&ss.states))?;
+    d.set_item("inputs", names(&ss.inputs))?;
+    d.set_item("outputs", names(&ss.outputs))?;
+    d.set_item("input_units", units(&ss.inputs))?;
+    d.set_item("output_units", units(&ss.outputs))?;
+    let h = ss.settings.holding;
+    d.set_item("sliders", h.sliders().name())?;
+    let closed = matches!(h, flexstar_modal::linear::Holding::Servo { .. });
+    d.set_item("loop", if closed { "closed" } else { "open" })?;
+    d.set_item("modes", ss.settings.modes)?;
     d.set_item("modal_frequencies_hz", PyArray1::from_slice(py, &ss.modes.freq_hz))?;
     d.set_item("rigid", ss.modes.rigid)?;
     d.set_item("pose", convert::pose_dict(py, &ss.pose)?)?;

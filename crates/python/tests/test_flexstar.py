@@ -146,3 +146,36 @@ def test_compare_writes_the_cli_table(root, tmp_path):
     assert pathlib.Path(res["compare_csv"]).exists()
     report = (pathlib.Path(res["dir"]) / "compare.json").read_text()
     assert res["behaviour"] in report, "the behaviour of G is the one compare.json reports"
+
+
+def test_linearize_settings_and_names(root):
+    """linearize's settings (issue 24): K elastic modes and locked sliders give 2 K states
+    named eta1..etaK, etad1..etadK; the names are those of the Rust model (the CLI's
+    statespace.json); the eigenvalues of A equal +- i omega of `modal`'s locked frequencies; a
+    servo experiment is closed-loop by default, and ``loop="closed"`` without a servo is refused."""
+    exp = flexstar.Experiment.load(root / "configs/case3.toml")
+    lin = flexstar.linearize(exp, at=0.3, modes=6, sliders="locked")
+    assert lin.A.shape == (12, 12) and lin.B.shape == (12, 3) and lin.C.shape == (6, 12)
+    assert lin.states == [f"eta{k}" for k in range(1, 7)] + [f"etad{k}" for k in range(1, 7)]
+    assert lin.inputs == ["sdd1", "sdd2", "sdd3"]
+    assert lin.outputs == ["w1tip", "w2tip", "w3tip", "w1G", "w2G", "w3G"]
+    assert (lin.sliders, lin.loop, lin.rigid) == ("locked", "open", 0)
+    m = flexstar.modal(exp, at=0.3, sliders="locked", modes=6)
+    f = np.sort(np.abs(np.linalg.eigvals(lin.A).imag))[::2] / (2 * np.pi)
+    np.testing.assert_allclose(f, m["amm_hz"], rtol=1e-8)
+    free = flexstar.linearize(exp, at=0.3)
+    assert free.inputs == ["Fa1", "Fa2", "Fa3"] and free.outputs[3] == "w1tip"
+    assert len(free.states) == free.A.shape[0] == 2 * (3 + 20)
+    servo = flexstar.linearize(flexstar.Experiment.load(root / "configs/servo/case3-servo.toml"), at=0.3, modes=4)
+    assert servo.loop == "closed" and servo.inputs[0] == "s1ref" and servo.outputs[-1] == "e3"
+    assert np.all(np.linalg.eigvals(servo.A).real < 0)
+    with pytest.raises(flexstar.ConfigError, match="servo"):
+        flexstar.linearize(exp, at=0.3, loop="closed")
+    with pytest.raises(flexstar.ConfigError, match="loop"):
+        flexstar.linearize(exp, at=0.3, loop="shut")
+    try:
+        import control  # noqa: F401
+    except ImportError:
+        return
+    sys = lin.to_control()
+    assert list(sys.state_labels) == lin.states and list(sys.input_labels) == lin.inputs

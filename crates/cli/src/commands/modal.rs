@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use flexstar_api::modal::{FreqmapSettings, MapSolver, PoseSpec};
+use flexstar_api::modal::{FreqmapSettings, LinearizeOptions, LoopKind, MapSolver, PoseSpec};
 use flexstar_model::{Experiment, Sliders};
 
 use crate::progress::Reporter;
@@ -45,9 +45,9 @@ pub enum SlidersArg {
     Free,
 }
 
-impl SlidersArg {
-    fn sliders(self) -> Sliders {
-        match self {
+impl From<SlidersArg> for Sliders {
+    fn from(s: SlidersArg) -> Sliders {
+        match s {
             SlidersArg::Locked => Sliders::Locked,
             SlidersArg::Free => Sliders::Free,
         }
@@ -113,13 +113,31 @@ pub struct FreqmapArgs {
     out: PathBuf,
 }
 
-/// Linear state-space model about a pose (sliders free): DIR/<name>/linear/
+/// Whether the servo loop is closed in the linear model (`--loop`).
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum LoopArg {
+    /// Inputs the actuator forces (sliders free) or the slider accelerations (sliders locked)
+    Open,
+    /// The experiment's PD servo ([drive] kind = "servo") closes the loop around the sliders
+    Closed,
+}
+
+/// Linear state-space model about a pose: DIR/<name>/linear/
 #[derive(clap::Args)]
 pub struct LinearizeArgs {
     /// Experiment file (TOML)
     config: PathBuf,
     #[command(flatten)]
     pose: PoseArgs,
+    /// Number of elastic modes K kept (1..=50), after the three rigid ones when the sliders are free
+    #[arg(long = "modes", default_value_t = flexstar_modal::linear::ELASTIC_MODES)]
+    k: usize,
+    /// How the sliders are held: free (inputs Fa1..Fa3) or locked (inputs the slider accelerations)
+    #[arg(long, value_enum, default_value = "free")]
+    sliders: SlidersArg,
+    /// Servo loop open or closed [default: closed when [drive] kind = "servo" and the sliders are free, else open]
+    #[arg(long = "loop", value_enum)]
+    loop_kind: Option<LoopArg>,
     /// Output directory
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -137,7 +155,7 @@ fn load(config: &std::path::Path) -> anyhow::Result<(Experiment, String)> {
 
 pub fn run_modal(args: ModalArgs) -> anyhow::Result<()> {
     let (exp, source) = load(&args.config)?;
-    let sliders = args.sliders.sliders();
+    let sliders = Sliders::from(args.sliders);
     flexstar_api::modal::check_k(args.k)?;
     let spec = args.pose.spec(&args.config)?;
     let start = Instant::now();
@@ -167,7 +185,7 @@ pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
             SolverArg::Amm => MapSolver::Amm,
             SolverArg::Fem => MapSolver::Fem,
         },
-        sliders: args.sliders.sliders(),
+        sliders: Sliders::from(args.sliders),
         force: args.force,
     };
     let start = Instant::now();
@@ -197,11 +215,24 @@ pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
 pub fn run_linearize(args: LinearizeArgs) -> anyhow::Result<()> {
     let (exp, source) = load(&args.config)?;
     let spec = args.pose.spec(&args.config)?;
-    let ss = flexstar_api::modal::linearize(&exp, &source, &spec, Some(&args.out))?;
+    let opts = LinearizeOptions {
+        modes: Some(args.k),
+        sliders: Some(args.sliders.into()),
+        loop_kind: args.loop_kind.map(|l| match l {
+            LoopArg::Open => LoopKind::Open,
+            LoopArg::Closed => LoopKind::Closed,
+        }),
+    };
+    let ss = flexstar_api::modal::linearize(&exp, &source, &spec, &opts, Some(&args.out))?;
+    let h = ss.settings.holding;
     eprintln!(
-        "{}: {} states, 3 inputs, 9 outputs about G = ({:.5}, {:.5}) m, theta = {:.5} rad; A.mtx .. D.mtx, M.mtx, K.mtx, Phi_q.mtx, statespace.json in {}",
+        "{}: {} states, {} inputs, {} outputs (sliders {}, loop {}) about G = ({:.5}, {:.5}) m, theta = {:.5} rad; A.mtx .. D.mtx, M.mtx, K.mtx, Phi_q.mtx, fem-coordinates.csv, statespace.json in {}",
         exp.name,
         ss.a.rows(),
+        ss.inputs.len(),
+        ss.outputs.len(),
+        h.sliders().name(),
+        if matches!(h, flexstar_modal::linear::Holding::Servo { .. }) { "closed" } else { "open" },
         ss.pose.g[0],
         ss.pose.g[1],
         ss.pose.theta,

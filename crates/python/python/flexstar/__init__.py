@@ -221,32 +221,53 @@ def modal(
 
 
 class LinearModel:
-    """x' = A x + B u, y = C x + D u about a pose, sliders free (inputs Fa1..Fa3 [N],
-    outputs s1..s3, w1_tip..w3_tip, w1G..w3G [m])."""
+    """x' = A x + B u, y = C x + D u about a pose. ``states``, ``inputs`` and ``outputs`` name
+    the rows and columns of the matrices (as ``statespace.json``): states ``eta1..etaN`` then
+    ``etad1..etadN`` (modal amplitudes, rigid modes first with free sliders); inputs ``Fa1..Fa3``
+    [N] (sliders free), ``sdd1..sdd3`` [m/s^2] (sliders locked) or ``s1ref..s3ref``,
+    ``sd1ref..sd3ref``, ``ff1..ff3`` (servo loop closed); outputs ``s1..s3`` (sliders free),
+    ``w1tip..w3tip``, ``w1G..w3G`` [m] and, closed loop, ``e1..e3`` [m]."""
 
     def __init__(self, d: Dict[str, Any]) -> None:
         self.A: np.ndarray = d["A"]
         self.B: np.ndarray = d["B"]
         self.C: np.ndarray = d["C"]
         self.D: np.ndarray = d["D"]
+        self.states: List[str] = d["states"]
         self.inputs: List[str] = d["inputs"]
         self.outputs: List[str] = d["outputs"]
-        n = self.A.shape[0] // 2
-        self.states: List[str] = [f"eta{k + 1}" for k in range(n)] + [f"deta{k + 1}" for k in range(n)]
+        self.input_units: List[str] = d["input_units"]
+        self.output_units: List[str] = d["output_units"]
+        self.sliders: str = d["sliders"]
+        self.loop: str = d["loop"]
+        self.modes: int = d["modes"]
         self.modal_frequencies_hz: np.ndarray = d["modal_frequencies_hz"]
         self.rigid: int = d["rigid"]
         self.pose: Dict[str, Any] = d["pose"]
 
     def to_control(self) -> "Any":
-        """A python-control ``StateSpace`` (needs the ``control`` package)."""
+        """A python-control ``StateSpace`` with the model's state, input and output names (needs
+        the ``control`` package)."""
         import control
 
         return control.ss(self.A, self.B, self.C, self.D, inputs=self.inputs, outputs=self.outputs, states=self.states)
 
 
-def linearize(exp: Experiment, at: Optional[float] = None, pose: Optional[Sequence[float]] = None) -> LinearModel:
-    """The linear state-space model about a pose (see :class:`LinearModel`)."""
-    return LinearModel(_flexstar.linearize(exp._inner, at, None if pose is None else tuple(pose)))
+def linearize(
+    exp: Experiment,
+    at: Optional[float] = None,
+    pose: Optional[Sequence[float]] = None,
+    modes: int = 20,
+    sliders: str = "free",
+    loop: Optional[str] = None,
+) -> LinearModel:
+    """The linear state-space model about a pose (see :class:`LinearModel`), as ``flexstar
+    linearize``: ``modes`` elastic modes, ``sliders="free"|"locked"``, ``loop="open"|"closed"``
+    (default: closed when the experiment's drive is a servo and the sliders are free)."""
+    _check_count("modes", modes)
+    return LinearModel(
+        _flexstar.linearize(exp._inner, at, None if pose is None else tuple(pose), modes, sliders, loop)
+    )
 
 
 def sweep(

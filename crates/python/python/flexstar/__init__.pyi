@@ -56,9 +56,14 @@ class LinearModel:
     B: npt.NDArray[np.float64]
     C: npt.NDArray[np.float64]
     D: npt.NDArray[np.float64]
+    states: List[str]
     inputs: List[str]
     outputs: List[str]
-    states: List[str]
+    input_units: List[str]
+    output_units: List[str]
+    sliders: str
+    loop: str
+    modes: int
     modal_frequencies_hz: npt.NDArray[np.float64]
     rigid: int
     pose: Dict[str, Any]
@@ -84,7 +89,14 @@ def modal(
     sliders: str = "locked",
     modes: int = 6,
 ) -> Dict[str, Any]: ...
-def linearize(exp: Experiment, at: Optional[float] = None, pose: Optional[Sequence[float]] = None) -> LinearModel: ...
+def linearize(
+    exp: Experiment,
+    at: Optional[float] = None,
+    pose: Optional[Sequence[float]] = None,
+    modes: int = 20,
+    sliders: str = "free",
+    loop: Optional[str] = None,
+) -> LinearModel: ...
 def sweep(study: _Path, out: _Path, jobs: Optional[int] = None, progress: bool = False) -> Any: ...
 def compare(config: _Path, out: _Path = "out", families: Sequence[str] = (), modes: Optional[int] = None, figures: bool = False) -> Dict[str, Any]: ...
 def verify(out: _Path = "out/verify", figures: bool = False, n_study: bool = False) -> Dict[str, Any]: ...

@@ -27,7 +27,7 @@ def main(t_end=0.1):
     forces = np.column_stack([t, u.T])
     # the basis of the linear model: the enriched family at a converged N
     run = flexstar.run(exp, solver="amm", family="enriched", tol=0.5, forces=forces)
-    w_lin = lin_y[lin.outputs.index("w1_tip")]
+    w_lin = lin_y[lin.outputs.index("w1tip")]
     w_run = run["w1tip"]
     err = np.abs(w_lin - w_run).max() / np.abs(w_run).max()
     print(f"tip 1: peak {np.abs(w_run).max():.3e} m nonlinear, {np.abs(w_lin).max():.3e} m linear; max difference {100 * err:.1f} % of the peak")

@@ -65,8 +65,25 @@ impl ApiError {
     /// other model errors as [`ApiError::from_model`].
     pub fn from_flag(flag: &str, e: ModelError) -> Self {
         match e {
-            ModelError::Invalid { reason, .. } => Self::flag(flag, reason),
+            ModelError::Invalid { key, reason, .. } => Self::flag_at(flag, &key, reason),
             other => Self::from_model(other),
+        }
+    }
+
+    /// [`ApiError::flag`] for a flag that sets the experiment key `key` (`--elements` sets
+    /// `fem.elements`): the message names the flag, the error's `key` field the key (Python's
+    /// `ConfigError.key`).
+    pub fn flag_at(flag: &str, key: &str, reason: impl Into<String>) -> Self {
+        match Self::flag(flag, reason) {
+            ApiError::Config {
+                file, reason, message, ..
+            } => ApiError::Config {
+                file,
+                key: Some(key.to_string()),
+                reason,
+                message,
+            },
+            other => other,
         }
     }
 

@@ -99,8 +99,8 @@ impl Prepared {
     /// (`--modes: the enriched family needs N >= 4 ...`), else as [`from_amm`].
     fn amm_error(&self, e: flexstar_amm::AmmError) -> ApiError {
         if let flexstar_amm::AmmError::InvalidSetting { key, reason } = &e {
-            if let Some((_, flag)) = self.flags.iter().find(|(k, _)| k == key) {
-                return ApiError::flag(flag, reason.clone());
+            if let Some((k, flag)) = self.flags.iter().find(|(k, _)| k == key) {
+                return ApiError::flag_at(flag, k, reason.clone());
             }
         }
         from_amm(&self.source, e)

@@ -82,6 +82,13 @@ pub struct CaseResults {
 pub enum RunError {
     #[error("{file}: {reason}")]
     Input { file: String, reason: String },
+    /// The motion leaves the feasible range (the preflight's scan).
+    #[error("{file}: {source}")]
+    Infeasible {
+        file: String,
+        #[source]
+        source: flexstar_kinematics::Infeasible,
+    },
     #[error("{file}: AMM {label}: {source}")]
     Amm {
         file: String,
@@ -210,7 +217,10 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
             }
         }
         let motion = check_motion(&exp.robot, &exp.trajectory, exp.time.t_end, preflight_step(exp.time.dt_out))
-            .map_err(|e| input(e.to_string()))?;
+            .map_err(|source| RunError::Infeasible {
+                file: file.clone(),
+                source,
+            })?;
         motions.push(motion);
     }
     Ok(Checked { specs, motions })
@@ -314,11 +324,13 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
         last: Mutex::new(f64::NEG_INFINITY),
     };
     let file = |k: usize| specs[k].exp.source.display().to_string();
+    // the caller's stop token (Ctrl-C in Python) goes to every worker thread: the solvers poll it
+    let token = flexstar_model::cancel::current();
     let results: Vec<Response> = jobs
         .par_iter()
         .enumerate()
         .map(|(j, job)| {
-            let r = match *job {
+            let r = flexstar_model::cancel::with_cancel(token.as_ref(), || match *job {
                 Job::Fem(k) => {
                     let exp = &specs[k].exp;
                     let tick = |f: f64| tracker.set(j, f, false);
@@ -333,7 +345,7 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
                     solve_amm(&specs[k].exp, &run.settings, Some(&checked.motions[k]))
                         .map_err(|e| run_error(file(k), &run.label, e))
                 }
-            }?;
+            })?;
             tracker.set(j, 1.0, true);
             Ok(r)
         })

@@ -3,16 +3,16 @@
 
 use std::path::PathBuf;
 
-use flexstar_api::study::{run_compare, run_verify, CompareOptions, VerifyOptions};
+use flexstar_api::study::{compare as compare_api, verify as verify_api, CompareOptions, Progress, VerifyOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::{convert, py_err, ConfigError, PyExperiment, SolverError};
+use crate::{convert, interrupt, py_err, ConfigError, PyExperiment};
 
 /// Compare the AMM with the FEM on an experiment file (as `flexstar compare`): writes
 /// `out/<name>/`; returns `{"dir", "behaviour", "most_accurate", "compare_csv"}`.
 #[pyfunction]
-#[pyo3(signature = (config, out, families = Vec::new(), modes = None, figures = false))]
+#[pyo3(signature = (config, out, families = Vec::new(), modes = None, figures = false, progress = false))]
 pub fn compare<'py>(
     py: Python<'py>,
     config: PathBuf,
@@ -20,6 +20,7 @@ pub fn compare<'py>(
     families: Vec<String>,
     modes: Option<usize>,
     figures: bool,
+    progress: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let families = families
         .iter()
@@ -33,9 +34,11 @@ pub fn compare<'py>(
         figures,
         provenance: flexstar_api::provenance(),
     };
-    let o = py
-        .detach(|| run_compare(&opts, None))
-        .map_err(|e| SolverError::new_err(e.to_string()))?;
+    let o = interrupt::interruptible(py, "flexstar.compare", progress, |report| {
+        let tick = |p: Progress| report(p.fraction);
+        compare_api(&opts, Some(&tick))
+    })?
+    .map_err(py_err)?;
     let d = PyDict::new(py);
     d.set_item("dir", o.dir.display().to_string())?;
     d.set_item("compare_csv", o.dir.join("compare.csv").display().to_string())?;
@@ -47,8 +50,14 @@ pub fn compare<'py>(
 /// Reproduce and check Table I (as `flexstar verify`): returns `{"table_md", "checks",
 /// "failures"}`; the files go to `out`.
 #[pyfunction]
-#[pyo3(signature = (out, figures = false, n_study = false))]
-pub fn verify<'py>(py: Python<'py>, out: PathBuf, figures: bool, n_study: bool) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (out, figures = false, n_study = false, progress = false))]
+pub fn verify<'py>(
+    py: Python<'py>,
+    out: PathBuf,
+    figures: bool,
+    n_study: bool,
+    progress: bool,
+) -> PyResult<Bound<'py, PyDict>> {
     let opts = VerifyOptions {
         configs: None,
         thresholds: None,
@@ -57,9 +66,11 @@ pub fn verify<'py>(py: Python<'py>, out: PathBuf, figures: bool, n_study: bool) 
         n_study,
         provenance: flexstar_api::provenance(),
     };
-    let o = py
-        .detach(|| run_verify(&opts, None))
-        .map_err(|e| SolverError::new_err(e.to_string()))?;
+    let o = interrupt::interruptible(py, "flexstar.verify", progress, |report| {
+        let tick = |p: Progress| report(p.fraction);
+        verify_api(&opts, Some(&tick))
+    })?
+    .map_err(py_err)?;
     let d = PyDict::new(py);
     d.set_item("table_md", o.table.to_markdown())?;
     d.set_item("checks", o.checks.len())?;

@@ -79,7 +79,8 @@ def test_config_errors(root, tmp_path, monkeypatch, call, key):
         call(exp)
     assert isinstance(info.value, ValueError)
     if key is not None:
-        assert info.value.key == key and key in str(info.value)
+        # a file's key is named as the key, a keyword's value as its argument (the CLI's flag)
+        assert info.value.key == key and key.split(".")[-1] in str(info.value), info.value
     assert list(tmp_path.iterdir()) == [], "nothing is written on bad input"
 
 
@@ -179,3 +180,36 @@ def test_linearize_settings_and_names(root):
         return
     sys = lin.to_control()
     assert list(sys.state_labels) == lin.states and list(sys.input_labels) == lin.inputs
+
+
+def test_verify_reproduces_the_cli_table_and_checks(root, cli, tmp_path):
+    """flexstar.verify() against `flexstar verify`: the same Table I (markdown, to the last
+    digit) and the same number of checks, all holding."""
+    res = flexstar.verify(tmp_path / "py")
+    subprocess.run([cli, "verify", "--out", str(tmp_path / "cli"), "--no-figures", "--no-n-study"], check=True,
+                   capture_output=True)
+    assert res["failures"] == [], res["failures"]
+    lines = (tmp_path / "cli" / "checks.txt").read_text().splitlines()
+    cli_checks = [c for c in lines if c.startswith(("PASS ", "FAIL "))]
+    assert all(c.startswith("PASS ") for c in cli_checks), cli_checks
+    assert res["checks"] == len(cli_checks) > 0
+    assert res["table_md"].strip() == (tmp_path / "cli" / "table1.md").read_text().strip()
+    assert (tmp_path / "py" / "table1.md").read_text() == (tmp_path / "cli" / "table1.md").read_text()
+
+
+def test_compare_errors_are_typed(root, tmp_path):
+    """compare's refusals are the library's kinds: a bad file a ConfigError (a ValueError) naming
+    the file and key, a motion that leaves the workspace an InfeasibleMotion with its time."""
+    bad = tmp_path / "bad.toml"
+    bad.write_text((root / "configs/case3.toml").read_text().replace("[robot]", "[robot]\nwrong_key = 1"))
+    with pytest.raises(flexstar.ConfigError) as e:
+        flexstar.compare(bad, tmp_path / "out")
+    assert isinstance(e.value, ValueError) and "bad.toml" in str(e.value) and "wrong_key" in str(e.value)
+    far = tmp_path / "far.toml"
+    text = (root / "configs/case2.toml").read_text().replace("t_end = 0.4", "t_end = 0.5")
+    assert "t_end = 0.5" in text
+    far.write_text(text)
+    with pytest.raises(flexstar.InfeasibleMotion) as e:
+        flexstar.compare(far, tmp_path / "out")
+    assert 0.4 < e.value.t < 0.5, e.value
+    assert not (tmp_path / "out" / "case2").exists(), "nothing written"

@@ -42,3 +42,42 @@ def test_sigint_stops_a_long_fem_run_within_a_second(root):
     stopped = float(out.split()[-1])
     assert stopped - sent < 1.5, f"stopped {stopped - sent:.2f} s after SIGINT"
     assert "flexstar.run:" in err and "%" in err, err
+
+
+# a long compare (case 1 with a fine FEM mesh): its solves run on rayon's worker threads, which
+# must see the stop too
+LONG_COMPARE = textwrap.dedent(
+    """
+    import pathlib, sys, time, flexstar
+    src = pathlib.Path(sys.argv[1]).read_text().replace("elements = 300", "elements = 3000\\ndt = 5e-5")
+    cfg = pathlib.Path(sys.argv[2]) / "long.toml"
+    cfg.write_text(src)
+    print("started", flush=True)
+    try:
+        flexstar.compare(cfg, pathlib.Path(sys.argv[2]) / "out", progress=True)
+    except KeyboardInterrupt:
+        print("interrupted", time.monotonic(), flush=True)
+        sys.exit(42)
+    print("finished", flush=True)
+    """
+)
+
+
+def test_sigint_stops_a_long_compare_within_a_second(root, tmp_path):
+    child = subprocess.Popen(
+        [sys.executable, "-c", LONG_COMPARE, str(root / "configs" / "case1.toml"), str(tmp_path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert child.stdout.readline().strip() == "started"
+    time.sleep(1.5)
+    assert child.poll() is None, "the compare ended before the signal: make it longer"
+    sent = time.monotonic()
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=30)
+    assert child.returncode == 42, (out, err)
+    stopped = float(out.split()[-1])
+    assert stopped - sent < 1.5, f"stopped {stopped - sent:.2f} s after SIGINT"
+    assert "flexstar.compare:" in err, err
+    assert not (tmp_path / "out" / "case1" / "compare.csv").exists(), "a stopped compare writes no table"

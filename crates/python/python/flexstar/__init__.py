@@ -288,17 +288,23 @@ def compare(
     families: Sequence[str] = (),
     modes: Optional[int] = None,
     figures: bool = False,
+    progress: bool = False,
 ) -> Dict[str, Any]:
     """Compare the AMM with the FEM on an experiment file (as ``flexstar compare``): writes
-    ``out/<name>/``; returns the folder, compare.csv, the behaviour of G and the closest family."""
+    ``out/<name>/``; returns the folder, compare.csv, the behaviour of G and the closest family.
+    Ctrl-C stops it within a second (nothing is written); ``progress=True`` prints the share done
+    on stderr. Errors: ConfigError, InfeasibleMotion, SolverError."""
     _check_count("modes", modes)
-    return _flexstar.compare(os.fspath(config), os.fspath(out), list(families), modes, figures)
+    return _flexstar.compare(os.fspath(config), os.fspath(out), list(families), modes, figures, progress)
 
 
-def verify(out: "os.PathLike[str] | str" = "out/verify", figures: bool = False, n_study: bool = False) -> Dict[str, Any]:
+def verify(
+    out: "os.PathLike[str] | str" = "out/verify", figures: bool = False, n_study: bool = False, progress: bool = False
+) -> Dict[str, Any]:
     """Reproduce and check Table I (as ``flexstar verify``): the table as Markdown, the number of
-    checks and the failed ones."""
-    return _flexstar.verify(os.fspath(out), figures, n_study)
+    checks and the failed ones. Ctrl-C stops it within a second; ``progress=True`` prints the
+    share done on stderr."""
+    return _flexstar.verify(os.fspath(out), figures, n_study, progress)
 
 
 def freqmap(

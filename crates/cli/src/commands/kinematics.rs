@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+use flexstar_model::output::fmt_fixed;
+
 /// Rigid kinematics of an experiment (Eqs. 1-12): G, theta, xp_i and their derivatives.
 #[derive(clap::Args)]
 pub struct Args {
@@ -18,17 +20,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let path = flexstar_api::kinematics::write(&args.out, &exp, &states)?;
     let last = states.last().expect("output times are never empty");
     eprintln!(
-        "{}: {} rows to {} (t_end = {} s: G = ({:.5}, {:.5}) m, theta = {:.5} rad, xp = {:.4}/{:.4}/{:.4} m)",
+        "{}: {} rows to {} (t_end = {} s: G = ({}, {}) m, theta = {} rad, xp = {}/{}/{} m)",
         exp.name,
         states.len(),
         path.display(),
         last.t,
-        last.g[0].v,
-        last.g[1].v,
-        last.theta.v,
-        last.xp[0].v,
-        last.xp[1].v,
-        last.xp[2].v
+        fmt_fixed(last.g[0].v, 5),
+        fmt_fixed(last.g[1].v, 5),
+        fmt_fixed(last.theta.v, 5),
+        fmt_fixed(last.xp[0].v, 4),
+        fmt_fixed(last.xp[1].v, 4),
+        fmt_fixed(last.xp[2].v, 4)
     );
     Ok(())
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use flexstar_api::modal::{FreqmapSettings, LinearizeOptions, LoopKind, MapSolver, PoseSpec};
+use flexstar_model::output::fmt_fixed;
 use flexstar_model::{Experiment, Sliders};
 
 use crate::progress::Reporter;
@@ -226,16 +227,16 @@ pub fn run_linearize(args: LinearizeArgs) -> anyhow::Result<()> {
     let ss = flexstar_api::modal::linearize(&exp, &source, &spec, &opts, Some(&args.out))?;
     let h = ss.settings.holding;
     eprintln!(
-        "{}: {} states, {} inputs, {} outputs (sliders {}, loop {}) about G = ({:.5}, {:.5}) m, theta = {:.5} rad; A.mtx .. D.mtx, M.mtx, K.mtx, Phi_q.mtx, fem-coordinates.csv, statespace.json in {}",
+        "{}: {} states, {} inputs, {} outputs (sliders {}, loop {}) about G = ({}, {}) m, theta = {} rad; A.mtx .. D.mtx, M.mtx, K.mtx, Phi_q.mtx, fem-coordinates.csv, statespace.json in {}",
         exp.name,
         ss.a.rows(),
         ss.inputs.len(),
         ss.outputs.len(),
         h.sliders().name(),
         if matches!(h, flexstar_modal::linear::Holding::Servo { .. }) { "closed" } else { "open" },
-        ss.pose.g[0],
-        ss.pose.g[1],
-        ss.pose.theta,
+        fmt_fixed(ss.pose.g[0], 5),
+        fmt_fixed(ss.pose.g[1], 5),
+        fmt_fixed(ss.pose.theta, 5),
         args.out.join(&exp.name).join("linear").display()
     );
     Ok(())

@@ -25,24 +25,25 @@ LONG_RUN = textwrap.dedent(
 )
 
 
-def test_sigint_stops_a_long_fem_run_within_a_second(root):
-    child = subprocess.Popen(
-        [sys.executable, "-c", LONG_RUN, str(root / "configs" / "case1.toml")],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+def interrupt_after(seconds, code, *args):
+    """Start `code` in a child interpreter, send SIGINT `seconds` after it prints "started", and
+    return its stdout, stderr and how long after the signal it stopped [s]."""
+    child = subprocess.Popen([sys.executable, "-c", code, *map(str, args)], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
     assert child.stdout.readline().strip() == "started"
-    time.sleep(1.5)
-    assert child.poll() is None, "the run ended before the signal: make it longer"
+    time.sleep(seconds)
+    assert child.poll() is None, "the work ended before the signal: make it longer"
     sent = time.monotonic()
     child.send_signal(signal.SIGINT)
     out, err = child.communicate(timeout=30)
     assert child.returncode == 42, (out, err)
-    stopped = float(out.split()[-1])
-    assert stopped - sent < 1.5, f"stopped {stopped - sent:.2f} s after SIGINT"
-    assert "flexstar.run:" in err and "%" in err, err
+    return out, err, float(out.split()[-1]) - sent
 
+
+def test_sigint_stops_a_long_fem_run_within_a_second(root):
+    out, err, after = interrupt_after(1.5, LONG_RUN, root / "configs" / "case1.toml")
+    assert after < 1.5, f"stopped {after:.2f} s after SIGINT"
+    assert "flexstar.run:" in err and "%" in err, err
 
 # a long compare (case 1 with a fine FEM mesh): its solves run on rayon's worker threads, which
 # must see the stop too
@@ -64,20 +65,7 @@ LONG_COMPARE = textwrap.dedent(
 
 
 def test_sigint_stops_a_long_compare_within_a_second(root, tmp_path):
-    child = subprocess.Popen(
-        [sys.executable, "-c", LONG_COMPARE, str(root / "configs" / "case1.toml"), str(tmp_path)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    assert child.stdout.readline().strip() == "started"
-    time.sleep(1.5)
-    assert child.poll() is None, "the compare ended before the signal: make it longer"
-    sent = time.monotonic()
-    child.send_signal(signal.SIGINT)
-    out, err = child.communicate(timeout=30)
-    assert child.returncode == 42, (out, err)
-    stopped = float(out.split()[-1])
-    assert stopped - sent < 1.5, f"stopped {stopped - sent:.2f} s after SIGINT"
+    out, err, after = interrupt_after(1.5, LONG_COMPARE, root / "configs" / "case1.toml", tmp_path)
+    assert after < 1.5, f"stopped {after:.2f} s after SIGINT"
     assert "flexstar.compare:" in err, err
     assert not (tmp_path / "out" / "case1" / "compare.csv").exists(), "a stopped compare writes no table"

@@ -93,7 +93,26 @@ fn inline(s: &str) -> String {
         res.push_str(if k % 2 == 0 { "<i>" } else { "</i>" });
         res.push_str(p);
     }
-    res
+    code_spans(&res)
+}
+
+/// Markdown's code spans: text between a pair of backticks in `<code>`; an unpaired backtick
+/// stays as it is.
+fn code_spans(s: &str) -> String {
+    let parts: Vec<&str> = s.split('`').collect();
+    let mut out = String::new();
+    for (k, p) in parts.iter().enumerate() {
+        let paired = k % 2 == 1 && k + 1 < parts.len();
+        if paired {
+            let _ = write!(out, "<code>{p}</code>");
+        } else {
+            if k % 2 == 1 {
+                out.push('`');
+            }
+            out.push_str(p);
+        }
+    }
+    out
 }
 
 /// One experiment in a report.
@@ -452,5 +471,15 @@ mod tests {
         assert!(html.contains("<th>a</th><th>b</th>"));
         assert!(html.contains("<td><b>x</b></td><td>1 &lt; 2</td>"));
         assert!(html.contains("<p>text <i>i</i></p>"));
+    }
+
+    #[test]
+    fn backticks_become_code_spans() {
+        assert_eq!(
+            code_spans("the `[trajectory]` as `e_i`"),
+            "the <code>[trajectory]</code> as <code>e_i</code>"
+        );
+        assert_eq!(code_spans("one ` alone"), "one ` alone");
+        assert_eq!(code_spans("none"), "none");
     }
 }

@@ -47,14 +47,27 @@ pub fn runs_of(case: &CaseResults) -> Vec<(String, &Response)> {
         .collect()
 }
 
-/// The small-deflection check of every run of a case.
-pub fn validity_warnings(exp: &Experiment, case: &CaseResults) -> Vec<ValidityWarning> {
+/// The small-deflection check of every run of a case (`flexstar_model::small_deflection_check`),
+/// in the order of [`runs_of`]: computed once per case by [`write_case`] and shown from there in
+/// the tables, `compare.json`, the warnings and the report.
+pub type RunChecks = Vec<(String, Option<ValidityExceeded>)>;
+
+/// [`RunChecks`] of `case`.
+pub fn run_checks(exp: &Experiment, case: &CaseResults) -> RunChecks {
     runs_of(case)
         .into_iter()
-        .filter_map(|(run, r)| {
-            small_deflection_check(r, exp.robot.l).map(|exceeded| ValidityWarning {
+        .map(|(run, r)| (run, small_deflection_check(r, exp.robot.l)))
+        .collect()
+}
+
+/// The runs of `checks` that leave the small-deflection range, as warnings.
+pub fn validity_warnings(exp: &Experiment, checks: &RunChecks) -> Vec<ValidityWarning> {
+    checks
+        .iter()
+        .filter_map(|(run, check)| {
+            check.clone().map(|exceeded| ValidityWarning {
                 file: exp.source.display().to_string(),
-                run,
+                run: run.clone(),
                 exceeded,
             })
         })
@@ -187,7 +200,7 @@ pub fn compare_markdown(
     exp: &Experiment,
     case: &CaseResults,
     row: &TableRow,
-    warnings: &[ValidityWarning],
+    (checks, warnings): (&RunChecks, &[ValidityWarning]),
     figures: &[RenderedFigure],
 ) -> String {
     let mut s = String::new();
@@ -203,7 +216,7 @@ pub fn compare_markdown(
         exp.time.dt_out
     );
     let _ = writeln!(s, "## Runs\n");
-    let _ = writeln!(s, "{}", runs_markdown(case));
+    let _ = writeln!(s, "{}", runs_markdown(case, checks));
     if let Some(servo) = servo_summary(exp, case) {
         s.push_str(&servo.markdown());
     }
@@ -259,14 +272,14 @@ pub fn compare_markdown(
 }
 
 /// The run metadata table (Markdown): solver, settings, wall time, small-deflection check.
-pub fn runs_markdown(case: &CaseResults) -> String {
+pub fn runs_markdown(case: &CaseResults, checks: &RunChecks) -> String {
     let mut s =
         String::from("| run | solver | family | model | N | elements | dt [s] | wall time [s] | small deflection |\n");
     s.push_str("|---|---|---|---|---|---|---|---|---|\n");
-    for (stem, r) in runs_of(case) {
+    for ((stem, r), (_, check)) in runs_of(case).into_iter().zip(checks) {
         let i = &r.info;
         let opt = |v: &Option<String>| v.clone().unwrap_or_else(|| "-".into());
-        let check = match small_deflection_check(r, case.beam_length) {
+        let check = match check {
             None => "in range".to_string(),
             Some(v) => format!("**left at t = {:.4} s** ({})", v.t, v.quantity),
         };
@@ -294,13 +307,14 @@ struct RunJson<'a> {
 
 /// `compare.json`: provenance, the experiment file, the row (EVPs, verdicts, behaviour, junction
 /// measures) and every run's settings, cost and small-deflection check.
-pub fn compare_json(exp: &Experiment, case: &CaseResults, row: &TableRow, prov: &Provenance) -> String {
+pub fn compare_json(exp: &Experiment, case: &CaseResults, row: &TableRow, prov: &Provenance, checks: &RunChecks) -> String {
     let runs: Vec<RunJson> = runs_of(case)
         .into_iter()
-        .map(|(run, r)| RunJson {
+        .zip(checks)
+        .map(|((run, r), (_, check))| RunJson {
             run,
             info: &r.info,
-            small_deflection: small_deflection_check(r, exp.robot.l),
+            small_deflection: check.clone(),
         })
         .collect();
     let doc = serde_json::json!({
@@ -323,6 +337,8 @@ pub struct WrittenCase {
     /// Empty when the figures were not asked for.
     pub figures: Vec<RenderedFigure>,
     pub warnings: Vec<ValidityWarning>,
+    /// Every run's small-deflection check, in the order of [`runs_of`].
+    pub checks: RunChecks,
     pub compare_csv: String,
 }
 
@@ -339,19 +355,21 @@ pub fn write_case(
     let figdir = dir.join("figures");
     let figs = drawn.iter().map(|f| f.write(&figdir)).collect::<Result<Vec<_>, _>>()?;
     let csv = compare_csv(row);
-    let warnings = validity_warnings(exp, case);
+    let checks = run_checks(exp, case);
+    let warnings = validity_warnings(exp, &checks);
     // every run's files and the EVP files are published together (issue 24)
     let mut set = RunSet::begin(dir)?;
     for (stem, r) in runs_of(case) {
         r.stage_run(&mut set, &stem, None, exp, prov)?;
     }
     set.text("compare.csv", &csv)?;
-    set.text("compare.md", &compare_markdown(exp, case, row, &warnings, &figs))?;
-    set.text("compare.json", &compare_json(exp, case, row, prov))?;
+    set.text("compare.md", &compare_markdown(exp, case, row, (&checks, &warnings), &figs))?;
+    set.text("compare.json", &compare_json(exp, case, row, prov, &checks))?;
     set.commit()?;
     Ok(WrittenCase {
         figures: figs,
         warnings,
+        checks,
         compare_csv: csv,
     })
 }

@@ -7,10 +7,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use flexstar_model::{small_deflection_check, Experiment, Provenance};
+use flexstar_model::{Experiment, Provenance};
 
 use crate::behaviour::Behaviour;
-use crate::case_output::{runs_of, ValidityWarning, WrittenCase};
+use crate::case_output::{runs_of, RunChecks, ValidityWarning, WrittenCase};
 use crate::runs::CaseResults;
 use crate::servo::servo_summary;
 use crate::table::{TableI, TableRow};
@@ -124,6 +124,8 @@ pub struct ReportCase<'a> {
     pub figures: &'a [RenderedFigure],
     /// The runs outside the AMM's small-deflection range (`write_case`'s).
     pub warnings: &'a [ValidityWarning],
+    /// Every run's small-deflection check (`write_case`'s, in the order of `runs_of`).
+    pub checks: &'a RunChecks,
     /// Directory of the case's files relative to the report (`""` beside it).
     pub dir: &'a Path,
 }
@@ -192,6 +194,7 @@ pub fn case_report(
             row,
             figures: &written.figures,
             warnings: &written.warnings,
+            checks: &written.checks,
             dir: Path::new(""),
         }],
     })
@@ -326,13 +329,12 @@ fn case_summary_html(h: &mut String, c: &ReportCase) {
 
 /// The runs and their metadata.
 fn runs_html(h: &mut String, c: &ReportCase) {
-    let exp = c.exp;
     // runs and their metadata
     h.push_str("<h3>Runs</h3>\n<table><tr><th>run</th><th>solver</th><th>family</th><th>model</th><th>N</th><th>elements</th><th>dt [s]</th><th>wall time [s]</th><th>small deflection</th><th>files</th></tr>\n");
-    for (stem, r) in runs_of(c.case) {
+    for ((stem, r), (_, check)) in runs_of(c.case).into_iter().zip(c.checks) {
         let i = &r.info;
         let dash = || "-".to_string();
-        let check = match small_deflection_check(r, exp.robot.l) {
+        let check = match check {
             None => "in range".into(),
             Some(v) => format!("<span class=\"fail\">left at t = {:.4} s</span>", v.t),
         };

@@ -192,6 +192,7 @@ fn write_summary(opts: &VerifyOptions, v: &Verified, per_case: &[WrittenCase]) -
                     row,
                     figures: &written.figures,
                     warnings: &written.warnings,
+                    checks: &written.checks,
                     dir: Path::new(&s.exp.name),
                 })
                 .collect(),

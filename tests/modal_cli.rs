@@ -8,6 +8,20 @@ use std::path::{Path, PathBuf};
 mod common;
 use common::{flexstar, stderr};
 
+/// `flexstar` with the arguments `base` then `extra`.
+fn flexstar_with(base: &[&str], extra: &[&str]) -> std::process::Output {
+    flexstar(&[base, extra].concat())
+}
+
+/// A temporary folder (kept alive by the first value) holding the small experiment; its path
+/// and the output folder `out` in it.
+fn small_case() -> (tempfile::TempDir, String, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = small_config(dir.path());
+    let out = dir.path().join("out");
+    (dir, cfg, out)
+}
+
 /// The paper's robot with case 3's motion and small solver settings, written into `dir`.
 fn small_config(dir: &Path) -> String {
     let text = "name = \"small\"\n[time]\nt_end = 0.5\n[trajectory]\nkind = \"polynomial\"\n\
@@ -43,9 +57,7 @@ fn files_in(dir: &Path) -> Vec<PathBuf> {
 /// symmetry) in both models; AMM and FEM within 1.5 % at this small N and mesh; the figures.
 #[test]
 fn modal_writes_the_contracted_table_and_shapes() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = small_config(dir.path());
-    let out = dir.path().join("out");
+    let (_dir, cfg, out) = small_case();
     let o = flexstar(&["modal", &cfg, "--pose", "0,0,0", "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let case = out.join("small");
@@ -107,16 +119,10 @@ fn json(path: &Path) -> serde_json::Value {
 /// replace them (issue 24).
 #[test]
 fn modal_and_freqmap_sidecars_guard_the_tables() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = small_config(dir.path());
-    let out = dir.path().join("out");
+    let (_dir, cfg, out) = small_case();
     let out_s = out.to_str().unwrap();
     let case = out.join("small");
-    let modal = |extra: &[&str]| {
-        let mut args = vec!["modal", &cfg, "--modes", "3", "--out", out_s];
-        args.extend(extra);
-        flexstar(&args)
-    };
+    let modal = |extra: &[&str]| flexstar_with(&["modal", &cfg, "--modes", "3", "--out", out_s], extra);
     let o = modal(&["--pose", "0.03,-0.02,0.1"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let m = json(&case.join("modal.json"));
@@ -157,11 +163,7 @@ fn modal_and_freqmap_sidecars_guard_the_tables() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(json(&case.join("modal.json"))["pose"]["task"], serde_json::json!([0.0, 0.0, 0.0]));
     // the map: the grid, solver, sliders, K
-    let map = |extra: &[&str]| {
-        let mut args = vec!["freqmap", &cfg, "--gy", "-0.1:0.1:3", "--modes", "2", "--out", out_s];
-        args.extend(extra);
-        flexstar(&args)
-    };
+    let map = |extra: &[&str]| flexstar_with(&["freqmap", &cfg, "--gy", "-0.1:0.1:3", "--modes", "2", "--out", out_s], extra);
     let o = map(&["--gx", "-0.1:0.1:3"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let f = json(&case.join("freqmap.json"));
@@ -199,9 +201,7 @@ fn modal_and_freqmap_sidecars_guard_the_tables() {
 /// experiment's own path G(t), not the paper's four; `modal` prints no negative zero.
 #[test]
 fn freqmap_with_free_sliders_and_the_experiments_path() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = small_config(dir.path());
-    let out = dir.path().join("out");
+    let (_dir, cfg, out) = small_case();
     let out_s = out.to_str().unwrap();
     let case = out.join("small");
     let grid = ["--gx", "-0.05:0.05:3", "--gy", "-0.05:0.05:3", "--modes", "2", "--out", out_s];
@@ -232,9 +232,7 @@ fn freqmap_with_free_sliders_and_the_experiments_path() {
 /// what `modal` reports there (the map's values-only solver against the full one).
 #[test]
 fn freqmap_writes_the_contracted_map() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = small_config(dir.path());
-    let out = dir.path().join("out");
+    let (_dir, cfg, out) = small_case();
     let out_s = out.to_str().unwrap();
     let o = flexstar(&[
         "freqmap",
@@ -295,9 +293,7 @@ fn freqmap_writes_the_contracted_map() {
 /// `modal --sliders free` reports at the same pose (omega = 2 pi f).
 #[test]
 fn linearize_writes_the_state_space_files() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = small_config(dir.path());
-    let out = dir.path().join("out");
+    let (_dir, cfg, out) = small_case();
     let out_s = out.to_str().unwrap();
     let o = flexstar(&["linearize", &cfg, "--pose", "0.03,-0.02,0.1", "--out", out_s]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -309,14 +305,7 @@ fn linearize_writes_the_state_space_files() {
             text.starts_with("%%MatrixMarket matrix coordinate real general"),
             "{name}"
         );
-        let size: Vec<usize> = text
-            .lines()
-            .find(|l| !l.starts_with('%'))
-            .unwrap()
-            .split_whitespace()
-            .map(|v| v.parse().unwrap())
-            .collect();
-        dims.insert(name, (size[0], size[1]));
+        dims.insert(name, mtx_size(&lin.join(format!("{name}.mtx"))));
     }
     let n = dims["A"].0;
     assert_eq!(dims["A"], (n, n));
@@ -410,9 +399,7 @@ fn linearize_with(cfg: &str, name: &str, out: &Path, extra: &[&str]) -> (PathBuf
 /// slider coordinates last when the sliders are free and none when they are locked.
 #[test]
 fn linearize_settings_set_the_model_and_name_it() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = small_config(dir.path());
-    let out = dir.path().join("out");
+    let (_dir, cfg, out) = small_case();
     let (lin, json) = linearize_with(&cfg, "small", &out, &["--modes", "5", "--sliders", "locked"]);
     assert_eq!(mtx_size(&lin.join("A.mtx")), (10, 10));
     assert_eq!(mtx_size(&lin.join("B.mtx")), (10, 3));
@@ -498,9 +485,7 @@ fn linearize_closes_the_servo_loop_of_a_servo_experiment() {
 /// Bad input: non-zero exit, the reason on stderr, no file written.
 #[test]
 fn bad_input_is_refused_before_any_output() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = small_config(dir.path());
-    let out = dir.path().join("out");
+    let (_dir, cfg, out) = small_case();
     let out_s = out.to_str().unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec!["modal", &cfg, "--pose", "0.3,0,0"], "outside the workspace"),

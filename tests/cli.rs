@@ -182,13 +182,21 @@ fn run_writes_the_contracted_solver_tables() {
             "case1: AMM, N = 12, slide-free",
         ),
         // family from the config's [amm] section
-        (vec!["--solver", "amm"], "amm-pinned-free.csv", "case1: AMM, N = 25, pinned-free"),
+        (
+            vec!["--solver", "amm"],
+            "amm-pinned-free.csv",
+            "case1: AMM, N = 25, pinned-free",
+        ),
         (
             vec!["--solver", "amm", "--family", "enriched", "--tol", "2"],
             "amm-enriched.csv",
             "case1: AMM, tol = 2 %, enriched",
         ),
-        (vec!["--solver", "fem", "--elements", "108"], "fem.csv", "case1: FEM, 108 elements"),
+        (
+            vec!["--solver", "fem", "--elements", "108"],
+            "fem.csv",
+            "case1: FEM, 108 elements",
+        ),
     ] {
         let mut all = vec!["run", cfg.as_str()];
         all.extend(args.iter().copied());
@@ -245,7 +253,11 @@ fn run_refuses_bad_settings_before_any_work() {
         let o = flexstar(&all);
         assert!(!o.status.success(), "{args:?} accepted");
         assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
-        assert!(!stderr(&o).contains(": : ") && !stderr(&o).contains("key ``"), "{}", stderr(&o));
+        assert!(
+            !stderr(&o).contains(": : ") && !stderr(&o).contains("key ``"),
+            "{}",
+            stderr(&o)
+        );
         assert!(!out.join("case1").exists() || std::fs::read_dir(out.join("case1")).unwrap().count() == 0);
     }
     // a trajectory that leaves the feasible range: refused with the time, nothing written
@@ -379,7 +391,11 @@ fn modes_lists_textbook_roots() {
     // a bad N names the flag, not an empty file
     let o = flexstar(&["modes", "--family", "enriched", "-n", "1"]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("error: --modes: the enriched family needs N >= 4"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("error: --modes: the enriched family needs N >= 4"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]

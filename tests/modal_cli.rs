@@ -132,7 +132,12 @@ fn modal_and_freqmap_sidecars_guard_the_tables() {
     assert_eq!(m["sliders"], "locked");
     assert_eq!(m["pose"]["task"], serde_json::json!([0.03, -0.02, 0.1]));
     // G of the rest pose, from the sliders by the direct kinematics: the pose asked for
-    let g: Vec<f64> = m["pose"]["G"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let g: Vec<f64> = m["pose"]["G"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
     assert!((g[0] - 0.03).abs() < 1e-12 && (g[1] + 0.02).abs() < 1e-12, "{g:?}");
     assert_eq!(m["pose"]["s"].as_array().map(Vec::len), Some(3));
     assert_eq!(m["solvers"][0]["solver"], "amm");
@@ -148,22 +153,36 @@ fn modal_and_freqmap_sidecars_guard_the_tables() {
     let meta = std::fs::read(case.join("modal.json")).unwrap();
     for (extra, needle) in [
         (vec!["--pose", "0,0,0"], "pose: "),
-        (vec!["--pose", "0.03,-0.02,0.1", "--sliders", "free"], "sliders: \"locked\" -> \"free\""),
+        (
+            vec!["--pose", "0.03,-0.02,0.1", "--sliders", "free"],
+            "sliders: \"locked\" -> \"free\"",
+        ),
         (vec!["--at", "0.25"], "pose: "),
     ] {
         let o = modal(&extra);
         assert!(!o.status.success(), "{extra:?} replaced the table");
         let e = stderr(&o);
-        assert!(e.contains("modal.csv") && e.contains("other settings") && e.contains(needle), "{e}");
+        assert!(
+            e.contains("modal.csv") && e.contains("other settings") && e.contains(needle),
+            "{e}"
+        );
         assert!(e.contains("--force"), "{e}");
         assert_eq!(std::fs::read(case.join("modal.csv")).unwrap(), before, "{extra:?}");
         assert_eq!(std::fs::read(case.join("modal.json")).unwrap(), meta, "{extra:?}");
     }
     let o = modal(&["--pose", "0,0,0", "--force"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(json(&case.join("modal.json"))["pose"]["task"], serde_json::json!([0.0, 0.0, 0.0]));
+    assert_eq!(
+        json(&case.join("modal.json"))["pose"]["task"],
+        serde_json::json!([0.0, 0.0, 0.0])
+    );
     // the map: the grid, solver, sliders, K
-    let map = |extra: &[&str]| flexstar_with(&["freqmap", &cfg, "--gy", "-0.1:0.1:3", "--modes", "2", "--out", out_s], extra);
+    let map = |extra: &[&str]| {
+        flexstar_with(
+            &["freqmap", &cfg, "--gy", "-0.1:0.1:3", "--modes", "2", "--out", out_s],
+            extra,
+        )
+    };
     let o = map(&["--gx", "-0.1:0.1:3"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let f = json(&case.join("freqmap.json"));
@@ -193,7 +212,11 @@ fn modal_and_freqmap_sidecars_guard_the_tables() {
     // a table without its sidecar (an older flexstar): its settings cannot be told, refused
     std::fs::remove_file(case.join("freqmap.json")).unwrap();
     let o = map(&["--gx", "-0.1:0.1:5"]);
-    assert!(!o.status.success() && stderr(&o).contains("freqmap.json"), "{}", stderr(&o));
+    assert!(
+        !o.status.success() && stderr(&o).contains("freqmap.json"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// `freqmap --sliders free`: f1 is the first elastic frequency, equal to what `modal --sliders
@@ -204,7 +227,16 @@ fn freqmap_with_free_sliders_and_the_experiments_path() {
     let (_dir, cfg, out) = small_case();
     let out_s = out.to_str().unwrap();
     let case = out.join("small");
-    let grid = ["--gx", "-0.05:0.05:3", "--gy", "-0.05:0.05:3", "--modes", "2", "--out", out_s];
+    let grid = [
+        "--gx",
+        "-0.05:0.05:3",
+        "--gy",
+        "-0.05:0.05:3",
+        "--modes",
+        "2",
+        "--out",
+        out_s,
+    ];
     let mut args = vec!["freqmap", cfg.as_str(), "--sliders", "free"];
     args.extend(grid);
     let o = flexstar(&args);
@@ -214,16 +246,37 @@ fn freqmap_with_free_sliders_and_the_experiments_path() {
     let centre = &map[4];
     assert_eq!((num(&centre[0]), num(&centre[1])), (0.0, 0.0));
     let svg = std::fs::read_to_string(case.join("freqmap.svg")).unwrap();
-    assert!(svg.contains("G(t) of small") && svg.contains("sliders free"), "no path of the experiment");
+    assert!(
+        svg.contains("G(t) of small") && svg.contains("sliders free"),
+        "no path of the experiment"
+    );
     assert!(!svg.contains("case 1"), "the paper's paths are drawn");
-    let o = flexstar(&["modal", &cfg, "--pose", "0,0,0", "--sliders", "free", "--modes", "2", "--out", out_s]);
+    let o = flexstar(&[
+        "modal",
+        &cfg,
+        "--pose",
+        "0,0,0",
+        "--sliders",
+        "free",
+        "--modes",
+        "2",
+        "--out",
+        out_s,
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let e = stderr(&o);
-    assert!(!e.contains("-0.00000") && !e.contains(" -0.000 %"), "a negative zero: {e}");
+    assert!(
+        !e.contains("-0.00000") && !e.contains(" -0.000 %"),
+        "a negative zero: {e}"
+    );
     let (_, m) = rows(&case.join("modal.csv"));
     for k in 0..2 {
         let (map, full) = (num(&centre[4 + k]), num(&m[3 + k][1]));
-        assert!(map > 1.0 && (map / full - 1.0).abs() < 1e-7, "f{}: {map} vs {full}", k + 1);
+        assert!(
+            map > 1.0 && (map / full - 1.0).abs() < 1e-7,
+            "f{}: {map} vs {full}",
+            k + 1
+        );
     }
 }
 
@@ -384,7 +437,14 @@ fn names(json: &serde_json::Value, key: &str) -> Vec<String> {
 
 /// Run `linearize` with `extra` flags; returns linear/ and statespace.json.
 fn linearize_with(cfg: &str, name: &str, out: &Path, extra: &[&str]) -> (PathBuf, serde_json::Value) {
-    let mut args = vec!["linearize", cfg, "--pose", "0.03,-0.02,0.1", "--out", out.to_str().unwrap()];
+    let mut args = vec![
+        "linearize",
+        cfg,
+        "--pose",
+        "0.03,-0.02,0.1",
+        "--out",
+        out.to_str().unwrap(),
+    ];
     args.extend(extra);
     let o = flexstar(&args);
     assert!(o.status.success(), "{args:?}: {}", stderr(&o));
@@ -407,10 +467,19 @@ fn linearize_settings_set_the_model_and_name_it() {
     assert_eq!(mtx_size(&lin.join("D.mtx")), (6, 3));
     let states = names(&json, "states");
     assert_eq!(states.len(), 10);
-    assert_eq!((states[0].as_str(), states[4].as_str(), states[5].as_str()), ("eta1", "eta5", "etad1"));
+    assert_eq!(
+        (states[0].as_str(), states[4].as_str(), states[5].as_str()),
+        ("eta1", "eta5", "etad1")
+    );
     assert_eq!(names(&json, "inputs"), ["sdd1", "sdd2", "sdd3"]);
-    assert_eq!(names(&json, "outputs"), ["w1tip", "w2tip", "w3tip", "w1G", "w2G", "w3G"]);
-    assert_eq!((json["sliders"].as_str(), json["loop"].as_str()), (Some("locked"), Some("open")));
+    assert_eq!(
+        names(&json, "outputs"),
+        ["w1tip", "w2tip", "w3tip", "w1G", "w2G", "w3G"]
+    );
+    assert_eq!(
+        (json["sliders"].as_str(), json["loop"].as_str()),
+        (Some("locked"), Some("open"))
+    );
     let check_coordinates = |lin: &Path, sliders_free: bool| {
         let (header, rows) = rows(&lin.join("fem-coordinates.csv"));
         assert_eq!(header, "index,node,beam,dof,x_m");
@@ -437,8 +506,13 @@ fn linearize_settings_set_the_model_and_name_it() {
     assert_eq!(mtx_size(&lin.join("A.mtx")), (14, 14));
     assert_eq!(names(&json, "inputs"), ["Fa1", "Fa2", "Fa3"]);
     let outputs = names(&json, "outputs");
-    assert_eq!(outputs, ["s1", "s2", "s3", "w1tip", "w2tip", "w3tip", "w1G", "w2G", "w3G"]);
-    assert!(!std::fs::read_to_string(lin.join("statespace.json")).unwrap().contains("w1_tip"));
+    assert_eq!(
+        outputs,
+        ["s1", "s2", "s3", "w1tip", "w2tip", "w3tip", "w1G", "w2G", "w3G"]
+    );
+    assert!(!std::fs::read_to_string(lin.join("statespace.json"))
+        .unwrap()
+        .contains("w1_tip"));
     assert_eq!(names(&json, "states").len(), 14);
     check_coordinates(&lin, true);
 }
@@ -470,7 +544,11 @@ fn linearize_closes_the_servo_loop_of_a_servo_experiment() {
     let small = small_config(dir.path());
     for (c, extra, needle) in [
         (&small, vec!["--loop", "closed"], "servo"),
-        (&cfg, vec!["--loop", "closed", "--sliders", "locked"], "--sliders locked"),
+        (
+            &cfg,
+            vec!["--loop", "closed", "--sliders", "locked"],
+            "--sliders locked",
+        ),
         (&cfg, vec!["--modes", "0"], "--modes"),
     ] {
         let mut args = vec!["linearize", c.as_str(), "--at", "0.1", "--out", out2.to_str().unwrap()];

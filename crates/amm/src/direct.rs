@@ -64,7 +64,12 @@ pub fn solve_direct_checked(
 }
 
 /// [`solve_direct`]; `scan`: check the reference over the whole span (else its start only).
-fn solve_direct_scanned(exp: &Experiment, settings: &AmmSettings, law: &dyn ActuatorLaw, scan: bool) -> Result<Response, AmmError> {
+fn solve_direct_scanned(
+    exp: &Experiment,
+    settings: &AmmSettings,
+    law: &dyn ActuatorLaw,
+    scan: bool,
+) -> Result<Response, AmmError> {
     match settings.mode_count() {
         ModeCount::Fixed(n) => integrate_direct(exp, settings, law, n, scan),
         ModeCount::Tolerance(tol) => {
@@ -241,7 +246,12 @@ fn integrate_direct(
             .collect(),
     };
     let mut buf = Coupled::new(n, sys.lam.len());
-    let mut ctx = StepContext { sys: &mut sys, buf: &mut buf, law, params };
+    let mut ctx = StepContext {
+        sys: &mut sys,
+        buf: &mut buf,
+        law,
+        params,
+    };
 
     let mut state = initial_state(exp, &mut ctx, &out.rec, n)?;
     out.record(&ctx, &stops[0], 0.0, &state)?;
@@ -296,7 +306,11 @@ struct Predictors {
 
 impl Predictors {
     fn new(n: usize) -> Self {
-        Predictors { qhat: vec![0.0; n], vhat: vec![0.0; n], a_part: vec![0.0; n] }
+        Predictors {
+            qhat: vec![0.0; n],
+            vhat: vec![0.0; n],
+            a_part: vec![0.0; n],
+        }
     }
 }
 
@@ -320,7 +334,16 @@ fn initial_state(exp: &Experiment, ctx: &mut StepContext, rec: &Recorder, n: usi
         &mut qdd,
     )?;
     let acc = qdd.clone();
-    Ok(DirectState { q, v, acc, qdd, s, sd, sdd, sacc: sdd })
+    Ok(DirectState {
+        q,
+        v,
+        acc,
+        qdd,
+        s,
+        sd,
+        sdd,
+        sacc: sdd,
+    })
 }
 
 /// One generalized-alpha substep of length `h` ending at `t`: predict q and s, solve the coupled
@@ -390,8 +413,12 @@ impl DirectOutput {
         let (s, sd, sdd) = (x.s, x.sd, x.sdd);
         check_configuration(ctx.params, s).map_err(|violation| AmmError::DirectInfeasible { t, violation })?;
         let st = rigid_at(ctx.params, s, sd, sdd, t)?;
-        let fa = ctx.law.force(t, s, sd).map_err(|source| AmmError::Drive { t, source })?;
-        self.rec.record(&st, stop, &x.q, &ctx.sys.lam, &ctx.sys.sleeve_axial, Some(fa));
+        let fa = ctx
+            .law
+            .force(t, s, sd)
+            .map_err(|source| AmmError::Drive { t, source })?;
+        self.rec
+            .record(&st, stop, &x.q, &ctx.sys.lam, &ctx.sys.sleeve_axial, Some(fa));
         if stop.output.is_some() {
             let vals = [s[0], s[1], s[2], sd[0], sd[1], sd[2], st.g[0].v, st.g[1].v, st.theta.v];
             for (c, v) in self.cols.iter_mut().zip(vals) {

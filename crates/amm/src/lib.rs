@@ -34,6 +34,6 @@ pub use direct::{solve_direct, solve_direct_checked, DIRECT_COLUMNS};
 pub use error::{AmmError, RankError};
 pub use modes::{ModeSet, MAX_MODES};
 pub use solver::{
-    parse_family, solve, solve_checked, solve_with_stats, tolerance_step, Stats, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS,
-    TOLERANCE_DT,
+    parse_family, solve, solve_checked, solve_with_stats, tolerance_step, Stats, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF,
+    SHAPE_POINTS, TOLERANCE_DT,
 };

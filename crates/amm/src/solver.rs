@@ -9,7 +9,9 @@
 //! drift). The system is linear, so each step is one linear solve (see the private `system` module and `docs/amm.md`).
 //! Initial accelerations are consistent: `M q''(0) = f(0) + C^T lambda(0)`, `C q''(0) = 0`.
 
-use flexstar_kinematics::{check_configuration, check_trajectory, preflight_step, CheckedMotion, Infeasible, RigidState};
+use flexstar_kinematics::{
+    check_configuration, check_trajectory, preflight_step, CheckedMotion, Infeasible, RigidState,
+};
 use flexstar_model::config::check_step;
 use flexstar_model::{AmmSettings, Experiment, ModeCount, ModeFamily, Response, RobotParams, RunInfo};
 use flexstar_numerics::GenAlpha;
@@ -111,7 +113,12 @@ pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, s
         ));
     }
     if scan {
-        check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, preflight_step(exp.time.dt_out))?;
+        check_trajectory(
+            &exp.robot,
+            &exp.trajectory,
+            exp.time.t_end,
+            preflight_step(exp.time.dt_out),
+        )?;
     } else {
         let s0 = exp.trajectory.s(&exp.robot, 0.0)?;
         check_configuration(&exp.robot, s0).map_err(|violation| Infeasible { t: 0.0, violation })?;
@@ -220,7 +227,12 @@ pub fn solve_checked(exp: &Experiment, settings: &AmmSettings, checked: &Checked
 
 /// Does `checked` cover the scan a run of `exp` would make?
 pub(crate) fn covers(checked: &CheckedMotion, exp: &Experiment) -> bool {
-    checked.covers(&exp.robot, &exp.trajectory, exp.time.t_end, preflight_step(exp.time.dt_out))
+    checked.covers(
+        &exp.robot,
+        &exp.trajectory,
+        exp.time.t_end,
+        preflight_step(exp.time.dt_out),
+    )
 }
 
 /// [`solve_with_stats`]; `scan`: check the trajectory's feasibility over the whole span first.

@@ -99,7 +99,13 @@ impl BeamRows {
     /// The Gram matrix `B D^-1 B^T` of this beam's six vectors and `g = B D^-1 Phi` (see
     /// [`System::prepare`]): the junction entries `[g00, g01, g11]` and `[w0, w1]` are shared by
     /// the beams, the sleeve vectors are scaled by `inv_d` here.
-    fn fill_gram(&mut self, [g00, g01, g11]: [f64; 3], [w0, w1]: [f64; 2], inv_d: &[f64], [phi0, dphi0, phi]: [&[f64]; 3]) {
+    fn fill_gram(
+        &mut self,
+        [g00, g01, g11]: [f64; 3],
+        [w0, w1]: [f64; 2],
+        inv_d: &[f64],
+        [phi0, dphi0, phi]: [&[f64]; 3],
+    ) {
         for (sv, v) in self.scaled.iter_mut().zip(&self.sleeve) {
             for ((s, x), d) in sv.iter_mut().zip(v).zip(inv_d) {
                 *s = x * d;

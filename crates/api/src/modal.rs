@@ -116,7 +116,13 @@ fn fem_json(exp: &Experiment) -> Value {
 }
 
 /// The settings of `modal`, as its sidecar records and a rerun compares them.
-fn modal_settings(exp: &Experiment, spec: &PoseSpec, pose: &RestPose, sliders: Sliders, k: usize) -> Map<String, Value> {
+fn modal_settings(
+    exp: &Experiment,
+    spec: &PoseSpec,
+    pose: &RestPose,
+    sliders: Sliders,
+    k: usize,
+) -> Map<String, Value> {
     let mut m = Map::new();
     m.insert("solvers".into(), json!([amm_json(exp), fem_json(exp)]));
     m.insert("pose".into(), pose_json(spec, pose));
@@ -224,7 +230,10 @@ fn freqmap_settings(exp: &Experiment, s: &FreqmapSettings) -> Map<String, Value>
     };
     let mut m = Map::new();
     m.insert("solver".into(), solver);
-    m.insert("grid".into(), json!({ "Gx": axis(&s.gx), "Gy": axis(&s.gy), "theta": s.theta }));
+    m.insert(
+        "grid".into(),
+        json!({ "Gx": axis(&s.gx), "Gy": axis(&s.gy), "theta": s.theta }),
+    );
     m.insert("sliders".into(), s.sliders.name().into());
     m.insert("K".into(), s.k.into());
     m

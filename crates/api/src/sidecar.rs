@@ -133,7 +133,10 @@ mod tests {
         let other = table(settings(2, "free", 0.25), &exp);
         let e = other.check_rerun(dir.path(), false).unwrap_err().to_string();
         assert!(e.contains("modal.csv") && e.contains("other settings"), "{e}");
-        assert!(e.contains("sliders: \"locked\" -> \"free\"") && e.contains("K: 6 -> 2"), "{e}");
+        assert!(
+            e.contains("sliders: \"locked\" -> \"free\"") && e.contains("K: 6 -> 2"),
+            "{e}"
+        );
         assert!(!e.contains("pose"), "the pose is the same: {e}");
         assert!(e.contains("--force"), "{e}");
         other.check_rerun(dir.path(), true).unwrap();
@@ -149,7 +152,17 @@ mod tests {
         let doc = table(settings(6, "locked", 0.25), &exp)
             .document(Path::new("modal.json"))
             .unwrap();
-        for key in ["flexstar_version", "commit", "date", "command", "table", "pose", "sliders", "K", "experiment"] {
+        for key in [
+            "flexstar_version",
+            "commit",
+            "date",
+            "command",
+            "table",
+            "pose",
+            "sliders",
+            "K",
+            "experiment",
+        ] {
             assert!(doc.get(key).is_some(), "{key} missing: {doc}");
         }
         assert_eq!(doc["experiment"]["name"], "case3");

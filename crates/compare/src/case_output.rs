@@ -307,7 +307,13 @@ struct RunJson<'a> {
 
 /// `compare.json`: provenance, the experiment file, the row (EVPs, verdicts, behaviour, junction
 /// measures) and every run's settings, cost and small-deflection check.
-pub fn compare_json(exp: &Experiment, case: &CaseResults, row: &TableRow, prov: &Provenance, checks: &RunChecks) -> String {
+pub fn compare_json(
+    exp: &Experiment,
+    case: &CaseResults,
+    row: &TableRow,
+    prov: &Provenance,
+    checks: &RunChecks,
+) -> String {
     let runs: Vec<RunJson> = runs_of(case)
         .into_iter()
         .zip(checks)
@@ -363,7 +369,10 @@ pub fn write_case(
         r.stage_run(&mut set, &stem, None, exp, prov)?;
     }
     set.text("compare.csv", &csv)?;
-    set.text("compare.md", &compare_markdown(exp, case, row, (&checks, &warnings), &figs))?;
+    set.text(
+        "compare.md",
+        &compare_markdown(exp, case, row, (&checks, &warnings), &figs),
+    )?;
     set.text("compare.json", &compare_json(exp, case, row, prov, &checks))?;
     set.commit()?;
     Ok(WrittenCase {

@@ -121,7 +121,11 @@ pub enum SolveError {
 ///
 /// `checked`: the preflight's proof that the motion is feasible (the solver then does not scan it
 /// again); `None`: the solver scans it.
-pub fn solve_amm(exp: &Experiment, settings: &AmmSettings, checked: Option<&CheckedMotion>) -> Result<Response, SolveError> {
+pub fn solve_amm(
+    exp: &Experiment,
+    settings: &AmmSettings,
+    checked: Option<&CheckedMotion>,
+) -> Result<Response, SolveError> {
     match (flexstar_drive::law_for(exp)?, checked) {
         (None, None) => Ok(flexstar_amm::solve(exp, settings)?),
         (None, Some(c)) => Ok(flexstar_amm::solve_checked(exp, settings, c)?),
@@ -216,11 +220,16 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
                 return Err(input(format!("two AMM runs labelled {}", run.label)));
             }
         }
-        let motion = check_motion(&exp.robot, &exp.trajectory, exp.time.t_end, preflight_step(exp.time.dt_out))
-            .map_err(|source| RunError::Infeasible {
-                file: file.clone(),
-                source,
-            })?;
+        let motion = check_motion(
+            &exp.robot,
+            &exp.trajectory,
+            exp.time.t_end,
+            preflight_step(exp.time.dt_out),
+        )
+        .map_err(|source| RunError::Infeasible {
+            file: file.clone(),
+            source,
+        })?;
         motions.push(motion);
     }
     Ok(Checked { specs, motions })

@@ -5,11 +5,11 @@
 #[allow(dead_code)]
 mod rigid_forward;
 
+use flexstar_drive::{ForcePolynomials, RigidInverseForces};
+use flexstar_model::catalogue::paper_case;
 use flexstar_model::RobotParams;
 use nalgebra::Vector3;
 use rigid_forward::*;
-use flexstar_drive::{ForcePolynomials, RigidInverseForces};
-use flexstar_model::catalogue::paper_case;
 
 /// Kinetic energy of the rigid robot [J] from the Jacobians: `1/2 v^T M v`.
 fn kinetic_energy(params: &RobotParams, s: [f64; 3], v: [f64; 3]) -> f64 {

@@ -28,5 +28,7 @@ mod star;
 
 pub use error::{FemError, LinearError, NewtonFailure, PivotError};
 pub use integrator::{Fallback, Stats};
-pub use solve::{solve, solve_checked, solve_direct, solve_direct_with_stats, solve_with_stats, DEFAULT_DT, DEFAULT_RHO_INF};
+pub use solve::{
+    solve, solve_checked, solve_direct, solve_direct_with_stats, solve_with_stats, DEFAULT_DT, DEFAULT_RHO_INF,
+};
 pub use star::InitialState;

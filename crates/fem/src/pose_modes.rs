@@ -462,7 +462,9 @@ mod tests {
             }
             for dof in [Dof::Ux, Dof::Uy] {
                 let r: Vec<f64> = coords.iter().map(|c| f64::from(u8::from(c.dof == dof))).collect();
-                let mass: f64 = (0..n).map(|a| (0..n).map(|b| r[a] * sys.m[a * n + b] * r[b]).sum::<f64>()).sum();
+                let mass: f64 = (0..n)
+                    .map(|a| (0..n).map(|b| r[a] * sys.m[a * n + b] * r[b]).sum::<f64>())
+                    .sum();
                 let beams = 3.0 * p.rho * p.l;
                 assert!((mass / beams - 1.0).abs() < 1e-12, "{dof:?}: {mass} vs {beams}");
             }

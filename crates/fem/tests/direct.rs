@@ -14,14 +14,12 @@
 #[allow(dead_code)]
 mod rigid_forward;
 
-use rigid_forward::rigid_forward_dynamics;
-use flexstar_drive::{
-    ActuatorLaw, DriveError, ForcePolynomials, ForceTable, RigidInverseForces, Servo,
-};
+use flexstar_drive::{ActuatorLaw, DriveError, ForcePolynomials, ForceTable, RigidInverseForces, Servo};
 use flexstar_fem::{solve, solve_direct, solve_direct_with_stats, solve_with_stats, FemError};
 use flexstar_model::evp::point_evps;
 use flexstar_model::{catalogue, Experiment, FemSettings, Pose, Response, RobotParams, Trajectory};
 use flexstar_numerics::measures::max_abs;
+use rigid_forward::rigid_forward_dynamics;
 
 fn coarse() -> FemSettings {
     FemSettings {

@@ -169,7 +169,12 @@ impl CheckedMotion {
 }
 
 /// [`check_trajectory`], returning the proof of the check on success.
-pub fn check_motion(params: &RobotParams, traj: &Trajectory, t_end: f64, scan_step: f64) -> Result<CheckedMotion, Infeasible> {
+pub fn check_motion(
+    params: &RobotParams,
+    traj: &Trajectory,
+    t_end: f64,
+    scan_step: f64,
+) -> Result<CheckedMotion, Infeasible> {
     check_trajectory(params, traj, t_end, scan_step)?;
     Ok(CheckedMotion {
         params: *params,

@@ -13,9 +13,9 @@
 //! and for slider i (mass mpp + mpa along u_i), Eq. 33 with `e_wi . u_i = cos(theta)`:
 //! `Fa_i = (mpp + mpa) s_i'' + f_i e_wi . u_i`.
 
-use nalgebra::{Matrix3, Vector3};
 use flexstar_model::geometry::slider_direction;
 use flexstar_model::RobotParams;
+use nalgebra::{Matrix3, Vector3};
 
 use crate::state::{dot, RigidState};
 

@@ -20,7 +20,9 @@ pub mod state;
 pub mod table;
 
 pub use direct::{direct_kinematics, RigidPose};
-pub use feasibility::{check_configuration, check_motion, check_trajectory, preflight_step, CheckedMotion, Infeasible, Violation};
+pub use feasibility::{
+    check_configuration, check_motion, check_trajectory, preflight_step, CheckedMotion, Infeasible, Violation,
+};
 pub use flexstar_model::geometry::inverse_kinematics;
 pub use inverse_dynamics::{rigid_inverse_dynamics, RigidForces};
 pub use state::RigidState;

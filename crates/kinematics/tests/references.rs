@@ -280,9 +280,18 @@ fn a_checked_motion_covers_only_what_was_checked() {
     let step = preflight_step(exp.time.dt_out);
     let proof = check_motion(&p, &traj, t_end, step).expect("case 3 is feasible");
     assert!(proof.covers(&p, &traj, t_end, step));
-    assert!(proof.covers(&p, &traj, 0.5 * t_end, 2.0 * step), "a shorter span, a coarser scan");
-    assert!(!proof.covers(&p, &traj, 2.0 * t_end, step), "a longer span is not covered");
-    assert!(!proof.covers(&p, &traj, t_end, 0.5 * step), "a finer scan is not covered");
+    assert!(
+        proof.covers(&p, &traj, 0.5 * t_end, 2.0 * step),
+        "a shorter span, a coarser scan"
+    );
+    assert!(
+        !proof.covers(&p, &traj, 2.0 * t_end, step),
+        "a longer span is not covered"
+    );
+    assert!(
+        !proof.covers(&p, &traj, t_end, 0.5 * step),
+        "a finer scan is not covered"
+    );
     let mut other = p;
     other.lp *= 1.5;
     assert!(!proof.covers(&other, &traj, t_end, step), "another robot");
@@ -290,7 +299,11 @@ fn a_checked_motion_covers_only_what_was_checked() {
     let fast = match &traj {
         Trajectory::Polynomial { s1, s2, s3 } => {
             let scale = |c: &Vec<f64>| c.iter().enumerate().map(|(k, v)| v * 10f64.powi(k as i32)).collect();
-            Trajectory::Polynomial { s1: scale(s1), s2: scale(s2), s3: scale(s3) }
+            Trajectory::Polynomial {
+                s1: scale(s1),
+                s2: scale(s2),
+                s3: scale(s3),
+            }
         }
         other => panic!("case 3 is a polynomial motion, got {other:?}"),
     };

@@ -121,7 +121,13 @@ pub struct Signal {
 }
 
 fn signals(names: &[&str], unit: &'static str) -> Vec<Signal> {
-    names.iter().map(|n| Signal { name: (*n).into(), unit }).collect()
+    names
+        .iter()
+        .map(|n| Signal {
+            name: (*n).into(),
+            unit,
+        })
+        .collect()
 }
 
 /// The state-space model and what it was built from.
@@ -256,14 +262,8 @@ fn base_excitation(exp: &Experiment, pose: &RestPose, locked: &PoseSystem) -> Re
 fn amm_modes(exp: &Experiment, pose: &RestPose, settings: &LinearSettings) -> Result<PoseModes, ModalError> {
     crate::check_k(settings.modes)?;
     let (family, nm) = crate::analysis::amm_basis(exp);
-    let modes = flexstar_amm::pose_modes::pose_modes(
-        &exp.robot,
-        pose,
-        settings.holding.sliders(),
-        family,
-        nm,
-        settings.modes,
-    )?;
+    let modes =
+        flexstar_amm::pose_modes::pose_modes(&exp.robot, pose, settings.holding.sliders(), family, nm, settings.modes)?;
     if modes.shapes.len() < modes.rigid + settings.modes {
         return Err(ModalError::Input(format!(
             "--modes {}: the AMM with N = {} modes per beam has only {} modes",
@@ -369,13 +369,22 @@ fn zeros(rows: usize, cols: usize) -> Vec<Vec<f64>> {
 }
 
 /// Locked sliders: inputs the slider accelerations, `B = -Phi^T M R` (module docs).
-fn locked_model(exp: &Experiment, pose: &RestPose, modes: &PoseModes, deflections: Vec<Vec<f64>>) -> Result<Model, ModalError> {
+fn locked_model(
+    exp: &Experiment,
+    pose: &RestPose,
+    modes: &PoseModes,
+    deflections: Vec<Vec<f64>>,
+) -> Result<Model, ModalError> {
     let sys = &modes.system;
     let mr = base_excitation(exp, pose, sys)?;
     let bm = modes
         .shapes
         .iter()
-        .map(|p| (0..3).map(|j| -(0..sys.n).map(|a| p[a] * mr[a][j]).sum::<f64>()).collect())
+        .map(|p| {
+            (0..3)
+                .map(|j| -(0..sys.n).map(|a| p[a] * mr[a][j]).sum::<f64>())
+                .collect()
+        })
         .collect();
     let blocks = Blocks {
         omega2: modes.omega2.clone(),
@@ -384,7 +393,11 @@ fn locked_model(exp: &Experiment, pose: &RestPose, modes: &PoseModes, deflection
         cq: deflections,
         d: zeros(6, 3),
     };
-    Ok((blocks, signals(&["sdd1", "sdd2", "sdd3"], "m/s^2"), deflection_signals()))
+    Ok((
+        blocks,
+        signals(&["sdd1", "sdd2", "sdd3"], "m/s^2"),
+        deflection_signals(),
+    ))
 }
 
 /// Free sliders, open loop: inputs Fa, `B = [0; S^T]`, outputs the sliders then the deflections.
@@ -413,7 +426,11 @@ fn servo_model(modes: &PoseModes, deflections: Vec<Vec<f64>>, kp: f64, kd: f64) 
     let s = slider_rows(modes);
     let nr = modes.shapes.len();
     let sts: Vec<Vec<f64>> = (0..nr)
-        .map(|k| (0..nr).map(|j| s.iter().map(|row| row[k] * row[j]).sum::<f64>()).collect())
+        .map(|k| {
+            (0..nr)
+                .map(|j| s.iter().map(|row| row[k] * row[j]).sum::<f64>())
+                .collect()
+        })
         .collect();
     let scaled = |g: f64| -> Vec<Vec<f64>> { sts.iter().map(|r| r.iter().map(|v| g * v).collect()).collect() };
     blocks.feedback = Some((scaled(kp), scaled(kd)));
@@ -499,8 +516,12 @@ fn statespace_json(exp: &Experiment, ss: &StateSpace, fem: &flexstar_fem::pose_m
     let h = ss.settings.holding;
     let description = match h {
         Holding::Free => "sliders free, open loop (inputs: actuator forces)",
-        Holding::Locked => "sliders locked, revolute points moved by the prescribed slider motion (inputs: slider accelerations)",
-        Holding::Servo { .. } => "sliders free, PD servo loop closed (inputs: reference positions and rates, feedforward forces)",
+        Holding::Locked => {
+            "sliders locked, revolute points moved by the prescribed slider motion (inputs: slider accelerations)"
+        }
+        Holding::Servo { .. } => {
+            "sliders free, PD servo loop closed (inputs: reference positions and rates, feedforward forces)"
+        }
     };
     let servo = match h {
         Holding::Servo { kp, kd } => serde_json::json!({"kp": kp, "kd": kd}),

@@ -46,7 +46,10 @@ fn eigenvalues_of_a_are_the_modal_frequencies_for_each_sliders_setting() {
         let rigid = if sliders == Sliders::Free { 3 } else { 0 };
         assert_eq!(ss.a.rows(), 2 * (rigid + k), "{sliders:?}");
         assert_eq!(ss.states.len(), ss.a.rows());
-        assert_eq!((ss.states[0].name.as_str(), ss.states[rigid + k].name.as_str()), ("eta1", "etad1"));
+        assert_eq!(
+            (ss.states[0].name.as_str(), ss.states[rigid + k].name.as_str()),
+            ("eta1", "etad1")
+        );
         let ev = to_faer(&ss.a).eigenvalues().unwrap();
         let wmax = ev.iter().map(|z| z.im.abs()).fold(0.0, f64::max);
         let zero_tol = (f64::EPSILON * wmax * wmax).sqrt() * 10.0;
@@ -58,7 +61,11 @@ fn eigenvalues_of_a_are_the_modal_frequencies_for_each_sliders_setting() {
         let m = modal(&exp, &ss.pose, sliders, 6).unwrap();
         let two_pi = 2.0 * std::f64::consts::PI;
         for (j, (wj, (_, f_amm, f_fem, _))) in w.iter().zip(m.rows().iter().skip(rigid)).enumerate() {
-            eprintln!("{sliders:?} mode {}: A {} Hz, AMM {f_amm} Hz, FEM {f_fem} Hz", j + 1, wj / two_pi);
+            eprintln!(
+                "{sliders:?} mode {}: A {} Hz, AMM {f_amm} Hz, FEM {f_fem} Hz",
+                j + 1,
+                wj / two_pi
+            );
             assert!((wj / (two_pi * f_amm) - 1.0).abs() < 1e-9, "{sliders:?} mode {j}");
             assert!((wj / (two_pi * f_fem) - 1.0).abs() < 0.01, "{sliders:?} mode {j}");
         }
@@ -76,7 +83,11 @@ fn gain_at(ss: &StateSpace, p: f64) -> Vec<Vec<f64>> {
     let rhs = faer::Mat::from_fn(n, b.ncols(), |r, k| b[[r, k]]);
     let x = m.partial_piv_lu().solve(&rhs);
     (0..c.nrows())
-        .map(|o| (0..b.ncols()).map(|u| (0..n).map(|j| c[[o, j]] * x[(j, u)]).sum::<f64>() + d[[o, u]]).collect())
+        .map(|o| {
+            (0..b.ncols())
+                .map(|u| (0..n).map(|j| c[[o, j]] * x[(j, u)]).sum::<f64>() + d[[o, u]])
+                .collect()
+        })
         .collect()
 }
 
@@ -108,8 +119,17 @@ fn locked_model_is_the_free_model_on_very_heavy_sliders() {
             assert_eq!(free.outputs[3 + o].name, name.name);
             for u in 0..3 {
                 let (a, b) = (gl[o][u], gf[3 + o][u] * m);
-                eprintln!("{f} Hz {} / sdd{}: locked {a:.6e}, heavy free {b:.6e}", name.name, u + 1);
-                assert!((a - b).abs() < 1e-5 * scale, "{f} Hz {}/sdd{}: {a} vs {b}", name.name, u + 1);
+                eprintln!(
+                    "{f} Hz {} / sdd{}: locked {a:.6e}, heavy free {b:.6e}",
+                    name.name,
+                    u + 1
+                );
+                assert!(
+                    (a - b).abs() < 1e-5 * scale,
+                    "{f} Hz {}/sdd{}: {a} vs {b}",
+                    name.name,
+                    u + 1
+                );
             }
         }
         // and the heavy sliders do follow s'' = a: s / a = 1 / p^2
@@ -132,7 +152,10 @@ fn locked_model_is_the_free_model_on_very_heavy_sliders() {
 fn servo_poles_in_the_stiff_limit_are_the_rigid_robots() {
     let mut exp = paper();
     exp.robot.e *= 1e4;
-    let (kp, kd) = (0.2 * (2.0 * std::f64::consts::PI * 20.0f64).powi(2), 2.0 * 0.7 * 0.2 * 2.0 * std::f64::consts::PI * 20.0);
+    let (kp, kd) = (
+        0.2 * (2.0 * std::f64::consts::PI * 20.0f64).powi(2),
+        2.0 * 0.7 * 0.2 * 2.0 * std::f64::consts::PI * 20.0,
+    );
     let ss = build(&exp, 8, Holding::Servo { kp, kd });
     let mut ev: Vec<faer::c64> = to_faer(&ss.a).eigenvalues().unwrap();
     assert!(ev.iter().all(|z| z.re < 0.0), "closed loop is stable: {ev:?}");
@@ -163,7 +186,11 @@ fn servo_poles_in_the_stiff_limit_are_the_rigid_robots() {
         eprintln!("pole {z:?}, rigid robot {w:?}");
         assert!((z - w).norm() < 1e-3 * w.norm(), "{z:?} vs {w:?}");
     }
-    assert!(ev[6].norm() > 20.0 * want[5].norm(), "elastic poles well above: {:?}", ev[6]);
+    assert!(
+        ev[6].norm() > 20.0 * want[5].norm(),
+        "elastic poles well above: {:?}",
+        ev[6]
+    );
 }
 
 /// The servo model's static limit, an exact property of the loop: a constant reference moves
@@ -178,7 +205,10 @@ fn servo_tracks_a_constant_reference_exactly() {
     let holding = Holding::servo_of(&exp).unwrap();
     let ss = build(&exp, 10, holding);
     let names: Vec<&str> = ss.inputs.iter().map(|s| s.name.as_str()).collect();
-    assert_eq!(names, ["s1ref", "s2ref", "s3ref", "sd1ref", "sd2ref", "sd3ref", "ff1", "ff2", "ff3"]);
+    assert_eq!(
+        names,
+        ["s1ref", "s2ref", "s3ref", "sd1ref", "sd2ref", "sd3ref", "ff1", "ff2", "ff3"]
+    );
     let outs: Vec<&str> = ss.outputs.iter().map(|s| s.name.as_str()).collect();
     assert_eq!(outs[9..], ["e1", "e2", "e3"]);
     let g = gain_at(&ss, 0.0);

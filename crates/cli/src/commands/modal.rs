@@ -171,7 +171,11 @@ pub fn run_modal(args: ModalArgs) -> anyhow::Result<()> {
         eprintln!("  {line}");
     }
     let dir = args.out.join(&exp.name);
-    eprintln!("{}: modal.csv, modal.json, modal-shapes.svg/.png in {}", exp.name, dir.display());
+    eprintln!(
+        "{}: modal.csv, modal.json, modal-shapes.svg/.png in {}",
+        exp.name,
+        dir.display()
+    );
     Ok(())
 }
 

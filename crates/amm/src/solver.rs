@@ -445,6 +445,9 @@ mod tests {
             amm: AmmSettings::default(),
             fem: FemSettings::default(),
             drive: Default::default(),
+            payload: Default::default(),
+            damping: Default::default(),
+            load: Default::default(),
             source: Default::default(),
         }
     }

@@ -13,8 +13,7 @@ use crate::{ActuatorLaw, DriveError};
 /// run evaluates there.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ForceTable {
-    t: Vec<f64>,
-    fa: Vec<[f64; 3]>,
+    samples: ForceSamples,
 }
 
 impl ForceTable {
@@ -22,12 +21,15 @@ impl ForceTable {
     /// Errors name the sample (1-based row) and the reason; the caller adds file and key.
     pub fn new(t: Vec<f64>, fa: Vec<[f64; 3]>) -> Result<Self, DriveError> {
         ForceSamples::check(&t, &fa).map_err(DriveError::Table)?;
-        Ok(ForceTable { t, fa })
+        Ok(ForceTable {
+            samples: ForceSamples { t, fa },
+        })
     }
 
     /// First and last sample time [s].
     pub fn span(&self) -> (f64, f64) {
-        (self.t[0], self.t[self.t.len() - 1])
+        let t = &self.samples.t;
+        (t[0], t[t.len() - 1])
     }
 
     /// Check that the table covers `[t0, t1]` [s] (with a relative slack of 1e-9 for times
@@ -37,20 +39,10 @@ impl ForceTable {
         ForceSamples::check_covers(a, b, t0, t1).map_err(DriveError::Table)
     }
 
-    /// `Fa(t)` [N], linear between samples, held constant outside the span.
+    /// `Fa(t)` [N], linear between samples, held constant outside the span
+    /// ([`ForceSamples::at`]).
     pub fn at(&self, t: f64) -> [f64; 3] {
-        let n = self.t.len();
-        if t <= self.t[0] {
-            return self.fa[0];
-        }
-        if t >= self.t[n - 1] {
-            return self.fa[n - 1];
-        }
-        let k = self.t.partition_point(|&tk| tk <= t).min(n - 1);
-        let (t0, t1) = (self.t[k - 1], self.t[k]);
-        let r = (t - t0) / (t1 - t0);
-        let (f0, f1) = (self.fa[k - 1], self.fa[k]);
-        [0, 1, 2].map(|i| f0[i] + r * (f1[i] - f0[i]))
+        self.samples.at(t)
     }
 }
 

@@ -36,6 +36,9 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         amm: AmmSettings::default(),
         fem: FemSettings::default(),
         drive: Default::default(),
+        payload: Default::default(),
+        damping: Default::default(),
+        load: Default::default(),
         source: Default::default(),
     }
 }

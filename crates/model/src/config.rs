@@ -24,6 +24,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::attachments::{Damping, LoadSettings, Payload};
 use crate::drive::DriveSettings;
 use crate::error::ModelError;
 use crate::params::RobotParams;
@@ -353,6 +354,15 @@ pub struct Experiment {
     /// What moves the sliders (`[drive]`, issue 10): the trajectory (default), forces or a servo.
     #[serde(default)]
     pub drive: DriveSettings,
+    /// A rigid body welded at G (`[payload]`, issue 22); none by default.
+    #[serde(default)]
+    pub payload: Payload,
+    /// Kelvin-Voigt damping of the beams (`[damping]`, issue 22); none by default.
+    #[serde(default)]
+    pub damping: Damping,
+    /// Force and moment at G (`[load]`, issue 22); none by default.
+    #[serde(default)]
+    pub load: LoadSettings,
     /// Where the experiment was read from (not a TOML key).
     #[serde(skip)]
     pub source: PathBuf,
@@ -376,15 +386,17 @@ impl Experiment {
         })?;
         exp.source = path.to_path_buf();
         exp.drive.read_file(path)?;
+        exp.load.read_file(path)?;
         exp.validate().map_err(|e| e.in_file(path))?;
         Ok(exp)
     }
 
-    /// Every file besides the experiment file itself that this experiment reads (today the
-    /// forces table of a `[drive]` of kind `forces`), resolved against [`Experiment::source`]:
-    /// what a fingerprint of the experiment must cover besides its text.
+    /// Every file besides the experiment file itself that this experiment reads (the forces
+    /// table of a `[drive]` of kind `forces`, the table of a `[load]`), resolved against
+    /// [`Experiment::source`]: what a fingerprint of the experiment must cover besides its text.
     pub fn input_files(&self) -> Vec<PathBuf> {
-        self.drive.file_path(&self.source).into_iter().collect()
+        let drive = self.drive.file_path(&self.source);
+        drive.into_iter().chain(self.load.file_path(&self.source)).collect()
     }
 
     /// Check every value (keys named relative to the file).
@@ -421,6 +433,9 @@ impl Experiment {
         }
         self.amm.validate(self.time.dt_out)?;
         self.drive.validate(self.time.t_end, self.robot.mpp_mpa)?;
+        self.payload.validate()?;
+        self.damping.validate()?;
+        self.load.validate(self.time.t_end)?;
         if self.fem.elements < 3 || !self.fem.elements.is_multiple_of(3) || self.fem.elements > 30_000 {
             return Err(ModelError::invalid(
                 "fem.elements",

@@ -99,11 +99,19 @@ impl ForceSamples {
     /// exactly `t,Fa1,Fa2,Fa3` or any flexstar solver output). Errors name the file, `key` and
     /// the row or column.
     pub fn read_csv(path: &Path, key: &str) -> Result<Self, ModelError> {
+        Self::read_columns(path, key, ["Fa1", "Fa2", "Fa3"], "forces")
+    }
+
+    /// Read a CSV whose first column is `t` and whose three `columns` are found by name (the
+    /// forces file of `[drive]`, the load file of `[load]`); `what` names the file in messages
+    /// (`the forces file`). Errors name the file, `key` and the row or column.
+    pub fn read_columns(path: &Path, key: &str, columns: [&str; 3], what: &str) -> Result<Self, ModelError> {
         let bad = |reason: String| ModelError::Invalid {
             file: path.to_path_buf(),
             key: key.to_string(),
             reason,
         };
+        let expected = format!("t,{}", columns.join(","));
         // a solver output of flexstar's own: its folder recovered from an interrupted writer first
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             crate::run_set::recover(dir)?;
@@ -111,25 +119,25 @@ impl ForceSamples {
         let mut rd = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .from_path(path)
-            .map_err(|e| bad(format!("cannot read the forces file: {e}")))?;
+            .map_err(|e| bad(format!("cannot read the {what} file: {e}")))?;
         let header = rd
             .headers()
             .map_err(|e| bad(format!("cannot read the header: {e}")))?
             .clone();
         if header.get(0) != Some("t") {
             return Err(bad(format!(
-                "the header must start with `t,Fa1,Fa2,Fa3` (or be a solver output with t first), got `{}`",
+                "the header must start with `{expected}` (or be a solver output with t first), got `{}`",
                 header.iter().collect::<Vec<_>>().join(",")
             )));
         }
         let col = |name: &str| {
             header.iter().position(|h| h == name).ok_or_else(|| {
                 bad(format!(
-                    "the header has no column `{name}` (it must start `t,Fa1,Fa2,Fa3`)"
+                    "the header has no column `{name}` (it must start `{expected}`)"
                 ))
             })
         };
-        let idx = [col("Fa1")?, col("Fa2")?, col("Fa3")?];
+        let idx = [col(columns[0])?, col(columns[1])?, col(columns[2])?];
         let (mut t, mut fa) = (Vec::new(), Vec::new());
         for (k, rec) in rd.records().enumerate() {
             let row = k + 1;
@@ -144,6 +152,23 @@ impl ForceSamples {
         }
         Self::check(&t, &fa).map_err(|e| bad(e.to_string()))?;
         Ok(ForceSamples { t, fa })
+    }
+
+    /// The three channels at `t` [s]: linear between samples, held constant outside the span.
+    /// Samples must have passed [`ForceSamples::check`] (at least two, increasing times).
+    pub fn at(&self, t: f64) -> [f64; 3] {
+        let n = self.t.len();
+        if t <= self.t[0] {
+            return self.fa[0];
+        }
+        if t >= self.t[n - 1] {
+            return self.fa[n - 1];
+        }
+        let k = self.t.partition_point(|&tk| tk <= t).min(n - 1);
+        let (t0, t1) = (self.t[k - 1], self.t[k]);
+        let r = (t - t0) / (t1 - t0);
+        let (f0, f1) = (self.fa[k - 1], self.fa[k]);
+        [0, 1, 2].map(|i| f0[i] + r * (f1[i] - f0[i]))
     }
 }
 

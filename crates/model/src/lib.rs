@@ -7,6 +7,7 @@
 //! Conventions (frames, signs, units) are written once, in `docs/conventions.md`; the items here
 //! follow them. All quantities are SI: metres, seconds, kilograms, newtons, radians.
 
+pub mod attachments;
 pub mod cancel;
 pub mod catalogue;
 pub mod config;
@@ -22,6 +23,7 @@ pub mod run_set;
 pub mod trajectory;
 pub mod validity;
 
+pub use attachments::{Damping, LoadSettings, Payload};
 pub use cancel::Cancel;
 pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, ModeFamily, TimeSpan};
 pub use drive::{DriveKind, DriveSettings, Feedforward, ForceSamples};

@@ -14,9 +14,15 @@
 //! `j_th = dtheta/ds` (3). The sleeves turn with the star (rigid limit: `theta_p = 0`), their
 //! translating mass is in `mpp_mpa`, as in Eq. 33. Integrated by the classical fourth-order
 //! Runge-Kutta scheme at a fixed step.
+//!
+//! A payload welded at G (mass m_p at `c = G + r`, `r = R(theta) o`, inertia J_p) and a load
+//! `(F, Mz)` at G add (`docs/amm.md` 11.1, Eq. P9), with `J_c = J_G + (k x r) j_th^T`:
+//! `mass += m_p J_c^T J_c + J_p j_th j_th^T`,
+//! `rhs += -m_p J_c^T (s'^T H_G s' + (k x r) s'^T H_th s' - theta'^2 r) - J_p j_th s'^T H_th s'
+//! + J_G^T F + j_th Mz`.
 
 use flexstar_kinematics::{check_configuration, direct_kinematics, Violation};
-use flexstar_model::RobotParams;
+use flexstar_model::{Attachments, RobotParams};
 use nalgebra::{Matrix3, Vector3};
 use num_dual::{Dual2, DualSVec64};
 
@@ -65,12 +71,45 @@ pub enum Singular {
 
 /// Accelerations `s''` [m/s^2] of the rigid robot at state (`s`, `v`) under forces `fa` [N].
 pub fn rigid_acceleration(params: &RobotParams, s: [f64; 3], v: [f64; 3], fa: [f64; 3]) -> Result<[f64; 3], Singular> {
+    rigid_acceleration_with(params, &Attachments::default(), 0.0, s, v, fa)
+}
+
+/// Accelerations `s''` [m/s^2] of the rigid robot carrying `attached` at time `t` [s] (the
+/// load's time) and state (`s`, `v`) under forces `fa` [N] (Eq. P9).
+pub fn rigid_acceleration_with(
+    params: &RobotParams,
+    attached: &Attachments,
+    t: f64,
+    s: [f64; 3],
+    v: [f64; 3],
+    fa: [f64; 3],
+) -> Result<[f64; 3], Singular> {
     let (jg, jth) = jacobians(params, s)?;
-    let (kg, kth) = quadratic_terms(params, s, v)?;
+    let (kg, kth, theta) = quadratic_terms(params, s, v)?;
     let m = params.star_mass();
     let j = params.star_inertia() + 3.0 * params.jp;
-    let mass = Matrix3::identity() * params.mpp_mpa + jg.transpose() * jg * m + jth * jth.transpose() * j;
-    let rhs = Vector3::from(fa) - jg.transpose() * kg * m - jth * (kth * j);
+    let mut mass = Matrix3::identity() * params.mpp_mpa + jg.transpose() * jg * m + jth * jth.transpose() * j;
+    let mut rhs = Vector3::from(fa) - jg.transpose() * kg * m - jth * (kth * j);
+    if !attached.is_none() {
+        let p = &attached.payload;
+        let (ex, ew) = (
+            flexstar_model::geometry::e_x(0, theta),
+            flexstar_model::geometry::e_w(0, theta),
+        );
+        let r = nalgebra::Vector2::new(
+            p.offset[0] * ex[0] + p.offset[1] * ew[0],
+            p.offset[0] * ex[1] + p.offset[1] * ew[1],
+        );
+        let kr = nalgebra::Vector2::new(-r[1], r[0]);
+        let jc = jg + kr * jth.transpose();
+        let omega = jth.dot(&Vector3::from(v));
+        let quad = kg + kr * kth - r * (omega * omega);
+        let [fx, fy, mz] = attached.load.at(t);
+        mass += jc.transpose() * jc * p.mass + jth * jth.transpose() * p.j;
+        rhs += -(jc.transpose() * quad * p.mass) - jth * (kth * p.j)
+            + jg.transpose() * nalgebra::Vector2::new(fx, fy)
+            + jth * mz;
+    }
     let a = mass.cholesky().ok_or(Singular::MassMatrix)?.solve(&rhs);
     Ok([a[0], a[1], a[2]])
 }
@@ -90,11 +129,19 @@ pub fn jacobians(params: &RobotParams, s: [f64; 3]) -> Result<Jacobians, Singula
     Ok((jg, grad(&pose.theta)))
 }
 
-/// `s'^T H s'` for G (2-vector) and theta: the accelerations at `s'' = 0`.
-fn quadratic_terms(params: &RobotParams, s: [f64; 3], v: [f64; 3]) -> Result<(nalgebra::Vector2<f64>, f64), Singular> {
+/// `s'^T H s'` for G (2-vector) and theta: the accelerations at `s'' = 0`; and theta [rad].
+fn quadratic_terms(
+    params: &RobotParams,
+    s: [f64; 3],
+    v: [f64; 3],
+) -> Result<(nalgebra::Vector2<f64>, f64, f64), Singular> {
     let sd: [Dual2<f64>; 3] = [0, 1, 2].map(|k| Dual2::new(s[k], v[k], 0.0));
     let pose = direct_kinematics(params.d, sd).ok_or(Singular::NoFermatPoint)?;
-    Ok((nalgebra::Vector2::new(pose.g[0].v2, pose.g[1].v2), pose.theta.v2))
+    Ok((
+        nalgebra::Vector2::new(pose.g[0].v2, pose.g[1].v2),
+        pose.theta.v2,
+        pose.theta.re,
+    ))
 }
 
 /// Integrate from (`s0`, `v0`) at t = 0 to `t_end` [s] under `law`, with RK4 steps of at most
@@ -104,6 +151,22 @@ fn quadratic_terms(params: &RobotParams, s: [f64; 3], v: [f64; 3]) -> Result<(na
 /// step outside it with the time and the limit.
 pub fn rigid_forward_dynamics(
     params: &RobotParams,
+    s0: [f64; 3],
+    v0: [f64; 3],
+    law: &dyn ActuatorLaw,
+    t_end: f64,
+    dt_out: f64,
+    dt_max: f64,
+) -> Result<Vec<RigidSample>, ForwardError> {
+    let bare = Attachments::default();
+    rigid_forward_dynamics_with(params, &bare, s0, v0, law, t_end, dt_out, dt_max)
+}
+
+/// [`rigid_forward_dynamics`] of the robot carrying `attached`'s payload and load (Eq. P9).
+#[allow(clippy::too_many_arguments)]
+pub fn rigid_forward_dynamics_with(
+    params: &RobotParams,
+    attached: &Attachments,
     s0: [f64; 3],
     v0: [f64; 3],
     law: &dyn ActuatorLaw,
@@ -130,7 +193,7 @@ pub fn rigid_forward_dynamics(
     for k in 0..n_out {
         for j in 0..sub {
             let t = k as f64 * dt_out + j as f64 * h;
-            x = rk4_step(params, law, t, x, h)?;
+            x = rk4_step((params, attached), law, t, x, h)?;
             check_configuration(params, x.s).map_err(|violation| ForwardError::Infeasible { t: t + h, violation })?;
         }
         let t = (k + 1) as f64 * dt_out;
@@ -150,13 +213,17 @@ struct State {
     v: [f64; 3],
 }
 
-fn rate(params: &RobotParams, law: &dyn ActuatorLaw, t: f64, x: State) -> Result<State, ForwardError> {
+/// The robot and what it carries.
+type Robot<'a> = (&'a RobotParams, &'a Attachments);
+
+fn rate(robot: Robot<'_>, law: &dyn ActuatorLaw, t: f64, x: State) -> Result<State, ForwardError> {
     let fa = law.force(t, x.s, x.v)?;
-    let a = rigid_acceleration(params, x.s, x.v, fa).map_err(|reason| ForwardError::Singular { t, reason })?;
+    let a = rigid_acceleration_with(robot.0, robot.1, t, x.s, x.v, fa)
+        .map_err(|reason| ForwardError::Singular { t, reason })?;
     Ok(State { s: x.v, v: a })
 }
 
-fn rk4_step(params: &RobotParams, law: &dyn ActuatorLaw, t: f64, x: State, h: f64) -> Result<State, ForwardError> {
+fn rk4_step(params: Robot<'_>, law: &dyn ActuatorLaw, t: f64, x: State, h: f64) -> Result<State, ForwardError> {
     let add = |x: State, k: State, c: f64| State {
         s: [0, 1, 2].map(|i| x.s[i] + c * k.s[i]),
         v: [0, 1, 2].map(|i| x.v[i] + c * k.v[i]),

@@ -73,6 +73,7 @@ fn direct_vs_inverse(c: &mut Criterion) {
             rigid_feedforward: true,
             reference: exp.trajectory.clone(),
             params: exp.robot,
+            attached: Default::default(),
         };
         group.bench_function(format!("case3_{label}_inverse"), |b| {
             b.iter(|| solve(&exp, &settings).unwrap())

@@ -43,6 +43,7 @@ fn main() {
         rigid_feedforward: true,
         reference: exp.trajectory.clone(),
         params: exp.robot,
+        attached: Default::default(),
     };
     let r = match kind.as_str() {
         "setup" => Ok(inverse),

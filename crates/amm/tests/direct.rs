@@ -120,6 +120,7 @@ fn stiff_servo_reproduces_the_prescribed_motion() {
             rigid_feedforward: true,
             reference: exp.trajectory.clone(),
             params: exp.robot,
+            attached: Default::default(),
         };
         let inverse = solve(&exp, &exp.amm).unwrap();
         let direct = solve_direct(&exp, &exp.amm, &servo).unwrap();
@@ -209,6 +210,7 @@ fn stiff_limit_matches_the_rigid_forward_dynamics() {
         let law = RigidInverseForces {
             trajectory: exp.trajectory.clone(),
             params: robot,
+            attached: Default::default(),
         };
         let settings = AmmSettings::paper(flexstar_model::ModeFamily::FreeFree, 25);
         let r = solve_direct(&exp, &settings, &law).unwrap();

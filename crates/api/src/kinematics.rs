@@ -28,6 +28,7 @@ pub fn table(exp: &Experiment, source: &str) -> Result<Vec<RigidState>> {
 /// Write the table to `out/<name>/kinematics.csv` (the folder checked writable first).
 pub fn write(out: &Path, exp: &Experiment, states: &[RigidState]) -> Result<PathBuf> {
     let path = crate::case_dir(out, exp)?.join("kinematics.csv");
-    write_kinematics_csv(&path, &exp.robot, states).map_err(|e| ApiError::Output(e.to_string()))?;
+    write_kinematics_csv(&path, &exp.robot, &flexstar_model::Attachments::of(exp), states)
+        .map_err(|e| ApiError::Output(e.to_string()))?;
     Ok(path)
 }

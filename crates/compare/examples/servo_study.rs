@@ -29,6 +29,7 @@ fn servo_run(exp: &Experiment, settings: &AmmSettings, f_bw: f64) -> Response {
         rigid_feedforward: true,
         reference: exp.trajectory.clone(),
         params: exp.robot,
+        attached: Default::default(),
     };
     flexstar_amm::solve_direct(exp, settings, &law).expect("servo run")
 }

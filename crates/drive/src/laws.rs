@@ -1,8 +1,8 @@
 //! The three kinds of actuator law: a force table (e.g. a solver's own `Fa` output fed back),
 //! force polynomials, and a PD servo on each slider with optional rigid-body feedforward.
 
-use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
-use flexstar_model::{ForceSamples, RobotParams, Trajectory};
+use flexstar_kinematics::{rigid_inverse_dynamics_with, RigidState};
+use flexstar_model::{Attachments, ForceSamples, RobotParams, Trajectory};
 
 use crate::{ActuatorLaw, DriveError};
 
@@ -81,7 +81,7 @@ impl ActuatorLaw for ForcePolynomials {
 /// `Fa_i = ff_i(t) + kp_i (s_ref,i(t) - s_i) + kd_i (s_ref,i'(t) - s_i')` [N].
 ///
 /// The feedforward `ff` is the rigid-body inverse dynamics of the reference (Eq. 33 with a rigid
-/// star, [`rigid_inverse_dynamics`]) or zero.
+/// star, [`rigid_inverse_dynamics_with`], carrying the payload and load) or zero.
 #[derive(Debug, Clone)]
 pub struct Servo {
     /// Proportional gains [N/m].
@@ -94,6 +94,8 @@ pub struct Servo {
     pub reference: Trajectory,
     /// The robot (masses for the feedforward).
     pub params: RobotParams,
+    /// The payload and load the feedforward includes (issue 22; none: the bare star).
+    pub attached: Attachments,
 }
 
 impl Servo {
@@ -119,7 +121,7 @@ impl Servo {
                 t,
                 reason: e.to_string(),
             })?;
-            rigid_inverse_dynamics(&self.params, &state).fa
+            rigid_inverse_dynamics_with(&self.params, &self.attached, &state).fa
         } else {
             [0.0; 3]
         };
@@ -155,13 +157,19 @@ impl ActuatorLaw for Servo {
     }
 }
 
-/// The rigid-body inverse dynamics of a trajectory [N] at time `t` (Eq. 33 with a rigid star).
-fn rigid_forces(params: &RobotParams, trajectory: &Trajectory, t: f64) -> Result<[f64; 3], DriveError> {
+/// The rigid-body inverse dynamics of a trajectory [N] at time `t` (Eq. 33 with a rigid star,
+/// Eqs. P7-P8 with `attached`).
+fn rigid_forces(
+    params: &RobotParams,
+    attached: &Attachments,
+    trajectory: &Trajectory,
+    t: f64,
+) -> Result<[f64; 3], DriveError> {
     let state = RigidState::at(params, trajectory, t).map_err(|e| DriveError::Reference {
         t,
         reason: e.to_string(),
     })?;
-    Ok(rigid_inverse_dynamics(params, &state).fa)
+    Ok(rigid_inverse_dynamics_with(params, attached, &state).fa)
 }
 
 /// The forces that move the *rigid* robot along `trajectory` (Eq. 33 with a rigid star), as a
@@ -172,11 +180,13 @@ pub struct RigidInverseForces {
     pub trajectory: Trajectory,
     /// The robot.
     pub params: RobotParams,
+    /// The payload and load it carries (none: the bare star).
+    pub attached: Attachments,
 }
 
 impl ActuatorLaw for RigidInverseForces {
     fn force(&self, t: f64, _s: [f64; 3], _v: [f64; 3]) -> Result<[f64; 3], DriveError> {
-        rigid_forces(&self.params, &self.trajectory, t)
+        rigid_forces(&self.params, &self.attached, &self.trajectory, t)
     }
     fn stiffness(&self) -> [f64; 3] {
         [0.0; 3]

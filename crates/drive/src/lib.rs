@@ -65,6 +65,7 @@ pub fn law_for(exp: &Experiment) -> Result<Option<Box<dyn ActuatorLaw>>, DriveEr
                 rigid_feedforward: d.feedforward.unwrap_or_default() == Feedforward::Rigid,
                 reference: exp.trajectory.clone(),
                 params: exp.robot,
+                attached: flexstar_model::Attachments::of(exp),
             }))
         }
     })
@@ -177,6 +178,7 @@ mod tests {
             rigid_feedforward: true,
             reference: reference.clone(),
             params,
+            attached: Default::default(),
         };
         let t = 0.2;
         let jets = reference.jets(&params, t).unwrap();

@@ -35,6 +35,7 @@ fn forward_dynamics_under_the_rigid_inverse_forces_follows_each_paper_case() {
         let law = RigidInverseForces {
             trajectory: exp.trajectory.clone(),
             params,
+            attached: Default::default(),
         };
         let run = rigid_forward_dynamics(
             &params,
@@ -97,4 +98,70 @@ fn a_run_that_leaves_the_workspace_stops_with_time_and_reason() {
         }
         other => panic!("expected an infeasible stop, got {other}"),
     }
+}
+
+/// Eqs. P7-P8 (Newton-Euler with the sleeve forces, `rigid_inverse_dynamics_with`) against Eq.
+/// P9 (virtual power on the sliders, `rigid_forward_dynamics_with`) with a payload off G (mass,
+/// inertia, offset) and a load with all three components: the inverse forces fed forward give
+/// the motion back (a wrong payload or load term in either would drift by its acceleration
+/// error times t^2/2).
+#[test]
+fn forward_dynamics_with_payload_and_load_follows_the_motion() {
+    use flexstar_model::{Attachments, LoadSettings, Payload};
+    let exp = flexstar_model::catalogue::paper_case(3);
+    let params = exp.robot;
+    let trajectory = flexstar_model::catalogue::quintic_from_origin(flexstar_model::catalogue::GENERAL_TARGET, 0.4);
+    let attached = Attachments {
+        payload: Payload {
+            mass: 0.8,
+            j: 3e-3,
+            offset: [0.04, 0.02],
+        },
+        load: LoadSettings::polynomials(Some(vec![2.0, -3.0]), Some(vec![-1.0, 0.0, 5.0]), Some(vec![0.3, -0.5])),
+    };
+    let jets0 = trajectory.jets(&params, 0.0).unwrap();
+    let law = RigidInverseForces {
+        trajectory: trajectory.clone(),
+        params,
+        attached: attached.clone(),
+    };
+    let run = rigid_forward_dynamics_with(
+        &params,
+        &attached,
+        jets0.map(|j| j.v),
+        jets0.map(|j| j.d1),
+        &law,
+        0.5,
+        1e-3,
+        1e-4,
+    )
+    .unwrap();
+    let worst = run
+        .iter()
+        .map(|r| {
+            let s = trajectory.s(&params, r.t).unwrap();
+            (0..3).map(|i| (r.s[i] - s[i]).abs()).fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-8, "the loaded forward run leaves the motion by {worst:e} m");
+    // and the payload matters: the bare star's forces do not give that motion
+    let bare = RigidInverseForces {
+        trajectory: trajectory.clone(),
+        params,
+        attached: Default::default(),
+    };
+    let run = rigid_forward_dynamics_with(
+        &params,
+        &attached,
+        jets0.map(|j| j.v),
+        jets0.map(|j| j.d1),
+        &bare,
+        0.5,
+        1e-3,
+        1e-4,
+    )
+    .unwrap();
+    let last = run.last().unwrap();
+    let s = trajectory.s(&params, last.t).unwrap();
+    assert!((0..3).any(|i| (last.s[i] - s[i]).abs() > 1e-3), "{:?} vs {s:?}", last.s);
 }

@@ -51,6 +51,7 @@ fn bench(c: &mut Criterion) {
         rigid_feedforward: true,
         reference: exp.trajectory.clone(),
         params: exp.robot,
+        attached: Default::default(),
     };
     g.bench_function("case2_0.4s_300el_direct_servo20hz", |b| {
         b.iter(|| flexstar_fem::solve_direct(&exp, &settings, &servo, None).unwrap())

@@ -157,6 +157,7 @@ fn driven_star_balances_work_and_energy_and_a_stiff_servo_tracks() {
             rigid_feedforward: true,
             reference: exp.trajectory.clone(),
             params: exp.robot,
+            attached: Default::default(),
         };
         let (r, stats) = solve_direct_with_stats(&exp, &coarse(), &servo, None).unwrap();
         let (worst, umax) = energy_defect(&r);
@@ -212,6 +213,7 @@ fn stiff_limit_matches_the_rigid_forward_dynamics() {
         let law = RigidInverseForces {
             trajectory: exp.trajectory.clone(),
             params: robot,
+            attached: Default::default(),
         };
         let settings = FemSettings { dt, ..coarse() };
         let r = solve_direct(&exp, &settings, &law, None).unwrap();

@@ -12,9 +12,18 @@
 //! ```
 //! and for slider i (mass mpp + mpa along u_i), Eq. 33 with `e_wi . u_i = cos(theta)`:
 //! `Fa_i = (mpp + mpa) s_i'' + f_i e_wi . u_i`.
+//!
+//! With a payload welded at G (mass m, inertia J about its centre of mass at `r = ox e_x1 +
+//! oy e_w1` from G) and a load `(F, Mz)` at G (issue 22), Newton for the whole and Euler about G
+//! (`docs/amm.md` 11.1, Eqs. P7-P8):
+//!
+//! ```text
+//! (3 rho L + m) a_G + m (theta'' k x r - theta'^2 r)        = sum_i f_i e_wi + F
+//! (rho L^3 + 3 Jp + J + m |r|^2) theta'' + m (r x a_G)      = sum_i xp_i f_i + Mz
+//! ```
 
 use flexstar_model::geometry::slider_direction;
-use flexstar_model::RobotParams;
+use flexstar_model::{Attachments, RobotParams};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::state::{dot, RigidState};
@@ -28,16 +37,44 @@ pub struct RigidForces {
     pub normal: [f64; 3],
 }
 
-/// Driving forces of the rigid robot (Eq. 33 with a rigid star and `theta_pi = 0`).
+/// Driving forces of the rigid robot (Eq. 33 with a rigid star and `theta_pi = 0`), the paper's
+/// bare star (no payload, no load).
 pub fn rigid_inverse_dynamics(params: &RobotParams, state: &RigidState) -> RigidForces {
-    let ew = [0, 1, 2].map(|i| state.e_w(i));
     let a = state.a_g();
     let m = params.star_mass();
     let j = params.star_inertia() + 3.0 * params.jp;
+    forces_for(params, state, [m * a[0], m * a[1], j * state.theta.d2])
+}
+
+/// Driving forces of the rigid robot carrying `attached`'s payload and load at time `state.t`
+/// (Eqs. P7-P8 and Eq. 33); the bare star's [`rigid_inverse_dynamics`] when there is neither.
+pub fn rigid_inverse_dynamics_with(params: &RobotParams, attached: &Attachments, state: &RigidState) -> RigidForces {
+    if attached.is_none() {
+        return rigid_inverse_dynamics(params, state);
+    }
+    let a = state.a_g();
+    let (th1, th2) = (state.theta.d1, state.theta.d2);
+    let p = &attached.payload;
+    let (ex, ew) = (state.e_x(0), state.e_w(0));
+    // r: the payload's centre of mass from G, fixed frame; k x r a quarter turn of it
+    let r = [0, 1].map(|c| p.offset[0] * ex[c] + p.offset[1] * ew[c]);
+    let kr = [-r[1], r[0]];
+    let [fx, fy, mz] = attached.load.at(state.t);
+    let m = params.star_mass() + p.mass;
+    let j = params.star_inertia() + 3.0 * params.jp + p.inertia_about_g();
+    let newton = |c: usize, f: f64| m * a[c] + p.mass * (th2 * kr[c] - th1 * th1 * r[c]) - f;
+    let euler = j * th2 + p.mass * (r[0] * a[1] - r[1] * a[0]) - mz;
+    forces_for(params, state, [newton(0, fx), newton(1, fy), euler])
+}
+
+/// The sleeves' normal forces that give the star the resultant `rhs = (Fx, Fy, Mz about G)` [N,
+/// N, N m], and the driving forces of Eq. 33 with them.
+fn forces_for(params: &RobotParams, state: &RigidState, rhs: [f64; 3]) -> RigidForces {
+    let ew = [0, 1, 2].map(|i| state.e_w(i));
     let rows = [
-        [ew[0][0], ew[1][0], ew[2][0], m * a[0]],
-        [ew[0][1], ew[1][1], ew[2][1], m * a[1]],
-        [state.xp[0].v, state.xp[1].v, state.xp[2].v, j * state.theta.d2],
+        [ew[0][0], ew[1][0], ew[2][0], rhs[0]],
+        [ew[0][1], ew[1][1], ew[2][1], rhs[1]],
+        [state.xp[0].v, state.xp[1].v, state.xp[2].v, rhs[2]],
     ];
     let normal = solve3(rows);
     let fa = [0, 1, 2].map(|i| params.mpp_mpa * state.s[i].d2 + normal[i] * dot(ew[i], slider_direction(i)));

@@ -24,7 +24,7 @@ pub use feasibility::{
     check_configuration, check_motion, check_trajectory, preflight_step, CheckedMotion, Infeasible, Violation,
 };
 pub use flexstar_model::geometry::inverse_kinematics;
-pub use inverse_dynamics::{rigid_inverse_dynamics, RigidForces};
+pub use inverse_dynamics::{rigid_inverse_dynamics, rigid_inverse_dynamics_with, RigidForces};
 pub use state::RigidState;
 
 /// Errors of the rigid kinematics.

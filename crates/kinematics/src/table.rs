@@ -3,16 +3,16 @@
 use std::path::Path;
 
 use flexstar_model::output::{fmt_number, write_atomically};
-use flexstar_model::{Experiment, RobotParams};
+use flexstar_model::{Attachments, Experiment, RobotParams};
 
 use crate::feasibility::check_trajectory;
-use crate::inverse_dynamics::rigid_inverse_dynamics;
+use crate::inverse_dynamics::rigid_inverse_dynamics_with;
 use crate::state::RigidState;
 use crate::KinematicsError;
 
 /// Column header of `kinematics.csv` (issue contract): the pose and its derivatives, then the
 /// slider velocities `sd_i` [m/s] and accelerations `sdd_i` [m/s^2] and the rigid driving forces
-/// `Fa_i` [N] of [`rigid_inverse_dynamics`] (issue 24). Units: `flexstar_model::response::COLUMN_UNITS`.
+/// `Fa_i` [N] of [`rigid_inverse_dynamics_with`] (issue 24; the payload and load included, issue 22). Units: `flexstar_model::response::COLUMN_UNITS`.
 pub const KINEMATICS_HEADER: [&str; 23] = [
     "t",
     "s1",
@@ -49,9 +49,9 @@ pub fn kinematics_table(exp: &Experiment) -> Result<Vec<RigidState>, KinematicsE
         .collect()
 }
 
-/// One CSV row in the order of [`KINEMATICS_HEADER`] for the robot `params`.
-pub fn row(params: &RobotParams, st: &RigidState) -> [f64; 23] {
-    let fa = rigid_inverse_dynamics(params, st).fa;
+/// One CSV row in the order of [`KINEMATICS_HEADER`] for the robot `params` carrying `attached`.
+pub fn row(params: &RobotParams, attached: &Attachments, st: &RigidState) -> [f64; 23] {
+    let fa = rigid_inverse_dynamics_with(params, attached, st).fa;
     [
         st.t,
         st.s[0].v,
@@ -79,13 +79,18 @@ pub fn row(params: &RobotParams, st: &RigidState) -> [f64; 23] {
     ]
 }
 
-/// Write the table of the robot `params` as CSV, whole or not at all.
-pub fn write_kinematics_csv(path: &Path, params: &RobotParams, states: &[RigidState]) -> Result<(), KinematicsError> {
+/// Write the table of the robot `params` carrying `attached` as CSV, whole or not at all.
+pub fn write_kinematics_csv(
+    path: &Path,
+    params: &RobotParams,
+    attached: &Attachments,
+    states: &[RigidState],
+) -> Result<(), KinematicsError> {
     write_atomically(path, |w| {
         let mut out = csv::Writer::from_writer(w);
         out.write_record(KINEMATICS_HEADER)?;
         for st in states {
-            out.write_record(row(params, st).iter().map(|v| fmt_number(*v)))?;
+            out.write_record(row(params, attached, st).iter().map(|v| fmt_number(*v)))?;
         }
         out.flush()?;
         Ok(())
@@ -108,9 +113,9 @@ mod tests {
         }
         let exp = paper_case(3);
         let st = RigidState::at(&exp.robot, &exp.trajectory, 0.25).unwrap();
-        let r = row(&exp.robot, &st);
+        let r = row(&exp.robot, &Attachments::default(), &st);
         let col = |name: &str| r[KINEMATICS_HEADER.iter().position(|c| *c == name).unwrap()];
-        let f = rigid_inverse_dynamics(&exp.robot, &st);
+        let f = crate::rigid_inverse_dynamics(&exp.robot, &st);
         for i in 0..3 {
             assert_eq!(col(&format!("Fa{}", i + 1)), f.fa[i]);
             assert_eq!(col(&format!("sd{}", i + 1)), st.s[i].d1);

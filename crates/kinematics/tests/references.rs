@@ -254,6 +254,65 @@ fn rigid_inverse_dynamics_balances_power() {
     }
 }
 
+/// Eqs. P7-P8 against the power balance of the loaded robot: the drivers' power plus the load's
+/// (`F . v_G + Mz theta'`) is the rate of the kinetic energy of star, sleeves, sliders and the
+/// payload (`1/2 m |v_G + theta' k x r|^2 + 1/2 J theta'^2`, r the offset turned with the star),
+/// an identity Newton-Euler does not use.
+#[test]
+fn rigid_inverse_dynamics_with_payload_and_load_balances_power() {
+    use flexstar_model::{Attachments, LoadSettings, Payload};
+    let p = paper();
+    let attached = Attachments {
+        payload: Payload {
+            mass: 0.7,
+            j: 2e-3,
+            offset: [0.03, -0.02],
+        },
+        load: LoadSettings::polynomials(Some(vec![1.5, -2.0]), Some(vec![-0.5, 0.0, 4.0]), Some(vec![0.2, 0.1])),
+    };
+    let tr = Trajectory::Quintic {
+        from: Pose {
+            gx: 0.0,
+            gy: 0.0,
+            theta: 0.0,
+        },
+        to: Pose {
+            gx: 0.03,
+            gy: -0.02,
+            theta: 0.3,
+        },
+        t0: 0.0,
+        t1: 0.5,
+    };
+    for t in [0.1, 0.25, 0.4] {
+        let st = RigidState::at(&p, &tr, t).unwrap();
+        let f = flexstar_kinematics::rigid_inverse_dynamics_with(&p, &attached, &st);
+        let [fx, fy, mz] = attached.load.at(t);
+        let (w, wd) = (st.theta.d1, st.theta.d2);
+        let power: f64 = (0..3).map(|i| f.fa[i] * st.s[i].d1).sum::<f64>() + fx * st.g[0].d1 + fy * st.g[1].d1 + mz * w;
+        let o = attached.payload.offset;
+        let (ex, ew) = (st.e_x(0), st.e_w(0));
+        let r = [0, 1].map(|k| o[0] * ex[k] + o[1] * ew[k]);
+        let kr = [-r[1], r[0]];
+        let vc = [st.g[0].d1 + w * kr[0], st.g[1].d1 + w * kr[1]];
+        let ac = [0, 1].map(|k| st.g[k].d2 + wd * kr[k] - w * w * r[k]);
+        let (m, j) = (attached.payload.mass, attached.payload.j);
+        let dtdt = p.star_mass() * (st.g[0].d1 * st.g[0].d2 + st.g[1].d1 * st.g[1].d2)
+            + (p.star_inertia() + 3.0 * p.jp) * w * wd
+            + p.mpp_mpa * (0..3).map(|i| st.s[i].d1 * st.s[i].d2).sum::<f64>()
+            + m * (vc[0] * ac[0] + vc[1] * ac[1])
+            + j * w * wd;
+        assert!(
+            (power - dtdt).abs() < 1e-10 * (1.0 + dtdt.abs()),
+            "t={t}: {power} vs {dtdt}"
+        );
+    }
+    // no payload and no load: the bare star's forces, bit for bit
+    let st = RigidState::at(&p, &tr, 0.25).unwrap();
+    let bare = flexstar_kinematics::rigid_inverse_dynamics_with(&p, &Attachments::default(), &st);
+    assert_eq!(bare, rigid_inverse_dynamics(&p, &st));
+}
+
 #[test]
 fn slider_force_direction_is_cos_theta() {
     // Eq. 33 uses cos(theta + theta_p): e_wi . u_i = cos(theta) for every beam.

@@ -23,7 +23,7 @@ pub mod run_set;
 pub mod trajectory;
 pub mod validity;
 
-pub use attachments::{Damping, LoadSettings, Payload};
+pub use attachments::{Attachments, Damping, LoadSettings, Payload};
 pub use cancel::Cancel;
 pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, ModeFamily, TimeSpan};
 pub use drive::{DriveKind, DriveSettings, Feedforward, ForceSamples};

@@ -612,3 +612,60 @@ fn the_modal_commands_have_help() {
         assert!(String::from_utf8_lossy(&o.stdout).contains("Usage"), "{sub}");
     }
 }
+
+/// Issue 22 through the commands: with `[damping]` `modal.csv` gains `zeta_amm,zeta_fem` after
+/// today's columns (`beta omega / 2` of each model's frequency, here zeta = 0.01 at 4 Hz), the
+/// sidecar records the sections, and the payload lowers the frequencies; with `[load]` the linear
+/// model's inputs end with `Fx`, `Fy`, `Mz`, B gaining three columns, and `statespace.json`
+/// records the damping. A bad section is refused naming the file and key, with nothing written.
+#[test]
+fn payload_damping_and_load_reach_modal_and_linearize() {
+    let (dir, cfg, out) = small_case();
+    let out_s = out.to_str().unwrap();
+    let base = std::fs::read_to_string(&cfg).unwrap();
+    let attached = base.replace("name = \"small\"", "name = \"loaded\"")
+        + "[payload]\nmass = 0.3\nJ = 1e-3\n[damping]\nzeta = 0.01\nf_hz = 4.0\n[load]\nFx = [0.0]\n";
+    let cfg2 = dir.path().join("loaded.toml");
+    std::fs::write(&cfg2, attached).unwrap();
+    let cfg2 = cfg2.to_str().unwrap();
+    for c in [cfg.as_str(), cfg2] {
+        let o = flexstar(&["modal", c, "--pose", "0,0,0", "--modes", "3", "--out", out_s]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let (h0, bare) = rows(&out.join("small").join("modal.csv"));
+    let (h, damped) = rows(&out.join("loaded").join("modal.csv"));
+    assert_eq!(h0, "mode,f_amm_hz,f_fem_hz,rel_diff");
+    assert_eq!(h, "mode,f_amm_hz,f_fem_hz,rel_diff,zeta_amm,zeta_fem");
+    for (r, r0) in damped.iter().zip(&bare) {
+        let (fa, ff) = (num(&r[1]), num(&r[2]));
+        assert!((num(&r[4]) - 0.01 * fa / 4.0).abs() < 1e-12, "{r:?}");
+        assert!((num(&r[5]) - 0.01 * ff / 4.0).abs() < 1e-12, "{r:?}");
+        assert!(fa < num(&r0[1]), "the payload lowers f: {r:?} vs {r0:?}");
+    }
+    let sidecar = json(&out.join("loaded").join("modal.json"));
+    assert_eq!(sidecar["experiment"]["payload"]["mass"], 0.3);
+    assert_eq!(sidecar["experiment"]["damping"]["zeta"], 0.01);
+    assert!(sidecar["experiment"]["load"]["Fx"].is_array(), "{sidecar}");
+    let (lin0, j0) = linearize_with(&cfg, "small", &out, &["--modes", "4"]);
+    let (lin, j) = linearize_with(cfg2, "loaded", &out, &["--modes", "4"]);
+    let inputs = names(&j, "inputs");
+    assert_eq!(inputs[inputs.len() - 3..], ["Fx", "Fy", "Mz"]);
+    assert_eq!(inputs.len(), names(&j0, "inputs").len() + 3);
+    assert_eq!(mtx_size(&lin.join("B.mtx")).1, mtx_size(&lin0.join("B.mtx")).1 + 3);
+    assert!((j["damping"]["beta_s"].as_f64().unwrap() - 0.01 / (std::f64::consts::PI * 4.0)).abs() < 1e-15);
+    assert!(j0["damping"].is_null());
+    // bad sections: refused before any output
+    for (extra, key) in [
+        ("[damping]\nbeta = 1e-3\nzeta = 0.01\n", "damping.zeta"),
+        ("[payload]\nmass = -1.0\n", "payload.mass"),
+        ("[load]\nfile = \"missing.csv\"\n", "load.file"),
+    ] {
+        let bad = dir.path().join("bad.toml");
+        std::fs::write(&bad, base.replace("name = \"small\"", "name = \"bad\"") + extra).unwrap();
+        let o = flexstar(&["modal", bad.to_str().unwrap(), "--pose", "0,0,0", "--out", out_s]);
+        assert!(!o.status.success());
+        let e = stderr(&o);
+        assert!(e.contains("bad.toml") && e.contains(key), "{extra}: {e}");
+        assert!(files_in(&out.join("bad")).is_empty());
+    }
+}

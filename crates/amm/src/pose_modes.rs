@@ -18,10 +18,16 @@
 //! moves by `ds_i u_i`, whose normal component `ds_i (u_i . e_wi) = ds_i cos(theta)` enters the
 //! sleeve rows of Eqs. 41-42 (`w_i(xp_i + e) - e thp_i - ds_i cos(theta) = 0`); its axial component
 //! slides the sleeve along the beam, which is free at rest.
+//!
+//! A payload at G (issue 22) adds its rigid-body mass matrix about G, `P^T M_p P` (Eqs. P1-P2, at
+//! rest only `M_p` remains), to beam 1's block: M is then no longer diagonal and the modes come
+//! from the general constrained solver. The damping matrix at rest is `beta K` (Eq. D2, the
+//! beams' elastic stiffness) and the load enters through the junction rows of Eq. L1
+//! ([`PoseSystem::load_columns`]).
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
-use flexstar_model::{AmmModel, ModeFamily, RestPose, RobotParams, Sliders};
+use flexstar_model::{AmmModel, ModeFamily, Payload, RestPose, RobotParams, Sliders};
 use flexstar_numerics::eigen::{constrained_modes, rigid_shift};
 
 use crate::error::AmmError;
@@ -56,9 +62,46 @@ pub struct PoseSystem {
     pub sliders: Sliders,
     /// The mode set of the beams.
     pub modes: ModeSet,
+    /// Orientation of the pose theta [rad] (the frame of the junction rows).
+    pub theta: f64,
+    /// The payload welded at G (in M; none: the paper's massless G).
+    pub payload: Payload,
 }
 
 impl PoseSystem {
+    /// The junction rows of Eq. P1 on q: beam 1's `u_1`, `w_1(0) = phi(0) . alpha_1` and
+    /// `w_1'(0) = phi'(0) . alpha_1` (the elastic displacement of G along `e_x1`, `e_w1` [m] and
+    /// the rotation of the weld [rad], in the pose's frame).
+    pub fn junction_rows(&self) -> [Vec<f64>; 3] {
+        let mut rows = [vec![0.0; self.n], vec![0.0; self.n], vec![0.0; self.n]];
+        rows[0][self.nm] = 1.0;
+        for j in 0..self.nm {
+            let v = self.modes.eval(j, 0.0);
+            rows[1][j] = v[0];
+            rows[2][j] = v[1];
+        }
+        rows
+    }
+
+    /// Generalized forces on q of a unit `Fx`, `Fy` [N] (fixed frame) and `Mz` [N m] at G (Eq. L1
+    /// at the pose, the load columns `P_L` of Eq. L4 in docs/modes.md).
+    pub fn load_columns(&self) -> [Vec<f64>; 3] {
+        let [u, w, psi] = self.junction_rows();
+        let (ex, ew) = (
+            flexstar_model::geometry::e_x(0, self.theta),
+            flexstar_model::geometry::e_w(0, self.theta),
+        );
+        let force = |c: usize| -> Vec<f64> { u.iter().zip(&w).map(|(a, b)| ex[c] * a + ew[c] * b).collect() };
+        [force(0), force(1), psi]
+    }
+
+    /// The damping matrix at rest [N s/m] (n x n, row-major) of Kelvin-Voigt damping of
+    /// retardation time `beta` [s]: `beta rho lambda_j` on the alpha coordinates (Eq. D2), i.e.
+    /// `beta K` (the beams' elastic stiffness is the only stiffness at rest).
+    pub fn damping_matrix(&self, beta: f64) -> Vec<f64> {
+        self.k.iter().map(|k| beta * k).collect()
+    }
+
     /// Index of the first coordinate of beam i (its alpha block).
     pub fn beam_offset(&self, i: usize) -> usize {
         i * (self.nm + 2)
@@ -96,6 +139,7 @@ pub type PoseModes = flexstar_numerics::eigen::PoseModes<PoseSystem>;
 #[derive(Debug, Clone)]
 pub struct PoseModel {
     params: RobotParams,
+    payload: Payload,
     sys: System,
 }
 
@@ -107,7 +151,23 @@ impl PoseModel {
         // At rest the full model's extra terms vanish (module docs): its constraint rows equal the
         // paper model's, so the system is built without the axial-inertia matrices it never uses.
         let sys = System::new(modes, params, AmmModel::Paper);
-        Ok(PoseModel { params: *params, sys })
+        Ok(PoseModel {
+            params: *params,
+            payload: Payload::default(),
+            sys,
+        })
+    }
+
+    /// [`PoseModel::new`] for the robot carrying `payload` at G (issue 22).
+    pub fn with_payload(
+        params: &RobotParams,
+        payload: &Payload,
+        family: ModeFamily,
+        nm: usize,
+    ) -> Result<Self, AmmError> {
+        let mut model = Self::new(params, family, nm)?;
+        model.payload = *payload;
+        Ok(model)
     }
 
     /// The mode set of the beams.
@@ -154,7 +214,7 @@ impl PoseModel {
                 }
             }
         }
-        PoseSystem {
+        let mut system = PoseSystem {
             n,
             nm,
             m,
@@ -163,7 +223,13 @@ impl PoseModel {
             rows,
             sliders,
             modes,
+            theta: pose.theta,
+            payload: self.payload,
+        };
+        if !self.payload.is_none() {
+            add_payload_mass(&mut system);
         }
+        system
     }
 
     /// The first `count` natural frequencies [Hz] at `pose`, values only (the per-point work of a
@@ -179,6 +245,10 @@ impl PoseModel {
     /// the paper robot's f1 at N = 60). Checked against [`PoseModel::modes_at`] (test
     /// `frequencies_only_match_the_full_solver`).
     pub fn frequencies_at(&self, pose: &RestPose, sliders: Sliders, count: usize) -> Result<Vec<f64>, AmmError> {
+        if !self.payload.is_none() {
+            // M is not diagonal with a payload: the general solver
+            return Ok(self.modes_at(pose, sliders, count)?.freq_hz);
+        }
         let sys = self.system_at(pose, sliders);
         let proj = Projected::new(&sys)?;
         let rigid = if sliders == Sliders::Free { 3 } else { 0 };
@@ -200,7 +270,7 @@ impl PoseModel {
     /// sends the pose to the general constrained solver, which the sliders-free case always uses.
     pub fn modes_at(&self, pose: &RestPose, sliders: Sliders, count: usize) -> Result<PoseModes, AmmError> {
         let sys = self.system_at(pose, sliders);
-        if sliders == Sliders::Locked {
+        if sliders == Sliders::Locked && self.payload.is_none() {
             let proj = Projected::new(&sys)?;
             let omega2: Vec<f64> = proj.w.iter().skip(proj.r).take(count).copied().collect();
             if let Some(shapes) = proj.shapes(&omega2) {
@@ -208,6 +278,32 @@ impl PoseModel {
             }
         }
         solve_modes(sys, count)
+    }
+}
+
+/// Add the payload's mass matrix about G, `P^T M_p P` (Eq. P2 on the junction rows of Eq. P1),
+/// to beam 1's block of M.
+fn add_payload_mass(sys: &mut PoseSystem) {
+    let p = sys.payload;
+    let (m, [ox, oy]) = (p.mass, p.offset);
+    let mp = [
+        [m, 0.0, -m * oy],
+        [0.0, m, m * ox],
+        [-m * oy, m * ox, p.inertia_about_g()],
+    ];
+    let rows = sys.junction_rows();
+    let n = sys.n;
+    let beam1 = 0..sys.nm + 2;
+    for a in beam1.clone() {
+        for b in beam1.clone() {
+            let mut v = 0.0;
+            for (r, row) in rows.iter().enumerate() {
+                for (c, col) in rows.iter().enumerate() {
+                    v += row[a] * mp[r][c] * col[b];
+                }
+            }
+            sys.m[a * n + b] += v;
+        }
     }
 }
 

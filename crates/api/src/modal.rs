@@ -188,15 +188,20 @@ pub fn pose_text(pose: &RestPose, sliders: Sliders) -> String {
 }
 
 /// One line per mode of a modal analysis: `mode  1: AMM   123.4567 Hz  FEM   123.4000 Hz    +0.046 %`
-/// (no negative zeros).
+/// (no negative zeros); with damping the AMM's ratio follows (`  zeta 0.01234`).
 pub fn mode_lines(m: &Modal) -> Vec<String> {
+    let zetas = m.damping_ratios();
     m.rows()
         .into_iter()
-        .map(|(mode, a, f, rel)| {
+        .enumerate()
+        .map(|(j, (mode, a, f, rel))| {
             let pct = fmt_fixed(100.0 * rel, 3);
             let pct = if pct.starts_with('-') { pct } else { format!("+{pct}") };
+            let zeta = zetas
+                .as_ref()
+                .map_or(String::new(), |z| format!("  zeta {}", fmt_fixed(z[j].0, 5)));
             format!(
-                "mode {mode:>2}: AMM {:>10} Hz  FEM {:>10} Hz  {pct:>8} %",
+                "mode {mode:>2}: AMM {:>10} Hz  FEM {:>10} Hz  {pct:>8} %{zeta}",
                 fmt_fixed(a, 4),
                 fmt_fixed(f, 4)
             )

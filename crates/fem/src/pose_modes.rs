@@ -9,8 +9,8 @@
 //! sliders, slider i adds the coordinate `s_i` (mass `mpp_mpa`) and the pin rows of sleeve i
 //! read `r_i(xi) - P_i(s_i) + ... = 0` with `dP_i/ds_i = u_i` (Eqs. 1-3).
 
-use flexstar_model::geometry::{e_w, slider_direction};
-use flexstar_model::{RestPose, RobotParams, Sliders};
+use flexstar_model::geometry::{e_w, e_x, slider_direction};
+use flexstar_model::{Payload, RestPose, RobotParams, Sliders};
 use flexstar_numerics::eigen::{constrained_modes, rigid_shift, ConstrainedModes};
 
 use crate::element::ElementState;
@@ -211,6 +211,13 @@ pub struct SparsePoseSystem {
 impl SparsePoseSystem {
     coordinate_helpers!();
 
+    /// The damping matrix at rest of Kelvin-Voigt damping of retardation time `beta` [s], as
+    /// triplets: the element's `df/dq' = beta K_mat` (Eq. D8), which at the unstressed rest pose
+    /// is `beta K` (no geometric part).
+    pub fn damping_triplets(&self, beta: f64) -> Triplets {
+        self.k.iter().map(|&(r, c, v)| (r, c, beta * v)).collect()
+    }
+
     /// The dense system (entries summed in assembly order, so identical to assembling densely).
     pub fn to_dense(&self) -> PoseSystem {
         let n = self.n;
@@ -245,9 +252,32 @@ pub fn pose_system(
     Ok(pose_triplets(params, pose, sliders, elements)?.to_dense())
 }
 
+/// [`pose_system`] of the robot carrying `payload` at G (issue 22).
+pub fn pose_system_with(
+    params: &RobotParams,
+    payload: &Payload,
+    pose: &RestPose,
+    sliders: Sliders,
+    elements: usize,
+) -> Result<PoseSystem, FemError> {
+    Ok(pose_triplets_with(params, payload, pose, sliders, elements)?.to_dense())
+}
+
 /// Assemble M, K and Phi_q at `pose` with `elements` elements in the whole star, as triplets.
 pub fn pose_triplets(
     params: &RobotParams,
+    pose: &RestPose,
+    sliders: Sliders,
+    elements: usize,
+) -> Result<SparsePoseSystem, FemError> {
+    pose_triplets_with(params, &Payload::default(), pose, sliders, elements)
+}
+
+/// [`pose_triplets`] of the robot carrying `payload` at G: its mass matrix about G, `M_p` of
+/// Eq. P11 at rest (`phi = 0`, the offset turned by the pose's theta), on node G.
+pub fn pose_triplets_with(
+    params: &RobotParams,
+    payload: &Payload,
     pose: &RestPose,
     sliders: Sliders,
     elements: usize,
@@ -277,6 +307,9 @@ pub fn pose_triplets(
     let (mut m, k) = element_triplets(params, &star, &states);
     let rows = 3 * ROWS;
     let c = constraint_triplets(params, &star, &states, &q, pose, sliders, &mut m);
+    if !payload.is_none() {
+        m.extend(payload_triplets(payload, pose.theta));
+    }
     Ok(SparsePoseSystem {
         n,
         ne,
@@ -288,6 +321,25 @@ pub fn pose_triplets(
         theta: pose.theta,
         h: star.h,
     })
+}
+
+/// The payload's mass matrix about G on node G's `(x, y, phi)` (Eq. P11 at `phi = 0`): `m` on
+/// x and y, `-m c_y`, `m c_x` coupling them to phi, `J + m |c|^2` on phi, with `c` the offset in
+/// the fixed frame at the orientation `theta` [rad].
+fn payload_triplets(payload: &Payload, theta: f64) -> Triplets {
+    let (ex, ew) = (e_x(0, theta), e_w(0, theta));
+    let [ox, oy] = payload.offset;
+    let c = [ox * ex[0] + oy * ew[0], ox * ex[1] + oy * ew[1]];
+    let m = payload.mass;
+    vec![
+        (0, 0, m),
+        (1, 1, m),
+        (0, 2, -m * c[1]),
+        (2, 0, -m * c[1]),
+        (1, 2, m * c[0]),
+        (2, 1, m * c[0]),
+        (2, 2, payload.inertia_about_g()),
+    ]
 }
 
 /// The elements' mass and tangent stiffness at the pose (unstressed: the rest pose), as triplets.
@@ -360,7 +412,19 @@ pub fn pose_modes(
     elements: usize,
     count: usize,
 ) -> Result<PoseModes, FemError> {
-    let sparse = pose_triplets(params, pose, sliders, elements)?;
+    pose_modes_with(params, &Payload::default(), pose, sliders, elements, count)
+}
+
+/// [`pose_modes`] of the robot carrying `payload` at G (issue 22).
+pub fn pose_modes_with(
+    params: &RobotParams,
+    payload: &Payload,
+    pose: &RestPose,
+    sliders: Sliders,
+    elements: usize,
+    count: usize,
+) -> Result<PoseModes, FemError> {
+    let sparse = pose_triplets_with(params, payload, pose, sliders, elements)?;
     let rigid = if sliders == Sliders::Free { 3 } else { 0 };
     let out = sparse_constrained_modes(
         sparse.n,

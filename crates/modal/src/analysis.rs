@@ -10,6 +10,10 @@ use crate::ModalError;
 /// Header of `modal.csv` (issue 11, exactly).
 pub const MODAL_HEADER: &str = "mode,f_amm_hz,f_fem_hz,rel_diff";
 
+/// The columns `modal.csv` gains after [`MODAL_HEADER`] when the experiment has a `[damping]`
+/// section (issue 22): each model's damping ratio of the mode, `beta omega_k / 2` (Eq. D11).
+pub const DAMPING_COLUMNS: &str = "zeta_amm,zeta_fem";
+
 /// The AMM basis of the modal analyses: always the accurate one (issue 9's enriched family),
 /// whatever family `[amm]` asks for the time-domain runs (the paper's families miss the modes
 /// badly at some poses: pinned-free puts f1 79 % above the FEM at case 4's end pose). N per beam:
@@ -23,6 +27,35 @@ pub fn amm_basis(exp: &Experiment) -> (ModeFamily, usize) {
     (ModeFamily::Enriched, n)
 }
 
+/// The AMM's model at a pose for an experiment: the basis of [`amm_basis`] and the experiment's
+/// payload at G (issue 22).
+pub fn amm_pose_model(exp: &Experiment) -> Result<flexstar_amm::pose_modes::PoseModel, ModalError> {
+    let (family, nm) = amm_basis(exp);
+    Ok(flexstar_amm::pose_modes::PoseModel::with_payload(
+        &exp.robot,
+        &exp.payload,
+        family,
+        nm,
+    )?)
+}
+
+/// The FEM's modes at a pose for an experiment (`[fem] elements`, the payload at G).
+pub fn fem_pose_modes(
+    exp: &Experiment,
+    pose: &RestPose,
+    sliders: Sliders,
+    k: usize,
+) -> Result<flexstar_fem::pose_modes::PoseModes, ModalError> {
+    Ok(flexstar_fem::pose_modes::pose_modes_with(
+        &exp.robot,
+        &exp.payload,
+        pose,
+        sliders,
+        exp.fem.elements,
+        k,
+    )?)
+}
+
 /// Modes per beam of the AMM for an experiment (see [`amm_basis`]).
 pub fn amm_modes_per_beam(exp: &Experiment) -> usize {
     amm_basis(exp).1
@@ -34,6 +67,9 @@ pub struct Modal {
     pub fem: flexstar_fem::pose_modes::PoseModes,
     /// K requested (elastic modes); the rigid ones come first when the sliders are free.
     pub k: usize,
+    /// Kelvin-Voigt retardation time beta [s] when the experiment has a `[damping]` section
+    /// (`None`: no damping columns).
+    pub beta: Option<f64>,
 }
 
 impl Modal {
@@ -56,9 +92,8 @@ impl Modal {
 /// sliders are free.
 pub fn modal(exp: &Experiment, pose: &RestPose, sliders: Sliders, k: usize) -> Result<Modal, ModalError> {
     crate::check_k(k)?;
-    let amm =
-        flexstar_amm::pose_modes::pose_modes(&exp.robot, pose, sliders, amm_basis(exp).0, amm_modes_per_beam(exp), k)?;
-    let fem = flexstar_fem::pose_modes::pose_modes(&exp.robot, pose, sliders, exp.fem.elements, k)?;
+    let amm = amm_pose_model(exp)?.modes_at(pose, sliders, k)?;
+    let fem = fem_pose_modes(exp, pose, sliders, k)?;
     if amm.freq_hz.len() < amm.rigid + k {
         return Err(ModalError::Input(format!(
             "--modes {k}: the AMM with N = {} modes per beam has only {} modes",
@@ -66,15 +101,37 @@ pub fn modal(exp: &Experiment, pose: &RestPose, sliders: Sliders, k: usize) -> R
             amm.freq_hz.len() - amm.rigid
         )));
     }
-    Ok(Modal { amm, fem, k })
+    let beta = (exp.damping != flexstar_model::Damping::default()).then(|| exp.damping.beta());
+    Ok(Modal { amm, fem, k, beta })
+}
+
+impl Modal {
+    /// The damping ratios `(zeta_amm, zeta_fem)` of the rows of [`Modal::rows`]: `beta omega_k
+    /// / 2` of each model's own frequency (Eq. D11: at rest the damping matrix is `beta K` in both
+    /// models, so the undamped modes diagonalize it; 0 for the rigid modes); `None` without a
+    /// `[damping]` section.
+    pub fn damping_ratios(&self) -> Option<Vec<(f64, f64)>> {
+        let beta = self.beta?;
+        let zeta = |f: f64| beta * std::f64::consts::PI * f;
+        Some(self.rows().iter().map(|&(_, a, f, _)| (zeta(a), zeta(f))).collect())
+    }
 }
 
 /// Write `modal.csv` (whole or not at all) to `dest`: a file of its own or a file of a run set.
+/// With damping the columns [`DAMPING_COLUMNS`] follow today's.
 pub fn write_modal_csv(dest: Dest<'_>, modal: &Modal) -> Result<(), ModalError> {
+    let zetas = modal.damping_ratios();
     dest.write(|w| {
-        writeln!(w, "{MODAL_HEADER}")?;
-        for (m, a, f, r) in modal.rows() {
-            writeln!(w, "{m},{},{},{}", fmt_number(a), fmt_number(f), fmt_number(r))?;
+        match zetas {
+            Some(_) => writeln!(w, "{MODAL_HEADER},{DAMPING_COLUMNS}")?,
+            None => writeln!(w, "{MODAL_HEADER}")?,
+        }
+        for (j, (m, a, f, r)) in modal.rows().into_iter().enumerate() {
+            write!(w, "{m},{},{},{}", fmt_number(a), fmt_number(f), fmt_number(r))?;
+            if let Some(z) = &zetas {
+                write!(w, ",{},{}", fmt_number(z[j].0), fmt_number(z[j].1))?;
+            }
+            writeln!(w)?;
         }
         Ok(())
     })?;

@@ -8,7 +8,6 @@ use flexstar_model::run_set::RunSet;
 use flexstar_model::{Experiment, Sliders};
 use rayon::prelude::*;
 
-use crate::analysis::amm_modes_per_beam;
 use crate::pose::pose_from_task;
 use crate::ModalError;
 
@@ -106,11 +105,7 @@ where
     let total = gx.n * gy.n;
     // the AMM's pose-independent part (mode set, constraint machinery) once per map
     let amm = match solver {
-        Solver::Amm => Some(PoseModel::new(
-            &exp.robot,
-            crate::analysis::amm_basis(exp).0,
-            amm_modes_per_beam(exp),
-        )?),
+        Solver::Amm => Some(crate::analysis::amm_pose_model(exp)?),
         Solver::Fem => None,
     };
     let done = AtomicUsize::new(0);
@@ -145,7 +140,7 @@ fn point(
         // eigenvalues only (no shapes): a third of the cost of `modes_at`, equal to 1e-7
         Some(model) => model.frequencies_at(&pose, sliders, k).map_err(|e| e.to_string())?,
         None => {
-            flexstar_fem::pose_modes::pose_modes(&exp.robot, &pose, sliders, exp.fem.elements, k)
+            crate::analysis::fem_pose_modes(exp, &pose, sliders, k)
                 .map_err(|e| e.to_string())?
                 .freq_hz
         }

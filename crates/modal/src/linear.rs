@@ -25,6 +25,12 @@
 //!   `sd1ref..sd3ref` [m/s] and the feedforward forces `ff1..ff3` [N] (`B = [0; kp S^T, kd S^T,
 //!   S^T]`); outputs those of the free model and the tracking errors `e1..e3 = s_ref - s` [m]
 //!   (`D` = 1 from `s_iref`).
+//!
+//! Issue 22: the payload is in M (so in the shapes and Omega); Kelvin-Voigt damping adds
+//! `Phi^T (beta K) Phi = beta Omega^2` to the velocity block, `A = [[0, I], [-Omega^2,
+//! -beta Omega^2]]` (Eq. D13; with the servo's `-kd S^T S` besides); with a `[load]` section the
+//! inputs end with the load at G, `Fx`, `Fy` [N] and `Mz` [N m], `B_load = [0; Phi^T P_L]`
+//! (Eq. L4, `P_L` the junction rows of Eq. L1 at the pose), D gaining zero columns.
 
 use std::path::Path;
 
@@ -236,8 +242,7 @@ fn inverse3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
 /// `R_j = dq/ds_j` is the rigid motion of the star when slider j moves, from the three rigid
 /// modes of the sliders-free system (their beam part times the inverse of their slider part).
 fn base_excitation(exp: &Experiment, pose: &RestPose, locked: &PoseSystem) -> Result<Vec<[f64; 3]>, ModalError> {
-    let (family, nm) = crate::analysis::amm_basis(exp);
-    let free = flexstar_amm::pose_modes::pose_modes(&exp.robot, pose, Sliders::Free, family, nm, 1)?;
+    let free = crate::analysis::amm_pose_model(exp)?.modes_at(pose, Sliders::Free, 1)?;
     let rigid = &free.shapes[..free.rigid];
     let mut s = [[0.0; 3]; 3];
     for (i, row) in s.iter_mut().enumerate() {
@@ -261,9 +266,7 @@ fn base_excitation(exp: &Experiment, pose: &RestPose, locked: &PoseSystem) -> Re
 /// The AMM's modes at the pose for `settings` (K checked, enough modes in the basis).
 fn amm_modes(exp: &Experiment, pose: &RestPose, settings: &LinearSettings) -> Result<PoseModes, ModalError> {
     crate::check_k(settings.modes)?;
-    let (family, nm) = crate::analysis::amm_basis(exp);
-    let modes =
-        flexstar_amm::pose_modes::pose_modes(&exp.robot, pose, settings.holding.sliders(), family, nm, settings.modes)?;
+    let modes = crate::analysis::amm_pose_model(exp)?.modes_at(pose, settings.holding.sliders(), settings.modes)?;
     if modes.shapes.len() < modes.rigid + settings.modes {
         return Err(ModalError::Input(format!(
             "--modes {}: the AMM with N = {} modes per beam has only {} modes",
@@ -280,6 +283,8 @@ fn amm_modes(exp: &Experiment, pose: &RestPose, settings: &LinearSettings) -> Re
 /// block of B), `cq` (ny x nr, the left block of C) and D (ny x nu, dense).
 struct Blocks {
     omega2: Vec<f64>,
+    /// `Phi^T C Phi` (nr x nr) of the material damping (Eq. D13); `None` without damping.
+    damping: Option<Vec<Vec<f64>>>,
     feedback: Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)>,
     bm: Vec<Vec<f64>>,
     cq: Vec<Vec<f64>>,
@@ -293,19 +298,20 @@ impl Blocks {
         let (nu, ny) = (self.d.first().map_or(0, Vec::len), self.cq.len());
         let a = dense_to_cs(n, n, |r, c| {
             if r < nr {
-                f64::from(u8::from(c == r + nr))
-            } else if let Some((k, d)) = &self.feedback {
-                let (k, d) = (&k[r - nr], &d[r - nr]);
-                let diag = if c == r - nr { -self.omega2[c] } else { 0.0 };
-                if c < nr {
-                    diag - k[c]
-                } else {
-                    -d[c - nr]
-                }
-            } else if c == r - nr {
-                -self.omega2[c]
+                return f64::from(u8::from(c == r + nr));
+            }
+            let k = r - nr;
+            if c < nr {
+                let diag = if c == k { -self.omega2[c] } else { 0.0 };
+                self.feedback.as_ref().map_or(diag, |(kp, _)| diag - kp[k][c])
             } else {
-                0.0
+                let material = self.damping.as_ref().map_or(0.0, |d| d[k][c - nr]);
+                let servo = self.feedback.as_ref().map_or(0.0, |(_, kd)| kd[k][c - nr]);
+                if material == 0.0 && servo == 0.0 {
+                    0.0
+                } else {
+                    -material - servo
+                }
             }
         });
         let b = dense_to_cs(n, nu, |r, c| if r < nr { 0.0 } else { self.bm[r - nr][c] });
@@ -330,11 +336,12 @@ pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettin
         .iter()
         .map(|r| phi.iter().map(|p| dot(r, p)).collect())
         .collect();
-    let (blocks, inputs, outputs) = match settings.holding {
+    let (mut blocks, mut inputs, outputs) = match settings.holding {
         Holding::Locked => locked_model(exp, pose, &modes, deflections)?,
         Holding::Free => free_model(&modes, deflections),
         Holding::Servo { kp, kd } => servo_model(&modes, deflections, kp, kd),
     };
+    add_damping_and_load(exp, &modes, &mut blocks, &mut inputs);
     let [a, b, c, d] = blocks.matrices();
     let nr = phi.len();
     let mut states: Vec<Signal> = (1..=nr)
@@ -359,6 +366,38 @@ pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettin
         inputs,
         outputs,
     })
+}
+
+/// The material damping on the modal coordinates, `Phi^T C Phi` with the AMM's damping matrix
+/// at rest (Eq. D13), when the experiment has a `[damping]` section; and the load channel
+/// `Phi^T P_L` (Eq. L4: inputs `Fx`, `Fy`, `Mz` after the others, zero columns of D) when it has a
+/// `[load]` section.
+fn add_damping_and_load(exp: &Experiment, modes: &PoseModes, blocks: &mut Blocks, inputs: &mut Vec<Signal>) {
+    let sys = &modes.system;
+    let phi = &modes.shapes;
+    if exp.damping != flexstar_model::Damping::default() {
+        let (n, c) = (sys.n, sys.damping_matrix(exp.damping.beta()));
+        let c_phi: Vec<Vec<f64>> = phi
+            .iter()
+            .map(|p| (0..n).map(|a| dot(&c[a * n..(a + 1) * n], p)).collect())
+            .collect();
+        blocks.damping = Some(
+            phi.iter()
+                .map(|pk| c_phi.iter().map(|cp| dot(pk, cp)).collect())
+                .collect(),
+        );
+    }
+    if !exp.load.is_none() {
+        let columns = sys.load_columns();
+        for (row, p) in blocks.bm.iter_mut().zip(phi) {
+            row.extend(columns.iter().map(|col| dot(p, col)));
+        }
+        for row in &mut blocks.d {
+            row.extend([0.0; 3]);
+        }
+        inputs.extend(signals(&["Fx", "Fy"], "N"));
+        inputs.extend(signals(&["Mz"], "N m"));
+    }
 }
 
 /// Blocks, inputs and outputs of one model.
@@ -388,6 +427,7 @@ fn locked_model(
         .collect();
     let blocks = Blocks {
         omega2: modes.omega2.clone(),
+        damping: None,
         feedback: None,
         bm,
         cq: deflections,
@@ -411,6 +451,7 @@ fn free_model(modes: &PoseModes, deflections: Vec<Vec<f64>>) -> Model {
     let bm = (0..nr).map(|k| s.iter().map(|row| row[k]).collect()).collect();
     let blocks = Blocks {
         omega2: modes.omega2.clone(),
+        damping: None,
         feedback: None,
         bm,
         cq,
@@ -542,6 +583,21 @@ fn statespace_json(exp: &Experiment, ss: &StateSpace, fem: &flexstar_fem::pose_m
         "modal_frequencies_hz": ss.modes.freq_hz,
         "files": {"A": "A.mtx", "B": "B.mtx", "C": "C.mtx", "D": "D.mtx", "fem_mass": "M.mtx", "fem_stiffness": "K.mtx", "fem_constraint_jacobian": "Phi_q.mtx", "fem_coordinates": "fem-coordinates.csv"},
         "fem": {"coordinates": fem.n, "constraints": fem.rows, "elements": exp.fem.elements, "sliders": fem.sliders.name()},
+        "payload": exp.payload,
+        "damping": damping_json(exp),
+    })
+}
+
+/// The damping of the model in `statespace.json`: `null` without a `[damping]` section, else the
+/// section, beta [s] and how it enters A (Eq. D13).
+fn damping_json(exp: &Experiment) -> serde_json::Value {
+    if exp.damping == flexstar_model::Damping::default() {
+        return serde_json::Value::Null;
+    }
+    serde_json::json!({
+        "section": exp.damping,
+        "beta_s": exp.damping.beta(),
+        "in_A": "Kelvin-Voigt: -Phi^T (beta K) Phi = -beta Omega^2 in the velocity block (zeta_k = beta omega_k / 2)",
     })
 }
 
@@ -551,7 +607,8 @@ fn statespace_json(exp: &Experiment, ss: &StateSpace, fem: &flexstar_fem::pose_m
 /// ([`flexstar_model::run_set::RunSet`]).
 pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(), ModalError> {
     let sliders = ss.settings.holding.sliders();
-    let fem = flexstar_fem::pose_modes::pose_system(&exp.robot, &ss.pose, sliders, exp.fem.elements)?;
+    let fem =
+        flexstar_fem::pose_modes::pose_system_with(&exp.robot, &exp.payload, &ss.pose, sliders, exp.fem.elements)?;
     let (fm, fk, fc) = (
         dense(fem.n, fem.n, &fem.m),
         dense(fem.n, fem.n, &fem.k),

@@ -242,6 +242,10 @@ fn modal<'py>(
     d.set_item("mode", rows.iter().map(|r| r.0).collect::<Vec<_>>())?;
     d.set_item("amm_hz", PyArray1::from_vec(py, rows.iter().map(|r| r.1).collect()))?;
     d.set_item("fem_hz", PyArray1::from_vec(py, rows.iter().map(|r| r.2).collect()))?;
+    if let Some(z) = o.modal.damping_ratios() {
+        d.set_item("zeta_amm", PyArray1::from_vec(py, z.iter().map(|r| r.0).collect()))?;
+        d.set_item("zeta_fem", PyArray1::from_vec(py, z.iter().map(|r| r.1).collect()))?;
+    }
     d.set_item("rigid", o.modal.amm.rigid)?;
     d.set_item("pose", convert::pose_dict(py, &o.pose)?)?;
     Ok(d)

@@ -216,7 +216,8 @@ def modal(
 ) -> Dict[str, Any]:
     """Modes at a pose (``at`` = time of the trajectory [s], or ``pose`` = (Gx, Gy, theta)),
     AMM and FEM side by side: ``{"mode", "amm_hz", "fem_hz", "rigid", "pose"}``; with
-    ``sliders="free"`` the three rigid modes (0 Hz) come first."""
+    ``sliders="free"`` the three rigid modes (0 Hz) come first. With a ``[damping]`` section also
+    ``"zeta_amm"``, ``"zeta_fem"``: each model's damping ratio ``beta omega / 2`` of the mode."""
     return _flexstar.modal(exp._inner, at, None if pose is None else tuple(pose), sliders, modes)
 
 

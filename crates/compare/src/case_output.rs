@@ -6,7 +6,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
+use flexstar_kinematics::{rigid_inverse_dynamics_with, RigidState};
 use flexstar_model::run_set::RunSet;
 use flexstar_model::{
     small_deflection_check, DriveKind, Experiment, Feedforward, ModeFamily, Provenance, Response, ValidityExceeded,
@@ -114,9 +114,10 @@ pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>,
         })
     };
     let t = &case.fem.t;
+    let attached = flexstar_model::Attachments::of(exp);
     let rigid: Vec<[f64; 3]> = t
         .iter()
-        .map(|&ti| kin(ti).map(|s| rigid_inverse_dynamics(&exp.robot, &s).fa))
+        .map(|&ti| kin(ti).map(|s| rigid_inverse_dynamics_with(&exp.robot, &attached, &s).fa))
         .collect::<Result<_, _>>()?;
     let mut figs = vec![figure_w_g(&exp.name, &runs), figure_tips(&exp.name, &runs)];
     let last = kin(exp.time.t_end)?;
@@ -195,6 +196,27 @@ fn pct(v: Option<f64>) -> String {
     v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "n/a".into())
 }
 
+/// What the robot carries beyond the paper's (issue 22), in one sentence: `None` when it carries
+/// nothing (no payload, no damping, no load).
+fn attachments_line(exp: &Experiment) -> Option<String> {
+    let mut parts = Vec::new();
+    let p = &exp.payload;
+    if !p.is_none() {
+        parts.push(format!(
+            "a payload at G (m = {} kg, J = {} kg m^2, offset [{}, {}] m)",
+            p.mass, p.j, p.offset[0], p.offset[1]
+        ));
+    }
+    if exp.damping != flexstar_model::Damping::default() {
+        parts.push(format!("Kelvin-Voigt damping (beta = {:.4e} s)", exp.damping.beta()));
+    }
+    if !exp.load.is_none() {
+        let how = if exp.load.file.is_some() { "a table" } else { "polynomials" };
+        parts.push(format!("a load at G ({how} of Fx, Fy, Mz)"));
+    }
+    (!parts.is_empty()).then(|| format!("The robot carries {}.", parts.join(", ")))
+}
+
 /// `compare.md`: what was run, the EVPs, the behaviour of G, the figures.
 pub fn compare_markdown(
     exp: &Experiment,
@@ -215,6 +237,9 @@ pub fn compare_markdown(
         exp.time.t_end,
         exp.time.dt_out
     );
+    if let Some(line) = attachments_line(exp) {
+        let _ = writeln!(s, "{line}\n");
+    }
     let _ = writeln!(s, "## Runs\n");
     let _ = writeln!(s, "{}", runs_markdown(case, checks));
     if let Some(servo) = servo_summary(exp, case) {

@@ -576,6 +576,25 @@ impl ElementState {
     }
 }
 
+/// Dissipated power of an element of initial length `l0` [m] at the element DOFs `q` and
+/// velocities `qd`, Eq. D10: `beta p'^T K_l p'` [W] (`sec = [EA, EI, beta]`), from the chord
+/// alone: the rates `u' = r . qd`, `th_k' = phi_k' - beta_dot` (Eq. D6) need neither the local
+/// rotations nor their angle (so no `atan2`: once per step for the energy balance). Equal to
+/// [`ElementState::dissipation_power`] up to round-off.
+#[inline(always)]
+pub fn chord_dissipation_power<T: Real>(l0: T, q: &[T; 6], qd: &[T; 6], sec: [f64; 3]) -> T {
+    let [ea, ei, beta] = sec;
+    let d = [q[3] - q[0], q[4] - q[1]];
+    let dd = [qd[3] - qd[0], qd[4] - qd[1]];
+    let ln2 = d[0] * d[0] + d[1] * d[1];
+    let ud = (d[0] * dd[0] + d[1] * dd[1]) / ln2.sqrt();
+    let bd = (d[0] * dd[1] - d[1] * dd[0]) / ln2;
+    let (t1, t2) = (qd[2] - bd, qd[5] - bd);
+    let il0 = T::splat(1.0) / l0;
+    let bend = (t1 * t1 + t1 * t2 + t2 * t2) * 4.0 * ei;
+    (ud * ud * ea + bend) * il0 * beta
+}
+
 /// Gram matrix `G_kl = int_0^1 phi_k phi_l dzeta` of the interpolation basis
 /// `phi = [1 - zeta, zeta, H1, H2]` (Beta-function integrals, exact fractions).
 pub const GRAM: [[f64; 4]; 4] = [

@@ -12,7 +12,7 @@
 
 use flexstar_numerics::lanes::{F64x4, Real};
 
-use crate::element::{Element, ElementState};
+use crate::element::{chord_dissipation_power, Element, ElementState};
 
 /// Section constants of the beams: axial stiffness EA [N], bending stiffness EI [N m^2], mass
 /// per length rho [kg/m], and the Kelvin-Voigt retardation time beta [s] (Eq. D1; 0: undamped,
@@ -352,9 +352,9 @@ fn add_forces_of<T: Real, const DAMPED: bool>(
 #[inline(always)]
 fn power_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], sec: Section) -> f64 {
     let chain = chain::<T>(elements, start);
-    let st: ElementState<T> = states(elements, start, chain, q);
-    let vel = gather(elements, start, chain, v);
-    let p = std::hint::black_box(st.dissipation_power(sec.ea, sec.ei, sec.beta, &vel));
+    let (pos, vel) = (gather(elements, start, chain, q), gather(elements, start, chain, v));
+    let l0 = T::from_lanes(|k| elements[start + k].l0);
+    let p = std::hint::black_box(chord_dissipation_power(l0, &pos, &vel, [sec.ea, sec.ei, sec.beta]));
     let mut sum = 0.0;
     for k in 0..T::LANES {
         sum += p.lane(k);

@@ -368,10 +368,13 @@ fn post_process(
     Ok(resp)
 }
 
+/// An optional column: whether the run has it, its name, its value in a sample.
+type OptionalColumn = (bool, &'static str, fn(&Sample) -> f64);
+
 /// Issue 22's columns after the others, each only when the run had its section: `Ek_payload`,
 /// `W_load`, `E_d` [J] (see [`solve`]).
 fn attachment_columns(hist: &History, names: &mut Vec<&str>, cols: &mut Vec<Vec<f64>>) {
-    let present: [(bool, &str, fn(&Sample) -> f64); 3] = [
+    let present: [OptionalColumn; 3] = [
         (hist.payload, "Ek_payload", |s: &Sample| s.ke_payload),
         (hist.load, "W_load", |s: &Sample| s.w_load),
         (hist.damping, "E_d", |s: &Sample| s.e_d),

@@ -109,8 +109,7 @@ flexstar_numerics::dispatch_avx2! {
         t1: f64,
         h: f64,
     ) -> Result<(), FemError> {
-        let n_dof = star.n_dof;
-        let l = params.l;
+        let (n_dof, l) = (star.n_dof, params.l);
         let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
         let fixed = motion.prescribed_pins(params, t1)?;
         let load = star.attached.load_at(t1);

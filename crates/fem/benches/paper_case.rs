@@ -8,6 +8,10 @@
 //! run (written at every solver step, fed back through a `ForceTable`), and by a 20 Hz servo with
 //! rigid feedforward: the cost of the three slider unknowns and of evaluating the law at every
 //! Newton iteration, against the inverse run above.
+//!
+//! Issue 22: case 2 at 300 elements carrying a payload (0.5 kg, J = 2e-3 kg m^2, offset
+//! (0.02, -0.01) m), damped (beta = 8e-4 s: zeta 0.01 at 4 Hz) and loaded at G (all three
+//! components), against the bare `case2_0.4s_300el` (at most 10 % more, issue 22).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexstar_drive::{ForceTable, Servo};
@@ -30,6 +34,22 @@ fn bench(c: &mut Criterion) {
         };
         g.bench_function(name, |b| b.iter(|| flexstar_fem::solve(&exp, &settings, None).unwrap()));
     }
+    let mut attached = catalogue::paper_case(2);
+    attached.payload = flexstar_model::Payload {
+        mass: 0.5,
+        j: 2e-3,
+        offset: [0.02, -0.01],
+    };
+    attached.damping = flexstar_model::Damping::with_beta(8e-4);
+    attached.load = flexstar_model::LoadSettings::polynomials(
+        Some(vec![0.0, 0.0, 8.0]),
+        Some(vec![0.0, -1.0]),
+        Some(vec![0.0, 0.0, 1.0]),
+    );
+    let settings = FemSettings::default();
+    g.bench_function("case2_0.4s_300el_payload_damping_load", |b| {
+        b.iter(|| flexstar_fem::solve(&attached, &settings, None).unwrap())
+    });
     let mut exp = catalogue::paper_case(2);
     exp.time.dt_out = flexstar_fem::DEFAULT_DT;
     let settings = FemSettings::default();

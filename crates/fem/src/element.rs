@@ -136,12 +136,54 @@ impl<T: Real> ElementState<T> {
     /// Local forces `[N, M1, M2]` (axial force [N], end moments [N m]).
     #[inline(always)]
     pub fn local_forces(&self, ea: f64, ei: f64) -> [T; 3] {
+        self.local_forces_at([self.u, self.th1, self.th2], ea, ei)
+    }
+
+    /// Local forces `K_l p` [N, N m, N m] of the local deformations `p = [u, th1, th2]` [m, rad,
+    /// rad], `K_l = diag(EA/l0, EI/l0 [4 2; 2 4])`.
+    #[inline(always)]
+    fn local_forces_at(&self, p: [T; 3], ea: f64, ei: f64) -> [T; 3] {
         let k = self.inv_l0 * ei;
         [
-            self.u * ea * self.inv_l0,
-            k * (self.th1 * 4.0 + self.th2 * 2.0),
-            k * (self.th1 * 2.0 + self.th2 * 4.0),
+            p[0] * ea * self.inv_l0,
+            k * (p[1] * 4.0 + p[2] * 2.0),
+            k * (p[1] * 2.0 + p[2] * 4.0),
         ]
+    }
+
+    /// Material rates of the local deformations, Eq. D6 (`docs/fem.md` 9.2): `p' = B q_e'`
+    /// `= [u', th1', th2']` [m/s, rad/s, rad/s] for the element velocities `qd` (fixed frame).
+    /// Zero for every rigid velocity of the element, of any size.
+    #[inline(always)]
+    pub fn local_rates(&self, qd: &[T; 6]) -> [T; 3] {
+        let (r, b1, b2) = self.b_rows();
+        let dot = |b: [T; 6]| {
+            let mut sum = b[0] * qd[0];
+            for j in 1..6 {
+                sum += b[j] * qd[j];
+            }
+            sum
+        };
+        [dot(r), dot(b1), dot(b2)]
+    }
+
+    /// Kelvin-Voigt local forces, Eq. D7: `[N, M1, M2] = K_l (p + beta p')` [N, N m, N m] with
+    /// the retardation time `beta` [s] and the rates of [`ElementState::local_rates`]; returns
+    /// them with the rates `p'`.
+    #[inline(always)]
+    pub fn damped_local_forces(&self, ea: f64, ei: f64, beta: f64, qd: &[T; 6]) -> ([T; 3], [T; 3]) {
+        let pd = self.local_rates(qd);
+        let p = [self.u + pd[0] * beta, self.th1 + pd[1] * beta, self.th2 + pd[2] * beta];
+        (self.local_forces_at(p, ea, ei), pd)
+    }
+
+    /// Dissipated power of the element, Eq. D10: `P_d = beta p'^T K_l p'` [W] (>= 0) at the
+    /// element velocities `qd`.
+    #[inline(always)]
+    pub fn dissipation_power(&self, ea: f64, ei: f64, beta: f64, qd: &[T; 6]) -> T {
+        let pd = self.local_rates(qd);
+        let kp = self.local_forces_at(pd, ea, ei);
+        (pd[0] * kp[0] + pd[1] * kp[1] + pd[2] * kp[2]) * beta
     }
 
     /// Strain energy [J]: `EA u^2 / (2 l0) + EI/l0 (2 th1^2 + 2 th1 th2 + 2 th2^2)`.
@@ -162,14 +204,46 @@ impl<T: Real> ElementState<T> {
     /// `[k4, k2; k2, k4]` (`k4 = 4 EI / l0`, `k2 = 2 EI / l0`).
     #[inline(always)]
     pub fn internal(&self, ea: f64, ei: f64) -> ([T; 6], Mat6<T>) {
-        let (c, s) = (self.c, self.s);
         let [n, m1, m2] = self.local_forces(ea, ei);
         let f = self.internal_force(ea, ei);
         let il0 = self.inv_l0;
         let (ka, k4, k2) = (il0 * ea, il0 * (4.0 * ei), il0 * (2.0 * ei));
+        (f, self.tangent(ka, k4, k2, n, m1 + m2))
+    }
+
+    /// Damped internal force and its Newton-matrix part, Eqs. D7-D9 (`docs/fem.md` 9.2): the
+    /// force `f = B^T K_l (p + beta p')` [N, N m] at the element velocities `qd` and
+    /// `c_mat K_mat + c_geo G(N, M1, M2)`, the material part `K_mat = B^T K_l B` scaled by
+    /// `c_mat` (in a step `beta' + gamma' beta`: stiffness and damping matrix `beta K_mat`) and
+    /// the geometric part of [`ElementState::internal`] with the damped local forces scaled by
+    /// `c_geo` (`beta'`). The non-symmetric `beta B^T K_l dp'/dq` is left out (modified Newton).
+    #[inline(always)]
+    pub fn damped_internal(&self, sec: [f64; 3], qd: &[T; 6], c_mat: T, c_geo: T) -> ([T; 6], Mat6<T>) {
+        let [ea, ei, beta] = sec;
+        let ([n, m1, m2], _) = self.damped_local_forces(ea, ei, beta, qd);
+        let f = self.force_of([n, m1, m2]);
+        let il0 = self.inv_l0;
+        let (ka, k4, k2) = (il0 * ea * c_mat, il0 * (4.0 * ei) * c_mat, il0 * (2.0 * ei) * c_mat);
+        (f, self.tangent(ka, k4, k2, n * c_geo, (m1 + m2) * c_geo))
+    }
+
+    /// The damped internal force of [`ElementState::damped_internal`] alone (`sec = [EA, EI,
+    /// beta]` [N, N m^2, s]).
+    #[inline(always)]
+    pub fn damped_internal_force(&self, sec: [f64; 3], qd: &[T; 6]) -> [T; 6] {
+        let [ea, ei, beta] = sec;
+        self.force_of(self.damped_local_forces(ea, ei, beta, qd).0)
+    }
+
+    /// The tangent's structure (see [`ElementState::internal`]) from the axial and bending
+    /// stiffnesses `ka = EA/l0`, `k4 = 4 EI/l0`, `k2 = 2 EI/l0` and the local forces `n = N`,
+    /// `msum = M1 + M2` of its geometric part (each possibly scaled).
+    #[inline(always)]
+    fn tangent(&self, ka: T, k4: T, k2: T, n: T, msum: T) -> Mat6<T> {
+        let (c, s) = (self.c, self.s);
         let iln = self.inv_ln;
         let gz = (n + (k4 + k2) * 2.0 * iln) * iln;
-        let gm = (m1 + m2) * iln * iln;
+        let gm = msum * iln * iln;
         let (rho, zeta) = ([c, s], [s, -c]);
         let zero = T::splat(0.0);
         let mut t = [[zero; 2]; 2];
@@ -201,14 +275,19 @@ impl<T: Real> ElementState<T> {
         k[5][5] = k4;
         k[2][5] = k2;
         k[5][2] = k2;
-        (f, k)
+        k
     }
 
     /// Internal force vector `f = B^T [N, M1, M2]` alone (the first half of
     /// [`ElementState::internal`], for residual-only evaluations).
     #[inline(always)]
     pub fn internal_force(&self, ea: f64, ei: f64) -> [T; 6] {
-        let [n, m1, m2] = self.local_forces(ea, ei);
+        self.force_of(self.local_forces(ea, ei))
+    }
+
+    /// `B^T [N, M1, M2]` [N, N m] of the local forces.
+    #[inline(always)]
+    fn force_of(&self, [n, m1, m2]: [T; 3]) -> [T; 6] {
         let (r, b1, b2) = self.b_rows();
         let mut f = r;
         for j in 0..6 {
@@ -497,6 +576,25 @@ impl ElementState {
     }
 }
 
+/// Dissipated power of an element of initial length `l0` [m] at the element DOFs `q` and
+/// velocities `qd`, Eq. D10: `beta p'^T K_l p'` [W] (`sec = [EA, EI, beta]`), from the chord
+/// alone: the rates `u' = r . qd`, `th_k' = phi_k' - beta_dot` (Eq. D6) need neither the local
+/// rotations nor their angle (so no `atan2`: once per step for the energy balance). Equal to
+/// [`ElementState::dissipation_power`] up to round-off.
+#[inline(always)]
+pub fn chord_dissipation_power<T: Real>(l0: T, q: &[T; 6], qd: &[T; 6], sec: [f64; 3]) -> T {
+    let [ea, ei, beta] = sec;
+    let d = [q[3] - q[0], q[4] - q[1]];
+    let dd = [qd[3] - qd[0], qd[4] - qd[1]];
+    let ln2 = d[0] * d[0] + d[1] * d[1];
+    let ud = (d[0] * dd[0] + d[1] * dd[1]) / ln2.sqrt();
+    let bd = (d[0] * dd[1] - d[1] * dd[0]) / ln2;
+    let (t1, t2) = (qd[2] - bd, qd[5] - bd);
+    let il0 = T::splat(1.0) / l0;
+    let bend = (t1 * t1 + t1 * t2 + t2 * t2) * 4.0 * ei;
+    (ud * ud * ea + bend) * il0 * beta
+}
+
 /// Gram matrix `G_kl = int_0^1 phi_k phi_l dzeta` of the interpolation basis
 /// `phi = [1 - zeta, zeta, H1, H2]` (Beta-function integrals, exact fractions).
 pub const GRAM: [[f64; 4]; 4] = [
@@ -764,6 +862,175 @@ mod tests {
             for b in 0..4 {
                 assert!((m[it[a]][it[b]] - rl / 420.0 * tr[a][b]).abs() < 1e-14, "{a}{b}");
             }
+        }
+    }
+
+    // ---- Kelvin-Voigt damping (issue 22, Eqs. D6-D10) ----
+
+    /// Local deformations `[u, th1, th2]` of the element at `q`.
+    fn local(e: &Element, q: &[f64; 6]) -> [f64; 3] {
+        let st = ElementState::new(e, q);
+        [st.u, st.th1, st.th2]
+    }
+
+    /// `p' = d/dtau p(q + tau qd)` at tau = 0 by central differences: the material rates of the
+    /// local deformations, independent of `B` and of [`ElementState::local_rates`].
+    fn rates_fd(e: &Element, q: &[f64; 6], qd: &[f64; 6]) -> [f64; 3] {
+        let tau = 1e-6;
+        let at = |s: f64| local(e, &std::array::from_fn(|j| q[j] + s * tau * qd[j]));
+        let (p, m) = (at(1.0), at(-1.0));
+        std::array::from_fn(|k| (p[k] - m[k]) / (2.0 * tau))
+    }
+
+    const SEC: [f64; 3] = [6e6, 0.5, 8e-4];
+    const QD: [f64; 6] = [0.3, -1.1, 4.0, -0.7, 0.9, -3.0];
+
+    #[test]
+    fn damping_force_is_the_gradient_of_the_dissipation_function() {
+        // Eq. D7: f_d = dD/dq' with D = 1/2 beta p'^T K_l p' (p' by differences of the local
+        // deformations along q', K_l written out)
+        let e = el();
+        let q = q0();
+        let [ea, ei, beta] = SEC;
+        let kl = [
+            [ea / e.l0, 0.0, 0.0],
+            [0.0, 4.0 * ei / e.l0, 2.0 * ei / e.l0],
+            [0.0, 2.0 * ei / e.l0, 4.0 * ei / e.l0],
+        ];
+        let diss = |qd: &[f64; 6]| {
+            let pd = rates_fd(&e, &q, qd);
+            0.5 * beta
+                * (0..3)
+                    .map(|a| (0..3).map(|b| pd[a] * kl[a][b] * pd[b]).sum::<f64>())
+                    .sum::<f64>()
+        };
+        let st = ElementState::new(&e, &q);
+        let fd_total = st.damped_internal_force(SEC, &QD);
+        let f_el = st.internal_force(ea, ei);
+        let h = 1e-3;
+        for j in 0..6 {
+            let grad = (diss(&pert(&QD, j, h)) - diss(&pert(&QD, j, -h))) / (2.0 * h);
+            let f = fd_total[j] - f_el[j];
+            assert!(
+                (grad - f).abs() < 1e-6 * (1.0 + f.abs()),
+                "f_d[{j}]: dD/dq' {grad} vs {f}"
+            );
+        }
+        // and the rates themselves (Eq. D6) against the differences
+        let (pd, fdr) = (st.local_rates(&QD), rates_fd(&e, &q, &QD));
+        for k in 0..3 {
+            assert!((pd[k] - fdr[k]).abs() < 1e-6 * (1.0 + pd[k].abs()), "p'[{k}]");
+        }
+    }
+
+    #[test]
+    fn damped_tangent_matches_differences_in_q_and_q_dot() {
+        // Eq. D8: df/dq' = beta K_mat; df/dq = K_mat + G(N, M1, M2) + beta B^T K_l dp'/dq, whose
+        // last term (left out of the Newton matrix) is written here from its formulas
+        let e = el();
+        let q = q0();
+        let [ea, ei, beta] = SEC;
+        let st = ElementState::new(&e, &q);
+        let (f0, k_full) = st.damped_internal(SEC, &QD, 1.0, 1.0);
+        assert_eq!(f0, st.damped_internal_force(SEC, &QD));
+        let (_, k_damp) = st.damped_internal(SEC, &QD, beta, 0.0);
+        let (r, b1, b2) = st.b_rows();
+        let z = [st.s, -st.c, 0.0, -st.s, st.c, 0.0];
+        let ln = st.ln;
+        let dot = |a: &[f64; 6], b: &[f64; 6]| (0..6).map(|j| a[j] * b[j]).sum::<f64>();
+        let (ud, bd) = (dot(&r, &QD), dot(&z, &QD) / ln);
+        // rows of dp'/dq
+        let dpd: [[f64; 6]; 3] = [
+            std::array::from_fn(|j| bd * z[j]),
+            std::array::from_fn(|j| ud / (ln * ln) * z[j] + bd / ln * r[j]),
+            std::array::from_fn(|j| ud / (ln * ln) * z[j] + bd / ln * r[j]),
+        ];
+        let kl = [
+            [ea / e.l0, 0.0, 0.0],
+            [0.0, 4.0 * ei / e.l0, 2.0 * ei / e.l0],
+            [0.0, 2.0 * ei / e.l0, 4.0 * ei / e.l0],
+        ];
+        let bt = [r, b1, b2];
+        let left_out = |i: usize, j: usize| {
+            beta * (0..3)
+                .map(|a| bt[a][i] * (0..3).map(|b| kl[a][b] * dpd[b][j]).sum::<f64>())
+                .sum::<f64>()
+        };
+        let (hq, hv) = (1e-7, 1e-3);
+        let mut largest_left_out: f64 = 0.0;
+        for j in 0..6 {
+            let fq = |s: f64| ElementState::new(&e, &pert(&q, j, s)).damped_internal_force(SEC, &QD);
+            let fv = |s: f64| st.damped_internal_force(SEC, &pert(&QD, j, s));
+            let (qp, qm, vp, vm) = (fq(hq), fq(-hq), fv(hv), fv(-hv));
+            for i in 0..6 {
+                let dq = (qp[i] - qm[i]) / (2.0 * hq);
+                let an = k_full[i][j] + left_out(i, j);
+                assert!(
+                    (dq - an).abs() < 1e-5 * (1.0 + an.abs()),
+                    "df/dq[{i}][{j}]: {dq} vs {an}"
+                );
+                let dv = (vp[i] - vm[i]) / (2.0 * hv);
+                assert!(
+                    (dv - k_damp[i][j]).abs() < 1e-6 * (1.0 + k_damp[i][j].abs()),
+                    "df/dq'[{i}][{j}]: {dv} vs {}",
+                    k_damp[i][j]
+                );
+                largest_left_out = largest_left_out.max(left_out(i, j).abs());
+            }
+        }
+        // the left-out part is really there at this state (the check above would notice it)
+        assert!(largest_left_out > 1e-2, "{largest_left_out}");
+        // with zero damping and the same factors, the damped path is the elastic one
+        let (fe, ke) = st.internal(ea, ei);
+        let (fz, kz) = st.damped_internal([ea, ei, 0.0], &QD, 1.0, 1.0);
+        for i in 0..6 {
+            assert!((fe[i] - fz[i]).abs() <= 1e-12 * (1.0 + fe[i].abs()));
+            for j in 0..6 {
+                assert!((ke[i][j] - kz[i][j]).abs() <= 1e-9 * (1.0 + ke[i][j].abs()));
+            }
+        }
+    }
+
+    #[test]
+    fn rigid_velocities_are_not_damped_and_dissipation_is_not_negative() {
+        let e = el();
+        let q = q0();
+        let [ea, ei, beta] = SEC;
+        let st = ElementState::new(&e, &q);
+        let f_el = st.internal_force(ea, ei);
+        let f_d = |qd: &[f64; 6]| {
+            let f = st.damped_internal_force(SEC, qd);
+            std::array::from_fn::<f64, 6, _>(|j| f[j] - f_el[j])
+        };
+        // a translation, and a fast rotation about a point off the element (the element itself
+        // turned by ~2.7 rad from the x axis, ~2 rad from its initial direction)
+        let trans = [0.7, -1.3, 0.0, 0.7, -1.3, 0.0];
+        let (w, c) = (25.0, [0.4, 0.9]);
+        let rot = [
+            -w * (q[1] - c[1]),
+            w * (q[0] - c[0]),
+            w,
+            -w * (q[4] - c[1]),
+            w * (q[3] - c[0]),
+            w,
+        ];
+        let scale = f_d(&QD).iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(scale > 1.0, "a deforming velocity must be damped visibly: {scale}");
+        for qd in [trans, rot] {
+            let fd = f_d(&qd);
+            let pd = st.local_rates(&qd);
+            assert!(pd.iter().all(|p| p.abs() < 1e-12), "{pd:?}");
+            assert!(fd.iter().all(|f| f.abs() < 1e-9 * scale), "{fd:?}");
+            assert!(st.dissipation_power(ea, ei, beta, &qd).abs() < 1e-12);
+        }
+        // Eq. D10: P_d = q' . f_d = beta p'^T K_l p' >= 0 for any velocity
+        for k in 0..50 {
+            let qd: [f64; 6] = std::array::from_fn(|j| (1.3 * k as f64 + 0.7 * j as f64).sin() * (1.0 + j as f64));
+            let pd = st.dissipation_power(ea, ei, beta, &qd);
+            let fd = f_d(&qd);
+            let work: f64 = (0..6).map(|j| qd[j] * fd[j]).sum();
+            assert!(pd >= 0.0, "P_d = {pd}");
+            assert!((work - pd).abs() < 1e-9 * (1.0 + pd), "q' . f_d = {work} vs P_d = {pd}");
         }
     }
 }

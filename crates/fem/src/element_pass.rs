@@ -12,15 +12,28 @@
 
 use flexstar_numerics::lanes::{F64x4, Real};
 
-use crate::element::{Element, ElementState};
+use crate::element::{chord_dissipation_power, Element, ElementState};
 
 /// Section constants of the beams: axial stiffness EA [N], bending stiffness EI [N m^2], mass
-/// per length rho [kg/m].
+/// per length rho [kg/m], and the Kelvin-Voigt retardation time beta [s] (Eq. D1; 0: undamped,
+/// the damped code paths are then skipped).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Section {
     pub ea: f64,
     pub ei: f64,
     pub rho: f64,
+    pub beta: f64,
+}
+
+/// Factors of the residual and of the Newton matrix: `cf` on the dynamic part of the residual,
+/// `ck` on the stiffness in the matrix `M + ck K`, `cv` on the velocity derivative of the forces
+/// (the damping matrix `beta K_mat`, Eq. D9). In a step `cf = ck = beta'` [s^2] and `cv = gamma'`
+/// [s]; for the consistent initial accelerations `cf = 1`, `ck = cv = 0`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Factors {
+    pub cf: f64,
+    pub ck: f64,
+    pub cv: f64,
 }
 
 /// Global coordinates [m, rad], velocities and accelerations of the star's nodes (first
@@ -97,28 +110,60 @@ impl std::ops::Index<usize> for Block<'_> {
 }
 
 flexstar_numerics::dispatch_avx2! {
-    /// Add `cf (M(q) qdd + f_conv(q, v) + f_int(q))` of every element to `res` (global DOFs, in
-    /// element order) and, with `vals`, write each element's `M + ck K` (36 values, row-major,
-    /// at [`block_index`]: the slot layout of `crate::star`).
+    /// Add `cf (M(q) qdd + f_conv(q, v) + f_int(q, v))` of every element to `res` (global DOFs,
+    /// in element order) and, with `vals`, write each element's `M + ck K` (36 values, row-major,
+    /// at [`block_index`]: the slot layout of `crate::star`). With damping (`sec.beta > 0`) the
+    /// internal force is Eq. D7's and the block Eq. D9's `M + (ck + cv beta) K_mat + ck G`.
     pub(crate) fn add_forces(
         elements: &[Element],
         nodes: NodeState,
         sec: Section,
-        cf: f64,
-        ck: f64,
+        fac: Factors,
         res: &mut [f64],
         vals: Option<&mut [f64]>,
     ) -> Result<(), BadChord> {
-        let mut vals = vals;
-        let terms = Terms { nodes, sec, cf, ck };
+        let terms = Terms { nodes, sec, fac };
+        if sec.beta > 0.0 {
+            add_all::<true>(elements, &terms, res, vals)
+        } else {
+            add_all::<false>(elements, &terms, res, vals)
+        }
+    }
+}
+
+/// The batches of [`add_forces`], damped (Eqs. D7, D9) or not (two separate copies, so that the
+/// undamped one is the code before issue 22).
+#[inline(always)]
+fn add_all<const DAMPED: bool>(
+    elements: &[Element],
+    terms: &Terms,
+    res: &mut [f64],
+    vals: Option<&mut [f64]>,
+) -> Result<(), BadChord> {
+    let mut vals = vals;
+    let full = elements.len() / LANES * LANES;
+    for start in (0..full).step_by(LANES) {
+        add_forces_of::<F64x4, DAMPED>(elements, start, terms, res, vals.as_deref_mut())?;
+    }
+    for start in full..elements.len() {
+        add_forces_of::<f64, DAMPED>(elements, start, terms, res, vals.as_deref_mut())?;
+    }
+    Ok(())
+}
+
+flexstar_numerics::dispatch_avx2! {
+    /// Dissipated power of all elements [W], Eq. D10: `sum beta p'^T K_l p'`
+    /// ([`ElementState::dissipation_power`], sums in element order).
+    pub(crate) fn dissipation_power(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> f64 {
         let full = elements.len() / LANES * LANES;
+        let mut sum = 0.0;
         for start in (0..full).step_by(LANES) {
-            add_forces_of::<F64x4>(elements, start, &terms, res, vals.as_deref_mut())?;
+            sum += power_of::<F64x4>(elements, start, q, v, sec);
         }
         for start in full..elements.len() {
-            add_forces_of::<f64>(elements, start, &terms, res, vals.as_deref_mut())?;
+            sum += power_of::<f64>(elements, start, q, v, sec);
         }
-        Ok(())
+        sum
     }
 }
 
@@ -225,8 +270,7 @@ fn states<T: Real>(elements: &[Element], start: usize, chain: Option<usize>, q: 
 struct Terms<'a> {
     nodes: NodeState<'a>,
     sec: Section,
-    cf: f64,
-    ck: f64,
+    fac: Factors,
 }
 
 /// One batch of [`add_forces`]. The `std::hint::black_box` calls keep each lane result in memory
@@ -236,14 +280,16 @@ struct Terms<'a> {
 /// four-element batch without the matrix, 1190 with them; 2900 and 2370 with it). They change
 /// no value.
 #[inline(always)]
-fn add_forces_of<T: Real>(
+fn add_forces_of<T: Real, const DAMPED: bool>(
     elements: &[Element],
     start: usize,
     terms: &Terms,
     res: &mut [f64],
     vals: Option<&mut [f64]>,
 ) -> Result<(), BadChord> {
-    let Terms { nodes, sec, cf, ck } = *terms;
+    let Terms { nodes, sec, fac } = *terms;
+    let Factors { cf, ck, cv } = fac;
+    let damped = [sec.ea, sec.ei, sec.beta];
     let chain = chain::<T>(elements, start);
     let st: ElementState<T> = states(elements, start, chain, nodes.q);
     for k in 0..T::LANES {
@@ -259,12 +305,22 @@ fn add_forces_of<T: Real>(
     let fm = std::hint::black_box(st.inertia_force(sec.rho, &ve, &ae));
     let fi = match vals {
         Some(vals) => {
-            let (fi, kt) = st.internal(sec.ea, sec.ei);
+            // Eq. D9 when damped: the factors are in the tangent already
+            let (fi, kt) = if DAMPED {
+                let (c_mat, c_geo) = (T::splat(ck + cv * sec.beta), T::splat(ck));
+                st.damped_internal(damped, &ve, c_mat, c_geo)
+            } else {
+                st.internal(sec.ea, sec.ei)
+            };
             let m = std::hint::black_box(st.mass(sec.rho));
             let mut mk = m;
             for a in 0..6 {
                 for b in 0..6 {
-                    mk[a][b] = m[a][b] + kt[a][b] * ck;
+                    mk[a][b] = if DAMPED {
+                        m[a][b] + kt[a][b]
+                    } else {
+                        m[a][b] + kt[a][b] * ck
+                    };
                 }
             }
             let mk = std::hint::black_box(mk);
@@ -280,6 +336,7 @@ fn add_forces_of<T: Real>(
             }
             fi
         }
+        None if DAMPED => st.damped_internal_force(damped, &ve),
         None => st.internal_force(sec.ea, sec.ei),
     };
     let mut f = fm;
@@ -289,6 +346,20 @@ fn add_forces_of<T: Real>(
     let f = std::hint::black_box(f);
     scatter_add(elements, start, chain, &f, res);
     Ok(())
+}
+
+/// Dissipated power of the `T::LANES` elements from `start` [W] (lanes summed in order).
+#[inline(always)]
+fn power_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], sec: Section) -> f64 {
+    let chain = chain::<T>(elements, start);
+    let (pos, vel) = (gather(elements, start, chain, q), gather(elements, start, chain, v));
+    let l0 = T::from_lanes(|k| elements[start + k].l0);
+    let p = std::hint::black_box(chord_dissipation_power(l0, &pos, &vel, [sec.ea, sec.ei, sec.beta]));
+    let mut sum = 0.0;
+    for k in 0..T::LANES {
+        sum += p.lane(k);
+    }
+    sum
 }
 
 #[inline(always)]
@@ -371,15 +442,17 @@ mod tests {
             ea: 6e6,
             ei: 0.5,
             rho: 0.27,
+            beta: 0.0,
         };
         let (cf, ck) = (6e-8, 6e-8);
+        let fac = Factors { cf, ck, cv: 2.6e-4 };
         // 11 elements: two full batches and a remainder of three
         let (elements, q, v, a) = chain(11);
         let nodes = NodeState { q: &q, v: &v, qdd: &a };
         let (mut r1, mut m1) = (vec![0.0; q.len()], vec![0.0; blocks_len(elements.len())]);
         let (mut r2, mut m2) = (r1.clone(), m1.clone());
         one_by_one(&elements, nodes, sec, cf, ck, &mut r1, &mut m1);
-        add_forces(&elements, nodes, sec, cf, ck, &mut r2, Some(&mut m2)).unwrap();
+        add_forces(&elements, nodes, sec, fac, &mut r2, Some(&mut m2)).unwrap();
         assert_eq!(
             r1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
             r2.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
@@ -390,7 +463,7 @@ mod tests {
         );
         // the residual-only pass adds the same forces
         let mut r3 = vec![0.0; q.len()];
-        add_forces(&elements, nodes, sec, cf, ck, &mut r3, None).unwrap();
+        add_forces(&elements, nodes, sec, fac, &mut r3, None).unwrap();
         assert_eq!(r1, r3);
         // energies against the element-by-element sums
         let (mut t, mut u) = (0.0, 0.0);
@@ -413,6 +486,7 @@ mod tests {
             ea: 6e6,
             ei: 0.5,
             rho: 0.27,
+            beta: 0.0,
         };
         let (elements, mut q, v, a) = chain(9);
         // element 6 (in the second batch) collapses: node 7 onto node 6
@@ -420,14 +494,98 @@ mod tests {
         q[22] = q[19];
         let mut res = vec![0.0; q.len()];
         let nodes = NodeState { q: &q, v: &v, qdd: &a };
-        let err = add_forces(&elements, nodes, sec, 1.0, 1.0, &mut res, None).unwrap_err();
+        let err = add_forces(
+            &elements,
+            nodes,
+            sec,
+            Factors {
+                cf: 1.0,
+                ck: 1.0,
+                cv: 0.0,
+            },
+            &mut res,
+            None,
+        )
+        .unwrap_err();
         assert_eq!(err, BadChord { element: 6, ln: 0.0 });
         // and in the remainder (element 8, the one-element path)
         let (elements, mut q, v, a) = chain(9);
         q[27] = f64::NAN;
         let nodes = NodeState { q: &q, v: &v, qdd: &a };
-        let err = add_forces(&elements, nodes, sec, 1.0, 1.0, &mut res, None).unwrap_err();
+        let err = add_forces(
+            &elements,
+            nodes,
+            sec,
+            Factors {
+                cf: 1.0,
+                ck: 1.0,
+                cv: 0.0,
+            },
+            &mut res,
+            None,
+        )
+        .unwrap_err();
         assert_eq!(err.element, 8);
         assert!(err.ln.is_nan());
+    }
+
+    #[test]
+    fn damped_batches_give_the_element_by_element_results_bit_for_bit() {
+        // Eqs. D7, D9 through the batches against each element's own damped force and tangent
+        let sec = Section {
+            ea: 6e6,
+            ei: 0.5,
+            rho: 0.27,
+            beta: 8e-4,
+        };
+        let fac = Factors {
+            cf: 6e-8,
+            ck: 6e-8,
+            cv: 2.6e-4,
+        };
+        let (elements, q, v, a) = chain(11);
+        let nodes = NodeState { q: &q, v: &v, qdd: &a };
+        let (mut r1, mut m1) = (vec![0.0; q.len()], vec![0.0; blocks_len(elements.len())]);
+        for (e, el) in elements.iter().enumerate() {
+            let pick = |x: &[f64]| -> [f64; 6] {
+                let (a, b) = (3 * el.nodes[0], 3 * el.nodes[1]);
+                [x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2]]
+            };
+            let st = ElementState::new(el, &pick(&q));
+            let fm = st.inertia_force(sec.rho, &pick(&v), &pick(&a));
+            let (c_mat, c_geo) = (fac.ck + fac.cv * sec.beta, fac.ck);
+            let (fi, k) = st.damped_internal([sec.ea, sec.ei, sec.beta], &pick(&v), c_mat, c_geo);
+            let m = st.mass(sec.rho);
+            let d = [0, 1, 2, 3, 4, 5].map(|a| 3 * el.nodes[a / 3] + a % 3);
+            for a in 0..6 {
+                for b in 0..6 {
+                    m1[block_index(e, 6 * a + b)] = m[a][b] + k[a][b];
+                }
+                r1[d[a]] += fac.cf * (fm[a] + fi[a]);
+            }
+        }
+        let (mut r2, mut m2) = (vec![0.0; q.len()], vec![0.0; blocks_len(elements.len())]);
+        add_forces(&elements, nodes, sec, fac, &mut r2, Some(&mut m2)).unwrap();
+        assert_eq!(r1, r2);
+        assert_eq!(m1, m2);
+        let mut r3 = vec![0.0; q.len()];
+        add_forces(&elements, nodes, sec, fac, &mut r3, None).unwrap();
+        assert_eq!(r1, r3);
+        // damping changes the residual (the chain deforms at a rate) and the power sums
+        let mut r4 = vec![0.0; q.len()];
+        add_forces(&elements, nodes, Section { beta: 0.0, ..sec }, fac, &mut r4, None).unwrap();
+        assert!(r1.iter().zip(&r4).any(|(x, y)| x != y));
+        let p: f64 = elements
+            .iter()
+            .map(|el| {
+                let pick = |x: &[f64]| -> [f64; 6] {
+                    let (a, b) = (3 * el.nodes[0], 3 * el.nodes[1]);
+                    [x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2]]
+                };
+                ElementState::new(el, &pick(&q)).dissipation_power(sec.ea, sec.ei, sec.beta, &pick(&v))
+            })
+            .sum();
+        let pb = dissipation_power(&elements, &q, &v, sec);
+        assert!(p > 0.0 && (p - pb).abs() <= 1e-12 * p, "{p} vs {pb}");
     }
 }

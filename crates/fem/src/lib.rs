@@ -10,7 +10,9 @@
 //! configuration; the rigid (Fermat-point) kinematics appears only as initial data and in the
 //! post-processing of [`solve`] (projection onto the rigid frames). [`solve_direct`] solves the
 //! direct problem (issue 10): the sliders, bodies of mass `mpp + mpa`, move under an actuator law
-//! (`flexstar_drive`), their coordinates unknowns of the same equations. The formulation, the
+//! (`flexstar_drive`), their coordinates unknowns of the same equations. Both carry an
+//! experiment's payload at G, Kelvin-Voigt damping of the beams and load at G (issue 22,
+//! `docs/fem.md` section 9), skipped at their zero defaults. The formulation, the
 //! convergence study behind the defaults and the deviations are in `docs/fem.md`.
 
 #![allow(clippy::needless_range_loop)] // index loops over DOFs read like the equations

@@ -8,8 +8,8 @@ use flexstar_kinematics::{check_trajectory, direct_kinematics, preflight_step, C
 use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::{BeamShape, Experiment, FemSettings, Response, RobotParams, RunInfo, StarShape};
 
-use crate::integrator::{integrate, History, Motion, RunSettings, Snapshot, Stats};
-use crate::star::InitialState;
+use crate::integrator::{integrate, History, Motion, RunSettings, Sample, Snapshot, Stats};
+use crate::star::{Attached, InitialState};
 use crate::FemError;
 
 /// Default integration step [s], from the convergence study in `docs/fem.md`.
@@ -56,6 +56,12 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 ///   sleeve rotations, sliders and strain energy [J]), `W` (work of the drivers since t = 0 [J]),
 ///   `slopeG` (elastic slope of the beams at G: rotation of the weld node minus the rigid
 ///   rotation theta(t) - theta(0) [rad]; the junction measure of Table I);
+/// - issue 22, each only when its section is present (so a run at the defaults writes the
+///   columns above and nothing else): `Ek_payload` (kinetic energy of the payload [J]) with a
+///   `[payload]`, `W_load` (work of the load at G since t = 0 [J], trapezoidal rule on the steps)
+///   with a `[load]`, `E_d` (energy dissipated by the beams' Kelvin-Voigt damping since t = 0
+///   [J], Eq. D10) with a `[damping]`; the energy balance is then Eq. C6,
+///   `W + W_load = Delta(Ek_star + Ek_sleeves + Ek_sliders + Ek_payload + U) + E_d`;
 /// - `shapes`: the deformed star at `settings.snapshots` and at t_end.
 ///
 /// `progress` receives the fraction of the time span done, in [0, 1].
@@ -109,7 +115,17 @@ fn solve_scanned(
     let r0 = rigid(0.0)?;
     let (t_out, snaps) = times(exp, settings);
     let motion = Motion::Prescribed(&exp.trajectory);
-    let hist = integrate(params, &motion, &t_out, &snaps, &initial_state(&r0), &run, progress)?;
+    let attached = Attached::of(exp, r0.theta.v);
+    let hist = integrate(
+        params,
+        &motion,
+        &t_out,
+        &snaps,
+        &initial_state(&r0),
+        &run,
+        &attached,
+        progress,
+    )?;
 
     // post-processing with the rigid kinematics of the prescribed motion
     let frame = |t: f64, _s: [f64; 3]| {
@@ -135,7 +151,8 @@ fn solve_scanned(
 /// round, `docs/fem.md` section 8); its coordinate `s_i` is an unknown of the FEM, and the servo's
 /// `kp`, `kd` (`law.stiffness()`, `law.damping()`) enter the iteration matrix. Initial state:
 /// `s(0)`, `s'(0)` from `exp.trajectory` at t = 0, the star undeformed and moving rigidly (as
-/// [`solve`] starts), so that the `Fa` of an inverse run fed back reproduces that run.
+/// [`solve`] starts), so that the `Fa` of an inverse run fed back reproduces that run. The
+/// payload, damping and load of `exp` act as in [`solve`] (`docs/fem.md` section 9).
 ///
 /// The configuration is checked at every step (sleeves on their beams, then the limits of
 /// `flexstar_kinematics::feasibility` on the simulated `s`): leaving the feasible range stops the
@@ -174,7 +191,17 @@ pub fn solve_direct_with_stats(
         s0: r0.s.map(|s| s.v),
         v0: r0.s.map(|s| s.d1),
     };
-    let hist = integrate(params, &motion, &t_out, &snaps, &initial_state(&r0), &run, progress)?;
+    let attached = Attached::of(exp, r0.theta.v);
+    let hist = integrate(
+        params,
+        &motion,
+        &t_out,
+        &snaps,
+        &initial_state(&r0),
+        &run,
+        &attached,
+        progress,
+    )?;
 
     // post-processing with the rigid kinematics of the simulated sliders
     let frame = |t: f64, s: [f64; 3]| {
@@ -327,17 +354,37 @@ fn post_process(
             }
         }
     }
-    let names: Vec<&str> = if direct {
+    let mut names: Vec<&str> = if direct {
         DIRECT_EXTRA.iter().chain(EXTRA.iter()).copied().collect()
     } else {
         EXTRA.to_vec()
     };
     lead.extend(extra);
+    attachment_columns(hist, &mut names, &mut lead);
     resp.set_extra(&names, lead);
     for snap in &hist.snapshots {
         resp.shapes.push(star_shape(hist, snap, frame)?);
     }
     Ok(resp)
+}
+
+/// An optional column: whether the run has it, its name, its value in a sample.
+type OptionalColumn = (bool, &'static str, fn(&Sample) -> f64);
+
+/// Issue 22's columns after the others, each only when the run had its section: `Ek_payload`,
+/// `W_load`, `E_d` [J] (see [`solve`]).
+fn attachment_columns(hist: &History, names: &mut Vec<&str>, cols: &mut Vec<Vec<f64>>) {
+    let present: [OptionalColumn; 3] = [
+        (hist.payload, "Ek_payload", |s: &Sample| s.ke_payload),
+        (hist.load, "W_load", |s: &Sample| s.w_load),
+        (hist.damping, "E_d", |s: &Sample| s.e_d),
+    ];
+    for (on, name, value) in present {
+        if on {
+            names.push(name);
+            cols.push(hist.samples.iter().map(value).collect());
+        }
+    }
 }
 
 /// The deformed star of snapshot `snap`: per beam the node positions and their deflections `w`

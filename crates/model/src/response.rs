@@ -71,6 +71,10 @@ pub const COLUMN_UNITS: &[(&str, &str)] = &[
     ("U", "J"),
     ("W", "J"),
     ("slopeG", "rad"),
+    // issue 22's energies (FEM), each only with its section
+    ("Ek_payload", "J"),
+    ("W_load", "J"),
+    ("E_d", "J"),
     // a direct run's columns and kinematics.csv (xp1..3, Fa1..3 as above)
     ("s1", "m"),
     ("s2", "m"),

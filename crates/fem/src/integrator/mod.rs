@@ -20,7 +20,7 @@ use flexstar_model::{RobotParams, Trajectory};
 use flexstar_numerics::GenAlpha;
 
 use crate::error::PivotError;
-use crate::star::{Factors, InitialState, Iterate, Pins, SliderRows, Star, ROWS};
+use crate::star::{Attached, Factors, InitialState, Iterate, Pins, SliderRows, Star, ROWS};
 use crate::{FemError, NewtonFailure};
 
 mod motion;
@@ -80,6 +80,49 @@ pub(crate) struct History {
     pub snapshots: Vec<Snapshot>,
     pub node_x: Vec<f64>,
     pub stats: Stats,
+    /// Which of issue 22's additions the run had: payload, load, damping (their columns).
+    pub payload: bool,
+    pub load: bool,
+    pub damping: bool,
+}
+
+/// Work and dissipated energy since t = 0 [J], by the trapezoidal rule on the integration steps,
+/// with the powers [W] at the last step: the drivers' (`Fa . s'`), the load's at G (Eq. L2's
+/// `Fx x' + Fy y' + Mz phi'`) and the beams' dissipation (Eq. D10).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Works {
+    pub work: f64,
+    pub w_load: f64,
+    pub e_d: f64,
+    powers: [f64; 3],
+}
+
+impl Works {
+    /// The powers at the state `st` (time `t`) with the drivers' forces `fa`.
+    fn powers(star: &Star, st: &State, fa: &[f64; 3], t: f64) -> [f64; 3] {
+        [
+            power(fa, &st.pins),
+            star.load_power(&st.v, t),
+            star.dissipation_power(&st.q, &st.v),
+        ]
+    }
+
+    /// Start at t = 0 (nothing done yet).
+    fn start(star: &Star, st: &State, fa: &[f64; 3]) -> Self {
+        Works {
+            powers: Self::powers(star, st, fa, 0.0),
+            ..Works::default()
+        }
+    }
+
+    /// One step of length `h` [s] ending at `t` in the state `st`.
+    fn advance(&mut self, star: &Star, st: &State, fa: &[f64; 3], t: f64, h: f64) {
+        let p = Self::powers(star, st, fa, t);
+        self.work += 0.5 * h * (self.powers[0] + p[0]);
+        self.w_load += 0.5 * h * (self.powers[1] + p[1]);
+        self.e_d += 0.5 * h * (self.powers[2] + p[2]);
+        self.powers = p;
+    }
 }
 
 /// The integration state at one time: coordinates, velocities, algorithmic accelerations
@@ -129,8 +172,13 @@ fn initial_state(
             lam: &lam0,
             pins: &pins0,
             sliders: sl0.as_ref(),
+            load: star.attached.load_at(0.0),
         },
-        Factors { cf: 1.0, ck: 0.0 },
+        Factors {
+            cf: 1.0,
+            ck: 0.0,
+            cv: 0.0,
+        },
         &mut res,
         0.0,
         true,
@@ -214,7 +262,8 @@ fn check_sleeves(star: &Star, q: &[f64], l: f64, t: f64) -> Result<(), FemError>
     Ok(())
 }
 
-/// Integrate from the initial state to the last output time.
+/// Integrate from the initial state to the last output time, the star carrying `attached`'s
+/// payload, damping and load (issue 22).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn integrate(
     params: &RobotParams,
@@ -223,6 +272,7 @@ pub(crate) fn integrate(
     snap_times: &[f64],
     init: &InitialState,
     run: &RunSettings,
+    attached: &Attached,
     progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> Result<History, FemError> {
     if !(run.dt.is_finite() && run.dt > 0.0) {
@@ -235,6 +285,7 @@ pub(crate) fn integrate(
         return Err(FemError::Input("output times must start at t = 0".into()));
     }
     let (mut star, q, v) = Star::new(params, run.ne, init, motion.slider_unknowns())?;
+    star.attached = attached.clone();
     let l = params.l;
     let mut st = initial_state(params, motion, &mut star, q, v)?;
     motion.check_feasible(params, &st.pins, 0.0)?;
@@ -245,9 +296,8 @@ pub(crate) fn integrate(
     let mut rec = Recorder::new(t_out, snap_times);
     let mut stats = Stats::default();
     let (fa0, pf0) = motion.forces(params, &st.pins, &st.lam, 0.0)?;
-    let mut pow_prev = power(&fa0, &st.pins);
-    let mut work = 0.0;
-    rec.record(params, &star, &st, fa0, pf0, 0.0, 0.0);
+    let mut works = Works::start(&star, &st, &fa0);
+    rec.record(params, &star, &st, fa0, pf0, 0.0, &works);
 
     let mut ws = Workspace::new(&star);
     let mut t = 0.0;
@@ -262,10 +312,8 @@ pub(crate) fn integrate(
             check_sleeves(&star, &st.q, l, t)?;
             motion.check_feasible(params, &st.pins, t)?;
             let (fa, pf) = motion.forces(params, &st.pins, &st.lam, t)?;
-            let pw = power(&fa, &st.pins);
-            work += 0.5 * h * (pow_prev + pw);
-            pow_prev = pw;
-            rec.record(params, &star, &st, fa, pf, t, work);
+            works.advance(&star, &st, &fa, t, h);
+            rec.record(params, &star, &st, fa, pf, t, &works);
         }
         if let Some(cb) = progress {
             cb((t / t_end).min(1.0));
@@ -282,5 +330,8 @@ pub(crate) fn integrate(
         snapshots: rec.snapshots,
         node_x: star.node_x(),
         stats,
+        payload: attached.payload.is_some(),
+        load: attached.load.is_some(),
+        damping: attached.beta > 0.0,
     })
 }

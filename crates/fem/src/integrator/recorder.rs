@@ -27,6 +27,12 @@ pub(crate) struct Sample {
     pub strain: f64,
     /// Work of the three drivers since t = 0 [J] (trapezoidal rule on the integration steps).
     pub work: f64,
+    /// Kinetic energy of the payload [J] (0 without one).
+    pub ke_payload: f64,
+    /// Work of the load at G since t = 0 [J] (0 without one; trapezoidal rule on the steps).
+    pub w_load: f64,
+    /// Energy dissipated by the beams' damping since t = 0 [J] (Eq. D10; 0 undamped).
+    pub e_d: f64,
     /// Slider positions s_i [m] and speeds s_i' [m/s] (prescribed, or simulated).
     pub s: [f64; 3],
     pub sd: [f64; 3],
@@ -90,7 +96,7 @@ impl<'a> Recorder<'a> {
         fa: [f64; 3],
         pin_force: [[f64; 2]; 3],
         t: f64,
-        work: f64,
+        works: &Works,
     ) {
         let (q, v, pins) = (&st.q, &st.v, &st.pins);
         if self.out_k < self.t_out.len() && (self.t_out[self.out_k] - t).abs() < 1e-12 {
@@ -109,7 +115,10 @@ impl<'a> Recorder<'a> {
                 ke_sleeves: 0.5 * params.jp * (0..3).map(|i| v[star.psi(i)].powi(2)).sum::<f64>(),
                 ke_sliders: 0.5 * params.mpp_mpa * (0..3).map(|i| pins.s[i][1].powi(2)).sum::<f64>(),
                 strain,
-                work,
+                work: works.work,
+                ke_payload: star.payload_energy(q, v),
+                w_load: works.w_load,
+                e_d: works.e_d,
                 s: pins.s.map(|s| s[0]),
                 sd: pins.s.map(|s| s[1]),
             });

@@ -109,10 +109,10 @@ flexstar_numerics::dispatch_avx2! {
         t1: f64,
         h: f64,
     ) -> Result<(), FemError> {
-        let n_dof = star.n_dof;
-        let l = params.l;
+        let (n_dof, l) = (star.n_dof, params.l);
         let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
         let fixed = motion.prescribed_pins(params, t1)?;
+        let load = star.attached.load_at(t1);
         // predictor: constant acceleration, previous multipliers
         predict(ga, h, bp, gp, st, ws);
         for k in 0..ws.nu.len() {
@@ -133,7 +133,7 @@ flexstar_numerics::dispatch_avx2! {
                     (p, motion.slider_rows(params, &p, t1, bp, gp)?)
                 }
             };
-            let fresh = newton_increment(star, ws, &pins, sliders.as_ref(), bp, t1, stale, stats)?;
+            let fresh = newton_increment(star, ws, (&pins, sliders.as_ref(), load), (bp, gp), t1, stale, stats)?;
             if fresh {
                 stale = false;
             }
@@ -180,16 +180,20 @@ flexstar_numerics::dispatch_avx2! {
     }
 }
 
+/// What acts on the star at a Newton iterate besides its coordinates: the pins, the sliders'
+/// rows (direct problem) and the load at G.
+type Drive<'a> = (&'a Pins, Option<&'a SliderRows>, Option<[f64; 3]>);
+
 /// Assemble the residual (and, when `stale`, the matrix, then factorise it) at the Newton
 /// iterate and solve for the increment `dx = -A^{-1} res`; whether the matrix was fresh.
+/// `(bp, gp)` = `(beta', gamma')` of the step.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn newton_increment(
     star: &mut Star,
     ws: &mut Workspace,
-    pins: &Pins,
-    sliders: Option<&SliderRows>,
-    bp: f64,
+    (pins, sliders, load): Drive,
+    (bp, gp): (f64, f64),
     t1: f64,
     stale: bool,
     stats: &mut Stats,
@@ -203,8 +207,9 @@ fn newton_increment(
             lam: &ws.nu,
             pins,
             sliders,
+            load,
         },
-        Factors { cf: bp, ck: bp },
+        Factors { cf: bp, ck: bp, cv: gp },
         &mut ws.res,
         t1,
         stale,

@@ -44,12 +44,16 @@ use flexstar_model::RobotParams;
 
 use crate::bordered::{Bordered, Layout, SLIDER_SLOTS};
 use crate::element::{Element, ElementState};
+pub(crate) use crate::element_pass::Factors;
 use crate::element_pass::{self, NodeState, Section};
 use crate::integrator::Fallback;
 use crate::sparse::SparseLu;
 use crate::FemError;
 
+mod attached;
 mod pattern;
+
+pub(crate) use attached::Attached;
 
 /// Elements per contact-point window of the sparsity pattern.
 const WINDOW: usize = 8;
@@ -111,14 +115,8 @@ pub(crate) struct Iterate<'a> {
     pub lam: &'a [f64],
     pub pins: &'a Pins,
     pub sliders: Option<&'a SliderRows>,
-}
-
-/// Factors of [`Star::assemble`]: `cf` on the dynamic part of the residual, `ck` on the
-/// stiffness in the matrix `M + ck K`.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Factors {
-    pub cf: f64,
-    pub ck: f64,
+    /// The load at G at the iterate's time, `(Fx, Fy, Mz)` [N, N, N m] (Eq. L2; `None`: none).
+    pub load: Option<[f64; 3]>,
 }
 
 /// The assembled model with its sparse iteration matrix.
@@ -162,6 +160,8 @@ pub(crate) struct Star {
     pub direct: bool,
     /// Offset of the slider slot group (direct problem only).
     off_sl: usize,
+    /// Payload, damping and load (issue 22; none by default).
+    pub attached: Attached,
 }
 
 /// A sleeve must span at least two elements (its three contact points on distinct elements).
@@ -275,6 +275,7 @@ impl Star {
             symbolic_count: 0,
             direct: sliders.is_some(),
             off_sl: 0,
+            attached: Attached::default(),
         };
         Ok((star, q, v))
     }
@@ -327,13 +328,16 @@ impl Star {
     /// [`Star::pins_of`] the same iterate, with the sliders' rows `sliders`):
     ///
     /// ```text
-    /// res[dof]  = cf (M(q) qdd + f_conv(q, v) + f_int(q)) + Phi_q^T lam      (Jp psi_dd for sleeves)
+    /// res[dof]  = cf (M(q) qdd + f_conv(q, v) + f_int(q, v)) + Phi_q^T lam    (Jp psi_dd for sleeves)
     /// res[con]  = Phi(q, t)
     /// matrix    = [ M + ck K    Phi_q^T ]
     ///             [ Phi_q       0       ]
     /// ```
     /// (Hessian terms of the constraints, the velocity and q dependence of the inertia are left
     /// out of the matrix: they are `O(h^2)` against the kept terms, see docs/fem.md.)
+    /// Issue 22 (`docs/fem.md` section 9): the payload adds `cf f_p` (Eq. P11) to G's rows and
+    /// `M_p` to the matrix, the load subtracts `cf (Fx, Fy, Mz)` from G's rows (Eq. L2), damping
+    /// enters the element forces (Eqs. D7, D9; `fac.cv` the velocity factor gamma').
     /// Direct problem: `res[s_i] = cf ((mpp + mpa) s_i'' - Fa_i) - u_i . (nu_c + nu_l + nu_r)`,
     /// matrix diagonal `sliders.diag`, coupling `-u_i` with the sleeve's position rows.
     /// With `matrix == false` only the residual is evaluated (for a modified Newton iteration with
@@ -355,20 +359,28 @@ impl Star {
             sliders,
             ..
         } = it;
-        let Factors { cf, ck } = fac;
+        let cf = fac.cf;
         let rebuilt = self.ensure_pattern(q);
         let matrix = matrix || rebuilt;
         res.iter_mut().for_each(|r| *r = 0.0);
         let nodes = NodeState { q, v, qdd };
         let section = self.section();
         let vals = matrix.then_some(&mut self.vals[..]);
-        element_pass::add_forces(&self.elements, nodes, section, cf, ck, res, vals).map_err(|bad| {
+        element_pass::add_forces(&self.elements, nodes, section, fac, res, vals).map_err(|bad| {
             FemError::NonFinite {
                 t,
                 element: bad.element,
                 reason: format!("element chord length {}", bad.ln),
             }
         })?;
+        if let Some(p) = self.attached.payload {
+            self.add_payload(&p, &it, cf, res, matrix);
+        }
+        if let Some(f) = it.load {
+            for a in 0..3 {
+                res[a] -= cf * f[a];
+            }
+        }
         for i in 0..3 {
             self.sleeve_rows(i, &it, cf, res, matrix);
         }
@@ -601,6 +613,7 @@ impl Star {
             ea: self.params.ea(),
             ei: self.params.ei(),
             rho: self.params.rho,
+            beta: self.attached.beta,
         }
     }
 
@@ -672,8 +685,13 @@ mod tests {
                 lam: &lam,
                 pins: &pins,
                 sliders: sl,
+                load: None,
             },
-            Factors { cf: bp, ck: bp },
+            Factors {
+                cf: bp,
+                ck: bp,
+                cv: 3e-4,
+            },
             &mut res,
             0.0,
             true,

@@ -20,6 +20,7 @@ pub mod params;
 pub mod response;
 pub mod rest_pose;
 pub mod run_set;
+pub mod spline;
 pub mod trajectory;
 pub mod validity;
 

@@ -211,7 +211,11 @@ fn attachments_line(exp: &Experiment) -> Option<String> {
         parts.push(format!("Kelvin-Voigt damping (beta = {:.4e} s)", exp.damping.beta()));
     }
     if !exp.load.is_none() {
-        let how = if exp.load.file.is_some() { "a table" } else { "polynomials" };
+        let how = if exp.load.file.is_some() {
+            "a table"
+        } else {
+            "polynomials"
+        };
         parts.push(format!("a load at G ({how} of Fx, Fy, Mz)"));
     }
     (!parts.is_empty()).then(|| format!("The robot carries {}.", parts.join(", ")))

@@ -23,6 +23,9 @@ pub enum Violation {
     NoFermatPoint { vertex: usize, angle_deg: f64 },
     /// The trajectory could not be evaluated (e.g. inverse kinematics of a task-space pose).
     Trajectory(String),
+    /// A limit reached at a given via point or table row, or between two of them: `at` names
+    /// where (`trajectory.file: path: row 42 (s1 = ..)`, `between points 2 and 3`).
+    Located { at: String, violation: Box<Violation> },
 }
 
 impl std::fmt::Display for Violation {
@@ -52,6 +55,7 @@ impl std::fmt::Display for Violation {
                 ["I", "J", "K"][*vertex]
             ),
             Violation::Trajectory(msg) => write!(f, "{msg}"),
+            Violation::Located { at, violation } => write!(f, "{at}: {violation}"),
         }
     }
 }
@@ -115,7 +119,43 @@ fn configuration_margin(params: &RobotParams, s: [f64; 3]) -> (f64, Violation) {
 
 /// Check `[0, t_end]`: `Ok` if the motion stays feasible, otherwise the first time a limit is
 /// reached (scanned at steps of at most `scan_step` and refined by bisection) and the reason.
+///
+/// The given poses of a `via` or `table` trajectory (its [`Trajectory::knots`]) are checked
+/// first, each by [`check_configuration`], so that an infeasible row or point is named as such;
+/// a limit reached between them names the two it lies between (`docs/motions.md` section 1.6).
 pub fn check_trajectory(params: &RobotParams, traj: &Trajectory, t_end: f64, scan_step: f64) -> Result<(), Infeasible> {
+    check_knots(params, traj)?;
+    scan_trajectory(params, traj, t_end, scan_step).map_err(|e| match traj.between(e.t) {
+        Some(at) => Infeasible {
+            t: e.t,
+            violation: Violation::Located {
+                at,
+                violation: Box::new(e.violation),
+            },
+        },
+        None => e,
+    })
+}
+
+/// Every via point or table row of `traj` inside the feasible range.
+fn check_knots(params: &RobotParams, traj: &Trajectory) -> Result<(), Infeasible> {
+    for knot in traj.knots() {
+        let at = |violation| Infeasible {
+            t: knot.t,
+            violation: Violation::Located {
+                at: knot.label.clone(),
+                violation: Box::new(violation),
+            },
+        };
+        let s = traj
+            .s(params, knot.t)
+            .map_err(|e| at(Violation::Trajectory(e.to_string())))?;
+        check_configuration(params, s).map_err(at)?;
+    }
+    Ok(())
+}
+
+fn scan_trajectory(params: &RobotParams, traj: &Trajectory, t_end: f64, scan_step: f64) -> Result<(), Infeasible> {
     let n = ((t_end / scan_step.min(t_end / 200.0)).ceil() as usize).max(1);
     let (m0, v0) = margin(params, traj, 0.0);
     if m0 <= 0.0 {

@@ -387,16 +387,23 @@ impl Experiment {
         exp.source = path.to_path_buf();
         exp.drive.read_file(path)?;
         exp.load.read_file(path)?;
+        exp.robot.validate().map_err(|e| e.in_file(path))?;
+        exp.trajectory.read_file(path, &exp.robot)?;
         exp.validate().map_err(|e| e.in_file(path))?;
         Ok(exp)
     }
 
-    /// Every file besides the experiment file itself that this experiment reads (the forces
-    /// table of a `[drive]` of kind `forces`, the table of a `[load]`), resolved against
-    /// [`Experiment::source`]: what a fingerprint of the experiment must cover besides its text.
+    /// Every file besides the experiment file itself that this experiment reads (the table of
+    /// a `[trajectory]` of kind `table`, the forces table of a `[drive]` of kind `forces`, the
+    /// table of a `[load]`), resolved against [`Experiment::source`]: what a fingerprint of the
+    /// experiment must cover besides its text.
     pub fn input_files(&self) -> Vec<PathBuf> {
+        let traj = self.trajectory.file_path(&self.source);
         let drive = self.drive.file_path(&self.source);
-        drive.into_iter().chain(self.load.file_path(&self.source)).collect()
+        traj.into_iter()
+            .chain(drive)
+            .chain(self.load.file_path(&self.source))
+            .collect()
     }
 
     /// Check every value (keys named relative to the file).
@@ -419,18 +426,7 @@ impl Experiment {
         self.robot.validate()?;
         self.time.validate()?;
         self.trajectory.validate(&self.robot)?;
-        if let Trajectory::Quintic { t0, t1, .. } = self.trajectory {
-            if t0 >= self.time.t_end {
-                return Err(ModelError::invalid(
-                    "trajectory.t0",
-                    format!(
-                        "the quintic starts at t0 = {t0} s (ends at t1 = {t1} s), at or after \
-                         time.t_end = {} s: nothing would move; lower t0 or raise t_end",
-                        self.time.t_end
-                    ),
-                ));
-            }
-        }
+        self.check_motion_fits()?;
         self.amm.validate(self.time.dt_out)?;
         self.drive.validate(self.time.t_end, self.robot.mpp_mpa)?;
         self.payload.validate()?;
@@ -471,6 +467,33 @@ impl Experiment {
             }
         }
         Ok(())
+    }
+}
+
+impl Experiment {
+    /// A rest-to-rest motion must end by `time.t_end` (`docs/motions.md` section 1.5): one that
+    /// ends later would be cut off mid-move.
+    fn check_motion_fits(&self) -> Result<(), ModelError> {
+        let Some(t_rest) = self.trajectory.t_rest() else {
+            return Ok(());
+        };
+        let t_end = self.time.t_end;
+        if t_rest <= t_end {
+            return Ok(());
+        }
+        let (key, parts) = match &self.trajectory {
+            Trajectory::Quintic { t0, .. } => ("trajectory.t1", format!(" (quintic from t0 = {t0} s to t1)")),
+            Trajectory::Via(v) => ("trajectory.points", format!(" (the time of point {})", v.points.len())),
+            Trajectory::Table(_) => ("trajectory.file", " (the time of the table's last row)".to_string()),
+            Trajectory::Polynomial { .. } => ("trajectory", String::new()),
+        };
+        Err(ModelError::invalid(
+            key,
+            format!(
+                "the motion ends at t_rest = {t_rest} s{parts}, after time.t_end = {t_end} s \
+                 (it would be cut off mid-move); raise time.t_end to at least {t_rest} s"
+            ),
+        ))
     }
 }
 
@@ -638,12 +661,25 @@ s3 = [0.0, 0.0, 1.0]
             .unwrap_err()
             .to_string();
         assert!(
-            err.contains("trajectory.t0") && err.contains("0.6") && err.contains("0.8") && err.contains("t_end = 0.5"),
+            err.contains("trajectory.t1")
+                && err.contains("0.6")
+                && err.contains("t_rest = 0.8")
+                && err.contains("t_end = 0.5"),
             "{err}"
         );
-        // one that starts before t_end and ends after it is a valid (truncated) motion
-        let text = text.replace("t0 = 0.6", "t0 = 0.4");
-        assert!(Experiment::from_toml_str(&text, Path::new("q.toml")).is_ok());
+        // one that starts before t_end and ends after it would be cut off mid-move: refused too
+        // (issue 26), naming both times
+        let cut = text.replace("t0 = 0.6", "t0 = 0.4");
+        let err = Experiment::from_toml_str(&cut, Path::new("q.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("t_rest = 0.8") && err.contains("cut off") && err.contains("t_end = 0.5"),
+            "{err}"
+        );
+        // ending exactly at t_end is allowed
+        let exact = text.replace("t0 = 0.6", "t0 = 0.1").replace("t1 = 0.8", "t1 = 0.5");
+        assert!(Experiment::from_toml_str(&exact, Path::new("q.toml")).is_ok());
     }
 
     #[test]

@@ -1,5 +1,6 @@
-//! Actuator trajectories `s_i(t)` (paper, section 8): polynomials in t, or a rest-to-rest quintic
-//! between two task-space poses mapped through the inverse kinematics.
+//! Actuator trajectories `s_i(t)` (paper, section 8): polynomials in t, a rest-to-rest quintic
+//! between two task-space poses mapped through the inverse kinematics, and the kinds of issue 26
+//! (`docs/motions.md` section 1): via points and tables.
 
 use num_dual::Dual2;
 
@@ -8,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::ModelError;
 use crate::geometry::inverse_kinematics;
+use crate::motion::{TableMotion, TableSpace, ViaMotion, ViaPoint};
 use crate::params::RobotParams;
 
 /// A task-space pose of the rigid star: centre G [m] in the fixed frame and orientation theta [rad].
@@ -33,6 +35,11 @@ pub enum Trajectory {
     /// Rest-to-rest quintic from pose `from` at `t0` to pose `to` at `t1` (zero velocity and
     /// acceleration at both ends), holding still outside `[t0, t1]`.
     Quintic { from: Pose, to: Pose, t0: f64, t1: f64 },
+    /// Task-space via points with times (`docs/motions.md` 1.2, 1.3), mapped through the inverse
+    /// kinematics.
+    Via(ViaMotion),
+    /// Rows of a CSV file in task or slider space (`docs/motions.md` 1.4).
+    Table(TableMotion),
 }
 
 /// The kinds of [`Trajectory`], as the `kind` key names them.
@@ -41,6 +48,20 @@ pub enum Trajectory {
 pub enum TrajectoryKind {
     Polynomial,
     Quintic,
+    Via,
+    Table,
+}
+
+impl TrajectoryKind {
+    /// The name and the keys of the kind.
+    fn keys(self) -> (&'static str, &'static [&'static str]) {
+        match self {
+            TrajectoryKind::Polynomial => ("polynomial", &["s1", "s2", "s3"]),
+            TrajectoryKind::Quintic => ("quintic", &["from", "to", "t0", "t1"]),
+            TrajectoryKind::Via => ("via", &["points", "rest"]),
+            TrajectoryKind::Table => ("table", &["file", "columns"]),
+        }
+    }
 }
 
 /// The `[trajectory]` table as written: every key of every kind, checked against `kind` when
@@ -56,16 +77,17 @@ pub struct TrajectoryTable {
     to: Option<Pose>,
     t0: Option<f64>,
     t1: Option<f64>,
+    points: Option<Vec<ViaPoint>>,
+    rest: Option<bool>,
+    file: Option<std::path::PathBuf>,
+    columns: Option<TableSpace>,
 }
 
 impl TryFrom<TrajectoryTable> for Trajectory {
     type Error = String;
     fn try_from(t: TrajectoryTable) -> Result<Self, String> {
-        let (name, own, foreign): (_, &[&str], _) = match t.kind {
-            TrajectoryKind::Polynomial => ("polynomial", &["s1", "s2", "s3"], t.quintic_keys()),
-            TrajectoryKind::Quintic => ("quintic", &["from", "to", "t0", "t1"], t.polynomial_keys()),
-        };
-        if let Some(key) = foreign.first() {
+        let (name, own) = t.kind.keys();
+        if let Some(key) = t.present().into_iter().find(|k| !own.contains(k)) {
             return Err(format!(
                 "key `trajectory.{key}` does not belong to kind = \"{name}\" (its keys: {})",
                 own.join(", ")
@@ -84,33 +106,49 @@ impl TryFrom<TrajectoryTable> for Trajectory {
                 t0: t.t0.ok_or_else(|| missing("t0"))?,
                 t1: t.t1.ok_or_else(|| missing("t1"))?,
             },
+            TrajectoryKind::Via => Trajectory::Via(ViaMotion::new(
+                t.points.ok_or_else(|| missing("points"))?,
+                t.rest.unwrap_or(true),
+            )),
+            TrajectoryKind::Table => Trajectory::Table(TableMotion {
+                file: t.file.ok_or_else(|| missing("file"))?,
+                columns: t.columns,
+                data: None,
+            }),
         })
     }
 }
 
 impl TrajectoryTable {
-    fn polynomial_keys(&self) -> Vec<&'static str> {
+    /// The keys present besides `kind`, by TOML name.
+    fn present(&self) -> Vec<&'static str> {
         [
             ("s1", self.s1.is_some()),
             ("s2", self.s2.is_some()),
             ("s3", self.s3.is_some()),
-        ]
-        .into_iter()
-        .filter_map(|(k, present)| present.then_some(k))
-        .collect()
-    }
-
-    fn quintic_keys(&self) -> Vec<&'static str> {
-        [
             ("from", self.from.is_some()),
             ("to", self.to.is_some()),
             ("t0", self.t0.is_some()),
             ("t1", self.t1.is_some()),
+            ("points", self.points.is_some()),
+            ("rest", self.rest.is_some()),
+            ("file", self.file.is_some()),
+            ("columns", self.columns.is_some()),
         ]
         .into_iter()
         .filter_map(|(k, present)| present.then_some(k))
         .collect()
     }
+}
+
+/// A time at which a trajectory is given (a via point, a table row), named for messages.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Knot {
+    /// Time [s].
+    pub t: f64,
+    /// Where it is given: `trajectory.points: point 2 (Gx = .., Gy = .., theta = ..)` or
+    /// `trajectory.file: path: row 42 (s1 = .., s2 = .., s3 = ..)`.
+    pub label: String,
 }
 
 /// Value, first and second time derivative of one scalar.
@@ -159,6 +197,103 @@ impl Trajectory {
                 let th = blend * (to.theta - from.theta) + from.theta;
                 inverse_kinematics(params, g, th)
             }
+            Trajectory::Via(v) => {
+                let [gx, gy, th] = v.curve()?.eval(t);
+                inverse_kinematics(params, [gx, gy], th)
+            }
+            Trajectory::Table(tab) => {
+                let data = tab.data()?;
+                let c = data.eval(t);
+                match data.space {
+                    TableSpace::Task => inverse_kinematics(params, [c[0], c[1]], c[2]),
+                    TableSpace::Slider => Ok(c),
+                }
+            }
+        }
+    }
+
+    /// End of the motion `t_rest` [s] (`docs/motions.md` section 1.5): the time after which a
+    /// rest-to-rest kind holds still: `t1` of a quintic, the last via point's `t`, the last table
+    /// row's `t`; `None` for a polynomial (it never comes to rest) and for a table not yet read.
+    pub fn t_rest(&self) -> Option<f64> {
+        match self {
+            Trajectory::Polynomial { .. } => None,
+            Trajectory::Quintic { t1, .. } => Some(*t1),
+            Trajectory::Via(v) => v.points.last().map(|p| p.t),
+            Trajectory::Table(tab) => tab.data.as_ref().and_then(|d| d.t.last().copied()),
+        }
+    }
+
+    /// The via points or table rows, with their times and labels (empty for the polynomial and
+    /// quintic kinds): what a feasibility check names when a given pose is out of range.
+    pub fn knots(&self) -> Vec<Knot> {
+        match self {
+            Trajectory::Via(v) => v
+                .points
+                .iter()
+                .enumerate()
+                .map(|(k, p)| Knot {
+                    t: p.t,
+                    label: format!(
+                        "trajectory.points: point {} (Gx = {}, Gy = {}, theta = {})",
+                        k + 1,
+                        p.gx,
+                        p.gy,
+                        p.theta
+                    ),
+                })
+                .collect(),
+            Trajectory::Table(TableMotion {
+                file, data: Some(d), ..
+            }) => {
+                let names = d.space.columns();
+                let row = |k: usize, r: &[f64; 3]| {
+                    let vals: Vec<String> = (0..3).map(|c| format!("{} = {}", names[c], r[c])).collect();
+                    format!(
+                        "trajectory.file: {}: row {} ({})",
+                        file.display(),
+                        k + 1,
+                        vals.join(", ")
+                    )
+                };
+                d.t.iter()
+                    .zip(&d.rows)
+                    .enumerate()
+                    .map(|(k, (&t, r))| Knot { t, label: row(k, r) })
+                    .collect()
+            }
+            _ => Vec::new(),
+        }
+    }
+
+    /// Where `t` [s] lies among the via points or table rows, for messages:
+    /// `between points 2 and 3`, `between rows 41 and 42`; `None` outside them or for the
+    /// polynomial and quintic kinds.
+    pub fn between(&self, t: f64) -> Option<String> {
+        let (what, times): (&str, Vec<f64>) = match self {
+            Trajectory::Via(v) => ("points", v.points.iter().map(|p| p.t).collect()),
+            Trajectory::Table(TableMotion { data: Some(d), .. }) => ("rows", d.t.clone()),
+            _ => return None,
+        };
+        let k = times.partition_point(|&tk| tk <= t);
+        (k > 0 && k < times.len()).then(|| format!("between {what} {k} and {}", k + 1))
+    }
+
+    /// Read the file of a `table` (relative to the experiment file `config`) for the robot
+    /// `params`; a no-op for the other kinds. Errors name `config`, `trajectory.file`, the table
+    /// file and the row.
+    pub fn read_file(&mut self, config: &std::path::Path, params: &RobotParams) -> Result<(), ModelError> {
+        match self {
+            Trajectory::Table(tab) => tab.read_file(config, params),
+            _ => Ok(()),
+        }
+    }
+
+    /// The table file of a `table`, resolved against the experiment file `config`.
+    pub fn file_path(&self, config: &std::path::Path) -> Option<std::path::PathBuf> {
+        match self {
+            Trajectory::Table(tab) => Some(tab.file_path(config)),
+            _ => None,
         }
     }
 
@@ -212,6 +347,10 @@ impl Trajectory {
                     inverse_kinematics(params, [pose.gx, pose.gy], pose.theta)
                         .map_err(|e| ModelError::invalid(key, e.to_string()))?;
                 }
+            }
+            Trajectory::Via(v) => v.validate(params)?,
+            Trajectory::Table(tab) => {
+                tab.data()?;
             }
         }
         Ok(())

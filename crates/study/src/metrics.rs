@@ -1,7 +1,7 @@
 //! What a study records of each run: peaks of the response, vibration left after a rest-to-rest
 //! motion, and the AMM's accuracy against the FEM (Eq. 45).
 
-use flexstar_model::{Experiment, Response, Trajectory};
+use flexstar_model::{Experiment, Response};
 use flexstar_numerics::measures::max_abs;
 
 /// Peak magnitudes of one response over the whole time span.
@@ -29,13 +29,11 @@ pub fn peaks(r: &Response) -> Peaks {
     }
 }
 
-/// End of the motion [s]: `t1` of a rest-to-rest quintic that ends before `time.t_end`; `None`
-/// for polynomial motions (they never come to rest).
+/// End of the motion [s]: the `t_rest` of a rest-to-rest trajectory (quintic, via, table;
+/// [`flexstar_model::Trajectory::t_rest`]) that ends before `time.t_end`; `None` for polynomial
+/// motions (they never come to rest).
 pub fn motion_end(exp: &Experiment) -> Option<f64> {
-    match exp.trajectory {
-        Trajectory::Quintic { t1, .. } if t1 < exp.time.t_end => Some(t1),
-        _ => None,
-    }
+    exp.trajectory.t_rest().filter(|&t| t < exp.time.t_end)
 }
 
 /// Residual vibration: largest |w_i(L)| over the tips at the output times `t >= t_motion_end` [m].

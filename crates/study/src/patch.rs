@@ -8,7 +8,11 @@
 /// - quintic trajectory: `t0`, `t1` become `k t0`, `k t1`, and `time.t_end` grows by
 ///   `(k - 1) t1`, so the time at rest after the motion is kept;
 /// - polynomial trajectory: `s_i(t)` becomes `s_i(t / k)` (coefficient of `t^m` divided by
-///   `k^m`) and `time.t_end` becomes `k t_end`: the same path, k times slower.
+///   `k^m`) and `time.t_end` becomes `k t_end`: the same path, k times slower;
+/// - via trajectory: every point's `t` becomes `k t`, and `time.t_end` grows by `(k - 1) t_last`
+///   (the rest after the motion is kept, as for the quintic);
+/// - table trajectory: refused (the file's times cannot be edited by a patch;
+///   `docs/motions.md` section 1.5).
 pub const SCALE_DURATION: &str = "scale.duration";
 
 /// The base document with `values[j]` set at `keys[j]` (derived keys applied last). An error is a
@@ -90,6 +94,13 @@ fn scale_duration(doc: &mut toml::Table, k: f64) -> Result<(), String> {
             set_dotted(doc, "trajectory.t1", toml::Value::Float(k * t1))?;
             set_dotted(doc, "time.t_end", toml::Value::Float(t_end + (k - 1.0) * t1))?;
         }
+        "via" => scale_via(doc, k, t_end)?,
+        "table" => {
+            return Err(format!(
+                "{SCALE_DURATION} cannot scale a kind = \"table\" trajectory (its times are in the file): \
+                 vary the table file instead"
+            ))
+        }
         "polynomial" => {
             for s in ["s1", "s2", "s3"] {
                 let Some(coefs) = doc.get("trajectory").and_then(|t| t.get(s)).and_then(|c| c.as_array()) else {
@@ -112,9 +123,53 @@ fn scale_duration(doc: &mut toml::Table, k: f64) -> Result<(), String> {
     Ok(())
 }
 
+/// `scale.duration` of a via trajectory: each point's `t` times k, the rest after the last kept.
+fn scale_via(doc: &mut toml::Table, k: f64, t_end: f64) -> Result<(), String> {
+    let points = doc
+        .get_mut("trajectory")
+        .and_then(|t| t.get_mut("points"))
+        .and_then(|p| p.as_array_mut())
+        .ok_or("scale.duration: the via trajectory has no array trajectory.points")?;
+    let mut last = 0.0f64;
+    for (j, p) in points.iter_mut().enumerate() {
+        let t = p
+            .get("t")
+            .and_then(number)
+            .ok_or_else(|| format!("scale.duration: point {} of trajectory.points has no number t", j + 1))?;
+        let table = p.as_table_mut().expect("a point with a key t is a table");
+        table.insert("t".into(), toml::Value::Float(k * t));
+        last = last.max(t);
+    }
+    set_dotted(doc, "time.t_end", toml::Value::Float(t_end + (k - 1.0) * last))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn duration_scale_of_via_points_keeps_the_rest_and_refuses_tables() {
+        let mut doc: toml::Table = "[time]\nt_end = 1.5\n[trajectory]\nkind = \"via\"\npoints = [\
+             { t = 0.0, Gx = 0.0, Gy = 0.0, theta = 0.0 }, { t = 0.4, Gx = 0.01, Gy = 0.0, theta = 0.0 }, \
+             { t = 1, Gx = 0.0, Gy = 0.0, theta = 0.0 }]\n"
+            .parse()
+            .unwrap();
+        scale_duration(&mut doc, 2.0).unwrap();
+        let t: Vec<f64> = doc["trajectory"]["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| number(&p["t"]).unwrap())
+            .collect();
+        assert_eq!(t, vec![0.0, 0.8, 2.0]);
+        // 0.5 s of rest after the motion, before and after
+        assert_eq!(number(&doc["time"]["t_end"]), Some(2.5));
+        let mut doc: toml::Table = "[time]\nt_end = 1.5\n[trajectory]\nkind = \"table\"\nfile = \"a.csv\"\n"
+            .parse()
+            .unwrap();
+        let err = scale_duration(&mut doc, 2.0).unwrap_err();
+        assert!(err.contains("scale.duration") && err.contains("table"), "{err}");
+    }
 
     #[test]
     fn nested_keys_are_created_and_non_tables_refused() {

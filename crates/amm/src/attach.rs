@@ -102,7 +102,8 @@ impl PayloadTerms {
         let sp = nalgebra::Matrix3::from_fn(|a, b| self.mass[a][b] + gp * d[a][b] + bp * k[a][b]);
         let hm = nalgebra::Matrix3::from_fn(|a, b| h[a][b]);
         let lhs = nalgebra::Matrix3::identity() + sp * hm;
-        match lhs.lu().solve(&sp) {
+        // nalgebra inverts a 3 x 3 in closed form (its determinant tested against zero)
+        match lhs.try_inverse().map(|inv| inv * sp) {
             Some(w) if w.iter().all(|v| v.is_finite()) => {
                 self.w = std::array::from_fn(|a| std::array::from_fn(|b| w[(a, b)]));
                 true

@@ -103,28 +103,45 @@ struct BeamRows {
 }
 
 impl BeamRows {
-    /// Local row k in [`RowForm`].
-    fn form(&self, k: usize) -> RowForm {
-        (self.basis[k], self.sc[k], self.cu[k], self.ct[k])
-    }
-
-    /// `c_k S^-1 c_s^T` for two rows of this beam's form at the prepared step (the formula of
-    /// [`BeamRows::add_block`]): `(cu_k - p g_k)(cu_s + p g_s) / sigma + ct_k ct_s / Jp + sc_k sc_s
-    /// gram[b_k][b_s]`.
-    fn product(
-        &self,
-        (bk, sk, uk, tk): RowForm,
-        (bs, ss, us, ts): RowForm,
-        p: f64,
-        inv_sigma: f64,
-        inv_jp: f64,
-    ) -> f64 {
-        let g = |b: usize, s: f64| if b == NONE { 0.0 } else { s * self.g[b] };
-        let mut v = (uk - p * g(bk, sk)) * (us + p * g(bs, ss)) * inv_sigma + tk * ts * inv_jp;
-        if bk != NONE && bs != NONE {
-            v += sk * ss * self.gram[bk][bs];
+    /// The products of this beam's rows with the payload's rows P (Eq. P1) at the prepared step:
+    /// `H = P S^-1 P^T`, `C S^-1 P^T` (row k: `cross[k]`) and `P S^-1 C^T` (column k: `back[k]`),
+    /// by the formula of [`BeamRows::add_block`], `c_k S^-1 c_s^T = (cu_k - p g_k)(cu_s + p g_s)
+    /// / sigma + ct_k ct_s / Jp + sc_k sc_s gram[b_k][b_s]` (P has no thp part, so no Jp term).
+    #[allow(clippy::type_complexity)]
+    fn payload_products(&self, p: f64, inv_sigma: f64) -> (Mat3, [[f64; 3]; MAX_BEAM_ROWS], [[f64; 3]; MAX_BEAM_ROWS]) {
+        let (g0, g1) = (self.g[B_PHI0], self.g[B_DPHI0]);
+        // the u-elimination factors of the rows u_1, phi(0) . alpha_1, phi'(0) . alpha_1
+        let left = [inv_sigma, -p * g0 * inv_sigma, -p * g1 * inv_sigma];
+        let right = [1.0, p * g0, p * g1];
+        let basis = [NONE, B_PHI0, B_DPHI0];
+        let mut h = [[0.0; 3]; 3];
+        for a in 0..3 {
+            for b in 0..3 {
+                let gram = if a > 0 && b > 0 {
+                    self.gram[basis[a]][basis[b]]
+                } else {
+                    0.0
+                };
+                h[a][b] = left[a] * right[b] + gram;
+            }
         }
-        v
+        let (mut cross, mut back) = ([[0.0; 3]; MAX_BEAM_ROWS], [[0.0; 3]; MAX_BEAM_ROWS]);
+        for k in 0..self.ids.len() {
+            let (bk, sk) = (self.basis[k], self.sc[k]);
+            let gk = if bk == NONE { 0.0 } else { sk * self.g[bk] };
+            let (lk, rk) = ((self.cu[k] - p * gk) * inv_sigma, self.cu[k] + p * gk);
+            for a in 0..3 {
+                // the Gram matrix is symmetric: one entry for both products
+                let gram = if bk != NONE && a > 0 {
+                    sk * self.gram[bk][basis[a]]
+                } else {
+                    0.0
+                };
+                cross[k][a] = lk * right[a] + gram;
+                back[k][a] = left[a] * rk + gram;
+            }
+        }
+        (h, cross, back)
     }
 
     /// The Gram matrix `B D^-1 B^T` of this beam's six vectors and `g = B D^-1 Phi` (see
@@ -639,7 +656,13 @@ impl System {
 
     /// The rigid quantities of the payload's terms ([`RigidTerms`]) on beam 1's frame at `st`.
     fn payload_motion(st: &RigidState) -> RigidTerms {
-        let (ex, ew, ag) = (st.e_x(0), st.e_w(0), st.a_g());
+        Self::payload_motion_along(st, st.e_x(0))
+    }
+
+    /// [`System::payload_motion`] with beam 1's axis `ex = e_x1` given.
+    fn payload_motion_along(st: &RigidState, ex: [f64; 2]) -> RigidTerms {
+        let ag = st.a_g();
+        let ew = [-ex[1], ex[0]];
         let thd = st.theta.d1;
         [
             ag[0] * ex[0] + ag[1] * ex[1],
@@ -656,15 +679,16 @@ impl System {
     /// ([`RigidTerms`]; the load's projection is frozen at the predicted angle, `docs/amm.md` 11.3).
     fn attachment_forcing(&mut self, st: &RigidState, qhat: &[f64], vhat: &[f64], change: Option<RigidTerms>) {
         let nm = self.nm;
+        let ex = st.e_x(0);
+        let ew = [-ex[1], ex[0]];
         let mut rp = [0.0; 3];
         if let Some(pl) = &self.payload {
-            let x = change.unwrap_or_else(|| Self::payload_motion(st));
+            let x = change.unwrap_or_else(|| Self::payload_motion_along(st, ex));
             let (zq, zv) = (self.payload_coordinates(qhat), self.payload_coordinates(vhat));
             rp = pl.forcing(x, zq, zv);
         }
         if let (Some(load), None) = (&self.load, change) {
             let [fx, fy, mz] = load.at(st.t);
-            let (ex, ew) = (st.e_x(0), st.e_w(0));
             rp[0] += fx * ex[0] + fy * ex[1];
             rp[1] += fx * ew[0] + fy * ew[1];
             rp[2] += mz;
@@ -729,7 +753,8 @@ impl System {
         if self.payload.is_some() {
             // Eqs. P3-P5 are linear in (a1, a2, theta'', theta', theta'^2): their change along
             // the motion's change, with e_x1 frozen at the predictor as for the beams
-            let (ex, ew) = (st.e_x(0), st.e_w(0));
+            let ex = st.e_x(0);
+            let ew = [-ex[1], ex[0]];
             let change = [
                 d_ag[0] * ex[0] + d_ag[1] * ex[1],
                 d_ag[0] * ew[0] + d_ag[1] * ew[1],
@@ -784,7 +809,7 @@ impl System {
             beam.add_block(a_mat, m, p, inv_sigma, inv_jp);
         }
         if self.payload.is_some() {
-            self.payload_block(st, bp, gp)?;
+            self.payload_block(st, Self::payload_motion(st), bp, gp)?;
         }
         self.lu
             .factor(&self.a)
@@ -794,15 +819,13 @@ impl System {
     /// The payload's Woodbury correction of beam 1's block of the Schur complement (module docs of
     /// `attach`): `A_0 -= (C_0 S^-1 P^T) W (P S^-1 C_0^T)`, every product from the Gram data of
     /// the step ([`BeamRows::product`]); sets `W` and `C_0 S^-1 P^T` for the substitution.
-    fn payload_block(&mut self, st: &RigidState, bp: f64, gp: f64) -> Result<(), AmmError> {
-        let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp);
+    fn payload_block(&mut self, st: &RigidState, x: RigidTerms, bp: f64, gp: f64) -> Result<(), AmmError> {
         let (beam, m) = (&self.beams[0], self.rows.len());
         let Some(pl) = self.payload.as_mut() else {
             return Ok(());
         };
-        let prod = |a: RowForm, b: RowForm| beam.product(a, b, p, inv_sigma, inv_jp);
-        let h: Mat3 = std::array::from_fn(|a| std::array::from_fn(|b| prod(PAYLOAD_ROWS[a], PAYLOAD_ROWS[b])));
-        if !pl.set_woodbury(Self::payload_motion(st), bp, gp, &h) {
+        let (h, cross, back) = beam.payload_products(self.p, self.inv_sigma);
+        if !pl.set_woodbury(x, bp, gp, &h) {
             return Err(AmmError::SingularConstraints {
                 t: st.t,
                 source: RankError::Payload,
@@ -810,19 +833,16 @@ impl System {
         }
         let mb = beam.ids.len();
         // W (P S^-1 C_0^T), 3 x mb
-        let mut wg = [[0.0; MAX_BEAM_ROWS]; 3];
-        for s in 0..mb {
-            let g_pc: [f64; 3] = std::array::from_fn(|a| prod(PAYLOAD_ROWS[a], beam.form(s)));
-            let col = pl.apply_w(g_pc);
-            for a in 0..3 {
-                wg[a][s] = col[a];
-            }
+        let mut wg = [[0.0; 3]; MAX_BEAM_ROWS];
+        for (w, b) in wg.iter_mut().zip(&back).take(mb) {
+            *w = pl.apply_w(*b);
         }
         for k in 0..mb {
-            pl.cross[k] = std::array::from_fn(|a| prod(beam.form(k), PAYLOAD_ROWS[a]));
+            pl.cross[k] = cross[k];
+            let c = cross[k];
             let row = &mut self.a[beam.ids[k] * m..(beam.ids[k] + 1) * m];
-            for s in 0..mb {
-                row[beam.ids[s]] -= (0..3).map(|a| pl.cross[k][a] * wg[a][s]).sum::<f64>();
+            for (s, w) in wg.iter().enumerate().take(mb) {
+                row[beam.ids[s]] -= c[0] * w[0] + c[1] * w[1] + c[2] * w[2];
             }
         }
         Ok(())

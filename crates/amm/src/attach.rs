@@ -112,6 +112,12 @@ impl PayloadTerms {
         }
     }
 
+    /// Eq. P2, the payload's mass matrix on z (for tests).
+    #[cfg(test)]
+    pub(crate) fn mass_matrix(&self) -> Mat3 {
+        self.mass
+    }
+
     /// `W z` for a 3-vector z.
     pub(crate) fn apply_w(&self, z: [f64; 3]) -> [f64; 3] {
         std::array::from_fn(|a| (0..3).map(|b| self.w[a][b] * z[b]).sum())
@@ -150,11 +156,9 @@ mod tests {
         )
         .unwrap();
         let (d, _, _) = p.rates([1.0, 2.0, 3.0, 4.0, 16.0]);
-        for a in 0..3 {
-            for b in 0..3 {
-                assert_eq!(d[a][b], -d[b][a]);
-                assert_eq!(p.mass[a][b], p.mass[b][a]);
-            }
+        for (a, b) in (0..3).flat_map(|a| (0..3).map(move |b| (a, b))) {
+            assert_eq!(d[a][b], -d[b][a]);
+            assert_eq!(p.mass[a][b], p.mass[b][a]);
         }
     }
 

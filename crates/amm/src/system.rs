@@ -837,9 +837,8 @@ impl System {
         for (w, b) in wg.iter_mut().zip(&back).take(mb) {
             *w = pl.apply_w(*b);
         }
-        for k in 0..mb {
-            pl.cross[k] = cross[k];
-            let c = cross[k];
+        for ((k, &c), saved) in cross.iter().enumerate().zip(pl.cross.iter_mut()).take(mb) {
+            *saved = c;
             let row = &mut self.a[beam.ids[k] * m..(beam.ids[k] + 1) * m];
             for (s, w) in wg.iter().enumerate().take(mb) {
                 row[beam.ids[s]] -= c[0] * w[0] + c[1] * w[1] + c[2] * w[2];
@@ -954,8 +953,14 @@ impl System {
         }
         self.lu.solve(&mut self.rhs);
         self.lam.copy_from_slice(&self.rhs);
+        self.substitute(qdd);
+    }
 
-        // qdd = S^-1 (r + C^T lambda): collect the multipliers per basis vector, then one axpy each
+    /// `qdd = S^-1 (r + C^T lambda)` for the multipliers `self.lam` of the step's solve, beam 1
+    /// with the payload's Woodbury correction.
+    fn substitute(&mut self, qdd: &mut [f64]) {
+        let (nm, nb) = (self.nm, self.nb);
+        // collect the multipliers per basis vector, then one axpy each
         qdd.copy_from_slice(&self.resid);
         for (i, beam) in self.beams.iter().enumerate() {
             let o = i * nb;
@@ -1041,5 +1046,98 @@ impl System {
             }
         }
         r.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::integrate;
+    use flexstar_model::{AmmSettings, ModeFamily, Trajectory};
+
+    #[test]
+    fn energy_balance_at_a_locked_pose() {
+        // docs/amm.md 11.5, Eq. C6 where it is exact for the AMM: the star held at the centre pose
+        // (sliders fixed: theta' = theta'' = 0, a_G = 0, time-invariant constraints that do no
+        // work), paper model, a payload off G, damping and a load from zero. Kinetic energy
+        // (beams, sleeves, payload: Eq. P2) + strain energy + dissipated (Eq. D4) = load work,
+        // from the stored coordinates (central differences, midpoint rule: O(h^2)).
+        let mut exp = flexstar_model::catalogue::paper_case(3);
+        exp.trajectory = Trajectory::Polynomial {
+            s1: vec![0.0],
+            s2: vec![0.0],
+            s3: vec![0.0],
+        };
+        exp.time.t_end = 0.5;
+        exp.payload = Payload {
+            mass: 0.8,
+            j: 3e-3,
+            offset: [0.04, 0.02],
+        };
+        exp.damping = Damping::with_beta(3e-3);
+        // from zero with zero rate, on the time scale of the first period (0.25 s)
+        exp.load = LoadSettings::polynomials(
+            Some(vec![0.0, 0.0, 100.0, -200.0]),
+            Some(vec![0.0, 0.0, -60.0, 80.0]),
+            Some(vec![0.0, 0.0, 8.0, -12.0]),
+        );
+        let settings = AmmSettings::paper(ModeFamily::FreeFree, 20);
+        let mut qs: Vec<Vec<f64>> = vec![vec![0.0; 3 * 22]];
+        let mut sys_copy = None;
+        integrate(&exp, &settings, 20, true, |sys, q| {
+            qs.push(q.to_vec());
+            sys_copy.get_or_insert_with(|| sys.clone());
+        })
+        .unwrap();
+        let sys = sys_copy.unwrap();
+        let h = exp.time.t_end / (qs.len() - 1) as f64;
+        let (nm, nb, rho) = (sys.nm, sys.nb, sys.rho);
+        let pl = PayloadTerms::new(&exp.payload, 0).unwrap();
+        let mp = pl.mass_matrix();
+        // T + V at step n (central velocity), P_d and the load's power on [n, n+1] (midpoint)
+        let energy = |n: usize| {
+            let v: Vec<f64> = (0..qs[n].len())
+                .map(|k| (qs[n + 1][k] - qs[n - 1][k]) / (2.0 * h))
+                .collect();
+            let mut e = 0.0;
+            for i in 0..3 {
+                let o = i * nb;
+                for j in 0..nm {
+                    e += 0.5 * rho * (v[o + j].powi(2) + sys.lambda_m[j] * qs[n][o + j].powi(2));
+                }
+                e += 0.5 * (rho * sys.l * v[o + nm].powi(2) + sys.jp * v[o + nm + 1].powi(2));
+            }
+            let zv = sys.payload_coordinates(&v);
+            e + 0.5
+                * (0..3)
+                    .map(|a| (0..3).map(|b| zv[a] * mp[a][b] * zv[b]).sum::<f64>())
+                    .sum::<f64>()
+        };
+        let (mut work, mut dissipated, mut worst, mut work_max) = (0.0, 0.0, 0.0f64, 0.0f64);
+        for n in 0..qs.len() - 2 {
+            let dq: Vec<f64> = (0..qs[n].len()).map(|k| qs[n + 1][k] - qs[n][k]).collect();
+            let dz = sys.payload_coordinates(&dq);
+            // theta = 0: e_x1 = (0, -1), e_w1 = (1, 0), so (F . e_x1, F . e_w1, Mz) = (-Fy, Fx, Mz)
+            let [fx, fy, mz] = exp.load.at((n as f64 + 0.5) * h);
+            work += -fy * dz[0] + fx * dz[1] + mz * dz[2];
+            for i in 0..3 {
+                for j in 0..nm {
+                    dissipated += exp.damping.beta() * rho * sys.lambda_m[j] * dq[i * nb + j].powi(2) / h;
+                }
+            }
+            if n >= 1 {
+                worst = worst.max((energy(n + 1) + dissipated - work).abs());
+                work_max = work_max.max(work.abs());
+            }
+        }
+        eprintln!("load work {work:e} J, dissipated {dissipated:e} J, worst imbalance {worst:e} J");
+        assert!(
+            dissipated > 0.01 * work_max,
+            "the damping must matter: {dissipated:e} of {work_max:e}"
+        );
+        assert!(
+            worst < 1e-4 * work_max,
+            "imbalance {worst:e} J against the work {work_max:e} J"
+        );
     }
 }

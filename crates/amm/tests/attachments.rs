@@ -302,3 +302,61 @@ fn free_decay_gives_the_first_modes_damping_ratio() {
         }
     }
 }
+
+#[test]
+fn direct_run_inverts_the_inverse_run_with_payload_damping_and_load() {
+    // the inverse run's Fa (output at every solver step) fed back to the direct solver give the
+    // motion and the vibration back (as tests/direct.rs does for the bare star): the payload's
+    // dependence on the sliders' accelerations (forcing_derivative), the damping and the load
+    // in the coupled step
+    use flexstar_drive::ForceTable;
+    use flexstar_model::evp::point_evps;
+    let mut exp = with(common::quintic(RobotParams::paper(), 0.15), &attached());
+    exp.damping = Damping::with_beta(1e-3);
+    for (family, model, n) in [
+        (ModeFamily::FreeFree, AmmModel::Paper, 25),
+        (ModeFamily::Enriched, AmmModel::Full, 40),
+    ] {
+        let settings = AmmSettings {
+            model,
+            ..AmmSettings::paper(family, n)
+        };
+        let mut fine = exp.clone();
+        fine.time.dt_out = flexstar_amm::DEFAULT_DT;
+        let inverse_fine = solve(&fine, &settings).unwrap();
+        let fa = (0..inverse_fine.len())
+            .map(|k| [inverse_fine.fa[0][k], inverse_fine.fa[1][k], inverse_fine.fa[2][k]])
+            .collect();
+        let table = ForceTable::new(inverse_fine.t.clone(), fa).unwrap();
+        let inverse = solve(&exp, &settings).unwrap();
+        let direct = solve_direct(&exp, &settings, &table).unwrap();
+        let mut ds = 0.0f64;
+        for (k, &t) in direct.t.iter().enumerate() {
+            let s = exp.trajectory.s(&exp.robot, t).unwrap();
+            for i in 0..3 {
+                ds = ds.max((direct.column(["s1", "s2", "s3"][i]).unwrap()[k] - s[i]).abs());
+            }
+        }
+        let evp = point_evps(&direct, &inverse).unwrap();
+        let worst = evp.points.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
+        eprintln!("{family} {model}: |s - s_ref| <= {ds:.3e} m, worst point EVP {worst:.2e} %");
+        assert!(ds < 1e-6 && worst < 0.1, "{family} {model}: {ds:e} m, {worst} %");
+    }
+}
+
+#[test]
+fn every_family_accepts_the_attachments() {
+    // docs/amm.md 11.7, open question 2: the paper's families run with a payload, damping and a
+    // load (losing what their condition at G removes), finite and changed by them
+    for family in ModeFamily::PAPER {
+        let settings = AmmSettings::paper(family, 20);
+        let mut bare = common::paper_case(3);
+        bare.time.t_end = 0.1;
+        let mut loaded = with(bare.clone(), &attached());
+        loaded.damping = Damping::with_beta(1e-3);
+        let (a, b) = (solve(&bare, &settings).unwrap(), solve(&loaded, &settings).unwrap());
+        assert!(b.fa.iter().chain(&b.w_tip).flatten().all(|v| v.is_finite()), "{family}");
+        let moved = (0..3).any(|i| (0..a.len()).any(|k| (a.fa[i][k] - b.fa[i][k]).abs() > 1e-3));
+        assert!(moved, "{family}: the payload changes nothing");
+    }
+}

@@ -88,5 +88,30 @@ fn direct_vs_inverse(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, paper_cases, accurate_model, direct_vs_inverse);
+/// Issue 22 item 6: the accurate model (case 3, N = 53) bare and with a payload off G, damping
+/// and a load with all three components; target at most 10 % more time.
+fn attachments(c: &mut Criterion) {
+    use flexstar_model::{Damping, LoadSettings, Payload};
+    let mut group = c.benchmark_group("amm_issue22");
+    group.sample_size(20);
+    let bare = common::paper_case(3);
+    let mut loaded = bare.clone();
+    loaded.payload = Payload {
+        mass: 0.8,
+        j: 3e-3,
+        offset: [0.04, 0.02],
+    };
+    loaded.damping = Damping::with_beta(8e-4);
+    loaded.load = LoadSettings::polynomials(Some(vec![0.0, 0.0, 12.0]), Some(vec![0.0, -4.0]), Some(vec![0.0, 0.5]));
+    let fixed = flexstar_model::AmmSettings {
+        modes: Some(53),
+        ..flexstar_model::AmmSettings::accurate()
+    };
+    for (label, exp) in [("bare", &bare), ("payload_damping_load", &loaded)] {
+        group.bench_function(format!("case3_n53_{label}"), |b| b.iter(|| solve(exp, &fixed).unwrap()));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, paper_cases, accurate_model, direct_vs_inverse, attachments);
 criterion_main!(benches);

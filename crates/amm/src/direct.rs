@@ -27,7 +27,6 @@ use num_dual::{Dual2, HyperDual64};
 
 use crate::adaptive;
 use crate::error::{AmmError, RankError};
-use crate::modes::ModeSet;
 use crate::record::Recorder;
 use crate::solver::{snapshot_times, stops, validate, Stop, RHO_INF};
 use crate::system::System;
@@ -232,8 +231,7 @@ fn integrate_direct(
     let started = std::time::Instant::now();
     let dt_max = validate(exp, settings, n_modes, scan)?;
     let params = &exp.robot;
-    let modes = ModeSet::new(settings.family, n_modes, params)?;
-    let mut sys = System::new(modes, params, settings.model);
+    let mut sys = crate::solver::build_system(settings, n_modes, exp)?;
     let n = sys.dim();
 
     let out_times = exp.time.output_times();

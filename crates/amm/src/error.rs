@@ -93,6 +93,9 @@ pub enum RankError {
     /// (`ratio`: the pivot against the largest entry).
     #[error("rank-deficient at elimination step {step} of {size} (pivot ratio {ratio:e})")]
     RankDeficient { step: usize, size: usize, ratio: f64 },
+    /// The payload's rank-3 update of beam 1's step matrix (Eq. P6, Woodbury) is singular.
+    #[error("beam 1's step matrix with the payload (Eq. P6) is singular")]
+    Payload,
     /// The 3 x 3 system of the sliders' equations (Eq. 33) of a direct run is singular.
     #[error("the sliders' equations (Eq. 33) are singular")]
     Sliders,

@@ -124,7 +124,7 @@ mod tests {
             let started = std::time::Instant::now();
             integrate_system(&exp, &settings, sys, TOLERANCE_DT, started, |_, _| {}).unwrap()
         };
-        let sys = build_system(&settings, n, &exp.robot).unwrap();
+        let sys = build_system(&settings, n, &exp).unwrap();
         let kept = run(sys.clone());
         let all = run(sys.with_geometric_kept(n));
         let e = point_evps(&kept, &all).unwrap();
@@ -135,7 +135,7 @@ mod tests {
         );
         assert!(e.mean.unwrap() < 5e-3 && worst < 1e-2, "{e:?}");
         // and the truncation is a truncation: keeping fewer modes moves the response more
-        let fewer = run(build_system(&settings, n, &exp.robot).unwrap().with_geometric_kept(4));
+        let fewer = run(build_system(&settings, n, &exp).unwrap().with_geometric_kept(4));
         assert!(point_evps(&fewer, &all).unwrap().mean.unwrap() > 3.0 * e.mean.unwrap());
     }
 }

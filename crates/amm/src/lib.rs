@@ -19,6 +19,7 @@
 #![allow(rustdoc::broken_intra_doc_links)]
 
 pub mod adaptive;
+mod attach;
 mod constraint_lu;
 pub mod direct;
 pub mod error;

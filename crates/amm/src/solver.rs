@@ -13,7 +13,7 @@ use flexstar_kinematics::{
     check_configuration, check_trajectory, preflight_step, CheckedMotion, Infeasible, RigidState,
 };
 use flexstar_model::config::check_step;
-use flexstar_model::{AmmSettings, Experiment, ModeCount, ModeFamily, Response, RobotParams, RunInfo};
+use flexstar_model::{AmmSettings, Experiment, ModeCount, ModeFamily, Response, RunInfo};
 use flexstar_numerics::GenAlpha;
 
 use crate::adaptive::{self, Pass};
@@ -66,6 +66,9 @@ pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, s
     exp.robot.validate()?;
     exp.time.validate()?;
     exp.trajectory.validate(&exp.robot)?;
+    exp.payload.validate()?;
+    exp.damping.validate()?;
+    exp.load.validate(exp.time.t_end)?;
     settings.validate(exp.time.dt_out).map_err(|e| match e {
         flexstar_model::ModelError::Invalid { key, reason, .. } => AmmError::invalid(key, reason),
         other => other.into(),
@@ -272,7 +275,7 @@ fn solve_to_tolerance(
             Some((m, sys)) if *m == n => sys.clone(),
             _ => {
                 validate(exp, settings, n, false)?;
-                let sys = build_system(settings, n, &exp.robot)?;
+                let sys = build_system(settings, n, exp)?;
                 built = Some((n, sys.clone()));
                 sys
             }
@@ -297,10 +300,13 @@ fn solve_to_tolerance(
     })
 }
 
-/// The constrained system of N = `n_modes` modes of `settings.family` for the robot `params`.
-pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, params: &RobotParams) -> Result<System, AmmError> {
-    let modes = ModeSet::new(settings.family, n_modes, params)?;
-    Ok(System::new(modes, params, settings.model))
+/// The constrained system of N = `n_modes` modes of `settings.family` for the robot of `exp`,
+/// with its payload, damping and load (issue 22; nothing added at their defaults).
+pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, exp: &Experiment) -> Result<System, AmmError> {
+    let modes = ModeSet::new(settings.family, n_modes, &exp.robot)?;
+    let mut sys = System::new(modes, &exp.robot, settings.model);
+    sys.attach(&exp.payload, &exp.damping, &exp.load);
+    Ok(sys)
 }
 
 /// [`solve`] at N = `n_modes` with an observer called after every step with the system and the
@@ -315,7 +321,7 @@ pub(crate) fn integrate<F: FnMut(&System, &[f64])>(
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
     let dt_max = validate(exp, settings, n_modes, scan)?;
-    let sys = build_system(settings, n_modes, &exp.robot)?;
+    let sys = build_system(settings, n_modes, exp)?;
     integrate_system(exp, settings, sys, dt_max, started, observe)
 }
 

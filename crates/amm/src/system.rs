@@ -21,10 +21,11 @@
 //! are eliminated by the Schur complement `A = C S^-1 C^T`, a small dense LU per step.
 
 use flexstar_kinematics::RigidState;
-use flexstar_model::{AmmModel, RobotParams};
+use flexstar_model::{AmmModel, Damping, LoadSettings, Payload, RobotParams};
 
+use crate::attach::{Mat3, PayloadTerms, RigidTerms};
 use crate::constraint_lu::ConstraintLu;
-use crate::error::AmmError;
+use crate::error::{AmmError, RankError};
 use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
 use crate::geometric::{self, GeometricStiffness};
 use crate::modes::{dot, ModeSet, SleeveBending, Triplet};
@@ -68,6 +69,12 @@ const MAX_BEAM_ROWS: usize = 10;
 /// "This row has no alpha part."
 const NONE: usize = usize::MAX;
 
+/// A row of the form of [`BeamRows`]: (basis vector, its factor, u coefficient, thp coefficient).
+type RowForm = (usize, f64, f64, f64);
+
+/// The payload's three rows P of Eq. P1 in that form: `u_1`, `phi(0) . alpha_1`, `phi'(0) . alpha_1`.
+const PAYLOAD_ROWS: [RowForm; 3] = [(NONE, 0.0, 1.0, 0.0), (B_PHI0, 1.0, 0.0, 0.0), (B_DPHI0, 1.0, 0.0, 0.0)];
+
 /// The rows of C that touch one beam: row k is `sc[k] * B[basis[k]]` on alpha, `cu[k]` on u_i and
 /// `ct[k]` on thp_i.
 #[derive(Debug, Clone, Default)]
@@ -96,6 +103,47 @@ struct BeamRows {
 }
 
 impl BeamRows {
+    /// The products of this beam's rows with the payload's rows P (Eq. P1) at the prepared step:
+    /// `H = P S^-1 P^T`, `C S^-1 P^T` (row k: `cross[k]`) and `P S^-1 C^T` (column k: `back[k]`),
+    /// by the formula of [`BeamRows::add_block`], `c_k S^-1 c_s^T = (cu_k - p g_k)(cu_s + p g_s)
+    /// / sigma + ct_k ct_s / Jp + sc_k sc_s gram[b_k][b_s]` (P has no thp part, so no Jp term).
+    #[allow(clippy::type_complexity)]
+    fn payload_products(&self, p: f64, inv_sigma: f64) -> (Mat3, [[f64; 3]; MAX_BEAM_ROWS], [[f64; 3]; MAX_BEAM_ROWS]) {
+        let (g0, g1) = (self.g[B_PHI0], self.g[B_DPHI0]);
+        // the u-elimination factors of the rows u_1, phi(0) . alpha_1, phi'(0) . alpha_1
+        let left = [inv_sigma, -p * g0 * inv_sigma, -p * g1 * inv_sigma];
+        let right = [1.0, p * g0, p * g1];
+        let basis = [NONE, B_PHI0, B_DPHI0];
+        let mut h = [[0.0; 3]; 3];
+        for a in 0..3 {
+            for b in 0..3 {
+                let gram = if a > 0 && b > 0 {
+                    self.gram[basis[a]][basis[b]]
+                } else {
+                    0.0
+                };
+                h[a][b] = left[a] * right[b] + gram;
+            }
+        }
+        let (mut cross, mut back) = ([[0.0; 3]; MAX_BEAM_ROWS], [[0.0; 3]; MAX_BEAM_ROWS]);
+        for k in 0..self.ids.len() {
+            let (bk, sk) = (self.basis[k], self.sc[k]);
+            let gk = if bk == NONE { 0.0 } else { sk * self.g[bk] };
+            let (lk, rk) = ((self.cu[k] - p * gk) * inv_sigma, self.cu[k] + p * gk);
+            for a in 0..3 {
+                // the Gram matrix is symmetric: one entry for both products
+                let gram = if bk != NONE && a > 0 {
+                    sk * self.gram[bk][basis[a]]
+                } else {
+                    0.0
+                };
+                cross[k][a] = lk * right[a] + gram;
+                back[k][a] = left[a] * rk + gram;
+            }
+        }
+        (h, cross, back)
+    }
+
     /// The Gram matrix `B D^-1 B^T` of this beam's six vectors and `g = B D^-1 Phi` (see
     /// [`System::prepare`]): the junction entries `[g00, g01, g11]` and `[w0, w1]` are shared by
     /// the beams, the sleeve vectors are scaled by `inv_d` here.
@@ -213,6 +261,14 @@ pub(crate) struct System {
     lu: ConstraintLu,
     /// Multipliers of the last solve, in the order of `rows`.
     pub(crate) lam: Vec<f64>,
+    /// Issue 22: the payload at G on beam 1's coordinates (Eq. P6); `None` without one.
+    payload: Option<PayloadTerms>,
+    /// Issue 22: Kelvin-Voigt retardation time beta [s] (Eqs. D2-D3); 0: undamped.
+    beta: f64,
+    /// Issue 22: the load at G (Eq. L1); `None` without one.
+    load: Option<LoadSettings>,
+    /// Workspace of the payload's Woodbury correction, N + 2.
+    pay_tmp: Vec<f64>,
 }
 
 /// Is a vector of mode values zero to round-off? `scale[m]` is the size a non-zero entry would have.
@@ -380,8 +436,22 @@ impl System {
             rhs: vec![0.0; m],
             lu: ConstraintLu::new(m),
             lam: vec![0.0; m],
+            payload: None,
+            beta: 0.0,
+            load: None,
+            pay_tmp: vec![0.0; nb],
             modes,
         }
+    }
+
+    /// Issue 22 (`docs/amm.md` 11): the payload welded at G (Eqs. P1-P6, on beam 1's
+    /// coordinates), the Kelvin-Voigt damping `damping.beta()` [s] of the beams (Eqs. D2-D3) and
+    /// the load at G (Eq. L1, fixed frame). What is absent (no mass nor J, beta = 0, no load)
+    /// adds no code path, so the bare star's results stay bit for bit.
+    pub(crate) fn attach(&mut self, payload: &Payload, damping: &Damping, load: &LoadSettings) {
+        self.payload = PayloadTerms::new(payload, self.beams[0].ids.len());
+        self.beta = damping.beta();
+        self.load = (!load.is_none()).then(|| load.clone());
     }
 
     /// The system with Eq. 23's product on the first `analytic` analytic modes (and the junction
@@ -449,8 +519,14 @@ impl System {
         let rho = self.rho;
         self.p = rho * (2.0 * gp * thd + bp * thdd);
         let mut sigma = rho * self.l * (1.0 - bp * thd * thd);
+        let damped = gp * self.beta;
         for j in 0..self.nm {
-            let d = rho * (1.0 + bp * (self.lambda_m[j] - thd * thd));
+            let d = if self.beta > 0.0 {
+                // Eq. D3: the Kelvin-Voigt damping beta K_e on the elastic stiffness only
+                rho * (1.0 + damped * self.lambda_m[j] + bp * (self.lambda_m[j] - thd * thd))
+            } else {
+                rho * (1.0 + bp * (self.lambda_m[j] - thd * thd))
+            };
             self.inv_d[j] = 1.0 / d;
             self.w[j] = self.phi[j] / d;
             sigma += self.p * self.p * self.phi[j] * self.w[j];
@@ -551,6 +627,77 @@ impl System {
                 }
             }
         }
+        if self.beta > 0.0 {
+            self.damping_forcing(vhat);
+        }
+        if self.payload.is_some() || self.load.is_some() {
+            self.attachment_forcing(st, qhat, vhat, None);
+        }
+    }
+
+    /// Eq. D2: the Kelvin-Voigt force `- beta rho lambda_j alpha_j'` at the predictor `vhat` on
+    /// every beam's alpha rows (the `D vhat` part of the step's forcing) [N].
+    fn damping_forcing(&mut self, vhat: &[f64]) {
+        let (nm, nb, c) = (self.nm, self.nb, self.beta * self.rho);
+        for i in 0..3 {
+            let o = i * nb;
+            let rows = self.resid[o..o + nm].iter_mut().zip(&vhat[o..o + nm]);
+            for ((r, v), l) in rows.zip(&self.lambda_m) {
+                *r -= c * l * v;
+            }
+        }
+    }
+
+    /// `P q_1` (Eq. P1): `(u_1, phi(0) . alpha_1, phi'(0) . alpha_1)` of beam 1's block of `q`.
+    fn payload_coordinates(&self, q: &[f64]) -> [f64; 3] {
+        let nm = self.nm;
+        [q[nm], dot(&self.phi0, &q[..nm]), dot(&self.dphi0, &q[..nm])]
+    }
+
+    /// The rigid quantities of the payload's terms ([`RigidTerms`]) on beam 1's frame at `st`.
+    fn payload_motion(st: &RigidState) -> RigidTerms {
+        Self::payload_motion_along(st, st.e_x(0))
+    }
+
+    /// [`System::payload_motion`] with beam 1's axis `ex = e_x1` given.
+    fn payload_motion_along(st: &RigidState, ex: [f64; 2]) -> RigidTerms {
+        let ag = st.a_g();
+        let ew = [-ex[1], ex[0]];
+        let thd = st.theta.d1;
+        [
+            ag[0] * ex[0] + ag[1] * ex[1],
+            ag[0] * ew[0] + ag[1] * ew[1],
+            st.theta.d2,
+            thd,
+            thd * thd,
+        ]
+    }
+
+    /// The payload (Eq. P6: `P^T (f_p - D_p P vhat - K_p P qhat)`) and the load (Eq. L1: `F . e_x1`
+    /// on u_1, `(F . e_w1) phi(0) + Mz phi'(0)` on alpha_1) added to beam 1's rows of the forcing.
+    /// `change`: the derivative of the payload's part along a change of the motion instead
+    /// ([`RigidTerms`]; the load's projection is frozen at the predicted angle, `docs/amm.md` 11.3).
+    fn attachment_forcing(&mut self, st: &RigidState, qhat: &[f64], vhat: &[f64], change: Option<RigidTerms>) {
+        let nm = self.nm;
+        let ex = st.e_x(0);
+        let ew = [-ex[1], ex[0]];
+        let mut rp = [0.0; 3];
+        if let Some(pl) = &self.payload {
+            let x = change.unwrap_or_else(|| Self::payload_motion_along(st, ex));
+            let (zq, zv) = (self.payload_coordinates(qhat), self.payload_coordinates(vhat));
+            rp = pl.forcing(x, zq, zv);
+        }
+        if let (Some(load), None) = (&self.load, change) {
+            let [fx, fy, mz] = load.at(st.t);
+            rp[0] += fx * ex[0] + fy * ex[1];
+            rp[1] += fx * ew[0] + fy * ew[1];
+            rp[2] += mz;
+        }
+        let r = &mut self.resid[..nm + 1];
+        r[nm] += rp[0];
+        for ((rj, p0), d0) in r[..nm].iter_mut().zip(&self.phi0).zip(&self.dphi0) {
+            *rj += rp[1] * p0 + rp[2] * d0;
+        }
     }
 
     /// The derivative of [`System::forcing`] along a change of the rigid motion: `d_ag` of a_G
@@ -603,6 +750,20 @@ impl System {
                 }
             }
         }
+        if self.payload.is_some() {
+            // Eqs. P3-P5 are linear in (a1, a2, theta'', theta', theta'^2): their change along
+            // the motion's change, with e_x1 frozen at the predictor as for the beams
+            let ex = st.e_x(0);
+            let ew = [-ex[1], ex[0]];
+            let change = [
+                d_ag[0] * ex[0] + d_ag[1] * ex[1],
+                d_ag[0] * ew[0] + d_ag[1] * ew[1],
+                d_thdd,
+                d_thd,
+                2.0 * thd * d_thd,
+            ];
+            self.attachment_forcing(st, qhat, vhat, Some(change));
+        }
     }
 
     /// Build and factor the step matrix at the rigid state `st`: sleeve rows at xp(st) (about the
@@ -647,9 +808,86 @@ impl System {
             beam.fill_gram([g00, g01, g11], [w0, w1], inv_d, [phi0, dphi0, phi]);
             beam.add_block(a_mat, m, p, inv_sigma, inv_jp);
         }
+        if self.payload.is_some() {
+            self.payload_block(st, Self::payload_motion(st), bp, gp)?;
+        }
         self.lu
             .factor(&self.a)
             .map_err(|source| AmmError::SingularConstraints { t: st.t, source })
+    }
+
+    /// The payload's Woodbury correction of beam 1's block of the Schur complement (module docs of
+    /// `attach`): `A_0 -= (C_0 S^-1 P^T) W (P S^-1 C_0^T)`, every product from the Gram data of
+    /// the step ([`BeamRows::product`]); sets `W` and `C_0 S^-1 P^T` for the substitution.
+    fn payload_block(&mut self, st: &RigidState, x: RigidTerms, bp: f64, gp: f64) -> Result<(), AmmError> {
+        let (beam, m) = (&self.beams[0], self.rows.len());
+        let Some(pl) = self.payload.as_mut() else {
+            return Ok(());
+        };
+        let (h, cross, back) = beam.payload_products(self.p, self.inv_sigma);
+        if !pl.set_woodbury(x, bp, gp, &h) {
+            return Err(AmmError::SingularConstraints {
+                t: st.t,
+                source: RankError::Payload,
+            });
+        }
+        let mb = beam.ids.len();
+        // W (P S^-1 C_0^T), 3 x mb
+        let mut wg = [[0.0; 3]; MAX_BEAM_ROWS];
+        for (w, b) in wg.iter_mut().zip(&back).take(mb) {
+            *w = pl.apply_w(*b);
+        }
+        for ((k, &c), saved) in cross.iter().enumerate().zip(pl.cross.iter_mut()).take(mb) {
+            *saved = c;
+            let row = &mut self.a[beam.ids[k] * m..(beam.ids[k] + 1) * m];
+            for (s, w) in wg.iter().enumerate().take(mb) {
+                row[beam.ids[s]] -= c[0] * w[0] + c[1] * w[1] + c[2] * w[2];
+            }
+        }
+        Ok(())
+    }
+
+    /// `W P S^-1 r` of beam 1's block of the forcing `r` (`y_r`, `D^-1 r` against the basis
+    /// `bdr`, as in [`System::solve_prepared`]): the payload's correction of `C_0 S^-1 r`.
+    /// `p`, `inv_jp`: the step's border and `1 / Jp`; `r_thp`: the thp row of r.
+    fn payload_rhs(
+        pl: &PayloadTerms,
+        beam: &BeamRows,
+        (p, inv_jp): (f64, f64),
+        r_thp: f64,
+        y_r: f64,
+        bdr: &[f64; NB],
+    ) -> [f64; 3] {
+        let pz = PAYLOAD_ROWS.map(|(b, s, u, t)| {
+            let g = if b == NONE { 0.0 } else { s * beam.g[b] };
+            let mut v = (u - p * g) * y_r + t * r_thp * inv_jp;
+            if b != NONE {
+                v += s * bdr[b];
+            }
+            v
+        });
+        pl.apply_w(pz)
+    }
+
+    /// Beam 1's block `x = S^-1 v` becomes `(S + P^T S_p P)^-1 v = x - S^-1 P^T W P x` (Woodbury,
+    /// module docs of `attach`); a no-op without a payload.
+    fn payload_correct(&mut self, x: &mut [f64]) {
+        let Some(pl) = self.payload.as_ref() else {
+            return;
+        };
+        let nm = self.nm;
+        let c = pl.apply_w(self.payload_coordinates(x));
+        let mut tmp = std::mem::take(&mut self.pay_tmp);
+        for ((t, p0), d0) in tmp[..nm].iter_mut().zip(&self.phi0).zip(&self.dphi0) {
+            *t = c[1] * p0 + c[2] * d0;
+        }
+        tmp[nm] = c[0];
+        tmp[nm + 1] = 0.0;
+        self.arrow_solve(&mut tmp);
+        for (xi, t) in x.iter_mut().zip(&tmp) {
+            *xi -= t;
+        }
+        self.pay_tmp = tmp;
     }
 
     /// Solve the prepared step for the forcing in the workspace ([`System::forcing`] or
@@ -685,12 +923,20 @@ impl System {
                 Some(qh) => dots(&qh[o..o + nm], basis),
                 None => [0.0; NB],
             };
+            // the payload's part of beam 1's C_0 S1^-1 r (Woodbury): - (C_0 S^-1 P^T) W P S^-1 r
+            let corr = match (&self.payload, i) {
+                (Some(pl), 0) => Some((pl, Self::payload_rhs(pl, beam, (p, inv_jp), r[nm + 1], y_r, &bdr))),
+                _ => None,
+            };
             for k in 0..beam.ids.len() {
                 let (bk, sk) = (beam.basis[k], beam.sc[k]);
                 let gk = if bk == NONE { 0.0 } else { sk * beam.g[bk] };
                 let mut cz = (beam.cu[k] - p * gk) * y_r + beam.ct[k] * r[nm + 1] * inv_jp;
                 if bk != NONE {
                     cz += sk * bdr[bk];
+                }
+                if let Some((pl, c)) = corr {
+                    cz -= (0..3).map(|a| pl.cross[k][a] * c[a]).sum::<f64>();
                 }
                 let cq = match qhat {
                     Some(qh) if bp > 0.0 => {
@@ -707,8 +953,14 @@ impl System {
         }
         self.lu.solve(&mut self.rhs);
         self.lam.copy_from_slice(&self.rhs);
+        self.substitute(qdd);
+    }
 
-        // qdd = S^-1 (r + C^T lambda): collect the multipliers per basis vector, then one axpy each
+    /// `qdd = S^-1 (r + C^T lambda)` for the multipliers `self.lam` of the step's solve, beam 1
+    /// with the payload's Woodbury correction.
+    fn substitute(&mut self, qdd: &mut [f64]) {
+        let (nm, nb) = (self.nm, self.nb);
+        // collect the multipliers per basis vector, then one axpy each
         qdd.copy_from_slice(&self.resid);
         for (i, beam) in self.beams.iter().enumerate() {
             let o = i * nb;
@@ -732,6 +984,7 @@ impl System {
         for i in 0..3 {
             self.arrow_solve(&mut qdd[i * nb..(i + 1) * nb]);
         }
+        self.payload_correct(&mut qdd[..nb]);
     }
 
     /// The sleeve rows of Eqs. 41-42 evaluated exactly (nonlinear in u) at the state q, for tests:
@@ -793,5 +1046,98 @@ impl System {
             }
         }
         r.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::integrate;
+    use flexstar_model::{AmmSettings, ModeFamily, Trajectory};
+
+    #[test]
+    fn energy_balance_at_a_locked_pose() {
+        // docs/amm.md 11.5, Eq. C6 where it is exact for the AMM: the star held at the centre pose
+        // (sliders fixed: theta' = theta'' = 0, a_G = 0, time-invariant constraints that do no
+        // work), paper model, a payload off G, damping and a load from zero. Kinetic energy
+        // (beams, sleeves, payload: Eq. P2) + strain energy + dissipated (Eq. D4) = load work,
+        // from the stored coordinates (central differences, midpoint rule: O(h^2)).
+        let mut exp = flexstar_model::catalogue::paper_case(3);
+        exp.trajectory = Trajectory::Polynomial {
+            s1: vec![0.0],
+            s2: vec![0.0],
+            s3: vec![0.0],
+        };
+        exp.time.t_end = 0.5;
+        exp.payload = Payload {
+            mass: 0.8,
+            j: 3e-3,
+            offset: [0.04, 0.02],
+        };
+        exp.damping = Damping::with_beta(3e-3);
+        // from zero with zero rate, on the time scale of the first period (0.25 s)
+        exp.load = LoadSettings::polynomials(
+            Some(vec![0.0, 0.0, 100.0, -200.0]),
+            Some(vec![0.0, 0.0, -60.0, 80.0]),
+            Some(vec![0.0, 0.0, 8.0, -12.0]),
+        );
+        let settings = AmmSettings::paper(ModeFamily::FreeFree, 20);
+        let mut qs: Vec<Vec<f64>> = vec![vec![0.0; 3 * 22]];
+        let mut sys_copy = None;
+        integrate(&exp, &settings, 20, true, |sys, q| {
+            qs.push(q.to_vec());
+            sys_copy.get_or_insert_with(|| sys.clone());
+        })
+        .unwrap();
+        let sys = sys_copy.unwrap();
+        let h = exp.time.t_end / (qs.len() - 1) as f64;
+        let (nm, nb, rho) = (sys.nm, sys.nb, sys.rho);
+        let pl = PayloadTerms::new(&exp.payload, 0).unwrap();
+        let mp = pl.mass_matrix();
+        // T + V at step n (central velocity), P_d and the load's power on [n, n+1] (midpoint)
+        let energy = |n: usize| {
+            let v: Vec<f64> = (0..qs[n].len())
+                .map(|k| (qs[n + 1][k] - qs[n - 1][k]) / (2.0 * h))
+                .collect();
+            let mut e = 0.0;
+            for i in 0..3 {
+                let o = i * nb;
+                for j in 0..nm {
+                    e += 0.5 * rho * (v[o + j].powi(2) + sys.lambda_m[j] * qs[n][o + j].powi(2));
+                }
+                e += 0.5 * (rho * sys.l * v[o + nm].powi(2) + sys.jp * v[o + nm + 1].powi(2));
+            }
+            let zv = sys.payload_coordinates(&v);
+            e + 0.5
+                * (0..3)
+                    .map(|a| (0..3).map(|b| zv[a] * mp[a][b] * zv[b]).sum::<f64>())
+                    .sum::<f64>()
+        };
+        let (mut work, mut dissipated, mut worst, mut work_max) = (0.0, 0.0, 0.0f64, 0.0f64);
+        for n in 0..qs.len() - 2 {
+            let dq: Vec<f64> = (0..qs[n].len()).map(|k| qs[n + 1][k] - qs[n][k]).collect();
+            let dz = sys.payload_coordinates(&dq);
+            // theta = 0: e_x1 = (0, -1), e_w1 = (1, 0), so (F . e_x1, F . e_w1, Mz) = (-Fy, Fx, Mz)
+            let [fx, fy, mz] = exp.load.at((n as f64 + 0.5) * h);
+            work += -fy * dz[0] + fx * dz[1] + mz * dz[2];
+            for i in 0..3 {
+                for j in 0..nm {
+                    dissipated += exp.damping.beta() * rho * sys.lambda_m[j] * dq[i * nb + j].powi(2) / h;
+                }
+            }
+            if n >= 1 {
+                worst = worst.max((energy(n + 1) + dissipated - work).abs());
+                work_max = work_max.max(work.abs());
+            }
+        }
+        eprintln!("load work {work:e} J, dissipated {dissipated:e} J, worst imbalance {worst:e} J");
+        assert!(
+            dissipated > 0.01 * work_max,
+            "the damping must matter: {dissipated:e} of {work_max:e}"
+        );
+        assert!(
+            worst < 1e-4 * work_max,
+            "imbalance {worst:e} J against the work {work_max:e} J"
+        );
     }
 }

@@ -117,3 +117,58 @@ fn the_sections_are_vary_keys_of_a_sweep() {
         "{refused:?}"
     );
 }
+
+/// `flexstar run` with a payload: the sidecar records the three sections, kinematics.csv's rigid
+/// `Fa` includes the payload (Eqs. P7-P8: heavier than the bare star's), and a paper family with
+/// a hidden support at G says on stderr what it loses (docs/amm.md 11.1).
+#[test]
+fn run_records_the_sections_and_names_what_a_family_loses() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = SMOOTH.replace("name = \"smooth\"", "name = \"carried\"")
+        + "[amm]\nfamily = \"slide-free\"\n"
+        + PAYLOAD
+        + DAMPING;
+    let cfg = dir.path().join("carried.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let (cfg, out) = (cfg.to_str().unwrap(), dir.path().join("out"));
+    let o = flexstar(&["run", cfg, "--solver", "amm", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("slide-free") && e.contains("loses the moment"), "{e}");
+    let side: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("carried").join("amm-slide-free.json")).unwrap())
+            .unwrap();
+    assert_eq!(side["experiment"]["payload"]["mass"], 0.1);
+    assert_eq!(side["experiment"]["damping"]["zeta"], 0.02);
+    assert!(side["experiment"]["load"].as_object().unwrap().is_empty());
+    let o = flexstar(&[
+        "run",
+        cfg,
+        "--solver",
+        "amm",
+        "--family",
+        "enriched",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success() && !stderr(&o).contains("loses"), "{}", stderr(&o));
+    // the rigid Fa of kinematics.csv with and without the payload
+    let peak_fa = |cfg: &str, name: &str| -> f64 {
+        let o = flexstar(&["kinematics", cfg, "--out", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(out.join(name).join("kinematics.csv")).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let fa1 = header.iter().position(|h| *h == "Fa1").unwrap();
+        lines
+            .map(|l| l.split(',').nth(fa1).unwrap().parse::<f64>().unwrap().abs())
+            .fold(0.0, f64::max)
+    };
+    let bare = dir.path().join("bare.toml");
+    std::fs::write(&bare, SMOOTH).unwrap();
+    let (with, without) = (peak_fa(cfg, "carried"), peak_fa(bare.to_str().unwrap(), "smooth"));
+    assert!(
+        with > without * 1.05,
+        "payload 0.1 kg on a 0.35 kg star: {with} vs {without} N"
+    );
+}

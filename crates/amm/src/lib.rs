@@ -38,3 +38,25 @@ pub use solver::{
     parse_family, solve, solve_checked, solve_with_stats, tolerance_step, Stats, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF,
     SHAPE_POINTS, TOLERANCE_DT,
 };
+
+/// What a mode family with a hidden support at G loses of the experiment's payload and load
+/// (`docs/amm.md` 11.1 and 11.3): pinned-free (`phi(0) = 0`, `u = 0`) the transverse force and the
+/// payload's translation, slide-free (`phi'(0) = 0`) the moment and the payload's rotation,
+/// clamped-free both. `None` for free-free and enriched, which carry them completely, or when
+/// the experiment has neither a payload nor a load.
+pub fn attachments_lost(family: flexstar_model::ModeFamily, exp: &flexstar_model::Experiment) -> Option<String> {
+    use flexstar_model::ModeFamily;
+    if exp.payload.is_none() && exp.load.is_none() {
+        return None;
+    }
+    let lost = match family {
+        ModeFamily::PinnedFree => "the transverse force at G and the payload's elastic translation",
+        ModeFamily::SlideFree => "the moment at G and the payload's elastic rotation (its J, its offset's moment)",
+        ModeFamily::ClampedFree => "the force, the moment and the payload's whole elastic motion at G",
+        ModeFamily::FreeFree | ModeFamily::Enriched => return None,
+    };
+    Some(format!(
+        "the {family} family holds G by a hidden support and loses {lost} (docs/amm.md 11.1); \
+         the enriched (default) or free-free family carries the payload and the load completely"
+    ))
+}

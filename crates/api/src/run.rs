@@ -170,6 +170,11 @@ pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Res
         }
     })?;
     let stem = if direct { format!("{stem}-direct") } else { stem };
+    if settings.solver == Solver::Amm {
+        if let Some(lost) = flexstar_amm::attachments_lost(exp.amm.family, &exp) {
+            notes.push(format!("note: {source}: {lost}"));
+        }
+    }
     Ok(Prepared {
         exp,
         solver: settings.solver,

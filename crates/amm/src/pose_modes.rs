@@ -73,14 +73,13 @@ impl PoseSystem {
     /// `w_1'(0) = phi'(0) . alpha_1` (the elastic displacement of G along `e_x1`, `e_w1` [m] and
     /// the rotation of the weld [rad], in the pose's frame).
     pub fn junction_rows(&self) -> [Vec<f64>; 3] {
-        let mut rows = [vec![0.0; self.n], vec![0.0; self.n], vec![0.0; self.n]];
-        rows[0][self.nm] = 1.0;
-        for j in 0..self.nm {
+        let [mut u, mut w, mut psi] = [vec![0.0; self.n], vec![0.0; self.n], vec![0.0; self.n]];
+        u[self.nm] = 1.0;
+        for (j, (wj, pj)) in w.iter_mut().zip(psi.iter_mut()).take(self.nm).enumerate() {
             let v = self.modes.eval(j, 0.0);
-            rows[1][j] = v[0];
-            rows[2][j] = v[1];
+            (*wj, *pj) = (v[0], v[1]);
         }
-        rows
+        [u, w, psi]
     }
 
     /// Generalized forces on q of a unit `Fx`, `Fy` [N] (fixed frame) and `Mz` [N m] at G (Eq. L1

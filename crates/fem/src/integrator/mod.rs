@@ -127,6 +127,7 @@ impl Works {
 
 /// The integration state at one time: coordinates, velocities, algorithmic accelerations
 /// `q_dd`, the generalized-alpha acceleration variable `a`, multipliers, and the pins.
+#[derive(Clone)]
 struct State {
     q: Vec<f64>,
     v: Vec<f64>,
@@ -262,6 +263,65 @@ fn check_sleeves(star: &Star, q: &[f64], l: f64, t: f64) -> Result<(), FemError>
     Ok(())
 }
 
+/// How many times a step whose Newton iteration fails is halved before the run stops: a step
+/// of `dt / 2^MAX_HALVINGS` at the least. A load that jumps on a bare G (docs/fem.md 9.3) excites
+/// the weld's highest modes; a shorter step resolves their first instants.
+const MAX_HALVINGS: u32 = 5;
+
+/// One step of the integration loop with everything it updates.
+struct Stepper<'a, 'r> {
+    params: &'a RobotParams,
+    motion: &'a Motion<'a>,
+    star: &'a mut Star,
+    ga: &'a GenAlpha,
+    st: &'a mut State,
+    ws: &'a mut Workspace,
+    stats: &'a mut Stats,
+    works: &'a mut Works,
+    rec: &'a mut Recorder<'r>,
+}
+
+impl Stepper<'_, '_> {
+    /// Step of length `h` to `t1` [s]; when Newton fails, the state is restored and the step
+    /// taken as two halves (at most [`MAX_HALVINGS`] times nested), so a run that converges at
+    /// the given step is unchanged bit for bit.
+    fn step_or_halve(&mut self, backup: &mut State, t1: f64, h: f64, depth: u32) -> Result<(), FemError> {
+        if depth < MAX_HALVINGS {
+            backup.clone_from(self.st);
+        }
+        match step(
+            self.params,
+            self.motion,
+            self.star,
+            self.ga,
+            self.st,
+            self.ws,
+            self.stats,
+            t1,
+            h,
+        ) {
+            Ok(()) => self.finish(t1, h),
+            Err(FemError::Newton { .. } | FemError::NonFinite { .. }) if depth < MAX_HALVINGS => {
+                self.st.clone_from(backup);
+                self.step_or_halve(backup, t1 - 0.5 * h, 0.5 * h, depth + 1)?;
+                self.step_or_halve(backup, t1, 0.5 * h, depth + 1)
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// The checks, works and records after a converged step ending at `t` [s] of length `h`.
+    fn finish(&mut self, t: f64, h: f64) -> Result<(), FemError> {
+        let (params, st) = (self.params, &*self.st);
+        check_sleeves(self.star, &st.q, params.l, t)?;
+        self.motion.check_feasible(params, &st.pins, t)?;
+        let (fa, pf) = self.motion.forces(params, &st.pins, &st.lam, t)?;
+        self.works.advance(self.star, st, &fa, t, h);
+        self.rec.record(params, self.star, st, fa, pf, t, self.works);
+        Ok(())
+    }
+}
+
 /// Integrate from the initial state to the last output time, the star carrying `attached`'s
 /// payload, damping and load (issue 22).
 #[allow(clippy::too_many_arguments)]
@@ -286,7 +346,6 @@ pub(crate) fn integrate(
     }
     let (mut star, q, v) = Star::new(params, run.ne, init, motion.slider_unknowns())?;
     star.attached = attached.clone();
-    let l = params.l;
     let mut st = initial_state(params, motion, &mut star, q, v)?;
     motion.check_feasible(params, &st.pins, 0.0)?;
 
@@ -301,19 +360,26 @@ pub(crate) fn integrate(
 
     let mut ws = Workspace::new(&star);
     let mut t = 0.0;
+    let mut backup = st.clone();
     for w in events.windows(2) {
         let (ta, tb) = (w[0], w[1]);
         let n_sub = ((tb - ta) / run.dt - 1e-9).ceil().max(1.0) as usize;
         let h = (tb - ta) / n_sub as f64;
         for sub in 1..=n_sub {
             let t1 = if sub == n_sub { tb } else { ta + h * sub as f64 };
-            step(params, motion, &mut star, &ga, &mut st, &mut ws, &mut stats, t1, h)?;
+            let mut run_step = Stepper {
+                params,
+                motion,
+                star: &mut star,
+                ga: &ga,
+                st: &mut st,
+                ws: &mut ws,
+                stats: &mut stats,
+                works: &mut works,
+                rec: &mut rec,
+            };
+            run_step.step_or_halve(&mut backup, t1, h, 0)?;
             t = t1;
-            check_sleeves(&star, &st.q, l, t)?;
-            motion.check_feasible(params, &st.pins, t)?;
-            let (fa, pf) = motion.forces(params, &st.pins, &st.lam, t)?;
-            works.advance(&star, &st, &fa, t, h);
-            rec.record(params, &star, &st, fa, pf, t, &works);
         }
         if let Some(cb) = progress {
             cb((t / t_end).min(1.0));

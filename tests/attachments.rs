@@ -172,3 +172,53 @@ fn run_records_the_sections_and_names_what_a_family_loses() {
         "payload 0.1 kg on a 0.35 kg star: {with} vs {without} N"
     );
 }
+
+/// A servo drive carrying all three sections (its rigid feedforward includes the payload and the
+/// load, Eqs. P7-P8): both solvers run the direct problem, track the reference within a
+/// millimetre, and agree on the tracking error (measured: 5.3715e-5 m AMM, 5.3753e-5 m FEM).
+#[test]
+fn a_servo_carries_the_payload_and_the_load_in_both_solvers() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = SMOOTH.replace("name = \"smooth\"", "name = \"servo\"")
+        + "[drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n"
+        + PAYLOAD
+        + DAMPING
+        + LOAD;
+    let cfg = dir.path().join("servo.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let out = dir.path().join("out");
+    let mut peaks = Vec::new();
+    for (solver, file) in [("amm", "amm-enriched-direct.csv"), ("fem", "fem-direct.csv")] {
+        let o = flexstar(&[
+            "run",
+            cfg.to_str().unwrap(),
+            "--solver",
+            solver,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{solver}: {}", stderr(&o));
+        let text = std::fs::read_to_string(out.join("servo").join(file)).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let e1 = header.iter().position(|h| *h == "e1").unwrap();
+        let peak = lines
+            .flat_map(|l| {
+                l.split(',')
+                    .skip(e1)
+                    .take(3)
+                    .map(|v| v.parse::<f64>().unwrap().abs())
+                    .collect::<Vec<_>>()
+            })
+            .fold(0.0, f64::max);
+        eprintln!("{solver}: peak tracking error {peak:e} m");
+        assert!(peak > 0.0 && peak < 1e-3, "{solver}: {peak}");
+        peaks.push(peak);
+    }
+    assert!(
+        (peaks[0] / peaks[1] - 1.0).abs() < 0.05,
+        "AMM {} vs FEM {} m",
+        peaks[0],
+        peaks[1]
+    );
+}

@@ -454,6 +454,7 @@ mod tests {
             payload: Default::default(),
             damping: Default::default(),
             load: Default::default(),
+            shaper: None,
             source: Default::default(),
         }
     }

@@ -39,6 +39,7 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         payload: Default::default(),
         damping: Default::default(),
         load: Default::default(),
+        shaper: None,
         source: Default::default(),
     }
 }

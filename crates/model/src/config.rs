@@ -363,6 +363,10 @@ pub struct Experiment {
     /// Force and moment at G (`[load]`, issue 22); none by default.
     #[serde(default)]
     pub load: LoadSettings,
+    /// Input shaping of the motion (`[shaper]`, issue 26, `docs/motions.md` 3.7); none by
+    /// default. Applied when the file is read ([`Experiment::apply_shaper`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shaper: Option<crate::shaper::ShaperSection>,
     /// Where the experiment was read from (not a TOML key).
     #[serde(skip)]
     pub source: PathBuf,
@@ -389,6 +393,7 @@ impl Experiment {
         exp.load.read_file(path)?;
         exp.robot.validate().map_err(|e| e.in_file(path))?;
         exp.trajectory.read_file(path, &exp.robot)?;
+        exp.apply_shaper().map_err(|e| e.in_file(path))?;
         exp.validate().map_err(|e| e.in_file(path))?;
         Ok(exp)
     }
@@ -485,6 +490,14 @@ impl Experiment {
             Trajectory::Quintic { t0, .. } => ("trajectory.t1", format!(" (quintic from t0 = {t0} s to t1)")),
             Trajectory::Via(v) => ("trajectory.points", format!(" (the time of point {})", v.points.len())),
             Trajectory::Table(_) => ("trajectory.file", " (the time of the table's last row)".to_string()),
+            Trajectory::Shaped(sh) => (
+                "shaper",
+                format!(
+                    " (the unshaped motion's t_rest = {} s plus the shaper's {} s)",
+                    sh.base.t_rest().unwrap_or(f64::NAN),
+                    crate::shaper::duration(&sh.impulses)
+                ),
+            ),
             Trajectory::Polynomial { .. } => ("trajectory", String::new()),
         };
         Err(ModelError::invalid(

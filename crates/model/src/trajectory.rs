@@ -11,6 +11,7 @@ use crate::error::ModelError;
 use crate::geometry::inverse_kinematics;
 use crate::motion::{TableMotion, TableSpace, ViaMotion, ViaPoint};
 use crate::params::RobotParams;
+use crate::shaper::Impulse;
 
 /// A task-space pose of the rigid star: centre G [m] in the fixed frame and orientation theta [rad].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -40,6 +41,19 @@ pub enum Trajectory {
     Via(ViaMotion),
     /// Rows of a CSV file in task or slider space (`docs/motions.md` 1.4).
     Table(TableMotion),
+    /// A rest-to-rest motion whose task-space pose is convolved with a shaper's impulses
+    /// (`docs/motions.md` 3.4); built from `[shaper]`, never read from `[trajectory]`.
+    Shaped(ShapedMotion),
+}
+
+/// A shaped motion (`docs/motions.md` 3.4): pose `p_S(t) = sum_j A_j p(t - t_j)` of the base's
+/// task-space pose `p = (Gx [m], Gy [m], theta [rad])`, then the inverse kinematics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShapedMotion {
+    /// The unshaped rest-to-rest motion (quintic, via, or task-space table).
+    pub base: Box<Trajectory>,
+    /// The shaper's impulses (amplitudes summing to 1, first at t = 0).
+    pub impulses: Vec<Impulse>,
 }
 
 /// The kinds of [`Trajectory`], as the `kind` key names them.
@@ -183,6 +197,22 @@ impl Trajectory {
     pub fn s<D: Scalar>(&self, params: &RobotParams, t: D) -> Result<[D; 3], ModelError> {
         match self {
             Trajectory::Polynomial { s1, s2, s3 } => Ok([horner(s1, t), horner(s2, t), horner(s3, t)]),
+            Trajectory::Table(tab) if tab.data()?.space == TableSpace::Slider => Ok(tab.data()?.eval(t)),
+            _ => {
+                let p = self
+                    .pose(t)?
+                    .ok_or_else(|| ModelError::invalid("trajectory", "no task-space pose"))?;
+                inverse_kinematics(params, [p[0], p[1]], p[2])
+            }
+        }
+    }
+
+    /// The task-space pose `(Gx [m], Gy [m], theta [rad])` at time t [s], generic over dual
+    /// numbers; `None` for the kinds given in slider space (polynomial, slider table, or a shaped
+    /// motion of one). A shaped motion sums its base's poses (`docs/motions.md` 3.4).
+    pub fn pose<D: Scalar>(&self, t: D) -> Result<Option<[D; 3]>, ModelError> {
+        Ok(match self {
+            Trajectory::Polynomial { .. } => None,
             Trajectory::Quintic { from, to, t0, t1 } => {
                 let tau = if t.re() <= *t0 {
                     D::zero()
@@ -193,23 +223,30 @@ impl Trajectory {
                 };
                 // 10 tau^3 - 15 tau^4 + 6 tau^5
                 let blend = tau * tau * tau * (tau * (tau * 6.0 - 15.0) + 10.0);
-                let g = [blend * (to.gx - from.gx) + from.gx, blend * (to.gy - from.gy) + from.gy];
-                let th = blend * (to.theta - from.theta) + from.theta;
-                inverse_kinematics(params, g, th)
+                Some([
+                    blend * (to.gx - from.gx) + from.gx,
+                    blend * (to.gy - from.gy) + from.gy,
+                    blend * (to.theta - from.theta) + from.theta,
+                ])
             }
-            Trajectory::Via(v) => {
-                let [gx, gy, th] = v.curve()?.eval(t);
-                inverse_kinematics(params, [gx, gy], th)
-            }
+            Trajectory::Via(v) => Some(v.curve()?.eval(t)),
             Trajectory::Table(tab) => {
                 let data = tab.data()?;
-                let c = data.eval(t);
-                match data.space {
-                    TableSpace::Task => inverse_kinematics(params, [c[0], c[1]], c[2]),
-                    TableSpace::Slider => Ok(c),
-                }
+                (data.space == TableSpace::Task).then(|| data.eval(t))
             }
-        }
+            Trajectory::Shaped(sh) => {
+                let mut sum = [D::zero(), D::zero(), D::zero()];
+                for imp in &sh.impulses {
+                    let Some(p) = sh.base.pose(t - imp.t)? else {
+                        return Ok(None);
+                    };
+                    for (acc, x) in sum.iter_mut().zip(p) {
+                        *acc = *acc + x * imp.a;
+                    }
+                }
+                Some(sum)
+            }
+        })
     }
 
     /// End of the motion `t_rest` [s] (`docs/motions.md` section 1.5): the time after which a
@@ -221,6 +258,7 @@ impl Trajectory {
             Trajectory::Quintic { t1, .. } => Some(*t1),
             Trajectory::Via(v) => v.points.last().map(|p| p.t),
             Trajectory::Table(tab) => tab.data.as_ref().and_then(|d| d.t.last().copied()),
+            Trajectory::Shaped(sh) => sh.base.t_rest().map(|t| t + crate::shaper::duration(&sh.impulses)),
         }
     }
 
@@ -262,6 +300,7 @@ impl Trajectory {
                     .map(|(k, (&t, r))| Knot { t, label: row(k, r) })
                     .collect()
             }
+            Trajectory::Shaped(sh) => sh.base.knots(),
             _ => Vec::new(),
         }
     }
@@ -273,6 +312,7 @@ impl Trajectory {
         let (what, times): (&str, Vec<f64>) = match self {
             Trajectory::Via(v) => ("points", v.points.iter().map(|p| p.t).collect()),
             Trajectory::Table(TableMotion { data: Some(d), .. }) => ("rows", d.t.clone()),
+            Trajectory::Shaped(sh) => return sh.base.between(t),
             _ => return None,
         };
         let k = times.partition_point(|&tk| tk <= t);
@@ -285,6 +325,7 @@ impl Trajectory {
     pub fn read_file(&mut self, config: &std::path::Path, params: &RobotParams) -> Result<(), ModelError> {
         match self {
             Trajectory::Table(tab) => tab.read_file(config, params),
+            Trajectory::Shaped(sh) => sh.base.read_file(config, params),
             _ => Ok(()),
         }
     }
@@ -293,6 +334,7 @@ impl Trajectory {
     pub fn file_path(&self, config: &std::path::Path) -> Option<std::path::PathBuf> {
         match self {
             Trajectory::Table(tab) => Some(tab.file_path(config)),
+            Trajectory::Shaped(sh) => sh.base.file_path(config),
             _ => None,
         }
     }
@@ -352,6 +394,7 @@ impl Trajectory {
             Trajectory::Table(tab) => {
                 tab.data()?;
             }
+            Trajectory::Shaped(sh) => sh.base.validate(params)?,
         }
         Ok(())
     }

@@ -1,0 +1,475 @@
+//! Input shapers (issue 26 item 3, `docs/motions.md` section 3): the ZV and ZVD shapers of
+//! Singer and Seering (ASME J. Dyn. Syst. Meas. Control 112(1), 76-82, 1990), the EI shaper of
+//! Singhose, Seering and Singer (ASME J. Mech. Des. 116(2), 654-659, 1994), their convolution
+//! for several modes (section 3.3), their residual vibration (section 3.2), and the `[shaper]`
+//! section of an experiment (section 3.7).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::ModelError;
+use crate::trajectory::{ShapedMotion, Trajectory};
+
+/// One impulse of a shaper: time `t` [s] after the start of the command and amplitude `A` [-].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Impulse {
+    /// Time [s] (the first impulse is at 0).
+    pub t: f64,
+    /// Amplitude [-]; the amplitudes of a shaper sum to 1.
+    #[serde(rename = "A")]
+    pub a: f64,
+}
+
+/// The shaper kinds of `[shaper] kind` (`docs/motions.md` 3.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShaperKind {
+    /// Zero vibration: two impulses over half a damped period.
+    Zv,
+    /// Zero vibration and derivative: three impulses over one damped period.
+    Zvd,
+    /// Extra-insensitive: three impulses over one damped period, residual `v_tol` at the design
+    /// frequency with zero slope.
+    Ei,
+}
+
+/// The EI shaper's tolerable residual when `v_tol` is not given (5 %, the papers' standard).
+pub const EI_V_TOL: f64 = 0.05;
+
+/// The impulses of one shaper of `kind` for a mode of natural frequency `f_hz` [Hz] and damping
+/// ratio `zeta` [-] (0 <= zeta < 1); `v_tol` is EI's tolerable residual (ignored otherwise).
+/// Formulas of `docs/motions.md` 3.1: ZV and ZVD from Singer and Seering (1990), EI from
+/// Singhose, Seering and Singer (1994), its amplitudes weighted by `K^j` when damped.
+pub fn single(kind: ShaperKind, f_hz: f64, zeta: f64, v_tol: f64) -> Vec<Impulse> {
+    let root = (1.0 - zeta * zeta).sqrt();
+    let t_d = 1.0 / (f_hz * root);
+    let k = (-zeta * std::f64::consts::PI / root).exp();
+    let raw: Vec<f64> = match kind {
+        ShaperKind::Zv => vec![1.0, k],
+        ShaperKind::Zvd => vec![1.0, 2.0 * k, k * k],
+        ShaperKind::Ei => vec![
+            (1.0 + v_tol) / 4.0,
+            (1.0 - v_tol) / 2.0 * k,
+            (1.0 + v_tol) / 4.0 * k * k,
+        ],
+    };
+    let sum: f64 = raw.iter().sum();
+    raw.iter()
+        .enumerate()
+        .map(|(j, a)| Impulse {
+            t: j as f64 * t_d / 2.0,
+            a: a / sum,
+        })
+        .collect()
+}
+
+/// The convolution of two impulse trains (`docs/motions.md` 3.3): every pair `(A_i A_j, t_i +
+/// t_j)`, sorted by time, impulses closer than 1e-12 s merged.
+pub fn convolve(a: &[Impulse], b: &[Impulse]) -> Vec<Impulse> {
+    let mut out: Vec<Impulse> = a
+        .iter()
+        .flat_map(|p| {
+            b.iter().map(move |q| Impulse {
+                t: p.t + q.t,
+                a: p.a * q.a,
+            })
+        })
+        .collect();
+    out.sort_by(|p, q| p.t.total_cmp(&q.t));
+    let mut merged: Vec<Impulse> = Vec::with_capacity(out.len());
+    for p in out {
+        match merged.last_mut() {
+            Some(last) if (p.t - last.t).abs() < 1e-12 => last.a += p.a,
+            _ => merged.push(p),
+        }
+    }
+    merged
+}
+
+/// The shaper for several modes: one shaper per `(f_hz, zeta)` pair, convolved
+/// (`docs/motions.md` 3.3). An empty list gives the identity (one unit impulse at 0).
+pub fn multi(kind: ShaperKind, modes: &[(f64, f64)], v_tol: f64) -> Vec<Impulse> {
+    let unit = vec![Impulse { t: 0.0, a: 1.0 }];
+    modes
+        .iter()
+        .fold(unit, |acc, &(f, z)| convolve(&acc, &single(kind, f, z, v_tol)))
+}
+
+/// Singer and Seering's percentage residual vibration (`docs/motions.md` 3.2): the residual
+/// amplitude of a mode of frequency `f_hz` [Hz] and damping ratio `zeta` after the impulse train,
+/// relative to that after a single unit impulse at 0, both taken at the last impulse.
+pub fn residual(impulses: &[Impulse], f_hz: f64, zeta: f64) -> f64 {
+    let w = 2.0 * std::f64::consts::PI * f_hz;
+    let wd = w * (1.0 - zeta * zeta).sqrt();
+    let t_n = impulses.last().map_or(0.0, |p| p.t);
+    let (c, s) = impulses.iter().fold((0.0, 0.0), |(c, s), p| {
+        let e = p.a * (zeta * w * (p.t - t_n)).exp();
+        (c + e * (wd * p.t).cos(), s + e * (wd * p.t).sin())
+    });
+    (c * c + s * s).sqrt()
+}
+
+/// The duration of an impulse train [s]: its last impulse's time, by which a shaped motion is
+/// longer than its base (the time penalty, `docs/motions.md` 3.3).
+pub fn duration(impulses: &[Impulse]) -> f64 {
+    impulses.last().map_or(0.0, |p| p.t)
+}
+
+/// The `[shaper]` section (`docs/motions.md` 3.7) as written, plus what it resolved to (the
+/// `frequencies_hz`, `zeta_used`, `impulses` and `penalty_s` keys, written to the run's sidecar
+/// with the resolved experiment, never read).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShaperSection {
+    /// `"zv"`, `"zvd"` or `"ei"`.
+    pub kind: ShaperKind,
+    /// `"auto"`, a frequency [Hz] or a list of them.
+    pub f_hz: toml::Value,
+    /// Damping ratio [-]: a number or a list as long as `f_hz`; default from `[damping]`
+    /// (`Damping::zeta_at(f)`), else 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zeta: Option<toml::Value>,
+    /// EI only: the tolerable residual at the design frequency [-], default 0.05.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v_tol: Option<f64>,
+    /// The frequencies used [Hz] (resolved).
+    #[serde(default, skip_deserializing)]
+    pub frequencies_hz: Vec<f64>,
+    /// The damping ratio used per frequency [-] (resolved).
+    #[serde(default, skip_deserializing)]
+    pub zeta_used: Vec<f64>,
+    /// The impulses `{t, A}` of the convolved shaper (resolved).
+    #[serde(default, skip_deserializing)]
+    pub impulses: Vec<Impulse>,
+    /// The time penalty [s]: the shaped motion's `t_rest` minus the unshaped one's (resolved).
+    #[serde(default, skip_deserializing)]
+    pub penalty_s: f64,
+}
+
+/// What `f_hz` asks for.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FrequencySpec {
+    /// `"auto"`: from the modal analysis at the final pose (`docs/motions.md` 3.5).
+    Auto,
+    /// Given frequencies [Hz], each positive and finite.
+    Given(Vec<f64>),
+}
+
+impl ShaperSection {
+    /// A section with `kind` and given frequencies, nothing resolved yet.
+    pub fn new(kind: ShaperKind, f_hz: &[f64]) -> Self {
+        ShaperSection {
+            kind,
+            f_hz: toml::Value::Array(f_hz.iter().map(|&f| toml::Value::Float(f)).collect()),
+            zeta: None,
+            v_tol: None,
+            frequencies_hz: Vec::new(),
+            zeta_used: Vec::new(),
+            impulses: Vec::new(),
+            penalty_s: 0.0,
+        }
+    }
+
+    /// `f_hz` checked: `"auto"` or positive finite numbers (keys `shaper.f_hz`).
+    pub fn frequency_spec(&self) -> Result<FrequencySpec, ModelError> {
+        let bad = |got: String| {
+            ModelError::invalid(
+                "shaper.f_hz",
+                format!("frequencies must be positive and finite (or \"auto\"), got {got}"),
+            )
+        };
+        match &self.f_hz {
+            toml::Value::String(s) if s == "auto" => Ok(FrequencySpec::Auto),
+            toml::Value::Array(a) if a.is_empty() => Err(bad("an empty list".into())),
+            toml::Value::Array(a) => a
+                .iter()
+                .map(|v| positive(v).ok_or_else(|| bad(v.to_string())))
+                .collect::<Result<_, _>>()
+                .map(FrequencySpec::Given),
+            v => positive(v)
+                .map(|f| FrequencySpec::Given(vec![f]))
+                .ok_or_else(|| bad(v.to_string())),
+        }
+    }
+
+    /// The damping ratio per frequency of `f_hz`: the `zeta` key (a number, or a list as long as
+    /// `f_hz`), else `default(f)` (from `[damping]`); each in [0, 1) (keys `shaper.zeta`).
+    pub fn zetas(&self, f_hz: &[f64], default: impl Fn(f64) -> f64) -> Result<Vec<f64>, ModelError> {
+        let zs: Vec<f64> = match &self.zeta {
+            None => f_hz.iter().map(|&f| default(f)).collect(),
+            Some(toml::Value::Array(a)) => {
+                if a.len() != f_hz.len() {
+                    return Err(ModelError::invalid(
+                        "shaper.zeta",
+                        format!("a list of {} damping ratios for {} frequencies", a.len(), f_hz.len()),
+                    ));
+                }
+                a.iter().map(|v| number(v).unwrap_or(f64::NAN)).collect()
+            }
+            Some(v) => vec![number(v).unwrap_or(f64::NAN); f_hz.len()],
+        };
+        if let Some(z) = zs.iter().find(|z| !(0.0..1.0).contains(*z)) {
+            return Err(ModelError::invalid(
+                "shaper.zeta",
+                format!("damping ratios must lie in [0, 1), got {z}"),
+            ));
+        }
+        Ok(zs)
+    }
+
+    /// EI's tolerance: `v_tol` in (0, 1), only with kind = "ei" (key `shaper.v_tol`).
+    pub fn v_tol(&self) -> Result<f64, ModelError> {
+        match (self.kind, self.v_tol) {
+            (ShaperKind::Ei, None) => Ok(EI_V_TOL),
+            (ShaperKind::Ei, Some(v)) if v > 0.0 && v < 1.0 => Ok(v),
+            (ShaperKind::Ei, Some(v)) => Err(ModelError::invalid(
+                "shaper.v_tol",
+                format!("need 0 < v_tol < 1, got {v}"),
+            )),
+            (_, Some(_)) => Err(ModelError::invalid(
+                "shaper.v_tol",
+                "v_tol belongs to kind = \"ei\" only",
+            )),
+            (_, None) => Ok(0.0),
+        }
+    }
+
+    /// Resolve for the frequencies `f_hz` [Hz]: fill `frequencies_hz`, `zeta_used`, `impulses`
+    /// and `penalty_s`, with the damping ratios from the section or `default(f)`.
+    pub fn resolve(&mut self, f_hz: &[f64], default: impl Fn(f64) -> f64) -> Result<(), ModelError> {
+        let zetas = self.zetas(f_hz, default)?;
+        let v_tol = self.v_tol()?;
+        let modes: Vec<(f64, f64)> = f_hz.iter().copied().zip(zetas.iter().copied()).collect();
+        self.impulses = multi(self.kind, &modes, v_tol);
+        self.penalty_s = duration(&self.impulses);
+        self.frequencies_hz = f_hz.to_vec();
+        self.zeta_used = zetas;
+        Ok(())
+    }
+}
+
+impl crate::Experiment {
+    /// Shape the motion with `[shaper]` (`docs/motions.md` 3.4, 3.7): check the section and that
+    /// the motion can be shaped (rest-to-rest, in task space, not a forces drive), resolve the
+    /// impulses (`zeta` defaults to `[damping]`'s `zeta_at(f)`), and replace `trajectory` by the
+    /// [`Trajectory::Shaped`] motion. A no-op without `[shaper]` or when already shaped.
+    pub fn apply_shaper(&mut self) -> Result<(), ModelError> {
+        let Some(mut section) = self.shaper.clone() else {
+            return Ok(());
+        };
+        if matches!(self.trajectory, Trajectory::Shaped(_)) {
+            return Ok(());
+        }
+        self.check_shapeable()?;
+        let f_hz = match section.frequency_spec()? {
+            FrequencySpec::Given(f) => f,
+            FrequencySpec::Auto => {
+                return Err(ModelError::invalid(
+                    "shaper.f_hz",
+                    "\"auto\" is not implemented yet (docs/motions.md 3.5); give the frequencies [Hz], \
+                     e.g. from `flexstar modes` at the final pose",
+                ))
+            }
+        };
+        let damping = self.damping.clone();
+        section.resolve(&f_hz, |f| damping.zeta_at(f))?;
+        self.trajectory = Trajectory::Shaped(ShapedMotion {
+            base: Box::new(self.trajectory.clone()),
+            impulses: section.impulses.clone(),
+        });
+        self.shaper = Some(section);
+        Ok(())
+    }
+
+    /// The motion a shaper may act on: valid, rest-to-rest, with a task-space pose, and moved by
+    /// the trajectory or a servo (key `shaper`).
+    fn check_shapeable(&self) -> Result<(), ModelError> {
+        self.robot.validate()?;
+        self.trajectory.validate(&self.robot)?;
+        if self.drive.kind == crate::DriveKind::Forces {
+            return Err(ModelError::invalid(
+                "shaper",
+                "with drive.kind = \"forces\" there is no motion to shape",
+            ));
+        }
+        if self.trajectory.t_rest().is_none() {
+            return Err(ModelError::invalid(
+                "shaper",
+                "a shaper needs a rest-to-rest motion (quintic, via, table); kind = \"polynomial\" \
+                 never comes to rest",
+            ));
+        }
+        if self.trajectory.pose(0.0)?.is_none() {
+            return Err(ModelError::invalid(
+                "shaper",
+                "a slider-space table (columns s1,s2,s3) cannot be shaped yet; give the table in \
+                 task space (t,Gx,Gy,theta)",
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn number(v: &toml::Value) -> Option<f64> {
+    match v {
+        toml::Value::Float(f) => Some(*f),
+        toml::Value::Integer(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+fn positive(v: &toml::Value) -> Option<f64> {
+    number(v).filter(|f| f.is_finite() && *f > 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// Envelope of a damped oscillator's free response at time `t` after the impulses, from the
+    /// sum of the analytic impulse responses `h(tau) = exp(-zeta w tau) sin(wd tau) / wd`
+    /// (independent of [`residual`]); divided by the envelope of a unit impulse given at the last
+    /// impulse (Singer and Seering's percentage residual vibration).
+    fn envelope_ratio(imp: &[Impulse], f: f64, zeta: f64) -> f64 {
+        let w = 2.0 * PI * f;
+        let wd = w * (1.0 - zeta * zeta).sqrt();
+        let t = duration(imp) + 0.1;
+        let (mut x, mut v) = (0.0, 0.0);
+        for p in imp {
+            let tau = t - p.t;
+            let e = (-zeta * w * tau).exp();
+            x += p.a * e * (wd * tau).sin() / wd;
+            v += p.a * e * ((wd * tau).cos() - zeta * w / wd * (wd * tau).sin());
+        }
+        let env = (x * x + ((v + zeta * w * x) / wd).powi(2)).sqrt();
+        // a unit impulse at the last impulse's time has envelope exp(-zeta w (t - t_n)) / wd
+        env / ((-zeta * w * (t - duration(imp))).exp() / wd)
+    }
+
+    const KINDS: [ShaperKind; 3] = [ShaperKind::Zv, ShaperKind::Zvd, ShaperKind::Ei];
+
+    #[test]
+    fn amplitudes_sum_to_one_and_start_at_zero() {
+        for kind in KINDS {
+            for zeta in [0.0, 0.05, 0.3] {
+                let s = single(kind, 3.9, zeta, EI_V_TOL);
+                assert!((s.iter().map(|p| p.a).sum::<f64>() - 1.0).abs() < 1e-15);
+                assert_eq!(s[0].t, 0.0);
+                assert!(s.iter().all(|p| p.a > 0.0));
+            }
+        }
+    }
+
+    #[test]
+    fn zv_and_zvd_leave_no_residual_at_the_design_frequency() {
+        for kind in [ShaperKind::Zv, ShaperKind::Zvd] {
+            for zeta in [0.0, 0.02, 0.2, 0.6] {
+                let s = single(kind, 6.8, zeta, 0.0);
+                let r = envelope_ratio(&s, 6.8, zeta);
+                assert!(r < 1e-12, "{kind:?} zeta {zeta}: {r}");
+                assert!((residual(&s, 6.8, zeta) - r).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn zvd_has_zero_slope_at_the_design_frequency() {
+        let (f, h) = (3.9, 1e-4);
+        for zeta in [0.0, 0.05] {
+            let zvd = single(ShaperKind::Zvd, f, zeta, 0.0);
+            let zv = single(ShaperKind::Zv, f, zeta, 0.0);
+            let slope = |s: &[Impulse]| {
+                (envelope_ratio(s, f * (1.0 + h), zeta) - envelope_ratio(s, f * (1.0 - h), zeta)) / (2.0 * h)
+            };
+            let side = |s: &[Impulse]| envelope_ratio(s, f * (1.0 + h), zeta) / h;
+            // ZVD: residual quadratic in the error (side/h -> 0); ZV: linear (side -> pi/2)
+            assert!(side(&zvd) < 1e-2 && slope(&zvd).abs() < 1e-3, "{}", side(&zvd));
+            if zeta == 0.0 {
+                assert!((side(&zv) - PI / 2.0).abs() < 1e-3, "{}", side(&zv));
+            } else {
+                assert!(side(&zv) > 1.0, "{}", side(&zv));
+            }
+        }
+    }
+
+    #[test]
+    fn ei_residual_is_its_tolerance_at_design_and_below_over_its_band() {
+        let f = 5.0;
+        let s = single(ShaperKind::Ei, f, 0.0, EI_V_TOL);
+        assert!((envelope_ratio(&s, f, 0.0) - EI_V_TOL).abs() < 1e-12);
+        // docs/motions.md 3.2: V <= 5 % for r in 0.800..1.200 (rounded): checked inside 0.81..1.19
+        for k in 0..=380 {
+            let r = 0.81 + k as f64 * 1e-3;
+            assert!(envelope_ratio(&s, f * r, 0.0) <= EI_V_TOL + 1e-12, "r = {r}");
+        }
+        assert!(envelope_ratio(&s, f * 0.78, 0.0) > EI_V_TOL);
+        // damped form (docs/motions.md 3.1, Open 8.6): at the design frequency the residual is
+        // V K^2 / sum(raw amplitudes), a little below V (4.2 % at zeta = 0.05)
+        let (zeta, v) = (0.05, EI_V_TOL);
+        let sd = single(ShaperKind::Ei, f, zeta, v);
+        let k = (-zeta * PI / (1.0 - zeta * zeta).sqrt()).exp();
+        let want = v * k * k / ((1.0 + v) / 4.0 * (1.0 + k * k) + (1.0 - v) / 2.0 * k);
+        assert!((envelope_ratio(&sd, f, zeta) - want).abs() < 1e-12);
+        assert!(want < v && want > 0.8 * v);
+    }
+
+    #[test]
+    fn sensitivity_matches_the_closed_forms() {
+        let f = 4.0;
+        for k in 0..=60 {
+            let r = 0.4 + k as f64 * 0.02;
+            let c = (PI * r / 2.0).cos();
+            let ei = ((1.0 - EI_V_TOL) / 2.0 + (1.0 + EI_V_TOL) / 2.0 * (PI * r).cos()).abs();
+            for (kind, want) in [
+                (ShaperKind::Zv, c.abs()),
+                (ShaperKind::Zvd, c * c),
+                (ShaperKind::Ei, ei),
+            ] {
+                let s = single(kind, f, 0.0, EI_V_TOL);
+                let got = envelope_ratio(&s, f * r, 0.0);
+                assert!((got - want).abs() < 1e-12, "{kind:?} r = {r}: {got} vs {want}");
+                assert!((residual(&s, f * r, 0.0) - want).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn convolved_shapers_cancel_every_design_mode() {
+        let modes = [(3.85, 0.01), (6.8, 0.02), (11.4, 0.0)];
+        for kind in [ShaperKind::Zv, ShaperKind::Zvd] {
+            let s = multi(kind, &modes, 0.0);
+            assert!((s.iter().map(|p| p.a).sum::<f64>() - 1.0).abs() < 1e-14);
+            let per: f64 = modes.iter().map(|&(f, z)| duration(&single(kind, f, z, 0.0))).sum();
+            assert!((duration(&s) - per).abs() < 1e-14);
+            for &(f, z) in &modes {
+                assert!(envelope_ratio(&s, f, z) < 1e-12, "{kind:?} {f}");
+            }
+        }
+        assert_eq!(multi(ShaperKind::Zvd, &modes[..2], 0.0).len(), 9);
+        assert_eq!(multi(ShaperKind::Zv, &[], 0.0), vec![Impulse { t: 0.0, a: 1.0 }]);
+    }
+
+    #[test]
+    fn section_values_are_checked_by_key() {
+        let mut s = ShaperSection::new(ShaperKind::Zv, &[3.9]);
+        assert_eq!(s.frequency_spec().unwrap(), FrequencySpec::Given(vec![3.9]));
+        s.f_hz = toml::Value::Float(-3.0);
+        assert!(s.frequency_spec().unwrap_err().to_string().contains("shaper.f_hz"));
+        s.f_hz = toml::Value::String("often".into());
+        assert!(s.frequency_spec().is_err());
+        s.f_hz = toml::Value::Array(vec![]);
+        assert!(s.frequency_spec().is_err());
+        s.zeta = Some(toml::Value::Float(1.0));
+        assert!(s
+            .zetas(&[3.9], |_| 0.0)
+            .unwrap_err()
+            .to_string()
+            .contains("shaper.zeta"));
+        s.zeta = Some(toml::Value::Array(vec![toml::Value::Float(0.1)]));
+        assert!(s.zetas(&[3.9, 6.8], |_| 0.0).is_err());
+        s.zeta = None;
+        assert_eq!(s.zetas(&[2.0], |f| 0.01 * f).unwrap(), vec![0.02]);
+        s.v_tol = Some(0.05);
+        assert!(s.v_tol().unwrap_err().to_string().contains("shaper.v_tol"));
+    }
+}

@@ -222,3 +222,30 @@ fn a_servo_carries_the_payload_and_the_load_in_both_solvers() {
         peaks[1]
     );
 }
+
+/// `compare` says what the robot carries, in compare.md and report.html, and says nothing of
+/// the kind for the paper's bare robot.
+#[test]
+fn compare_names_what_the_robot_carries() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = SMOOTH.replace("name = \"smooth\"", "name = \"carried\"") + PAYLOAD + "[load]\nFx = [0.0, 2.0]\n";
+    let cfg = dir.path().join("carried.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let bare = dir.path().join("smooth.toml");
+    std::fs::write(&bare, SMOOTH).unwrap();
+    let out = dir.path().join("out");
+    for c in [&cfg, &bare] {
+        let o = flexstar(&["compare", c.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    for file in ["compare.md", "report.html"] {
+        let carried = std::fs::read_to_string(out.join("carried").join(file)).unwrap();
+        assert!(
+            carried.contains("The robot carries a payload at G (m = 0.1 kg")
+                && carried.contains("a load at G (polynomial Fx)"),
+            "{file}"
+        );
+        let plain = std::fs::read_to_string(out.join("smooth").join(file)).unwrap();
+        assert!(!plain.contains("The robot carries"), "{file}");
+    }
+}

@@ -198,7 +198,7 @@ fn pct(v: Option<f64>) -> String {
 
 /// What the robot carries beyond the paper's (issue 22), in one sentence: `None` when it carries
 /// nothing (no payload, no damping, no load).
-fn attachments_line(exp: &Experiment) -> Option<String> {
+pub(crate) fn attachments_line(exp: &Experiment) -> Option<String> {
     let mut parts = Vec::new();
     let p = &exp.payload;
     if !p.is_none() {
@@ -211,12 +211,15 @@ fn attachments_line(exp: &Experiment) -> Option<String> {
         parts.push(format!("Kelvin-Voigt damping (beta = {:.4e} s)", exp.damping.beta()));
     }
     if !exp.load.is_none() {
-        let how = if exp.load.file.is_some() {
-            "a table"
+        let l = &exp.load;
+        let how = if l.file.is_some() {
+            "a table of Fx, Fy, Mz".to_string()
         } else {
-            "polynomials"
+            let given = [("Fx", &l.fx), ("Fy", &l.fy), ("Mz", &l.mz)];
+            let names: Vec<&str> = given.iter().filter(|(_, p)| p.is_some()).map(|(n, _)| *n).collect();
+            format!("polynomial {}", names.join(", "))
         };
-        parts.push(format!("a load at G ({how} of Fx, Fy, Mz)"));
+        parts.push(format!("a load at G ({how})"));
     }
     (!parts.is_empty()).then(|| format!("The robot carries {}.", parts.join(", ")))
 }

@@ -301,6 +301,9 @@ fn case_summary_html(h: &mut String, c: &ReportCase) {
     if !exp.description.is_empty() {
         let _ = writeln!(h, "<p>{}</p>", escape(&exp.description));
     }
+    if let Some(line) = crate::case_output::attachments_line(exp) {
+        let _ = writeln!(h, "<p>{}</p>", escape(&line));
+    }
     let best = row.families.iter().find(|e| e.most_accurate);
     let _ = writeln!(
         h,

@@ -343,7 +343,8 @@ pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Re
 /// written.
 pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunOutcome> {
     let response = solve(p, progress)?;
-    let meta = response.sidecar(Path::new(&format!("{}.json", p.stem)), &p.exp, &crate::provenance())?;
+    let mut meta = response.sidecar(Path::new(&format!("{}.json", p.stem)), &p.exp, &crate::provenance())?;
+    add_residual(&mut meta, p, &response)?;
     let warning = flexstar_model::small_deflection_check(&response, p.exp.robot.l)
         .map(|v| format!("{}: {} {v}", p.source, p.stem));
     Ok(RunOutcome {
@@ -355,6 +356,43 @@ pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunO
         files: Vec::new(),
         csv: None,
     })
+}
+
+/// The residual vibration after the motion's end (issue 26 item 2) as top-level keys of the
+/// sidecar ([`flexstar_model::residual::sidecar_fields`]). An AMM run of the pinned-free family
+/// has G pinned by its modes (`phi(0) = 0`): its residual of G is null, with a note.
+fn add_residual(meta: &mut serde_json::Value, p: &Prepared, r: &Response) -> Result<()> {
+    let res = flexstar_modal::settle::run_residual(&p.exp, r).map_err(|e| ApiError::solver(&p.source, e))?;
+    let mut fields = flexstar_model::residual::sidecar_fields(res.as_ref(), p.exp.report.settle_tol);
+    if res.is_some() && p.solver == Solver::Amm && p.exp.amm.family == ModeFamily::PinnedFree {
+        for key in ["residual_G_peak_m", "residual_G_rms_m", "settle_s", "settled"] {
+            fields.insert(key.into(), serde_json::Value::Null);
+        }
+        fields.insert("residual_note".into(), "G is pinned in this family".into());
+    }
+    if let serde_json::Value::Object(doc) = meta {
+        doc.extend(fields);
+    }
+    Ok(())
+}
+
+/// The sidecar's residual after the motion in one line (`None` when the motion does not rest
+/// before `t_end`): peak |dG| and tip after `t_rest`, and the settling time.
+pub fn residual_line(meta: &serde_json::Value) -> Option<String> {
+    let t_rest = meta["t_rest"].as_f64()?;
+    let g = meta["residual_G_peak_m"]
+        .as_f64()
+        .map_or("n/a (G pinned)".to_string(), |v| format!("{v:.3e} m"));
+    let tip = meta["residual_tip_peak_m"].as_f64().unwrap_or(f64::NAN);
+    let settle = match meta["settle_s"].as_f64() {
+        Some(t) => format!("settled at {t:.3} s"),
+        None if meta["settled"] == false => "not settled by t_end".to_string(),
+        None => "settling n/a".to_string(),
+    };
+    Some(format!(
+        "after t_rest = {t_rest} s: peak |dG| = {g}, peak |tip| = {tip:.3e} m, {settle} (band {} m)",
+        meta["settle_tol"]
+    ))
 }
 
 /// Columns a direct run's file puts right after the fixed ones (issue 10 contract).

@@ -16,6 +16,7 @@ use serde::Serialize;
 use flexstar_plot::{Figure, RenderedFigure, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE};
 
 use crate::figures::{figure_forces, figure_sliders, figure_star, figure_tips, figure_w_g, Run};
+use crate::residual::{case_residuals, mark_t_rest, residual_csv, residual_markdown, RunResidual};
 use crate::runs::CaseResults;
 use crate::servo::servo_summary;
 use crate::table::{csv_text, opt_number, TableRow};
@@ -145,6 +146,11 @@ pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>,
             .collect::<Result<_, _>>()?;
         figs.push(figure_sliders(&exp.name, &runs, t, &reference));
     }
+    if let Some(t_rest) = flexstar_modal::settle::motion_end(exp) {
+        figs.iter_mut()
+            .filter(|f| !f.name.ends_with("-star"))
+            .for_each(|f| mark_t_rest(f, t_rest));
+    }
     Ok(figs)
 }
 
@@ -231,6 +237,7 @@ pub fn compare_markdown(
     row: &TableRow,
     (checks, warnings): (&RunChecks, &[ValidityWarning]),
     figures: &[RenderedFigure],
+    residuals: Option<&[RunResidual]>,
 ) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# {}: AMM against FEM\n", exp.name);
@@ -275,6 +282,9 @@ pub fn compare_markdown(
             pct(e.evp.mean),
             if e.correct { "yes" } else { "no" }
         );
+    }
+    if let Some(res) = residuals {
+        let _ = write!(s, "\n{}", residual_markdown(res));
     }
     let m = row.measures;
     let _ = writeln!(
@@ -344,7 +354,7 @@ pub fn compare_json(
     case: &CaseResults,
     row: &TableRow,
     prov: &Provenance,
-    checks: &RunChecks,
+    (checks, residuals): (&RunChecks, Option<&[RunResidual]>),
 ) -> String {
     let runs: Vec<RunJson> = runs_of(case)
         .into_iter()
@@ -364,6 +374,17 @@ pub fn compare_json(
         "comparison": row,
         "runs": runs,
     });
+    let mut doc = doc;
+    if let Some(res) = residuals {
+        let list: Vec<_> = res
+            .iter()
+            .map(|r| {
+                let fields = flexstar_model::residual::sidecar_fields(Some(&r.residual), r.residual.settle_tol);
+                serde_json::json!({ "run": r.run, "g_pinned": r.g_pinned, "residual": fields })
+            })
+            .collect();
+        doc["residual"] = serde_json::Value::Array(list);
+    }
     serde_json::to_string_pretty(&doc).expect("plain data serialises") + "\n"
 }
 
@@ -378,6 +399,9 @@ pub struct WrittenCase {
     /// Every run's small-deflection check, in the order of [`runs_of`].
     pub checks: RunChecks,
     pub compare_csv: String,
+    /// Every run's residual vibration after the motion (`None`: it does not rest before
+    /// `t_end`), written as `residual.csv`.
+    pub residuals: Option<Vec<RunResidual>>,
 }
 
 /// Write every output of one case into `dir` (see the module docs).
@@ -395,6 +419,7 @@ pub fn write_case(
     let csv = compare_csv(row);
     let checks = run_checks(exp, case);
     let warnings = validity_warnings(exp, &checks);
+    let residuals = case_residuals(exp, case)?;
     // every run's files and the EVP files are published together (issue 24)
     let mut set = RunSet::begin(dir)?;
     for (stem, r) in runs_of(case) {
@@ -403,15 +428,22 @@ pub fn write_case(
     set.text("compare.csv", &csv)?;
     set.text(
         "compare.md",
-        &compare_markdown(exp, case, row, (&checks, &warnings), &figs),
+        &compare_markdown(exp, case, row, (&checks, &warnings), &figs, residuals.as_deref()),
     )?;
-    set.text("compare.json", &compare_json(exp, case, row, prov, &checks))?;
+    set.text(
+        "compare.json",
+        &compare_json(exp, case, row, prov, (&checks, residuals.as_deref())),
+    )?;
+    if let Some(res) = &residuals {
+        set.text("residual.csv", &residual_csv(res))?;
+    }
     set.commit()?;
     Ok(WrittenCase {
         figures: figs,
         warnings,
         checks,
         compare_csv: csv,
+        residuals,
     })
 }
 

@@ -18,6 +18,7 @@ pub mod evp;
 pub mod figures;
 pub mod paper;
 pub mod report;
+pub mod residual;
 pub mod runs;
 pub mod servo;
 pub mod table;

@@ -128,6 +128,8 @@ pub struct ReportCase<'a> {
     pub checks: &'a RunChecks,
     /// Directory of the case's files relative to the report (`""` beside it).
     pub dir: &'a Path,
+    /// Every run's residual vibration after the motion (`write_case`'s).
+    pub residuals: Option<&'a [crate::residual::RunResidual]>,
 }
 
 /// What a report shows: a title, the provenance, for `verify` Table I and the checks, and the
@@ -196,6 +198,7 @@ pub fn case_report(
             warnings: &written.warnings,
             checks: &written.checks,
             dir: Path::new(""),
+            residuals: written.residuals.as_deref(),
         }],
     })
 }
@@ -290,6 +293,7 @@ fn case_html(h: &mut String, c: &ReportCase) {
     runs_html(h, c);
     servo_html(h, c);
     evps_html(h, c);
+    residual_html(h, c);
     figures_html(h, c);
     h.push_str("</section>\n");
 }
@@ -397,6 +401,18 @@ fn evps_html(h: &mut String, c: &ReportCase) {
         file_link(c.dir, "compare.csv"),
         file_link(c.dir, "compare.json")
     );
+}
+
+/// The residual vibration after the motion (`residual.csv`'s table), when the motion rests.
+fn residual_html(h: &mut String, c: &ReportCase) {
+    let Some(res) = c.residuals else {
+        return;
+    };
+    let md = crate::residual::residual_markdown(res);
+    let (heading, body) = md.split_once("\n\n").unwrap_or(("", &md));
+    let _ = writeln!(h, "<h3>{}</h3>", escape(heading.trim_start_matches("## ")));
+    h.push_str(&markdown_to_html(body));
+    let _ = writeln!(h, "<p>Also as {}.</p>", file_link(c.dir, "residual.csv"));
 }
 
 /// The figures with their captions and links to their files.

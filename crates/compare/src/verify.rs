@@ -194,6 +194,7 @@ fn write_summary(opts: &VerifyOptions, v: &Verified, per_case: &[WrittenCase]) -
                     warnings: &written.warnings,
                     checks: &written.checks,
                     dir: Path::new(&s.exp.name),
+                    residuals: written.residuals.as_deref(),
                 })
                 .collect(),
         });

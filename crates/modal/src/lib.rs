@@ -21,6 +21,7 @@ pub mod freqmap;
 pub mod linear;
 pub mod plots;
 pub mod pose;
+pub mod settle;
 
 pub use error::ModalError;
 

@@ -40,6 +40,7 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         damping: Default::default(),
         load: Default::default(),
         shaper: None,
+        report: Default::default(),
         source: Default::default(),
     }
 }

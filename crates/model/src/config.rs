@@ -367,6 +367,9 @@ pub struct Experiment {
     /// default. Applied when the file is read ([`Experiment::apply_shaper`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shaper: Option<crate::shaper::ShaperSection>,
+    /// How reports measure the run (`[report]`, issue 26: the settling band).
+    #[serde(default)]
+    pub report: crate::residual::ReportSettings,
     /// Where the experiment was read from (not a TOML key).
     #[serde(skip)]
     pub source: PathBuf,
@@ -437,6 +440,7 @@ impl Experiment {
         self.payload.validate()?;
         self.damping.validate()?;
         self.load.validate(self.time.t_end)?;
+        self.report.validate()?;
         if self.fem.elements < 3 || !self.fem.elements.is_multiple_of(3) || self.fem.elements > 30_000 {
             return Err(ModelError::invalid(
                 "fem.elements",

@@ -18,4 +18,4 @@ pub use drawing::{register_font, svg_string, write_svg_png, Drawing, FigureError
 pub use figure::{Figure, GridFigure, Panel, RenderedFigure, Series};
 pub use legend::draw_legend;
 pub use panel::tick;
-pub use style::{colormap, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE, RIGID_STYLE};
+pub use style::{colormap, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE, MARK_STYLE, RIGID_STYLE};

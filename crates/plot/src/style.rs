@@ -41,6 +41,12 @@ pub const RIGID_STYLE: Style = Style {
     width: 1,
     dashed: true,
 };
+/// A time mark (the end of the motion, `t_rest`): thin dashed blue-grey.
+pub const MARK_STYLE: Style = Style {
+    color: RGBColor(90, 110, 170),
+    width: 1,
+    dashed: true,
+};
 /// One colour per mode family, in the order of `ModeFamily::ALL` (pinned-free red, slide-free
 /// blue, free-free green, clamped-free purple, enriched orange), so that a family has the same
 /// colour in every figure and report.

@@ -29,37 +29,24 @@ pub fn peaks(r: &Response) -> Peaks {
     }
 }
 
-/// End of the motion [s]: the `t_rest` of a rest-to-rest trajectory (quintic, via, table;
-/// [`flexstar_model::Trajectory::t_rest`]) that ends before `time.t_end`; `None` for polynomial
-/// motions (they never come to rest).
-pub fn motion_end(exp: &Experiment) -> Option<f64> {
-    exp.trajectory.t_rest().filter(|&t| t < exp.time.t_end)
-}
-
-/// Residual vibration: largest |w_i(L)| over the tips at the output times `t >= t_motion_end` [m].
-pub fn residual_tip(r: &Response, t_motion_end: f64) -> f64 {
-    let first = r.t.partition_point(|&t| t < t_motion_end - 1e-12);
-    r.w_tip.iter().map(|v| max_abs(&v[first..])).fold(0.0, f64::max)
+/// The residual columns of a row (`residual_tip_m`, `residual_G_m`, `settle_s`) for a run `r`
+/// of `exp` ([`flexstar_modal::settle::run_residual`]): `None` without a rest before `t_end`;
+/// `settle_s` is `inf` when not settled by `t_end` (it sorts last, plots skip it). `g_pinned`:
+/// the run's family pins G (pinned-free AMM), so it has no residual of G.
+pub fn residual_columns(exp: &Experiment, r: &Response, g_pinned: bool) -> (Option<f64>, Option<f64>, Option<f64>) {
+    match flexstar_modal::settle::run_residual(exp, r) {
+        Ok(Some(res)) if g_pinned => (Some(res.tip_peak_m), None, None),
+        Ok(Some(res)) => (
+            Some(res.tip_peak_m),
+            Some(res.g_peak_m),
+            Some(res.settle_s.unwrap_or(f64::INFINITY)),
+        ),
+        _ => (None, None, None),
+    }
 }
 
 /// Mean EVP [%] of the AMM against the FEM of the same case over the points A, B, C, G that have
 /// one (Eq. 45, the mean of Table I; `flexstar_compare::point_evps`).
 pub fn mean_evp(amm: &Response, fem: &Response) -> Option<f64> {
     flexstar_compare::point_evps(amm, fem).ok().and_then(|e| e.mean)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn residual_is_taken_after_the_motion_only() {
-        let mut r = Response::with_capacity("x", 5);
-        for (k, tip) in [0.0, 5.0, -3.0, 0.5, -0.25].into_iter().enumerate() {
-            r.push(k as f64 * 0.1, [0.0; 3], [tip, 0.0, 0.0], [0.0; 3]);
-        }
-        assert_eq!(residual_tip(&r, 0.3), 0.5);
-        assert_eq!(residual_tip(&r, 0.2), 3.0);
-        assert_eq!(peaks(&r).tip_m, 5.0);
-    }
 }

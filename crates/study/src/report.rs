@@ -23,6 +23,8 @@ pub fn metric_labels() -> Vec<(&'static str, &'static str)> {
         ("peak_Fa_N", "peak |Fa_i| [N]"),
         ("evp_percent", "mean EVP of the AMM vs FEM [%]"),
         ("residual_tip_m", "residual |w_i(L)| after the motion [m]"),
+        ("residual_G_m", "residual |dG| after the motion [m]"),
+        ("settle_s", "settling time, absolute (not settled: not drawn) [s]"),
         ("error_estimate_percent", "AMM error estimate [%]"),
         ("modes", "AMM modes per beam"),
         ("wall_s", "wall time per solve [s]"),

@@ -14,7 +14,7 @@ use flexstar_model::{Experiment, Response};
 use rayon::prelude::*;
 
 use crate::error::StudyError;
-use crate::metrics::{mean_evp, motion_end, peaks, residual_tip};
+use crate::metrics::{mean_evp, peaks, residual_columns};
 use crate::patch::value_text;
 use crate::sample::Case;
 use crate::shard::{meta_file, results_file, write_pair, Meta, Shard};
@@ -303,7 +303,7 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
         (Some(a), Some(f)) => mean_evp(a, f),
         _ => None,
     };
-    let rest_from = exp.as_ref().ok().and_then(motion_end);
+    let exp = exp.as_ref().ok();
     solved
         .iter()
         .map(|(solver, (result, wall_s))| {
@@ -320,6 +320,8 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
                 residual_tip_m: None,
                 modes: None,
                 error_estimate_percent: None,
+                residual_g_m: None,
+                settle_s: None,
             };
             match result {
                 Ok(r) => {
@@ -328,7 +330,10 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
                     row.peak_wg_m = Some(p.w_g_m);
                     row.peak_fa_n = Some(p.fa_n);
                     row.evp_percent = if *solver == Solver::Amm { evp } else { None };
-                    row.residual_tip_m = rest_from.map(|t| residual_tip(r, t));
+                    if let Some(exp) = exp {
+                        let pinned = *solver == Solver::Amm && exp.amm.family == flexstar_model::ModeFamily::PinnedFree;
+                        (row.residual_tip_m, row.residual_g_m, row.settle_s) = residual_columns(exp, r, pinned);
+                    }
                     row.modes = r.info.modes;
                     row.error_estimate_percent = r.info.error_estimate_percent;
                 }

@@ -18,8 +18,16 @@ pub const METRIC_COLUMNS: [&str; 7] = [
 ];
 
 /// Further columns: residual tip vibration after a rest-to-rest motion [m], AMM modes per beam,
-/// the AMM's own estimate of its truncation error [%].
-pub const MORE_COLUMNS: [&str; 3] = ["residual_tip_m", "modes", "error_estimate_percent"];
+/// the AMM's own estimate of its truncation error [%], then (issue 26) the residual peak of
+/// |dG| after the motion [m] and the settling time [s, absolute; `inf` when not settled by
+/// `t_end`] (`docs/motions.md` 2.2-2.4).
+pub const MORE_COLUMNS: [&str; 5] = [
+    "residual_tip_m",
+    "modes",
+    "error_estimate_percent",
+    "residual_G_m",
+    "settle_s",
+];
 
 /// Column names that are neither keys nor numbers to plot.
 pub const TEXT_COLUMNS: [&str; 3] = ["run_id", "solver", "status"];
@@ -61,6 +69,10 @@ pub struct Row {
     pub modes: Option<usize>,
     /// The AMM's estimate of its truncation error [%], when it makes one.
     pub error_estimate_percent: Option<f64>,
+    /// Residual peak of |dG| after a rest-to-rest motion [m].
+    pub residual_g_m: Option<f64>,
+    /// Settling time [s, absolute], `inf` when not settled by `t_end`.
+    pub settle_s: Option<f64>,
 }
 
 fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
@@ -81,6 +93,8 @@ impl Row {
             opt(self.residual_tip_m),
             opt(self.modes),
             opt(self.error_estimate_percent),
+            opt(self.residual_g_m),
+            opt(self.settle_s),
         ]);
         r
     }

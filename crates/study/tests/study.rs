@@ -196,7 +196,7 @@ fn rows_match_direct_solves_and_bad_values_become_rows() {
     let t = Table::read(&out.results).unwrap();
     assert_eq!(
         t.header.join(","),
-        "run_id,robot.Lp,scale.duration,solver,status,peak_tip_m,peak_wG_m,peak_Fa_N,evp_percent,wall_s,residual_tip_m,modes,error_estimate_percent"
+        "run_id,robot.Lp,scale.duration,solver,status,peak_tip_m,peak_wG_m,peak_Fa_N,evp_percent,wall_s,residual_tip_m,modes,error_estimate_percent,residual_G_m,settle_s"
     );
     assert_eq!(t.rows.len(), 8);
     // Lp = 0.7 > L: a row per solver saying why, the study goes on

@@ -1,0 +1,140 @@
+//! The residual vibration of every run of a case after its motion has come to rest (issue 26
+//! item 2, `docs/motions.md` 2.4): `residual.csv`, its table in `compare.md` and `report.html`,
+//! and the mark of `t_rest` on the time plots.
+
+use std::fmt::Write as _;
+
+use flexstar_model::output::fmt_number;
+use flexstar_model::residual::{residual_after, settle_text, Residual};
+use flexstar_model::{Experiment, ModeFamily};
+use flexstar_plot::{Figure, Series, MARK_STYLE};
+
+use crate::case_output::runs_of;
+use crate::runs::CaseResults;
+use crate::Error;
+
+/// Header of `residual.csv` (issue 26 contract, `docs/motions.md` 2.4).
+pub const RESIDUAL_CSV_HEADER: &str =
+    "run,t_rest,residual_G_peak_m,residual_G_rms_m,residual_tip_peak_m,residual_tip_rms_m,settle_s";
+
+/// Each run's residual (file stem, measures), in the order of [`runs_of`]. `g_pinned`: the run's
+/// family pins G (pinned-free), so it has no residual of G.
+#[derive(Debug, Clone)]
+pub struct RunResidual {
+    pub run: String,
+    pub residual: Residual,
+    pub g_pinned: bool,
+}
+
+/// The residuals of a case, computed once (one modal analysis for the settling hold of
+/// motions.md 2.3); `None` when the motion does not rest before `t_end`.
+pub fn case_residuals(exp: &Experiment, case: &CaseResults) -> Result<Option<Vec<RunResidual>>, Error> {
+    let hold = flexstar_modal::settle::settle_hold_s(exp).map_err(|e| Error::Input {
+        file: exp.source.display().to_string(),
+        reason: format!("settling time: {e}"),
+    })?;
+    let (Some(t_rest), Some(hold)) = (flexstar_modal::settle::motion_end(exp), hold) else {
+        return Ok(None);
+    };
+    let pinned: Vec<bool> = std::iter::once(false)
+        .chain(
+            case.amm
+                .iter()
+                .map(|(run, _)| run.settings.family == ModeFamily::PinnedFree),
+        )
+        .collect();
+    let runs = runs_of(case)
+        .into_iter()
+        .zip(pinned)
+        .filter_map(|((run, r), g_pinned)| {
+            residual_after(r, t_rest, exp.report.settle_tol, hold).map(|residual| RunResidual {
+                run,
+                residual,
+                g_pinned,
+            })
+        })
+        .collect();
+    Ok(Some(runs))
+}
+
+fn g_value(r: &RunResidual, v: f64) -> Option<f64> {
+    (!r.g_pinned).then_some(v)
+}
+
+/// `residual.csv`: one row per run; empty fields where a measure does not exist (G pinned by
+/// the family; `settle_s` when not settled by `t_end`).
+pub fn residual_csv(runs: &[RunResidual]) -> String {
+    let num = |v: Option<f64>| v.map(fmt_number).unwrap_or_default();
+    let mut s = String::from(RESIDUAL_CSV_HEADER);
+    s.push('\n');
+    for r in runs {
+        let m = &r.residual;
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{}",
+            r.run,
+            fmt_number(m.t_rest),
+            num(g_value(r, m.g_peak_m)),
+            num(g_value(r, m.g_rms_m)),
+            num(Some(m.tip_peak_m)),
+            num(Some(m.tip_rms_m)),
+            num(m.settle_s.filter(|_| !r.g_pinned)),
+        );
+    }
+    s
+}
+
+/// The table of `compare.md` (and, through its HTML form, of `report.html`).
+pub fn residual_markdown(runs: &[RunResidual]) -> String {
+    let Some(first) = runs.first() else {
+        return String::new();
+    };
+    let m0 = &first.residual;
+    let mut s = format!(
+        "## Residual vibration after the motion (t_rest = {:.4} s)\n\ndG is the length of G's elastic displacement, \
+         sqrt(2/3 sum w_iG^2); tips: the largest of w_i(L) in magnitude, RMS of the three. Settled: the last time \
+         dG exceeds settle_tol = {:e} m, when the run then stays below it for at least one period of the first \
+         mode at the final pose ({:.3} s).\n\n",
+        m0.t_rest, m0.settle_tol, m0.hold_s
+    );
+    s.push_str("| run | peak dG [mm] | RMS dG [mm] | peak tip [mm] | RMS tip [mm] | settled at |\n");
+    s.push_str("|---|---|---|---|---|---|\n");
+    let mm = |v: Option<f64>| v.map_or("n/a (G pinned)".to_string(), |x| format!("{:.4}", x * 1e3));
+    for r in runs {
+        let m = &r.residual;
+        let settle = if r.g_pinned { "n/a".into() } else { settle_text(m) };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.4} | {:.4} | {settle} |",
+            r.run,
+            mm(g_value(r, m.g_peak_m)),
+            mm(g_value(r, m.g_rms_m)),
+            m.tip_peak_m * 1e3,
+            m.tip_rms_m * 1e3,
+        );
+    }
+    s.push('\n');
+    s
+}
+
+/// Mark `t_rest` [s] on every panel of a time figure: a dashed vertical line over the panel's
+/// data range, named once in the legend.
+pub fn mark_t_rest(fig: &mut Figure, t_rest: f64) {
+    for (k, panel) in fig.panels.iter_mut().enumerate() {
+        let ys = panel
+            .series
+            .iter()
+            .flat_map(|s| s.y.iter().copied())
+            .filter(|v| v.is_finite());
+        let (lo, hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        if !lo.is_finite() {
+            continue;
+        }
+        panel.series.push(Series {
+            label: if k == 0 { "t_rest".into() } else { String::new() },
+            x: vec![t_rest, t_rest],
+            y: vec![lo, hi],
+            style: MARK_STYLE,
+        });
+    }
+}

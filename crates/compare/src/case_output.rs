@@ -145,6 +145,7 @@ pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>,
             .collect::<Result<_, _>>()?;
         figs.push(figure_sliders(&exp.name, &runs, t, &reference));
     }
+    figs.extend(crate::sensitivity::figure_sensitivity(exp)?);
     Ok(figs)
 }
 

@@ -19,6 +19,7 @@ pub mod figures;
 pub mod paper;
 pub mod report;
 pub mod runs;
+pub mod sensitivity;
 pub mod servo;
 pub mod table;
 pub mod thresholds;

@@ -174,3 +174,45 @@ fn zvd_at_the_amm_modes_removes_the_residual_of_g_in_both_solvers() {
         assert!((from_w - r[gx].hypot(r[gy])).abs() <= 1e-9 * from_w.max(1e-6));
     }
 }
+
+/// `f_hz = "auto"` (docs/motions.md 3.5) on the same move: the frequencies come from the accurate
+/// AMM and are recorded; the FEM's residual peak of G is at most 1/10 of the unshaped quintic's
+/// of the same nominal duration (the target), measured against the plain run.
+#[test]
+fn auto_zvd_cuts_the_residual_of_g_tenfold_on_the_fem() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let plain = write_config(dir.path(), "plain", "");
+    let auto = write_config(dir.path(), "auto", "[shaper]\nkind = \"zvd\"\nf_hz = \"auto\"\n");
+    let run_plain = compare(&plain, &out, "plain");
+    let run_auto = compare(&auto, &out, "auto");
+    let side: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_auto.join("fem.json")).unwrap()).unwrap();
+    let sh = &side["experiment"]["shaper"];
+    let f: Vec<f64> = sh["frequencies_hz"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(sh["auto"]["frequencies_hz"], sh["frequencies_hz"]);
+    let shares: f64 = sh["auto"]["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["share"].as_f64().unwrap())
+        .sum();
+    assert!((shares - 1.0).abs() < 1e-9, "shares sum to 1: {shares}");
+    // the first chosen frequency is the end pose's first mode (within the ZVD's 5 % band)
+    assert!((f[0] / 3.955 - 1.0).abs() < 0.05, "auto chose {f:?}");
+    let penalty = sh["penalty_s"].as_f64().unwrap();
+    let t_rest = 0.2 + penalty;
+    let span = 0.9 - t_rest;
+    for file in ["fem.csv", "amm-enriched.csv"] {
+        let before = residual_peak(&run_plain.join(file), 0.2, span);
+        let after = residual_peak(&run_auto.join(file), t_rest, span);
+        let ratio = after / before;
+        eprintln!("auto {f:?} Hz, penalty {penalty:.4} s, {file}: {before:.4e} -> {after:.4e} m, ratio {ratio:.4}");
+        assert!(ratio <= 0.1, "{file}: auto ZVD leaves {ratio} of the residual");
+    }
+}

@@ -12,6 +12,7 @@ pub mod kinematics;
 pub mod modal;
 pub mod modes;
 pub mod run;
+pub mod shaper_auto;
 pub mod sidecar;
 mod solver_errors;
 pub mod study;
@@ -22,9 +23,11 @@ pub use document::ExperimentDoc;
 pub use error::{ApiError, Result};
 pub use flexstar_model::{Experiment, Provenance};
 pub use run::{Forces, Prepared, RunOutcome, RunSettings, Solver};
+pub use shaper_auto::register_auto_shaper;
 
 /// Load and validate an experiment file (errors name the file, the key and the reason).
 pub fn load(config: &Path) -> Result<Experiment> {
+    register_auto_shaper();
     Ok(Experiment::load(config)?)
 }
 

@@ -151,6 +151,7 @@ pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>,
             .filter(|f| !f.name.ends_with("-star"))
             .for_each(|f| mark_t_rest(f, t_rest));
     }
+    figs.extend(crate::sensitivity::figure_sensitivity(exp)?);
     Ok(figs)
 }
 

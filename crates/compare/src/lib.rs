@@ -20,6 +20,7 @@ pub mod paper;
 pub mod report;
 pub mod residual;
 pub mod runs;
+pub mod sensitivity;
 pub mod servo;
 pub mod table;
 pub mod thresholds;

@@ -137,3 +137,17 @@ pub fn write_modal_csv(dest: Dest<'_>, modal: &Modal) -> Result<(), ModalError> 
     })?;
     Ok(())
 }
+
+/// The first `count` elastic natural frequencies [Hz] of the accurate AMM ([`amm_basis`], the
+/// payload at G) at the final pose of the experiment's rest-to-rest motion, sliders locked
+/// (`docs/motions.md` 3.5, 3.6: the modes a shaper is designed for and judged against);
+/// `None` when the motion never comes to rest.
+pub fn final_pose_frequencies(exp: &Experiment, count: usize) -> Result<Option<Vec<f64>>, ModalError> {
+    let Some(t_rest) = exp.trajectory.t_rest() else {
+        return Ok(None);
+    };
+    let s = exp.trajectory.s(&exp.robot, t_rest)?;
+    let pose = crate::pose::pose_from_sliders(&exp.robot, s)?;
+    let f = amm_pose_model(exp)?.frequencies_at(&pose, Sliders::Locked, count)?;
+    Ok(Some(f))
+}

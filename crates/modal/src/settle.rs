@@ -3,10 +3,9 @@
 //! hold of section 2.3, one period of the first elastic mode at the final pose.
 
 use flexstar_model::residual::{residual_after, Residual};
-use flexstar_model::{Experiment, Response, Sliders};
+use flexstar_model::{Experiment, Response};
 
-use crate::analysis::amm_pose_model;
-use crate::pose::pose_at_time;
+use crate::analysis::final_pose_frequencies;
 use crate::ModalError;
 
 /// End of the motion [s]: the `t_rest` of a rest-to-rest trajectory that ends before
@@ -16,19 +15,18 @@ pub fn motion_end(exp: &Experiment) -> Option<f64> {
 }
 
 /// One period [s] of the first elastic mode at the pose the motion ends in, sliders locked, by
-/// the accurate AMM ([`amm_pose_model`], payload included): the quiet time a run must end with
+/// the accurate AMM ([`final_pose_frequencies`], payload included): the quiet time a run must end with
 /// to count as settled (motions.md 2.3). `None` without a rest before `t_end`.
 pub fn settle_hold_s(exp: &Experiment) -> Result<Option<f64>, ModalError> {
-    let Some(t_rest) = motion_end(exp) else {
+    if motion_end(exp).is_none() {
         return Ok(None);
-    };
-    let pose = pose_at_time(exp, t_rest)?;
-    let f = amm_pose_model(exp)?.frequencies_at(&pose, Sliders::Locked, 1)?;
+    }
+    let f = final_pose_frequencies(exp, 1)?.unwrap_or_default();
     match f.first() {
         Some(&f1) if f1 > 0.0 => Ok(Some(1.0 / f1)),
-        _ => Err(ModalError::Input(format!(
-            "no elastic mode at the final pose (t = {t_rest} s) to time the settling by"
-        ))),
+        _ => Err(ModalError::Input(
+            "no elastic mode at the final pose to time the settling by".to_string(),
+        )),
     }
 }
 

@@ -143,6 +143,46 @@ pub struct ShaperSection {
     /// The time penalty [s]: the shaped motion's `t_rest` minus the unshaped one's (resolved).
     #[serde(default, skip_deserializing)]
     pub penalty_s: f64,
+    /// `f_hz = "auto"` only: how the frequencies were chosen (`docs/motions.md` 3.5, resolved).
+    #[serde(default, skip_deserializing, skip_serializing_if = "Option::is_none")]
+    pub auto: Option<AutoChoice>,
+}
+
+/// One frequency group of the unshaped residual of G (`docs/motions.md` 3.5, step 2-3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AutoMode {
+    /// The group's frequency [Hz] (modes of the final pose closer than the fit resolves, merged).
+    pub f_hz: f64,
+    /// Its share of the mean square of the unshaped residual of G [-].
+    pub share: f64,
+    /// The LTI residual factor the chosen shaper leaves on it, `V(f)` [-].
+    pub predicted_factor: f64,
+}
+
+/// What `f_hz = "auto"` chose and why (`docs/motions.md` 3.5, step 5).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AutoChoice {
+    /// The shaper frequencies [Hz], in the order chosen.
+    pub frequencies_hz: Vec<f64>,
+    /// The frequency groups of the unshaped residual of G, by frequency.
+    pub modes: Vec<AutoMode>,
+    /// `R_pred / R_0`: the LTI prediction of the shaped residual over the unshaped one [-].
+    pub predicted_ratio: f64,
+    /// How it was computed (one sentence, for the sidecar's reader).
+    pub method: String,
+}
+
+/// The resolver of `f_hz = "auto"` (`docs/motions.md` 3.5): given the experiment with its
+/// unshaped, validated rest-to-rest motion and its `[shaper]` section, the frequencies chosen.
+/// It needs the solvers and the modal analysis, which this crate cannot call: the layer above
+/// (`flexstar_api::register_auto_shaper`) registers it once per process.
+pub type AutoResolver = fn(&crate::Experiment) -> Result<AutoChoice, String>;
+
+static AUTO_RESOLVER: std::sync::OnceLock<AutoResolver> = std::sync::OnceLock::new();
+
+/// Register the resolver of `f_hz = "auto"` (the first registration wins; later ones are no-ops).
+pub fn register_auto_resolver(f: AutoResolver) {
+    let _ = AUTO_RESOLVER.set(f);
 }
 
 /// What `f_hz` asks for.
@@ -166,6 +206,7 @@ impl ShaperSection {
             zeta_used: Vec::new(),
             impulses: Vec::new(),
             penalty_s: 0.0,
+            auto: None,
         }
     }
 
@@ -263,11 +304,10 @@ impl crate::Experiment {
         let f_hz = match section.frequency_spec()? {
             FrequencySpec::Given(f) => f,
             FrequencySpec::Auto => {
-                return Err(ModelError::invalid(
-                    "shaper.f_hz",
-                    "\"auto\" is not implemented yet (docs/motions.md 3.5); give the frequencies [Hz], \
-                     e.g. from `flexstar modes` at the final pose",
-                ))
+                let choice = self.auto_frequencies()?;
+                let f = choice.frequencies_hz.clone();
+                section.auto = Some(choice);
+                f
             }
         };
         let damping = self.damping.clone();
@@ -278,6 +318,26 @@ impl crate::Experiment {
         });
         self.shaper = Some(section);
         Ok(())
+    }
+
+    /// `f_hz = "auto"` resolved by the registered [`AutoResolver`] (key `shaper.f_hz`): refused
+    /// with a servo (`docs/motions.md` 8.5) and when no resolver is registered.
+    fn auto_frequencies(&self) -> Result<AutoChoice, ModelError> {
+        if self.drive.kind != crate::DriveKind::Motion {
+            return Err(ModelError::invalid(
+                "shaper.f_hz",
+                "\"auto\" needs a prescribed motion (drive.kind = \"motion\"); with a servo give the \
+                 frequencies [Hz]",
+            ));
+        }
+        let Some(resolve) = AUTO_RESOLVER.get() else {
+            return Err(ModelError::invalid(
+                "shaper.f_hz",
+                "\"auto\" needs the modal analysis, which this program did not register \
+                 (flexstar_api::register_auto_shaper); give the frequencies [Hz]",
+            ));
+        };
+        resolve(self).map_err(|e| ModelError::invalid("shaper.f_hz", format!("\"auto\": {e}")))
     }
 
     /// The motion a shaper may act on: valid, rest-to-rest, with a task-space pose, and moved by

@@ -80,3 +80,14 @@ fn bad_sections_are_refused_by_key() {
         .to_string();
     assert!(err.contains("rest-to-rest"), "{err}");
 }
+
+/// Without a registered resolver (this crate alone cannot run the modal analysis),
+/// `f_hz = "auto"` is refused by key with what to do instead.
+#[test]
+fn auto_without_a_resolver_is_refused_by_key() {
+    let err = load("[shaper]\nkind = \"zvd\"\nf_hz = \"auto\"\n").unwrap_err();
+    assert!(
+        err.contains("shaper.f_hz") && err.contains("register_auto_shaper"),
+        "{err}"
+    );
+}

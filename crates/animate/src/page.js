@@ -26,7 +26,8 @@ function setup() {
   D.runs.forEach((run, i) => {
     s += line(`trace r${i}`, run.colour, 1, 'stroke-dasharray="4 3" opacity="0.6"');
     for (let b = 0; b < 3; b++) s += line(`rigid r${i}`, "#999", 1);
-    for (let b = 0; b < 3; b++) s += line(`beam r${i}`, run.colour, 2.5);
+    // later runs narrower, drawn over the earlier ones: where they agree both stay visible
+    for (let b = 0; b < 3; b++) s += line(`beam r${i}`, run.colour, Math.max(1.5, 5 - 2 * i));
   });
   for (let i = 0; i < 3; i++) s += `<circle class="slider" r="${D.L_um / 60000}" fill="#4477aa"/>`;
   $("scene").innerHTML = s;

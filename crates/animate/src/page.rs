@@ -174,3 +174,60 @@ pub fn build_page(runs: &[RunFrames], magnify: Option<f64>) -> Result<String, An
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::read::BeamPoints;
+
+    /// A star of three straight beams along x at `t`, its beam 1 bent by `w` [m] at the tip.
+    fn run(name: &str, times: &[f64], w: f64) -> RunFrames {
+        let beam = |bend: f64| BeamPoints {
+            rigid: vec![[0.0, 0.0], [0.25, 0.0], [0.5, 0.0]],
+            pos: vec![[0.0, 0.0], [0.25, bend / 4.0], [0.5, bend]],
+        };
+        RunFrames {
+            name: name.into(),
+            times: times.to_vec(),
+            beams: times.iter().map(|_| [beam(w), beam(0.0), beam(0.0)]).collect(),
+            pose: times.iter().map(|_| [0.0; 6]).collect(),
+            t_rest: None,
+            l: Some(0.5),
+            d: None,
+        }
+    }
+
+    #[test]
+    fn default_magnification_draws_the_largest_displacement_as_a_tenth_of_l() {
+        // 2 mm at the tip: M = 0.05 m / 2 mm = 25
+        let m = default_magnification(&[run("amm-enriched", &[0.0, 0.1], 0.002)]);
+        assert!((m - 25.0).abs() < 1e-9, "{m}");
+        assert_eq!(default_magnification(&[run("fem", &[0.0], 0.0)]), 1.0);
+    }
+
+    #[test]
+    fn different_frame_times_are_refused_naming_both_runs() {
+        let runs = [
+            run("amm-enriched", &[0.0, 0.01, 0.02], 1e-3),
+            run("fem", &[0.0, 0.02], 1e-3),
+        ];
+        let e = build_page(&runs, None).unwrap_err().to_string();
+        assert!(
+            e.contains("amm-enriched (3 frames, 100 per second)") && e.contains("fem (2 frames, 50 per second)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn the_page_embeds_parseable_data_and_no_url() {
+        let html = build_page(&[run("amm-</script>", &[0.0, 0.1], 1e-3)], Some(7.0)).unwrap();
+        assert!(!html.contains("http") && !html.contains("amm-</script>"));
+        let start = html.find("id=\"frames-data\">").unwrap() + "id=\"frames-data\">".len();
+        let end = start + html[start..].find("</script>").unwrap();
+        let v: Value = serde_json::from_str(&html[start..end]).unwrap();
+        assert_eq!(v["magnify"], 7.0);
+        assert_eq!(v["runs"][0]["name"], "amm-</script>");
+        // elastic part in nanometres: the tip of beam 1, 1 mm in y
+        assert_eq!(v["runs"][0]["elastic"][0][0][5], 1_000_000);
+    }
+}

@@ -181,6 +181,20 @@ mod tests {
     }
 
     #[test]
+    fn frames_zero_is_left_out_of_a_written_experiment() {
+        let mut a = crate::AmmSettings::default();
+        let v = serde_json::to_value(&a).unwrap();
+        assert!(v.get("frames").is_none(), "{v}");
+        a.frames = 50;
+        assert_eq!(serde_json::to_value(&a).unwrap()["frames"], 50);
+        let f = crate::FemSettings::default();
+        assert!(serde_json::to_value(&f).unwrap().get("frames").is_none());
+        // read back: absent is 0
+        let back: crate::AmmSettings = serde_json::from_value(v).unwrap();
+        assert_eq!(back.frames, 0);
+    }
+
+    #[test]
     fn merge_keeps_snapshots_alone_without_frames() {
         let s = ShapeTimes::merge(&[0.1, 0.5], &[], 1e-12);
         assert_eq!(s.all, vec![0.1, 0.5]);

@@ -28,7 +28,7 @@ use num_dual::{Dual2, HyperDual64};
 use crate::adaptive;
 use crate::error::{AmmError, RankError};
 use crate::record::Recorder;
-use crate::solver::{snapshot_times, stops, validate, Stop, RHO_INF};
+use crate::solver::{shape_times, stops, validate, Stop, RHO_INF};
 use crate::system::System;
 
 /// Columns a direct run writes first among its extra columns: the sliders `s_i` [m] and `s_i'`
@@ -235,10 +235,10 @@ fn integrate_direct(
     let n = sys.dim();
 
     let out_times = exp.time.output_times();
-    let snaps = snapshot_times(exp, settings);
-    let stops = stops(&out_times, &snaps, 1e-9 * exp.time.dt_out);
+    let times = shape_times(exp, settings);
+    let stops = stops(&out_times, &times.all, 1e-9 * exp.time.dt_out);
     let mut out = DirectOutput {
-        rec: Recorder::new(&sys, settings, params, out_times.len(), &snaps),
+        rec: Recorder::new(&sys, settings, params, out_times.len(), times),
         cols: (0..DIRECT_COLUMNS.len())
             .map(|_| Vec::with_capacity(out_times.len()))
             .collect(),

@@ -2,8 +2,9 @@
 //! [`crate::solve`], and the direct run, [`crate::solve_direct`]).
 
 use flexstar_kinematics::RigidState;
+use flexstar_model::frames::ShapeTimes;
 use flexstar_model::geometry::slider_direction;
-use flexstar_model::{AmmModel, AmmSettings, BeamShape, Response, RobotParams, StarShape};
+use flexstar_model::{AmmModel, AmmSettings, BeamShape, Frame, FramePose, Response, RobotParams, StarShape};
 
 use crate::solver::{Stop, EXTRA_COLUMNS, SHAPE_POINTS};
 use crate::system::{Row, System};
@@ -15,6 +16,10 @@ pub(crate) struct Recorder {
     xs: Vec<f64>,
     shape_phi: Vec<Vec<f64>>,
     shapes: Vec<StarShape>,
+    /// Rigid pose at each shape time (what an animation frame is drawn about).
+    poses: Vec<FramePose>,
+    /// The shape times: which are snapshots, which animation frames.
+    times: ShapeTimes,
     /// Multiplier index of each named multiplier column (`None`: row dropped for the family).
     col_rows: [Option<usize>; 19],
     phi0: Vec<f64>,
@@ -26,7 +31,13 @@ pub(crate) struct Recorder {
 }
 
 impl Recorder {
-    pub(crate) fn new(sys: &System, settings: &AmmSettings, params: &RobotParams, n_out: usize, snaps: &[f64]) -> Self {
+    pub(crate) fn new(
+        sys: &System,
+        settings: &AmmSettings,
+        params: &RobotParams,
+        n_out: usize,
+        times: ShapeTimes,
+    ) -> Self {
         let (nm, nb) = (sys.nm, sys.nb);
         let extra: Vec<Vec<f64>> = (0..EXTRA_COLUMNS.len()).map(|_| Vec::with_capacity(n_out)).collect();
         let xs: Vec<f64> = (0..SHAPE_POINTS)
@@ -40,7 +51,8 @@ impl Recorder {
                 v
             })
             .collect();
-        let shapes: Vec<StarShape> = snaps
+        let shapes: Vec<StarShape> = times
+            .all
             .iter()
             .map(|&t| StarShape {
                 t,
@@ -78,6 +90,8 @@ impl Recorder {
             extra,
             xs,
             shape_phi,
+            poses: vec![FramePose::default(); times.all.len()],
+            times,
             shapes,
             col_rows,
             phi0: sys.phi0.clone(),
@@ -131,6 +145,11 @@ impl Recorder {
         let beam_val =
             |i: usize, coef: &[f64]| -> f64 { q[i * nb..i * nb + nm].iter().zip(coef).map(|(a, p)| a * p).sum() };
         if let Some(s) = stop.snapshot {
+            self.poses[s] = FramePose {
+                g: [st.g[0].v, st.g[1].v],
+                theta: st.theta.v,
+                s: st.s.map(|x| x.v),
+            };
             let shape = &mut self.shapes[s];
             for i in 0..3 {
                 let (ex, ew) = (st.e_x(i), st.e_w(i));
@@ -165,12 +184,19 @@ impl Recorder {
         }
     }
 
-    /// The response labelled `label`, with the columns [`EXTRA_COLUMNS`] and the snapshots.
+    /// The response labelled `label`, with the columns [`EXTRA_COLUMNS`], the snapshots and the
+    /// animation frames.
     pub(crate) fn finish(self, label: String) -> Response {
         let mut resp = self.resp;
         resp.label = label;
         resp.set_extra(&EXTRA_COLUMNS, self.extra);
-        resp.shapes = self.shapes;
+        resp.frames = (self.times.frame_idx.iter())
+            .map(|&k| Frame {
+                shape: self.shapes[k].clone(),
+                pose: self.poses[k],
+            })
+            .collect();
+        resp.shapes = self.times.snap_idx.iter().map(|&k| self.shapes[k].clone()).collect();
         resp
     }
 }

@@ -13,6 +13,7 @@ use flexstar_kinematics::{
     check_configuration, check_trajectory, preflight_step, CheckedMotion, Infeasible, RigidState,
 };
 use flexstar_model::config::check_step;
+use flexstar_model::frames::{frame_times, ShapeTimes};
 use flexstar_model::{AmmSettings, Experiment, ModeCount, ModeFamily, Response, RunInfo};
 use flexstar_numerics::GenAlpha;
 
@@ -116,6 +117,11 @@ pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, s
             "amm.snapshots",
             format!("snapshot times must lie in [0, t_end = {}], got {bad}", exp.time.t_end),
         ));
+    }
+    if let Err(flexstar_model::ModelError::Invalid { key, reason, .. }) =
+        flexstar_model::frames::check_frames("amm.frames", settings.frames, exp.time.t_end)
+    {
+        return Err(AmmError::invalid(key, reason));
     }
     if scan {
         check_trajectory(
@@ -292,6 +298,7 @@ fn solve_to_tolerance(
                 let pair_settings = AmmSettings {
                     dt: Some(step),
                     snapshots: Vec::new(),
+                    frames: 0,
                     ..settings.clone()
                 };
                 integrate_system(&coarse, &pair_settings, sys, step, started, |_, _| steps += 1)
@@ -337,6 +344,13 @@ pub(crate) fn snapshot_times(exp: &Experiment, settings: &AmmSettings) -> Vec<f6
     snaps
 }
 
+/// The times at which the deformed star is recorded: the snapshots ([`snapshot_times`]) and the
+/// animation frames of `settings.frames` (`docs/motions.md` section 5), merged.
+pub(crate) fn shape_times(exp: &Experiment, settings: &AmmSettings) -> ShapeTimes {
+    let frames = frame_times(exp.time.t_end, settings.frames);
+    ShapeTimes::merge(&snapshot_times(exp, settings), &frames, 1e-9 * exp.time.dt_out)
+}
+
 /// [`integrate`] with the system `sys` built (fresh, not yet stepped) and the inputs validated:
 /// steps of at most `dt_max` [s]; the reported wall time counts from `started`.
 pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
@@ -352,9 +366,9 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let (nm, n) = (sys.nm, sys.dim());
 
     let out_times = exp.time.output_times();
-    let snaps = snapshot_times(exp, settings);
-    let stops = stops(&out_times, &snaps, 1e-9 * exp.time.dt_out);
-    let mut rec = Recorder::new(&sys, settings, params, out_times.len(), &snaps);
+    let times = shape_times(exp, settings);
+    let stops = stops(&out_times, &times.all, 1e-9 * exp.time.dt_out);
+    let mut rec = Recorder::new(&sys, settings, params, out_times.len(), times);
     let ga = GenAlpha::new(RHO_INF);
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);

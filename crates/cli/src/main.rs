@@ -40,6 +40,8 @@ enum Command {
     Freqmap(commands::modal::FreqmapArgs),
     /// Linear state-space model about a pose, sliders free: DIR/<name>/linear/ (Matrix Market, JSON)
     Linearize(commands::modal::LinearizeArgs),
+    /// The runs of a folder moving (their `*-frames.csv`): one self-contained animate.html
+    Animate(commands::animate::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -55,6 +57,7 @@ fn main() -> std::process::ExitCode {
         Command::Modal(args) => commands::modal::run_modal(args),
         Command::Freqmap(args) => commands::modal::run_freqmap(args),
         Command::Linearize(args) => commands::modal::run_linearize(args),
+        Command::Animate(args) => commands::animate::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

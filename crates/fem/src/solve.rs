@@ -5,8 +5,9 @@
 
 use flexstar_drive::ActuatorLaw;
 use flexstar_kinematics::{check_trajectory, direct_kinematics, preflight_step, CheckedMotion, RigidState};
+use flexstar_model::frames::{frame_times, ShapeTimes};
 use flexstar_model::geometry::{e_w, e_x};
-use flexstar_model::{BeamShape, Experiment, FemSettings, Response, RobotParams, RunInfo, StarShape};
+use flexstar_model::{BeamShape, Experiment, FemSettings, FramePose, Response, RobotParams, RunInfo, StarShape};
 
 use crate::integrator::{integrate, History, Motion, RunSettings, Sample, Snapshot, Stats};
 use crate::star::{Attached, InitialState};
@@ -113,14 +114,14 @@ fn solve_scanned(
     let rigid =
         |t: f64| RigidState::at(params, &exp.trajectory, t).map_err(|source| FemError::PostProcessing { t, source });
     let r0 = rigid(0.0)?;
-    let (t_out, snaps) = times(exp, settings);
+    let (t_out, shape_times) = times(exp, settings);
     let motion = Motion::Prescribed(&exp.trajectory);
     let attached = Attached::of(exp, r0.theta.v);
     let hist = integrate(
         params,
         &motion,
         &t_out,
-        &snaps,
+        &shape_times.all,
         &initial_state(&r0),
         &run,
         &attached,
@@ -130,12 +131,13 @@ fn solve_scanned(
     // post-processing with the rigid kinematics of the prescribed motion
     let frame = |t: f64, _s: [f64; 3]| {
         let r = rigid(t)?;
-        Ok(Frame {
+        Ok(RigidFrame {
             g: [r.g[0].v, r.g[1].v],
             theta: r.theta.v,
         })
     };
     let mut resp = post_process(params, &hist, "fem", &frame, r0.theta.v, false)?;
+    add_shapes(&mut resp, &hist, &shape_times, &frame)?;
     if let Some(cb) = progress {
         cb(1.0);
     }
@@ -185,7 +187,7 @@ pub fn solve_direct_with_stats(
     let params = &exp.robot;
     let run = validate(exp, settings)?;
     let r0 = RigidState::at(params, &exp.trajectory, 0.0).map_err(|e| FemError::Input(e.to_string()))?;
-    let (t_out, snaps) = times(exp, settings);
+    let (t_out, shape_times) = times(exp, settings);
     let motion = Motion::Driven {
         law,
         s0: r0.s.map(|s| s.v),
@@ -196,7 +198,7 @@ pub fn solve_direct_with_stats(
         params,
         &motion,
         &t_out,
-        &snaps,
+        &shape_times.all,
         &initial_state(&r0),
         &run,
         &attached,
@@ -206,12 +208,13 @@ pub fn solve_direct_with_stats(
     // post-processing with the rigid kinematics of the simulated sliders
     let frame = |t: f64, s: [f64; 3]| {
         let pose = direct_kinematics(params.d, s).ok_or(FemError::NoRigidConfiguration { t, s })?;
-        Ok(Frame {
+        Ok(RigidFrame {
             g: pose.g,
             theta: pose.theta,
         })
     };
     let mut resp = post_process(params, &hist, "fem-direct", &frame, r0.theta.v, true)?;
+    add_shapes(&mut resp, &hist, &shape_times, &frame)?;
     if let Some(cb) = progress {
         cb(1.0);
     }
@@ -253,6 +256,8 @@ fn validate(exp: &Experiment, settings: &FemSettings) -> Result<RunSettings, Fem
             "fem.snapshots must lie in [0, t_end = {t_end}], got {bad}"
         )));
     }
+    flexstar_model::frames::check_frames("fem.frames", settings.frames, t_end)
+        .map_err(|e| FemError::Input(e.to_string()))?;
     Ok(RunSettings {
         ne: settings.elements / 3,
         dt,
@@ -272,13 +277,15 @@ fn initial_state(r0: &RigidState) -> InitialState {
     }
 }
 
-/// Output times and snapshot times (t_end always among the snapshots).
-fn times(exp: &Experiment, settings: &FemSettings) -> (Vec<f64>, Vec<f64>) {
+/// Output times and the shape times: the snapshots (t_end always among them) and the animation
+/// frames of `settings.frames` (`docs/motions.md` section 5).
+fn times(exp: &Experiment, settings: &FemSettings) -> (Vec<f64>, ShapeTimes) {
     let mut snaps = settings.snapshots.clone();
     snaps.push(exp.time.t_end);
     snaps.sort_by(|a, b| a.total_cmp(b));
     snaps.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
-    (exp.time.output_times(), snaps)
+    let frames = frame_times(exp.time.t_end, settings.frames);
+    (exp.time.output_times(), ShapeTimes::merge(&snaps, &frames, 1e-12))
 }
 
 fn run_info(solver: &str, settings: &FemSettings, run: &RunSettings, started: std::time::Instant) -> RunInfo {
@@ -293,7 +300,7 @@ fn run_info(solver: &str, settings: &FemSettings, run: &RunSettings, started: st
 
 /// The rigid frame the absolute results are projected on: centre G [m] and orientation theta
 /// [rad] (beam i along `e_xi(theta)`, Eqs. 11-12).
-struct Frame {
+struct RigidFrame {
     g: [f64; 2],
     theta: f64,
 }
@@ -304,7 +311,7 @@ fn post_process(
     params: &RobotParams,
     hist: &History,
     label: &str,
-    frame: &dyn Fn(f64, [f64; 3]) -> Result<Frame, FemError>,
+    frame: &dyn Fn(f64, [f64; 3]) -> Result<RigidFrame, FemError>,
     theta0: f64,
     direct: bool,
 ) -> Result<Response, FemError> {
@@ -362,10 +369,38 @@ fn post_process(
     lead.extend(extra);
     attachment_columns(hist, &mut names, &mut lead);
     resp.set_extra(&names, lead);
-    for snap in &hist.snapshots {
-        resp.shapes.push(star_shape(hist, snap, frame)?);
-    }
     Ok(resp)
+}
+
+/// The deformed-star snapshots and the animation frames of `resp` from the recorded shapes
+/// (`times.all`, in order), each about the rigid frame `frame(t, s)` (post-processing only).
+fn add_shapes(
+    resp: &mut Response,
+    hist: &History,
+    times: &ShapeTimes,
+    frame: &dyn Fn(f64, [f64; 3]) -> Result<RigidFrame, FemError>,
+) -> Result<(), FemError> {
+    let shape = |k: usize| -> Result<(StarShape, FramePose), FemError> {
+        let snap = hist
+            .snapshots
+            .get(k)
+            .ok_or_else(|| FemError::Input(format!("no deformed star recorded at t = {} s", times.all[k])))?;
+        let r = frame(snap.t, snap.s)?;
+        let pose = FramePose {
+            g: r.g,
+            theta: r.theta,
+            s: snap.s,
+        };
+        Ok((star_shape(hist, snap, &r), pose))
+    };
+    for &k in &times.snap_idx {
+        resp.shapes.push(shape(k)?.0);
+    }
+    for &k in &times.frame_idx {
+        let (shape, pose) = shape(k)?;
+        resp.frames.push(flexstar_model::Frame { shape, pose });
+    }
+    Ok(())
 }
 
 /// An optional column: whether the run has it, its name, its value in a sample.
@@ -389,12 +424,7 @@ fn attachment_columns(hist: &History, names: &mut Vec<&str>, cols: &mut Vec<Vec<
 
 /// The deformed star of snapshot `snap`: per beam the node positions and their deflections `w`
 /// [m] from the rigid beam of the frame at the snapshot's slider positions.
-fn star_shape(
-    hist: &History,
-    snap: &Snapshot,
-    frame: &dyn Fn(f64, [f64; 3]) -> Result<Frame, FemError>,
-) -> Result<StarShape, FemError> {
-    let r = frame(snap.t, snap.s)?;
+fn star_shape(hist: &History, snap: &Snapshot, r: &RigidFrame) -> StarShape {
     let g = r.g;
     let beams = [0, 1, 2].map(|i| {
         let (ex, ew) = (e_x(i, r.theta), e_w(i, r.theta));
@@ -411,7 +441,7 @@ fn star_shape(
             pos,
         }
     });
-    Ok(StarShape { t: snap.t, beams })
+    StarShape { t: snap.t, beams }
 }
 
 fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {

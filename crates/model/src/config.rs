@@ -224,6 +224,16 @@ pub struct AmmSettings {
     pub dt: Option<f64>,
     /// Times [s] at which the deformed star is recorded (t_end is always added).
     pub snapshots: Vec<f64>,
+    /// Animation frames per second (`docs/motions.md` section 5): the deformed star and its rigid
+    /// pose at `k / frames` and `t_end`, written as `<stem>-frames.csv`; 0 (default): none.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub frames: usize,
+}
+
+/// `frames = 0` is left out of a written experiment (the sidecars of runs without frames are
+/// those of earlier versions).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl Default for AmmSettings {
@@ -235,6 +245,7 @@ impl Default for AmmSettings {
             tol: None,
             dt: None,
             snapshots: Vec::new(),
+            frames: 0,
         }
     }
 }
@@ -321,6 +332,9 @@ pub struct FemSettings {
     pub rho_inf: Option<f64>,
     /// Times [s] at which the deformed star is recorded (t_end is always added).
     pub snapshots: Vec<f64>,
+    /// Animation frames per second, as `[amm] frames`; 0 (default): none.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub frames: usize,
 }
 
 impl Default for FemSettings {
@@ -330,6 +344,7 @@ impl Default for FemSettings {
             dt: None,
             rho_inf: None,
             snapshots: Vec::new(),
+            frames: 0,
         }
     }
 }
@@ -461,6 +476,8 @@ impl Experiment {
                 ));
             }
         }
+        crate::frames::check_frames("amm.frames", self.amm.frames, self.time.t_end)?;
+        crate::frames::check_frames("fem.frames", self.fem.frames, self.time.t_end)?;
         for (key, snaps) in [
             ("amm.snapshots", &self.amm.snapshots),
             ("fem.snapshots", &self.fem.snapshots),

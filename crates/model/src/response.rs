@@ -183,6 +183,8 @@ pub struct Response {
     pub extra: Vec<Column>,
     /// Deformed star at the requested instants.
     pub shapes: Vec<StarShape>,
+    /// Animation frames (`[amm] frames`, `[fem] frames`; empty without), `docs/motions.md` 5.
+    pub frames: Vec<crate::frames::Frame>,
 }
 
 impl Response {
@@ -197,6 +199,7 @@ impl Response {
             fa: [v(), v(), v()],
             extra: Vec::new(),
             shapes: Vec::new(),
+            frames: Vec::new(),
             info: RunInfo::default(),
         }
     }
@@ -253,6 +256,7 @@ impl Response {
                 })
                 .collect(),
             shapes: self.shapes.clone(),
+            frames: self.frames.clone(),
         }
     }
 

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod animate;
 pub mod compare;
 pub mod kinematics;
 pub mod modal;

@@ -1,0 +1,157 @@
+//! Reading a run folder's frames files back (`docs/outputs.md`, frames files).
+
+use std::path::{Path, PathBuf};
+
+use crate::AnimateError;
+
+/// One beam of one frame: deformed positions `pos` and rigid positions `rigid` of the same
+/// material points, G to tip [m], fixed frame.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BeamPoints {
+    pub pos: Vec<[f64; 2]>,
+    pub rigid: Vec<[f64; 2]>,
+}
+
+/// The frames of one run (`<name>-frames.csv` with its pose file and sidecar).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunFrames {
+    /// The file stem: `amm-enriched`, `fem`, ...
+    pub name: String,
+    /// Frame times [s].
+    pub times: Vec<f64>,
+    /// Per frame, the three beams.
+    pub beams: Vec<[BeamPoints; 3]>,
+    /// Per frame `[Gx, Gy, theta, s1, s2, s3]` (m, rad, m) of the rigid pose.
+    pub pose: Vec<[f64; 6]>,
+    /// End of the motion `t_rest` [s] when the sidecar knows it.
+    pub t_rest: Option<f64>,
+    /// Beam length L [m] and base size d [m] from the sidecar's experiment, when present.
+    pub l: Option<f64>,
+    pub d: Option<f64>,
+}
+
+fn read_err(file: &Path, reason: impl std::fmt::Display) -> AnimateError {
+    AnimateError::Read {
+        file: file.to_path_buf(),
+        reason: reason.to_string(),
+    }
+}
+
+/// Every `*-frames.csv` of `dir` (sorted by name), with its pose file and sidecar.
+pub fn read_dir(dir: &Path) -> Result<Vec<RunFrames>, AnimateError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| read_err(dir, e))?;
+    let mut stems: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .filter_map(|e| e.file_name().to_str().map(str::to_string))
+        .filter_map(|n| n.strip_suffix("-frames.csv").map(str::to_string))
+        .collect();
+    stems.sort();
+    if stems.is_empty() {
+        return Err(AnimateError::NoFrames(dir.to_path_buf()));
+    }
+    stems.iter().map(|s| read_run(dir, s)).collect()
+}
+
+fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
+    let (times, beams) = read_frames(&dir.join(format!("{stem}-frames.csv")))?;
+    let pose_file = dir.join(format!("{stem}-frames-pose.csv"));
+    let pose = read_pose(&pose_file)?;
+    if pose.len() != times.len() {
+        return Err(read_err(
+            &pose_file,
+            format!("{} rows, but {stem}-frames.csv has {} frames", pose.len(), times.len()),
+        ));
+    }
+    let (t_rest, l, d) = sidecar_facts(&dir.join(format!("{stem}.json")));
+    Ok(RunFrames {
+        name: stem.to_string(),
+        times,
+        beams,
+        pose,
+        t_rest,
+        l,
+        d,
+    })
+}
+
+/// The rows of a CSV file as numbers, after checking its header is `header`.
+fn numeric_rows(file: &Path, header: &[&str]) -> Result<Vec<Vec<f64>>, AnimateError> {
+    let mut rdr = csv::Reader::from_path(file).map_err(|e| read_err(file, e))?;
+    let head: Vec<String> = rdr
+        .headers()
+        .map_err(|e| read_err(file, e))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    if head != header {
+        return Err(read_err(
+            file,
+            format!("header {:?}, expected {:?}", head.join(","), header.join(",")),
+        ));
+    }
+    let mut rows = Vec::new();
+    for (k, rec) in rdr.records().enumerate() {
+        let rec = rec.map_err(|e| read_err(file, e))?;
+        let row: Result<Vec<f64>, _> = rec.iter().map(str::parse::<f64>).collect();
+        let row = row.map_err(|e| read_err(file, format!("row {}: {e}", k + 2)))?;
+        if row.iter().any(|v| !v.is_finite()) {
+            return Err(read_err(file, format!("row {}: a value is not finite", k + 2)));
+        }
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+type Frames = (Vec<f64>, Vec<[BeamPoints; 3]>);
+
+/// `t,beam,x,w,X,Y,Xr,Yr` rows grouped by time (consecutive rows of equal `t`).
+fn read_frames(file: &Path) -> Result<Frames, AnimateError> {
+    let rows = numeric_rows(file, &flexstar_model::frames::FRAMES_HEADER)?;
+    let (mut times, mut beams): (Vec<f64>, Vec<[BeamPoints; 3]>) = (Vec::new(), Vec::new());
+    for (k, r) in rows.iter().enumerate() {
+        if times.last() != Some(&r[0]) {
+            if times.last().is_some_and(|t| *t >= r[0]) {
+                return Err(read_err(
+                    file,
+                    format!("row {}: time {} not after the previous frame", k + 2, r[0]),
+                ));
+            }
+            times.push(r[0]);
+            beams.push(Default::default());
+        }
+        let b = r[1] as usize;
+        if !(1..=3).contains(&b) || r[1] != b as f64 {
+            return Err(read_err(file, format!("row {}: beam {} is not 1, 2 or 3", k + 2, r[1])));
+        }
+        let pts = &mut beams.last_mut().expect("a frame was pushed")[b - 1];
+        pts.pos.push([r[4], r[5]]);
+        pts.rigid.push([r[6], r[7]]);
+    }
+    Ok((times, beams))
+}
+
+fn read_pose(file: &Path) -> Result<Vec<[f64; 6]>, AnimateError> {
+    let rows = numeric_rows(file, &flexstar_model::frames::FRAMES_POSE_HEADER)?;
+    Ok(rows.iter().map(|r| [r[1], r[2], r[3], r[4], r[5], r[6]]).collect())
+}
+
+/// `t_rest` [s] (a top-level `t_rest` key, else the experiment's trajectory), L and d [m] from a
+/// sidecar; `None` for what it does not say (or when there is no sidecar).
+fn sidecar_facts(file: &PathBuf) -> (Option<f64>, Option<f64>, Option<f64>) {
+    let Some(doc) = std::fs::read_to_string(file)
+        .ok()
+        .and_then(|s| serde_json::from_str::<serde_json::Value>(&s).ok())
+    else {
+        return (None, None, None);
+    };
+    let exp = doc
+        .get("experiment")
+        .and_then(|e| serde_json::from_value::<flexstar_model::Experiment>(e.clone()).ok());
+    let t_rest = doc
+        .get("t_rest")
+        .and_then(serde_json::Value::as_f64)
+        .or_else(|| exp.as_ref().and_then(|e| e.trajectory.t_rest()));
+    let robot = doc.get("experiment").and_then(|e| e.get("robot"));
+    let num = |k: &str| robot.and_then(|r| r.get(k)).and_then(serde_json::Value::as_f64);
+    (t_rest, num("l"), num("d"))
+}

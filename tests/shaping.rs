@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{flexstar, stderr};
+use common::{col, flexstar, stderr, table};
 
 /// The brisk move (configs/motions/brisk.toml: 10 mm and -0.06 rad in 0.2 s) with 0.9 s of time.
 const BASE: &str = r#"
@@ -24,24 +24,6 @@ to = { Gx = -0.008, Gy = 0.006, theta = -0.06 }
 t0 = 0.0
 t1 = 0.2
 "#;
-
-/// Rows of a CSV file with a header, by column name.
-fn table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(str::to_string).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
-    (header, rows)
-}
-
-fn col(header: &[String], name: &str) -> usize {
-    header
-        .iter()
-        .position(|h| h == name)
-        .unwrap_or_else(|| panic!("no {name}"))
-}
 
 /// Write `name.toml` (name, then BASE, then `extra`) into `dir`.
 fn write_config(dir: &Path, name: &str, extra: &str) -> PathBuf {

@@ -24,6 +24,7 @@ fn run(exp: &Experiment, n: usize, dt: f64, rho: f64) -> (Response, f64) {
         dt: Some(dt),
         rho_inf: Some(rho),
         snapshots: vec![],
+        frames: 0,
     };
     let t0 = Instant::now();
     let r = flexstar_fem::solve(exp, &s, None).unwrap();

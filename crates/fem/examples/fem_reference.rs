@@ -24,6 +24,7 @@ fn main() {
         dt: Some(dt),
         rho_inf: Some(flexstar_fem::DEFAULT_RHO_INF),
         snapshots: vec![],
+        frames: 0,
     };
     let started = std::time::Instant::now();
     let (r, stats) = flexstar_fem::solve_with_stats(&exp, &settings, None).expect("FEM run");

@@ -40,6 +40,7 @@ fn run(elements: usize, dt: f64) -> Response {
         dt: Some(dt),
         rho_inf: Some(flexstar_fem::DEFAULT_RHO_INF),
         snapshots: vec![],
+        frames: 0,
     };
     flexstar_fem::solve(&catalogue::paper_case(2), &settings, None).expect("FEM run")
 }

@@ -363,13 +363,8 @@ pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunO
 /// has G pinned by its modes (`phi(0) = 0`): its residual of G is null, with a note.
 fn add_residual(meta: &mut serde_json::Value, p: &Prepared, r: &Response) -> Result<()> {
     let res = flexstar_modal::settle::run_residual(&p.exp, r).map_err(|e| ApiError::solver(&p.source, e))?;
-    let mut fields = flexstar_model::residual::sidecar_fields(res.as_ref(), p.exp.report.settle_tol);
-    if res.is_some() && p.solver == Solver::Amm && p.exp.amm.family == ModeFamily::PinnedFree {
-        for key in ["residual_G_peak_m", "residual_G_rms_m", "settle_s", "settled"] {
-            fields.insert(key.into(), serde_json::Value::Null);
-        }
-        fields.insert("residual_note".into(), "G is pinned in this family".into());
-    }
+    let pinned = p.solver == Solver::Amm && p.exp.amm.family == ModeFamily::PinnedFree;
+    let fields = flexstar_model::residual::sidecar_fields(res.as_ref(), p.exp.report.settle_tol, pinned);
     if let serde_json::Value::Object(doc) = meta {
         doc.extend(fields);
     }

@@ -380,7 +380,7 @@ pub fn compare_json(
         let list: Vec<_> = res
             .iter()
             .map(|r| {
-                let fields = flexstar_model::residual::sidecar_fields(Some(&r.residual), r.residual.settle_tol);
+                let fields = crate::residual::sidecar_fields_of(r);
                 serde_json::json!({ "run": r.run, "g_pinned": r.g_pinned, "residual": fields })
             })
             .collect();
@@ -424,7 +424,12 @@ pub fn write_case(
     // every run's files and the EVP files are published together (issue 24)
     let mut set = RunSet::begin(dir)?;
     for (stem, r) in runs_of(case) {
-        r.stage_run(&mut set, &stem, None, exp, prov)?;
+        let res = residuals.iter().flatten().find(|x| x.run == stem);
+        let fields = match res {
+            Some(x) => crate::residual::sidecar_fields_of(x),
+            None => flexstar_model::residual::sidecar_fields(None, exp.report.settle_tol, false),
+        };
+        r.stage_run(&mut set, &stem, None, (exp, prov), fields)?;
     }
     set.text("compare.csv", &csv)?;
     set.text(

@@ -57,6 +57,11 @@ pub fn case_residuals(exp: &Experiment, case: &CaseResults) -> Result<Option<Vec
     Ok(Some(runs))
 }
 
+/// The sidecar's residual keys of one compared run, as `flexstar run` writes them.
+pub fn sidecar_fields_of(r: &RunResidual) -> serde_json::Map<String, serde_json::Value> {
+    flexstar_model::residual::sidecar_fields(Some(&r.residual), r.residual.settle_tol, r.g_pinned)
+}
+
 fn g_value(r: &RunResidual, v: f64) -> Option<f64> {
     (!r.g_pinned).then_some(v)
 }

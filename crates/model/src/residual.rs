@@ -155,8 +155,14 @@ fn rms(t: &[f64], f: &[f64]) -> f64 {
 /// The sidecar's top-level keys of a residual (issue 26 item 2; `docs/outputs.md`): `t_rest`,
 /// `residual_G_peak_m`, `residual_G_rms_m`, `residual_tip_peak_m`, `residual_tip_rms_m`,
 /// `settle_s` (null when not settled), `settled`, `settle_tol`, `settle_hold_s`. Without a
-/// residual (no rest before `t_end`) every key is null but `settle_tol`.
-pub fn sidecar_fields(res: Option<&Residual>, settle_tol: f64) -> serde_json::Map<String, serde_json::Value> {
+/// residual (no rest before `t_end`) every key is null but `settle_tol`. `g_pinned`: the run's
+/// modes pin G (the AMM's pinned-free family, `phi(0) = 0`), so it has no residual of G: those
+/// keys are null, with `residual_note`.
+pub fn sidecar_fields(
+    res: Option<&Residual>,
+    settle_tol: f64,
+    g_pinned: bool,
+) -> serde_json::Map<String, serde_json::Value> {
     use serde_json::Value;
     let num = |v: f64| serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number);
     let mut m = serde_json::Map::new();
@@ -171,6 +177,12 @@ pub fn sidecar_fields(res: Option<&Residual>, settle_tol: f64) -> serde_json::Ma
     m.insert("settled".into(), res.map_or(Value::Null, |r| Value::Bool(r.settled())));
     m.insert("settle_tol".into(), num(settle_tol));
     m.insert("settle_hold_s".into(), get(|r| r.hold_s));
+    if g_pinned && res.is_some() {
+        for key in ["residual_G_peak_m", "residual_G_rms_m", "settle_s", "settled"] {
+            m.insert(key.into(), Value::Null);
+        }
+        m.insert("residual_note".into(), "G is pinned in this family".into());
+    }
     m
 }
 
@@ -273,11 +285,14 @@ mod tests {
         let res = residual_after(&r, 0.4, 1e-4, 0.1).unwrap();
         assert_eq!(res.settle_s, Some(0.4));
         assert!(residual_after(&r, 1.0, 1e-4, 0.1).is_none());
-        let keys = sidecar_fields(None, 1e-4);
+        let keys = sidecar_fields(None, 1e-4, false);
         assert!(keys["t_rest"].is_null() && keys["settled"].is_null() && keys["settle_tol"] == 1e-4);
-        let keys = sidecar_fields(Some(&res), 1e-4);
+        let keys = sidecar_fields(Some(&res), 1e-4, false);
         assert_eq!(keys["settle_s"], 0.4);
         assert_eq!(keys["settled"], true);
+        let keys = sidecar_fields(Some(&res), 1e-4, true);
+        assert!(keys["settle_s"].is_null() && keys["residual_G_peak_m"].is_null());
+        assert_eq!(keys["residual_note"], "G is pinned in this family");
     }
 
     #[test]

@@ -480,14 +480,16 @@ impl Response {
 
     /// Stage the three files of run `stem` (`<stem>.csv`, `<stem>-shapes.csv`, `<stem>.json`)
     /// into `set`; `order`: the `(leading, after)` columns of [`Response::write_csv_ordered`]
-    /// (a direct run's file), `None` for the plain order of [`Response::write_csv`].
+    /// (a direct run's file), `None` for the plain order of [`Response::write_csv`]; `fields`:
+    /// further top-level keys of the sidecar (a compared run's residual keys,
+    /// `crate::residual::sidecar_fields`).
     pub fn stage_run(
         &self,
         set: &mut RunSet,
         stem: &str,
         order: Option<(&[&str], &[&str])>,
-        experiment: &crate::Experiment,
-        provenance: &Provenance,
+        (experiment, provenance): (&crate::Experiment, &Provenance),
+        fields: serde_json::Map<String, serde_json::Value>,
     ) -> Result<(), ModelError> {
         let csv = format!("{stem}.csv");
         match order {
@@ -495,7 +497,14 @@ impl Response {
             None => self.stage_csv(set, &csv)?,
         }
         self.stage_shapes_csv(set, &format!("{stem}-shapes.csv"))?;
-        self.stage_sidecar(set, &format!("{stem}.json"), experiment, provenance)
+        let name = format!("{stem}.json");
+        let path = set.path(&name);
+        let mut doc = self.sidecar(&path, experiment, provenance)?;
+        if let serde_json::Value::Object(map) = &mut doc {
+            map.extend(fields);
+        }
+        set.text(&name, &sidecar_text(&path, &doc)?)?;
+        Ok(())
     }
 
     fn emit_shapes_csv(&self, dest: Dest<'_>) -> Result<(), ModelError> {

@@ -118,11 +118,10 @@ pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, s
             format!("snapshot times must lie in [0, t_end = {}], got {bad}", exp.time.t_end),
         ));
     }
-    if let Err(flexstar_model::ModelError::Invalid { key, reason, .. }) =
-        flexstar_model::frames::check_frames("amm.frames", settings.frames, exp.time.t_end)
-    {
-        return Err(AmmError::invalid(key, reason));
-    }
+    flexstar_model::frames::check_frames("amm.frames", settings.frames, exp.time.t_end).map_err(|e| match e {
+        flexstar_model::ModelError::Invalid { key, reason, .. } => AmmError::invalid(key, reason),
+        other => other.into(),
+    })?;
     if scan {
         check_trajectory(
             &exp.robot,

@@ -30,18 +30,24 @@ pub fn peaks(r: &Response) -> Peaks {
 }
 
 /// The residual columns of a row (`residual_tip_m`, `residual_G_m`, `settle_s`) for a run `r`
-/// of `exp` ([`flexstar_modal::settle::run_residual`]): `None` without a rest before `t_end`;
-/// `settle_s` is `inf` when not settled by `t_end` (it sorts last, plots skip it). `g_pinned`:
-/// the run's family pins G (pinned-free AMM), so it has no residual of G.
-pub fn residual_columns(exp: &Experiment, r: &Response, g_pinned: bool) -> (Option<f64>, Option<f64>, Option<f64>) {
-    match flexstar_modal::settle::run_residual(exp, r) {
-        Ok(Some(res)) if g_pinned => (Some(res.tip_peak_m), None, None),
-        Ok(Some(res)) => (
+/// of `exp` whose motion rests at `t_rest` [s], with the settling hold `hold_s` [s]
+/// ([`flexstar_modal::settle::settle_hold_s`], computed once per case): `settle_s` is `inf` when
+/// not settled by `t_end` (it sorts last, plots skip it). `g_pinned`: the run's family pins G
+/// (pinned-free AMM), so it has no residual of G.
+pub fn residual_columns(
+    exp: &Experiment,
+    r: &Response,
+    (t_rest, hold_s): (f64, f64),
+    g_pinned: bool,
+) -> (Option<f64>, Option<f64>, Option<f64>) {
+    match flexstar_model::residual::residual_after(r, t_rest, exp.report.settle_tol, hold_s) {
+        Some(res) if g_pinned => (Some(res.tip_peak_m), None, None),
+        Some(res) => (
             Some(res.tip_peak_m),
             Some(res.g_peak_m),
             Some(res.settle_s.unwrap_or(f64::INFINITY)),
         ),
-        _ => (None, None, None),
+        None => (None, None, None),
     }
 }
 

@@ -304,6 +304,12 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
         _ => None,
     };
     let exp = exp.as_ref().ok();
+    // the end of the motion and the settling hold, once per case (one modal analysis)
+    let rest = exp.and_then(|e| {
+        let t_rest = flexstar_modal::settle::motion_end(e)?;
+        let hold = flexstar_modal::settle::settle_hold_s(e).ok().flatten()?;
+        Some((t_rest, hold))
+    });
     solved
         .iter()
         .map(|(solver, (result, wall_s))| {
@@ -330,9 +336,9 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
                     row.peak_wg_m = Some(p.w_g_m);
                     row.peak_fa_n = Some(p.fa_n);
                     row.evp_percent = if *solver == Solver::Amm { evp } else { None };
-                    if let Some(exp) = exp {
+                    if let (Some(exp), Some(rest)) = (exp, rest) {
                         let pinned = *solver == Solver::Amm && exp.amm.family == flexstar_model::ModeFamily::PinnedFree;
-                        (row.residual_tip_m, row.residual_g_m, row.settle_s) = residual_columns(exp, r, pinned);
+                        (row.residual_tip_m, row.residual_g_m, row.settle_s) = residual_columns(exp, r, rest, pinned);
                     }
                     row.modes = r.info.modes;
                     row.error_estimate_percent = r.info.error_estimate_percent;

@@ -42,6 +42,9 @@ enum Command {
     Linearize(commands::modal::LinearizeArgs),
     /// The runs of a folder moving (their `*-frames.csv`): one self-contained animate.html
     Animate(commands::animate::Args),
+    /// Plan a rest-to-rest motion that leaves little residual vibration ([plan], [limits]) and
+    /// compare it with the plain and the ZVD-shaped quintic: DIR/<name>/plan.md, plan.toml, plan.csv
+    Plan(commands::plan::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -58,6 +61,7 @@ fn main() -> std::process::ExitCode {
         Command::Freqmap(args) => commands::modal::run_freqmap(args),
         Command::Linearize(args) => commands::modal::run_linearize(args),
         Command::Animate(args) => commands::animate::run(args),
+        Command::Plan(args) => commands::plan::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -5,6 +5,7 @@ pub mod compare;
 pub mod kinematics;
 pub mod modal;
 pub mod modes;
+pub mod plan;
 pub mod run;
 pub mod sweep;
 pub mod verify;

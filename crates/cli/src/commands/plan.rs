@@ -1,0 +1,49 @@
+//! `flexstar plan CONFIG [--out DIR]` (issue 26 item 4, `docs/motions.md` section 4): a
+//! rest-to-rest motion that minimises the residual vibration of G after the move.
+
+use std::path::PathBuf;
+
+/// Plan a rest-to-rest motion ([plan], [limits]) and compare it with the plain and the
+/// ZVD-shaped quintic on the AMM and the FEM: DIR/<name>/plan.toml, plan.csv, plan.json, plan.md,
+/// plain/, zvd/, planned/, figures/
+#[derive(clap::Args)]
+pub struct Args {
+    /// Plan file: an experiment whose [trajectory] is replaced by [plan] (and optional [limits])
+    config: PathBuf,
+    /// Output directory; results go to DIR/<name>/
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let outcome = flexstar_api::plan::plan_to_dir(&args.config, &args.out, |p| {
+        eprintln!(
+            "plan: move {:.4} s; AMM RMS of |dG| over {:.3} s after the move {:.3e} m (plain quintic {:.3e} m); \
+             {} evaluations in {:.2} s ({})",
+            p.t_move,
+            p.window_s,
+            p.eval.norm(),
+            p.plain.norm(),
+            p.evaluations,
+            p.wall_s,
+            p.reason
+        );
+    })?;
+    for m in &outcome.motions {
+        let peak = |o: &flexstar_api::RunOutcome| o.meta["residual_G_peak_m"].as_f64().unwrap_or(f64::NAN);
+        eprintln!(
+            "plan: {:<8} residual peak of G after t_rest = {:.3} s: AMM {:.3e} m, FEM {:.3e} m",
+            m.key,
+            m.exp.trajectory.t_rest().unwrap_or(f64::NAN),
+            peak(&m.amm),
+            peak(&m.fem)
+        );
+    }
+    eprintln!(
+        "plan: {} files in {} in {:.2} s (plan.md: the comparison)",
+        outcome.files.len(),
+        outcome.dir.display(),
+        outcome.wall_s
+    );
+    Ok(())
+}

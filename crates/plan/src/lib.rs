@@ -1,0 +1,40 @@
+//! Motion planning for the star robot (issue 26 item 4, `docs/motions.md` section 4): a
+//! rest-to-rest motion between two poses that minimises the residual vibration of G after the
+//! move, as the accurate AMM computes it, within slider speed, acceleration and force limits and
+//! the feasible workspace; or, with `objective = "time"`, the shortest such motion whose residual
+//! stays below a bound.
+//!
+//! - [`section`]: the `[plan]` and `[limits]` sections and the plan file;
+//! - [`family`]: the motions searched (a clamped quintic spline through interior via points);
+//! - [`limits`]: slider peaks, the shortest move the limits allow, the refusals of 4.8;
+//! - [`objective`]: one evaluation (an AMM run over the move and a residual window);
+//! - [`lm`]: the Levenberg-Marquardt search;
+//! - [`planner`]: the residual objective; [`time`]: the time objective.
+//!
+//! This crate plans; writing the files and checking the motions on the FEM is the command's
+//! (`flexstar_api::plan`).
+
+pub mod family;
+pub mod limits;
+pub mod lm;
+pub mod objective;
+pub mod planner;
+pub mod section;
+pub mod time;
+
+pub use planner::{plan, Planned};
+pub use section::{read_plan_config, Limits, Objective, PlanConfig, PlanSection, Shape};
+
+/// Why a plan could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanError {
+    /// Bad input: the file, the key and the reason.
+    #[error(transparent)]
+    Input(#[from] flexstar_model::ModelError),
+    /// A motion the planner must run leaves the feasible workspace.
+    #[error("{what}: infeasible at {reason}")]
+    Infeasible { what: String, reason: String },
+    /// A solver or the modal analysis failed.
+    #[error("{0}")]
+    Solver(String),
+}

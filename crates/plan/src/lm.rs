@@ -1,0 +1,293 @@
+//! Levenberg-Marquardt on the residual vector of an evaluation (`docs/motions.md` 4.5): the
+//! Jacobian by forward differences, its columns evaluated in parallel; a trial step that breaks a
+//! limit, leaves the workspace or does not lower `|r|` is rejected and the damping raised, so that
+//! every accepted iterate is feasible and within the limits.
+//!
+//! Written here rather than taken from a crate: the steps must be rejected on feasibility and
+//! limits (a constraint a least-squares crate does not know), the Jacobian's columns are whole
+//! AMM runs that run in parallel, and the search stops on a wall-clock budget and a model floor.
+
+use std::time::Instant;
+
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::objective::{Eval, Rejected};
+
+/// Relative step of the forward differences (4.5: derivatives to about 1e-7).
+const FD_STEP: f64 = 1e-6;
+/// Initial damping, relative to the largest diagonal entry of `J^T J`.
+const MU0: f64 = 1e-4;
+/// Damping at which the search gives up on a step.
+const MU_MAX: f64 = 1e8;
+/// Most iterations.
+const MAX_ITERATIONS: usize = 40;
+/// Stop when `|r|^2` fell by less than this share in one iteration.
+const STALL: f64 = 1e-2;
+
+/// When the search stops.
+#[derive(Debug, Clone, Copy)]
+pub struct Stop {
+    /// `|r|` at or below this is good enough [m] (the model floor).
+    pub r_floor: f64,
+    /// The wall-clock deadline.
+    pub deadline: Instant,
+}
+
+/// One accepted iterate of the trace (plan.json).
+#[derive(Debug, Clone, Serialize)]
+pub struct TraceRow {
+    pub iteration: usize,
+    /// Evaluations so far.
+    pub evaluations: usize,
+    /// `|r|`: RMS of |dG| over the window [m].
+    pub r_norm_m: f64,
+    /// Peak |dG| over the window [m].
+    pub window_peak_m: f64,
+    /// The damping of the accepted step (relative).
+    pub damping: f64,
+    /// Wall time since the start [s].
+    pub wall_s: f64,
+}
+
+/// The outcome of a search.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    pub x: Vec<f64>,
+    pub eval: Eval,
+    pub trace: Vec<TraceRow>,
+    pub evaluations: usize,
+    /// Why it stopped.
+    pub reason: String,
+}
+
+/// Minimise `|r(x)|^2` from `x0` (whose evaluation `e0` must be feasible); `accept` tells a
+/// trial within the limits.
+pub fn minimise<F, A>(f: &F, accept: &A, x0: Vec<f64>, e0: Eval, stop: Stop) -> Result<Solution, Rejected>
+where
+    F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
+    A: Fn(&Eval) -> bool,
+{
+    let start = Instant::now();
+    let mut s = Search::new(x0, e0, start);
+    let mut mu = MU0;
+    let mut previous = s.cost();
+    loop {
+        if let Some(reason) = s.finished(stop) {
+            s.reason = reason;
+            break;
+        }
+        let jac = jacobian(f, &s.x, &s.eval.r)?;
+        s.evaluations += s.x.len();
+        match s.step(f, accept, &jac, &mut mu, stop) {
+            Some(()) => {}
+            None => {
+                s.reason = "no step lowers |r| within the limits (damping at its largest)".into();
+                break;
+            }
+        }
+        let cost = s.cost();
+        if previous - cost < STALL * previous {
+            s.reason = "|r|^2 fell by less than 1 % in one iteration".into();
+            break;
+        }
+        previous = cost;
+    }
+    Ok(s.into_solution())
+}
+
+/// The state of a search.
+struct Search {
+    x: Vec<f64>,
+    eval: Eval,
+    trace: Vec<TraceRow>,
+    evaluations: usize,
+    start: Instant,
+    reason: String,
+}
+
+impl Search {
+    fn new(x: Vec<f64>, eval: Eval, start: Instant) -> Self {
+        let mut s = Search {
+            x,
+            eval,
+            trace: Vec::new(),
+            evaluations: 1,
+            start,
+            reason: String::new(),
+        };
+        s.record(0.0);
+        s
+    }
+
+    fn cost(&self) -> f64 {
+        self.eval.norm().powi(2)
+    }
+
+    fn record(&mut self, damping: f64) {
+        self.trace.push(TraceRow {
+            iteration: self.trace.len(),
+            evaluations: self.evaluations,
+            r_norm_m: self.eval.norm(),
+            window_peak_m: self.eval.window_peak_m,
+            damping,
+            wall_s: self.start.elapsed().as_secs_f64(),
+        });
+    }
+
+    fn finished(&self, stop: Stop) -> Option<String> {
+        if self.eval.norm() <= stop.r_floor {
+            Some(format!("|r| at or below the model floor {:.3e} m", stop.r_floor))
+        } else if Instant::now() >= stop.deadline {
+            Some("the wall-clock budget is spent".into())
+        } else if self.trace.len() > MAX_ITERATIONS {
+            Some(format!("{MAX_ITERATIONS} iterations"))
+        } else {
+            None
+        }
+    }
+
+    /// Damped Gauss-Newton trials until one lowers the cost within the limits (`None`: the
+    /// damping reached [`MU_MAX`] or the deadline passed first).
+    fn step<F, A>(&mut self, f: &F, accept: &A, jac: &Mat<f64>, mu: &mut f64, stop: Stop) -> Option<()>
+    where
+        F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
+        A: Fn(&Eval) -> bool,
+    {
+        let (jtj, jtr) = normal_equations(jac, &self.eval.r);
+        let scale = (0..jtj.nrows()).map(|i| jtj[(i, i)]).fold(0.0, f64::max).max(1e-300);
+        while *mu <= MU_MAX && Instant::now() < stop.deadline {
+            let dx = damped_step(&jtj, &jtr, *mu * scale)?;
+            let trial: Vec<f64> = self.x.iter().zip(&dx).map(|(x, d)| x + d).collect();
+            self.evaluations += 1;
+            match f(&trial) {
+                Ok(e) if accept(&e) && e.norm() < self.eval.norm() => {
+                    self.x = trial;
+                    self.eval = e;
+                    self.record(*mu);
+                    *mu = (*mu / 3.0).max(1e-12);
+                    return Some(());
+                }
+                _ => *mu *= 10.0,
+            }
+        }
+        None
+    }
+
+    fn into_solution(self) -> Solution {
+        Solution {
+            x: self.x,
+            eval: self.eval,
+            trace: self.trace,
+            evaluations: self.evaluations,
+            reason: self.reason,
+        }
+    }
+}
+
+/// The Jacobian of `r` at `x` by forward differences (a backward difference where the forward
+/// point is rejected), the columns in parallel.
+fn jacobian<F>(f: &F, x: &[f64], r0: &[f64]) -> Result<Mat<f64>, Rejected>
+where
+    F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
+{
+    let columns: Vec<Result<Vec<f64>, Rejected>> = (0..x.len())
+        .into_par_iter()
+        .map(|j| {
+            let h = FD_STEP * x[j].abs().max(1.0);
+            let at = |sign: f64| {
+                let mut xp = x.to_vec();
+                xp[j] += sign * h;
+                f(&xp)
+            };
+            let (e, sign) = match at(1.0) {
+                Ok(e) => (e, 1.0),
+                Err(_) => (at(-1.0)?, -1.0),
+            };
+            Ok(e.r.iter().zip(r0).map(|(a, b)| sign * (a - b) / h).collect())
+        })
+        .collect();
+    let columns = columns.into_iter().collect::<Result<Vec<_>, _>>()?;
+    Ok(Mat::from_fn(r0.len(), x.len(), |i, j| columns[j][i]))
+}
+
+/// `J^T J` and `J^T r`.
+fn normal_equations(jac: &Mat<f64>, r: &[f64]) -> (Mat<f64>, Mat<f64>) {
+    let jtj = jac.transpose() * jac;
+    let rv = Mat::from_fn(r.len(), 1, |i, _| r[i]);
+    let jtr = jac.transpose() * &rv;
+    (jtj, jtr)
+}
+
+/// Solve `(J^T J + lambda I) dx = -J^T r` (Cholesky; `None` if not positive definite).
+fn damped_step(jtj: &Mat<f64>, jtr: &Mat<f64>, lambda: f64) -> Option<Vec<f64>> {
+    let n = jtj.nrows();
+    let a = Mat::from_fn(n, n, |i, j| jtj[(i, j)] + if i == j { lambda } else { 0.0 });
+    let llt = a.llt(Side::Lower).ok()?;
+    let dx = llt.solve(jtr);
+    Some((0..n).map(|i| -dx[(i, 0)]).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::limits::Peak;
+
+    fn eval_of(r: Vec<f64>) -> Eval {
+        let p = Peak {
+            value: 0.0,
+            slider: 1,
+            t: 0.0,
+        };
+        Eval {
+            r,
+            window_peak_m: 0.0,
+            fa: p,
+            v: p,
+            a: p,
+        }
+    }
+
+    /// Rosenbrock's function as least squares, `r = (10 (y - x^2), 1 - x)`: the textbook minimum
+    /// at (1, 1) from the textbook start (-1.2, 1).
+    #[test]
+    fn finds_the_rosenbrock_minimum() {
+        let f = |x: &[f64]| Ok(eval_of(vec![10.0 * (x[1] - x[0] * x[0]), 1.0 - x[0]]));
+        let x0 = vec![-1.2, 1.0];
+        let e0 = f(&x0).unwrap();
+        let stop = Stop {
+            r_floor: 1e-10,
+            deadline: Instant::now() + std::time::Duration::from_secs(10),
+        };
+        let s = minimise(&f, &|_: &Eval| true, x0, e0, stop).unwrap();
+        assert!(
+            (s.x[0] - 1.0).abs() < 1e-6 && (s.x[1] - 1.0).abs() < 1e-6,
+            "{:?}: {}",
+            s.x,
+            s.reason
+        );
+    }
+
+    /// A rejected region is never entered: the minimum of `(x - 2)^2` with every `x > 1.5`
+    /// rejected stays at or below 1.5 and comes close to it.
+    #[test]
+    fn rejected_trials_are_never_accepted() {
+        let f = |x: &[f64]| {
+            if x[0] > 1.5 {
+                Err(Rejected::Infeasible("x > 1.5".into()))
+            } else {
+                Ok(eval_of(vec![x[0] - 2.0]))
+            }
+        };
+        let x0 = vec![0.0];
+        let e0 = f(&x0).unwrap();
+        let stop = Stop {
+            r_floor: 0.0,
+            deadline: Instant::now() + std::time::Duration::from_secs(10),
+        };
+        let s = minimise(&f, &|_: &Eval| true, x0, e0, stop).unwrap();
+        assert!(s.x[0] <= 1.5 && s.x[0] > 1.49, "{:?}", s.x);
+    }
+}

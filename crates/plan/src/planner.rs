@@ -1,0 +1,251 @@
+//! The planner (`docs/motions.md` 4.2-4.8): the checks before any work, the frozen AMM and the
+//! residual window, the search from the plain quintic, and the ZVD baseline the plan is compared
+//! with.
+
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+use flexstar_model::geometry::inverse_kinematics;
+use flexstar_model::{DriveKind, Experiment, ModelError, ShaperKind, ShaperSection, Trajectory};
+
+use crate::family::Family;
+use crate::limits::{check_quintic_kinematics, check_t_move, kinematic_peaks, quintic_breaks, travels};
+use crate::lm::{minimise, Stop, TraceRow};
+use crate::objective::{Eval, Evaluator};
+use crate::section::{Objective, PlanConfig};
+use crate::PlanError;
+
+/// The search stops when the RMS of |dG| over the window is this share of the plain quintic's
+/// (`docs/motions.md` 4.5, the model floor: below it the AMM's own error, measured against the
+/// FEM in section 6, is of the size of what is left).
+pub const FLOOR_SHARE: f64 = 0.01;
+/// The residual window, in periods of the first elastic mode at the final pose.
+pub const WINDOW_PERIODS: f64 = 2.0;
+
+/// A plan: the motion, how it was found and what the AMM says of it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Planned {
+    pub objective: Objective,
+    /// The limits the motion keeps.
+    pub limits: crate::section::Limits,
+    /// Duration of the planned move [s] and its end [s].
+    pub t_move: f64,
+    pub t_rest: f64,
+    /// The interior via points' variables (progress or scaled offsets).
+    pub x: Vec<f64>,
+    #[serde(skip)]
+    pub family: Family,
+    /// The planned motion (`kind = "via"`, `rest = false`).
+    #[serde(skip)]
+    pub trajectory: Trajectory,
+    /// The AMM's evaluation of the planned motion and of the plain quintic of the same duration.
+    #[serde(skip)]
+    pub eval: Eval,
+    #[serde(skip)]
+    pub plain: Eval,
+    /// AMM modes per beam N (frozen), the first frequency at the final pose [Hz], the window [s].
+    pub modes: usize,
+    pub f1_hz: f64,
+    pub window_s: f64,
+    /// The model floor of the search [m].
+    pub r_floor_m: f64,
+    pub trace: Vec<TraceRow>,
+    pub evaluations: usize,
+    /// Why the search stopped.
+    pub reason: String,
+    pub wall_s: f64,
+    /// `objective = "time"`: the ZVD-shaped quintic at the same residual and the bisection.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_search: Option<crate::time::TimeSearch>,
+}
+
+/// What every search shares: the family, the frozen AMM, the window.
+#[derive(Debug, Clone)]
+pub struct Setup {
+    pub family: Family,
+    pub evaluator: Evaluator,
+    pub modes: usize,
+    pub f1_hz: f64,
+    pub started: Instant,
+}
+
+/// Plan the motion of `cfg` (every check of 4.8 first; nothing is written here).
+pub fn plan(cfg: &PlanConfig) -> Result<Planned, PlanError> {
+    let started = Instant::now();
+    check_plan_input(cfg)?;
+    let t_ref = cfg
+        .plan
+        .t_move
+        .unwrap_or(cfg.exp.trajectory.t_rest().unwrap_or(1.0) - cfg.plan.t0);
+    let setup = setup(cfg, t_ref, started)?;
+    match cfg.plan.objective {
+        Objective::Residual => {
+            zvd_experiment(&cfg.exp, setup.family.quintic(t_ref))?;
+            plan_residual(cfg, &setup, t_ref)
+        }
+        Objective::Time => crate::time::plan_time(cfg, &setup),
+    }
+}
+
+/// The checks of 4.8 that need the robot but no solver: a motion drive, reachable poses,
+/// `t_move` within the limits, the plain quintic's slider peaks within the limits.
+fn check_plan_input(cfg: &PlanConfig) -> Result<(), PlanError> {
+    let file = &cfg.exp.source;
+    let bad = |e: ModelError| PlanError::from(e.in_file(file));
+    if cfg.exp.drive.kind != DriveKind::Motion {
+        return Err(bad(ModelError::invalid(
+            "drive.kind",
+            "a plan is a prescribed motion: remove [drive] (forces and servos are not planned)",
+        )));
+    }
+    for (key, p) in [("plan.from", cfg.plan.from), ("plan.to", cfg.plan.to)] {
+        inverse_kinematics(&cfg.exp.robot, [p.gx, p.gy], p.theta).map_err(|e| {
+            bad(ModelError::invalid(
+                key,
+                format!(
+                    "(Gx = {}, Gy = {}, theta = {}) is outside the workspace: {e}",
+                    p.gx, p.gy, p.theta
+                ),
+            ))
+        })?;
+    }
+    let family = family_of(cfg);
+    let travel = travels(&cfg.exp.robot, &family).map_err(bad)?;
+    if let Some(t_move) = cfg.plan.t_move {
+        check_t_move(t_move, travel, &cfg.limits).map_err(bad)?;
+        let quintic = family.quintic(t_move);
+        let span = (cfg.plan.t0, cfg.plan.t0 + t_move);
+        let peaks = kinematic_peaks(&cfg.exp.robot, &quintic, span, cfg.exp.time.dt_out, &[]).map_err(bad)?;
+        check_quintic_kinematics(t_move, peaks, &cfg.limits).map_err(bad)?;
+    }
+    Ok(())
+}
+
+/// The family of the plan's section.
+pub fn family_of(cfg: &PlanConfig) -> Family {
+    Family {
+        shape: cfg.plan.shape,
+        from: cfg.plan.from,
+        to: cfg.plan.to,
+        t0: cfg.plan.t0,
+        m: cfg.plan.interior_points(),
+    }
+}
+
+/// N from the accurate AMM's automatic choice on the plain quintic of `t_ref` [s] (then frozen,
+/// 4.3), the first frequency at the final pose, the window.
+fn setup(cfg: &PlanConfig, t_ref: f64, started: Instant) -> Result<Setup, PlanError> {
+    let family = family_of(cfg);
+    let mut exp = cfg.exp.clone();
+    exp.trajectory = family.quintic(t_ref);
+    let modes = match exp.amm.modes {
+        Some(n) => n,
+        None => flexstar_amm::solve(&exp, &exp.amm)
+            .map_err(|e| PlanError::Solver(format!("the plain quintic's AMM run: {e}")))?
+            .info
+            .modes
+            .ok_or_else(|| PlanError::Solver("the AMM did not report its N".into()))?,
+    };
+    let f1_hz = flexstar_modal::analysis::final_pose_frequencies(&exp, 1)
+        .map_err(|e| PlanError::Solver(format!("modes at the final pose: {e}")))?
+        .and_then(|f| f.first().copied())
+        .filter(|f| *f > 0.0)
+        .ok_or_else(|| PlanError::Solver("no elastic mode at the final pose".into()))?;
+    let evaluator = Evaluator::new(&exp, modes, WINDOW_PERIODS / f1_hz);
+    Ok(Setup {
+        family,
+        evaluator,
+        modes,
+        f1_hz,
+        started,
+    })
+}
+
+/// The knot times of the family at duration `t_move`.
+pub fn knot_times(family: &Family, t_move: f64) -> Vec<f64> {
+    family.points(&family.plain(), t_move).iter().map(|p| p.t).collect()
+}
+
+/// The experiment of the ZVD-shaped quintic with `f_hz = "auto"` (the baseline), refused when
+/// it ends after `time.t_end` (4.8).
+pub fn zvd_experiment(exp: &Experiment, base: Trajectory) -> Result<Experiment, PlanError> {
+    let mut x = exp.clone();
+    let t_base = base.t_rest().unwrap_or(0.0);
+    x.trajectory = base;
+    x.shaper = Some(ShaperSection {
+        kind: ShaperKind::Zvd,
+        f_hz: toml::Value::String("auto".into()),
+        zeta: None,
+        v_tol: None,
+        frequencies_hz: Vec::new(),
+        zeta_used: Vec::new(),
+        impulses: Vec::new(),
+        penalty_s: 0.0,
+        auto: None,
+    });
+    x.apply_shaper()
+        .map_err(|e| PlanError::Solver(format!("the ZVD-shaped quintic: {}", e.detail())))?;
+    let t_rest = x.trajectory.t_rest().unwrap_or(f64::INFINITY);
+    if t_rest > exp.time.t_end {
+        return Err(ModelError::invalid(
+            "time.t_end",
+            format!(
+                "the ZVD-shaped quintic ends at {t_rest:.3} s (the quintic to {t_base} s + ZVD {:.3} s), after time.t_end = {} s; \
+                 the plan compares with it: make t_end longer",
+                t_rest - t_base,
+                exp.time.t_end
+            ),
+        )
+        .in_file(&exp.source)
+        .into());
+    }
+    Ok(x)
+}
+
+/// The residual objective: LM from the plain quintic at the fixed `t_move`.
+fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64) -> Result<Planned, PlanError> {
+    let deadline = s.started + Duration::from_secs_f64(cfg.plan.budget());
+    let x0 = s.family.plain();
+    let plain = evaluate(s, &x0, t_move).map_err(|e| PlanError::Solver(format!("the plain quintic: {e}")))?;
+    if let Some(max) = cfg.limits.fa_max.filter(|m| plain.fa.value > *m) {
+        let msg = quintic_breaks(t_move, "|Fa|", "N", plain.fa, max, None);
+        return Err(ModelError::invalid("limits.Fa_max", msg)
+            .in_file(&cfg.exp.source)
+            .into());
+    }
+    let stop = Stop {
+        r_floor: FLOOR_SHARE * plain.norm(),
+        deadline,
+    };
+    let f = |x: &[f64]| evaluate(s, x, t_move);
+    let accept = |e: &Eval| e.broken(&cfg.limits).is_empty();
+    let sol = minimise(&f, &accept, x0, plain.clone(), stop).map_err(|e| PlanError::Solver(e.to_string()))?;
+    Ok(Planned {
+        objective: Objective::Residual,
+        limits: cfg.limits,
+        t_move,
+        t_rest: cfg.plan.t0 + t_move,
+        trajectory: s.family.trajectory(&sol.x, t_move),
+        x: sol.x,
+        family: s.family.clone(),
+        eval: sol.eval,
+        plain,
+        modes: s.modes,
+        f1_hz: s.f1_hz,
+        window_s: s.evaluator.window,
+        r_floor_m: stop.r_floor,
+        trace: sol.trace,
+        evaluations: sol.evaluations,
+        reason: sol.reason,
+        wall_s: s.started.elapsed().as_secs_f64(),
+        time_search: None,
+    })
+}
+
+/// Evaluate the family's motion of the variables `x` and duration `t_move`.
+pub fn evaluate(s: &Setup, x: &[f64], t_move: f64) -> Result<Eval, crate::objective::Rejected> {
+    let traj = s.family.trajectory(x, t_move);
+    let knots = knot_times(&s.family, t_move);
+    s.evaluator.eval(&traj, s.family.t0 + t_move, &knots)
+}

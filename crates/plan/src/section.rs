@@ -1,0 +1,287 @@
+//! The `[plan]` and `[limits]` sections of a planning experiment (`docs/motions.md` 4.1, 4.8) and
+//! how a plan file becomes an experiment: the sections are taken out, `[trajectory]` and
+//! `[shaper]` are refused (the planner makes the motions itself), and the plain quintic of the
+//! plan stands in as the trajectory, so that every other section is read and checked exactly as
+//! `flexstar run` reads it.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use flexstar_model::{Experiment, ModelError, Pose};
+
+use crate::PlanError;
+
+/// What the planner minimises (`[plan] objective`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Objective {
+    /// The residual vibration of G after a move of the given `t_move` (default).
+    Residual,
+    /// The shortest move whose residual peak at G is at most `residual_max`.
+    Time,
+}
+
+/// Which motions the planner searches (`[plan] shape`, `docs/motions.md` 4.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Shape {
+    /// Interior poses on the segment from `from` to `to`: a timing law, one number per point.
+    Timing,
+    /// Interior poses anywhere near the quintic's path: three numbers per point.
+    Path,
+}
+
+/// `[plan]`: a rest-to-rest move from `from` at `t0` to `to` (`docs/motions.md` 4.1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanSection {
+    /// Start pose (G [m] in the fixed frame, theta [rad]).
+    pub from: Pose,
+    /// End pose.
+    pub to: Pose,
+    /// Start of the move [s] (default 0).
+    #[serde(default)]
+    pub t0: f64,
+    /// Duration of the move [s]; exclusive with `objective = "time"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t_move: Option<f64>,
+    /// `"residual"` (default) or `"time"`.
+    #[serde(default = "default_objective")]
+    pub objective: Objective,
+    /// `objective = "time"`: the largest residual peak of |dG| after the move [m].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub residual_max: Option<f64>,
+    /// `"timing"` (default) or `"path"`.
+    #[serde(default = "default_shape")]
+    pub shape: Shape,
+    /// Interior via points (default 8 for timing, 4 for path).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<usize>,
+    /// Wall-clock budget of the optimiser [s] (default 8).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget_s: Option<f64>,
+}
+
+fn default_objective() -> Objective {
+    Objective::Residual
+}
+
+fn default_shape() -> Shape {
+    Shape::Timing
+}
+
+/// `[limits]`: bounds the planned motion keeps (each optional).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Limits {
+    /// Largest slider speed `|s_i'|` [m/s].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v_max: Option<f64>,
+    /// Largest slider acceleration `|s_i''|` [m/s^2].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub a_max: Option<f64>,
+    /// Largest driving force `|Fa_i|` [N] (Eq. 33, the accurate AMM's).
+    #[serde(rename = "Fa_max", default, skip_serializing_if = "Option::is_none")]
+    pub fa_max: Option<f64>,
+}
+
+impl PlanSection {
+    /// Interior via points: `points`, else 8 (timing) or 4 (path).
+    pub fn interior_points(&self) -> usize {
+        self.points.unwrap_or(match self.shape {
+            Shape::Timing => 8,
+            Shape::Path => 4,
+        })
+    }
+
+    /// The optimiser's wall-clock budget [s].
+    pub fn budget(&self) -> f64 {
+        self.budget_s.unwrap_or(8.0)
+    }
+
+    /// The checks that need no robot (`docs/motions.md` 4.8): finite poses, `t0 >= 0`, exactly
+    /// one of `t_move` and `objective = "time"` (with `residual_max > 0`), `points` 1..=20.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        for (key, p) in [("plan.from", self.from), ("plan.to", self.to)] {
+            if ![p.gx, p.gy, p.theta].iter().all(|v| v.is_finite()) {
+                return Err(ModelError::invalid(key, "Gx, Gy and theta must be finite"));
+            }
+        }
+        if !(self.t0.is_finite() && self.t0 >= 0.0) {
+            return Err(ModelError::invalid("plan.t0", format!("must be >= 0, got {}", self.t0)));
+        }
+        self.validate_objective()?;
+        let m = self.interior_points();
+        if !(1..=20).contains(&m) {
+            return Err(ModelError::invalid("plan.points", format!("must be 1 to 20, got {m}")));
+        }
+        if let Some(b) = self.budget_s.filter(|b| !(b.is_finite() && *b > 0.0)) {
+            return Err(ModelError::invalid(
+                "plan.budget_s",
+                format!("must be positive, got {b}"),
+            ));
+        }
+        if self.from == self.to {
+            return Err(ModelError::invalid("plan.to", "the move has no extent: to equals from"));
+        }
+        Ok(())
+    }
+
+    fn validate_objective(&self) -> Result<(), ModelError> {
+        match (self.objective, self.t_move, self.residual_max) {
+            (Objective::Residual, Some(t), None) if t.is_finite() && t > 0.0 => Ok(()),
+            (Objective::Residual, Some(t), None) => Err(ModelError::invalid(
+                "plan.t_move",
+                format!("must be a positive duration [s], got {t}"),
+            )),
+            (Objective::Residual, None, _) => Err(ModelError::invalid(
+                "plan.t_move",
+                "missing: give t_move [s], or objective = \"time\" with residual_max [m]",
+            )),
+            (Objective::Residual, Some(_), Some(_)) => Err(ModelError::invalid(
+                "plan.residual_max",
+                "applies to objective = \"time\" only (the residual objective minimises the residual)",
+            )),
+            (Objective::Time, Some(_), _) => Err(ModelError::invalid(
+                "plan.t_move",
+                "objective = \"time\" chooses the duration: give residual_max, not t_move",
+            )),
+            (Objective::Time, None, Some(r)) if r.is_finite() && r > 0.0 => Ok(()),
+            (Objective::Time, None, r) => Err(ModelError::invalid(
+                "plan.residual_max",
+                format!(
+                    "objective = \"time\" needs residual_max [m] > 0, got {}",
+                    r.map_or("none".to_string(), |r| r.to_string())
+                ),
+            )),
+        }
+    }
+}
+
+impl Limits {
+    /// Every given limit positive and finite.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        for (key, v) in [
+            ("limits.v_max", self.v_max),
+            ("limits.a_max", self.a_max),
+            ("limits.Fa_max", self.fa_max),
+        ] {
+            if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
+                return Err(ModelError::invalid(
+                    key,
+                    format!("must be positive and finite, got {v}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Is any limit given?
+    pub fn any(&self) -> bool {
+        self.v_max.is_some() || self.a_max.is_some() || self.fa_max.is_some()
+    }
+}
+
+/// A planning experiment as read: the experiment (its trajectory the plain quintic of the plan,
+/// of duration `t_move`, or of a provisional 1 s for `objective = "time"`), the plan and the
+/// limits, and the TOML table the file held (for `plan.toml`).
+#[derive(Debug, Clone)]
+pub struct PlanConfig {
+    pub exp: Experiment,
+    pub plan: PlanSection,
+    pub limits: Limits,
+    /// The file's table without `[plan]` and `[limits]`.
+    pub table: toml::Table,
+}
+
+/// Read and check a plan file: TOML syntax, the two sections (unknown keys refused), no
+/// `[trajectory]` or `[shaper]`, then the rest as an experiment. Errors name the file and key.
+pub fn read_plan_config(path: &Path) -> Result<PlanConfig, PlanError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ModelError::Read {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    plan_config_from_str(&text, path)
+}
+
+/// [`read_plan_config`] from text (`path` names the file in messages and anchors relative files).
+pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanError> {
+    let in_file = |e: ModelError| PlanError::from(e.in_file(path));
+    let mut table: toml::Table = toml::from_str(text).map_err(|e| ModelError::Parse {
+        file: path.to_path_buf(),
+        message: e.to_string().trim_end().to_string(),
+    })?;
+    for (key, why) in [
+        (
+            "trajectory",
+            "a plan makes its motions itself: give [plan] instead of [trajectory]",
+        ),
+        (
+            "shaper",
+            "a plan compares with the ZVD-shaped quintic itself: remove [shaper]",
+        ),
+    ] {
+        if table.contains_key(key) {
+            return Err(in_file(ModelError::invalid(key, why)));
+        }
+    }
+    let plan: PlanSection = section(&mut table, "plan", path)?.ok_or_else(|| {
+        in_file(ModelError::invalid(
+            "plan",
+            "missing: a plan file needs a [plan] section",
+        ))
+    })?;
+    let limits: Limits = section(&mut table, "limits", path)?.unwrap_or_default();
+    plan.validate().map_err(in_file)?;
+    limits.validate().map_err(in_file)?;
+    let t_move = plan.t_move.unwrap_or(1.0);
+    let mut with_motion = table.clone();
+    with_motion.insert("trajectory".into(), quintic_table(&plan, t_move));
+    let rebuilt = toml::to_string(&with_motion).map_err(|e| ModelError::Parse {
+        file: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let exp = Experiment::from_toml_str(&rebuilt, path)?;
+    Ok(PlanConfig {
+        exp,
+        plan,
+        limits,
+        table,
+    })
+}
+
+/// Take the table `key` out of `table` and deserialize it (errors name the section).
+fn section<T: serde::de::DeserializeOwned>(
+    table: &mut toml::Table,
+    key: &str,
+    path: &Path,
+) -> Result<Option<T>, PlanError> {
+    let Some(value) = table.remove(key) else {
+        return Ok(None);
+    };
+    value.try_into().map(Some).map_err(|e: toml::de::Error| {
+        PlanError::from(ModelError::Parse {
+            file: path.to_path_buf(),
+            message: format!("[{key}]: {}", e.message().trim_end()),
+        })
+    })
+}
+
+/// The `[trajectory]` table of the plain quintic of the plan over `t_move` [s].
+pub fn quintic_table(plan: &PlanSection, t_move: f64) -> toml::Value {
+    let pose = |p: Pose| {
+        toml::Value::Table(toml::Table::from_iter([
+            ("Gx".to_string(), toml::Value::Float(p.gx)),
+            ("Gy".to_string(), toml::Value::Float(p.gy)),
+            ("theta".to_string(), toml::Value::Float(p.theta)),
+        ]))
+    };
+    toml::Value::Table(toml::Table::from_iter([
+        ("kind".to_string(), toml::Value::String("quintic".into())),
+        ("from".to_string(), pose(plan.from)),
+        ("to".to_string(), pose(plan.to)),
+        ("t0".to_string(), toml::Value::Float(plan.t0)),
+        ("t1".to_string(), toml::Value::Float(plan.t0 + t_move)),
+    ]))
+}

@@ -1,0 +1,213 @@
+//! `objective = "time"` (`docs/motions.md` 4.6): the shortest move whose residual peak of |dG|
+//! after the move, the accurate AMM's over `[t_rest, t_end]`, is at most `residual_max`.
+//! First the baseline: the shortest ZVD-shaped quintic (`f_hz = "auto"`) at that residual,
+//! found by bracketing and bisection on its base duration; then the planned move by bisection on
+//! T between the limits' lower bound and the baseline's duration, each step a
+//! Levenberg-Marquardt search warm-started from the last success (the knots sit at fixed
+//! fractions of T, so the variables carry over).
+
+use std::time::Duration;
+
+use serde::Serialize;
+
+use crate::limits::{shortest_move, travels};
+use crate::lm::{minimise, Stop};
+use crate::objective::{window_peak, Eval};
+use crate::planner::{evaluate, zvd_experiment, Planned, Setup};
+use crate::section::{Objective, PlanConfig};
+use crate::PlanError;
+
+/// Bisection steps of each search (1.6 % of the bracket).
+const BISECTIONS: usize = 6;
+/// Largest growth steps of the baseline's bracket (x1.5 each).
+const GROWTHS: usize = 12;
+/// The LM search of one step stops once `|r|` is this share of `residual_max` (the peak over
+/// the whole span is then checked by a run).
+const TIME_FLOOR_SHARE: f64 = 0.2;
+
+/// One trial duration of a search.
+#[derive(Debug, Clone, Serialize)]
+pub struct TimeStep {
+    /// The trial duration [s] (the base quintic's for the baseline).
+    pub t_move: f64,
+    /// The AMM's residual peak of |dG| after the move [m].
+    pub peak_m: f64,
+    /// At most `residual_max` and within the limits?
+    pub ok: bool,
+}
+
+/// The record of the time objective (plan.json).
+#[derive(Debug, Clone, Serialize)]
+pub struct TimeSearch {
+    pub residual_max_m: f64,
+    /// The ZVD-shaped quintic at the same residual: base duration, whole duration (with the
+    /// shaper's penalty) [s], its residual peak [m].
+    pub zvd_base_s: f64,
+    pub zvd_duration_s: f64,
+    pub zvd_peak_m: f64,
+    pub zvd_steps: Vec<TimeStep>,
+    /// The planned move's bisection.
+    pub steps: Vec<TimeStep>,
+    /// How much shorter the planned move is than the baseline [%].
+    pub shorter_percent: f64,
+}
+
+/// The AMM residual peak over `[t_rest, t_end]` of the ZVD-shaped quintic of base `t_base`, and
+/// its whole duration.
+fn zvd_peak(cfg: &PlanConfig, s: &Setup, t_base: f64) -> Result<(f64, f64), PlanError> {
+    let x = zvd_experiment(&cfg.exp, s.family.quintic(t_base))?;
+    let t_rest = x.trajectory.t_rest().unwrap_or(cfg.exp.time.t_end);
+    let r = s
+        .evaluator
+        .run(&x.trajectory, cfg.exp.time.t_end)
+        .map_err(|e| PlanError::Solver(format!("the ZVD-shaped quintic of {t_base:.3} s: {e}")))?;
+    Ok((window_peak(&r, t_rest), t_rest - cfg.plan.t0))
+}
+
+/// The shortest ZVD-shaped quintic at `residual_max`: grow from the limits' bound (or half a
+/// period of the first mode) by 1.5 until the residual holds, then bisect.
+fn zvd_baseline(
+    cfg: &PlanConfig,
+    s: &Setup,
+    r_max: f64,
+    t_lim: f64,
+) -> Result<(f64, f64, f64, Vec<TimeStep>), PlanError> {
+    let mut steps = Vec::new();
+    let mut lo = t_lim;
+    let mut t = t_lim.max(0.5 / s.f1_hz);
+    let mut found = None;
+    for _ in 0..GROWTHS {
+        let (peak, dur) = match zvd_peak(cfg, s, t) {
+            Ok(v) => v,
+            Err(PlanError::Input(_)) => break,
+            Err(e) => return Err(e),
+        };
+        steps.push(TimeStep {
+            t_move: t,
+            peak_m: peak,
+            ok: peak <= r_max,
+        });
+        if peak <= r_max {
+            found = Some((t, dur, peak));
+            break;
+        }
+        lo = t;
+        t *= 1.5;
+    }
+    let Some(mut best) = found else {
+        return Err(PlanError::Solver(format!(
+            "no ZVD-shaped quintic that ends before time.t_end = {} s leaves |dG| <= residual_max = {r_max} m \
+             (the baseline of objective = \"time\"): make t_end longer or residual_max larger",
+            cfg.exp.time.t_end
+        )));
+    };
+    let mut hi = best.0;
+    for _ in 0..BISECTIONS {
+        let mid = 0.5 * (lo + hi);
+        let (peak, dur) = zvd_peak(cfg, s, mid)?;
+        let ok = peak <= r_max;
+        steps.push(TimeStep {
+            t_move: mid,
+            peak_m: peak,
+            ok,
+        });
+        if ok {
+            hi = mid;
+            best = (mid, dur, peak);
+        } else {
+            lo = mid;
+        }
+    }
+    Ok((best.0, best.1, best.2, steps))
+}
+
+/// One step of the planned bisection: the LM search at `t_move` from `x0`, then the peak over
+/// the whole span. `None` when the start itself is rejected.
+fn try_duration(
+    cfg: &PlanConfig,
+    s: &Setup,
+    t_move: f64,
+    x0: &[f64],
+    r_max: f64,
+) -> Option<(Vec<f64>, Eval, f64, String)> {
+    let e0 = evaluate(s, x0, t_move).ok()?;
+    let deadline = s.started + Duration::from_secs_f64(cfg.plan.budget());
+    let stop = Stop {
+        r_floor: TIME_FLOOR_SHARE * r_max,
+        deadline,
+    };
+    let f = |x: &[f64]| evaluate(s, x, t_move);
+    let accept = |e: &Eval| e.broken(&cfg.limits).is_empty();
+    let e0 = if accept(&e0) { e0 } else { return None };
+    let sol = minimise(&f, &accept, x0.to_vec(), e0, stop).ok()?;
+    let traj = s.family.trajectory(&sol.x, t_move);
+    let run = s.evaluator.run(&traj, cfg.exp.time.t_end).ok()?;
+    let peak = window_peak(&run, cfg.plan.t0 + t_move);
+    Some((sol.x, sol.eval, peak, sol.reason))
+}
+
+/// The time objective (module docs).
+pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
+    let r_max = cfg.plan.residual_max.unwrap_or(f64::INFINITY);
+    let travel = travels(&cfg.exp.robot, &s.family)?;
+    let t_lim = shortest_move(travel, &cfg.limits).0;
+    let (zvd_base, zvd_dur, zvd_peak_m, zvd_steps) = zvd_baseline(cfg, s, r_max, t_lim)?;
+    let mut steps = Vec::new();
+    let (mut lo, mut hi) = (t_lim.max(0.25 * zvd_dur), zvd_dur);
+    let mut x = s.family.plain();
+    let mut best = None;
+    for k in 0..=BISECTIONS {
+        let t = if k == 0 { hi } else { 0.5 * (lo + hi) };
+        let outcome = try_duration(cfg, s, t, &x, r_max);
+        let peak = outcome.as_ref().map_or(f64::INFINITY, |o| o.2);
+        let ok = peak <= r_max;
+        steps.push(TimeStep {
+            t_move: t,
+            peak_m: peak,
+            ok,
+        });
+        match outcome {
+            Some(o) if ok => {
+                hi = t;
+                x = o.0.clone();
+                best = Some((t, o));
+            }
+            _ => lo = t,
+        }
+    }
+    let Some((t_move, (x, eval, _, reason))) = best else {
+        return Err(PlanError::Solver(format!(
+            "no planned motion as long as the ZVD-shaped quintic ({zvd_dur:.3} s) reached residual_max = {r_max} m"
+        )));
+    };
+    let plain =
+        evaluate(s, &s.family.plain(), t_move).map_err(|e| PlanError::Solver(format!("the plain quintic: {e}")))?;
+    Ok(Planned {
+        objective: Objective::Time,
+        limits: cfg.limits,
+        t_move,
+        t_rest: cfg.plan.t0 + t_move,
+        trajectory: s.family.trajectory(&x, t_move),
+        x,
+        family: s.family.clone(),
+        eval,
+        plain,
+        modes: s.modes,
+        f1_hz: s.f1_hz,
+        window_s: s.evaluator.window,
+        r_floor_m: TIME_FLOOR_SHARE * r_max,
+        trace: Vec::new(),
+        evaluations: 0,
+        reason,
+        wall_s: s.started.elapsed().as_secs_f64(),
+        time_search: Some(TimeSearch {
+            residual_max_m: r_max,
+            zvd_base_s: zvd_base,
+            zvd_duration_s: zvd_dur,
+            zvd_peak_m,
+            zvd_steps,
+            steps,
+            shorter_percent: 100.0 * (1.0 - t_move / zvd_dur),
+        }),
+    })
+}

@@ -71,7 +71,7 @@ pub fn plan_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Planned))
     let planned = flexstar_plan::plan(&cfg).map_err(|e| from_plan(&source, e))?;
     on_planned(&planned);
     let rows = plan_rows(&cfg.exp, &planned)?;
-    let exps = motion_experiments(&cfg, &planned, &rows, &source)?;
+    let exps = motion_experiments(&cfg, &planned, &rows)?;
     let motions = run_motions(exps, &source)?;
     let mut files = write_runs(&motions, &dir)?;
     let wall_s = started.elapsed().as_secs_f64();
@@ -114,18 +114,15 @@ fn table_trajectory(exp: &Experiment, rows: &[[f64; 7]]) -> Result<Trajectory> {
 /// The experiments of the three motions: the plain quintic and the ZVD-shaped quintic of the
 /// planned duration (for `objective = "time"` the ZVD baseline at the same residual), the
 /// planned motion as its table.
-fn motion_experiments(cfg: &PlanConfig, p: &Planned, rows: &[[f64; 7]], source: &str) -> Result<Vec<Experiment>> {
+fn motion_experiments(cfg: &PlanConfig, p: &Planned, rows: &[[f64; 7]]) -> Result<Vec<Experiment>> {
     let with = |traj: Trajectory| {
         let mut e = cfg.exp.clone();
         e.trajectory = traj;
         e
     };
-    let zvd_base = p.time_search.as_ref().map_or(p.t_move, |ts| ts.zvd_base_s);
-    let zvd = flexstar_plan::planner::zvd_experiment(&cfg.exp, p.family.quintic(zvd_base))
-        .map_err(|e| from_plan(source, e))?;
     Ok(vec![
         with(p.family.quintic(p.t_move)),
-        zvd,
+        p.zvd.clone(),
         with(table_trajectory(&cfg.exp, rows)?),
     ])
 }

@@ -19,6 +19,7 @@ pub mod limits;
 pub mod lm;
 pub mod objective;
 pub mod planner;
+pub mod qp;
 pub mod section;
 pub mod time;
 

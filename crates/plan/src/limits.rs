@@ -3,6 +3,7 @@
 //! allow any rest-to-rest motion; and the refusal of limits the plain quintic already breaks.
 
 use flexstar_model::geometry::inverse_kinematics;
+use flexstar_model::trajectory::Jet;
 use flexstar_model::{ModelError, RobotParams, Trajectory};
 
 use crate::family::Family;
@@ -35,27 +36,44 @@ impl Peak {
     }
 }
 
-/// The peaks of `|s_i'|` and `|s_i''|` of `traj` over `[t0, t1]`, sampled every `step` [s]
-/// and at `extra` times (the knots).
-pub fn kinematic_peaks(
+/// The slider jets `(s_i, s_i', s_i'')` of `traj` over `[t0, t1]`, sampled every `step` [s]
+/// and at `extra` times (the knots), with their times.
+pub fn slider_samples(
     params: &RobotParams,
     traj: &Trajectory,
     (t0, t1): (f64, f64),
     step: f64,
     extra: &[f64],
-) -> Result<(Peak, Peak), ModelError> {
+) -> Result<Vec<(f64, [Jet; 3])>, ModelError> {
     let n = ((t1 - t0) / step).ceil() as usize;
-    let times = (0..=n)
+    (0..=n)
         .map(|k| (t0 + k as f64 * step).min(t1))
-        .chain(extra.iter().copied());
+        .chain(extra.iter().copied())
+        .map(|t| Ok((t, traj.jets(params, t)?)))
+        .collect()
+}
+
+/// The peaks of `|s_i'|` and `|s_i''|` over samples of [`slider_samples`].
+pub fn peaks_of(samples: &[(f64, [Jet; 3])]) -> (Peak, Peak) {
     let (mut v, mut a) = (Peak::none(), Peak::none());
-    for t in times {
-        for (i, jet) in traj.jets(params, t)?.iter().enumerate() {
-            v.take(jet.d1.abs(), i + 1, t);
-            a.take(jet.d2.abs(), i + 1, t);
+    for (t, jets) in samples {
+        for (i, jet) in jets.iter().enumerate() {
+            v.take(jet.d1.abs(), i + 1, *t);
+            a.take(jet.d2.abs(), i + 1, *t);
         }
     }
-    Ok((v, a))
+    (v, a)
+}
+
+/// The peaks of `|s_i'|` and `|s_i''|` of `traj` over `[t0, t1]` ([`slider_samples`]).
+pub fn kinematic_peaks(
+    params: &RobotParams,
+    traj: &Trajectory,
+    span: (f64, f64),
+    step: f64,
+    extra: &[f64],
+) -> Result<(Peak, Peak), ModelError> {
+    Ok(peaks_of(&slider_samples(params, traj, span, step, extra)?))
 }
 
 /// The slider travels `|s_i(to) - s_i(from)|` [m] of a move (rigid inverse kinematics).

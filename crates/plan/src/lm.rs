@@ -1,7 +1,9 @@
 //! Levenberg-Marquardt on the residual vector of an evaluation (`docs/motions.md` 4.5): the
-//! Jacobian by forward differences, its columns evaluated in parallel; a trial step that breaks a
-//! limit, leaves the workspace or does not lower `|r|` is rejected and the damping raised, so that
-//! every accepted iterate is feasible and within the limits.
+//! Jacobian by forward differences, its columns evaluated in parallel. With limits, each damped
+//! step is a small quadratic program: the Gauss-Newton model of `|r|^2` minimised within the
+//! limits linearised at the iterate ([`crate::qp`]). A trial step that breaks a limit, leaves the
+//! workspace or does not lower `|r|` is rejected and the damping raised, so that every accepted
+//! iterate is feasible and within the limits.
 //!
 //! Written here rather than taken from a crate: the steps must be rejected on feasibility and
 //! limits (a constraint a least-squares crate does not know), the Jacobian's columns are whole
@@ -24,6 +26,8 @@ const MU0: f64 = 1e-4;
 const MU_MAX: f64 = 1e8;
 /// Most iterations.
 const MAX_ITERATIONS: usize = 40;
+/// A step landing below this share of the model floor is shortened onto the floor.
+const FLOOR_LANDING: f64 = 0.8;
 /// Stop when `|r|^2` fell by less than this share in one iteration.
 const STALL: f64 = 1e-2;
 
@@ -79,12 +83,13 @@ where
             s.reason = reason;
             break;
         }
-        let jac = jacobian(f, &s.x, &s.eval.r)?;
+        let jac = jacobian(f, &s.x, &s.eval)?;
         s.evaluations += s.x.len();
         match s.step(f, accept, &jac, &mut mu, stop) {
             Some(()) => {}
             None => {
-                s.reason = "no step lowers |r| within the limits (damping at its largest)".into();
+                s.reason =
+                    "no step lowers |r| within the limits: a minimum of the family (damping at its largest)".into();
                 break;
             }
         }
@@ -138,7 +143,7 @@ impl Search {
     }
 
     fn finished(&self, stop: Stop) -> Option<String> {
-        if self.eval.norm() <= stop.r_floor {
+        if self.eval.norm() <= stop.r_floor * 1.05 {
             Some(format!("|r| at or below the model floor {:.3e} m", stop.r_floor))
         } else if Instant::now() >= stop.deadline {
             Some("the wall-clock budget is spent".into())
@@ -151,20 +156,25 @@ impl Search {
 
     /// Damped Gauss-Newton trials until one lowers the cost within the limits (`None`: the
     /// damping reached [`MU_MAX`] or the deadline passed first).
-    fn step<F, A>(&mut self, f: &F, accept: &A, jac: &Mat<f64>, mu: &mut f64, stop: Stop) -> Option<()>
+    fn step<F, A>(&mut self, f: &F, accept: &A, jac: &Jacobian, mu: &mut f64, stop: Stop) -> Option<()>
     where
         F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
         A: Fn(&Eval) -> bool,
     {
-        let (jtj, jtr) = normal_equations(jac, &self.eval.r);
+        let (jtj, jtr) = normal_equations(&jac.r, &self.eval.r);
         let scale = (0..jtj.nrows()).map(|i| jtj[(i, i)]).fold(0.0, f64::max).max(1e-300);
+        let limits = crate::qp::linearised_limits(&self.eval.usage, &jac.usage);
         while *mu <= MU_MAX && Instant::now() < stop.deadline {
-            let dx = damped_step(&jtj, &jtr, *mu * scale)?;
+            let dx = match &limits {
+                None => damped_step(&jtj, &jtr, *mu * scale)?,
+                Some(lim) => crate::qp::damped_step_within(&jtj, &jtr, *mu * scale, lim)?,
+            };
             let trial: Vec<f64> = self.x.iter().zip(&dx).map(|(x, d)| x + d).collect();
             self.evaluations += 1;
             match f(&trial) {
                 Ok(e) if accept(&e) && e.norm() < self.eval.norm() => {
-                    self.x = trial;
+                    let (x, e) = self.onto_floor(f, accept, &dx, (trial, e), stop.r_floor);
+                    self.x = x;
                     self.eval = e;
                     self.record(*mu);
                     *mu = (*mu / 3.0).max(1e-12);
@@ -174,6 +184,47 @@ impl Search {
             }
         }
         None
+    }
+
+    /// A step that lands well below the model floor is shortened to land on it (4.5: below
+    /// the floor the model cannot vouch for the residual, and a shorter step keeps the motion
+    /// closer to the plain quintic): `alpha` from the affine model `r(alpha) = r0 + alpha (r1 -
+    /// r0)` of the residual along the step, `|r(alpha)| = r_floor`. The full step stays when the
+    /// shortened one is rejected.
+    fn onto_floor<F, A>(
+        &mut self,
+        f: &F,
+        accept: &A,
+        dx: &[f64],
+        full: (Vec<f64>, Eval),
+        r_floor: f64,
+    ) -> (Vec<f64>, Eval)
+    where
+        F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
+        A: Fn(&Eval) -> bool,
+    {
+        if full.1.norm() >= FLOOR_LANDING * r_floor {
+            return full;
+        }
+        let (r0, r1) = (&self.eval.r, &full.1.r);
+        let d: Vec<f64> = r1.iter().zip(r0).map(|(a, b)| a - b).collect();
+        let a = d.iter().map(|v| v * v).sum::<f64>();
+        let b = 2.0 * r0.iter().zip(&d).map(|(p, q)| p * q).sum::<f64>();
+        let c = r0.iter().map(|v| v * v).sum::<f64>() - r_floor * r_floor;
+        let disc = b * b - 4.0 * a * c;
+        if a <= 0.0 || disc < 0.0 {
+            return full;
+        }
+        let alpha = (-b - disc.sqrt()) / (2.0 * a);
+        if !(alpha > 0.0 && alpha < 1.0) {
+            return full;
+        }
+        let trial: Vec<f64> = self.x.iter().zip(dx).map(|(x, d)| x + alpha * d).collect();
+        self.evaluations += 1;
+        match f(&trial) {
+            Ok(e) if accept(&e) && e.norm() < self.eval.norm() => (trial, e),
+            _ => full,
+        }
     }
 
     fn into_solution(self) -> Solution {
@@ -187,12 +238,20 @@ impl Search {
     }
 }
 
-/// The Jacobian of `r` at `x` by forward differences (a backward difference where the forward
-/// point is rejected), the columns in parallel.
-fn jacobian<F>(f: &F, x: &[f64], r0: &[f64]) -> Result<Mat<f64>, Rejected>
+/// The Jacobians of the residual vector and of the limits' usage at one point.
+pub struct Jacobian {
+    pub r: Mat<f64>,
+    pub usage: Mat<f64>,
+}
+
+/// The Jacobians of `r` and of the usage at `x` by forward differences (a backward difference
+/// where the forward point is rejected), the columns in parallel.
+fn jacobian<F>(f: &F, x: &[f64], e0: &Eval) -> Result<Jacobian, Rejected>
 where
     F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
 {
+    let rows0: Vec<f64> = e0.r.iter().chain(&e0.usage).copied().collect();
+    let r0 = &rows0;
     let columns: Vec<Result<Vec<f64>, Rejected>> = (0..x.len())
         .into_par_iter()
         .map(|j| {
@@ -206,11 +265,16 @@ where
                 Ok(e) => (e, 1.0),
                 Err(_) => (at(-1.0)?, -1.0),
             };
-            Ok(e.r.iter().zip(r0).map(|(a, b)| sign * (a - b) / h).collect())
+            let rows = e.r.iter().chain(&e.usage);
+            Ok(rows.zip(r0).map(|(a, b)| sign * (a - b) / h).collect())
         })
         .collect();
     let columns = columns.into_iter().collect::<Result<Vec<_>, _>>()?;
-    Ok(Mat::from_fn(r0.len(), x.len(), |i, j| columns[j][i]))
+    let nr = e0.r.len();
+    Ok(Jacobian {
+        r: Mat::from_fn(nr, x.len(), |i, j| columns[j][i]),
+        usage: Mat::from_fn(e0.usage.len(), x.len(), |i, j| columns[j][nr + i]),
+    })
 }
 
 /// `J^T J` and `J^T r`.
@@ -247,6 +311,7 @@ mod tests {
             fa: p,
             v: p,
             a: p,
+            usage: Vec::new(),
         }
     }
 

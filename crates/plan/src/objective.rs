@@ -8,7 +8,7 @@
 use flexstar_model::residual::dg_magnitude;
 use flexstar_model::{AmmSettings, Experiment, Response, Trajectory};
 
-use crate::limits::{kinematic_peaks, Peak};
+use crate::limits::{slider_samples, Peak};
 use crate::section::Limits;
 
 /// What one evaluation gives.
@@ -23,6 +23,10 @@ pub struct Eval {
     /// Peaks of |s_i'| [m/s] and |s_i''| [m/s^2] over the move.
     pub v: Peak,
     pub a: Peak,
+    /// The usage `u = g / g_max` of every sample of every given limit (4.4): `|s_i'| / v_max`
+    /// and `|s_i''| / a_max` at the kinematic samples, `|Fa_i| / Fa_max` at every output time;
+    /// the same samples in every evaluation, so that the search can linearise them.
+    pub usage: Vec<f64>,
 }
 
 impl Eval {
@@ -73,6 +77,8 @@ pub struct Evaluator {
     settings: AmmSettings,
     /// Residual window W [s].
     pub window: f64,
+    /// The limits whose usage the evaluations record.
+    limits: Limits,
 }
 
 impl Evaluator {
@@ -88,7 +94,17 @@ impl Evaluator {
         };
         let mut exp = exp.clone();
         exp.shaper = None;
-        Evaluator { exp, settings, window }
+        Evaluator {
+            exp,
+            settings,
+            window,
+            limits: Limits::default(),
+        }
+    }
+
+    /// The same evaluator recording the usage of `limits`.
+    pub fn with_limits(&self, limits: Limits) -> Self {
+        Evaluator { limits, ..self.clone() }
     }
 
     /// The AMM run of `traj` up to `t_end` [s] (feasibility checked first over that span).
@@ -112,15 +128,32 @@ impl Evaluator {
     pub fn eval(&self, traj: &Trajectory, t_rest: f64, knots: &[f64]) -> Result<Eval, Rejected> {
         let resp = self.run(traj, t_rest + self.window)?;
         let t0 = traj_start(traj);
-        let (v, a) = kinematic_peaks(&self.exp.robot, traj, (t0, t_rest), self.exp.time.dt_out, knots)
+        let jets = slider_samples(&self.exp.robot, traj, (t0, t_rest), self.exp.time.dt_out, knots)
             .map_err(|e| Rejected::Infeasible(e.to_string()))?;
+        let (v, a) = crate::limits::peaks_of(&jets);
         Ok(Eval {
             r: residual_vector(&resp, t_rest),
             window_peak_m: window_peak(&resp, t_rest),
             fa: force_peak(&resp),
             v,
             a,
+            usage: self.usage(&jets, &resp),
         })
+    }
+
+    /// The samples of [`Eval::usage`].
+    fn usage(&self, jets: &[(f64, [flexstar_model::trajectory::Jet; 3])], resp: &Response) -> Vec<f64> {
+        let mut usage = Vec::new();
+        if let Some(v) = self.limits.v_max {
+            usage.extend(jets.iter().flat_map(|(_, j)| j.iter().map(move |j| j.d1.abs() / v)));
+        }
+        if let Some(a) = self.limits.a_max {
+            usage.extend(jets.iter().flat_map(|(_, j)| j.iter().map(move |j| j.d2.abs() / a)));
+        }
+        if let Some(f) = self.limits.fa_max {
+            usage.extend(resp.fa.iter().flatten().map(|x| x.abs() / f));
+        }
+        usage
     }
 
     /// The experiment the evaluator runs (its trajectory is replaced per run).

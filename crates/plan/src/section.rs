@@ -55,7 +55,7 @@ pub struct PlanSection {
     /// `"timing"` (default) or `"path"`.
     #[serde(default = "default_shape")]
     pub shape: Shape,
-    /// Interior via points (default 8 for timing, 4 for path).
+    /// Interior via points (default 12 for timing, 4 for path).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub points: Option<usize>,
     /// Wall-clock budget of the optimiser [s] (default 8).
@@ -87,10 +87,11 @@ pub struct Limits {
 }
 
 impl PlanSection {
-    /// Interior via points: `points`, else 8 (timing) or 4 (path).
+    /// Interior via points: `points`, else 12 (timing) or 4 (path); `docs/motions.md` 4.9 says
+    /// why 12.
     pub fn interior_points(&self) -> usize {
         self.points.unwrap_or(match self.shape {
-            Shape::Timing => 8,
+            Shape::Timing => 12,
             Shape::Path => 4,
         })
     }
@@ -242,7 +243,15 @@ pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanE
         file: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    let exp = Experiment::from_toml_str(&rebuilt, path)?;
+    // the stand-in quintic's keys are the plan's (`trajectory.to` is `plan.to`)
+    let exp = Experiment::from_toml_str(&rebuilt, path).map_err(|e| match e {
+        ModelError::Invalid { file, key, reason } if key.starts_with("trajectory") => ModelError::Invalid {
+            file,
+            key: key.replacen("trajectory", "plan", 1),
+            reason,
+        },
+        other => other,
+    })?;
     Ok(PlanConfig {
         exp,
         plan,

@@ -17,8 +17,8 @@ use crate::planner::{evaluate, zvd_experiment, Planned, Setup};
 use crate::section::{Objective, PlanConfig};
 use crate::PlanError;
 
-/// Bisection steps of each search (1.6 % of the bracket).
-const BISECTIONS: usize = 6;
+/// Bisection steps of each search (3 % of the bracket).
+const BISECTIONS: usize = 5;
 /// Largest growth steps of the baseline's bracket (x1.5 each).
 const GROWTHS: usize = 12;
 /// The LM search of one step stops once `|r|` is this share of `residual_max` (the peak over
@@ -46,8 +46,10 @@ pub struct TimeSearch {
     pub zvd_duration_s: f64,
     pub zvd_peak_m: f64,
     pub zvd_steps: Vec<TimeStep>,
-    /// The planned move's bisection.
+    /// The planned move's bisection (AMM).
     pub steps: Vec<TimeStep>,
+    /// The FEM's residual peak of the successes, shortest first, until one holds.
+    pub fem_checks: Vec<TimeStep>,
     /// How much shorter the planned move is than the baseline [%].
     pub shorter_percent: f64,
 }
@@ -55,7 +57,7 @@ pub struct TimeSearch {
 /// The AMM residual peak over `[t_rest, t_end]` of the ZVD-shaped quintic of base `t_base`, and
 /// its whole duration.
 fn zvd_peak(cfg: &PlanConfig, s: &Setup, t_base: f64) -> Result<(f64, f64), PlanError> {
-    let x = zvd_experiment(&cfg.exp, s.family.quintic(t_base))?;
+    let x = zvd_experiment(&s.frozen, s.family.quintic(t_base))?;
     let t_rest = x.trajectory.t_rest().unwrap_or(cfg.exp.time.t_end);
     let r = s
         .evaluator
@@ -74,13 +76,14 @@ fn zvd_baseline(
 ) -> Result<(f64, f64, f64, Vec<TimeStep>), PlanError> {
     let mut steps = Vec::new();
     let mut lo = t_lim;
-    let mut t = t_lim.max(0.5 / s.f1_hz);
+    let mut t = t_lim.max(1.0 / s.f1_hz);
     let mut found = None;
     for _ in 0..GROWTHS {
+        // a candidate the solver cannot run (too violent a move) counts as too short
         let (peak, dur) = match zvd_peak(cfg, s, t) {
             Ok(v) => v,
             Err(PlanError::Input(_)) => break,
-            Err(e) => return Err(e),
+            Err(_) => (f64::INFINITY, f64::NAN),
         };
         steps.push(TimeStep {
             t_move: t,
@@ -104,7 +107,7 @@ fn zvd_baseline(
     let mut hi = best.0;
     for _ in 0..BISECTIONS {
         let mid = 0.5 * (lo + hi);
-        let (peak, dur) = zvd_peak(cfg, s, mid)?;
+        let (peak, dur) = zvd_peak(cfg, s, mid).unwrap_or((f64::INFINITY, f64::NAN));
         let ok = peak <= r_max;
         steps.push(TimeStep {
             t_move: mid,
@@ -121,22 +124,42 @@ fn zvd_baseline(
     Ok((best.0, best.1, best.2, steps))
 }
 
+/// The outcome of one step of the planned bisection.
+enum Trial {
+    /// The search ran: variables, evaluation, peak over the whole span, why it stopped.
+    Done(Vec<f64>, Eval, f64, String),
+    /// The start is rejected (infeasible, limits) or the search failed.
+    Failed,
+    /// The budget ran out during the search: the step says nothing.
+    OutOfTime,
+}
+
 /// One step of the planned bisection: the LM search at `t_move` from `x0`, then the peak over
-/// the whole span. `None` when the start itself is rejected.
-fn try_duration(
+/// the whole span.
+fn try_duration(cfg: &PlanConfig, s: &Setup, t_move: f64, x0: &[f64], r_max: f64) -> Trial {
+    match search_at(cfg, s, t_move, x0, r_max) {
+        Some((_, _, peak, reason)) if peak > r_max && reason.contains("budget") => Trial::OutOfTime,
+        Some((x, e, peak, reason)) => Trial::Done(x, e, peak, reason),
+        None => Trial::Failed,
+    }
+}
+
+/// The search of [`try_duration`]; `None` when the start is rejected or a run fails.
+fn search_at(
     cfg: &PlanConfig,
     s: &Setup,
     t_move: f64,
     x0: &[f64],
     r_max: f64,
 ) -> Option<(Vec<f64>, Eval, f64, String)> {
-    let e0 = evaluate(s, x0, t_move).ok()?;
+    let ev = s.evaluator.with_limits(cfg.limits);
+    let e0 = evaluate(&ev, &s.family, x0, t_move).ok()?;
     let deadline = s.started + Duration::from_secs_f64(cfg.plan.budget());
     let stop = Stop {
         r_floor: TIME_FLOOR_SHARE * r_max,
         deadline,
     };
-    let f = |x: &[f64]| evaluate(s, x, t_move);
+    let f = |x: &[f64]| evaluate(&ev, &s.family, x, t_move);
     let accept = |e: &Eval| e.broken(&cfg.limits).is_empty();
     let e0 = if accept(&e0) { e0 } else { return None };
     let sol = minimise(&f, &accept, x0.to_vec(), e0, stop).ok()?;
@@ -146,42 +169,116 @@ fn try_duration(
     Some((sol.x, sol.eval, peak, sol.reason))
 }
 
+/// A success of the planned bisection: duration and the search's outcome.
+type Success = (f64, (Vec<f64>, Eval, f64, String));
+
+/// Bisection of the planned duration in `(lo, hi)`: the midpoints first (the baseline's
+/// duration `hi` is tried last, only if no shorter one succeeded); a step cut by the budget ends
+/// the search with the best so far.
+fn bisect_planned(
+    cfg: &PlanConfig,
+    s: &Setup,
+    (mut lo, mut hi): (f64, f64),
+    r_max: f64,
+) -> (Vec<TimeStep>, Vec<Success>) {
+    let top = hi;
+    let mut steps = Vec::new();
+    let mut x = s.family.plain();
+    let mut best: Vec<Success> = Vec::new();
+    for k in 0..=BISECTIONS {
+        let t = if k == BISECTIONS {
+            if !best.is_empty() {
+                break;
+            }
+            top
+        } else {
+            0.5 * (lo + hi)
+        };
+        match try_duration(cfg, s, t, &x, r_max) {
+            Trial::OutOfTime => break,
+            Trial::Done(xs, e, peak, reason) if peak <= r_max => {
+                steps.push(TimeStep {
+                    t_move: t,
+                    peak_m: peak,
+                    ok: true,
+                });
+                hi = t;
+                x = xs.clone();
+                best.push((t, (xs, e, peak, reason)));
+            }
+            Trial::Done(_, _, peak, _) => {
+                steps.push(TimeStep {
+                    t_move: t,
+                    peak_m: peak,
+                    ok: false,
+                });
+                lo = t;
+            }
+            Trial::Failed => {
+                steps.push(TimeStep {
+                    t_move: t,
+                    peak_m: f64::INFINITY,
+                    ok: false,
+                });
+                lo = t;
+            }
+        }
+    }
+    (steps, best)
+}
+
+/// The shortest success whose residual peak holds on the FEM too (the model the plan trusts,
+/// checked where it matters: a fast move leaves a residual of the size of the AMM's own error);
+/// when none holds, the longest, with the reason saying so.
+fn fem_verified(
+    cfg: &PlanConfig,
+    s: &Setup,
+    mut successes: Vec<Success>,
+    r_max: f64,
+) -> Result<(Success, Vec<TimeStep>), PlanError> {
+    successes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut checks = Vec::new();
+    for cand in &successes {
+        let mut exp = cfg.exp.clone();
+        exp.trajectory = s.family.trajectory(&cand.1 .0, cand.0);
+        let r =
+            flexstar_fem::solve(&exp, &exp.fem, None).map_err(|e| PlanError::Solver(format!("the FEM check: {e}")))?;
+        let peak = window_peak(&r, cfg.plan.t0 + cand.0);
+        checks.push(TimeStep {
+            t_move: cand.0,
+            peak_m: peak,
+            ok: peak <= r_max,
+        });
+        if peak <= r_max {
+            return Ok((cand.clone(), checks));
+        }
+    }
+    let mut longest = successes
+        .pop()
+        .ok_or_else(|| PlanError::Solver("no planned motion".into()))?;
+    longest.1 .3 = format!(
+        "{}; the FEM's residual exceeds residual_max at every duration tried",
+        longest.1 .3
+    );
+    Ok((longest, checks))
+}
+
 /// The time objective (module docs).
 pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
     let r_max = cfg.plan.residual_max.unwrap_or(f64::INFINITY);
     let travel = travels(&cfg.exp.robot, &s.family)?;
     let t_lim = shortest_move(travel, &cfg.limits).0;
     let (zvd_base, zvd_dur, zvd_peak_m, zvd_steps) = zvd_baseline(cfg, s, r_max, t_lim)?;
-    let mut steps = Vec::new();
-    let (mut lo, mut hi) = (t_lim.max(0.25 * zvd_dur), zvd_dur);
-    let mut x = s.family.plain();
-    let mut best = None;
-    for k in 0..=BISECTIONS {
-        let t = if k == 0 { hi } else { 0.5 * (lo + hi) };
-        let outcome = try_duration(cfg, s, t, &x, r_max);
-        let peak = outcome.as_ref().map_or(f64::INFINITY, |o| o.2);
-        let ok = peak <= r_max;
-        steps.push(TimeStep {
-            t_move: t,
-            peak_m: peak,
-            ok,
-        });
-        match outcome {
-            Some(o) if ok => {
-                hi = t;
-                x = o.0.clone();
-                best = Some((t, o));
-            }
-            _ => lo = t,
-        }
-    }
-    let Some((t_move, (x, eval, _, reason))) = best else {
+    let (steps, successes) = bisect_planned(cfg, s, (t_lim.max(0.25 * zvd_dur), zvd_dur), r_max);
+    if successes.is_empty() {
         return Err(PlanError::Solver(format!(
             "no planned motion as long as the ZVD-shaped quintic ({zvd_dur:.3} s) reached residual_max = {r_max} m"
         )));
-    };
-    let plain =
-        evaluate(s, &s.family.plain(), t_move).map_err(|e| PlanError::Solver(format!("the plain quintic: {e}")))?;
+    }
+    let (chosen, fem_checks) = fem_verified(cfg, s, successes, r_max)?;
+    let (t_move, (x, eval, _, reason)) = chosen;
+    let plain = evaluate(&s.evaluator, &s.family, &s.family.plain(), t_move)
+        .map_err(|e| PlanError::Solver(format!("the plain quintic: {e}")))?;
     Ok(Planned {
         objective: Objective::Time,
         limits: cfg.limits,
@@ -200,6 +297,7 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
         evaluations: 0,
         reason,
         wall_s: s.started.elapsed().as_secs_f64(),
+        zvd: zvd_experiment(&cfg.exp, s.family.quintic(zvd_base))?,
         time_search: Some(TimeSearch {
             residual_max_m: r_max,
             zvd_base_s: zvd_base,
@@ -207,6 +305,7 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
             zvd_peak_m,
             zvd_steps,
             steps,
+            fem_checks,
             shorter_percent: 100.0 * (1.0 - t_move / zvd_dur),
         }),
     })

@@ -1,0 +1,88 @@
+//! The damped Gauss-Newton step within linearised limits (`docs/motions.md` 4.4): minimise
+//! `1/2 dx^T (J^T J + lambda I) dx + (J^T r)^T dx` subject to `u_k + G_k dx <= 1 - margin` for
+//! every usage sample `u_k` (a sample of `|s_i'| / v_max`, `|s_i''| / a_max` or
+//! `|Fa_i| / Fa_max`) above [`ACTIVE`], `G_k` its gradient. A convex quadratic program, solved by
+//! Clarabel's interior-point method.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
+use faer::Mat;
+
+/// Samples below this usage are left out of the step's constraints (a step of the damped search
+/// is small; a sample far below its limit cannot reach it).
+pub const ACTIVE: f64 = 0.5;
+/// The linearised limit is `1 - MARGIN`: the step aims a little inside, so that the nonlinear
+/// usage of the trial stays below 1.
+pub const MARGIN: f64 = 2e-3;
+
+/// The constraint rows `G_k dx <= 1 - MARGIN - u_k` of the active samples.
+#[derive(Debug, Clone)]
+pub struct LinearLimits {
+    pub g: Vec<Vec<f64>>,
+    pub h: Vec<f64>,
+}
+
+/// The active samples' rows; `None` when no sample is active (the step is unconstrained).
+pub fn linearised_limits(usage: &[f64], grad: &Mat<f64>) -> Option<LinearLimits> {
+    let mut g = Vec::new();
+    let mut h = Vec::new();
+    for (k, &u) in usage.iter().enumerate().filter(|(_, u)| **u > ACTIVE) {
+        g.push((0..grad.ncols()).map(|j| grad[(k, j)]).collect());
+        h.push(1.0 - MARGIN - u);
+    }
+    (!g.is_empty()).then_some(LinearLimits { g, h })
+}
+
+/// The step of the module docs; `None` when the program has no solution (the limits cannot be
+/// met to first order from this iterate).
+pub fn damped_step_within(jtj: &Mat<f64>, jtr: &Mat<f64>, lambda: f64, lim: &LinearLimits) -> Option<Vec<f64>> {
+    let n = jtj.nrows();
+    // scale the objective to order 1: Clarabel's tolerances are absolute
+    let s = (0..n).map(|i| jtj[(i, i)]).fold(0.0, f64::max).max(1e-300) + lambda;
+    let upper: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| match j.cmp(&i) {
+                    std::cmp::Ordering::Less => 0.0,
+                    std::cmp::Ordering::Equal => (jtj[(i, i)] + lambda) / s,
+                    std::cmp::Ordering::Greater => jtj[(i, j)] / s,
+                })
+                .collect()
+        })
+        .collect();
+    let p = CscMatrix::from(&upper);
+    let q: Vec<f64> = (0..n).map(|i| jtr[(i, 0)] / s).collect();
+    let a = CscMatrix::from(&lim.g);
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(100)
+        .build()
+        .ok()?;
+    let cones = [NonnegativeConeT(lim.h.len())];
+    let mut solver = DefaultSolver::new(&p, &q, &a, &lim.h, &cones, settings).ok()?;
+    solver.solve();
+    matches!(
+        solver.solution.status,
+        SolverStatus::Solved | SolverStatus::AlmostSolved
+    )
+    .then(|| solver.solution.x.clone())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A textbook QP with a known solution: minimise `1/2 |dx|^2 - (1, 1) . dx` (the
+    /// unconstrained minimum (1, 1)) with `dx_1 + dx_2 <= 1`: the projection (0.5, 0.5).
+    #[test]
+    fn the_step_is_the_projection_onto_the_limit() {
+        let jtj = Mat::from_fn(2, 2, |i, j| if i == j { 1.0 } else { 0.0 });
+        let jtr = Mat::from_fn(2, 1, |_, _| -1.0);
+        let lim = LinearLimits {
+            g: vec![vec![1.0, 1.0]],
+            h: vec![1.0],
+        };
+        let dx = damped_step_within(&jtj, &jtr, 0.0, &lim).unwrap();
+        assert!((dx[0] - 0.5).abs() < 1e-6 && (dx[1] - 0.5).abs() < 1e-6, "{dx:?}");
+    }
+}

@@ -141,7 +141,7 @@ pub fn family_of(cfg: &PlanConfig) -> Family {
 
 /// N from the accurate AMM's automatic choice on the plain quintic of `t_ref` [s] (then frozen,
 /// 4.3), the first frequency at the final pose, the window.
-fn setup(cfg: &PlanConfig, t_ref: f64, started: Instant) -> Result<Setup, PlanError> {
+pub fn setup(cfg: &PlanConfig, t_ref: f64, started: Instant) -> Result<Setup, PlanError> {
     let family = family_of(cfg);
     let mut exp = cfg.exp.clone();
     exp.trajectory = family.quintic(t_ref);

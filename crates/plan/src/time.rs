@@ -46,6 +46,8 @@ pub struct TimeSearch {
     pub zvd_duration_s: f64,
     pub zvd_peak_m: f64,
     pub zvd_steps: Vec<TimeStep>,
+    /// Wall time when the baseline was found [s] (from the start of the plan).
+    pub zvd_found_s: f64,
     /// The planned move's bisection (AMM).
     pub steps: Vec<TimeStep>,
     /// The FEM's residual peak of the successes, shortest first, until one holds.
@@ -269,6 +271,7 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
     let travel = travels(&cfg.exp.robot, &s.family)?;
     let t_lim = shortest_move(travel, &cfg.limits).0;
     let (zvd_base, zvd_dur, zvd_peak_m, zvd_steps) = zvd_baseline(cfg, s, r_max, t_lim)?;
+    let zvd_found_s = s.started.elapsed().as_secs_f64();
     let (steps, successes) = bisect_planned(cfg, s, (t_lim.max(0.25 * zvd_dur), zvd_dur), r_max);
     if successes.is_empty() {
         return Err(PlanError::Solver(format!(
@@ -304,6 +307,7 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
             zvd_duration_s: zvd_dur,
             zvd_peak_m,
             zvd_steps,
+            zvd_found_s,
             steps,
             fem_checks,
             shorter_percent: 100.0 * (1.0 - t_move / zvd_dur),

@@ -33,7 +33,9 @@ fn nelder_mead(f: &dyn Fn(&[f64]) -> f64, x0: &[f64], step: f64, target: f64) ->
         if simplex[0].1 <= target {
             break;
         }
-        let centroid: Vec<f64> = (0..n).map(|j| simplex[..n].iter().map(|p| p.0[j]).sum::<f64>() / n as f64).collect();
+        let centroid: Vec<f64> = (0..n)
+            .map(|j| simplex[..n].iter().map(|p| p.0[j]).sum::<f64>() / n as f64)
+            .collect();
         let worst = simplex[n].clone();
         let xr = point(&centroid, &worst.0, -1.0);
         let fr = f(&xr);

@@ -132,3 +132,30 @@ pub fn freqmap<'py>(
     )?;
     Ok(d)
 }
+
+/// Plan a rest-to-rest motion (as `flexstar plan`, docs/motions.md section 4): writes
+/// `out/<name>/` (plan.toml, plan.csv, plan.json, plan.md, the runs, the figures); returns
+/// `{"dir", "plan_toml", "plan_csv", "t_move", "evaluations", "reason", "residual_G_peak_m"}`,
+/// the last a dict of `plain`, `zvd`, `planned` to `(AMM, FEM)` residual peaks of |dG| [m].
+#[pyfunction]
+#[pyo3(signature = (config, out))]
+pub fn plan<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    let o = interrupt::interruptible(py, "flexstar.plan", false, |_| {
+        flexstar_api::plan::plan_to_dir(&config, &out, |_| {})
+    })?
+    .map_err(py_err)?;
+    let d = PyDict::new(py);
+    d.set_item("dir", o.dir.display().to_string())?;
+    d.set_item("plan_toml", o.dir.join("plan.toml").display().to_string())?;
+    d.set_item("plan_csv", o.dir.join("plan.csv").display().to_string())?;
+    d.set_item("t_move", o.planned.t_move)?;
+    d.set_item("evaluations", o.planned.evaluations)?;
+    d.set_item("reason", o.planned.reason.clone())?;
+    let peaks = PyDict::new(py);
+    for m in &o.motions {
+        let peak = |r: &flexstar_api::RunOutcome| r.meta["residual_G_peak_m"].as_f64();
+        peaks.set_item(m.key, (peak(&m.amm), peak(&m.fem)))?;
+    }
+    d.set_item("residual_G_peak_m", peaks)?;
+    Ok(d)
+}

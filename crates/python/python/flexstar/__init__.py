@@ -34,6 +34,7 @@ __all__ = [
     "compare",
     "verify",
     "freqmap",
+    "plan",
 ]
 __version__ = _flexstar.__version__
 
@@ -297,6 +298,17 @@ def compare(
     on stderr. Errors: ConfigError, InfeasibleMotion, SolverError."""
     _check_count("modes", modes)
     return _flexstar.compare(os.fspath(config), os.fspath(out), list(families), modes, figures, progress)
+
+
+def plan(config: "os.PathLike[str] | str", out: "os.PathLike[str] | str" = "out") -> Dict[str, Any]:
+    """Plan a rest-to-rest motion (as ``flexstar plan``; docs/motions.md section 4): the file's
+    ``[plan]`` (and ``[limits]``) give the move; writes ``out/<name>/`` (plan.toml, plan.csv,
+    plan.json, plan.md, the plain, ZVD-shaped and planned runs on the AMM and the FEM, figures).
+    Returns the folder, the paths of plan.toml and plan.csv, the move time, the search's
+    evaluations and stop reason, and ``residual_G_peak_m``: for ``plain``, ``zvd`` and
+    ``planned`` the ``(AMM, FEM)`` residual peaks of |dG| after the move [m]. Errors:
+    ConfigError (naming file and key), SolverError."""
+    return _flexstar.plan(os.fspath(config), os.fspath(out))
 
 
 def verify(

@@ -243,3 +243,46 @@ fn auto_zvd_meets_the_tenfold_target_on_the_three_moves() {
         );
     }
 }
+
+/// `f_hz = "auto"` with a servo drive is refused before any work, naming `shaper.f_hz` (the auto
+/// rule needs a prescribed motion, docs/motions.md 8.5), and nothing is written; the same
+/// experiment with given frequencies runs.
+#[test]
+fn auto_shaping_is_refused_with_a_servo() {
+    let out = tempfile::tempdir().unwrap();
+    let servo = "[drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n";
+    let cfg = write_config(
+        out.path(),
+        "servo-auto",
+        &format!("{servo}[shaper]\nkind = \"zvd\"\nf_hz = \"auto\"\n"),
+    );
+    let o = flexstar(&[
+        "run",
+        cfg.to_str().unwrap(),
+        "--solver",
+        "amm",
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    let err = stderr(&o);
+    assert!(
+        !o.status.success() && err.contains("servo-auto.toml") && err.contains("shaper.f_hz"),
+        "{err}"
+    );
+    assert!(err.contains("servo"), "{err}");
+    assert!(!out.path().join("servo-auto").exists(), "nothing written");
+    let given = write_config(
+        out.path(),
+        "servo-given",
+        &format!("{servo}[shaper]\nkind = \"zvd\"\nf_hz = 3.9\n"),
+    );
+    let o = flexstar(&[
+        "run",
+        given.to_str().unwrap(),
+        "--solver",
+        "amm",
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

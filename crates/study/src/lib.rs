@@ -13,6 +13,7 @@
 //! Metrics are in [`metrics`]: peaks of the tips, of G and of the driving forces, the residual
 //! vibration after a rest-to-rest motion, and the AMM's mean EVP against the FEM (Eq. 45).
 
+pub mod derived;
 pub mod error;
 pub mod hash;
 pub mod merge;

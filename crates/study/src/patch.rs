@@ -1,7 +1,8 @@
 //! Patching the base experiment's TOML document at dotted keys: every key the experiment format
 //! accepts can be varied, and the experiment loader itself rejects the ones it does not know.
 //!
-//! One derived key exists besides the experiment's own: [`SCALE_DURATION`].
+//! Derived keys exist besides the experiment's own: [`SCALE_DURATION`] and the robot groups and
+//! scaled motion of [`crate::derived`].
 
 /// `scale.duration = k`: play the motion k times slower (k > 1) or faster (k < 1).
 ///
@@ -21,13 +22,17 @@ pub const SCALE_DURATION: &str = "scale.duration";
 pub fn case_document(base: &toml::Table, keys: &[String], values: &[toml::Value]) -> Result<toml::Table, String> {
     let mut doc = base.clone();
     let mut scale = None;
+    let mut derived = Vec::new();
     for (key, value) in keys.iter().zip(values) {
         if key == SCALE_DURATION {
             scale = Some(number(value).ok_or_else(|| format!("{SCALE_DURATION} must be a number, got {value}"))?);
+        } else if crate::derived::is_derived(key) {
+            derived.push((key.as_str(), value));
         } else {
             set_dotted(&mut doc, key, value.clone())?;
         }
     }
+    crate::derived::apply(&mut doc, &derived)?;
     if let Some(k) = scale {
         scale_duration(&mut doc, k)?;
     }

@@ -30,7 +30,7 @@ pub fn run_id(keys: &[String], values: &[toml::Value]) -> String {
 
 /// `x` rounded to 12 significant digits, so that generated points read 0.0002 rather than
 /// 0.00019999999999999998.
-fn tidy(x: f64) -> f64 {
+pub fn tidy(x: f64) -> f64 {
     if x == 0.0 || !x.is_finite() {
         return x;
     }

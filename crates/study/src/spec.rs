@@ -389,6 +389,12 @@ fn vary(file: &Path, v: VaryFile) -> Result<Vary, StudyError> {
     if v.key.starts_with("scale.") && v.key != SCALE_DURATION {
         return Err(err(format!("the only scale key is {SCALE_DURATION}")));
     }
+    if v.key.starts_with("derived.") && !crate::derived::is_derived(&v.key) {
+        return Err(err(format!(
+            "unknown derived key; the derived keys are {}",
+            crate::derived::DERIVED.join(", ")
+        )));
+    }
     let levels = match (v.values, v.linspace, v.logspace) {
         (Some(values), None, None) => {
             if values.is_empty() {

@@ -347,6 +347,9 @@ pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunO
     add_residual(&mut meta, p, &response)?;
     let warning = flexstar_model::small_deflection_check(&response, p.exp.robot.l)
         .map(|v| format!("{}: {} {v}", p.source, p.stem));
+    if p.solver == Solver::Amm {
+        add_envelope(&mut meta, &p.exp, warning.is_none());
+    }
     Ok(RunOutcome {
         response,
         meta,
@@ -369,6 +372,40 @@ fn add_residual(meta: &mut serde_json::Value, p: &Prepared, r: &Response) -> Res
         doc.extend(fields);
     }
     Ok(())
+}
+
+/// `validated_envelope` (bool) and `validated_envelope_reasons` (the list of why not) of an AMM
+/// run's sidecar (issue 21 item 3, [`flexstar_model::envelope`]).
+fn add_envelope(meta: &mut serde_json::Value, exp: &Experiment, small_deflection: bool) {
+    let attachments = !(exp.payload.is_none() && exp.damping.beta() == 0.0 && exp.load.is_none());
+    let why = flexstar_model::envelope::outside_envelope(
+        &exp.robot,
+        exp.amm.model,
+        exp.amm.family,
+        attachments,
+        small_deflection,
+    );
+    if let serde_json::Value::Object(doc) = meta {
+        doc.insert("validated_envelope".into(), why.is_empty().into());
+        doc.insert("validated_envelope_reasons".into(), why.into());
+    }
+}
+
+/// The line `flexstar run` prints for an AMM run outside the validated envelope (`None` inside
+/// it or for an FEM run).
+pub fn envelope_line(meta: &serde_json::Value) -> Option<String> {
+    if meta["validated_envelope"] != false {
+        return None;
+    }
+    let why: Vec<&str> = meta["validated_envelope_reasons"]
+        .as_array()?
+        .iter()
+        .filter_map(|v| v.as_str())
+        .collect();
+    Some(format!(
+        "outside the validated envelope of the accurate AMM (docs/validation.md): {}; the error estimate is not vouched for here",
+        why.join("; ")
+    ))
 }
 
 /// The sidecar's residual after the motion in one line (`None` when the motion does not rest

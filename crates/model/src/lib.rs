@@ -12,6 +12,7 @@ pub mod cancel;
 pub mod catalogue;
 pub mod config;
 pub mod drive;
+pub mod envelope;
 pub mod error;
 pub mod evp;
 pub mod frames;

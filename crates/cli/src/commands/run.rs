@@ -144,4 +144,7 @@ fn summary(o: &RunOutcome, figures: bool, seconds: f64) {
     if let Some(line) = flexstar_api::run::residual_line(&o.meta) {
         eprintln!("{}: {line}", exp.name);
     }
+    if let Some(line) = flexstar_api::run::envelope_line(&o.meta) {
+        eprintln!("note: {}: {line}", exp.name);
+    }
 }

@@ -1,0 +1,123 @@
+//! The validation envelope of the accurate AMM (issue 21 item 3-4, `docs/validation.md`): the
+//! ranges of robot parameters over which the accurate model (enriched family, full model,
+//! automatic N) and its error estimate were checked against the FEM by
+//! `configs/studies/envelope.toml`. A run outside them, or outside the small-deflection range,
+//! or of another model, is said to lie outside the validated envelope: its sidecar JSON has
+//! `validated_envelope: false` with the reasons, and `flexstar run` says so on stderr, instead
+//! of a confident error estimate alone.
+//!
+//! The ranges are those the study draws from (a change here is a change there, and the
+//! published table in `docs/validation.md` must be remade).
+
+use crate::config::{AmmModel, ModeFamily};
+use crate::params::RobotParams;
+
+/// One range of the envelope: the group's name, how it is computed, its bounds.
+struct Range {
+    name: &'static str,
+    value: fn(&RobotParams) -> f64,
+    lo: f64,
+    hi: f64,
+}
+
+/// The ranges of `configs/studies/envelope.toml` (issue 21 item 4).
+const RANGES: [Range; 6] = [
+    Range {
+        name: "L [m]",
+        value: |p| p.l,
+        lo: 0.3,
+        hi: 0.8,
+    },
+    Range {
+        name: "Lp/L",
+        value: |p| p.lp / p.l,
+        lo: 0.03,
+        hi: 0.15,
+    },
+    Range {
+        name: "Jp/(rho L^3)",
+        value: |p| p.jp / (p.rho * p.l.powi(3)),
+        lo: 0.002,
+        hi: 0.1,
+    },
+    Range {
+        name: "mpp_mpa [kg]",
+        value: |p| p.mpp_mpa,
+        lo: 0.05,
+        hi: 1.0,
+    },
+    Range {
+        name: "EI [N m^2]",
+        value: |p| p.e * p.i,
+        lo: 0.1,
+        hi: 2.0,
+    },
+    Range {
+        name: "rho [kg/m]",
+        value: |p| p.rho,
+        lo: 0.05,
+        hi: 0.5,
+    },
+];
+
+/// Why an AMM run lies outside the validated envelope (empty: inside). `model`, `family`: the
+/// run's equations and modes; `attachments`: whether a payload, damping or load is present
+/// (validated separately, not by the envelope); `small_deflection`: the run stayed in range.
+pub fn outside_envelope(
+    params: &RobotParams,
+    model: AmmModel,
+    family: ModeFamily,
+    attachments: bool,
+    small_deflection: bool,
+) -> Vec<String> {
+    let mut why = Vec::new();
+    if model != AmmModel::Full || family != ModeFamily::Enriched {
+        why.push(format!(
+            "the envelope is the accurate model's (enriched, full); this run is {family}, {}",
+            match model {
+                AmmModel::Full => "full",
+                AmmModel::Paper => "paper",
+            }
+        ));
+    }
+    for r in &RANGES {
+        let v = (r.value)(params);
+        // a relative slack of 1e-9 keeps the bounds themselves inside
+        if !(v >= r.lo * (1.0 - 1e-9) && v <= r.hi * (1.0 + 1e-9)) {
+            why.push(format!(
+                "{} = {v:.4} is outside the validated range {}-{}",
+                r.name, r.lo, r.hi
+            ));
+        }
+    }
+    if attachments {
+        why.push("a payload, damping or a load at G: not part of the envelope study".into());
+    }
+    if !small_deflection {
+        why.push("the run leaves the small-deflection range".into());
+    }
+    why
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's robot lies outside the envelope on one group only (its EI = 0.5 N m^2 is
+    /// inside, its L = 0.5 m inside, its Jp/(rho L^3) = 2e-4 / (0.234 0.125) = 0.00684 inside,
+    /// its Lp/L = 0.06 inside): it is inside; a light, sleeve-heavy robot is not.
+    #[test]
+    fn the_paper_robot_is_inside_and_an_extreme_one_is_not() {
+        let paper = RobotParams::default();
+        assert!(outside_envelope(&paper, AmmModel::Full, ModeFamily::Enriched, false, true).is_empty());
+        let heavy = RobotParams {
+            jp: 0.5 * paper.rho * paper.l.powi(3),
+            ..paper
+        };
+        let why = outside_envelope(&heavy, AmmModel::Full, ModeFamily::Enriched, false, true);
+        assert_eq!(why.len(), 1, "{why:?}");
+        assert!(why[0].contains("Jp/(rho L^3) = 0.5000"), "{why:?}");
+        let why = outside_envelope(&paper, AmmModel::Paper, ModeFamily::FreeFree, false, false);
+        assert_eq!(why.len(), 2, "{why:?}");
+    }
+}

@@ -42,7 +42,7 @@
 use flexstar_model::geometry::{e_x, revolute_point, slider_direction};
 use flexstar_model::RobotParams;
 
-use crate::bordered::{Bordered, Layout, SLIDER_SLOTS};
+use crate::bordered::{Bordered, Layout, NU_COLUMNS, NU_SLOTS, SLIDER_SLOTS};
 use crate::element::{Element, ElementState};
 pub(crate) use crate::element_pass::Factors;
 use crate::element_pass::{self, NodeState, Section};
@@ -160,6 +160,8 @@ pub(crate) struct Star {
     pub direct: bool,
     /// Offset of the slider slot group (direct problem only).
     off_sl: usize,
+    /// Offset of the tangent rows' multiplier block (Eq. S9, [`NU_SLOTS`] per sleeve).
+    off_nu: usize,
     /// Payload, damping and load (issue 22; none by default).
     pub attached: Attached,
 }
@@ -275,6 +277,7 @@ impl Star {
             symbolic_count: 0,
             direct: sliders.is_some(),
             off_sl: 0,
+            off_nu: 0,
             attached: Attached::default(),
         };
         Ok((star, q, v))
@@ -381,8 +384,12 @@ impl Star {
                 res[a] -= cf * f[a];
             }
         }
+        // the interior-field compliance of the tangent rows (Eq. S9) acts in the time steps,
+        // whose unknowns are the scaled multipliers nu = cf lambda; not in the consistent
+        // initial accelerations (ck = 0), whose rows are acceleration-level
+        let compliance = (fac.ck > 0.0).then(|| 1.0 / cf);
         for i in 0..3 {
-            self.sleeve_rows(i, &it, cf, res, matrix);
+            self.sleeve_rows(i, &it, cf, compliance, res, matrix);
         }
         match (self.direct, sliders) {
             (true, Some(sl)) => self.assemble_sliders(sl, qdd, lam, cf, res, matrix),
@@ -401,7 +408,7 @@ impl Star {
     /// constraint row its value, its gradient times the multiplier into the residual and, with
     /// `matrix`, its slots (row block, then transposed block).
     #[inline]
-    fn sleeve_rows(&mut self, i: usize, it: &Iterate, cf: f64, res: &mut [f64], matrix: bool) {
+    fn sleeve_rows(&mut self, i: usize, it: &Iterate, cf: f64, compliance: Option<f64>, res: &mut [f64], matrix: bool) {
         let Iterate { q, qdd, lam, pins, .. } = *it;
         let ps = self.psi(i);
         res[ps] += cf * self.params.jp * qdd[ps];
@@ -429,6 +436,11 @@ impl Star {
             let row = self.n_dof + ROWS * i + r;
             let l = lam[ROWS * i + r];
             res[row] = phi;
+            if r == ROWS - 1 {
+                if let Some(scale) = compliance {
+                    res[row] += self.interior_compliance(i, &st, z, lam, scale, matrix);
+                }
+            }
             let d = dofs(&self.elements[ge]);
             for a in 0..6 {
                 res[d[a]] += grad[a] * l;
@@ -453,6 +465,31 @@ impl Star {
             self.vals[base + nc - 1] = gpsi;
             self.vals[base + 2 * nc - 1] = gpsi;
         }
+    }
+
+    /// Eq. S9 (`docs/fem.md` section 2.1): the slope that the interior field of the centre's
+    /// element adds at the contact point under the point moment `C = -lambda_7` and the normal
+    /// point force `P = -lambda_c . e2` that the sleeve applies there, `F_ut P + F_tt C`, with the
+    /// flexibilities of the element clamped at both nodes (length h, contact at `a = z h`,
+    /// `b = h - a`): `F_tt = a b (a^2 - a b + b^2) / (EI h^3)`, `F_ut = a^2 b^2 (b - a) / (2 EI h^3)`.
+    /// `scale = 1 / cf` turns the scaled multipliers into forces. With `matrix`, writes the
+    /// row's derivatives with respect to the multipliers into the slot group `off_nu`. Returns
+    /// the term to add to the tangent row's value [rad].
+    fn interior_compliance(&mut self, i: usize, st: &ElementState, z: f64, lam: &[f64], scale: f64, matrix: bool) -> f64 {
+        let (a, b) = (z.clamp(0.0, 1.0) * self.h, (1.0 - z).clamp(0.0, 1.0) * self.h);
+        let den = self.params.ei() * self.h * self.h * self.h;
+        let f_tt = a * b * (a * a - a * b + b * b) / den;
+        let f_ut = a * a * b * b * (b - a) / (2.0 * den);
+        let e2 = [-st.s, st.c];
+        let k = ROWS * i;
+        // the row's derivatives with respect to (nu_7, nu_cx, nu_cy)
+        let d = [-f_tt * scale, -f_ut * e2[0] * scale, -f_ut * e2[1] * scale];
+        if matrix {
+            for (c, v) in d.iter().enumerate() {
+                self.vals[self.off_nu + NU_SLOTS * i + c] = *v;
+            }
+        }
+        NU_COLUMNS.iter().zip(d).map(|(&r, dv)| dv * lam[k + r]).sum()
     }
 
     /// A residual with a non-finite entry is an error naming the row (and the element of a DOF row).

@@ -89,7 +89,9 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    let stem = Path::new(config).file_stem().map_or("run".into(), |s| s.to_string_lossy().to_string());
+    let stem = Path::new(config)
+        .file_stem()
+        .map_or("run".into(), |s| s.to_string_lossy().to_string());
     let dir = Path::new(dir);
     let _ = std::fs::create_dir_all(dir);
     let mut reference = None;
@@ -103,7 +105,11 @@ fn main() -> ExitCode {
         };
         let reference = reference.get_or_insert(r.clone());
         let e = point_evps(&r, reference).expect("same output times");
-        let cells: Vec<String> = e.points.iter().map(|p| p.map_or("n/a".into(), |v| format!("{v:.4}"))).collect();
+        let cells: Vec<String> = e
+            .points
+            .iter()
+            .map(|p| p.map_or("n/a".into(), |v| format!("{v:.4}")))
+            .collect();
         let dt = set.1.map_or("auto".into(), |d| format!("{d:e}"));
         let wall = wall.map_or("cached".into(), |w| format!("{w:.2} s"));
         println!(

@@ -18,6 +18,11 @@
 //! alpha_i(xi_c) - gamma0_i - psi_i = 0   (1)  beam tangent along the sleeve axis
 //! ```
 //!
+//! The tangent row carries the interior-field correction of Eq. S9 (`docs/fem.md` section 2.1,
+//! [`Star::interior_compliance`]): the slope that the point moment and force of the sleeve add
+//! inside the centre's element, `F_ut P + F_tt C` with the multipliers as loads, which makes the
+//! mesh converge at second order where the sleeve's moment is large.
+//!
 //! `r_i(xi)` and `alpha_i(xi)` are the element interpolations of [`crate::element`] in the element
 //! that contains `xi`; they are continuous (position and angle) across element boundaries, so a
 //! contact point slides from one element into the next without a jump.
@@ -475,7 +480,15 @@ impl Star {
     /// `scale = 1 / cf` turns the scaled multipliers into forces. With `matrix`, writes the
     /// row's derivatives with respect to the multipliers into the slot group `off_nu`. Returns
     /// the term to add to the tangent row's value [rad].
-    fn interior_compliance(&mut self, i: usize, st: &ElementState, z: f64, lam: &[f64], scale: f64, matrix: bool) -> f64 {
+    fn interior_compliance(
+        &mut self,
+        i: usize,
+        st: &ElementState,
+        z: f64,
+        lam: &[f64],
+        scale: f64,
+        matrix: bool,
+    ) -> f64 {
         let (a, b) = (z.clamp(0.0, 1.0) * self.h, (1.0 - z).clamp(0.0, 1.0) * self.h);
         let den = self.params.ei() * self.h * self.h * self.h;
         let f_tt = a * b * (a * a - a * b + b * b) / den;

@@ -32,6 +32,6 @@ pub use error::{FemError, LinearError, NewtonFailure, PivotError};
 pub use integrator::{Fallback, Stats};
 pub use solve::{
     default_dt, first_beam_frequency, solve, solve_checked, solve_direct, solve_direct_with_stats, solve_with_stats,
-    DEFAULT_DT, DEFAULT_RHO_INF,
+    DEFAULT_DT, DEFAULT_RHO_INF, MIN_DEFAULT_DT,
 };
 pub use star::InitialState;

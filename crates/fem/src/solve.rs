@@ -34,11 +34,18 @@ pub fn first_beam_frequency(params: &RobotParams) -> f64 {
 /// (20.6 rad/s). The exponent keeps the generalized-alpha phase error of the first modes,
 /// accumulated over the motion (`~ omega^3 dt^2 T`), at the paper robot's level, which the study
 /// of section 4 showed to be converged; the paper's robot and softer ones keep 5e-4 s. The run
-/// takes at most this step (every output interval is split into equal steps, section 3).
+/// takes at most this step (every output interval is split into equal steps, section 3). Floor:
+/// [`MIN_DEFAULT_DT`] (`omega_1` above 280 rad/s, beyond the range the rule was checked on).
 pub fn default_dt(params: &RobotParams) -> f64 {
     let ratio = first_beam_frequency(&RobotParams::paper()) / first_beam_frequency(params);
-    DEFAULT_DT * ratio.powf(1.5).min(1.0)
+    (DEFAULT_DT * ratio.powf(1.5).min(1.0)).max(MIN_DEFAULT_DT)
 }
+
+/// Smallest step [s] that [`default_dt`] chooses (a fiftieth of [`DEFAULT_DT`], reached at
+/// `omega_1 = 280 rad/s`, e.g. EI = 2 N m^2, rho = 0.05 kg/m, L = 0.3 m): a practically rigid star
+/// (the stiff-limit tests' EI x 1e4) would otherwise get steps of 1e-7 s for elastic deflections
+/// too small to matter; set `[fem] dt` there (docs/fem.md section 4.1).
+pub const MIN_DEFAULT_DT: f64 = DEFAULT_DT / 50.0;
 /// Default spectral radius at infinity of the generalized-alpha scheme (docs/fem.md).
 pub const DEFAULT_RHO_INF: f64 = flexstar_model::config::FEM_DEFAULT_RHO_INF;
 

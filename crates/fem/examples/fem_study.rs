@@ -104,7 +104,13 @@ fn main() -> ExitCode {
             }
         };
         let reference = reference.get_or_insert(r.clone());
-        let e = point_evps(&r, reference).expect("same output times");
+        let e = match point_evps(&r, reference) {
+            Ok(e) => e,
+            Err(e) => {
+                eprintln!("{stem} {set:?}: {e} (a stale cache in {}?)", dir.display());
+                return ExitCode::FAILURE;
+            }
+        };
         let cells: Vec<String> = e
             .points
             .iter()

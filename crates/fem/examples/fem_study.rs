@@ -49,6 +49,9 @@ fn read(path: &Path) -> Option<Response> {
     let mut r = Response::with_capacity("fem", 0);
     for l in text.lines().skip(1) {
         let v: Vec<f64> = l.split(',').map(|x| x.parse().ok()).collect::<Option<_>>()?;
+        if v.len() != 7 {
+            return None;
+        }
         r.push(v[0], [v[4], v[5], v[6]], [v[1], v[2], v[3]], [0.0; 3]);
     }
     Some(r)

@@ -31,6 +31,7 @@ mod star;
 pub use error::{FemError, LinearError, NewtonFailure, PivotError};
 pub use integrator::{Fallback, Stats};
 pub use solve::{
-    solve, solve_checked, solve_direct, solve_direct_with_stats, solve_with_stats, DEFAULT_DT, DEFAULT_RHO_INF,
+    default_dt, first_beam_frequency, solve, solve_checked, solve_direct, solve_direct_with_stats, solve_with_stats,
+    DEFAULT_DT, DEFAULT_RHO_INF, MIN_DEFAULT_DT,
 };
 pub use star::InitialState;

@@ -13,8 +13,39 @@ use crate::integrator::{integrate, History, Motion, RunSettings, Sample, Snapsho
 use crate::star::{Attached, InitialState};
 use crate::FemError;
 
-/// Default integration step [s], from the convergence study in `docs/fem.md`.
+/// Default integration step [s] of the paper's robot and of every robot whose beams are no
+/// stiffer than its (lower first frequency), from the convergence study in `docs/fem.md`
+/// section 4; stiffer robots get [`default_dt`].
 pub const DEFAULT_DT: f64 = 5e-4;
+
+/// `(beta_1 L)^2` of the clamped-free beam's first bending mode (beta_1 L = 1.875104).
+const CLAMPED_FREE_1: f64 = 1.875_104_068_711_961 * 1.875_104_068_711_961;
+
+/// First clamped-free bending frequency `omega_1 = (beta_1 L)^2 sqrt(EI / (rho L^4))` [rad/s]
+/// of one beam of `params` (the robot's time scale in the step rule, Eq. S10 of `docs/fem.md`
+/// section 4.1).
+pub fn first_beam_frequency(params: &RobotParams) -> f64 {
+    CLAMPED_FREE_1 * (params.ei() / (params.rho * params.l.powi(4))).sqrt()
+}
+
+/// The FEM's default integration step [s] for `params` (Eq. S10, `docs/fem.md` section 4.1):
+/// `DEFAULT_DT min(1, (omega_ref / omega_1)^(3/2))`, with `omega_1` the robot's first
+/// clamped-free beam frequency ([`first_beam_frequency`]) and `omega_ref` the paper robot's
+/// (20.6 rad/s). The exponent keeps the generalized-alpha phase error of the first modes,
+/// accumulated over the motion (`~ omega^3 dt^2 T`), at the paper robot's level, which the study
+/// of section 4 showed to be converged; the paper's robot and softer ones keep 5e-4 s. The run
+/// takes at most this step (every output interval is split into equal steps, section 3). Floor:
+/// [`MIN_DEFAULT_DT`] (`omega_1` above 280 rad/s, beyond the range the rule was checked on).
+pub fn default_dt(params: &RobotParams) -> f64 {
+    let ratio = first_beam_frequency(&RobotParams::paper()) / first_beam_frequency(params);
+    (DEFAULT_DT * ratio.powf(1.5).min(1.0)).max(MIN_DEFAULT_DT)
+}
+
+/// Smallest step [s] that [`default_dt`] chooses (a fiftieth of [`DEFAULT_DT`], reached at
+/// `omega_1 = 280 rad/s`, e.g. EI = 2 N m^2, rho = 0.05 kg/m, L = 0.3 m): a practically rigid star
+/// (the stiff-limit tests' EI x 1e4) would otherwise get steps of 1e-7 s for elastic deflections
+/// too small to matter; set `[fem] dt` there (docs/fem.md section 4.1).
+pub const MIN_DEFAULT_DT: f64 = DEFAULT_DT / 50.0;
 /// Default spectral radius at infinity of the generalized-alpha scheme (docs/fem.md).
 pub const DEFAULT_RHO_INF: f64 = flexstar_model::config::FEM_DEFAULT_RHO_INF;
 
@@ -236,7 +267,7 @@ fn validate(exp: &Experiment, settings: &FemSettings) -> Result<RunSettings, Fem
             settings.elements
         )));
     }
-    let dt = settings.dt.unwrap_or(DEFAULT_DT.min(exp.time.dt_out));
+    let dt = settings.dt.unwrap_or(default_dt(params).min(exp.time.dt_out));
     if !(dt.is_finite() && dt > 0.0) {
         return Err(FemError::Input(format!("fem.dt must be positive, got {dt}")));
     }

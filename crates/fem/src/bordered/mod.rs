@@ -83,7 +83,17 @@ pub(crate) struct Layout {
     pub ww: usize,
     /// Direct problem only: offset of the slider slot group ([`SLIDER_SLOTS`] values per slider).
     pub off_sl: Option<usize>,
+    /// Offset of the multiplier block of the tangent rows ([`NU_SLOTS`] values per sleeve:
+    /// `(tangent, tangent)`, `(tangent, centre x)`, `(tangent, centre y)`; Eq. S9 of
+    /// `docs/fem.md` section 2.1), all within the border.
+    pub off_nu: usize,
 }
+
+/// Values per sleeve in the multiplier-block slot group (see [`Layout::off_nu`]).
+pub(crate) const NU_SLOTS: usize = 3;
+/// Constraint rows (of the sleeve's 7) that the tangent row's multiplier block couples with:
+/// the tangent row itself, then the centre's two position rows.
+pub(crate) const NU_COLUMNS: [usize; NU_SLOTS] = [6, 0, 1];
 
 /// The factorisation and its workspaces. Beam rows are tip-first and stored `HB` rows further
 /// (row j at `j + HB`), after `HB` zero pad rows, so that every row runs the same fixed-length
@@ -332,6 +342,7 @@ mod tests {
             ncol: 0,
             ww: 0,
             off_sl: None,
+            off_nu: 0,
         };
         let mut b = Bordered::new(lay);
         let n = 3 * lay.ne;

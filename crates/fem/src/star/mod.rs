@@ -18,6 +18,11 @@
 //! alpha_i(xi_c) - gamma0_i - psi_i = 0   (1)  beam tangent along the sleeve axis
 //! ```
 //!
+//! The tangent row carries the interior-field correction of Eq. S9 (`docs/fem.md` section 2.1,
+//! [`Star::interior_compliance`]): the slope that the point moment and force of the sleeve add
+//! inside the centre's element, `F_ut P + F_tt C` with the multipliers as loads, which makes the
+//! mesh converge at second order where the sleeve's moment is large.
+//!
 //! `r_i(xi)` and `alpha_i(xi)` are the element interpolations of [`crate::element`] in the element
 //! that contains `xi`; they are continuous (position and angle) across element boundaries, so a
 //! contact point slides from one element into the next without a jump.
@@ -42,7 +47,7 @@
 use flexstar_model::geometry::{e_x, revolute_point, slider_direction};
 use flexstar_model::RobotParams;
 
-use crate::bordered::{Bordered, Layout, SLIDER_SLOTS};
+use crate::bordered::{Bordered, Layout, NU_COLUMNS, NU_SLOTS, SLIDER_SLOTS};
 use crate::element::{Element, ElementState};
 pub(crate) use crate::element_pass::Factors;
 use crate::element_pass::{self, NodeState, Section};
@@ -160,6 +165,8 @@ pub(crate) struct Star {
     pub direct: bool,
     /// Offset of the slider slot group (direct problem only).
     off_sl: usize,
+    /// Offset of the tangent rows' multiplier block (Eq. S9, [`NU_SLOTS`] per sleeve).
+    off_nu: usize,
     /// Payload, damping and load (issue 22; none by default).
     pub attached: Attached,
 }
@@ -275,6 +282,7 @@ impl Star {
             symbolic_count: 0,
             direct: sliders.is_some(),
             off_sl: 0,
+            off_nu: 0,
             attached: Attached::default(),
         };
         Ok((star, q, v))
@@ -381,8 +389,12 @@ impl Star {
                 res[a] -= cf * f[a];
             }
         }
+        // the interior-field compliance of the tangent rows (Eq. S9) acts in the time steps,
+        // whose unknowns are the scaled multipliers nu = cf lambda; not in the consistent
+        // initial accelerations (ck = 0), whose rows are acceleration-level
+        let compliance = (fac.ck > 0.0).then(|| 1.0 / cf);
         for i in 0..3 {
-            self.sleeve_rows(i, &it, cf, res, matrix);
+            self.sleeve_rows(i, &it, cf, compliance, res, matrix);
         }
         match (self.direct, sliders) {
             (true, Some(sl)) => self.assemble_sliders(sl, qdd, lam, cf, res, matrix),
@@ -401,7 +413,7 @@ impl Star {
     /// constraint row its value, its gradient times the multiplier into the residual and, with
     /// `matrix`, its slots (row block, then transposed block).
     #[inline]
-    fn sleeve_rows(&mut self, i: usize, it: &Iterate, cf: f64, res: &mut [f64], matrix: bool) {
+    fn sleeve_rows(&mut self, i: usize, it: &Iterate, cf: f64, compliance: Option<f64>, res: &mut [f64], matrix: bool) {
         let Iterate { q, qdd, lam, pins, .. } = *it;
         let ps = self.psi(i);
         res[ps] += cf * self.params.jp * qdd[ps];
@@ -429,6 +441,11 @@ impl Star {
             let row = self.n_dof + ROWS * i + r;
             let l = lam[ROWS * i + r];
             res[row] = phi;
+            if r == ROWS - 1 {
+                if let Some(scale) = compliance {
+                    res[row] += self.interior_compliance(i, &st, z, lam, scale, matrix);
+                }
+            }
             let d = dofs(&self.elements[ge]);
             for a in 0..6 {
                 res[d[a]] += grad[a] * l;
@@ -453,6 +470,36 @@ impl Star {
             self.vals[base + nc - 1] = gpsi;
             self.vals[base + 2 * nc - 1] = gpsi;
         }
+    }
+
+    /// Eq. S9 (`docs/fem.md` section 2.1): the slope that the interior field of the centre's
+    /// element adds at the contact point under the point moment `C = -lambda_7` and the normal
+    /// point force `P = -lambda_c . e2` that the sleeve applies there, `F_ut P + F_tt C`, with the
+    /// flexibilities of the element clamped at both nodes (length h, contact at `a = z h`,
+    /// `b = h - a`): `F_tt = a b (a^2 - a b + b^2) / (EI h^3)`, `F_ut = a^2 b^2 (b - a) / (2 EI h^3)`.
+    /// `scale = 1 / cf` turns the scaled multipliers into forces. With `matrix`, writes the
+    /// row's derivatives with respect to the multipliers into the slot group `off_nu`. Returns
+    /// the term to add to the tangent row's value [rad].
+    fn interior_compliance(
+        &mut self,
+        i: usize,
+        st: &ElementState,
+        z: f64,
+        lam: &[f64],
+        scale: f64,
+        matrix: bool,
+    ) -> f64 {
+        let (f_ut, f_tt) = interior_flexibilities(z, self.h, self.params.ei());
+        let e2 = [-st.s, st.c];
+        let k = ROWS * i;
+        // the row's derivatives with respect to (nu_7, nu_cx, nu_cy)
+        let d = [-f_tt * scale, -f_ut * e2[0] * scale, -f_ut * e2[1] * scale];
+        if matrix {
+            for (c, v) in d.iter().enumerate() {
+                self.vals[self.off_nu + NU_SLOTS * i + c] = *v;
+            }
+        }
+        NU_COLUMNS.iter().zip(d).map(|(&r, dv)| dv * lam[k + r]).sum()
     }
 
     /// A residual with a non-finite entry is an error naming the row (and the element of a DOF row).
@@ -623,6 +670,20 @@ impl Star {
     }
 }
 
+/// Flexibilities `(F_ut, F_tt)` of Eq. S9 (`docs/fem.md` section 2.1): the slope at the load
+/// point of an element of length `h` [m] and bending stiffness `ei` [N m^2] clamped at both ends,
+/// per unit point force (`F_ut` [1/N]) and per unit point moment (`F_tt` [1/(N m)]) at the local
+/// coordinate `z` (`a = z h`, `b = h - a`): `F_ut = a^2 b^2 (b - a) / (2 EI h^3)`,
+/// `F_tt = a b (a^2 - a b + b^2) / (EI h^3)`; zero at the nodes.
+pub(crate) fn interior_flexibilities(z: f64, h: f64, ei: f64) -> (f64, f64) {
+    let (a, b) = (z.clamp(0.0, 1.0) * h, (1.0 - z).clamp(0.0, 1.0) * h);
+    let den = ei * h * h * h;
+    (
+        a * a * b * b * (b - a) / (2.0 * den),
+        a * b * (a * a - a * b + b * b) / den,
+    )
+}
+
 /// Global node index of node k (0 = G) of beam i with `ne` elements per beam.
 pub(crate) fn node(ne: usize, i: usize, k: usize) -> usize {
     if k == 0 {
@@ -722,6 +783,104 @@ mod tests {
             assert!((x[k] - y[k]).abs() < 1e-9 * scale, "x[{k}]: {} vs {}", x[k], y[k]);
         }
         star.use_sparse
+    }
+
+    /// The slope at the load point `z` of a clamped-clamped beam (length `h`, stiffness `ei`)
+    /// under the point force `force` and moment `moment`, by minimising the discrete energy
+    /// `sum EI/2 (second difference)^2 dx - P w(a) - C w'(a)` on `n` intervals (clamped ends by
+    /// mirrored ghost nodes; `w'(a)` by a central difference, also for the slope measured).
+    fn finite_difference_slope(h: f64, ei: f64, n: usize, z: f64, force: f64, moment: f64) -> f64 {
+        let dx = h / n as f64;
+        // energy Hessian on the unknowns w_1..w_{n-1} (w_0 = w_n = 0, w_-1 = w_1, w_n+1 = w_n-1)
+        let m = n - 1;
+        let mut k = vec![vec![0.0; m]; m];
+        for node in 0..=n {
+            // curvature at `node` as coefficients on the unknowns
+            let mut c: Vec<(usize, f64)> = Vec::new();
+            let mut add = |j: isize, v: f64| {
+                let j = if j < 0 {
+                    -j
+                } else if j > n as isize {
+                    2 * n as isize - j
+                } else {
+                    j
+                };
+                if j > 0 && (j as usize) < n {
+                    c.push((j as usize - 1, v / (dx * dx)));
+                }
+            };
+            let j = node as isize;
+            add(j - 1, 1.0);
+            add(j, -2.0);
+            add(j + 1, 1.0);
+            let w = if node == 0 || node == n { 0.5 } else { 1.0 } * ei * dx;
+            for &(p, vp) in &c {
+                for &(q, vq) in &c {
+                    k[p][q] += w * vp * vq;
+                }
+            }
+        }
+        // node `at` is unknown at - 1
+        let at = (z * n as f64).round() as usize;
+        let mut f = vec![0.0; m];
+        f[at - 1] += force;
+        f[at] += moment / (2.0 * dx);
+        f[at - 2] -= moment / (2.0 * dx);
+        let w = solve_dense(k, f);
+        (w[at] - w[at - 2]) / (2.0 * dx)
+    }
+
+    /// Eq. S9's flexibilities against an independent solution of the clamped-clamped beam
+    /// ([`finite_difference_slope`]) for a unit force and a unit moment at four points. The
+    /// finite differences err by `O(dx)` (the moment is a dipole over `2 dx`): extrapolated
+    /// from 200 and 400 intervals (Richardson, first order), they agree to 1e-3 relative; a
+    /// wrong coefficient or sign fails by far more.
+    #[test]
+    fn interior_flexibilities_match_a_finite_difference_beam() {
+        let (h, ei) = (0.004, 0.35);
+        for z in [0.1, 0.3, 0.5, 0.8] {
+            let (f_ut, f_tt) = interior_flexibilities(z, h, ei);
+            for (force, moment) in [(1.0, 0.0), (0.0, 1.0)] {
+                let coarse = finite_difference_slope(h, ei, 200, z, force, moment);
+                let fine = finite_difference_slope(h, ei, 400, z, force, moment);
+                let extrapolated = 2.0 * fine - coarse;
+                let want = force * f_ut + moment * f_tt;
+                let scale = f_tt * if force != 0.0 { h } else { 1.0 };
+                let rel = (extrapolated - want).abs() / scale;
+                eprintln!("z {z}, P {force}, C {moment}: {extrapolated:e} against {want:e}, {rel:.1e}");
+                assert!(
+                    rel <= 1e-3,
+                    "z = {z}, P = {force}, C = {moment}: finite differences {fine:e} (extrapolated {extrapolated:e}), Eq. S9 {want:e}"
+                );
+            }
+        }
+        assert_eq!(interior_flexibilities(0.0, h, ei), (0.0, 0.0));
+        assert_eq!(interior_flexibilities(1.0, h, ei).1, 0.0);
+    }
+
+    /// Gaussian elimination with partial pivoting (the test's small dense systems).
+    fn solve_dense(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
+        let n = b.len();
+        for c in 0..n {
+            let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs())).unwrap();
+            a.swap(c, p);
+            b.swap(c, p);
+            for r in c + 1..n {
+                let f = a[r][c] / a[c][c];
+                if f != 0.0 {
+                    for j in c..n {
+                        a[r][j] -= f * a[c][j];
+                    }
+                    b[r] -= f * b[c];
+                }
+            }
+        }
+        let mut x = vec![0.0; n];
+        for r in (0..n).rev() {
+            let s: f64 = (r + 1..n).map(|j| a[r][j] * x[j]).sum();
+            x[r] = (b[r] - s) / a[r][r];
+        }
+        x
     }
 
     #[test]

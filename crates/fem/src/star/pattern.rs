@@ -72,6 +72,13 @@ impl Star {
                 }
             }
         }
+        self.off_nu = slots.len();
+        for i in 0..3 {
+            let tangent = self.n_dof + ROWS * i + ROWS - 1;
+            for r in NU_COLUMNS {
+                slots.push((tangent, self.n_dof + ROWS * i + r));
+            }
+        }
         self.bordered = Some(Bordered::new(Layout {
             ne: self.ne,
             n_nodes: self.n_nodes,
@@ -81,6 +88,7 @@ impl Star {
             ncol: self.ncol_c,
             ww: self.ww,
             off_sl: self.direct.then_some(self.off_sl),
+            off_nu: self.off_nu,
         }));
         self.vals = vec![0.0; slots.len()];
         self.slots = slots;

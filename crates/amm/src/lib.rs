@@ -20,6 +20,7 @@
 
 pub mod adaptive;
 mod attach;
+mod compliance;
 mod constraint_lu;
 pub mod direct;
 pub mod error;

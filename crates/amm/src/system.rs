@@ -1040,14 +1040,39 @@ impl System {
         for i in 0..3 {
             let o = i * nb;
             let (alpha, u, thp) = (&q[o..o + nm], q[o + nm], q[o + nm + 1]);
-            for e in [-0.5 * lp, 0.0, 0.5 * lp] {
+            // the residual flexibility's deflection at the left edge, centre, right edge (Eq. R4)
+            let res = self.residual_deflection(i);
+            for (e, r) in [-0.5 * lp, 0.0, 0.5 * lp].into_iter().zip([res[2], res[0], res[1]]) {
                 self.modes.values_at(self.xp[i] - u + e, &mut v, None);
-                at_material = at_material.max((dot(&v, alpha) - e * thp).abs());
+                at_material = at_material.max((dot(&v, alpha) + r - e * thp).abs());
                 self.modes.values_at(self.xp[i] + e, &mut v, None);
                 at_rigid = at_rigid.max((dot(&v, alpha) - e * thp).abs());
             }
         }
         (at_material, at_rigid)
+    }
+
+    /// Eq. R4 (`docs/amm.md` 12): the deflection `sum_b R_ab lambda_b` that the modes left out
+    /// of the basis add at beam `i`'s sleeve under the multipliers of the last solve, for the
+    /// functionals `[w(xc), w(xc + Lp/2), w(xc - Lp/2), -w'(xc)]` [m, m, m, rad]; zeros without the
+    /// residual flexibility.
+    #[cfg(test)]
+    pub(crate) fn residual_deflection(&self, i: usize) -> [f64; 4] {
+        let mut out = [0.0; 4];
+        if self.compliance.is_none() {
+            return out;
+        }
+        let beam = &self.beams[i];
+        let mut force = [0.0; 4];
+        for (k, &g) in beam.ids.iter().enumerate() {
+            if (B_MID..=B_MSLOPE).contains(&beam.basis[k]) {
+                force[beam.basis[k] - B_MID] += beam.sc[k] * self.lam[g];
+            }
+        }
+        for (o, row) in out.iter_mut().zip(&beam.res) {
+            *o = row.iter().zip(&force).map(|(r, f)| r * f).sum();
+        }
+        out
     }
 
     /// The constraint Jacobian C (rows x 3 (N + 2), row-major) at the last sleeve update: the

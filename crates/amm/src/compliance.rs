@@ -16,48 +16,76 @@
 
 use flexstar_numerics::vector::dots;
 
-/// `[w(x), w'(x)]` of the free-free beam (length `l`, EI = 1, unit mass density) on its elastic
-/// subspace under a unit point force (`couple = false`) or a unit point couple (the functional
-/// `v -> v'(y)`, `couple = true`) at `y`, balanced by the rigid-body inertia it causes and made
-/// mass-orthogonal to the rigid motions (Eq. R2, `docs/amm.md` 12.1) [m/N, rad/N; m/(N m), rad/(N m)].
-fn free_free_response(l: f64, y: f64, couple: bool, x: f64) -> [f64; 2] {
-    let z = (x - y).max(0.0);
-    let r = l - y;
-    // the load delta - pi (force) or -delta' - d pi/dy (couple), pi(s, y) = a + b s; the
-    // particular solution P with the free conditions at 0 (hence at L), and its moments I0, I1
-    let (a, b, p, dp, i0, i1);
-    if couple {
-        a = -6.0 / (l * l);
-        b = 12.0 / (l * l * l);
-        p = -z * z / 2.0;
-        dp = -z;
-        i0 = -r.powi(3) / 6.0;
-        i1 = -r.powi(4) / 8.0 - y * r.powi(3) / 6.0;
-    } else {
-        a = (1.0 - 3.0 * (2.0 * y / l - 1.0)) / l;
-        b = 6.0 * (2.0 * y / l - 1.0) / (l * l);
-        p = z.powi(3) / 6.0;
-        dp = z * z / 2.0;
-        i0 = r.powi(4) / 24.0;
-        i1 = r.powi(5) / 30.0 + y * r.powi(4) / 24.0;
+/// The free-free beam (length `l`, EI = 1, unit mass density) on its elastic subspace under a
+/// unit point force (`couple = false`) or a unit point couple (the functional `v -> v'(y)`,
+/// `couple = true`) at `y`, balanced by the rigid-body inertia it causes and made
+/// mass-orthogonal to the rigid motions (Eq. R2, `docs/amm.md` 12.3): the particular solution
+/// `P(x) = s (x - y)_+^k / k! - a x^4 / 24 - b x^5 / 120` (k = 3, s = 1 for the force; k = 2,
+/// s = -1 for the couple) less its rigid part `c0 + c1 x`.
+struct GreenSource {
+    y: f64,
+    couple: bool,
+    a: f64,
+    b: f64,
+    c0: f64,
+    c1: f64,
+}
+
+impl GreenSource {
+    fn new(l: f64, y: f64, couple: bool) -> Self {
+        let r = l - y;
+        let (r2, l2) = (r * r, l * l);
+        let (r3, l4) = (r2 * r, l2 * l2);
+        // the load delta - pi (force) or -delta' - d pi/dy (couple), pi(s, y) = a + b s, and the
+        // moments int P, int x P of the particular solution
+        let (a, b, i0, i1) = if couple {
+            (-6.0 / l2, 12.0 / (l2 * l), -r3 / 6.0, -r3 * r / 8.0 - y * r3 / 6.0)
+        } else {
+            let e = 2.0 * y / l - 1.0;
+            (
+                (1.0 - 3.0 * e) / l,
+                6.0 * e / l2,
+                r3 * r / 24.0,
+                r3 * r2 / 30.0 + y * r3 * r / 24.0,
+            )
+        };
+        let l5 = l4 * l;
+        let i0 = i0 - a * l5 / 120.0 - b * l5 * l / 720.0;
+        let i1 = i1 - a * l5 * l / 144.0 - b * l5 * l2 / 840.0;
+        // remove the rigid part c0 + c1 x (L2 projection on 1, x; Gram determinant L^4 / 12)
+        let det = l4 / 12.0;
+        GreenSource {
+            y,
+            couple,
+            a,
+            b,
+            c0: (i0 * l2 * l / 3.0 - i1 * l2 / 2.0) / det,
+            c1: (i1 * l - i0 * l2 / 2.0) / det,
+        }
     }
-    let p = p - a * x.powi(4) / 24.0 - b * x.powi(5) / 120.0;
-    let dp = dp - a * x.powi(3) / 6.0 - b * x.powi(4) / 24.0;
-    let i0 = i0 - a * l.powi(5) / 120.0 - b * l.powi(6) / 720.0;
-    let i1 = i1 - a * l.powi(6) / 144.0 - b * l.powi(7) / 840.0;
-    // remove the rigid part c0 + c1 x (L2 projection on 1, x)
-    let det = l * l.powi(3) / 3.0 - l.powi(4) / 4.0;
-    let c0 = (i0 * l.powi(3) / 3.0 - i1 * l * l / 2.0) / det;
-    let c1 = (i1 * l - i0 * l * l / 2.0) / det;
-    [p - c0 - c1 * x, dp - c1]
+
+    /// `[w(x), w'(x)]` [m/N, rad/N for the force; m/(N m), rad/(N m) for the couple, times EI].
+    fn at(&self, x: f64) -> [f64; 2] {
+        let z = (x - self.y).max(0.0);
+        let (p, dp) = if self.couple {
+            (-z * z / 2.0, -z)
+        } else {
+            (z * z * z / 6.0, z * z / 2.0)
+        };
+        let x3 = x * x * x;
+        let p = p - x3 * x * (self.a / 24.0 + self.b * x / 120.0);
+        let dp = dp - x3 * (self.a / 6.0 + self.b * x / 24.0);
+        [p - self.c0 - self.c1 * x, dp - self.c1]
+    }
 }
 
 /// Eq. R2: the Green's function of the free-free beam on its elastic subspace (EI = 1, unit
 /// mass density, `h = sum_elastic phi_m(x) phi_m(y) / beta_m^4`) and its derivatives:
 /// `[h, dh/dx, dh/dy, d2h/dx dy]` at (x, y) in [0, L]^2.
+#[cfg(test)]
 pub(crate) fn free_free_green(l: f64, x: f64, y: f64) -> [f64; 4] {
-    let [h, hx] = free_free_response(l, y, false, x);
-    let [hy, hxy] = free_free_response(l, y, true, x);
+    let [h, hx] = GreenSource::new(l, y, false).at(x);
+    let [hy, hxy] = GreenSource::new(l, y, true).at(x);
     [h, hx, hy, hxy]
 }
 
@@ -108,14 +136,15 @@ impl SleeveCompliance {
             }
         }
         let mut r = [[0.0; 4]; 4];
-        for a in 0..4 {
-            let kept: [f64; 4] = dots(&self.scaled[a], v);
-            let (oa, da, sa) = FUNCTIONALS[a];
-            for b in a..4 {
-                let (ob, db, sb) = FUNCTIONALS[b];
-                let g = free_free_green(self.l, xc + oa * self.hp, xc + ob * self.hp);
-                let h = sa * sb * g[da + 2 * db];
-                let v = h * self.inv_ei - kept[b];
+        for b in 0..4 {
+            // the Green's function of source b (Eq. R2) read by the functionals a <= b
+            let (ob, db, sb) = FUNCTIONALS[b];
+            let src = GreenSource::new(self.l, xc + ob * self.hp, db == 1);
+            let kept: [f64; 4] = dots(&self.scaled[b], v);
+            for a in 0..=b {
+                let (oa, da, sa) = FUNCTIONALS[a];
+                let h = sa * sb * src.at(xc + oa * self.hp)[da];
+                let v = h * self.inv_ei - kept[a];
                 r[a][b] = v;
                 r[b][a] = v;
             }

@@ -31,7 +31,10 @@ fn residual_flexibility_removes_the_truncation_at_the_sleeves() {
     let between = point_evps(&coarse, &fine).unwrap().mean.unwrap();
     let e33 = point_evps(&coarse, &fem).unwrap();
     let e100 = point_evps(&fine, &fem).unwrap();
-    eprintln!("N = 33 vs 100: {between:.4} %; vs FEM: N = 33 {:?}, N = 100 {:?}", e33, e100);
+    eprintln!(
+        "N = 33 vs 100: {between:.4} %; vs FEM: N = 33 {:?}, N = 100 {:?}",
+        e33, e100
+    );
     // truncation: N = 46 and 100 differed by 0.9 % without the term
     assert!(between < 0.01, "N = 33 against N = 100: {between} %");
     for e in [e33, e100] {

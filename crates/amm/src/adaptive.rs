@@ -43,6 +43,16 @@ pub const ESTIMATE_STEP_FACTOR: f64 = 8.0;
 /// 8-21 % and their pair differences 0.87-0.99 times those at the delivered step (module docs).
 pub const MAX_ESTIMATE_TIME_ERROR: f64 = 10.0;
 
+/// Issue 21 (`docs/amm.md` 12.5): the time error of the coarse step over the time error of the
+/// delivered one, `E(8 h, h) / e(h)`, with which the reported estimate adds the delivered run's
+/// time error to its truncation. Measured (N = 33-46, e(h) against a run at h / 20 or finer, each
+/// at its tolerance step, equal steps on the coarse grid): 11.4 on robot 1 of issue 21 (at its
+/// step 2.1e-4 s), 30-46 on the paper's four cases and the other issue-21 robots, 46 and 62 on
+/// `brisk` and `smooth`. The time error is not in its asymptotic range at 8 h (part of it falls
+/// at first order in h), so no constant fits all: 25 keeps the time part at least 0.46 times the
+/// true one (robot 1) and at most 2.5 times (`smooth`).
+pub const TIME_ERROR_RATIO: f64 = 25.0;
+
 /// Fewest output rows of the estimate's coarse grid; shorter spans run their pairs at the
 /// delivered step.
 pub const MIN_ESTIMATE_ROWS: usize = 20;
@@ -155,6 +165,8 @@ where
     F: FnMut(usize, Pass) -> Result<Response, AmmError>,
 {
     let mut wall = 0.0;
+    // the delivered run's time error, E(K h, h) / TIME_ERROR_RATIO, where a coarse run exists
+    let mut time_part = 0.0;
     if let Some(every) = every {
         let pass = Pass::Estimate { every };
         let (n, estimate, coarse, pair_wall) = raise_until_below(exp, tol, pass, &mut run)?;
@@ -164,12 +176,15 @@ where
             .ok()
             .and_then(|e| e.mean)
             .unwrap_or(f64::INFINITY);
+        if time_error.is_finite() {
+            time_part = time_error / TIME_ERROR_RATIO;
+        }
         if time_error <= MAX_ESTIMATE_TIME_ERROR {
-            return Ok(finish(delivered, estimate, tol, wall));
+            return Ok(finish(delivered, estimate + time_part, tol, wall));
         }
     }
     let (_, estimate, delivered, pair_wall) = raise_until_below(exp, tol, Pass::Deliver, &mut run)?;
-    Ok(finish(delivered, estimate, tol, wall + pair_wall))
+    Ok(finish(delivered, estimate + time_part, tol, wall + pair_wall))
 }
 
 /// The delivered run with the automatic choice's report.
@@ -235,9 +250,11 @@ mod tests {
             assert_eq!(delivered, delivered_runs, "{passes:?}");
             assert_eq!(passes.iter().filter(|(_, p)| *p != Pass::Deliver).count(), 2);
             assert_eq!(r.len(), exp.time.output_times().len());
-            // Richardson is exact for the power law: 0.3 % (to the EVP's trapezoidal rule)
+            // Richardson is exact for the power law: 0.3 % (to the EVP's trapezoidal rule),
+            // plus the time part: the coarse run's time error over TIME_ERROR_RATIO
             let est = r.info.error_estimate_percent.unwrap();
-            assert!((est - 0.3).abs() < 0.01, "{est}");
+            let time_part = 100.0 * coarse_time_error / TIME_ERROR_RATIO;
+            assert!((est - 0.3 - time_part).abs() < 0.01 + 0.01 * time_part, "{est}");
         }
         // too short a span for 20 coarse rows: pairs at the delivered step
         let mut short = paper_case(3);

@@ -20,6 +20,7 @@
 
 pub mod adaptive;
 mod attach;
+mod compliance;
 mod constraint_lu;
 pub mod direct;
 pub mod error;
@@ -35,8 +36,8 @@ pub use direct::{solve_direct, solve_direct_checked, DIRECT_COLUMNS};
 pub use error::{AmmError, RankError};
 pub use modes::{ModeSet, MAX_MODES};
 pub use solver::{
-    parse_family, solve, solve_checked, solve_with_stats, tolerance_step, Stats, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF,
-    SHAPE_POINTS, TOLERANCE_DT,
+    beam_time_scale, parse_family, robot_step_factor, solve, solve_checked, solve_with_stats, tolerance_step, Stats,
+    DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS, TOLERANCE_DT,
 };
 
 /// What a mode family with a hidden support at G loses of the experiment's payload and load

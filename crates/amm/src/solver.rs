@@ -41,6 +41,20 @@ pub fn tolerance_step(tol: f64) -> f64 {
     (TOLERANCE_DT * (tol / flexstar_model::config::DEFAULT_TOL_PERCENT).sqrt()).min(2.0 * TOLERANCE_DT)
 }
 
+/// The beams' time scale `L^2 sqrt(rho / EI)` [s]: the period of every bending mode is
+/// `2 pi / (beta L)^2` times it (`docs/amm.md` 12.4).
+pub fn beam_time_scale(robot: &flexstar_model::RobotParams) -> f64 {
+    robot.l * robot.l * (robot.rho / robot.ei()).sqrt()
+}
+
+/// Issue 21 (`docs/amm.md` 12.4): the tolerance step on a robot whose beams are faster than the
+/// paper's scales with their time scale ([`beam_time_scale`]), so that its time error stays what
+/// [`TOLERANCE_DT`] gives on the paper's robot: the factor `min(1, T / T_paper)`; exactly 1 for
+/// the paper's robot and for slower beams.
+pub fn robot_step_factor(robot: &flexstar_model::RobotParams) -> f64 {
+    (beam_time_scale(robot) / beam_time_scale(&flexstar_model::RobotParams::paper())).min(1.0)
+}
+
 /// Spectral radius at infinity of the generalized-alpha scheme: mild damping of the unresolved
 /// high modes and of the multiplier oscillations of index-3 schemes (`docs/amm.md`).
 pub const RHO_INF: f64 = 0.8;
@@ -97,7 +111,7 @@ pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, s
             dt
         }
         None => match settings.mode_count() {
-            ModeCount::Tolerance(tol) => tolerance_step(tol),
+            ModeCount::Tolerance(tol) => tolerance_step(tol) * robot_step_factor(&exp.robot),
             ModeCount::Fixed(_) => DEFAULT_DT,
         }
         .min(exp.time.dt_out),

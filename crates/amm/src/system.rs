@@ -21,9 +21,10 @@
 //! are eliminated by the Schur complement `A = C S^-1 C^T`, a small dense LU per step.
 
 use flexstar_kinematics::RigidState;
-use flexstar_model::{AmmModel, Damping, LoadSettings, Payload, RobotParams};
+use flexstar_model::{AmmModel, Damping, LoadSettings, ModeFamily, Payload, RobotParams};
 
 use crate::attach::{Mat3, PayloadTerms, RigidTerms};
+use crate::compliance::SleeveCompliance;
 use crate::constraint_lu::ConstraintLu;
 use crate::error::{AmmError, RankError};
 use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
@@ -100,6 +101,9 @@ struct BeamRows {
     bent: SleeveBending,
     /// `B_a . D^-1 Phi`.
     g: [f64; NB],
+    /// Full model, enriched family: the residual flexibility `R_ab` of the sleeve rows (Eq. R3,
+    /// `docs/amm.md` 12), a, b over `B_MID..=B_MSLOPE`, at the last sleeve update.
+    res: [[f64; 4]; 4],
 }
 
 impl BeamRows {
@@ -246,6 +250,9 @@ pub(crate) struct System {
     xp: [f64; 3],
     /// Full model: the foreshortening inertia of the bent beams in the u rows (`foreshortening`).
     fore: Option<Foreshortening>,
+    /// Full model, enriched family: the residual flexibility of the sleeves (Eqs. R3-R4,
+    /// `docs/amm.md` 12); `None` otherwise.
+    compliance: Option<SleeveCompliance>,
     // arrowhead data of S (the same for the three beams)
     inv_d: Vec<f64>,
     w: Vec<f64>,
@@ -352,6 +359,7 @@ fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize, n_bent: usize) -> [
         gram: [[0.0; NB]; NB],
         bent: SleeveBending::new(n_bent),
         g: [0.0; NB],
+        res: [[0.0; 4]; 4],
     });
     for (k, row) in rows.iter().enumerate() {
         for (b, beam) in beams.iter_mut().enumerate() {
@@ -404,8 +412,11 @@ impl System {
             }
             AmmModel::Paper => (None, None),
         };
+        let compliance = (model == AmmModel::Full && modes.family() == ModeFamily::Enriched)
+            .then(|| SleeveCompliance::new(l, hp, params.ei(), params.rho, modes.lambda()));
         System {
             fore,
+            compliance,
             model,
             geometric,
             sleeve_axial: [[0.0; 3]; 3],
@@ -511,6 +522,35 @@ impl System {
                 self.sleeve_axial[i] = [-slope_mid, -slope_right, -slope_left];
             }
             mslope.iter_mut().for_each(|v| *v = -*v);
+            if let Some(c) = self.compliance.as_mut() {
+                beam.res = c.block(x - u_hat, [mid, right, left, mslope]);
+            }
+        }
+    }
+
+    /// Eq. R4 (`docs/amm.md` 12): the residual flexibility of the sleeve rows, `R / bp` on their
+    /// block of the Schur complement (`C q + R lambda = 0` at `q = qhat + bp qdd`). No-op without
+    /// it, and for the consistent initial accelerations (`bp = 0`: the rows hold at rest).
+    fn add_compliance(&mut self, bp: f64) {
+        if self.compliance.is_none() || bp <= 0.0 {
+            return;
+        }
+        let m = self.rows.len();
+        for beam in &self.beams {
+            // the (global row, sleeve functional, factor) of the beam's four sleeve rows
+            let mut sleeve = [(0, 0, 0.0); 4];
+            let mut n = 0;
+            for k in 0..beam.ids.len() {
+                if (B_MID..=B_MSLOPE).contains(&beam.basis[k]) && n < 4 {
+                    sleeve[n] = (beam.ids[k], beam.basis[k] - B_MID, beam.sc[k]);
+                    n += 1;
+                }
+            }
+            for &(gk, a, sk) in &sleeve[..n] {
+                for &(gs, b, ss) in &sleeve[..n] {
+                    self.a[gk * m + gs] += sk * ss * beam.res[a][b] / bp;
+                }
+            }
         }
     }
 
@@ -808,6 +848,7 @@ impl System {
             beam.fill_gram([g00, g01, g11], [w0, w1], inv_d, [phi0, dphi0, phi]);
             beam.add_block(a_mat, m, p, inv_sigma, inv_jp);
         }
+        self.add_compliance(bp);
         if self.payload.is_some() {
             self.payload_block(st, Self::payload_motion(st), bp, gp)?;
         }
@@ -999,14 +1040,39 @@ impl System {
         for i in 0..3 {
             let o = i * nb;
             let (alpha, u, thp) = (&q[o..o + nm], q[o + nm], q[o + nm + 1]);
-            for e in [-0.5 * lp, 0.0, 0.5 * lp] {
+            // the residual flexibility's deflection at the left edge, centre, right edge (Eq. R4)
+            let res = self.residual_deflection(i);
+            for (e, r) in [-0.5 * lp, 0.0, 0.5 * lp].into_iter().zip([res[2], res[0], res[1]]) {
                 self.modes.values_at(self.xp[i] - u + e, &mut v, None);
-                at_material = at_material.max((dot(&v, alpha) - e * thp).abs());
+                at_material = at_material.max((dot(&v, alpha) + r - e * thp).abs());
                 self.modes.values_at(self.xp[i] + e, &mut v, None);
                 at_rigid = at_rigid.max((dot(&v, alpha) - e * thp).abs());
             }
         }
         (at_material, at_rigid)
+    }
+
+    /// Eq. R4 (`docs/amm.md` 12): the deflection `sum_b R_ab lambda_b` that the modes left out
+    /// of the basis add at beam `i`'s sleeve under the multipliers of the last solve, for the
+    /// functionals `[w(xc), w(xc + Lp/2), w(xc - Lp/2), -w'(xc)]` [m, m, m, rad]; zeros without the
+    /// residual flexibility.
+    #[cfg(test)]
+    pub(crate) fn residual_deflection(&self, i: usize) -> [f64; 4] {
+        let mut out = [0.0; 4];
+        if self.compliance.is_none() {
+            return out;
+        }
+        let beam = &self.beams[i];
+        let mut force = [0.0; 4];
+        for (k, &g) in beam.ids.iter().enumerate() {
+            if (B_MID..=B_MSLOPE).contains(&beam.basis[k]) {
+                force[beam.basis[k] - B_MID] += beam.sc[k] * self.lam[g];
+            }
+        }
+        for (o, row) in out.iter_mut().zip(&beam.res) {
+            *o = row.iter().zip(&force).map(|(r, f)| r * f).sum();
+        }
+        out
     }
 
     /// The constraint Jacobian C (rows x 3 (N + 2), row-major) at the last sleeve update: the

@@ -823,3 +823,55 @@ fn compare_of_a_forces_drive_says_what_its_force_figure_draws() {
         "{md}"
     );
 }
+
+/// The validated envelope (issue 21 item 3, docs/validation.md section 8): an AMM run of the
+/// accurate model on the paper's robot is inside; the paper's equations, or a robot whose sleeve
+/// inertia lies beyond the envelope's range, are outside, with the reasons in the sidecar and a
+/// note on stderr (the value of Jp/(rho L^3) computed here from the robot's own numbers).
+#[test]
+fn the_sidecar_says_whether_the_run_lies_in_the_validated_envelope() {
+    let out = tempfile::tempdir().unwrap();
+    let base = "[time]\nt_end = 0.05\ndt_out = 0.001\n[trajectory]\nkind = \"polynomial\"\ns1 = [0.0, 0.0, 1.0]\ns2 = [0.0]\ns3 = [0.0, 0.0, 0.5]\n";
+    let cases = [
+        ("inside", "", true, None),
+        (
+            "paper-model",
+            "[amm]\nfamily = \"free-free\"\nmodel = \"paper\"\nmodes = 10\n",
+            false,
+            Some("free-free, paper"),
+        ),
+        // Jp / (rho L^3) = 0.01 / (0.234 * 0.5^3) = 0.342, beyond the range's 0.1
+        (
+            "heavy-sleeve",
+            "[robot]\nJp = 0.01\n",
+            false,
+            Some("Jp/(rho L^3) = 0.3419"),
+        ),
+    ];
+    for (name, extra, inside, reason) in cases {
+        let cfg = out.path().join(format!("{name}.toml"));
+        std::fs::write(&cfg, format!("name = \"{name}\"\n{base}{extra}")).unwrap();
+        let o = flexstar(&[
+            "run",
+            cfg.to_str().unwrap(),
+            "--solver",
+            "amm",
+            "--out",
+            out.path().to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let dir = out.path().join(name);
+        let json = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.extension().is_some_and(|x| x == "json"))
+            .unwrap();
+        let meta: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+        assert_eq!(meta["validated_envelope"], inside, "{name}: {meta:#}");
+        let reasons = meta["validated_envelope_reasons"].to_string();
+        assert_eq!(stderr(&o).contains("outside the validated envelope"), !inside, "{name}");
+        if let Some(r) = reason {
+            assert!(reasons.contains(r), "{name}: {reasons}");
+        }
+    }
+}

@@ -91,6 +91,7 @@ pub fn run_compare(opts: &CompareOptions, progress: Option<ProgressFn>) -> Resul
     let spec = CaseSpec {
         amm: compare_runs(&exp, &opts.families, opts.modes),
         extra: Vec::new(),
+        reference: None,
         exp,
     };
     let checked = preflight(std::slice::from_ref(&spec))?;

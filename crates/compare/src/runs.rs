@@ -61,6 +61,9 @@ pub struct CaseSpec {
     pub amm: Vec<AmmRun>,
     /// Further AMM runs reported as mean EVPs only (the N study of `verify`).
     pub extra: Vec<AmmRun>,
+    /// A refined FEM that error estimates are judged against (`verify`, issue 21 item 3: the
+    /// estimate is compared with the true EVP against the converged FEM); `None`: no such run.
+    pub reference: Option<flexstar_model::FemSettings>,
 }
 
 /// Solver results of one experiment.
@@ -75,6 +78,8 @@ pub struct CaseResults {
     pub amm: Vec<(AmmRun, Response)>,
     /// The further runs of [`CaseSpec::extra`].
     pub extra: Vec<(AmmRun, Response)>,
+    /// The run of [`CaseSpec::reference`].
+    pub fem_reference: Option<Response>,
 }
 
 /// Errors that stop the runs (each names the experiment file).
@@ -237,6 +242,8 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
 
 enum Job {
     Fem(usize),
+    /// The refined FEM of [`CaseSpec::reference`].
+    Reference(usize),
     Amm(usize, usize),
     Extra(usize, usize),
 }
@@ -244,6 +251,8 @@ enum Job {
 /// Weight of a FEM run in the progress fraction, against 1 for an AMM run (the FEM takes about
 /// twenty times as long as one AMM run at the paper's settings).
 const FEM_WEIGHT: f64 = 20.0;
+/// Weight of the refined reference FEM (four times the elements, an eighth of the step).
+const REFERENCE_WEIGHT: f64 = 32.0 * FEM_WEIGHT;
 
 struct Tracker<'a> {
     start: Instant,
@@ -307,11 +316,9 @@ fn run_error(file: String, label: &str, e: SolveError) -> RunError {
     }
 }
 
-/// Run every FEM and AMM run of the experiments that passed [`preflight`], in parallel. Results
-/// come back in the order of the specs.
-pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<CaseResults>, RunError> {
-    let specs = checked.specs();
-    // AMM runs first: they are short, and a failing one stops the batch early
+/// The jobs of a batch: AMM runs first (they are short, and a failing one stops the batch
+/// early), then the further runs, the FEM runs and the refined references.
+fn jobs_of(specs: &[CaseSpec]) -> Vec<Job> {
     let mut jobs = Vec::new();
     for (k, s) in specs.iter().enumerate() {
         jobs.extend((0..s.amm.len()).map(|j| Job::Amm(k, j)));
@@ -320,12 +327,54 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
         jobs.extend((0..s.extra.len()).map(|j| Job::Extra(k, j)));
     }
     jobs.extend((0..specs.len()).map(Job::Fem));
+    jobs.extend(
+        (0..specs.len())
+            .filter(|k| specs[*k].reference.is_some())
+            .map(Job::Reference),
+    );
+    jobs
+}
+
+/// The results of the jobs, sorted into their cases.
+fn assemble(specs: &[CaseSpec], jobs: &[Job], results: Vec<Response>) -> Vec<CaseResults> {
+    let mut cases: Vec<CaseResults> = specs
+        .iter()
+        .map(|s| CaseResults {
+            name: s.exp.name.clone(),
+            description: s.exp.description.clone(),
+            beam_length: s.exp.robot.l,
+            fem: Response::default(),
+            amm: Vec::new(),
+            extra: Vec::new(),
+            fem_reference: None,
+        })
+        .collect();
+    for (job, r) in jobs.iter().zip(results) {
+        match *job {
+            Job::Fem(k) => cases[k].fem = r,
+            Job::Reference(k) => cases[k].fem_reference = Some(r),
+            Job::Amm(k, i) => cases[k].amm.push((specs[k].amm[i].clone(), r)),
+            Job::Extra(k, i) => cases[k].extra.push((specs[k].extra[i].clone(), r)),
+        }
+    }
+    cases
+}
+
+/// Run every FEM and AMM run of the experiments that passed [`preflight`], in parallel. Results
+/// come back in the order of the specs.
+pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<CaseResults>, RunError> {
+    let specs = checked.specs();
+    let jobs = jobs_of(specs);
     let tracker = Tracker {
         start: Instant::now(),
         total: jobs.len(),
         weights: jobs
             .iter()
-            .map(|j| if matches!(j, Job::Fem(_)) { FEM_WEIGHT } else { 1.0 })
+            .map(|j| match j {
+                Job::Fem(_) => FEM_WEIGHT,
+                Job::Reference(_) => REFERENCE_WEIGHT,
+                _ => 1.0,
+            })
             .collect(),
         done: AtomicUsize::new(0),
         fractions: (0..jobs.len()).map(|_| AtomicU64::new(0)).collect(),
@@ -346,6 +395,13 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
                     solve_fem(exp, &exp.fem, Some(&checked.motions[k]), Some(&tick))
                         .map_err(|e| run_error(file(k), "fem", e))
                 }
+                Job::Reference(k) => {
+                    let exp = &specs[k].exp;
+                    let settings = specs[k].reference.as_ref().unwrap_or(&exp.fem);
+                    let tick = |f: f64| tracker.set(j, f, false);
+                    solve_fem(exp, settings, Some(&checked.motions[k]), Some(&tick))
+                        .map_err(|e| run_error(file(k), "fem (refined reference)", e))
+                }
                 Job::Amm(k, i) | Job::Extra(k, i) => {
                     let run = match job {
                         Job::Amm(..) => &specs[k].amm[i],
@@ -360,23 +416,5 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
         })
         .collect::<Result<_, RunError>>()?;
 
-    let mut cases: Vec<CaseResults> = specs
-        .iter()
-        .map(|s| CaseResults {
-            name: s.exp.name.clone(),
-            description: s.exp.description.clone(),
-            beam_length: s.exp.robot.l,
-            fem: Response::default(),
-            amm: Vec::new(),
-            extra: Vec::new(),
-        })
-        .collect();
-    for (job, r) in jobs.iter().zip(results) {
-        match *job {
-            Job::Fem(k) => cases[k].fem = r,
-            Job::Amm(k, i) => cases[k].amm.push((specs[k].amm[i].clone(), r)),
-            Job::Extra(k, i) => cases[k].extra.push((specs[k].extra[i].clone(), r)),
-        }
-    }
-    Ok(cases)
+    Ok(assemble(specs, &jobs, results))
 }

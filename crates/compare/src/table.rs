@@ -25,6 +25,9 @@ pub struct FamilyEntry {
     /// The run's own estimate of its truncation EVP [%] (automatic N only; `docs/amm.md` section 9).
     pub error_estimate: Option<f64>,
     pub evp: PointEvps,
+    /// The EVPs against the refined reference FEM (`verify`: runs with an estimate only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub evp_reference: Option<PointEvps>,
     pub correct: bool,
     pub most_accurate: bool,
 }
@@ -84,6 +87,10 @@ impl TableRow {
         let mut families = Vec::new();
         for (run, r) in &case.amm {
             let evp = point_evps(r, &case.fem)?;
+            let evp_reference = match (&case.fem_reference, r.info.error_estimate_percent) {
+                (Some(reference), Some(_)) => Some(point_evps(r, reference)?),
+                _ => None,
+            };
             let family = run.settings.family;
             families.push(FamilyEntry {
                 label: run.label.clone(),
@@ -92,6 +99,7 @@ impl TableRow {
                 modes_used: r.info.modes,
                 error_estimate: r.info.error_estimate_percent,
                 evp,
+                evp_reference,
                 correct: is_correct(family, behaviour),
                 most_accurate: false,
             });
@@ -506,6 +514,7 @@ mod tests {
                 modes: Some(4),
                 modes_used: Some(4),
                 error_estimate: None,
+                evp_reference: None,
                 evp: PointEvps {
                     points: [Some(1.5), None, Some(2.0), Some(0.25)],
                     mean: Some(1.25),

@@ -8,9 +8,19 @@
 //!
 //! The ranges are those the study draws from (a change here is a change there, and the
 //! published table in `docs/validation.md` must be remade).
+//!
+//! **Status** ([`ENVELOPE_MET`]): the study's first draw (`docs/validation.md` section 8) does
+//! not meet the targets on every case, so no robot is yet called validated by the envelope; the
+//! paper's robot is, by `flexstar verify`'s four cases and the motions of `tests/cross_models.rs`
+//! (an AMM run on it, in range, gets `validated_envelope: true`). Every other run gets `false`
+//! with the reason, and the envelope's ranges tell how far it lies from the validated region.
 
 use crate::config::{AmmModel, ModeFamily};
 use crate::params::RobotParams;
+
+/// Does the envelope study meet its targets on every case (`docs/validation.md` section 8)? Not
+/// yet: until it does, only the paper's robot counts as validated.
+pub const ENVELOPE_MET: bool = false;
 
 /// One range of the envelope: the group's name, how it is computed, its bounds.
 struct Range {
@@ -80,6 +90,13 @@ pub fn outside_envelope(
             }
         ));
     }
+    if !ENVELOPE_MET && *params != RobotParams::default() {
+        why.push(
+            "the envelope study does not yet meet its targets on every robot (docs/validation.md section 8): \
+             only the paper's robot is validated"
+                .into(),
+        );
+    }
     for r in &RANGES {
         let v = (r.value)(params);
         // a relative slack of 1e-9 keeps the bounds themselves inside
@@ -103,9 +120,9 @@ pub fn outside_envelope(
 mod tests {
     use super::*;
 
-    /// The paper's robot lies outside the envelope on one group only (its EI = 0.5 N m^2 is
-    /// inside, its L = 0.5 m inside, its Jp/(rho L^3) = 2e-4 / (0.234 0.125) = 0.00684 inside,
-    /// its Lp/L = 0.06 inside): it is inside; a light, sleeve-heavy robot is not.
+    /// The paper's robot lies inside every range (EI = 0.5 N m^2, L = 0.5 m, Jp/(rho L^3) =
+    /// 2e-4 / (0.234 0.125) = 0.00684, Lp/L = 0.06, mpp_mpa = 0.2 kg, rho = 0.234 kg/m): it is
+    /// validated; a sleeve-heavy robot is not, and the range it leaves is named.
     #[test]
     fn the_paper_robot_is_inside_and_an_extreme_one_is_not() {
         let paper = RobotParams::default();
@@ -115,8 +132,8 @@ mod tests {
             ..paper
         };
         let why = outside_envelope(&heavy, AmmModel::Full, ModeFamily::Enriched, false, true);
-        assert_eq!(why.len(), 1, "{why:?}");
-        assert!(why[0].contains("Jp/(rho L^3) = 0.5000"), "{why:?}");
+        assert_eq!(why.len(), if ENVELOPE_MET { 1 } else { 2 }, "{why:?}");
+        assert!(why.iter().any(|w| w.contains("Jp/(rho L^3) = 0.5000")), "{why:?}");
         let why = outside_envelope(&paper, AmmModel::Paper, ModeFamily::FreeFree, false, false);
         assert_eq!(why.len(), 2, "{why:?}");
     }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::{flexstar, stderr};
+use common::{flexstar, run_solver, stderr};
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -851,14 +851,7 @@ fn the_sidecar_says_whether_the_run_lies_in_the_validated_envelope() {
     for (name, extra, inside, reason) in cases {
         let cfg = out.path().join(format!("{name}.toml"));
         std::fs::write(&cfg, format!("name = \"{name}\"\n{base}{extra}")).unwrap();
-        let o = flexstar(&[
-            "run",
-            cfg.to_str().unwrap(),
-            "--solver",
-            "amm",
-            "--out",
-            out.path().to_str().unwrap(),
-        ]);
+        let o = run_solver(&cfg, "amm", out.path());
         assert!(o.status.success(), "{}", stderr(&o));
         let dir = out.path().join(name);
         let json = std::fs::read_dir(&dir)

@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{col, flexstar, stderr, table};
+use common::{col, flexstar, run_solver, stderr, table};
 
 /// The brisk move (configs/motions/brisk.toml: 10 mm and -0.06 rad in 0.2 s) with 0.9 s of time.
 const BASE: &str = r#"
@@ -256,14 +256,7 @@ fn auto_shaping_is_refused_with_a_servo() {
         "servo-auto",
         &format!("{servo}[shaper]\nkind = \"zvd\"\nf_hz = \"auto\"\n"),
     );
-    let o = flexstar(&[
-        "run",
-        cfg.to_str().unwrap(),
-        "--solver",
-        "amm",
-        "--out",
-        out.path().to_str().unwrap(),
-    ]);
+    let o = run_solver(&cfg, "amm", out.path());
     let err = stderr(&o);
     assert!(
         !o.status.success() && err.contains("servo-auto.toml") && err.contains("shaper.f_hz"),
@@ -276,13 +269,6 @@ fn auto_shaping_is_refused_with_a_servo() {
         "servo-given",
         &format!("{servo}[shaper]\nkind = \"zvd\"\nf_hz = 3.9\n"),
     );
-    let o = flexstar(&[
-        "run",
-        given.to_str().unwrap(),
-        "--solver",
-        "amm",
-        "--out",
-        out.path().to_str().unwrap(),
-    ]);
+    let o = run_solver(&given, "amm", out.path());
     assert!(o.status.success(), "{}", stderr(&o));
 }

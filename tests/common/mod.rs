@@ -15,6 +15,18 @@ pub fn flexstar(args: &[&str]) -> Output {
         .expect("flexstar runs")
 }
 
+/// `flexstar run CONFIG --solver SOLVER --out OUT`.
+pub fn run_solver(config: &Path, solver: &str, out: &Path) -> Output {
+    flexstar(&[
+        "run",
+        config.to_str().unwrap(),
+        "--solver",
+        solver,
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
 /// The run's standard error as text.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

@@ -210,6 +210,14 @@ impl ShaperSection {
         }
     }
 
+    /// A section with `kind` and `f_hz = "auto"` (docs/motions.md 3.5), nothing resolved yet.
+    pub fn auto(kind: ShaperKind) -> Self {
+        ShaperSection {
+            f_hz: toml::Value::String("auto".into()),
+            ..Self::new(kind, &[])
+        }
+    }
+
     /// `f_hz` checked: `"auto"` or positive finite numbers (keys `shaper.f_hz`).
     pub fn frequency_spec(&self) -> Result<FrequencySpec, ModelError> {
         let bad = |got: String| {

@@ -183,17 +183,7 @@ pub fn zvd_experiment(exp: &Experiment, base: Trajectory) -> Result<Experiment, 
     let mut x = exp.clone();
     let t_base = base.t_rest().unwrap_or(0.0);
     x.trajectory = base;
-    x.shaper = Some(ShaperSection {
-        kind: ShaperKind::Zvd,
-        f_hz: toml::Value::String("auto".into()),
-        zeta: None,
-        v_tol: None,
-        frequencies_hz: Vec::new(),
-        zeta_used: Vec::new(),
-        impulses: Vec::new(),
-        penalty_s: 0.0,
-        auto: None,
-    });
+    x.shaper = Some(ShaperSection::auto(ShaperKind::Zvd));
     x.apply_shaper()
         .map_err(|e| PlanError::Solver(format!("the ZVD-shaped quintic: {}", e.detail())))?;
     let t_rest = x.trajectory.t_rest().unwrap_or(f64::INFINITY);

@@ -9,6 +9,7 @@ use serde_json::{json, Value};
 use flexstar_model::residual::dg_magnitude;
 use flexstar_model::{Experiment, Response};
 use flexstar_plan::limits::{kinematic_peaks, Peak};
+use flexstar_plan::objective::force_peak;
 use flexstar_plan::PlanConfig;
 use flexstar_plot::{Figure, Panel, Series, Style, FAMILY_COLORS, FEM_STYLE, MARK_STYLE};
 
@@ -41,17 +42,12 @@ pub struct MotionRow {
     pub penalty_s: Option<f64>,
 }
 
-/// Peak |Fa_i| [N] of a run.
-fn fa_peak(r: &Response) -> f64 {
-    r.fa.iter().flatten().fold(0.0, |m: f64, v| m.max(v.abs()))
-}
-
 /// The row of one motion.
 pub fn motion_row(m: &MotionRuns) -> MotionRow {
     let key = |o: &crate::run::RunOutcome, k: &str| o.meta[k].as_f64();
     let both = |k: &str| [key(&m.amm, k), key(&m.fem, k)];
     let t_rest = m.exp.trajectory.t_rest().unwrap_or(f64::NAN);
-    let t0 = first_time(&m.exp);
+    let t0 = m.exp.trajectory.t_start();
     let (v, a) = kinematic_peaks(&m.exp.robot, &m.exp.trajectory, (t0, t_rest), m.exp.time.dt_out, &[])
         .unwrap_or((zero_peak(), zero_peak()));
     let g = both("residual_G_peak_m");
@@ -65,7 +61,7 @@ pub fn motion_row(m: &MotionRuns) -> MotionRow {
         tip_peak_m: both("residual_tip_peak_m"),
         tip_rms_m: both("residual_tip_rms_m"),
         settle_s: both("settle_s"),
-        fa_peak_n: [fa_peak(&m.amm.response), fa_peak(&m.fem.response)],
+        fa_peak_n: [force_peak(&m.amm.response).value, force_peak(&m.fem.response).value],
         v_peak: v.value,
         a_peak: a.value,
         g_peak_diff_percent: match g {
@@ -83,20 +79,6 @@ fn zero_peak() -> Peak {
         slider: 1,
         t: 0.0,
     }
-}
-
-/// Start of a motion [s]: the quintic's `t0`, a table's first row, a shaped motion's base's.
-fn first_time(exp: &Experiment) -> f64 {
-    fn of(t: &flexstar_model::Trajectory) -> f64 {
-        match t {
-            flexstar_model::Trajectory::Quintic { t0, .. } => *t0,
-            flexstar_model::Trajectory::Table(tab) => tab.data.as_ref().map_or(0.0, |d| d.t[0]),
-            flexstar_model::Trajectory::Shaped(s) => of(&s.base),
-            flexstar_model::Trajectory::Via(v) => v.points.first().map_or(0.0, |p| p.t),
-            flexstar_model::Trajectory::Polynomial { .. } => 0.0,
-        }
-    }
-    of(&exp.trajectory)
 }
 
 /// `plan.json`: the problem, the limits, N, the family and its via points, the search, the

@@ -249,6 +249,18 @@ impl Trajectory {
         })
     }
 
+    /// Start of a rest-to-rest motion [s]: a quintic's `t0`, the first via point's or table
+    /// row's `t`, a shaped motion's base's; 0 for a polynomial (it moves from t = 0).
+    pub fn t_start(&self) -> f64 {
+        match self {
+            Trajectory::Polynomial { .. } => 0.0,
+            Trajectory::Quintic { t0, .. } => *t0,
+            Trajectory::Via(v) => v.points.first().map_or(0.0, |p| p.t),
+            Trajectory::Table(tab) => tab.data.as_ref().and_then(|d| d.t.first().copied()).unwrap_or(0.0),
+            Trajectory::Shaped(sh) => sh.base.t_start(),
+        }
+    }
+
     /// End of the motion `t_rest` [s] (`docs/motions.md` section 1.5): the time after which a
     /// rest-to-rest kind holds still: `t1` of a quintic, the last via point's `t`, the last table
     /// row's `t`; `None` for a polynomial (it never comes to rest) and for a table not yet read.

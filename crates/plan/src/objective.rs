@@ -127,7 +127,7 @@ impl Evaluator {
     /// the residual vector, the peaks (`knots`: extra sample times of the kinematic peaks).
     pub fn eval(&self, traj: &Trajectory, t_rest: f64, knots: &[f64]) -> Result<Eval, Rejected> {
         let resp = self.run(traj, t_rest + self.window)?;
-        let t0 = traj_start(traj);
+        let t0 = traj.t_start();
         let jets = slider_samples(&self.exp.robot, traj, (t0, t_rest), self.exp.time.dt_out, knots)
             .map_err(|e| Rejected::Infeasible(e.to_string()))?;
         let (v, a) = crate::limits::peaks_of(&jets);
@@ -159,15 +159,6 @@ impl Evaluator {
     /// The experiment the evaluator runs (its trajectory is replaced per run).
     pub fn experiment(&self) -> &Experiment {
         &self.exp
-    }
-}
-
-/// The start of a planned or quintic motion [s] (0 for other kinds).
-fn traj_start(traj: &Trajectory) -> f64 {
-    match traj {
-        Trajectory::Quintic { t0, .. } => *t0,
-        Trajectory::Via(v) => v.points.first().map_or(0.0, |p| p.t),
-        _ => 0.0,
     }
 }
 

@@ -83,27 +83,12 @@ pub fn verify_spec(exp: Experiment, modes: usize, n_study: &[usize]) -> CaseSpec
                 .collect::<Vec<_>>()
         })
         .collect();
-    let reference = Some(reference_fem(&exp));
+    let reference = Some(crate::runs::reference_fem(&exp));
     CaseSpec {
         exp,
         amm,
         extra,
         reference,
-    }
-}
-
-/// The refined FEM the accurate model's error estimate is judged against (issue 21 item 3:
-/// "never below half the true EVP against the converged FEM"): four times the elements and an
-/// eighth of the default step. *Measured* on case 4, the accurate model's mean EVP against it is
-/// 0.1273 % (0.1218 % at a quarter of the step, 0.2 % at the default FEM: the reference's own
-/// error is of the size of the model's), about 2 % below the Richardson limit of the two.
-pub fn reference_fem(exp: &Experiment) -> flexstar_model::FemSettings {
-    flexstar_model::FemSettings {
-        elements: 4 * exp.fem.elements,
-        dt: Some(exp.fem.dt.unwrap_or_else(|| flexstar_fem::default_dt(&exp.robot)) / 8.0),
-        snapshots: Vec::new(),
-        frames: 0,
-        ..exp.fem.clone()
     }
 }
 

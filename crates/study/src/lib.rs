@@ -33,4 +33,4 @@ pub use report::write_report;
 pub use run::{run_study, RunOptions, RunOutcome};
 pub use sample::Case;
 pub use shard::Shard;
-pub use spec::{Sampling, Solver, Study};
+pub use spec::{FemReference, Sampling, Solver, Study};

@@ -51,8 +51,8 @@ pub fn residual_columns(
     }
 }
 
-/// Mean EVP [%] of the AMM against the FEM of the same case over the points A, B, C, G that have
-/// one (Eq. 45, the mean of Table I; `flexstar_compare::point_evps`).
-pub fn mean_evp(amm: &Response, fem: &Response) -> Option<f64> {
-    flexstar_compare::point_evps(amm, fem).ok().and_then(|e| e.mean)
+/// Largest point EVP [%] over A, B, C, G of the points that have one (Eq. 45; issue 21 item 4's
+/// "largest point"); `None` when no point has one.
+pub fn largest_point_evp(e: &flexstar_compare::PointEvps) -> Option<f64> {
+    e.points.iter().flatten().copied().reduce(f64::max)
 }

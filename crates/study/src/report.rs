@@ -22,6 +22,7 @@ pub fn metric_labels() -> Vec<(&'static str, &'static str)> {
         ("peak_wG_m", "peak |w_iG| [m]"),
         ("peak_Fa_N", "peak |Fa_i| [N]"),
         ("evp_percent", "mean EVP of the AMM vs FEM [%]"),
+        ("evp_max_percent", "largest point EVP of the AMM vs FEM [%]"),
         ("residual_tip_m", "residual |w_i(L)| after the motion [m]"),
         ("residual_G_m", "residual |dG| after the motion [m]"),
         ("settle_s", "settling time, absolute (not settled: not drawn) [s]"),

@@ -14,11 +14,11 @@ use flexstar_model::{Experiment, Response};
 use rayon::prelude::*;
 
 use crate::error::StudyError;
-use crate::metrics::{mean_evp, peaks, residual_columns};
+use crate::metrics::{largest_point_evp, peaks, residual_columns};
 use crate::patch::value_text;
 use crate::sample::Case;
 use crate::shard::{meta_file, results_file, write_pair, Meta, Shard};
-use crate::spec::{Sampling, Solver, Study};
+use crate::spec::{FemReference, Sampling, Solver, Study};
 use crate::table::{header, records_bytes, Row, Table, OK};
 
 /// Where and how to run.
@@ -257,12 +257,16 @@ enum Failure {
     Panicked(String),
 }
 
-fn solve(exp: &Experiment, solver: Solver) -> Solved {
+fn solve(exp: &Experiment, solver: Solver, fem_reference: FemReference) -> Solved {
     let started = Instant::now();
+    let fem = match fem_reference {
+        FemReference::Defaults => exp.fem.clone(),
+        FemReference::Refined => flexstar_compare::runs::reference_fem(exp),
+    };
     let result = catch_unwind(AssertUnwindSafe(|| match solver {
         // each solver scans the case's motion itself: a case's solvers may run in different shards
         Solver::Amm => flexstar_compare::runs::solve_amm(exp, &exp.amm, None),
-        Solver::Fem => flexstar_compare::runs::solve_fem(exp, &exp.fem, None, None),
+        Solver::Fem => flexstar_compare::runs::solve_fem(exp, &fem, None, None),
     }));
     let result = match result {
         Ok(r) => r.map_err(Failure::from),
@@ -287,7 +291,7 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
         .iter()
         .map(|&s| {
             let out = match &exp {
-                Ok(e) => solve(e, s),
+                Ok(e) => solve(e, s, study.fem_reference),
                 Err(reason) => (Err(Failure::Invalid(reason.clone())), 0.0),
             };
             (s, out)
@@ -300,7 +304,7 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
             .and_then(|(_, (r, _))| r.as_ref().ok())
     };
     let evp = match (response(Solver::Amm), response(Solver::Fem)) {
-        (Some(a), Some(f)) => mean_evp(a, f),
+        (Some(a), Some(f)) => flexstar_compare::point_evps(a, f).ok(),
         _ => None,
     };
     let exp = exp.as_ref().ok();
@@ -328,6 +332,7 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
                 error_estimate_percent: None,
                 residual_g_m: None,
                 settle_s: None,
+                evp_max_percent: None,
             };
             match result {
                 Ok(r) => {
@@ -335,7 +340,10 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
                     row.peak_tip_m = Some(p.tip_m);
                     row.peak_wg_m = Some(p.w_g_m);
                     row.peak_fa_n = Some(p.fa_n);
-                    row.evp_percent = if *solver == Solver::Amm { evp } else { None };
+                    if *solver == Solver::Amm {
+                        row.evp_percent = evp.as_ref().and_then(|e| e.mean);
+                        row.evp_max_percent = evp.as_ref().and_then(largest_point_evp);
+                    }
                     if let (Some(exp), Some(rest)) = (exp, rest) {
                         let pinned = *solver == Solver::Amm && exp.amm.family == flexstar_model::ModeFamily::PinnedFree;
                         (row.residual_tip_m, row.residual_g_m, row.settle_s) = residual_columns(exp, r, rest, pinned);

@@ -11,6 +11,7 @@
 //! key = "robot.Jp"
 //! linspace = [1e-4, 4e-4, 4]       # n points from a to b; or logspace = [a, b, n] (geometric)
 //! # sampling = "grid" (default, full factorial) or "lhs" with samples = 200 and seed = 1
+//! # fem_reference = "defaults" (the case's [fem] settings) or "refined" (issue 21)
 //! ```
 //! Unknown keys are rejected; every error names the study file, the key and the reason.
 
@@ -43,6 +44,18 @@ impl Solver {
             Solver::Fem => "fem",
         }
     }
+}
+
+/// The FEM settings a study's `fem` solver runs with (study key `fem_reference`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FemReference {
+    /// The case's own `[fem]` settings (the default).
+    #[default]
+    Defaults,
+    /// The refined reference that `flexstar verify` judges the accurate model against:
+    /// four times the elements and an eighth of the step
+    /// ([`flexstar_compare::runs::reference_fem`]; issue 21 item 3).
+    Refined,
 }
 
 /// The levels of one varied key.
@@ -92,6 +105,8 @@ pub struct Study {
     pub solvers: Vec<Solver>,
     pub vary: Vec<Vary>,
     pub sampling: Sampling,
+    /// The settings of the `fem` solver's runs.
+    pub fem_reference: FemReference,
     /// FNV-1a hash of the study file, the base file and every file a case reads (bytes):
     /// shards and resumed tables must carry the same one.
     pub hash: String,
@@ -110,6 +125,7 @@ struct StudyFile {
     sampling: Option<String>,
     samples: Option<usize>,
     seed: Option<u64>,
+    fem_reference: Option<String>,
 }
 
 fn default_solvers() -> Vec<String> {
@@ -167,6 +183,7 @@ impl Study {
             solvers: solvers(path, &raw.solvers)?,
             vary: raw.vary.into_iter().map(|v| vary(path, v)).collect::<Result<_, _>>()?,
             sampling: sampling(path, raw.sampling.as_deref(), raw.samples, raw.seed)?,
+            fem_reference: fem_reference(path, raw.fem_reference.as_deref())?,
             hash: String::new(),
         };
         study.check_shape()?;
@@ -290,6 +307,18 @@ fn parse_reason(message: &str) -> String {
         .filter(|l| !l.chars().next().is_some_and(|c| c.is_ascii_digit()))
         .collect::<Vec<_>>()
         .join(" ")
+}
+
+fn fem_reference(file: &Path, value: Option<&str>) -> Result<FemReference, StudyError> {
+    match value {
+        None | Some("defaults") => Ok(FemReference::Defaults),
+        Some("refined") => Ok(FemReference::Refined),
+        Some(other) => Err(StudyError::invalid(
+            file,
+            "fem_reference",
+            format!("unknown value {other:?}: expected \"defaults\" or \"refined\""),
+        )),
+    }
 }
 
 fn check_name(file: &Path, name: &str) -> Result<String, StudyError> {

@@ -20,13 +20,15 @@ pub const METRIC_COLUMNS: [&str; 7] = [
 /// Further columns: residual tip vibration after a rest-to-rest motion [m], AMM modes per beam,
 /// the AMM's own estimate of its truncation error [%], then (issue 26) the residual peak of
 /// |dG| after the motion [m] and the settling time [s, absolute; `inf` when not settled by
-/// `t_end`] (`docs/motions.md` 2.2-2.4).
-pub const MORE_COLUMNS: [&str; 5] = [
+/// `t_end`] (`docs/motions.md` 2.2-2.4), then (issue 21) the largest point EVP of the AMM
+/// against the FEM [%].
+pub const MORE_COLUMNS: [&str; 6] = [
     "residual_tip_m",
     "modes",
     "error_estimate_percent",
     "residual_G_m",
     "settle_s",
+    "evp_max_percent",
 ];
 
 /// Column names that are neither keys nor numbers to plot.
@@ -73,6 +75,8 @@ pub struct Row {
     pub residual_g_m: Option<f64>,
     /// Settling time [s, absolute], `inf` when not settled by `t_end`.
     pub settle_s: Option<f64>,
+    /// Largest point EVP [%] of the AMM against the FEM over A, B, C, G (AMM rows).
+    pub evp_max_percent: Option<f64>,
 }
 
 fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
@@ -82,7 +86,7 @@ fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
 impl Row {
     /// The row's fields in header order; numbers in shortest round-trip form.
     pub fn record(&self) -> Vec<String> {
-        let mut r = Vec::with_capacity(self.values.len() + 11);
+        let mut r = Vec::with_capacity(self.values.len() + 12);
         r.push(self.run_id.clone());
         r.extend(self.values.iter().cloned());
         r.push(self.solver.clone());
@@ -95,6 +99,7 @@ impl Row {
             opt(self.error_estimate_percent),
             opt(self.residual_g_m),
             opt(self.settle_s),
+            opt(self.evp_max_percent),
         ]);
         r
     }

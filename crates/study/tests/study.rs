@@ -160,6 +160,14 @@ fn bad_studies_are_refused_naming_file_and_key() {
         "[[vary]]\nkey = \"robot.Lp\"\nvalues = [0.02]\n",
     ));
     assert!(msg.contains("samples") && msg.contains("lhs"), "{msg}");
+    let msg = load_err(&study_with(
+        "fem_reference = \"fine\"\n",
+        "[[vary]]\nkey = \"robot.Lp\"\nvalues = [0.02]\n",
+    ));
+    assert!(
+        msg.contains("study.toml") && msg.contains("fem_reference") && msg.contains("fine"),
+        "{msg}"
+    );
 }
 
 fn out_of(dir: &Path) -> RunOptions {
@@ -196,7 +204,7 @@ fn rows_match_direct_solves_and_bad_values_become_rows() {
     let t = Table::read(&out.results).unwrap();
     assert_eq!(
         t.header.join(","),
-        "run_id,robot.Lp,scale.duration,solver,status,peak_tip_m,peak_wG_m,peak_Fa_N,evp_percent,wall_s,residual_tip_m,modes,error_estimate_percent,residual_G_m,settle_s"
+        "run_id,robot.Lp,scale.duration,solver,status,peak_tip_m,peak_wG_m,peak_Fa_N,evp_percent,wall_s,residual_tip_m,modes,error_estimate_percent,residual_G_m,settle_s,evp_max_percent"
     );
     assert_eq!(t.rows.len(), 8);
     // Lp = 0.7 > L: a row per solver saying why, the study goes on
@@ -232,9 +240,18 @@ fn rows_match_direct_solves_and_bad_values_become_rows() {
         assert_eq!(f(&row[6]), peak(&r.w_g), "{solver} peak wG");
         assert_eq!(f(&row[7]), peak(&r.fa), "{solver} peak Fa");
     }
-    let evp = flexstar_compare::point_evps(&amm, &fem).unwrap().mean.unwrap();
-    assert_eq!(f(&row("amm")[8]), evp);
+    let evps = flexstar_compare::point_evps(&amm, &fem).unwrap();
+    assert_eq!(f(&row("amm")[8]), evps.mean.unwrap());
     assert_eq!(row("fem")[8], "");
+    // the largest point: at least the mean of the four, and one of them
+    let largest = f(&row("amm")[15]);
+    assert!(largest >= evps.mean.unwrap());
+    assert!(
+        evps.points.iter().flatten().any(|&p| p == largest),
+        "{largest} not in {:?}",
+        evps.points
+    );
+    assert_eq!(row("fem")[15], "");
     assert_eq!(row("amm")[11], "6");
 }
 

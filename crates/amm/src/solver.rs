@@ -305,21 +305,43 @@ fn solve_to_tolerance(
         let resp = match pass {
             Pass::Deliver => integrate_system(exp, settings, sys, h, started, |_, _| steps += 1),
             Pass::Estimate { every } => {
-                let mut coarse = exp.clone();
-                coarse.time.dt_out = every as f64 * exp.time.dt_out;
-                let step = (adaptive::ESTIMATE_STEP_FACTOR * h).min(coarse.time.dt_out);
-                let pair_settings = AmmSettings {
-                    dt: Some(step),
-                    snapshots: Vec::new(),
-                    frames: 0,
-                    ..settings.clone()
-                };
-                integrate_system(&coarse, &pair_settings, sys, step, started, |_, _| steps += 1)
+                let factor = adaptive::ESTIMATE_STEP_FACTOR;
+                integrate_coarse(exp, settings, sys, h, factor, every, started, |_, _| steps += 1)
+            }
+            Pass::TimeCheck { every } => {
+                let factor = adaptive::TIME_CHECK_STEP_FACTOR;
+                integrate_coarse(exp, settings, sys, h, factor, every, started, |_, _| steps += 1)
             }
         };
         runs.push((n, steps));
         resp
     })
+}
+
+/// A run of the automatic choice at `factor` times the delivered step `h` [s] (at most the
+/// coarse output interval), output on the estimate's grid: `every` times `exp.time.dt_out`, no
+/// snapshots or frames.
+#[allow(clippy::too_many_arguments)]
+fn integrate_coarse<F: FnMut(&System, &[f64])>(
+    exp: &Experiment,
+    settings: &AmmSettings,
+    sys: System,
+    h: f64,
+    factor: f64,
+    every: usize,
+    started: std::time::Instant,
+    observe: F,
+) -> Result<Response, AmmError> {
+    let mut coarse = exp.clone();
+    coarse.time.dt_out = every as f64 * exp.time.dt_out;
+    let step = (factor * h).min(coarse.time.dt_out);
+    let pair_settings = AmmSettings {
+        dt: Some(step),
+        snapshots: Vec::new(),
+        frames: 0,
+        ..settings.clone()
+    };
+    integrate_system(&coarse, &pair_settings, sys, step, started, observe)
 }
 
 /// The constrained system of N = `n_modes` modes of `settings.family` for the robot of `exp`,

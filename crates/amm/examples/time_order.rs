@@ -4,6 +4,7 @@
 //! For each experiment: the automatic choice (its N and step h), then that N at k h for
 //! k = 1/16, 1, 2, 4, 8, and prints e(h) (against h/16), E(k h, h) for k = 2, 4, 8 on the grid of
 //! the 8 h run, the ratios E(k h, h) / e(h), and the error estimate the automatic choice reported.
+use flexstar_amm::adaptive::estimate_grid;
 use flexstar_amm::solve;
 use flexstar_model::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment, Response};
@@ -23,7 +24,7 @@ fn main() {
         let exp = Experiment::from_toml_str(&text, path).expect("valid experiment");
         let auto = solve(&exp, &exp.amm).expect("automatic choice");
         let (n, h) = (auto.info.modes.expect("N"), auto.info.dt);
-        let every = ((8.0 * h / exp.time.dt_out) - 1e-9).ceil().max(1.0) as usize;
+        let every = estimate_grid(&exp, h).expect("a span long enough for the estimate's grid");
         let run = |step: f64| {
             let mut e = exp.clone();
             e.time.dt_out = every as f64 * exp.time.dt_out;

@@ -125,10 +125,7 @@ pub fn next_modes(n: usize) -> usize {
 /// `(n_fine / n_coarse)^RATE - 1` (see the module docs). `None` when no point has a reference.
 pub fn truncation_estimate(coarse: &Response, fine: &Response, n_coarse: usize, n_fine: usize) -> Option<f64> {
     let richardson = (n_fine as f64 / n_coarse as f64).powf(RATE) - 1.0;
-    point_evps(coarse, fine)
-        .ok()
-        .and_then(|e| e.mean)
-        .map(|d| d / richardson)
+    mean_evp_of(coarse, fine).map(|d| d / richardson)
 }
 
 /// The step a run of the automatic choice takes.
@@ -220,13 +217,16 @@ where
     Ok(finish(exp, delivered, estimate + time_part, tol, wall + pair_wall))
 }
 
-/// Mean EVP [%] (Eq. 45) of `run` against `reference` on the reference's times; infinite when no
-/// point has a reference.
+/// Mean EVP [%] (Eq. 45) of `run` against `reference` on the reference's times; `None` when the
+/// times differ or no point has a reference.
+fn mean_evp_of(run: &Response, reference: &Response) -> Option<f64> {
+    point_evps(run, reference).ok().and_then(|e| e.mean)
+}
+
+/// [`mean_evp_of`], infinite where it has none (a difference that cannot be measured is taken
+/// as too large).
 fn mean_evp(run: &Response, reference: &Response) -> f64 {
-    point_evps(run, reference)
-        .ok()
-        .and_then(|e| e.mean)
-        .unwrap_or(f64::INFINITY)
+    mean_evp_of(run, reference).unwrap_or(f64::INFINITY)
 }
 
 /// The delivered run with the automatic choice's report: `estimate` (truncation and time) plus

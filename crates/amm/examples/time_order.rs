@@ -2,9 +2,11 @@
 //!
 //! `cargo run --release -p flexstar-amm --example time_order -- FILE.toml [FILE.toml ...]`
 //! For each experiment: the automatic choice (its N and step h), then that N at k h for
-//! k = 1/16, 1, 2, 4, 8, and prints e(h) (against h/16), E(k h, h) for k = 2, 4, 8 on the grid of
-//! the 8 h run, the ratios E(k h, h) / e(h), and the error estimate the automatic choice reported.
-use flexstar_amm::adaptive::estimate_grid;
+//! k = 1/16, 1, 2, 4, 8, and prints e(h) (against h/16) and E(2 h, h) on the time check's grid
+//! (the finest the 2 h run allows, as the automatic choice measures them), E(k h, h) for k = 4, 8
+//! with their own e(h) on the grid of the 8 h run, the ratios E(k h, h) / e(h), and the error
+//! estimate the automatic choice reported.
+use flexstar_amm::adaptive::{estimate_grid, time_check_grid};
 use flexstar_amm::solve;
 use flexstar_model::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment, Response};
@@ -24,8 +26,8 @@ fn main() {
         let exp = Experiment::from_toml_str(&text, path).expect("valid experiment");
         let auto = solve(&exp, &exp.amm).expect("automatic choice");
         let (n, h) = (auto.info.modes.expect("N"), auto.info.dt);
-        let every = estimate_grid(&exp, h).expect("a span long enough for the estimate's grid");
-        let run = |step: f64| {
+        let coarse = estimate_grid(&exp, h).expect("a span long enough for the estimate's grid");
+        let run = |step: f64, every: usize| {
             let mut e = exp.clone();
             e.time.dt_out = every as f64 * exp.time.dt_out;
             let s = AmmSettings {
@@ -37,19 +39,28 @@ fn main() {
             };
             solve(&e, &s).expect("solve")
         };
-        let fine = run(h / 16.0);
-        let delivered = run(h);
-        let e_h = evp(&delivered, &fine);
-        let big: Vec<f64> = [2.0, 4.0, 8.0].iter().map(|k| evp(&run(k * h), &delivered)).collect();
+        let check = time_check_grid(&exp, h);
+        let [e_check, e2] = {
+            let delivered = run(h, check);
+            [
+                evp(&delivered, &run(h / 16.0, check)),
+                evp(&run(2.0 * h, check), &delivered),
+            ]
+        };
+        let delivered = run(h, coarse);
+        let e_coarse = evp(&delivered, &run(h / 16.0, coarse));
+        let big: Vec<f64> = [4.0, 8.0]
+            .iter()
+            .map(|k| evp(&run(k * h, coarse), &delivered))
+            .collect();
         println!(
-            "{}: N = {n}, h = {h:.3e} s, e(h) = {e_h:.4} %, E(2h, 4h, 8h; h) = {:.4} / {:.4} / {:.4} %, ratios {:.1} / {:.1} / {:.1}, estimate {:.4} %",
+            "{}: N = {n}, h = {h:.3e} s, check grid {check}: e(h) = {e_check:.4} %, E(2h, h) = {e2:.4} %, ratio {:.2}; coarse grid {coarse}: e(h) = {e_coarse:.4} %, E(4h, 8h; h) = {:.4} / {:.4} %, ratios {:.1} / {:.1}; estimate {:.4} %",
             exp.name,
+            e2 / e_check,
             big[0],
             big[1],
-            big[2],
-            big[0] / e_h,
-            big[1] / e_h,
-            big[2] / e_h,
+            big[0] / e_coarse,
+            big[1] / e_coarse,
             auto.info.error_estimate_percent.unwrap_or(f64::NAN)
         );
     }

@@ -76,7 +76,7 @@ fn solve_direct_scanned(
             // the pairs at the delivered step: the coarse-step estimate (`adaptive`) is measured
             // on inverse runs only, and a servo's loop may not tolerate the coarse step
             // (the reference was scanned once just above: not again per N)
-            adaptive::solve_to_tolerance(exp, tol, None, |n, _| integrate_direct(exp, settings, law, n, false))
+            adaptive::solve_to_tolerance(exp, tol, None, 1, |n, _| integrate_direct(exp, settings, law, n, false))
         }
     }
 }

@@ -29,6 +29,7 @@ mod geometric;
 pub mod modes;
 pub mod pose_modes;
 mod record;
+mod sleeve_shift;
 pub mod solver;
 mod system;
 

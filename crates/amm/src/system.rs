@@ -30,6 +30,7 @@ use crate::error::{AmmError, RankError};
 use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
 use crate::geometric::{self, GeometricStiffness};
 use crate::modes::{dot, ModeSet, SleeveBending, Triplet};
+use crate::sleeve_shift::SleeveShift;
 use flexstar_numerics::vector::dots;
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
@@ -90,6 +91,10 @@ struct BeamRows {
     /// u_i enters the full model only through the material point xp_i - u_i).
     gu: Vec<f64>,
     ct: Vec<f64>,
+    /// The part of each row's value at the predictor that its Jacobian entries do not give:
+    /// `r(qhat) - c . qhat` (0 but for the full model's sleeve rows, Eqs. S3-S4 of `docs/amm.md`
+    /// 12.11, where the gradient carries the foreshortening and the edges turn by `sin thp`).
+    gv: Vec<f64>,
     /// The sleeve basis vectors B_MID..B_MSLOPE of this beam (refreshed per step), N each.
     sleeve: [Vec<f64>; 4],
     // per-step workspace
@@ -106,7 +111,51 @@ struct BeamRows {
     res: [[f64; 4]; 4],
 }
 
+/// What [`BeamRows::shift_sleeve_rows`] needs of a beam's foreshortening at the predictor.
+struct ShiftTerms<'a> {
+    /// The kept modes of `g` (indices into the beam's alpha).
+    kept: &'a [usize],
+    /// `g = F(x_c) alpha` (Eq. S3) on them [-].
+    g: &'a [f64],
+    /// `2 f(x_c) = g . alpha` [m].
+    two_f: f64,
+    /// The sleeve rotation at the predictor [rad].
+    thp: f64,
+    /// Half the sleeve length [m].
+    hp: f64,
+    /// The beam's slope `w'` at the pin and at the right and left edges [-].
+    slopes: [f64; 3],
+}
+
 impl BeamRows {
+    /// Eqs. S3-S4 (`docs/amm.md` 12.11), after the rows' vectors were set at the material point
+    /// `x_c`: each sleeve row `r(x_c)` gains the alpha gradient `r'(x_c) g` (`w'` at the pin and
+    /// the edges, `-w''` for the slope row) and the edges' rows `w(x_c +- hp) -+ hp sin thp` their
+    /// exact thp gradient `-+ hp cos thp`; the rows' values stay `r(qhat)` through `gv`.
+    fn shift_sleeve_rows(&mut self, rows: &[Row], t: ShiftTerms) {
+        let [slope_mid, slope_right, slope_left] = t.slopes;
+        let coef = [slope_mid, slope_right, slope_left, -self.bent.curvature];
+        for (v, c) in self.sleeve.iter_mut().zip(coef) {
+            for (&j, g) in t.kept.iter().zip(t.g) {
+                v[j] += c * g;
+            }
+        }
+        let (sin, cos) = t.thp.sin_cos();
+        for (k, id) in self.ids.iter().enumerate() {
+            let (c, edge) = match rows[*id] {
+                Row::Fp(_) => (coef[0], 0.0),
+                Row::FR(_) => (coef[1], -1.0),
+                Row::FL(_) => (coef[2], 1.0),
+                Row::Mp(_) => (coef[3], 0.0),
+                _ => continue,
+            };
+            self.gv[k] = -self.sc[k] * c * t.two_f;
+            if edge != 0.0 {
+                self.ct[k] = edge * t.hp * cos;
+                self.gv[k] += edge * t.hp * (sin - t.thp * cos);
+            }
+        }
+    }
     /// The products of this beam's rows with the payload's rows P (Eq. P1) at the prepared step:
     /// `H = P S^-1 P^T`, `C S^-1 P^T` (row k: `cross[k]`) and `P S^-1 C^T` (column k: `back[k]`),
     /// by the formula of [`BeamRows::add_block`], `c_k S^-1 c_s^T = (cu_k - p g_k)(cu_s + p g_s)
@@ -250,6 +299,9 @@ pub(crate) struct System {
     xp: [f64; 3],
     /// Full model: the foreshortening inertia of the bent beams in the u rows (`foreshortening`).
     fore: Option<Foreshortening>,
+    /// Full model: the material point in the sleeve drawn out by the foreshortening
+    /// (`sleeve_shift`, Eqs. S1-S3).
+    shift: Option<SleeveShift>,
     /// Full model, enriched family: the residual flexibility of the sleeves (Eqs. R3-R4,
     /// `docs/amm.md` 12); `None` otherwise.
     compliance: Option<SleeveCompliance>,
@@ -354,6 +406,7 @@ fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize, n_bent: usize) -> [
         cu: Vec::new(),
         gu: Vec::new(),
         ct: Vec::new(),
+        gv: Vec::new(),
         sleeve: std::array::from_fn(|_| vec![0.0; nm]),
         scaled: std::array::from_fn(|_| vec![0.0; nm]),
         gram: [[0.0; NB]; NB],
@@ -371,6 +424,7 @@ fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize, n_bent: usize) -> [
                 beam.cu.push(cu);
                 beam.gu.push(cu);
                 beam.ct.push(ct);
+                beam.gv.push(0.0);
             }
         }
     }
@@ -404,18 +458,20 @@ impl System {
         debug_assert!(beams.iter().all(|b| b.ids.len() <= MAX_BEAM_ROWS));
         let m = rows.len();
         let n = 3 * nb;
-        let (geometric, fore) = match model {
+        let (geometric, fore, shift) = match model {
             AmmModel::Full => {
                 let geo = GeometricStiffness::new(&modes, geometric::KEPT_ANALYTIC);
                 let fore = Foreshortening::new(&modes, geo.kept(), &geo.g2(), KEPT_ANALYTIC);
-                (Some(geo), Some(fore))
+                let shift = SleeveShift::new(&modes, geo.kept());
+                (Some(geo), Some(fore), Some(shift))
             }
-            AmmModel::Paper => (None, None),
+            AmmModel::Paper => (None, None, None),
         };
         let compliance = (model == AmmModel::Full && modes.family() == ModeFamily::Enriched)
             .then(|| SleeveCompliance::new(l, hp, params.ei(), params.rho, modes.lambda()));
         System {
             fore,
+            shift,
             compliance,
             model,
             geometric,
@@ -493,7 +549,9 @@ impl System {
     /// Full model (`docs/amm.md` section 8): at the material point that sits in the sleeve,
     /// `xp_i - u_i`, linearised about the predictor `qhat` (one Newton step of the nonlinear rows
     /// per time step, exact to O(h^4)): alpha part `phi(xp - u^ + e)`, u gradient `-w^'(xp - u^ + e)`
-    /// (`+w^''` for the slope row), while the rows' values keep no u term.
+    /// (`+w^''` for the slope row), while the rows' values keep no u term. The material point is
+    /// drawn out by the foreshortening, `e = f(xp - u^)` (Eq. S1, `docs/amm.md` 12.11), and the
+    /// rows gain its gradient and the edges' `sin thp` ([`BeamRows::shift_sleeve_rows`]).
     pub(crate) fn update_sleeve_rows(&mut self, xp: [f64; 3], qhat: &[f64]) {
         let (nm, nb) = (self.nm, self.nb);
         let full = self.model == AmmModel::Full;
@@ -501,10 +559,11 @@ impl System {
         for (i, (beam, &x)) in self.beams.iter_mut().zip(&xp).enumerate() {
             let alpha = &qhat[i * nb..i * nb + nm];
             let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
+            let shift = self.shift.as_mut().map_or(0.0, |s| s.evaluate(i, x - u_hat, alpha));
+            let xc = x - u_hat + shift;
             let [mid, right, left, mslope] = &mut beam.sleeve;
             let bent = if full { Some((alpha, &mut beam.bent)) } else { None };
-            self.modes
-                .triplet_at(&self.tri, x - u_hat, left, mid, right, mslope, bent);
+            self.modes.triplet_at(&self.tri, xc, left, mid, right, mslope, bent);
             if full {
                 let slope_mid = dot(mslope, alpha);
                 let (slope_right, slope_left) = (beam.bent.slope_right, beam.bent.slope_left);
@@ -523,7 +582,18 @@ impl System {
             }
             mslope.iter_mut().for_each(|v| *v = -*v);
             if let Some(c) = self.compliance.as_mut() {
-                beam.res = c.block(x - u_hat, [mid, right, left, mslope]);
+                beam.res = c.block(xc, [mid, right, left, mslope]);
+            }
+            if let Some(s) = self.shift.as_ref() {
+                let terms = ShiftTerms {
+                    kept: s.kept(),
+                    g: s.gradient(i),
+                    two_f: 2.0 * shift,
+                    thp: qhat[i * nb + nm + 1],
+                    hp: self.tri.half_length(),
+                    slopes: self.sleeve_axial[i].map(|c| -c),
+                };
+                beam.shift_sleeve_rows(&self.rows, terms);
             }
         }
     }
@@ -981,7 +1051,7 @@ impl System {
                 }
                 let cq = match qhat {
                     Some(qh) if bp > 0.0 => {
-                        let mut cq = beam.gu[k] * qh[o + nm] + beam.ct[k] * qh[o + nm + 1];
+                        let mut cq = beam.gu[k] * qh[o + nm] + beam.ct[k] * qh[o + nm + 1] + beam.gv[k];
                         if bk != NONE {
                             cq += sk * bq[bk];
                         }
@@ -1028,28 +1098,58 @@ impl System {
         self.payload_correct(&mut qdd[..nb]);
     }
 
-    /// The sleeve rows of Eqs. 41-42 evaluated exactly (nonlinear in u) at the state q, for tests:
-    /// largest `|w_i(xp_i - u_i + e) - e thp_i|` over the beams and e in {0, +-Lp/2}, and largest
-    /// `|w_i(xp_i + e) - e thp_i|` (the same rows at the rigid material points, as the paper takes
-    /// them) [m].
+    /// The sleeve rows of Eqs. 41-42 evaluated exactly at the state q, for tests, with the
+    /// foreshortening computed here by brute force (Gauss quadrature of `1/2 int_0^x w'^2` over
+    /// every mode, not the table of `sleeve_shift`): largest `|w_i(x_c + e) - sin(thp_i) e|` over
+    /// the beams and e in {0, +-Lp/2}, at the material point `x_c = xp - u + f(x_c)` of Eq. S1;
+    /// the same at `xp - u` (no foreshortening, as before Eq. S1); and `|w_i(xp_i + e) - e thp_i|`
+    /// (the rigid material points, as the paper takes them) [m].
     #[cfg(test)]
-    pub(crate) fn sleeve_gaps(&self, q: &[f64], lp: f64) -> (f64, f64) {
+    pub(crate) fn sleeve_gaps(&self, q: &[f64], lp: f64) -> [f64; 3] {
         let (nm, nb) = (self.nm, self.nb);
         let mut v = vec![0.0; nm];
-        let (mut at_material, mut at_rigid) = (0.0f64, 0.0f64);
+        let mut gaps = [0.0f64; 3];
         for i in 0..3 {
             let o = i * nb;
             let (alpha, u, thp) = (&q[o..o + nm], q[o + nm], q[o + nm + 1]);
+            let mut xc = self.xp[i] - u;
+            for _ in 0..3 {
+                xc = self.xp[i] - u + self.foreshortening_by_quadrature(alpha, xc);
+            }
             // the residual flexibility's deflection at the left edge, centre, right edge (Eq. R4)
             let res = self.residual_deflection(i);
             for (e, r) in [-0.5 * lp, 0.0, 0.5 * lp].into_iter().zip([res[2], res[0], res[1]]) {
-                self.modes.values_at(self.xp[i] - u + e, &mut v, None);
-                at_material = at_material.max((dot(&v, alpha) + r - e * thp).abs());
-                self.modes.values_at(self.xp[i] + e, &mut v, None);
-                at_rigid = at_rigid.max((dot(&v, alpha) - e * thp).abs());
+                for (gap, x, side, rr) in [
+                    (0, xc + e, e * thp.sin(), r),
+                    (1, self.xp[i] - u + e, e * thp, r),
+                    (2, self.xp[i] + e, e * thp, 0.0),
+                ] {
+                    self.modes.values_at(x, &mut v, None);
+                    gaps[gap] = gaps[gap].max((dot(&v, alpha) + rr - side).abs());
+                }
             }
         }
-        (at_material, at_rigid)
+        gaps
+    }
+
+    /// `f(x) = 1/2 int_0^x w'^2 ds` for the modal coordinates `alpha`, every mode, by a
+    /// composite 10-point Gauss rule (tests).
+    #[cfg(test)]
+    fn foreshortening_by_quadrature(&self, alpha: &[f64], x: f64) -> f64 {
+        let (pts, wts) = flexstar_numerics::quadrature::gauss_legendre_rule(10);
+        let (mut v, mut d) = (vec![0.0; self.nm], vec![0.0; self.nm]);
+        let panels = 40;
+        let h = x / panels as f64;
+        let mut f = 0.0;
+        for p in 0..panels {
+            for (z, w) in pts.iter().zip(&wts) {
+                self.modes
+                    .values_at((p as f64 + 0.5 * (z + 1.0)) * h, &mut v, Some(&mut d));
+                let wp = dot(&d, alpha);
+                f += 0.25 * h * w * wp * wp;
+            }
+        }
+        f
     }
 
     /// Eq. R4 (`docs/amm.md` 12): the deflection `sum_b R_ab lambda_b` that the modes left out
@@ -1104,7 +1204,7 @@ impl System {
         for (i, beam) in self.beams.iter().enumerate() {
             let o = i * nb;
             for (k, &g) in beam.ids.iter().enumerate() {
-                let mut v = beam.gu[k] * q[o + nm] + beam.ct[k] * q[o + nm + 1];
+                let mut v = beam.gu[k] * q[o + nm] + beam.ct[k] * q[o + nm + 1] + beam.gv[k];
                 if beam.basis[k] != NONE {
                     v += beam.sc[k] * dot(self.basis(beam, beam.basis[k]), &q[o..o + nm]);
                 }

@@ -3,11 +3,12 @@
 //!
 //! The cases are drawn by the study file itself (same Latin hypercube, same run ids), each run by
 //! the accurate AMM and by the refined FEM (`fem_reference = "refined"`), the independent
-//! reference. Eight of the 35 in-range cases of the draw: six polynomial motions spanning Lp/L
-//! 0.03-0.14 and two quintics, the cheapest of their kind (about 11 s in all). On these eight
-//! every target of the issue holds; on the whole draw the estimate ratio does not yet (one case
-//! below 1/2, three above 2, listed in validation.md section 8), so the ratio bound is asserted
-//! here only for the chosen eight and the test says so in its name.
+//! reference. Nine of the 35 in-range cases of the draw: six polynomial motions spanning Lp/L
+//! 0.03-0.14 and two quintics, the cheapest of their kind, and the quintic with the long sleeve
+//! that was the draw's worst case before the foreshortening of the sleeve rows (`a6dd7202`: mean
+//! EVP 0.433 %, estimate 0.29 times it; now 0.071 %, docs/amm.md 12.11), about 16 s in all. On
+//! the whole seed-21 draw every target holds (estimate / true 0.59-1.86); on the seed-22 draw
+//! one case is above 2 (validation.md section 8), so the envelope is not declared met.
 
 use std::path::Path;
 
@@ -18,7 +19,7 @@ use rayon::prelude::*;
 
 /// Run ids of the chosen cases (the study's stable FNV-1a ids of their values; validation.md 8
 /// gives each one's robot, motion and measured numbers).
-const CHOSEN: [&str; 8] = [
+const CHOSEN: [&str; 9] = [
     "32a9dd8b8f3f0af4", // polynomial, Lp/L 0.032
     "54f4ac5cb98b4279", // polynomial, Lp/L 0.045
     "ce30e1bd508228fd", // polynomial, Lp/L 0.061
@@ -27,10 +28,11 @@ const CHOSEN: [&str; 8] = [
     "ed68474913ae3c16", // polynomial, Lp/L 0.138
     "1f06cc0060f138be", // quintic, Lp/L 0.051
     "62482dc3cba3f920", // quintic, Lp/L 0.057
+    "a6dd72026589d75e", // quintic, Lp/L 0.144 (the former worst case)
 ];
 
 #[test]
-fn eight_envelope_cases_meet_the_evp_bounds_and_their_estimates_are_within_a_factor_two() {
+fn nine_envelope_cases_meet_the_evp_bounds_and_their_estimates_are_within_a_factor_two() {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/studies/envelope.toml");
     let study = Study::load(&file).expect("the envelope study loads");
     let cases: Vec<_> = study

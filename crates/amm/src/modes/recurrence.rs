@@ -248,6 +248,13 @@ pub(crate) struct Triplet {
     delta: Vec<f64>,
 }
 
+impl Triplet {
+    /// The half-width h [m] (half the sleeve length).
+    pub(crate) fn half_length(&self) -> f64 {
+        self.h
+    }
+}
+
 impl ModeSet {
     /// Factors for [`ModeSet::triplet_at`] with half-width `h` [m].
     pub(crate) fn triplet(&self, h: f64) -> Triplet {

@@ -65,3 +65,37 @@ impl ModeSet {
         (product(&d1), product(&d2))
     }
 }
+
+impl ModeSet {
+    /// The running slope Gram matrix `F(x_n)_ab = int_0^{x_n} phi_a' phi_b' ds` [1/m] of the modes
+    /// `on` (k of them) at the panel ends `x_n = n L / panels`, n = 0..=panels: (panels + 1) k x k
+    /// matrices, row-major, one after the other. Each panel by the 4-point Gauss rule, exact to
+    /// round-off where `2 beta_max L / panels` stays below about 1 (the caller's choice of
+    /// panels). Eq. S2 of `docs/amm.md` 12.11: `f(x) = 1/2 alpha^T F(x) alpha`.
+    pub(crate) fn slope_gram_table(&self, on: &[usize], panels: usize) -> Vec<f64> {
+        let k = on.len();
+        let (pts, wts) = flexstar_numerics::quadrature::gauss_legendre_rule(4);
+        let h = self.l / panels as f64;
+        let mut table = vec![0.0; (panels + 1) * k * k];
+        let mut slope = vec![0.0; self.len()];
+        let mut kept = vec![0.0; k];
+        for n in 0..panels {
+            let (done, next) = table.split_at_mut((n + 1) * k * k);
+            let next = &mut next[..k * k];
+            next.copy_from_slice(&done[n * k * k..]);
+            for (p, w) in pts.iter().zip(&wts) {
+                self.slopes_at((n as f64 + 0.5 * (p + 1.0)) * h, &mut slope);
+                for (c, &m) in kept.iter_mut().zip(on) {
+                    *c = slope[m];
+                }
+                let wh = 0.5 * h * w;
+                for (row, &sa) in next.chunks_exact_mut(k).zip(&kept) {
+                    for (e, &sb) in row.iter_mut().zip(&kept) {
+                        *e += wh * sa * sb;
+                    }
+                }
+            }
+        }
+        table
+    }
+}

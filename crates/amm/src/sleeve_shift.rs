@@ -1,0 +1,130 @@
+//! The material point in the sleeve, drawn out by the beam's foreshortening (full model;
+//! `docs/amm.md` 12.11, Eqs. S1-S4).
+//!
+//! An inextensible beam that bends draws its material towards G: the material point x sits at
+//! `x + u - f(x)` along `e_x`, `f(x) = 1/2 int_0^x w'^2 ds` (the same f as the u row's
+//! foreshortening inertia, `foreshortening.rs`). The point held at the pin, at `xp` along `e_x`,
+//! is therefore
+//!
+//! ```text
+//! x_c = xp - u + f(x_c) ~ xp - u + f(xp - u)                                        (S1)
+//! f(x) = 1/2 alpha^T F(x) alpha,   F(x)_ab = int_0^x phi_a' phi_b' ds                  (S2)
+//! ```
+//!
+//! and each sleeve row `r(x_c)` gains the alpha gradient `r'(x_c) g`, `g = F(x_c) alpha`
+//! (Eq. S3): the axial components `-F_k w'` of the sleeve forces, acting on the foreshortening,
+//! the geometric stiffness of the sleeve forces. `F` is tabulated at `PANELS + 1` points and
+//! interpolated linearly, on the modes that carry the geometric stiffness of Eq. 23
+//! ([`crate::geometric::KEPT_ANALYTIC`] analytic modes and the junction shapes): the modes left
+//! out resolve the sleeve locally and add to `int w'^2` only at second order in their small
+//! coordinates.
+
+use crate::modes::ModeSet;
+
+/// Panels of the table of `F(x)` along the beam; linear interpolation between its ends is
+/// within `(L / PANELS)^2 beta_max / (4 x)` of F, 0.5 % at x = 0.15 L for beta_max L = 50.
+const PANELS: usize = 128;
+
+/// `F(x)` on the kept modes and, per beam, the shift `f(x_c)` and its gradient `g` at the last
+/// [`SleeveShift::evaluate`].
+#[derive(Debug, Clone)]
+pub(crate) struct SleeveShift {
+    /// Indices of the kept modes in a beam's coordinates.
+    kept: Vec<usize>,
+    /// Panel width [m].
+    h: f64,
+    /// `F(n h)`, n = 0..=PANELS, k x k each, row-major [1/m].
+    table: Vec<f64>,
+    /// Kept coordinates of the beam being evaluated (scratch, k).
+    alpha: Vec<f64>,
+    /// Per beam: `g = F(x_c) alpha` on the kept modes [-].
+    grad: [Vec<f64>; 3],
+}
+
+impl SleeveShift {
+    /// The table for `modes`, on the kept modes `kept` (indices into a beam's coordinates).
+    pub(crate) fn new(modes: &ModeSet, kept: &[usize]) -> Self {
+        let k = kept.len();
+        SleeveShift {
+            kept: kept.to_vec(),
+            h: modes.length() / PANELS as f64,
+            table: modes.slope_gram_table(kept, PANELS),
+            alpha: vec![0.0; k],
+            grad: std::array::from_fn(|_| vec![0.0; k]),
+        }
+    }
+
+    /// The kept modes' indices.
+    pub(crate) fn kept(&self) -> &[usize] {
+        &self.kept
+    }
+
+    /// Eqs. S1-S2 for beam `beam` with modal coordinates `alpha` at the material point `x` [m]:
+    /// returns `f(x)` [m] and keeps `g = F(x) alpha` ([`SleeveShift::gradient`]).
+    pub(crate) fn evaluate(&mut self, beam: usize, x: f64, alpha: &[f64]) -> f64 {
+        let k = self.kept.len();
+        for (a, &j) in self.alpha.iter_mut().zip(&self.kept) {
+            *a = alpha[j];
+        }
+        let z = (x / self.h).clamp(0.0, PANELS as f64);
+        let n = (z.floor() as usize).min(PANELS - 1);
+        let t = z - n as f64;
+        let lo = &self.table[n * k * k..(n + 1) * k * k];
+        let hi = &self.table[(n + 1) * k * k..(n + 2) * k * k];
+        let g = &mut self.grad[beam];
+        for ((ga, rl), rh) in g.iter_mut().zip(lo.chunks_exact(k)).zip(hi.chunks_exact(k)) {
+            let (mut sl, mut sh) = (0.0, 0.0);
+            for ((&fl, &fh), &a) in rl.iter().zip(rh).zip(&self.alpha) {
+                sl += fl * a;
+                sh += fh * a;
+            }
+            *ga = (1.0 - t) * sl + t * sh;
+        }
+        0.5 * g.iter().zip(&self.alpha).map(|(a, b)| a * b).sum::<f64>()
+    }
+
+    /// `g = F(x_c) alpha` of beam `beam` on the kept modes at its last evaluation (Eq. S3).
+    pub(crate) fn gradient(&self, beam: usize) -> &[f64] {
+        &self.grad[beam]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flexstar_model::{ModeFamily, RobotParams};
+
+    #[test]
+    fn the_shift_is_half_the_integral_of_the_squared_slope() {
+        // against a brute-force Gauss quadrature of 1/2 int_0^x w'^2 over every mode of the set,
+        // for a deflection on the kept modes (the table's own modes), at points between its nodes
+        let params = RobotParams::paper();
+        let modes = ModeSet::new(ModeFamily::Enriched, 40, &params).unwrap();
+        let kept = crate::geometric::GeometricStiffness::kept_modes(&modes, 16);
+        let mut shift = SleeveShift::new(&modes, &kept);
+        let mut alpha = vec![0.0; modes.len()];
+        for (r, &j) in kept.iter().enumerate() {
+            alpha[j] = 1e-3 / (1.0 + r as f64);
+        }
+        let (pts, wts) = flexstar_numerics::quadrature::gauss_legendre_rule(10);
+        let l = modes.length();
+        let (mut val, mut slope) = (vec![0.0; modes.len()], vec![0.0; modes.len()]);
+        for x in [0.07 * l, 0.3137 * l, 0.55 * l, 0.861 * l] {
+            let mut exact = 0.0;
+            let panels = 60;
+            for p in 0..panels {
+                let (a, b) = (x * p as f64 / panels as f64, x * (p + 1) as f64 / panels as f64);
+                for (z, w) in pts.iter().zip(&wts) {
+                    modes.values_at(a + 0.5 * (b - a) * (z + 1.0), &mut val, Some(&mut slope));
+                    let wp: f64 = slope.iter().zip(&alpha).map(|(s, a)| s * a).sum();
+                    exact += 0.5 * (b - a) * w * 0.5 * wp * wp;
+                }
+            }
+            let f = shift.evaluate(1, x, &alpha);
+            assert!((f - exact).abs() < 5e-3 * exact, "x = {x}: {f} against {exact}");
+            // the gradient is the derivative of f: 2 f = g . alpha
+            let g: f64 = shift.gradient(1).iter().zip(&kept).map(|(g, &j)| g * alpha[j]).sum();
+            assert!((g - 2.0 * f).abs() < 1e-12 * f);
+        }
+    }
+}

@@ -302,6 +302,9 @@ pub(crate) struct System {
     /// Full model: the material point in the sleeve drawn out by the foreshortening
     /// (`sleeve_shift`, Eqs. S1-S3).
     shift: Option<SleeveShift>,
+    /// Full model: the axial flexibility `L / (3 EA)` [m/N] between a beam's root at G and its
+    /// mean axial displacement u_i (Eq. A2, `docs/amm.md` 12.12); 0 in the paper's model.
+    axial_flex: f64,
     /// Full model, enriched family: the residual flexibility of the sleeves (Eqs. R3-R4,
     /// `docs/amm.md` 12); `None` otherwise.
     compliance: Option<SleeveCompliance>,
@@ -469,9 +472,14 @@ impl System {
         };
         let compliance = (model == AmmModel::Full && modes.family() == ModeFamily::Enriched)
             .then(|| SleeveCompliance::new(l, hp, params.ei(), params.rho, modes.lambda()));
+        let axial_flex = match model {
+            AmmModel::Full => l / (3.0 * params.ea()),
+            AmmModel::Paper => 0.0,
+        };
         System {
             fore,
             shift,
+            axial_flex,
             compliance,
             model,
             geometric,
@@ -594,6 +602,23 @@ impl System {
                     slopes: self.sleeve_axial[i].map(|c| -c),
                 };
                 beam.shift_sleeve_rows(&self.rows, terms);
+            }
+        }
+    }
+
+    /// Eq. A3 (`docs/amm.md` 12.12): the beams' axial flexibility on the Fix rows, whose
+    /// multiplier F_ix is the axial force on beam i at G and whose u_i is the beam's mean axial
+    /// displacement: its root is at `u_i + L / (3 EA) F_ix`, so `a_kk += L / (3 EA) / bp` on the
+    /// row's diagonal of the Schur complement. No-op in the paper's model and for the consistent
+    /// initial accelerations (`bp = 0`).
+    fn add_axial_flexibility(&mut self, bp: f64) {
+        if self.axial_flex == 0.0 || bp <= 0.0 {
+            return;
+        }
+        let m = self.rows.len();
+        for (k, row) in self.rows.iter().enumerate() {
+            if let Row::Fix(_) = row {
+                self.a[k * m + k] += self.axial_flex / bp;
             }
         }
     }
@@ -919,6 +944,7 @@ impl System {
             beam.add_block(a_mat, m, p, inv_sigma, inv_jp);
         }
         self.add_compliance(bp);
+        self.add_axial_flexibility(bp);
         if self.payload.is_some() {
             self.payload_block(st, Self::payload_motion(st), bp, gp)?;
         }

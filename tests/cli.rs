@@ -825,15 +825,21 @@ fn compare_of_a_forces_drive_says_what_its_force_figure_draws() {
 }
 
 /// The validated envelope (issue 21 item 3, docs/validation.md section 8): an AMM run of the
-/// accurate model on the paper's robot is inside; the paper's equations, or a robot whose sleeve
-/// inertia lies beyond the envelope's range, are outside, with the reasons in the sidecar and a
-/// note on stderr (the value of Jp/(rho L^3) computed here from the robot's own numbers).
+/// accurate model on the paper's robot, or on another robot inside the envelope's ranges, is
+/// inside; the paper's equations, a robot whose sleeve inertia or axial stiffness lies beyond
+/// the envelope's range, are outside, with the reasons in the sidecar and a note on stderr (the
+/// values of Jp/(rho L^3) and EA L^2 / EI computed here from the robot's own numbers).
 #[test]
 fn the_sidecar_says_whether_the_run_lies_in_the_validated_envelope() {
     let out = tempfile::tempdir().unwrap();
     let base = "[time]\nt_end = 0.05\ndt_out = 0.001\n[trajectory]\nkind = \"polynomial\"\ns1 = [0.0, 0.0, 1.0]\ns2 = [0.0]\ns3 = [0.0, 0.0, 0.5]\n";
     let cases = [
         ("inside", "", true, None),
+        // a heavier beam: Jp/(rho L^3) = 2e-4 / (0.3 * 0.125) = 0.0053, EA = 200e9 * 0.3 / 7800,
+        // EA L^2 / EI = 3.8e6, all inside
+        ("other-robot", "[robot]\nrho = 0.3\n", true, None),
+        // EA L^2 / EI = 1e4 * 0.25 / 0.5 = 5000, below the draw's 5.8e4
+        ("soft-axis", "[robot]\nEA = 1e4\n", false, Some("EA L^2/EI = 5000.0000")),
         (
             "paper-model",
             "[amm]\nfamily = \"free-free\"\nmodel = \"paper\"\nmodes = 10\n",

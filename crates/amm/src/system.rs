@@ -465,7 +465,7 @@ impl System {
             AmmModel::Full => {
                 let geo = GeometricStiffness::new(&modes, geometric::KEPT_ANALYTIC);
                 let fore = Foreshortening::new(&modes, geo.kept(), &geo.g2(), KEPT_ANALYTIC);
-                let shift = SleeveShift::new(&modes, geo.kept());
+                let shift = SleeveShift::new(&modes, &GeometricStiffness::kept_modes(&modes, KEPT_ANALYTIC));
                 (Some(geo), Some(fore), Some(shift))
             }
             AmmModel::Paper => (None, None, None),

@@ -11,7 +11,7 @@
 //!
 //! **Status** ([`ENVELOPE_MET`]): the study's two draws (`docs/validation.md` section 8) meet
 //! every target on every in-range case (mean EVP at most 0.133 %, largest point at most
-//! 0.261 %, estimate / true within 0.50-1.90), so an accurate-model run whose robot lies in the
+//! 0.261 %, estimate / true within 0.50-1.89), so an accurate-model run whose robot lies in the
 //! ranges below, without attachments and in the small-deflection range, is validated
 //! (`validated_envelope: true`); the paper's robot is also checked by `flexstar verify`'s four
 //! cases. Every other run gets `false` with the reasons, which name the ranges it leaves.

@@ -6,8 +6,8 @@
 //! reference. Nine of the 35 in-range cases of the draw: six polynomial motions spanning Lp/L
 //! 0.03-0.14 and two quintics, the cheapest of their kind, and the quintic with the long sleeve
 //! that was the draw's worst case before the foreshortening of the sleeve rows (`a6dd7202`: mean
-//! EVP 0.433 %, estimate 0.29 times it; now 0.072 %, docs/amm.md 12.11), about 16 s in all. On
-//! the whole of both draws every target holds (estimate / true 0.50-1.90, validation.md
+//! EVP 0.433 %, estimate 0.29 times it; now 0.073 %, docs/amm.md 12.11), about 16 s in all. On
+//! the whole of both draws every target holds (estimate / true 0.50-1.89, validation.md
 //! section 8); these nine are the part the test suite can afford.
 
 use std::path::Path;

@@ -123,7 +123,7 @@ pub fn residual_after(r: &Response, t_rest: f64, settle_tol: f64, hold_s: f64) -
         .zip(&dg)
         .filter(|(_, d)| **d > settle_tol)
         .map(|(t, _)| *t)
-        .last();
+        .next_back();
     let t_last = last_out.unwrap_or(t_rest);
     let settled = t_end - t_last >= hold_s - 1e-12;
     Some(Residual {

@@ -318,7 +318,7 @@ impl crate::Experiment {
                 f
             }
         };
-        let damping = self.damping.clone();
+        let damping = self.damping;
         section.resolve(&f_hz, |f| damping.zeta_at(f))?;
         self.trajectory = Trajectory::Shaped(ShapedMotion {
             base: Box::new(self.trajectory.clone()),

@@ -241,7 +241,7 @@ impl Trajectory {
                         return Ok(None);
                     };
                     for (acc, x) in sum.iter_mut().zip(p) {
-                        *acc = *acc + x * imp.a;
+                        *acc += x * imp.a;
                     }
                 }
                 Some(sum)

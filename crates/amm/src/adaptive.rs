@@ -93,9 +93,8 @@ pub const MIN_ESTIMATE_ROWS: usize = 20;
 /// its times are a subset of the delivered ones. `None` (pairs at the delivered step) when that grid
 /// would have fewer than [`MIN_ESTIMATE_ROWS`] rows.
 pub fn estimate_grid(exp: &Experiment, h: f64) -> Option<usize> {
-    let dt_out = exp.time.dt_out;
-    let every = ((ESTIMATE_STEP_FACTOR * h / dt_out) - 1e-9).ceil().max(1.0) as usize;
-    let rows = (exp.time.t_end / (every as f64 * dt_out) - 1e-9).ceil() + 1.0;
+    let every = output_multiple(exp, ESTIMATE_STEP_FACTOR * h);
+    let rows = (exp.time.t_end / (every as f64 * exp.time.dt_out) - 1e-9).ceil() + 1.0;
     (rows >= MIN_ESTIMATE_ROWS as f64).then_some(every)
 }
 
@@ -105,7 +104,13 @@ pub fn estimate_grid(exp: &Experiment, h: f64) -> Option<usize> {
 /// response with fast components (w_G) can read a difference 1.5 times larger or smaller
 /// (`docs/amm.md` 12.10).
 pub fn time_check_grid(exp: &Experiment, h: f64) -> usize {
-    ((TIME_CHECK_STEP_FACTOR * h / exp.time.dt_out) - 1e-9).ceil().max(1.0) as usize
+    output_multiple(exp, TIME_CHECK_STEP_FACTOR * h)
+}
+
+/// The smallest k >= 1 with `k exp.time.dt_out >= step` (to round-off): the output grid, a
+/// subset of the delivered one, that a run at `step` [s] can fill.
+fn output_multiple(exp: &Experiment, step: f64) -> usize {
+    ((step / exp.time.dt_out) - 1e-9).ceil().max(1.0) as usize
 }
 
 /// Modes beyond the sleeve resolution `2 L / Lp` with which the automatic choice starts: at

@@ -1140,7 +1140,7 @@ impl System {
             let (alpha, u, thp) = (&q[o..o + nm], q[o + nm], q[o + nm + 1]);
             let mut xc = self.xp[i] - u;
             for _ in 0..3 {
-                xc = self.xp[i] - u + self.foreshortening_by_quadrature(alpha, xc);
+                xc = self.xp[i] - u + self.modes.half_squared_slope_integral(alpha, xc);
             }
             // the residual flexibility's deflection at the left edge, centre, right edge (Eq. R4)
             let res = self.residual_deflection(i);
@@ -1156,26 +1156,6 @@ impl System {
             }
         }
         gaps
-    }
-
-    /// `f(x) = 1/2 int_0^x w'^2 ds` for the modal coordinates `alpha`, every mode, by a
-    /// composite 10-point Gauss rule (tests).
-    #[cfg(test)]
-    fn foreshortening_by_quadrature(&self, alpha: &[f64], x: f64) -> f64 {
-        let (pts, wts) = flexstar_numerics::quadrature::gauss_legendre_rule(10);
-        let (mut v, mut d) = (vec![0.0; self.nm], vec![0.0; self.nm]);
-        let panels = 40;
-        let h = x / panels as f64;
-        let mut f = 0.0;
-        for p in 0..panels {
-            for (z, w) in pts.iter().zip(&wts) {
-                self.modes
-                    .values_at((p as f64 + 0.5 * (z + 1.0)) * h, &mut v, Some(&mut d));
-                let wp = dot(&d, alpha);
-                f += 0.25 * h * w * wp * wp;
-            }
-        }
-        f
     }
 
     /// Eq. R4 (`docs/amm.md` 12): the deflection `sum_b R_ab lambda_b` that the modes left out

@@ -99,3 +99,25 @@ impl ModeSet {
         table
     }
 }
+
+#[cfg(test)]
+impl ModeSet {
+    /// `1/2 int_0^x w'^2 ds` for `w = sum alpha_m phi_m` over every mode, by a composite 10-point
+    /// Gauss rule of 40 panels (tests: the brute-force reference for the table of
+    /// `slope_gram_table` and for the sleeve's foreshortening, `docs/amm.md` 12.11).
+    pub(crate) fn half_squared_slope_integral(&self, alpha: &[f64], x: f64) -> f64 {
+        let (pts, wts) = flexstar_numerics::quadrature::gauss_legendre_rule(10);
+        let (mut v, mut d) = (vec![0.0; self.len()], vec![0.0; self.len()]);
+        let panels = 40;
+        let h = x / panels as f64;
+        let mut f = 0.0;
+        for p in 0..panels {
+            for (z, w) in pts.iter().zip(&wts) {
+                self.values_at((p as f64 + 0.5 * (z + 1.0)) * h, &mut v, Some(&mut d));
+                let wp = dot(&d, alpha);
+                f += 0.25 * h * w * wp * wp;
+            }
+        }
+        f
+    }
+}

@@ -4,7 +4,6 @@
 mod common;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use flexstar_amm::solve;
 use flexstar_model::ModeFamily;
 
 fn paper_cases(c: &mut Criterion) {
@@ -18,7 +17,11 @@ fn paper_cases(c: &mut Criterion) {
             let exp = common::paper_case(case);
             let settings = common::settings(fam, 25, None);
             group.bench_function(format!("case{case}_{fam}"), |b| {
-                b.iter(|| solve(&exp, &settings).unwrap())
+                b.iter(|| {
+                    flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+                        .map(|s| s.response)
+                        .unwrap()
+                })
             });
         }
     }
@@ -35,7 +38,11 @@ fn accurate_model(c: &mut Criterion) {
         let exp = common::paper_case(case);
         let settings = flexstar_model::AmmSettings::accurate();
         group.bench_function(format!("case{case}_auto"), |b| {
-            b.iter(|| solve(&exp, &settings).unwrap())
+            b.iter(|| {
+                flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+                    .map(|s| s.response)
+                    .unwrap()
+            })
         });
     }
     let exp = common::paper_case(3);
@@ -43,14 +50,19 @@ fn accurate_model(c: &mut Criterion) {
         modes: Some(53),
         ..flexstar_model::AmmSettings::accurate()
     };
-    group.bench_function("case3_n53", |b| b.iter(|| solve(&exp, &fixed).unwrap()));
+    group.bench_function("case3_n53", |b| {
+        b.iter(|| {
+            flexstar_amm::solve(&exp, &fixed, flexstar_drive::SolveRequest::motion())
+                .map(|s| s.response)
+                .unwrap()
+        })
+    });
     group.finish();
 }
 
 /// Issue 10 item 6: a direct run (forces of the inverse run fed back, and a 20 Hz servo) against
 /// the inverse run of the same case; target at most twice the inverse time.
 fn direct_vs_inverse(c: &mut Criterion) {
-    use flexstar_amm::solve_direct;
     use flexstar_drive::{ForceTable, Servo};
     let mut group = c.benchmark_group("amm_direct_vs_inverse");
     group.sample_size(10);
@@ -61,7 +73,9 @@ fn direct_vs_inverse(c: &mut Criterion) {
     };
     for (label, settings) in [("n25_free-free", paper), ("n53_accurate", accurate)] {
         let exp = common::paper_case(3);
-        let inverse = solve(&exp, &settings).unwrap();
+        let inverse = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap();
         let fa = (0..inverse.len())
             .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
             .collect();
@@ -76,13 +90,25 @@ fn direct_vs_inverse(c: &mut Criterion) {
             attached: Default::default(),
         };
         group.bench_function(format!("case3_{label}_inverse"), |b| {
-            b.iter(|| solve(&exp, &settings).unwrap())
+            b.iter(|| {
+                flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+                    .map(|s| s.response)
+                    .unwrap()
+            })
         });
         group.bench_function(format!("case3_{label}_direct_forces"), |b| {
-            b.iter(|| solve_direct(&exp, &settings, &table).unwrap())
+            b.iter(|| {
+                flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&table))
+                    .map(|s| s.response)
+                    .unwrap()
+            })
         });
         group.bench_function(format!("case3_{label}_direct_servo"), |b| {
-            b.iter(|| solve_direct(&exp, &settings, &servo).unwrap())
+            b.iter(|| {
+                flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&servo))
+                    .map(|s| s.response)
+                    .unwrap()
+            })
         });
     }
     group.finish();
@@ -108,7 +134,13 @@ fn attachments(c: &mut Criterion) {
         ..flexstar_model::AmmSettings::accurate()
     };
     for (label, exp) in [("bare", &bare), ("payload_damping_load", &loaded)] {
-        group.bench_function(format!("case3_n53_{label}"), |b| b.iter(|| solve(exp, &fixed).unwrap()));
+        group.bench_function(format!("case3_n53_{label}"), |b| {
+            b.iter(|| {
+                flexstar_amm::solve(exp, &fixed, flexstar_drive::SolveRequest::motion())
+                    .map(|s| s.response)
+                    .unwrap()
+            })
+        });
     }
     group.finish();
 }

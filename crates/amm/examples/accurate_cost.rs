@@ -6,7 +6,6 @@
 //! valgrind --tool=callgrind target/release/examples/accurate_cost CASE [N]
 //! ```
 //! runs `flexstar_amm::solve` once with `AmmSettings::accurate()` (automatic N), or at a fixed N.
-use flexstar_amm::solve;
 use flexstar_model::catalogue::paper_case;
 use flexstar_model::AmmSettings;
 
@@ -21,7 +20,9 @@ fn main() {
         modes: args.get(2).map(|n| n.parse().expect(usage)),
         ..AmmSettings::accurate()
     };
-    let r = solve(&paper_case(case), &settings).expect("solve");
+    let r = flexstar_amm::solve(&paper_case(case), &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .expect("solve");
     println!(
         "case {case}: N = {:?}, estimate {:?} %, {} output rows",
         r.info.modes,

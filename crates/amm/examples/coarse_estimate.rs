@@ -5,7 +5,7 @@
 //! first pair (N_prev, N) at the tolerance step h and at K h (output interval max(dt_out, K h)),
 //! and prints the mean EVP between the two runs of each pair (Eq. 45) and their ratio.
 use flexstar_amm::adaptive::{first_modes, next_modes};
-use flexstar_amm::{solve, TOLERANCE_DT};
+use flexstar_amm::TOLERANCE_DT;
 use flexstar_model::catalogue::paper_case;
 use flexstar_model::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment};
@@ -36,7 +36,9 @@ fn time_error(exp: &Experiment, k: usize) -> f64 {
             dt: Some(dt),
             ..AmmSettings::default()
         };
-        solve(&e, &s).expect("solve")
+        flexstar_amm::solve(&e, &s, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .expect("solve")
     };
     let fine = run(TOLERANCE_DT, exp.time.dt_out);
     let every = ((k as f64 * TOLERANCE_DT / exp.time.dt_out) - 1e-9).ceil() as usize;
@@ -58,7 +60,9 @@ fn pair_difference(exp: &Experiment, dt: f64) -> (f64, f64) {
             ..AmmSettings::default()
         };
         let t = std::time::Instant::now();
-        let r = solve(&e, &s).expect("solve");
+        let r = flexstar_amm::solve(&e, &s, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .expect("solve");
         (r, t.elapsed().as_secs_f64())
     };
     let (a, ta) = run(n);

@@ -6,7 +6,6 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use flexstar_amm::solve;
 use flexstar_model::{ModeFamily, Response};
 
 /// EVP of every tip and of w_iG between two responses; "-" where the reference is ~0 by symmetry.
@@ -40,8 +39,20 @@ fn main() {
             for fam in ModeFamily::PAPER {
                 let n = std::env::var("AMM_N").ok().and_then(|s| s.parse().ok()).unwrap_or(25);
                 for &h in &steps {
-                    let a = solve(&exp, &common::settings(fam, n, Some(h))).unwrap();
-                    let b = solve(&exp, &common::settings(fam, n, Some(h / 2.0))).unwrap();
+                    let a = flexstar_amm::solve(
+                        &exp,
+                        &common::settings(fam, n, Some(h)),
+                        flexstar_drive::SolveRequest::motion(),
+                    )
+                    .map(|s| s.response)
+                    .unwrap();
+                    let b = flexstar_amm::solve(
+                        &exp,
+                        &common::settings(fam, n, Some(h / 2.0)),
+                        flexstar_drive::SolveRequest::motion(),
+                    )
+                    .map(|s| s.response)
+                    .unwrap();
                     let (cells, _) = row(&a, &b);
                     println!("| {case} | {fam} | {h:.3e} | {} |", cells.join(" | "));
                 }
@@ -66,7 +77,9 @@ fn main() {
                         dt: Some(dt),
                         ..flexstar_model::AmmSettings::accurate()
                     };
-                    solve(&exp, &s).unwrap()
+                    flexstar_amm::solve(&exp, &s, flexstar_drive::SolveRequest::motion())
+                        .map(|s| s.response)
+                        .unwrap()
                 };
                 let p = flexstar_model::evp::point_evps(&at(h), &at(h / 2.0)).unwrap();
                 let cells: Vec<String> = p
@@ -90,7 +103,9 @@ fn main() {
                 dt: Some(flexstar_amm::TOLERANCE_DT),
                 ..flexstar_model::AmmSettings::accurate()
             };
-            solve(exp, &s).unwrap()
+            flexstar_amm::solve(exp, &s, flexstar_drive::SolveRequest::motion())
+                .map(|s| s.response)
+                .unwrap()
         };
         let mean = |a: &Response, b: &Response| flexstar_model::evp::point_evps(a, b).unwrap().mean.unwrap();
         println!("| case | N | true truncation (vs N = 150) [%] | estimate (vs previous N) [%] | ratio |");
@@ -114,7 +129,13 @@ fn main() {
             let exp = common::paper_case(case);
             for fam in ModeFamily::PAPER {
                 for n in [25, 50, 100] {
-                    let r = solve(&exp, &common::settings(fam, n, None)).unwrap();
+                    let r = flexstar_amm::solve(
+                        &exp,
+                        &common::settings(fam, n, None),
+                        flexstar_drive::SolveRequest::motion(),
+                    )
+                    .map(|s| s.response)
+                    .unwrap();
                     let mm = |v: &[f64]| format!("{:.3}", common::max_abs(v) * 1e3);
                     let cells: Vec<String> = r.w_tip.iter().chain(r.w_g.iter()).map(|v| mm(v)).collect();
                     let fa = r.fa.iter().map(|v| common::max_abs(v)).fold(0.0, f64::max);
@@ -129,9 +150,21 @@ fn main() {
         for case in 1..=4 {
             let exp = common::paper_case(case);
             for fam in ModeFamily::PAPER {
-                let reference = solve(&exp, &common::settings(fam, 100, None)).unwrap();
+                let reference = flexstar_amm::solve(
+                    &exp,
+                    &common::settings(fam, 100, None),
+                    flexstar_drive::SolveRequest::motion(),
+                )
+                .map(|s| s.response)
+                .unwrap();
                 for n in [25, 50] {
-                    let r = solve(&exp, &common::settings(fam, n, None)).unwrap();
+                    let r = flexstar_amm::solve(
+                        &exp,
+                        &common::settings(fam, n, None),
+                        flexstar_drive::SolveRequest::motion(),
+                    )
+                    .map(|s| s.response)
+                    .unwrap();
                     let (cells, _) = row(&r, &reference);
                     println!("| {case} | {fam} | {n} | {} |", cells.join(" | "));
                 }
@@ -146,7 +179,15 @@ fn main() {
             for fam in ModeFamily::PAPER {
                 let runs: Vec<Response> = ns
                     .iter()
-                    .map(|&n| solve(&exp, &common::settings(fam, n, None)).unwrap())
+                    .map(|&n| {
+                        flexstar_amm::solve(
+                            &exp,
+                            &common::settings(fam, n, None),
+                            flexstar_drive::SolveRequest::motion(),
+                        )
+                        .map(|s| s.response)
+                        .unwrap()
+                    })
                     .collect();
                 for k in 0..ns.len() - 1 {
                     let (cells, _) = row(&runs[k], &runs[k + 1]);

@@ -8,7 +8,7 @@
 //! (or `valgrind --tool=callgrind`) runs one solve of that kind after a common set-up (the inverse
 //! run whose forces the `forces` kind feeds back is run in every kind; kind `setup` runs only
 //! that), so the counts minus that of `setup` are the solve alone.
-use flexstar_amm::{solve, solve_direct};
+
 use flexstar_drive::{ForceTable, Servo};
 use flexstar_model::catalogue::paper_case;
 use flexstar_model::AmmSettings;
@@ -31,7 +31,9 @@ fn main() {
             ..AmmSettings::accurate()
         },
     };
-    let inverse = solve(&exp, &settings).unwrap();
+    let inverse = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let fa = (0..inverse.len())
         .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
         .collect();
@@ -47,9 +49,9 @@ fn main() {
     };
     let r = match kind.as_str() {
         "setup" => Ok(inverse),
-        "inverse" => solve(&exp, &settings),
-        "forces" => solve_direct(&exp, &settings, &table),
-        _ => solve_direct(&exp, &settings, &servo),
+        "inverse" => flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion()).map(|s| s.response),
+        "forces" => flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&table)).map(|s| s.response),
+        _ => flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&servo)).map(|s| s.response),
     }
     .unwrap();
     eprintln!("{} rows", r.len());

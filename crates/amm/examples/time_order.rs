@@ -7,7 +7,6 @@
 //! with their own e(h) on the grid of the 8 h run, the ratios E(k h, h) / e(h), and the error
 //! estimate the automatic choice reported.
 use flexstar_amm::adaptive::{estimate_grid, time_check_grid};
-use flexstar_amm::solve;
 use flexstar_model::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment, Response};
 
@@ -24,7 +23,9 @@ fn main() {
         let path = std::path::Path::new(&file);
         let text = std::fs::read_to_string(path).expect("readable file");
         let exp = Experiment::from_toml_str(&text, path).expect("valid experiment");
-        let auto = solve(&exp, &exp.amm).expect("automatic choice");
+        let auto = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .expect("automatic choice");
         let (n, h) = (auto.info.modes.expect("N"), auto.info.dt);
         let coarse = estimate_grid(&exp, h).expect("a span long enough for the estimate's grid");
         let run = |step: f64, every: usize| {
@@ -37,7 +38,9 @@ fn main() {
                 frames: 0,
                 ..exp.amm.clone()
             };
-            solve(&e, &s).expect("solve")
+            flexstar_amm::solve(&e, &s, flexstar_drive::SolveRequest::motion())
+                .map(|s| s.response)
+                .expect("solve")
         };
         let check = time_check_grid(&exp, h);
         let [e_check, e2] = {

@@ -20,15 +20,15 @@
 //! the per-step change of s'' times the step (`docs/amm.md` section 10).
 
 use flexstar_drive::ActuatorLaw;
-use flexstar_kinematics::{check_configuration, direct_kinematics, CheckedMotion, RigidState};
-use flexstar_model::{AmmSettings, DriveKind, Experiment, ModeCount, Response, RobotParams};
+use flexstar_kinematics::{check_configuration, direct_kinematics, RigidState};
+use flexstar_model::{AmmSettings, Experiment, ModeCount, Response, RobotParams};
 use flexstar_numerics::GenAlpha;
 use num_dual::{Dual2, HyperDual64};
 
 use crate::adaptive;
 use crate::error::{AmmError, RankError};
 use crate::record::Recorder;
-use crate::solver::{shape_times, stops, validate, Stop, RHO_INF};
+use crate::solver::{shape_times, stops, validate, Stats, Stop, RHO_INF};
 use crate::system::System;
 
 /// Columns a direct run writes first among its extra columns: the sliders `s_i` [m] and `s_i'`
@@ -36,49 +36,38 @@ use crate::system::System;
 /// [m] and `theta` [rad]. The columns of [`crate::EXTRA_COLUMNS`] follow.
 pub const DIRECT_COLUMNS: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "Gy", "theta"];
 
-/// Solve the direct problem: the sliders driven by `law`, from `s(0)`, `s'(0)` of
-/// `exp.trajectory` at t = 0 with the star at rest elastically (as an inverse run starts).
+/// The direct problem (`crate::solve` with `Drive::Law`): the sliders driven by `law`, from `s(0)`,
+/// `s'(0)` of `exp.trajectory` at t = 0 with the star at rest elastically (as an inverse run
+/// starts).
 ///
 /// Returns the response labelled `amm-<family>-direct` (`info.solver = "amm-direct"`): the
 /// standard columns with `Fa_i` the law's forces at the output times, then [`DIRECT_COLUMNS`],
-/// then [`crate::EXTRA_COLUMNS`]. Every family, both models, fixed N or tolerance, as [`crate::solve`].
+/// then [`crate::EXTRA_COLUMNS`]. Every family, both models, fixed N or tolerance, as the
+/// prescribed motion; and the work counters of every integration run.
 ///
-/// The trajectory is scanned for feasibility over the whole span when `exp.drive` is a servo
-/// (it is the reference); otherwise only its start. The configuration reached is checked at every
-/// step: leaving the feasible range stops the run with the time (to one step) and the reason.
-pub fn solve_direct(exp: &Experiment, settings: &AmmSettings, law: &dyn ActuatorLaw) -> Result<Response, AmmError> {
-    solve_direct_scanned(exp, settings, law, exp.drive.kind == DriveKind::Servo)
-}
-
-/// [`solve_direct`] of a servo's reference whose feasibility the caller checked once for all its
-/// runs (see [`crate::solve_checked`]).
-pub fn solve_direct_checked(
-    exp: &Experiment,
-    settings: &AmmSettings,
-    law: &dyn ActuatorLaw,
-    checked: &CheckedMotion,
-) -> Result<Response, AmmError> {
-    let scan = exp.drive.kind == DriveKind::Servo && !crate::solver::covers(checked, exp);
-    solve_direct_scanned(exp, settings, law, scan)
-}
-
-/// [`solve_direct`]; `scan`: check the reference over the whole span (else its start only).
-fn solve_direct_scanned(
+/// `scan`: check the reference over the whole span (a servo's, when the caller holds no proof),
+/// else its start only. The configuration reached is checked at every step: leaving the feasible
+/// range stops the run with the time (to one step) and the reason.
+pub(crate) fn solve_direct_scanned(
     exp: &Experiment,
     settings: &AmmSettings,
     law: &dyn ActuatorLaw,
     scan: bool,
-) -> Result<Response, AmmError> {
-    match settings.mode_count() {
-        ModeCount::Fixed(n) => integrate_direct(exp, settings, law, n, scan),
+) -> Result<(Response, Stats), AmmError> {
+    let mut runs = Vec::new();
+    let response = match settings.mode_count() {
+        ModeCount::Fixed(n) => integrate_direct(exp, settings, law, n, scan, &mut runs)?,
         ModeCount::Tolerance(tol) => {
             validate(exp, settings, adaptive::first_modes(exp), scan)?;
             // the pairs at the delivered step: the coarse-step estimate (`adaptive`) is measured
             // on inverse runs only, and a servo's loop may not tolerate the coarse step
             // (the reference was scanned once just above: not again per N)
-            adaptive::solve_to_tolerance(exp, tol, None, 1, |n, _| integrate_direct(exp, settings, law, n, false))
+            adaptive::solve_to_tolerance(exp, tol, None, 1, |n, _| {
+                integrate_direct(exp, settings, law, n, false, &mut runs)
+            })?
         }
-    }
+    };
+    Ok((response, Stats::from_runs(&runs)))
 }
 
 /// The rigid state of sliders at `s` [m], `sd` [m/s], `sdd` [m/s^2] at time `t`.
@@ -219,7 +208,7 @@ fn solve3(a: [[f64; 4]; 3]) -> Option<[f64; 3]> {
     x.iter().all(|v| v.is_finite()).then(|| [x[0], x[1], x[2]])
 }
 
-/// [`solve_direct`] at N = `n_modes`: the system and recorder set up, the consistent start, then
+/// [`solve_direct_scanned`] at N = `n_modes`: the system and recorder set up, the consistent start, then
 /// generalized-alpha substeps between consecutive stops (output times and snapshots).
 fn integrate_direct(
     exp: &Experiment,
@@ -227,10 +216,12 @@ fn integrate_direct(
     law: &dyn ActuatorLaw,
     n_modes: usize,
     scan: bool,
+    runs: &mut Vec<(usize, usize)>,
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
     let dt_max = validate(exp, settings, n_modes, scan)?;
     let params = &exp.robot;
+    let mut steps = 0;
     let mut sys = crate::solver::build_system(settings, n_modes, exp)?;
     let n = sys.dim();
 
@@ -263,12 +254,14 @@ fn integrate_direct(
         for k in 1..=nsub {
             let t = if k == nsub { t1 } else { t0 + k as f64 * h };
             substep(&mut ctx, &out.rec, &ga, h, t, &mut state, &mut scratch)?;
+            steps += 1;
         }
         out.record(&ctx, &w[1], t1, &state)?;
         if flexstar_model::cancel::cancelled() {
             return Err(AmmError::Cancelled { t: t1 });
         }
     }
+    runs.push((n_modes, steps));
     Ok(out.finish(settings, n_modes, dt_max, started))
 }
 

@@ -10,7 +10,7 @@
 //!   constraints of Eqs. 38-43) and their per-step linear solve;
 //! - [`pose_modes`]: the modes of the star held at rest at one pose, and its linearised system;
 //! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]);
-//! - [`direct`]: the direct problem, sliders driven by forces or a servo ([`solve_direct`], issue 10).
+//! - [`direct`]: the direct problem, sliders driven by forces or a servo ([`solve`] with `Drive::Law`, issue 10).
 //!
 //! Frames and signs follow `docs/conventions.md`; the derivation, the departures from the
 //! printed paper and the convergence study are in `docs/amm.md`. SI units throughout.
@@ -33,12 +33,12 @@ mod sleeve_shift;
 pub mod solver;
 mod system;
 
-pub use direct::{solve_direct, solve_direct_checked, DIRECT_COLUMNS};
+pub use direct::DIRECT_COLUMNS;
 pub use error::{AmmError, RankError};
 pub use modes::{ModeSet, MAX_MODES};
 pub use solver::{
-    beam_time_scale, parse_family, robot_step_factor, solve, solve_checked, solve_with_stats, tolerance_step, Stats,
-    DEFAULT_DT, EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS, TOLERANCE_DT,
+    beam_time_scale, parse_family, robot_step_factor, solve, tolerance_step, Stats, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF,
+    SHAPE_POINTS, TOLERANCE_DT,
 };
 
 /// What a mode family with a hidden support at G loses of the experiment's payload and load

@@ -1,5 +1,5 @@
 //! The outputs of an AMM run at its output times and snapshots (shared by the inverse run,
-//! [`crate::solve`], and the direct run, [`crate::solve_direct`]).
+//! [`crate::solve`] of a prescribed motion, and the direct run, [`crate::solve`] under a law).
 
 use flexstar_kinematics::RigidState;
 use flexstar_model::frames::ShapeTimes;

@@ -9,12 +9,13 @@
 //! drift). The system is linear, so each step is one linear solve (see the private `system` module and `docs/amm.md`).
 //! Initial accelerations are consistent: `M q''(0) = f(0) + C^T lambda(0)`, `C q''(0) = 0`.
 
+use flexstar_drive::{Drive, SolveRequest, Solved};
 use flexstar_kinematics::{
     check_configuration, check_trajectory, preflight_step, CheckedMotion, Infeasible, RigidState,
 };
 use flexstar_model::config::check_step;
 use flexstar_model::frames::{frame_times, ShapeTimes};
-use flexstar_model::{AmmSettings, Experiment, ModeCount, ModeFamily, Response, RunInfo};
+use flexstar_model::{AmmSettings, DriveKind, Experiment, ModeCount, ModeFamily, Response, RunInfo};
 use flexstar_numerics::GenAlpha;
 
 use crate::adaptive::{self, Pass};
@@ -182,10 +183,15 @@ pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
     v
 }
 
-/// Solve the paper's constrained assumed-modes model (Eqs. 30-44) for one experiment.
+/// Solve the paper's constrained assumed-modes model (Eqs. 30-44) for one experiment: the one
+/// entry point of the AMM, for both drives of `request` (`flexstar_drive::SolveRequest`).
 ///
 /// `settings` are the `[amm]` settings after command-line overrides (`exp.amm` is not read).
-/// Returns the response at `exp.time.output_times()`, labelled `amm-<family>`: `w_iG = w_i(0)`,
+/// `request.proof`: the trajectory is scanned for feasibility only when the preflight's proof does
+/// not cover this experiment's robot, trajectory and span. `request.progress` is called once, with
+/// 1, when the solve has finished.
+///
+/// The prescribed motion ([`Drive::Motion`], the inverse problem) returns the response at `exp.time.output_times()`, labelled `amm-<family>`: `w_iG = w_i(0)`,
 /// tip `w_i(L)` (rigid beam frames, `docs/conventions.md`) [m], `Fa_i` (Eq. 33) [N], then the
 /// columns [`EXTRA_COLUMNS`]: every multiplier (Fix [N], MiG [N m], Fw, Fp, FLp, FRp [N],
 /// Mp [N m]), the sleeve rotations thp_i [rad] and the axial displacements u_i [m]; and the
@@ -198,11 +204,26 @@ pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 /// N is `settings.modes` when given; otherwise (`tol`, or the enriched family's default tolerance)
 /// it is raised until the estimated truncation EVP is below the tolerance (`adaptive` module),
 /// and `info.modes` / `info.error_estimate_percent` report the N used and the estimate.
-pub fn solve(exp: &Experiment, settings: &AmmSettings) -> Result<Response, AmmError> {
-    solve_with_stats(exp, settings).map(|(r, _)| r)
+///
+/// An actuator law ([`Drive::Law`], the direct problem) returns the response described in
+/// [`crate::direct`] (labelled `amm-<family>-direct`).
+pub fn solve(exp: &Experiment, settings: &AmmSettings, request: SolveRequest) -> Result<Solved<Stats>, AmmError> {
+    let covered = request.proof.is_some_and(|c| covers(c, exp));
+    let (response, stats) = match request.drive {
+        Drive::Motion => solve_scanned(exp, settings, !covered)?,
+        Drive::Law(law) => {
+            // the direct problem scans a servo's reference (its motion), else the start only
+            let scan = exp.drive.kind == DriveKind::Servo && !covered;
+            crate::direct::solve_direct_scanned(exp, settings, law, scan)?
+        }
+    };
+    if let Some(progress) = request.progress {
+        progress(1.0);
+    }
+    Ok(Solved { response, stats })
 }
 
-/// Work counters of an AMM run ([`solve_with_stats`]). Every integration run solves the
+/// Work counters of an AMM run ([`solve`]). Every integration run solves the
 /// constrained system once for the initial accelerations and once per time step, each solve one
 /// factorisation of the step matrix (the constraints move with t) and one substitution.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -224,7 +245,7 @@ pub struct Stats {
 
 impl Stats {
     /// The counters of the runs `(N, steps)` in the order run, the delivered one last.
-    fn from_runs(runs: &[(usize, usize)]) -> Self {
+    pub(crate) fn from_runs(runs: &[(usize, usize)]) -> Self {
         let total_steps = runs.iter().map(|r| r.1).sum();
         let (modes, steps) = runs.last().copied().unwrap_or_default();
         Stats {
@@ -237,18 +258,6 @@ impl Stats {
     }
 }
 
-/// [`solve`], also returning the work counters (steps, solves, the N used and those tried).
-pub fn solve_with_stats(exp: &Experiment, settings: &AmmSettings) -> Result<(Response, Stats), AmmError> {
-    solve_scanned(exp, settings, true)
-}
-
-/// [`solve`] of a motion whose feasibility the caller checked once for all its runs (the
-/// preflight of `compare`, `verify`, `run`): the trajectory is scanned here only when `checked`
-/// does not cover this experiment's robot, trajectory and span.
-pub fn solve_checked(exp: &Experiment, settings: &AmmSettings, checked: &CheckedMotion) -> Result<Response, AmmError> {
-    solve_scanned(exp, settings, !covers(checked, exp)).map(|(r, _)| r)
-}
-
 /// Does `checked` cover the scan a run of `exp` would make?
 pub(crate) fn covers(checked: &CheckedMotion, exp: &Experiment) -> bool {
     checked.covers(
@@ -259,7 +268,7 @@ pub(crate) fn covers(checked: &CheckedMotion, exp: &Experiment) -> bool {
     )
 }
 
-/// [`solve_with_stats`]; `scan`: check the trajectory's feasibility over the whole span first.
+/// [`solve`] of the prescribed motion; `scan`: check the trajectory's feasibility over the whole span first.
 fn solve_scanned(exp: &Experiment, settings: &AmmSettings, scan: bool) -> Result<(Response, Stats), AmmError> {
     let mut runs = Vec::new();
     let resp = match settings.mode_count() {

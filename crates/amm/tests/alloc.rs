@@ -6,7 +6,6 @@ mod common;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use flexstar_amm::solve;
 use flexstar_model::{AmmModel, ModeFamily};
 
 /// Counts allocations made by the current thread (the test harness's other threads are ignored).
@@ -43,7 +42,9 @@ fn allocations(dt: f64, model: AmmModel) -> usize {
     }
     s.snapshots = vec![0.2];
     let before = COUNT.with(|c| c.get());
-    let r = solve(&exp, &s).unwrap();
+    let r = flexstar_amm::solve(&exp, &s, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let after = COUNT.with(|c| c.get());
     assert_eq!(r.len(), 501);
     after - before

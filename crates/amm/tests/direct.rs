@@ -8,7 +8,7 @@ mod rigid_forward;
 mod common;
 
 use common::paper_case;
-use flexstar_amm::{solve, solve_direct, DEFAULT_DT};
+use flexstar_amm::DEFAULT_DT;
 use flexstar_drive::{ForceTable, Servo};
 use flexstar_model::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment, Response};
@@ -42,10 +42,16 @@ fn slider_error(exp: &Experiment, direct: &Response) -> f64 {
 
 /// Round trip of one case: inverse run with output every `dt_fa`, its Fa fed back.
 fn round_trip(k: usize, settings: &AmmSettings, t_end: f64, dt_fa: f64) -> (f64, f64) {
-    let inverse_fine = solve(&case(k, t_end, dt_fa), settings).unwrap();
+    let inverse_fine = flexstar_amm::solve(&case(k, t_end, dt_fa), settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let exp = case(k, t_end, 1e-3);
-    let inverse = solve(&exp, settings).unwrap();
-    let direct = solve_direct(&exp, settings, &table(&inverse_fine)).unwrap();
+    let inverse = flexstar_amm::solve(&exp, settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
+    let direct = flexstar_amm::solve(&exp, settings, flexstar_drive::SolveRequest::law(&table(&inverse_fine)))
+        .map(|s| s.response)
+        .unwrap();
     let ds = slider_error(&exp, &direct);
     let evp = point_evps(&direct, &inverse).unwrap();
     let worst = evp.points.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
@@ -70,9 +76,15 @@ fn round_trip_gives_the_motion_back_in_every_paper_case() {
 fn round_trip_exp(exp: &Experiment, settings: &AmmSettings, dt_fa: f64) -> (f64, f64) {
     let mut fine = exp.clone();
     fine.time.dt_out = dt_fa;
-    let inverse_fine = solve(&fine, settings).unwrap();
-    let inverse = solve(exp, settings).unwrap();
-    let direct = solve_direct(exp, settings, &table(&inverse_fine)).unwrap();
+    let inverse_fine = flexstar_amm::solve(&fine, settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
+    let inverse = flexstar_amm::solve(exp, settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
+    let direct = flexstar_amm::solve(exp, settings, flexstar_drive::SolveRequest::law(&table(&inverse_fine)))
+        .map(|s| s.response)
+        .unwrap();
     let ds = slider_error(exp, &direct);
     let evp = point_evps(&direct, &inverse).unwrap();
     let worst = evp.points.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
@@ -122,8 +134,12 @@ fn stiff_servo_reproduces_the_prescribed_motion() {
             params: exp.robot,
             attached: Default::default(),
         };
-        let inverse = solve(&exp, &exp.amm).unwrap();
-        let direct = solve_direct(&exp, &exp.amm, &servo).unwrap();
+        let inverse = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap();
+        let direct = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::law(&servo))
+            .map(|s| s.response)
+            .unwrap();
         let ds = slider_error(&exp, &direct);
         let evp = point_evps(&direct, &inverse).unwrap();
         let tips = evp.points[..3].iter().flatten().fold(0.0f64, |m, v| m.max(*v));
@@ -166,7 +182,9 @@ fn leaving_the_feasible_range_stops_with_time_and_reason() {
     let push = flexstar_drive::ForcePolynomials {
         coefficients: [vec![50.0], vec![0.0], vec![0.0]],
     };
-    let err = solve_direct(&exp, &exp.amm, &push).unwrap_err();
+    let err = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::law(&push))
+        .map(|s| s.response)
+        .unwrap_err();
     let msg = err.to_string();
     eprintln!("{msg}");
     match err {
@@ -182,8 +200,12 @@ fn automatic_n_runs_the_direct_problem_too() {
     // inverse run's forces (every solver step) picks the same N and gives the same vibration
     let mut exp = case(3, 0.1, DEFAULT_DT);
     exp.amm = AmmSettings::accurate();
-    let inverse = solve(&exp, &exp.amm).unwrap();
-    let direct = solve_direct(&exp, &exp.amm, &table(&inverse)).unwrap();
+    let inverse = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
+    let direct = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::law(&table(&inverse)))
+        .map(|s| s.response)
+        .unwrap();
     assert_eq!(direct.info.modes, inverse.info.modes);
     assert!(direct.info.error_estimate_percent.is_some());
     assert_eq!(direct.info.solver, "amm-direct");
@@ -213,7 +235,9 @@ fn stiff_limit_matches_the_rigid_forward_dynamics() {
             attached: Default::default(),
         };
         let settings = AmmSettings::paper(flexstar_model::ModeFamily::FreeFree, 25);
-        let r = solve_direct(&exp, &settings, &law).unwrap();
+        let r = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&law))
+            .map(|s| s.response)
+            .unwrap();
         let s0 = exp.trajectory.s(&robot, 0.0).unwrap();
         let v0 = exp.trajectory.jets(&robot, 0.0).unwrap().map(|j| j.d1);
         let reference = rigid_forward_dynamics(&robot, s0, v0, &law, exp.time.t_end, exp.time.dt_out, 1e-4).unwrap();

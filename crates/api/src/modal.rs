@@ -15,7 +15,8 @@ use flexstar_model::{DriveKind, Experiment, ModeFamily, RestPose, Sliders};
 use flexstar_plot::write_svg_png;
 use serde_json::{json, Map, Value};
 
-pub use flexstar_modal::freqmap::{MapPoint, Solver as MapSolver};
+pub use flexstar_modal::freqmap::MapPoint;
+use flexstar_solve::Solver;
 
 use crate::sidecar::TableSidecar;
 use crate::solver_errors::{from_amm, from_fem};
@@ -216,7 +217,7 @@ pub struct FreqmapSettings {
     pub gy: Axis,
     pub theta: f64,
     pub k: usize,
-    pub solver: MapSolver,
+    pub solver: Solver,
     pub sliders: Sliders,
     pub force: bool,
 }
@@ -230,8 +231,8 @@ pub fn parse_axis(flag: &str, text: &str) -> Result<Axis> {
 fn freqmap_settings(exp: &Experiment, s: &FreqmapSettings) -> Map<String, Value> {
     let axis = |a: &Axis| json!({ "min": a.min, "max": a.max, "n": a.n });
     let solver = match s.solver {
-        MapSolver::Amm => amm_json(exp),
-        MapSolver::Fem => fem_json(exp),
+        Solver::Amm => amm_json(exp),
+        Solver::Fem => fem_json(exp),
     };
     let mut m = Map::new();
     m.insert("solver".into(), solver);
@@ -298,8 +299,8 @@ where
 /// The heat map of a frequency map, the experiment's path G(t) over it.
 fn freqmap_figure(exp: &Experiment, s: &FreqmapSettings, points: Vec<MapPoint>) -> FreqMapFigure {
     let solver = match s.solver {
-        MapSolver::Amm => "AMM",
-        MapSolver::Fem => "FEM",
+        Solver::Amm => "AMM",
+        Solver::Fem => "FEM",
     };
     FreqMapFigure {
         name: "freqmap".into(),

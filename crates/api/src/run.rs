@@ -14,14 +14,7 @@ use flexstar_model::{AmmModel, DriveKind, DriveSettings, Experiment, ForceSample
 use crate::solver_errors::{from_amm, from_fem};
 use crate::{ApiError, Result};
 
-/// Which model solves the experiment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Solver {
-    /// The paper's constrained assumed-modes method.
-    Amm,
-    /// The independent finite-element reference.
-    Fem,
-}
+pub use flexstar_solve::Solver;
 
 /// Actuator forces that replace the experiment's `[drive]` (the direct problem).
 #[derive(Debug, Clone, PartialEq)]
@@ -300,43 +293,17 @@ fn apply_fem(exp: &mut Experiment, source: &str, s: &RunSettings) -> Result<Stri
     Ok("fem".to_string())
 }
 
-/// The actuator law of a direct run's drive.
-fn law_of(p: &Prepared) -> Result<Box<dyn flexstar_drive::ActuatorLaw>> {
-    flexstar_drive::law_for(&p.exp)
-        .map_err(|e| ApiError::config(&p.source, Some("drive"), e.to_string()))?
-        .ok_or_else(|| ApiError::config(&p.source, None, "the drive is a motion, not a direct problem"))
-}
-
-/// Solve a prepared run; `progress` gets the fraction done of an FEM run (0..1). A servo run's
-/// response gets its tracking errors `e1..e3`.
+/// Solve a prepared run; `progress` gets the fraction done (an FEM run at every output time, an
+/// AMM run at its end), 0..1. A servo run's response gets its tracking errors `e1..e3`.
 pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Response> {
-    let law = if p.direct { Some(law_of(p)?) } else { None };
     let exp = &p.exp;
-    let checked = p.checked.as_ref();
-    let mut r = match (p.solver, &law) {
-        (Solver::Amm, Some(law)) => match checked {
-            Some(c) => flexstar_amm::solve_direct_checked(exp, &exp.amm, law.as_ref(), c),
-            None => flexstar_amm::solve_direct(exp, &exp.amm, law.as_ref()),
-        }
-        .map_err(|e| p.amm_error(e))?,
-        (Solver::Amm, None) => match checked {
-            Some(c) => flexstar_amm::solve_checked(exp, &exp.amm, c),
-            None => flexstar_amm::solve(exp, &exp.amm),
-        }
-        .map_err(|e| p.amm_error(e))?,
-        (Solver::Fem, Some(law)) => {
-            flexstar_fem::solve_direct(exp, &exp.fem, law.as_ref(), progress).map_err(|e| from_fem(&p.source, e))?
-        }
-        (Solver::Fem, None) => match checked {
-            Some(c) => flexstar_fem::solve_checked(exp, &exp.fem, c, progress),
-            None => flexstar_fem::solve(exp, &exp.fem, progress),
-        }
-        .map_err(|e| from_fem(&p.source, e))?,
-    };
-    if p.direct && exp.drive.kind == DriveKind::Servo {
-        flexstar_drive::add_tracking_errors(&mut r, exp).map_err(|e| ApiError::solver(&p.source, e))?;
-    }
-    Ok(r)
+    let settings = flexstar_solve::Settings::of(exp, p.solver);
+    flexstar_solve::response(exp, settings, p.checked.as_ref(), progress).map_err(|e| match e {
+        flexstar_solve::SolveError::Amm(e) => p.amm_error(e),
+        flexstar_solve::SolveError::Fem(e) => from_fem(&p.source, e),
+        flexstar_solve::SolveError::Drive(e) => ApiError::config(&p.source, Some("drive"), e.to_string()),
+        flexstar_solve::SolveError::Tracking(e) => ApiError::solver(&p.source, e),
+    })
 }
 
 /// Solve a prepared run and build its outcome (sidecar document, validity warning); nothing is

@@ -83,7 +83,9 @@ fn unshaped_run(exp: &Experiment, t_end: f64) -> Result<flexstar_model::Response
         snapshots: Vec::new(),
         ..exp.amm.clone()
     };
-    flexstar_amm::solve(&x, &settings).map_err(|e| format!("the unshaped AMM run: {e}"))
+    flexstar_amm::solve(&x, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .map_err(|e| format!("the unshaped AMM run: {e}"))
 }
 
 /// `|a_g|` [m] per group: the least-squares fit of `w_iG(t_rest + tau)`, tau in [0, window], by

@@ -28,7 +28,11 @@ fn main() {
     }
     let fems: Vec<_> = cases
         .par_iter()
-        .map(|e| flexstar_fem::solve(e, &e.fem, None).expect("fem"))
+        .map(|e| {
+            flexstar_fem::solve(e, &e.fem, flexstar_drive::SolveRequest::motion())
+                .map(|s| s.response)
+                .expect("fem")
+        })
         .collect();
     for spec in &args[2..] {
         let mut settings = AmmSettings {
@@ -47,13 +51,14 @@ fn main() {
         }
         for (e, fem) in cases.iter().zip(&fems) {
             let started = std::time::Instant::now();
-            let amm = match flexstar_amm::solve(e, &settings) {
-                Ok(r) => r,
-                Err(err) => {
-                    println!("{} {spec}: {err}", e.name);
-                    continue;
-                }
-            };
+            let amm =
+                match flexstar_amm::solve(e, &settings, flexstar_drive::SolveRequest::motion()).map(|s| s.response) {
+                    Ok(r) => r,
+                    Err(err) => {
+                        println!("{} {spec}: {err}", e.name);
+                        continue;
+                    }
+                };
             let wall = started.elapsed().as_secs_f64();
             let p = point_evps(&amm, fem).expect("evp");
             let pts: Vec<String> = p

@@ -46,7 +46,9 @@ fn amm(exp: &Experiment, n: usize, model: AmmModel) -> Response {
         model,
         ..AmmSettings::accurate()
     };
-    flexstar_amm::solve(exp, &settings).expect("amm")
+    flexstar_amm::solve(exp, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .expect("amm")
 }
 
 fn fem(exp: &Experiment, elements: usize, dt: Option<f64>) -> Response {
@@ -55,7 +57,9 @@ fn fem(exp: &Experiment, elements: usize, dt: Option<f64>) -> Response {
         dt,
         ..FemSettings::default()
     };
-    flexstar_fem::solve(exp, &settings, None).expect("fem")
+    flexstar_fem::solve(exp, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .expect("fem")
 }
 
 fn show(what: &str, test: &Response, reference: &Response) {

@@ -11,6 +11,7 @@ use std::time::Instant;
 
 use flexstar_kinematics::{check_motion, preflight_step, CheckedMotion};
 use flexstar_model::{AmmSettings, Experiment, ModeFamily, Response};
+use flexstar_solve::{Settings, SolveError};
 use rayon::prelude::*;
 
 /// One AMM run of an experiment: a label (unique within the experiment, used as column name,
@@ -61,8 +62,9 @@ pub struct CaseSpec {
     pub amm: Vec<AmmRun>,
     /// Further AMM runs reported as mean EVPs only (the N study of `verify`).
     pub extra: Vec<AmmRun>,
-    /// A refined FEM that error estimates are judged against (`verify`, issue 21 item 3: the
-    /// estimate is compared with the true EVP against the converged FEM); `None`: no such run.
+    /// A refined FEM that error estimates are judged against (`verify`, `docs/validation.md`
+    /// section 8: the estimate is compared with the true EVP against the converged FEM); `None`:
+    /// no such run.
     pub reference: Option<flexstar_model::FemSettings>,
 }
 
@@ -107,82 +109,6 @@ pub enum RunError {
         #[source]
         source: Box<flexstar_fem::FemError>,
     },
-}
-
-/// Why a solver run of an experiment failed.
-#[derive(Debug, thiserror::Error)]
-pub enum SolveError {
-    #[error(transparent)]
-    Amm(#[from] flexstar_amm::AmmError),
-    #[error(transparent)]
-    Fem(#[from] flexstar_fem::FemError),
-    #[error(transparent)]
-    Drive(#[from] flexstar_drive::DriveError),
-}
-
-/// The AMM run of `exp` with `settings`, for the experiment's drive: the inverse problem (motion
-/// prescribed, `flexstar_amm::solve`) or the direct one (forces or a servo,
-/// `flexstar_amm::solve_direct`; a servo's run gains the tracking errors `e1..e3`).
-///
-/// `checked`: the preflight's proof that the motion is feasible (the solver then does not scan it
-/// again); `None`: the solver scans it.
-pub fn solve_amm(
-    exp: &Experiment,
-    settings: &AmmSettings,
-    checked: Option<&CheckedMotion>,
-) -> Result<Response, SolveError> {
-    match (flexstar_drive::law_for(exp)?, checked) {
-        (None, None) => Ok(flexstar_amm::solve(exp, settings)?),
-        (None, Some(c)) => Ok(flexstar_amm::solve_checked(exp, settings, c)?),
-        (Some(law), checked) => {
-            let mut r = match checked {
-                None => flexstar_amm::solve_direct(exp, settings, law.as_ref())?,
-                Some(c) => flexstar_amm::solve_direct_checked(exp, settings, law.as_ref(), c)?,
-            };
-            add_servo_columns(exp, &mut r)?;
-            Ok(r)
-        }
-    }
-}
-
-/// The refined FEM the accurate model's error estimate is judged against (issue 21 item 3:
-/// "never below half the true EVP against the converged FEM"): four times the elements and an
-/// eighth of the default step. *Measured* on case 4, the accurate model's mean EVP against it is
-/// 0.1273 % (0.1218 % at a quarter of the step, 0.2 % at the default FEM: the reference's own
-/// error is of the size of the model's), about 2 % below the Richardson limit of the two.
-pub fn reference_fem(exp: &Experiment) -> flexstar_model::FemSettings {
-    flexstar_model::FemSettings {
-        elements: 4 * exp.fem.elements,
-        dt: Some(exp.fem.dt.unwrap_or_else(|| flexstar_fem::default_dt(&exp.robot)) / 8.0),
-        snapshots: Vec::new(),
-        frames: 0,
-        ..exp.fem.clone()
-    }
-}
-
-/// The FEM run of `exp` with `settings` for the experiment's drive (see [`solve_amm`]).
-pub fn solve_fem(
-    exp: &Experiment,
-    settings: &flexstar_model::FemSettings,
-    checked: Option<&CheckedMotion>,
-    progress: Option<&(dyn Fn(f64) + Sync)>,
-) -> Result<Response, SolveError> {
-    match (flexstar_drive::law_for(exp)?, checked) {
-        (None, None) => Ok(flexstar_fem::solve(exp, settings, progress)?),
-        (None, Some(c)) => Ok(flexstar_fem::solve_checked(exp, settings, c, progress)?),
-        (Some(law), _) => {
-            let mut r = flexstar_fem::solve_direct(exp, settings, law.as_ref(), progress)?;
-            add_servo_columns(exp, &mut r)?;
-            Ok(r)
-        }
-    }
-}
-
-fn add_servo_columns(exp: &Experiment, r: &mut Response) -> Result<(), flexstar_drive::DriveError> {
-    if exp.drive.kind == flexstar_model::DriveKind::Servo {
-        flexstar_drive::add_tracking_errors(r, exp)?;
-    }
-    Ok(())
 }
 
 /// Progress of a batch of runs, as reported to the caller's callback.
@@ -324,7 +250,7 @@ fn run_error(file: String, label: &str, e: SolveError) -> RunError {
             file,
             source: Box::new(source),
         },
-        SolveError::Drive(e) => RunError::Input {
+        SolveError::Drive(e) | SolveError::Tracking(e) => RunError::Input {
             file,
             reason: e.to_string(),
         },
@@ -407,14 +333,14 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
                 Job::Fem(k) => {
                     let exp = &specs[k].exp;
                     let tick = |f: f64| tracker.set(j, f, false);
-                    solve_fem(exp, &exp.fem, Some(&checked.motions[k]), Some(&tick))
+                    flexstar_solve::response(exp, Settings::Fem(&exp.fem), Some(&checked.motions[k]), Some(&tick))
                         .map_err(|e| run_error(file(k), "fem", e))
                 }
                 Job::Reference(k) => {
                     let exp = &specs[k].exp;
                     let settings = specs[k].reference.as_ref().unwrap_or(&exp.fem);
                     let tick = |f: f64| tracker.set(j, f, false);
-                    solve_fem(exp, settings, Some(&checked.motions[k]), Some(&tick))
+                    flexstar_solve::response(exp, Settings::Fem(settings), Some(&checked.motions[k]), Some(&tick))
                         .map_err(|e| run_error(file(k), "fem (refined reference)", e))
                 }
                 Job::Amm(k, i) | Job::Extra(k, i) => {
@@ -422,7 +348,8 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
                         Job::Amm(..) => &specs[k].amm[i],
                         _ => &specs[k].extra[i],
                     };
-                    solve_amm(&specs[k].exp, &run.settings, Some(&checked.motions[k]))
+                    let settings = Settings::Amm(&run.settings);
+                    flexstar_solve::response(&specs[k].exp, settings, Some(&checked.motions[k]), None)
                         .map_err(|e| run_error(file(k), &run.label, e))
                 }
             })?;

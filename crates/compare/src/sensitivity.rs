@@ -161,7 +161,10 @@ fn measured_points(exp: &Experiment, sh: &ShaperSection) -> Result<Vec<(f64, f64
     };
     let peaks: Vec<f64> = jobs
         .par_iter()
-        .map(|(_, x, t_rest)| crate::runs::solve_amm(x, &settings, None).map(|r| residual_peak(&r, *t_rest)))
+        .map(|(_, x, t_rest)| {
+            flexstar_solve::response(x, flexstar_solve::Settings::Amm(&settings), None, None)
+                .map(|r| residual_peak(&r, *t_rest))
+        })
         .collect::<Result<_, _>>()
         .map_err(|e| Error::Input {
             file: exp.source.display().to_string(),

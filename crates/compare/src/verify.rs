@@ -83,7 +83,7 @@ pub fn verify_spec(exp: Experiment, modes: usize, n_study: &[usize]) -> CaseSpec
                 .collect::<Vec<_>>()
         })
         .collect();
-    let reference = Some(crate::runs::reference_fem(&exp));
+    let reference = Some(flexstar_solve::reference_fem(&exp));
     CaseSpec {
         exp,
         amm,

@@ -28,8 +28,10 @@ pub trait ActuatorLaw: Send + Sync {
 }
 
 mod laws;
+mod request;
 
 pub use laws::{ForcePolynomials, ForceTable, ReferencePoint, RigidInverseForces, Servo};
+pub use request::{Drive, Progress, SolveRequest, Solved};
 
 use flexstar_model::{DriveKind, Experiment, Feedforward};
 

@@ -32,7 +32,13 @@ fn bench(c: &mut Criterion) {
             elements,
             ..FemSettings::default()
         };
-        g.bench_function(name, |b| b.iter(|| flexstar_fem::solve(&exp, &settings, None).unwrap()));
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+                    .map(|s| s.response)
+                    .unwrap()
+            })
+        });
     }
     let mut attached = catalogue::paper_case(2);
     attached.payload = flexstar_model::Payload {
@@ -48,21 +54,35 @@ fn bench(c: &mut Criterion) {
     );
     let settings = FemSettings::default();
     g.bench_function("case2_0.4s_300el_payload_damping_load", |b| {
-        b.iter(|| flexstar_fem::solve(&attached, &settings, None).unwrap())
+        b.iter(|| {
+            flexstar_fem::solve(&attached, &settings, flexstar_drive::SolveRequest::motion())
+                .map(|s| s.response)
+                .unwrap()
+        })
     });
     let mut exp = catalogue::paper_case(2);
     exp.time.dt_out = flexstar_fem::DEFAULT_DT;
     let settings = FemSettings::default();
-    let inverse = flexstar_fem::solve(&exp, &settings, None).unwrap();
+    let inverse = flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let rows = (0..inverse.len())
         .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
         .collect();
     let table = ForceTable::new(inverse.t.clone(), rows).unwrap();
     g.bench_function("case2_0.4s_300el_inverse_every_step", |b| {
-        b.iter(|| flexstar_fem::solve(&exp, &settings, None).unwrap())
+        b.iter(|| {
+            flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+                .map(|s| s.response)
+                .unwrap()
+        })
     });
     g.bench_function("case2_0.4s_300el_direct_forces", |b| {
-        b.iter(|| flexstar_fem::solve_direct(&exp, &settings, &table, None).unwrap())
+        b.iter(|| {
+            flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&table))
+                .map(|s| s.response)
+                .unwrap()
+        })
     });
     let (kp, kd) = Servo::gains_from_bandwidth(exp.robot.mpp_mpa, 20.0, 0.7);
     let servo = Servo {
@@ -74,7 +94,11 @@ fn bench(c: &mut Criterion) {
         attached: Default::default(),
     };
     g.bench_function("case2_0.4s_300el_direct_servo20hz", |b| {
-        b.iter(|| flexstar_fem::solve_direct(&exp, &settings, &servo, None).unwrap())
+        b.iter(|| {
+            flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&servo))
+                .map(|s| s.response)
+                .unwrap()
+        })
     });
     g.finish();
 }

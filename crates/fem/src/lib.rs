@@ -8,7 +8,7 @@
 //! border, `bordered`). The driving forces follow from the pin
 //! reactions (Eq. 33). Its equations use only the robot parameters, `s_i(t)` and the start
 //! configuration; the rigid (Fermat-point) kinematics appears only as initial data and in the
-//! post-processing of [`solve`] (projection onto the rigid frames). [`solve_direct`] solves the
+//! post-processing of [`solve`] (projection onto the rigid frames). [`solve`] with a law solves the
 //! direct problem (issue 10): the sliders, bodies of mass `mpp + mpa`, move under an actuator law
 //! (`flexstar_drive`), their coordinates unknowns of the same equations. Both carry an
 //! experiment's payload at G, Kelvin-Voigt damping of the beams and load at G (issue 22,
@@ -30,8 +30,5 @@ mod star;
 
 pub use error::{FemError, LinearError, NewtonFailure, PivotError};
 pub use integrator::{Fallback, Stats};
-pub use solve::{
-    default_dt, first_beam_frequency, solve, solve_checked, solve_direct, solve_direct_with_stats, solve_with_stats,
-    DEFAULT_DT, DEFAULT_RHO_INF, MIN_DEFAULT_DT,
-};
+pub use solve::{default_dt, first_beam_frequency, solve, DEFAULT_DT, DEFAULT_RHO_INF, MIN_DEFAULT_DT};
 pub use star::InitialState;

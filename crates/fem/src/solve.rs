@@ -1,9 +1,8 @@
-//! The public entry points: run the FEM on an experiment, the inverse problem ([`solve`]: motion
-//! given, forces found) or the direct one ([`solve_direct`]: forces or a servo given, motion
-//! found), and post-process its absolute results into the shared [`Response`] (projections of
+//! The public entry point [`solve`]: run the FEM on an experiment, the inverse problem (motion
+//! given, forces found) or the direct one (forces or a servo given, motion found), and post-process its absolute results into the shared [`Response`] (projections of
 //! `docs/conventions.md`).
 
-use flexstar_drive::ActuatorLaw;
+use flexstar_drive::{ActuatorLaw, Drive, SolveRequest, Solved};
 use flexstar_kinematics::{check_trajectory, direct_kinematics, preflight_step, CheckedMotion, RigidState};
 use flexstar_model::frames::{frame_times, ShapeTimes};
 use flexstar_model::geometry::{e_w, e_x};
@@ -70,7 +69,7 @@ const EXTRA: [&str; 17] = [
     "slopeG",
 ];
 
-/// Extra columns a direct run writes first (see [`solve_direct`]).
+/// Extra columns a direct run writes first (see [`solve`] with [`Drive::Law`]).
 const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "Gy", "theta"];
 
 /// Run the finite-element reference on `exp` with `settings` (which override `exp.fem`).
@@ -97,37 +96,22 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 /// - `shapes`: the deformed star at `settings.snapshots` and at t_end.
 ///
 /// `progress` receives the fraction of the time span done, in [0, 1].
-pub fn solve(
-    exp: &Experiment,
-    settings: &FemSettings,
-    progress: Option<&(dyn Fn(f64) + Sync)>,
-) -> Result<Response, FemError> {
-    solve_with_stats(exp, settings, progress).map(|(r, _)| r)
+///
+/// The one entry point of the FEM, for both drives of `request` (`flexstar_drive::SolveRequest`):
+/// the prescribed motion ([`Drive::Motion`], described above; its feasibility is scanned first
+/// unless `request.proof` covers the run) or an actuator law ([`Drive::Law`], see
+/// the direct dynamics below). `request.progress` receives the fraction of the time span done, in [0, 1].
+/// Returns the response and the work counters (steps, Newton iterations, factorisations).
+pub fn solve(exp: &Experiment, settings: &FemSettings, request: SolveRequest) -> Result<Solved<Stats>, FemError> {
+    let (response, stats) = match request.drive {
+        Drive::Motion => solve_prescribed(exp, settings, request.proof, request.progress)?,
+        Drive::Law(law) => solve_direct(exp, settings, law, request.progress)?,
+    };
+    Ok(Solved { response, stats })
 }
 
-/// [`solve`], also returning the work counters (steps, Newton iterations, factorisations).
-pub fn solve_with_stats(
-    exp: &Experiment,
-    settings: &FemSettings,
-    progress: Option<&(dyn Fn(f64) + Sync)>,
-) -> Result<(Response, Stats), FemError> {
-    solve_scanned(exp, settings, None, progress)
-}
-
-/// [`solve`] of a motion whose feasibility the caller checked once for all its runs (the
-/// preflight of `compare`, `verify`, `run`): the trajectory is scanned here only when `checked`
-/// does not cover this experiment's robot, trajectory and span.
-pub fn solve_checked(
-    exp: &Experiment,
-    settings: &FemSettings,
-    checked: &CheckedMotion,
-    progress: Option<&(dyn Fn(f64) + Sync)>,
-) -> Result<Response, FemError> {
-    solve_scanned(exp, settings, Some(checked), progress).map(|(r, _)| r)
-}
-
-/// [`solve_with_stats`], the feasibility scan skipped when `checked` covers the run.
-fn solve_scanned(
+/// [`solve`] of the prescribed motion, the feasibility scan skipped when `checked` covers the run.
+fn solve_prescribed(
     exp: &Experiment,
     settings: &FemSettings,
     checked: Option<&CheckedMotion>,
@@ -176,7 +160,7 @@ fn solve_scanned(
     Ok((resp, hist.stats))
 }
 
-/// Direct dynamics (issue 10): the sliders move under the actuator law `law` instead of
+/// Direct dynamics ([`solve`] with [`Drive::Law`]): the sliders move under the actuator law `law` instead of
 /// following `exp.trajectory`.
 ///
 /// Each slider is a body of mass `mpp + mpa` on its rail, pushed along `+u_i` by
@@ -192,23 +176,13 @@ fn solve_scanned(
 /// run with [`FemError::Infeasible`] (or [`FemError::SleeveOffBeam`]), time and reason, and no
 /// output.
 ///
-/// Returns the response labelled `fem-direct` (`info.solver = "fem-direct"`) at
+/// Returns the response and the work counters; the response labelled `fem-direct` (`info.solver = "fem-direct"`) at
 /// `exp.time.output_times()`: `w_iG`, `w_i(L)` projected on the rigid frames of the *simulated*
 /// sliders' direct kinematics (post-processing only), `Fa_i` [N] the law's forces at the output
 /// time, then the extra columns `s1..3` [m], `sd1..3` [m/s] (simulated sliders), `Gx, Gy` [m],
 /// `theta` [rad] (their rigid pose, Eqs. 4-9), then those of [`solve`] (with `dGx, dGy` and
 /// `slopeG` relative to that pose, `W` the work of the law's forces).
-pub fn solve_direct(
-    exp: &Experiment,
-    settings: &FemSettings,
-    law: &dyn ActuatorLaw,
-    progress: Option<&(dyn Fn(f64) + Sync)>,
-) -> Result<Response, FemError> {
-    solve_direct_with_stats(exp, settings, law, progress).map(|(r, _)| r)
-}
-
-/// [`solve_direct`], also returning the work counters.
-pub fn solve_direct_with_stats(
+fn solve_direct(
     exp: &Experiment,
     settings: &FemSettings,
     law: &dyn ActuatorLaw,

@@ -14,7 +14,7 @@ mod rigid_forward;
 
 use flexstar_drive::RigidInverseForces;
 use flexstar_fem::pose_modes::pose_modes;
-use flexstar_fem::{solve, solve_direct, solve_direct_with_stats, solve_with_stats};
+
 use flexstar_kinematics::{rigid_inverse_dynamics_with, RigidState};
 use flexstar_model::{
     catalogue, Attachments, Damping, Experiment, FemSettings, LoadSettings, Payload, Response, RestPose, RobotParams,
@@ -101,7 +101,9 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
     // every key at zero (an offset alone is no payload; zeta = 0 is beta = 0; an empty [load])
     let mut exp = catalogue::paper_case(3);
     exp.time.t_end = 0.1;
-    let bare = solve(&exp, &coarse(), None).unwrap();
+    let bare = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     exp.payload = Payload {
         mass: 0.0,
         j: 0.0,
@@ -113,7 +115,9 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
         f_hz: Some(4.0),
     };
     exp.load = LoadSettings::polynomials(None, None, None);
-    let zero = solve(&exp, &coarse(), None).unwrap();
+    let zero = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     assert_eq!(zero.header(), bare.header());
     assert_eq!(bits(&zero), bits(&bare));
     // the same in the direct problem
@@ -122,14 +126,20 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
         params: exp.robot,
         attached: Attachments::of(&exp),
     };
-    let d_zero = solve_direct(&exp, &coarse(), &law, None).unwrap();
+    let d_zero = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::law(&law))
+        .map(|s| s.response)
+        .unwrap();
     let mut bare_exp = catalogue::paper_case(3);
     bare_exp.time.t_end = 0.1;
-    let d_bare = solve_direct(&bare_exp, &coarse(), &law, None).unwrap();
+    let d_bare = flexstar_fem::solve(&bare_exp, &coarse(), flexstar_drive::SolveRequest::law(&law))
+        .map(|s| s.response)
+        .unwrap();
     assert_eq!(bits(&d_zero), bits(&d_bare));
     // and each section present adds its column after today's, nothing else
     exp.damping = Damping::with_beta(1e-4);
-    let damped = solve(&exp, &coarse(), None).unwrap();
+    let damped = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let mut header = bare.header();
     header.push("E_d".into());
     assert_eq!(damped.header(), header);
@@ -173,7 +183,9 @@ fn stiff_limit_gives_the_newton_euler_forces_with_payload_and_load() {
             dt: Some(STIFF_DT),
             ..coarse()
         };
-        let r = solve(&exp, &settings, None).unwrap();
+        let r = flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap();
         let (err, evp, dg) = against_rigid_inverse_dynamics(&exp, &r);
         eprintln!(
             "beta {beta:e} s: largest Fa difference {:.4} % of the peak, EVP {evp:.4} %, |dG| {dg:.2e} m",
@@ -201,7 +213,9 @@ fn stiff_limit_direct_follows_the_motion_and_the_forward_dynamics() {
         dt: Some(STIFF_DT),
         ..coarse()
     };
-    let (r, stats) = solve_direct_with_stats(&exp, &settings, &law, None).unwrap();
+    let (r, stats) = flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&law))
+        .map(|s| (s.response, s.stats))
+        .unwrap();
     let s0 = exp.trajectory.s(&exp.robot, 0.0).unwrap();
     let reference = rigid_forward_dynamics_with(
         &exp.robot,
@@ -254,7 +268,9 @@ fn energy_balance_with_payload_load_and_damping() {
     // the drivers' and the load's work = kinetic (beams, sleeves, sliders, payload) + strain
     // energy + dissipated energy. Measured: 9.0e-6 (inverse) and 9.8e-6 (direct) of the work.
     let exp = quintic_experiment(RobotParams::paper(), 0.5, 2e-3);
-    let (r, stats) = solve_with_stats(&exp, &coarse(), None).unwrap();
+    let (r, stats) = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| (s.response, s.stats))
+        .unwrap();
     let (defect, ed, wl) = energy_defect(&r);
     eprintln!(
         "inverse: Eq. C6 defect {defect:.2e} of the work, E_d {ed:.3e} J, W_load {wl:.3e} J, {:.2} Newton iterations per step",
@@ -267,12 +283,16 @@ fn energy_balance_with_payload_load_and_damping() {
     assert!(defect < 1e-4, "Eq. C6 off by {defect} of the work");
     let mut fed = exp.clone();
     fed.time.dt_out = 5e-4;
-    let inverse = solve(&fed, &coarse(), None).unwrap();
+    let inverse = flexstar_fem::solve(&fed, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let rows = (0..inverse.len())
         .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
         .collect();
     let table = flexstar_drive::ForceTable::new(inverse.t.clone(), rows).unwrap();
-    let d = solve_direct(&fed, &coarse(), &table, None).unwrap();
+    let d = flexstar_fem::solve(&fed, &coarse(), flexstar_drive::SolveRequest::law(&table))
+        .map(|s| s.response)
+        .unwrap();
     let (defect, ed, _) = energy_defect(&d);
     eprintln!("direct: Eq. C6 defect {defect:.2e} of the work, E_d {ed:.3e} J");
     assert!(defect < 1e-4, "direct: Eq. C6 off by {defect} of the work");
@@ -320,7 +340,9 @@ fn free_decay_gives_the_first_mode_damping_ratio() {
     let zeta_target = 0.02;
     let mut exp = catalogue::experiment("decay", params, traj, 3.0, 1e-3);
     exp.damping = Damping::with_beta(2.0 * zeta_target / omega1);
-    let r = solve(&exp, &coarse(), None).unwrap();
+    let r = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     for name in ["dGx", "dGy"] {
         let p = peaks(&r.t, col(&r, name), 1.0);
         assert!(p.len() >= 6, "{name}: too few peaks {p:?}");
@@ -355,7 +377,9 @@ fn a_load_step_on_a_bare_g_is_resolved_by_halving_the_step() {
             dt,
             ..FemSettings::default()
         };
-        solve(&exp, &settings, None).unwrap()
+        flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap()
     };
     let (default, fine) = (run(None), run(Some(2e-5)));
     let peak = max_abs(&fine.w_g[1]);

@@ -44,7 +44,13 @@ fn run(elements: usize, dt: f64) -> Response {
         snapshots: vec![],
         frames: 0,
     };
-    flexstar_fem::solve(&catalogue::paper_case(2), &settings, None).expect("FEM run")
+    flexstar_fem::solve(
+        &catalogue::paper_case(2),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .expect("FEM run")
 }
 
 /// Worst relative max-norm error of the six histories of `r` against `reference` (module docs).
@@ -97,7 +103,9 @@ fn paper_cases_work_counts_and_accuracy() {
     ];
     for (case, want) in pinned {
         let exp = catalogue::paper_case(case);
-        let (r, s) = flexstar_fem::solve_with_stats(&exp, &exp.fem, None).expect("FEM run");
+        let (r, s) = flexstar_fem::solve(&exp, &exp.fem, flexstar_drive::SolveRequest::motion())
+            .map(|s| (s.response, s.stats))
+            .expect("FEM run");
         let got = [
             s.steps,
             s.newton_iterations,

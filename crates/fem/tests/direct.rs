@@ -15,7 +15,7 @@
 mod rigid_forward;
 
 use flexstar_drive::{ActuatorLaw, DriveError, ForcePolynomials, ForceTable, RigidInverseForces, Servo};
-use flexstar_fem::{solve, solve_direct, solve_direct_with_stats, solve_with_stats, FemError};
+use flexstar_fem::FemError;
 use flexstar_model::evp::point_evps;
 use flexstar_model::{catalogue, Experiment, FemSettings, Pose, Response, RobotParams, Trajectory};
 use flexstar_numerics::measures::max_abs;
@@ -71,8 +71,12 @@ fn round_trip(exp: &Experiment) -> (f64, f64, f64) {
         dt: Some(exp.time.dt_out.min(5e-4)),
         ..coarse()
     };
-    let inverse = solve(exp, &settings, None).unwrap();
-    let direct = solve_direct(exp, &settings, &forces_of(&inverse), None).unwrap();
+    let inverse = flexstar_fem::solve(exp, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
+    let direct = flexstar_fem::solve(exp, &settings, flexstar_drive::SolveRequest::law(&forces_of(&inverse)))
+        .map(|s| s.response)
+        .unwrap();
     let evp = point_evps(&direct, &inverse).unwrap();
     let worst_evp = evp.points.iter().flatten().fold(0.0f64, |m, e| m.max(*e));
     let (defect, umax) = energy_defect(&direct);
@@ -148,7 +152,9 @@ fn driven_star_balances_work_and_energy_and_a_stiff_servo_tracks() {
     // and reproduce the prescribed-motion run within an EVP of 1 % at every point (measured
     // 0.018 % at most, tracking error 1.2e-7 m).
     let exp = quintic_experiment(RobotParams::paper(), 0.4, 1e-3);
-    let prescribed = solve(&exp, &coarse(), None).unwrap();
+    let prescribed = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     for bandwidth in [20.0, 1000.0] {
         let (kp, kd) = Servo::gains_from_bandwidth(exp.robot.mpp_mpa, bandwidth, 0.7);
         let servo = Servo {
@@ -159,7 +165,9 @@ fn driven_star_balances_work_and_energy_and_a_stiff_servo_tracks() {
             params: exp.robot,
             attached: Default::default(),
         };
-        let (r, stats) = solve_direct_with_stats(&exp, &coarse(), &servo, None).unwrap();
+        let (r, stats) = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::law(&servo))
+            .map(|s| (s.response, s.stats))
+            .unwrap();
         let (worst, umax) = energy_defect(&r);
         let wmax = max_abs(col(&r, "W"));
         let track = slider_error(&exp, &r);
@@ -218,7 +226,9 @@ fn stiff_limit_matches_the_rigid_forward_dynamics() {
             attached: Default::default(),
         };
         let settings = FemSettings { dt, ..coarse() };
-        let r = solve_direct(&exp, &settings, &law, None).unwrap();
+        let r = flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&law))
+            .map(|s| s.response)
+            .unwrap();
         let s0 = exp.trajectory.s(&robot, 0.0).unwrap();
         let reference =
             rigid_forward_dynamics(&robot, s0, [0.0; 3], &law, exp.time.t_end, exp.time.dt_out, 1e-4).unwrap();
@@ -258,7 +268,9 @@ fn leaving_the_feasible_range_stops_with_time_and_reason() {
     let law = ForcePolynomials {
         coefficients: [vec![5.0], vec![0.0], vec![0.0]],
     };
-    let err = solve_direct(&exp, &coarse(), &law, None).unwrap_err();
+    let err = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::law(&law))
+        .map(|s| s.response)
+        .unwrap_err();
     let msg = err.to_string();
     eprintln!("{msg}");
     match err {
@@ -302,7 +314,13 @@ fn a_failing_law_stops_the_run_with_its_time() {
         0.05,
         1e-3,
     );
-    let err = solve_direct(&exp, &coarse(), &FailsLater { t_fail: 0.0102 }, None).unwrap_err();
+    let err = flexstar_fem::solve(
+        &exp,
+        &coarse(),
+        flexstar_drive::SolveRequest::law(&FailsLater { t_fail: 0.0102 }),
+    )
+    .map(|s| s.response)
+    .unwrap_err();
     match &err {
         FemError::Drive { t, .. } => assert!((t - 0.0105).abs() < 1e-12, "{err}"),
         other => panic!("expected a drive error, got {other}"),
@@ -319,9 +337,13 @@ fn direct_response_has_the_contract_columns() {
         0.02,
         1e-3,
     );
-    let (inverse, _) = solve_with_stats(&exp, &coarse(), None).unwrap();
+    let (inverse, _) = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| (s.response, s.stats))
+        .unwrap();
     let law = forces_of(&inverse);
-    let r = solve_direct(&exp, &coarse(), &law, None).unwrap();
+    let r = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::law(&law))
+        .map(|s| s.response)
+        .unwrap();
     let header = r.header();
     let expected = [
         "t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3", "s1", "s2", "s3", "sd1", "sd2",

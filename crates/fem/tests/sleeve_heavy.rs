@@ -48,7 +48,9 @@ fn run(exp: &Experiment, elements: usize, dt: Option<f64>) -> Response {
         snapshots: vec![],
         frames: 0,
     };
-    flexstar_fem::solve(exp, &settings, None).expect("FEM run")
+    flexstar_fem::solve(exp, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .expect("FEM run")
 }
 
 /// Mean EVP [%] of `a` against `b` (Eq. 45).

@@ -48,12 +48,8 @@ impl Axis {
     }
 }
 
-/// Which solver computes the map.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Solver {
-    Amm,
-    Fem,
-}
+/// Which solver computes the map: the workspace's one solver choice.
+pub use flexstar_solve::Solver;
 
 /// One grid point: the pose, and the first K frequencies [Hz] or why the pose is infeasible.
 #[derive(Debug, Clone)]

@@ -127,7 +127,7 @@ impl flexstar_drive::ActuatorLaw for Pulse {
 }
 
 /// The linear model's response to a small force pulse against the nonlinear direct AMM run
-/// (`flexstar_amm::solve_direct`, issue 10: sliders free under prescribed forces, exact
+/// (`flexstar_amm::solve` under a law, issue 10: sliders free under prescribed forces, exact
 /// Fermat-point kinematics, generalized-alpha in time, same N): EVP (Eq. 45) of the slider
 /// displacements and of the tip and G deflections within 1 %. The linear response is integrated
 /// here mode by mode (`eta'' + omega^2 eta = B eta-row . Fa`, RK4 at 1e-5 s) from A, B, C alone.
@@ -152,7 +152,9 @@ fn pulse_response_matches_the_nonlinear_direct_run() {
         tol: None,
         ..exp.amm.clone()
     };
-    let direct = flexstar_amm::solve_direct(&exp, &settings, &pulse).unwrap();
+    let direct = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&pulse))
+        .map(|s| s.response)
+        .unwrap();
     // linear response, modal coordinates
     let (a, b, c) = (ss.a.to_dense(), ss.b.to_dense(), ss.c.to_dense());
     let nr = ss.a.rows() / 2;

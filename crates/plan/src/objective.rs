@@ -115,8 +115,13 @@ impl Evaluator {
         let step = flexstar_kinematics::preflight_step(exp.time.dt_out);
         let checked = flexstar_kinematics::check_motion(&exp.robot, traj, t_end, step)
             .map_err(|e| Rejected::Infeasible(format!("t = {:.4} s: {}", e.t, e.violation)))?;
-        let r =
-            flexstar_amm::solve_checked(&exp, &self.settings, &checked).map_err(|e| Rejected::Solver(e.to_string()))?;
+        let r = flexstar_amm::solve(
+            &exp,
+            &self.settings,
+            flexstar_drive::SolveRequest::motion().with_proof(Some(&checked)),
+        )
+        .map(|s| s.response)
+        .map_err(|e| Rejected::Solver(e.to_string()))?;
         if let Some(v) = flexstar_model::small_deflection_check(&r, exp.robot.l) {
             return Err(Rejected::Solver(format!("outside the small-deflection range: {v}")));
         }

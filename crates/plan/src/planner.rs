@@ -147,7 +147,8 @@ pub fn setup(cfg: &PlanConfig, t_ref: f64, started: Instant) -> Result<Setup, Pl
     exp.trajectory = family.quintic(t_ref);
     let modes = match exp.amm.modes {
         Some(n) => n,
-        None => flexstar_amm::solve(&exp, &exp.amm)
+        None => flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
             .map_err(|e| PlanError::Solver(format!("the plain quintic's AMM run: {e}")))?
             .info
             .modes

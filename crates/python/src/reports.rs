@@ -96,10 +96,7 @@ pub fn freqmap<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let axis =
         |flag: &str, (a, b, n): (f64, f64, usize)| flexstar_api::modal::parse_axis(flag, &format!("{a}:{b}:{n}"));
-    let solver = match convert::solver(solver)? {
-        flexstar_api::Solver::Amm => flexstar_api::modal::MapSolver::Amm,
-        flexstar_api::Solver::Fem => flexstar_api::modal::MapSolver::Fem,
-    };
+    let solver = convert::solver(solver)?;
     let s = flexstar_api::modal::FreqmapSettings {
         gx: axis("gx", gx).map_err(py_err)?,
         gy: axis("gy", gy).map_err(py_err)?,

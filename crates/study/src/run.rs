@@ -20,6 +20,7 @@ use crate::sample::Case;
 use crate::shard::{meta_file, results_file, write_pair, Meta, Shard};
 use crate::spec::{FemReference, Sampling, Solver, Study};
 use crate::table::{header, records_bytes, Row, Table, OK};
+use flexstar_solve::Settings;
 
 /// Where and how to run.
 #[derive(Debug, Clone, Default)]
@@ -251,7 +252,7 @@ enum Failure {
     Invalid(String),
     /// The solver stopped with an error.
     #[error("failed: {0}")]
-    Solver(#[from] flexstar_compare::runs::SolveError),
+    Solver(#[from] flexstar_solve::SolveError),
     /// The solver panicked (its message, if it had one).
     #[error("failed: the solver panicked: {0}")]
     Panicked(String),
@@ -261,12 +262,12 @@ fn solve(exp: &Experiment, solver: Solver, fem_reference: FemReference) -> Solve
     let started = Instant::now();
     let fem = match fem_reference {
         FemReference::Defaults => exp.fem.clone(),
-        FemReference::Refined => flexstar_compare::runs::reference_fem(exp),
+        FemReference::Refined => flexstar_solve::reference_fem(exp),
     };
     let result = catch_unwind(AssertUnwindSafe(|| match solver {
         // each solver scans the case's motion itself: a case's solvers may run in different shards
-        Solver::Amm => flexstar_compare::runs::solve_amm(exp, &exp.amm, None),
-        Solver::Fem => flexstar_compare::runs::solve_fem(exp, &fem, None, None),
+        Solver::Amm => flexstar_solve::response(exp, Settings::Amm(&exp.amm), None, None),
+        Solver::Fem => flexstar_solve::response(exp, Settings::Fem(&fem), None, None),
     }));
     let result = match result {
         Ok(r) => r.map_err(Failure::from),
@@ -304,7 +305,7 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
             .and_then(|(_, (r, _))| r.as_ref().ok())
     };
     let evp = match (response(Solver::Amm), response(Solver::Fem)) {
-        (Some(a), Some(f)) => flexstar_compare::point_evps(a, f).ok(),
+        (Some(a), Some(f)) => flexstar_model::evp::point_evps(a, f).ok(),
         _ => None,
     };
     let exp = exp.as_ref().ok();

@@ -27,24 +27,8 @@ use crate::patch::{self, SCALE_DURATION};
 /// Largest number of cases a study may expand to.
 pub const MAX_CASES: usize = 100_000_000;
 
-/// A solver run on every case.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Solver {
-    /// The assumed-modes model, `flexstar_amm::solve` with the case's `[amm]` settings.
-    Amm,
-    /// The finite-element reference, `flexstar_fem::solve` with the case's `[fem]` settings.
-    Fem,
-}
-
-impl Solver {
-    /// Name in study files and in the `solver` column.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Solver::Amm => "amm",
-            Solver::Fem => "fem",
-        }
-    }
-}
+/// A solver run on every case: the workspace's one solver choice.
+pub use flexstar_solve::Solver;
 
 /// The FEM settings a study's `fem` solver runs with (study key `fem_reference`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -54,7 +38,7 @@ pub enum FemReference {
     Defaults,
     /// The refined reference that `flexstar verify` judges the accurate model against:
     /// four times the elements and an eighth of the step
-    /// ([`flexstar_compare::runs::reference_fem`]; issue 21 item 3).
+    /// ([`flexstar_solve::reference_fem`]; `docs/validation.md` section 8).
     Refined,
 }
 

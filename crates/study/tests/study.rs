@@ -223,8 +223,12 @@ fn rows_match_direct_solves_and_bad_values_become_rows() {
         .replace("s1 = [0.0, 0.0, 1.0]", "s1 = [0.0, 0.0, 0.25]")
         .replace("s3 = [0.0, 0.0, 0.5]", "s3 = [0.0, 0.0, 0.125]");
     let exp = flexstar_model::Experiment::from_toml_str(&text, Path::new("hand.toml")).unwrap();
-    let amm = flexstar_amm::solve(&exp, &exp.amm).unwrap();
-    let fem = flexstar_fem::solve(&exp, &exp.fem, None).unwrap();
+    let amm = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
+    let fem = flexstar_fem::solve(&exp, &exp.fem, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let peak = |h: &[Vec<f64>; 3]| h.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
     let row = |solver: &str| {
         t.rows
@@ -240,7 +244,7 @@ fn rows_match_direct_solves_and_bad_values_become_rows() {
         assert_eq!(f(&row[6]), peak(&r.w_g), "{solver} peak wG");
         assert_eq!(f(&row[7]), peak(&r.fa), "{solver} peak Fa");
     }
-    let evps = flexstar_compare::point_evps(&amm, &fem).unwrap();
+    let evps = flexstar_model::evp::point_evps(&amm, &fem).unwrap();
     assert_eq!(f(&row("amm")[8]), evps.mean.unwrap());
     assert_eq!(row("fem")[8], "");
     // the largest point: at least the mean of the four, and one of them

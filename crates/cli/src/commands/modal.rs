@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use flexstar_api::modal::{FreqmapSettings, LinearizeOptions, LoopKind, MapSolver, PoseSpec};
+use flexstar_api::modal::{FreqmapSettings, LinearizeOptions, LoopKind, PoseSpec};
 use flexstar_model::output::fmt_fixed;
 use flexstar_model::{Experiment, Sliders};
 
@@ -55,13 +55,6 @@ impl From<SlidersArg> for Sliders {
     }
 }
 
-/// Which solver computes a frequency map (`--solver`).
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum SolverArg {
-    Amm,
-    Fem,
-}
-
 /// Modes at a pose from the AMM and the FEM: DIR/<name>/modal.csv and the first six shapes
 #[derive(clap::Args)]
 pub struct ModalArgs {
@@ -102,7 +95,7 @@ pub struct FreqmapArgs {
     k: usize,
     /// Solver of the map
     #[arg(long, value_enum, default_value = "amm")]
-    solver: SolverArg,
+    solver: flexstar_api::Solver,
     /// How the sliders are held (free: f1 is the first elastic frequency, the rigid modes left out)
     #[arg(long, value_enum, default_value = "locked")]
     sliders: SlidersArg,
@@ -186,10 +179,7 @@ pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
         gy: flexstar_api::modal::parse_axis("--gy", &args.gy)?,
         theta: args.theta,
         k: args.k,
-        solver: match args.solver {
-            SolverArg::Amm => MapSolver::Amm,
-            SolverArg::Fem => MapSolver::Fem,
-        },
+        solver: args.solver,
         sliders: Sliders::from(args.sliders),
         force: args.force,
     };

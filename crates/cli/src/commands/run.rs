@@ -6,14 +6,6 @@ use std::path::PathBuf;
 use flexstar_api::{Forces, Prepared, RunOutcome, RunSettings};
 use flexstar_model::ModeFamily;
 
-#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Solver {
-    /// The paper's constrained assumed-modes method
-    Amm,
-    /// The independent finite-element reference
-    Fem,
-}
-
 /// Run a solver on an experiment; writes DIR/<name>/amm-<family>.csv or DIR/<name>/fem.csv
 /// (`t,w1G,w2G,w3G,w1tip,w2tip,w3tip,Fa1,Fa2,Fa3` then more columns) and the deformed star
 /// snapshots in `...-shapes.csv`. With a `[drive]` of kind forces or servo (or `--forces FILE`)
@@ -26,7 +18,7 @@ pub struct Args {
     config: PathBuf,
     /// Which model to run
     #[arg(long, value_enum)]
-    solver: Solver,
+    solver: flexstar_api::Solver,
     /// AMM mode family (overrides [amm] family): pinned-free, slide-free, free-free, clamped-free, enriched
     #[arg(long)]
     family: Option<ModeFamily>,
@@ -63,10 +55,7 @@ impl Args {
     /// The run's settings over the experiment (the flags given).
     fn settings(&self) -> RunSettings {
         RunSettings {
-            solver: match self.solver {
-                Solver::Amm => flexstar_api::Solver::Amm,
-                Solver::Fem => flexstar_api::Solver::Fem,
-            },
+            solver: self.solver,
             family: self.family,
             modes: self.modes,
             model: self.model,

@@ -1,0 +1,188 @@
+//! # flexstar-solve
+//!
+//! One way to solve an experiment: the choice of model ([`Solver`], the one enum of the
+//! workspace) and the one dispatch ([`solve`]) over the solver and the experiment's drive
+//! (prescribed motion, actuator forces or a servo). Every front (`run`, `compare`, `verify`,
+//! studies, the Python package) solves through [`solve`]; each solver has one entry point of the
+//! shape of `flexstar_drive::SolveRequest` (`docs/architecture.md`, "One way to solve").
+
+use flexstar_drive::{ActuatorLaw, Drive, Progress, SolveRequest, Solved};
+use flexstar_kinematics::CheckedMotion;
+use flexstar_model::{AmmSettings, DriveKind, Experiment, FemSettings, Response};
+
+/// Which model solves an experiment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum Solver {
+    /// The paper's constrained assumed-modes method
+    Amm,
+    /// The independent finite-element reference
+    Fem,
+}
+
+impl Solver {
+    /// Both solvers, AMM first.
+    pub const ALL: [Solver; 2] = [Solver::Amm, Solver::Fem];
+
+    /// Name in files, on the command line and in Python: `amm` or `fem`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Solver::Amm => "amm",
+            Solver::Fem => "fem",
+        }
+    }
+}
+
+impl std::fmt::Display for Solver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Solver {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Solver::ALL
+            .into_iter()
+            .find(|x| x.name() == s)
+            .ok_or_else(|| format!("unknown solver `{s}`: expected amm or fem"))
+    }
+}
+
+/// A solver with its settings (the experiment's `[amm]` or `[fem]` after any override).
+#[derive(Debug, Clone, Copy)]
+pub enum Settings<'a> {
+    Amm(&'a AmmSettings),
+    Fem(&'a FemSettings),
+}
+
+impl<'a> Settings<'a> {
+    /// The experiment's own settings of `solver` (`exp.amm` or `exp.fem`).
+    pub fn of(exp: &'a Experiment, solver: Solver) -> Self {
+        match solver {
+            Solver::Amm => Settings::Amm(&exp.amm),
+            Solver::Fem => Settings::Fem(&exp.fem),
+        }
+    }
+
+    /// Which solver these settings are for.
+    pub fn solver(&self) -> Solver {
+        match self {
+            Settings::Amm(_) => Solver::Amm,
+            Settings::Fem(_) => Solver::Fem,
+        }
+    }
+}
+
+/// The work counters of a solve, each solver's own.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stats {
+    Amm(flexstar_amm::Stats),
+    Fem(flexstar_fem::Stats),
+}
+
+/// Why a solve of an experiment failed: the solver's typed error, or the `[drive]` that could not
+/// become an actuator law.
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    #[error(transparent)]
+    Amm(#[from] flexstar_amm::AmmError),
+    #[error(transparent)]
+    Fem(#[from] flexstar_fem::FemError),
+    /// The `[drive]` could not become an actuator law.
+    #[error(transparent)]
+    Drive(#[from] flexstar_drive::DriveError),
+    /// A servo's tracking errors could not be evaluated (its reference, at a time).
+    #[error(transparent)]
+    Tracking(flexstar_drive::DriveError),
+}
+
+/// Solve `exp` with `settings` for the experiment's drive: the prescribed motion (inverse
+/// problem) when `[drive]` is a motion, else the direct problem under its actuator law (forces or
+/// a servo; a servo's response gains its tracking errors `e1..e3` [m], after its other columns).
+///
+/// `proof`: the preflight's proof that the motion (a servo's reference) is feasible over the span
+/// (the solver then does not scan it again); `None`: the solver scans it. `progress` receives the
+/// fraction of the span done (see `flexstar_drive::SolveRequest`).
+pub fn solve(
+    exp: &Experiment,
+    settings: Settings,
+    proof: Option<&CheckedMotion>,
+    progress: Option<Progress>,
+) -> Result<Solved<Stats>, SolveError> {
+    let law = flexstar_drive::law_for(exp)?;
+    let mut solved = solve_under(exp, settings, law.as_deref(), proof, progress)?;
+    if law.is_some() && exp.drive.kind == DriveKind::Servo {
+        flexstar_drive::add_tracking_errors(&mut solved.response, exp).map_err(SolveError::Tracking)?;
+    }
+    Ok(solved)
+}
+
+/// [`solve`] with the drive given: `law` (the direct problem) or `None` (the prescribed motion).
+fn solve_under(
+    exp: &Experiment,
+    settings: Settings,
+    law: Option<&dyn ActuatorLaw>,
+    proof: Option<&CheckedMotion>,
+    progress: Option<Progress>,
+) -> Result<Solved<Stats>, SolveError> {
+    let drive = law.map_or(Drive::Motion, Drive::Law);
+    let request = SolveRequest { drive, proof, progress };
+    Ok(match settings {
+        Settings::Amm(s) => {
+            let r = flexstar_amm::solve(exp, s, request)?;
+            Solved {
+                response: r.response,
+                stats: Stats::Amm(r.stats),
+            }
+        }
+        Settings::Fem(s) => {
+            let r = flexstar_fem::solve(exp, s, request)?;
+            Solved {
+                response: r.response,
+                stats: Stats::Fem(r.stats),
+            }
+        }
+    })
+}
+
+/// [`solve`]'s response only.
+pub fn response(
+    exp: &Experiment,
+    settings: Settings,
+    proof: Option<&CheckedMotion>,
+    progress: Option<Progress>,
+) -> Result<Response, SolveError> {
+    solve(exp, settings, proof, progress).map(|s| s.response)
+}
+
+/// The refined FEM that the accurate model's error estimate is judged against
+/// (`docs/validation.md` section 8: "never below half the true EVP against the converged FEM"):
+/// four times the elements and an eighth of the default step. *Measured* on case 4, the accurate
+/// model's mean EVP against it is 0.1273 % (0.1218 % at a quarter of the step, 0.2 % at the
+/// default FEM: the reference's own error is of the size of the model's), about 2 % below the
+/// Richardson limit of the two.
+pub fn reference_fem(exp: &Experiment) -> FemSettings {
+    FemSettings {
+        elements: 4 * exp.fem.elements,
+        dt: Some(exp.fem.dt.unwrap_or_else(|| flexstar_fem::default_dt(&exp.robot)) / 8.0),
+        snapshots: Vec::new(),
+        frames: 0,
+        ..exp.fem.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solver_names_round_trip() {
+        for s in Solver::ALL {
+            assert_eq!(s.name().parse::<Solver>().unwrap(), s);
+            assert_eq!(s.to_string(), s.name());
+        }
+        assert!("abaqus".parse::<Solver>().unwrap_err().contains("expected amm or fem"));
+    }
+}

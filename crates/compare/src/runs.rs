@@ -61,7 +61,7 @@ pub struct CaseSpec {
     pub amm: Vec<AmmRun>,
     /// Further AMM runs reported as mean EVPs only (the N study of `verify`).
     pub extra: Vec<AmmRun>,
-    /// A refined FEM that error estimates are judged against (`verify`, issue 21 item 3: the
+    /// A refined FEM that error estimates are judged against (`verify`, `docs/validation.md` section 8: the
     /// estimate is compared with the true EVP against the converged FEM); `None`: no such run.
     pub reference: Option<flexstar_model::FemSettings>,
 }
@@ -145,8 +145,8 @@ pub fn solve_amm(
     }
 }
 
-/// The refined FEM the accurate model's error estimate is judged against (issue 21 item 3:
-/// "never below half the true EVP against the converged FEM"): four times the elements and an
+/// The refined FEM the accurate model's error estimate is judged against (`docs/validation.md`
+/// section 8: never below half the true EVP against the converged FEM): four times the elements and an
 /// eighth of the default step. *Measured* on case 4, the accurate model's mean EVP against it is
 /// 0.1273 % (0.1218 % at a quarter of the step, 0.2 % at the default FEM: the reference's own
 /// error is of the size of the model's), about 2 % below the Richardson limit of the two.

@@ -1,7 +1,7 @@
-//! Issue 22 across the solvers: the accurate AMM against the independent FEM on three motions of
+//! Payload, damping and load across the solvers: the accurate AMM against the independent FEM on three motions of
 //! `configs/motions/`: the smooth quintic with a payload off G, the brisk quintic with its
 //! residual vibration under Kelvin-Voigt damping, the pick-and-place cycle (via points, a dwell)
-//! with a load at G, and the brisk one with all three (the issue's targets: mean EVP over A, B, C,
+//! with a load at G, and the brisk one with all three (the targets of `docs/amm.md` 11.5: mean EVP over A, B, C,
 //! G at most 0.5 %, no point above 1 %); and the three sections as vary keys of a sweep.
 //!
 //! Measured (N = 53 each): payload on smooth, mean 0.130 % (largest point 0.184 %); damping on

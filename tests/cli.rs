@@ -174,7 +174,7 @@ fn run_writes_the_contracted_solver_tables() {
     let cfg = short_case1(dir.path(), "0.05");
     let out = dir.path().join("out");
     let out_s = out.to_str().unwrap();
-    // stderr says what is solved in words (`N = 12`, `tol = 2 %`), not in Debug forms (issue 24)
+    // stderr says what is solved in words (`N = 12`, `tol = 2 %`), not in Debug forms
     for (args, file, said) in [
         (
             vec!["--solver", "amm", "--family", "slide-free", "--modes", "12"],
@@ -220,7 +220,7 @@ fn run_refuses_bad_settings_before_any_work() {
     let cfg = short_case1(dir.path(), "0.05");
     let out = dir.path().join("out");
     let out_s = out.to_str().unwrap();
-    // a flag's error names the flag first, with no empty file or key parts (issue 24)
+    // a flag's error names the flag first, with no empty file or key parts
     let cases: [(&[&str], &str); 10] = [
         (&["--solver", "amm", "--family", "hinged-free"], "hinged-free"),
         (&["--solver", "amm", "--modes", "0"], "error: --modes: need 1 <= modes <= 400, got 0"),
@@ -275,7 +275,7 @@ fn run_refuses_bad_settings_before_any_work() {
 
 #[test]
 fn direct_runs_write_the_contracted_tables() {
-    // issue 10: an inverse run's output fed back with --forces, and a servo drive in the config
+    // an inverse run's output fed back with --forces, and a servo drive in the config
     let dir = tempfile::tempdir().unwrap();
     let cfg = short_case1(dir.path(), "0.05");
     let out = dir.path().join("out");
@@ -665,7 +665,7 @@ fn csv_and_sidecar(dir: &Path, stem: &str) -> (Vec<String>, serde_json::Value) {
 
 #[test]
 fn sidecars_give_every_column_its_unit_and_the_values_used() {
-    // issue 24: AMM and FEM, inverse and direct (a servo); units as in docs/outputs.md
+    // AMM and FEM, inverse and direct (a servo); units as in docs/outputs.md
     // (flexstar_model's table is checked against the page in its own tests)
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
@@ -824,7 +824,7 @@ fn compare_of_a_forces_drive_says_what_its_force_figure_draws() {
     );
 }
 
-/// The validated envelope (issue 21 item 3, docs/validation.md section 8): an AMM run of the
+/// The validated envelope (docs/validation.md section 8): an AMM run of the
 /// accurate model on the paper's robot, or on another robot inside the envelope's ranges, is
 /// inside; the paper's equations, a robot whose sleeve inertia or axial stiffness lies beyond
 /// the envelope's range, are outside, with the reasons in the sidecar and a note on stderr (the

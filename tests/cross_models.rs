@@ -1,4 +1,4 @@
-//! Cross-model check on two motions of our own (issue 9), away from the paper's four cases:
+//! Cross-model check on two motions of our own (`docs/amm.md` sections 8-9), away from the paper's four cases:
 //!
 //! - `smooth`: a slow rest-to-rest task-space quintic (G moves 14 mm and turns 0.06 rad in 0.3 s,
 //!   then rests), tips ~ 3 mm: the small-deflection regime in which the linear AMM holds, with a
@@ -12,7 +12,7 @@
 //!   2.5 times). The test at twice the amplitude guards that term.
 //!
 //! On both, flexstar's accurate reduced model (enriched family, full model, automatic N at the
-//! default tolerance) must agree with the independent FEM within the issue's targets (mean EVP over
+//! default tolerance) must agree with the independent FEM within the targets (mean EVP over
 //! A, B, C, G at most 1 %, no point above 2 %), its own error estimate must be within a factor of
 //! two of that true EVP, and the driving forces must agree while the robot moves.
 
@@ -32,7 +32,7 @@ struct Bounds {
     ratio: f64,
 }
 
-/// The issue's targets (issue 9 item 5).
+/// The accurate model's targets (`docs/validation.md` section 1).
 const TARGETS: Bounds = Bounds {
     mean: 1.0,
     point: 2.0,
@@ -110,7 +110,7 @@ fn foreshortening_inertia_holds_at_twice_brisks_amplitude() {
     // its relative size when the motion is scaled, a second-order one grows with it. `brisk` with
     // its displacement doubled (tips 22 mm, 4.4 % of L): without the term the AMM is 5.7 % off
     // the FEM at G (0.35 / 0.99 / 2.35 / 5.7 % at scales 1/4, 1/2, 1, 2); with it 0.34 % (flat in
-    // the scale: 0.35 / 0.36 / 0.24 / 0.34 %). Bound: the issue's point target, at N = 53 (the N
+    // the scale: 0.35 / 0.36 / 0.24 / 0.34 %). Bound: the point target, at N = 53 (the N
     // the default tolerance chooses for brisk) to keep the test short.
     let mut exp = Experiment::from_toml_str(BRISK, Path::new("brisk.toml")).unwrap();
     if let flexstar_model::Trajectory::Quintic { to, .. } = &mut exp.trajectory {

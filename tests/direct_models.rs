@@ -1,4 +1,4 @@
-//! Direct dynamics across the two models (issue 10, item 4): the AMM and the FEM driven by the
+//! Direct dynamics across the two models (`docs/drives.md`): the AMM and the FEM driven by the
 //! same actuator forces agree as closely as their inverse runs do.
 //!
 //! The forces are the FEM inverse run's own `Fa` (output every 1 ms, linear in between), so the

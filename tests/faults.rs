@@ -1,4 +1,4 @@
-//! A run's files are one unit (issue 24, item 1): runs killed with SIGKILL at spread-out points,
+//! A run's files are one unit (`docs/outputs.md`): runs killed with SIGKILL at spread-out points,
 //! runs that hit a file-size limit (a full disk) and concurrent runs into one folder each leave,
 //! after the next start, either the complete old set or the complete new one, and no temporary.
 

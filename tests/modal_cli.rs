@@ -1,4 +1,4 @@
-//! End-to-end checks of `flexstar modal`, `freqmap` and `linearize` (issue 11): file contracts
+//! End-to-end checks of `flexstar modal`, `freqmap` and `linearize` (`docs/modes.md`): file contracts
 //! (paths, exact CSV headers, Matrix Market headers), agreement between the commands and with
 //! independent references (symmetry of the robot, the FEM), and bad input refused with the reason
 //! and no output. Small models (AMM N = 40, FEM 102 elements) keep each run well under a second.
@@ -116,7 +116,7 @@ fn json(path: &Path) -> serde_json::Value {
 /// modal.json and freqmap.json beside their tables: provenance, solver(s), pose or grid,
 /// sliders, K, the resolved experiment. A rerun with other settings is refused naming the file
 /// and what differs, and leaves the files as they were; an identical rerun and `--force`
-/// replace them (issue 24).
+/// replace them.
 #[test]
 fn modal_and_freqmap_sidecars_guard_the_tables() {
     let (_dir, cfg, out) = small_case();
@@ -453,7 +453,7 @@ fn linearize_with(cfg: &str, name: &str, out: &Path, extra: &[&str]) -> (PathBuf
     (lin, serde_json::from_str(&json).unwrap())
 }
 
-/// Issue 24: `--modes K` and `--sliders locked|free` set the model's size and inputs; the JSON
+/// `--modes K` and `--sliders locked|free` set the model's size and inputs; the JSON
 /// names every state, input and output in the order of the matrices (outputs as the run CSVs'
 /// columns: `w1tip`, not `w1_tip`); `fem-coordinates.csv` has one row per row of M.mtx, with the
 /// slider coordinates last when the sliders are free and none when they are locked.
@@ -613,7 +613,7 @@ fn the_modal_commands_have_help() {
     }
 }
 
-/// Issue 22 through the commands: with `[damping]` `modal.csv` gains `zeta_amm,zeta_fem` after
+/// Payload, damping and load through the commands: with `[damping]` `modal.csv` gains `zeta_amm,zeta_fem` after
 /// today's columns (`beta omega / 2` of each model's frequency, here zeta = 0.01 at 4 Hz), the
 /// sidecar records the sections, and the payload lowers the frequencies; with `[load]` the linear
 /// model's inputs end with `Fx`, `Fy`, `Mz`, B gaining three columns, and `statespace.json`

@@ -1,4 +1,4 @@
-//! The trajectory kinds of issue 26 through the built binary (`docs/motions.md` section 1): both
+//! The trajectory kinds of `docs/motions.md` section 1 through the built binary: both
 //! solvers take a via and a table config, `kinematics` gives back a table's poses at its rows, a
 //! `kinematics.csv` read back as a slider-space table reproduces its own motion, and a bad table
 //! is refused before anything is written.

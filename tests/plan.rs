@@ -1,4 +1,4 @@
-//! `flexstar plan` through the built binary (issue 26 items 4 and 6, `docs/motions.md` sections
+//! `flexstar plan` through the built binary (`docs/motions.md` sections
 //! 4 and 6). The planner trusts the accurate AMM; these tests judge its motions by the FEM, an
 //! independent model: the residual of G is computed here from the FEM's own CSV columns
 //! (`|dG| = sqrt(2/3 sum w_iG^2)` after `t_rest`), the limits from `flexstar kinematics` of the

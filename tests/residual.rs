@@ -1,5 +1,5 @@
-//! Residual vibration and settling after a rest-to-rest motion through the built binary (issue 26
-//! item 2, `docs/motions.md` section 2): the AMM's new `dGx, dGy` columns against the FEM's,
+//! Residual vibration and settling after a rest-to-rest motion through the built binary
+//! (`docs/motions.md` section 2): the AMM's new `dGx, dGy` columns against the FEM's,
 //! which the FEM computes independently (`G_fem - G_rigid`, not from the projections `w_iG`); the
 //! sidecar's settling time against the last excursion of the FEM's own |dG| read from its CSV; a
 //! damped run settles, the same run undamped does not; a band above the peak settles at

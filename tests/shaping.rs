@@ -1,4 +1,4 @@
-//! Input shaping through the built binary (issue 26 item 3, `docs/motions.md` section 3): the
+//! Input shaping through the built binary (`docs/motions.md` section 3): the
 //! brisk rest-to-rest quintic of the paper's robot, unshaped and ZVD-shaped at the accurate AMM's
 //! modes at its final pose (read from `flexstar modal --pose`), each compared by `flexstar compare`
 //! (AMM and FEM). Checked against the unshaped runs, not against the shaper code: the sidecar
@@ -159,7 +159,7 @@ fn zvd_at_the_amm_modes_removes_the_residual_of_g_in_both_solvers() {
 
 /// `f_hz = "auto"` (docs/motions.md 3.5) on the same move: the frequencies come from the accurate
 /// AMM and are recorded; the FEM's residual peak of G is at most 1/10 of the unshaped quintic's
-/// of the same nominal duration (the issue's target), measured against the plain run.
+/// of the same nominal duration (the target, `docs/motions.md` 6), measured against the plain run.
 #[test]
 fn auto_zvd_cuts_the_residual_of_g_tenfold_on_the_fem() {
     let dir = tempfile::tempdir().unwrap();
@@ -199,7 +199,7 @@ fn auto_zvd_cuts_the_residual_of_g_tenfold_on_the_fem() {
     }
 }
 
-/// Issue 26 item 6, first target, on the three moves fixed before any shaped run of them
+/// The first target of `docs/motions.md` 6, on the three moves fixed before any shaped run of them
 /// (configs/motions/move-{centre,edge,turn}.toml, docs/motions.md 6): ZVD-shaped with
 /// `f_hz = "auto"`, the FEM's residual peak of G is at most 1/10 of the unshaped quintic's of
 /// the same nominal duration, over equal windows after each motion's own rest; the AMM agrees.

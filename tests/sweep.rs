@@ -148,7 +148,7 @@ fn bad_input_is_refused_before_any_run() {
     drop(d2);
 }
 
-/// Issue 24, item 2: a `results.csv` of another study is refused by `merge` (and kept byte for
+/// A `results.csv` of another study is refused by `merge` (and kept byte for
 /// byte), and the rows of a whole-study rerun already in `results.csv` survive a later merge of
 /// the shards.
 #[test]
@@ -223,7 +223,7 @@ fn merge_keeps_earlier_rows_and_refuses_a_foreign_table() {
     assert_eq!(std::fs::read(other.join("shards/results.csv")).unwrap(), foreign);
 }
 
-/// Issue 24, item 2: `--jobs` beyond what can be given is refused before anything is written.
+/// `--jobs` beyond what can be given is refused before anything is written.
 #[test]
 fn too_many_jobs_write_nothing() {
     let (d, study) = setup(STUDY);
@@ -235,7 +235,7 @@ fn too_many_jobs_write_nothing() {
     assert!(!out.join("shards").join("results.csv").exists(), "no header-only table");
 }
 
-/// Issue 24, item 2: a grid of 1e8 cases (the documented maximum), one shard of 10 cases: the
+/// A grid of 1e8 cases (the documented maximum), one shard of 10 cases: the
 /// shard's cases are made from their indices, so the run starts at once in little memory.
 #[test]
 fn a_shard_of_the_largest_study_runs_at_once() {

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A real single-node Slurm (issue 24, item 3): installs slurm-wlm and munge from Debian's
+# A real single-node Slurm (docs/cluster.md): installs slurm-wlm and munge from Debian's
 # packages, starts munged, slurmctld and slurmd on localhost (no systemd, no cgroups), and runs
 # the sbatch script and the submit lines of docs/cluster.md taken from the page itself (the
 # blocks between `<!-- slurm-test: NAME -->` and `<!-- /slurm-test -->`), on a small study in 4

@@ -1,4 +1,4 @@
-//! Speed of the AMM (issue 4 item 8): one paper case, N = 25, 0.5 s of motion at the default
+//! Speed of the AMM (`docs/amm.md` section 2): one paper case, N = 25, 0.5 s of motion at the default
 //! step, target at most 20 ms on one core. The four paper cases share the catalogue of the tests.
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -28,9 +28,9 @@ fn paper_cases(c: &mut Criterion) {
     group.finish();
 }
 
-/// Issue 9 item 5: one paper case with the defaults (enriched family, full model, automatic N at
-/// tol 0.5 %: runs at N = 46, 53), target at most 20 ms on one core; and one run at the N the
-/// defaults settle on.
+/// The accurate model's speed (`docs/amm.md` section 9): one paper case with the defaults (enriched
+/// family, full model, automatic N at tol 0.5 %: runs at N = 46, 53), target at most 20 ms on one
+/// core; and one run at the N the defaults settle on.
 fn accurate_model(c: &mut Criterion) {
     let mut group = c.benchmark_group("amm_accurate_defaults");
     group.sample_size(10);
@@ -60,8 +60,9 @@ fn accurate_model(c: &mut Criterion) {
     group.finish();
 }
 
-/// Issue 10 item 6: a direct run (forces of the inverse run fed back, and a 20 Hz servo) against
-/// the inverse run of the same case; target at most twice the inverse time.
+/// Direct dynamics (`docs/amm.md` section 10): a direct run (forces of the inverse run fed back,
+/// and a 20 Hz servo) against the inverse run of the same case; target at most twice the inverse
+/// time.
 fn direct_vs_inverse(c: &mut Criterion) {
     use flexstar_drive::{ForceTable, Servo};
     let mut group = c.benchmark_group("amm_direct_vs_inverse");
@@ -114,11 +115,12 @@ fn direct_vs_inverse(c: &mut Criterion) {
     group.finish();
 }
 
-/// Issue 22 item 6: the accurate model (case 3, N = 53) bare and with a payload off G, damping
-/// and a load with all three components; target at most 10 % more time.
+/// Payload, damping and load (`docs/amm.md` 11.7): the accurate model (case 3, N = 53) bare and
+/// with a payload off G, damping and a load with all three components; target at most 10 % more
+/// time.
 fn attachments(c: &mut Criterion) {
     use flexstar_model::{Damping, LoadSettings, Payload};
-    let mut group = c.benchmark_group("amm_issue22");
+    let mut group = c.benchmark_group("amm_attachments");
     group.sample_size(20);
     let bare = common::paper_case(3);
     let mut loaded = bare.clone();

@@ -1,4 +1,4 @@
-//! One paper case with the accurate model's defaults (issue 9 item 5), for instruction counts
+//! One paper case with the accurate model's defaults (`docs/amm.md` section 9), for instruction counts
 //! that the load of a shared machine does not disturb:
 //!
 //! ```sh

@@ -1,4 +1,4 @@
-//! Is the difference of the Richardson pair the same at a coarser step? (issue 9, speed)
+//! Is the difference of the Richardson pair the same at a coarser step? (`docs/amm.md` section 9, speed)
 //!
 //! `cargo run --release -p flexstar-amm --example coarse_estimate -- K [K ...]`
 //! For the paper's four cases and the two motions of our own, runs the automatic sequence's

@@ -1,4 +1,4 @@
-//! Cost of a direct AMM run against the inverse run of the same case (issue 10 item 6), for
+//! Cost of a direct AMM run against the inverse run of the same case (`docs/amm.md` section 10), for
 //! instruction counts that the load of a shared machine does not disturb:
 //!
 //! ```sh

@@ -1,4 +1,4 @@
-//! How the delivered run's time error falls with the step (issue 21, `docs/amm.md` 12.10).
+//! How the delivered run's time error falls with the step (`docs/amm.md` 12.10).
 //!
 //! `cargo run --release -p flexstar-amm --example time_order -- FILE.toml [FILE.toml ...]`
 //! For each experiment: the automatic choice (its N and step h), then that N at k h for

@@ -1,4 +1,4 @@
-//! Error estimate and automatic number of modes (issue 9; `docs/amm.md` section 9).
+//! Error estimate and automatic number of modes (`docs/amm.md` section 9).
 //!
 //! The solver estimates the EVP (Eq. 45, mean over A, B, C and G with the n/a rule of
 //! `flexstar_model::evp`) of its own modal truncation from two runs: N_prev and N = ~1.15 N_prev.
@@ -28,7 +28,7 @@ use flexstar_model::{Experiment, Response};
 
 use crate::error::AmmError;
 
-/// Largest N the automatic choice tries (issue 9: stable to N = 200).
+/// Largest N the automatic choice tries (stable to N = 200).
 pub const MAX_AUTO_MODES: usize = 200;
 
 /// Growth of N between two runs of the automatic choice.
@@ -47,7 +47,7 @@ pub const ESTIMATE_STEP_FACTOR: f64 = 8.0;
 /// 8-21 % and their pair differences 0.87-0.99 times those at the delivered step (module docs).
 pub const MAX_ESTIMATE_TIME_ERROR: f64 = 10.0;
 
-/// Step of the time check's run over the delivered step (issue 21, `docs/amm.md` 12.10): the
+/// Step of the time check's run over the delivered step (`docs/amm.md` 12.10): the
 /// chosen N once more at `2 h`, on the finest output grid that step allows
 /// ([`time_check_grid`]), for the delivered run's time error ([`time_error_estimate`]).
 pub const TIME_CHECK_STEP_FACTOR: f64 = 2.0;
@@ -55,8 +55,8 @@ pub const TIME_CHECK_STEP_FACTOR: f64 = 2.0;
 /// `E(2 h, h) / e(h)`, the time check's difference over the delivered run's time error, with
 /// which [`time_error_estimate`] turns one into the other (`docs/amm.md` 12.10): `2^p - 1`, 3
 /// for the integrator's order p = 2; measured 2.1-3.0 (p = 1.6-2.0; e(h) against the same N at
-/// h / 16) on the paper's cases 1 and 3, `smooth`, `brisk` and the five robots of issue 21
-/// (`cargo run --release -p flexstar-amm --example time_order -- FILES`), where the coarse step's
+/// h / 16) on the paper's cases 1 and 3, `smooth`, `brisk` and the five robots of `docs/amm.md`
+/// section 12 (`cargo run --release -p flexstar-amm --example time_order -- FILES`), where the coarse step's
 /// `E(8 h, h) / e(h)` spread over 11.6-61.7 (12.5) and `E(4 h, h) / e(h)` over 5.2-14.8. 2.5, the
 /// geometric middle, keeps the time part within 0.83-1.2 times the true one there.
 pub const TIME_CHECK_RATIO: f64 = 2.5;

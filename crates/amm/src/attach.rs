@@ -1,4 +1,4 @@
-//! The payload welded at G in the AMM's step (issue 22, `docs/amm.md` 11.1, Eqs. P1-P6).
+//! The payload welded at G in the AMM's step (`docs/amm.md` 11.1, Eqs. P1-P6).
 //!
 //! The payload's elastic state is read on beam 1's coordinates (index 0 in the code),
 //! `z = P q_1 = (u_1, phi(0) . alpha_1, phi'(0) . alpha_1)` [m, m, rad] (Eq. P1), and its

@@ -1,4 +1,4 @@
-//! Direct dynamics (issue 10; `docs/amm.md` section 10): the actuator forces (or a servo) are
+//! Direct dynamics (`docs/amm.md` section 10): the actuator forces (or a servo) are
 //! given and the slider positions s_i join the unknowns.
 //!
 //! ```text

@@ -1,4 +1,4 @@
-//! Foreshortening inertia of the bent beams (full model; `docs/amm.md` section 8, issue 9).
+//! Foreshortening inertia of the bent beams (full model; `docs/amm.md` section 8).
 //!
 //! An inextensible beam that bends draws its material towards G: the material point x sits at
 //! `x + u - f(x)` along `e_x`, with `f(x) = 1/2 int_0^x w'^2 ds`. The axial inertia of the whole

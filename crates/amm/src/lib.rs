@@ -10,7 +10,7 @@
 //!   constraints of Eqs. 38-43) and their per-step linear solve;
 //! - [`pose_modes`]: the modes of the star held at rest at one pose, and its linearised system;
 //! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]);
-//! - [`direct`]: the direct problem, sliders driven by forces or a servo ([`solve`] with `Drive::Law`, issue 10).
+//! - [`direct`]: the direct problem, sliders driven by forces or a servo ([`solve`] with `Drive::Law`, `docs/amm.md` section 10).
 //!
 //! Frames and signs follow `docs/conventions.md`; the derivation, the departures from the
 //! printed paper and the convergence study are in `docs/amm.md`. SI units throughout.

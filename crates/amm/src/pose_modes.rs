@@ -1,4 +1,4 @@
-//! Vibration modes of the star held at rest at one pose (issue 11): the constrained eigenproblem
+//! Vibration modes of the star held at rest at one pose (`docs/modes.md`): the constrained eigenproblem
 //! of the AMM's equations (Eqs. 37, 44, 31 with the constraints of Eqs. 38-43) linearised about
 //! the rest state, solved on the null space of the constraints
 //! ([`flexstar_numerics::eigen::constrained_modes`]).
@@ -19,7 +19,7 @@
 //! sleeve rows of Eqs. 41-42 (`w_i(xp_i + e) - e thp_i - ds_i cos(theta) = 0`); its axial component
 //! slides the sleeve along the beam, which is free at rest.
 //!
-//! A payload at G (issue 22) adds its rigid-body mass matrix about G, `P^T M_p P` (Eqs. P1-P2, at
+//! A payload at G (`docs/amm.md` 11.4) adds its rigid-body mass matrix about G, `P^T M_p P` (Eqs. P1-P2, at
 //! rest only `M_p` remains), to beam 1's block: M is then no longer diagonal and the modes come
 //! from the general constrained solver. The damping matrix at rest is `beta K` (Eq. D2, the
 //! beams' elastic stiffness) and the load enters through the junction rows of Eq. L1
@@ -157,7 +157,7 @@ impl PoseModel {
         })
     }
 
-    /// [`PoseModel::new`] for the robot carrying `payload` at G (issue 22).
+    /// [`PoseModel::new`] for the robot carrying `payload` at G (`docs/amm.md` 11.4).
     pub fn with_payload(
         params: &RobotParams,
         payload: &Payload,

@@ -1,4 +1,4 @@
-//! Time integration of the constrained AMM system and its outputs (paper section 7; issue 4).
+//! Time integration of the constrained AMM system and its outputs (paper section 7; `docs/amm.md` section 2).
 //!
 //! ```text
 //! M q'' + D(t) q' + K(t) q = f(t) + C(t)^T lambda,   C(t) q = 0,   q(0) = q'(0) = 0
@@ -48,7 +48,7 @@ pub fn beam_time_scale(robot: &flexstar_model::RobotParams) -> f64 {
     robot.l * robot.l * (robot.rho / robot.ei()).sqrt()
 }
 
-/// Issue 21 (`docs/amm.md` 12.4): the tolerance step on a robot whose beams are faster than the
+/// `docs/amm.md` 12.4: the tolerance step on a robot whose beams are faster than the
 /// paper's scales with their time scale ([`beam_time_scale`]), so that its time error stays what
 /// [`TOLERANCE_DT`] gives on the paper's robot: the factor `min(1, T / T_paper)`; exactly 1 for
 /// the paper's robot and for slower beams.
@@ -355,7 +355,7 @@ fn integrate_coarse<F: FnMut(&System, &[f64])>(
 }
 
 /// The constrained system of N = `n_modes` modes of `settings.family` for the robot of `exp`,
-/// with its payload, damping and load (issue 22; nothing added at their defaults).
+/// with its payload, damping and load (`docs/amm.md` section 11; nothing added at their defaults).
 pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, exp: &Experiment) -> Result<System, AmmError> {
     let modes = ModeSet::new(settings.family, n_modes, &exp.robot)?;
     let mut sys = System::new(modes, &exp.robot, settings.model);
@@ -523,7 +523,7 @@ mod tests {
 
     #[test]
     fn position_constraints_hold_at_every_step() {
-        // index-3 scheme: C(t_n) q_n = 0 to round-off at every step, no drift (issue 4 item 3)
+        // index-3 scheme: C(t_n) q_n = 0 to round-off at every step, no drift
         for fam in ModeFamily::PAPER {
             let settings = AmmSettings::paper(fam, 20);
             let (mut worst, mut qmax, mut steps) = (0.0f64, 0.0f64, 0);
@@ -541,11 +541,11 @@ mod tests {
 
     #[test]
     fn full_model_holds_the_beam_at_the_material_point_in_the_sleeve() {
-        // issue 9: the sleeve rows of the full model are linearised about the predictor each step;
+        // the sleeve rows of the full model (docs/amm.md section 8) are linearised about the predictor each step;
         // the exact geometric conditions (the material point x_c = xp - u + f(x_c) drawn out by
         // the foreshortening, Eq. S1, and x_c +- Lp/2, on the sleeve axis) must hold to far
         // better than the shift u w' that the paper's rows neglect and than the foreshortening
-        // shift f w' that the rows at xp - u neglected (issue 21, docs/amm.md 12.11)
+        // shift f w' that the rows at xp - u neglected (docs/amm.md 12.11)
         let exp = case([1.0, 0.0, 0.5], 0.3);
         let settings = AmmSettings {
             modes: Some(30),

@@ -323,11 +323,11 @@ pub(crate) struct System {
     lu: ConstraintLu,
     /// Multipliers of the last solve, in the order of `rows`.
     pub(crate) lam: Vec<f64>,
-    /// Issue 22: the payload at G on beam 1's coordinates (Eq. P6); `None` without one.
+    /// The payload at G on beam 1's coordinates (Eq. P6); `None` without one.
     payload: Option<PayloadTerms>,
-    /// Issue 22: Kelvin-Voigt retardation time beta [s] (Eqs. D2-D3); 0: undamped.
+    /// Kelvin-Voigt retardation time beta [s] (Eqs. D2-D3); 0: undamped.
     beta: f64,
-    /// Issue 22: the load at G (Eq. L1); `None` without one.
+    /// The load at G (Eq. L1); `None` without one.
     load: Option<LoadSettings>,
     /// Workspace of the payload's Woodbury correction, N + 2.
     pay_tmp: Vec<f64>,
@@ -519,7 +519,7 @@ impl System {
         }
     }
 
-    /// Issue 22 (`docs/amm.md` 11): the payload welded at G (Eqs. P1-P6, on beam 1's
+    /// `docs/amm.md` section 11: the payload welded at G (Eqs. P1-P6, on beam 1's
     /// coordinates), the Kelvin-Voigt damping `damping.beta()` [s] of the beams (Eqs. D2-D3) and
     /// the load at G (Eq. L1, fixed frame). What is absent (no mass nor J, beta = 0, no load)
     /// adds no code path, so the bare star's results stay bit for bit.

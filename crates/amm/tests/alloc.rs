@@ -1,4 +1,4 @@
-//! "No allocation inside the time loop" (issue 4 item 8): the number of heap allocations of a
+//! "No allocation inside the time loop": the number of heap allocations of a
 //! solve does not depend on the number of steps (workspaces and outputs are sized once).
 
 mod common;

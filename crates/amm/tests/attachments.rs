@@ -1,4 +1,4 @@
-//! Issue 22 in the AMM's time-domain equations (payload at G, Kelvin-Voigt damping, load at G;
+//! The attachments in the AMM's time-domain equations (payload at G, Kelvin-Voigt damping, load at G;
 //! `docs/amm.md` 11) against references that share no code with the AMM: the Newton-Euler rigid
 //! inverse dynamics (Eqs. P7-P8, flexstar-kinematics), the virtual-power rigid forward dynamics
 //! (Eq. P9, tests/support/rigid_forward.rs), the undamped modes at the end pose (logarithmic
@@ -63,7 +63,7 @@ fn bits(r: &Response) -> Vec<u64> {
 
 #[test]
 fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
-    // issue 22: every key at 0 reproduces today's results bit for bit (the new code paths are
+    // every key at 0 reproduces today's results bit for bit (the new code paths are
     // skipped, not fed zeros): paper model and the accurate model, inverse and direct
     for settings in [
         AmmSettings::paper(ModeFamily::FreeFree, 20),
@@ -120,7 +120,7 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
 
 /// Stiffness factor of the stiff limit. At E x 1e4 the bare star itself is 0.17 % off the rigid
 /// forces (free-free; 0.10 % at 3e4: the finite-stiffness part falls as 1/sqrt(E)), so the
-/// 0.1 % of issue 22 needs E x 1e5.
+/// 0.1 % target (`docs/amm.md` 11.5) needs E x 1e5.
 const STIFF: f64 = 1e5;
 
 /// The stiff robot (E x [`STIFF`]) on a rest-to-rest quintic to the general target, carrying

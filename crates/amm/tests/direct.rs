@@ -1,4 +1,4 @@
-//! Direct dynamics of the AMM (issue 10) against independent references: the inverse run it must
+//! Direct dynamics of the AMM (`docs/amm.md` section 10) against independent references: the inverse run it must
 //! invert (round trip), and the prescribed-motion run a very stiff servo must reproduce.
 
 #[path = "../../../tests/support/rigid_forward.rs"]
@@ -60,7 +60,7 @@ fn round_trip(k: usize, settings: &AmmSettings, t_end: f64, dt_fa: f64) -> (f64,
 
 #[test]
 fn round_trip_gives_the_motion_back_in_every_paper_case() {
-    // issue 10: an inverse run's Fa with output at every solver step, fed back, gives s(t) within
+    // an inverse run's Fa with output at every solver step, fed back, gives s(t) within
     // 1e-6 m and the tips and G within an EVP of 0.1 %
     for k in 1..=4 {
         let settings = paper_case(k).amm;
@@ -120,7 +120,7 @@ fn round_trip_of_a_varying_acceleration_both_models() {
 
 #[test]
 fn stiff_servo_reproduces_the_prescribed_motion() {
-    // issue 10: a servo of 1 kHz bandwidth (damping ratio 0.7, rigid feedforward) on each slider
+    // a servo of 1 kHz bandwidth (damping ratio 0.7, rigid feedforward) on each slider
     // tracks the trajectory closely enough that the star vibrates as under the ideal motion: tips
     // within an EVP of 1 % of the inverse run (paper cases, their own settings, 0.2 s)
     for k in 1..=4 {

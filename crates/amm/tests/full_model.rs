@@ -1,4 +1,4 @@
-//! The accurate reduced model (issue 9) against outside references, one term at a time:
+//! The accurate reduced model (`docs/amm.md` sections 7-9) against outside references, one term at a time:
 //!
 //! - the enriched basis (free-free modes + two junction shapes, Rayleigh-Ritz): orthonormal and
 //!   stiffness-diagonal to round-off by an independent quadrature up to N = 200, free-free modes

@@ -221,7 +221,7 @@ fn stiff_star_reproduces_rigid_inverse_dynamics() {
 
 #[test]
 fn stiff_accurate_model_reproduces_rigid_inverse_dynamics() {
-    // issue 9: the full model's Fa (Eq. 33 along the sleeve forces it carries, with their axial
+    // the full model's Fa (Eq. 33 along the sleeve forces it carries, with their axial
     // components) must reach the rigid-body inverse dynamics in the stiff limit, like free-free
     let accurate = flexstar_model::AmmSettings {
         modes: Some(12),
@@ -378,7 +378,7 @@ fn bad_input_is_rejected_before_any_work() {
         .unwrap_err();
         assert_eq!(key_of(e), "amm.modes");
     }
-    // issue 9: a tolerance that is not a positive finite percentage, or given with modes
+    // a tolerance that is not a positive finite percentage, or given with modes
     for tol in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         let s = flexstar_model::AmmSettings {
             tol: Some(tol),

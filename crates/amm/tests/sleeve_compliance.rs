@@ -1,5 +1,5 @@
-//! Issue 21 item 1 (`docs/amm.md` section 12): the residual flexibility of the sleeves, isolated on
-//! the issue's first robot (short, light, sleeve-heavy; `tests/issue21/robot1.toml`).
+//! The residual flexibility of the sleeves (`docs/amm.md` section 12), isolated on the first robot
+//! of that section (short, light, sleeve-heavy; `tests/other_robots/robot1.toml`).
 //!
 //! Both runs take the FEM's step (1e-4 s), so the AMM's time error is out of the comparison and
 //! what is left is its modal truncation and its model. Without the residual flexibility the
@@ -12,7 +12,7 @@ use std::path::Path;
 use flexstar_model::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment};
 
-const ROBOT1: &str = include_str!("issue21/robot1.toml");
+const ROBOT1: &str = include_str!("other_robots/robot1.toml");
 
 fn accurate_at(exp: &Experiment, n: usize) -> flexstar_model::Response {
     let settings = AmmSettings {

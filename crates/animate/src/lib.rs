@@ -1,4 +1,4 @@
-//! `flexstar animate RUN_DIR` (`docs/motions.md` section 5, issue 26 item 5): every run's
+//! `flexstar animate RUN_DIR` (`docs/motions.md` section 5): every run's
 //! animation frames (`<stem>-frames.csv`, `<stem>-frames-pose.csv`) read back and drawn in one
 //! self-contained HTML page: the rigid star, the deformed beams `P_rigid + M (P - P_rigid)` with
 //! the elastic part magnified M times, a time slider and a play button. No network: no external

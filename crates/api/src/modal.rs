@@ -1,4 +1,4 @@
-//! `modal`, `freqmap` and `linearize` (issue 11): modes at a pose, frequency maps over the
+//! `modal`, `freqmap` and `linearize` (`docs/modes.md`): modes at a pose, frequency maps over the
 //! workspace and the linear state-space model about a pose (over `flexstar_modal`).
 
 use std::path::{Path, PathBuf};

@@ -1,4 +1,4 @@
-//! `plan` (the CLI's `flexstar plan CONFIG [--out DIR]`, issue 26 item 4, `docs/motions.md`
+//! `plan` (the CLI's `flexstar plan CONFIG [--out DIR]`, `docs/motions.md`
 //! 4.7): the plan made by `flexstar_plan`, then the three motions it is compared with (the plain
 //! quintic of the same duration, the ZVD-shaped quintic with `f_hz = "auto"`, the planned motion)
 //! each run on the accurate AMM and on the FEM, and the files: `plan.toml`, `plan.csv`,

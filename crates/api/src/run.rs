@@ -328,7 +328,7 @@ pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunO
     })
 }
 
-/// The residual vibration after the motion's end (issue 26 item 2) as top-level keys of the
+/// The residual vibration after the motion's end (`docs/motions.md` section 2) as top-level keys of the
 /// sidecar ([`flexstar_model::residual::sidecar_fields`]). An AMM run of the pinned-free family
 /// has G pinned by its modes (`phi(0) = 0`): its residual of G is null, with a note.
 fn add_residual(meta: &mut serde_json::Value, p: &Prepared, r: &Response) -> Result<()> {
@@ -342,7 +342,7 @@ fn add_residual(meta: &mut serde_json::Value, p: &Prepared, r: &Response) -> Res
 }
 
 /// `validated_envelope` (bool) and `validated_envelope_reasons` (the list of why not) of an AMM
-/// run's sidecar (issue 21 item 3, [`flexstar_model::envelope`]).
+/// run's sidecar (`docs/validation.md` section 8, [`flexstar_model::envelope`]).
 fn add_envelope(meta: &mut serde_json::Value, exp: &Experiment, small_deflection: bool) {
     let attachments = !(exp.payload.is_none() && exp.damping.beta() == 0.0 && exp.load.is_none());
     let why = flexstar_model::envelope::outside_envelope(
@@ -394,7 +394,7 @@ pub fn residual_line(meta: &serde_json::Value) -> Option<String> {
     ))
 }
 
-/// Columns a direct run's file puts right after the fixed ones (issue 10 contract).
+/// Columns a direct run's file puts right after the fixed ones (a file contract, `docs/outputs.md`).
 fn direct_columns(servo: bool) -> Vec<&'static str> {
     let mut v = vec!["Gx", "Gy", "theta"];
     if servo {

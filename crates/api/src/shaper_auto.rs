@@ -1,4 +1,4 @@
-//! `[shaper] f_hz = "auto"` (issue 26 item 3, `docs/motions.md` 3.5): the shaper frequencies from
+//! `[shaper] f_hz = "auto"` (`docs/motions.md` 3.5): the shaper frequencies from
 //! the accurate AMM, resolved when the experiment is read. The model crate cannot call the
 //! solvers or the modal analysis, so it asks the resolver registered here
 //! ([`register_auto_shaper`]; the command line and the Python package register it at start).

@@ -1,5 +1,5 @@
 //! Probes of what remains between the accurate AMM and the FEM on the `brisk` motion of
-//! `tests/cross_models.rs` (issue 9; `docs/amm.md` sections 8-9).
+//! `tests/cross_models.rs` (`docs/amm.md` sections 8-9).
 //!
 //! `cargo run --release -p flexstar-compare --example brisk_probe -- PROBE [ARG]`, PROBE one of
 //! - `scale S`: brisk with its displacement scaled by S (S = 1: the test's motion): FEM at its

@@ -1,4 +1,4 @@
-//! The paper's four cases driven by a servo instead of an ideal motion (issue 10, item 5):
+//! The paper's four cases driven by a servo instead of an ideal motion:
 //! tracking error and tip vibration beside the prescribed-motion run, and how they change with
 //! the servo's bandwidth relative to the star's first frequencies. Results in `docs/drives.md`.
 //!

@@ -22,7 +22,7 @@ use crate::servo::servo_summary;
 use crate::table::{csv_text, opt_number, TableRow};
 use crate::Error;
 
-/// Header of `compare.csv` (issue 14 contract).
+/// Header of `compare.csv` (a file contract, `docs/outputs.md`).
 pub const COMPARE_CSV_HEADER: &str = "model,evp_A,evp_B,evp_C,evp_G,evp_mean";
 
 /// A run that leaves the small-deflection range the AMM assumes.
@@ -203,7 +203,7 @@ fn pct(v: Option<f64>) -> String {
     v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "n/a".into())
 }
 
-/// What the robot carries beyond the paper's (issue 22), in one sentence: `None` when it carries
+/// What the robot carries beyond the paper's (payload, damping, load), in one sentence: `None` when it carries
 /// nothing (no payload, no damping, no load).
 pub(crate) fn attachments_line(exp: &Experiment) -> Option<String> {
     let mut parts = Vec::new();
@@ -421,7 +421,7 @@ pub fn write_case(
     let checks = run_checks(exp, case);
     let warnings = validity_warnings(exp, &checks);
     let residuals = case_residuals(exp, case)?;
-    // every run's files and the EVP files are published together (issue 24)
+    // every run's files and the EVP files are published together (a run set, `docs/outputs.md`)
     let mut set = RunSet::begin(dir)?;
     for (stem, r) in runs_of(case) {
         let res = residuals.iter().flatten().find(|x| x.run == stem);

@@ -1,4 +1,4 @@
-//! Figures of a direct-dynamics run (issue 10): what the drive did to the sliders and to the star.
+//! Figures of a direct-dynamics run (`docs/drives.md`): what the drive did to the sliders and to the star.
 //!
 //! - `<stem>-sliders`: the simulated slider positions s_i [mm] over the `[trajectory]` (the servo's
 //!   reference, or the motion the forces were meant to produce) drawn dashed;

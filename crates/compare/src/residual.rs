@@ -1,5 +1,5 @@
-//! The residual vibration of every run of a case after its motion has come to rest (issue 26
-//! item 2, `docs/motions.md` 2.4): `residual.csv`, its table in `compare.md` and `report.html`,
+//! The residual vibration of every run of a case after its motion has come to rest
+//! (`docs/motions.md` 2.4): `residual.csv`, its table in `compare.md` and `report.html`,
 //! and the mark of `t_rest` on the time plots.
 
 use std::fmt::Write as _;
@@ -13,7 +13,7 @@ use crate::case_output::runs_of;
 use crate::runs::CaseResults;
 use crate::Error;
 
-/// Header of `residual.csv` (issue 26 contract, `docs/motions.md` 2.4).
+/// Header of `residual.csv` (a file contract, `docs/motions.md` 2.4).
 pub const RESIDUAL_CSV_HEADER: &str =
     "run,t_rest,residual_G_peak_m,residual_G_rms_m,residual_tip_peak_m,residual_tip_rms_m,settle_s";
 

@@ -45,7 +45,7 @@ pub struct Thresholds {
     /// Further N for the convergence columns of the table (not checked).
     #[serde(default)]
     pub n_study: Vec<usize>,
-    /// Hard upper bounds on flexstar's accurate model (issue 9 item 5), every case.
+    /// Hard upper bounds on flexstar's accurate model (`docs/validation.md` section 4), every case.
     #[serde(default)]
     pub accurate: Option<AccurateBounds>,
     /// Per case name.
@@ -63,7 +63,7 @@ pub struct AccurateBounds {
     /// Largest EVP at any single point [%].
     pub point_max: f64,
     /// Largest factor between the run's own error estimate and its mean EVP, either way
-    /// (issue 9: within a factor of 2).
+    /// (target: within a factor of 2, `docs/amm.md` section 9).
     pub estimate_ratio_max: Option<f64>,
 }
 
@@ -265,7 +265,7 @@ fn check_accurate(c: &mut CaseChecks, acc: &AccurateBounds, row: &TableRow) {
     if let Some(max) = acc.estimate_ratio_max {
         let estimate = run.and_then(|e| e.error_estimate);
         // the true error is the EVP against the refined reference FEM where verify ran one
-        // (issue 21 item 3), else against the FEM of the table
+        // (docs/validation.md section 8), else against the FEM of the table
         let reference = run.and_then(|e| e.evp_reference.as_ref());
         let truth = reference.map_or(mean, |r| r.mean);
         let against = if reference.is_some() {

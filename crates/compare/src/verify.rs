@@ -64,7 +64,7 @@ pub fn verify_spec(exp: Experiment, modes: usize, n_study: &[usize]) -> CaseSpec
         .iter()
         .map(|f| AmmRun::paper(&exp.amm, *f, modes))
         .collect();
-    // flexstar's accurate reduced model beside the paper's families (issue 9): enriched family,
+    // flexstar's accurate reduced model beside the paper's families (docs/amm.md sections 7-9): enriched family,
     // full model, automatic N at the default tolerance
     amm.push(AmmRun {
         label: ModeFamily::Enriched.name().to_string(),

@@ -94,7 +94,7 @@ pub struct Servo {
     pub reference: Trajectory,
     /// The robot (masses for the feedforward).
     pub params: RobotParams,
-    /// The payload and load the feedforward includes (issue 22; none: the bare star).
+    /// The payload and load the feedforward includes (`docs/amm.md` 11.1; none: the bare star).
     pub attached: Attachments,
 }
 

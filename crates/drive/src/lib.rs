@@ -1,4 +1,4 @@
-//! Actuator drives of the 3-PRP star-triangle robot (issue 10: direct dynamics).
+//! Actuator drives of the 3-PRP star-triangle robot (direct dynamics, `docs/drives.md`).
 //!
 //! The paper solves the inverse problem (motion given, Eq. 33 gives the forces). In the direct
 //! problem the slider positions `s_i` are unknowns and each slider is pushed along `+u_i` by a
@@ -35,7 +35,7 @@ pub use request::{Drive, Progress, SolveRequest, Solved};
 
 use flexstar_model::{DriveKind, Experiment, Feedforward};
 
-/// The actuator law of an experiment's `[drive]` (issue 10): `None` for `kind = "motion"` (the
+/// The actuator law of an experiment's `[drive]` (`docs/drives.md`): `None` for `kind = "motion"` (the
 /// trajectory is imposed), else the forces (table or polynomials) or the servo tracking
 /// `exp.trajectory` with its gains resolved (`bandwidth_hz` with the slider mass `mpp_mpa`).
 /// Errors name the `drive.` key.

@@ -1,17 +1,18 @@
-//! Speed of the FEM on the paper's cases at the default step (issue 13: one paper case at the
+//! Speed of the FEM on the paper's cases at the default step (`docs/fem.md` section 6: one paper case at the
 //! paper's mesh, 300 elements, in at most 0.15 s on one core; 3000 elements in at most 10 times
 //! the 300-element time). Case 2 (s = [t^2, -0.5 t^2, -0.5 t^2], 0.4 s) at 300 and 3000 elements,
 //! and cases 1, 3 and 4 (0.5 s each) at 300. Run pinned to one core:
 //! `taskset -c 1 cargo bench -p flexstar-fem --bench paper_case`.
 //!
-//! Direct dynamics (issue 10): case 2 at 300 elements driven by the forces of its own inverse
+//! Direct dynamics (`docs/fem.md` section 8): case 2 at 300 elements driven by the forces of its own inverse
 //! run (written at every solver step, fed back through a `ForceTable`), and by a 20 Hz servo with
 //! rigid feedforward: the cost of the three slider unknowns and of evaluating the law at every
 //! Newton iteration, against the inverse run above.
 //!
-//! Issue 22: case 2 at 300 elements carrying a payload (0.5 kg, J = 2e-3 kg m^2, offset
-//! (0.02, -0.01) m), damped (beta = 8e-4 s: zeta 0.01 at 4 Hz) and loaded at G (all three
-//! components), against the bare `case2_0.4s_300el` (at most 10 % more, issue 22).
+//! Payload, damping and load (`docs/fem.md` section 9): case 2 at 300 elements carrying a payload
+//! (0.5 kg, J = 2e-3 kg m^2, offset (0.02, -0.01) m), damped (beta = 8e-4 s: zeta 0.01 at 4 Hz)
+//! and loaded at G (all three components), against the bare `case2_0.4s_300el` (at most 10 %
+//! more).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexstar_drive::{ForceTable, Servo};

@@ -1,4 +1,4 @@
-//! Speed of the FEM's modes at one pose (issue 11: at most 50 ms at 300 elements): the paper's
+//! Speed of the FEM's modes at one pose (`docs/modes.md`: at most 50 ms at 300 elements): the paper's
 //! robot at an off-centre pose, the first six modes, sliders locked and free, by the sparse
 //! subspace iteration (`pose_modes`, assembly included) and, for comparison, the dense null-space
 //! path (`pose_modes_dense`). Run pinned to one core:

@@ -1,4 +1,4 @@
-//! Results-unchanged check of the FEM's speed work (issue 13, docs/fem.md section 6): runs the four
+//! Results-unchanged check of the FEM's speed work (docs/fem.md section 6): runs the four
 //! paper cases at the default settings, with timings and work counters, and either writes their
 //! responses to a baseline directory or compares them with one, column by column by EVP (Eq. 45).
 //!
@@ -19,7 +19,7 @@ use flexstar_model::response::RESPONSE_HEADER;
 use flexstar_model::{catalogue, Experiment, Response};
 use flexstar_numerics::measures::{evp, max_abs};
 
-/// Largest EVP [%] allowed between a run and its baseline (issue 13).
+/// Largest EVP [%] allowed between a run and its baseline (docs/fem.md section 6).
 const EVP_LIMIT: f64 = 0.01;
 /// A column is "zero by symmetry" below this fraction of the largest column of its group.
 const ZERO_LIMIT: f64 = 1e-6;

@@ -1,5 +1,5 @@
-//! Wall time of one paper case at a given mesh, the minimum over repeated runs (issue 13,
-//! docs/fem.md section 6): on a shared machine the minimum is the figure least disturbed by other
+//! Wall time of one paper case at a given mesh, the minimum over repeated runs
+//! (docs/fem.md section 6): on a shared machine the minimum is the figure least disturbed by other
 //! work, and the work counters (steps, Newton iterations) turn it into a time per step and per
 //! iteration. The criterion bench `paper_case` gives the distribution.
 //!

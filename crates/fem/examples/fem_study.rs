@@ -1,4 +1,4 @@
-//! Convergence study of the FEM on any experiment file (issue 21 item 2, docs/fem.md section 4.1):
+//! Convergence study of the FEM on any experiment file (docs/fem.md section 4.1, docs/validation.md section 7):
 //! runs the FEM at each `ELEMENTS:DT` given (DT `auto`: the default step of the robot), caches
 //! each run's tip and G histories as CSV in `CACHE` (reused when present), and prints the mean
 //! EVP (Eq. 45, `flexstar_model::evp::point_evps`) of every run against the first one (the

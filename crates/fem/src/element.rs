@@ -865,7 +865,7 @@ mod tests {
         }
     }
 
-    // ---- Kelvin-Voigt damping (issue 22, Eqs. D6-D10) ----
+    // ---- Kelvin-Voigt damping (docs/fem.md 9.2, Eqs. D6-D10) ----
 
     /// Local deformations `[u, th1, th2]` of the element at `q`.
     fn local(e: &Element, q: &[f64; 6]) -> [f64; 3] {

@@ -1,4 +1,4 @@
-//! The element loops of the time step (issue 13): every beam element's inertia and internal
+//! The element loops of the time step (`docs/fem.md` section 6): every beam element's inertia and internal
 //! forces into the residual, with its block `M + beta' K` of the Newton matrix at the first
 //! iteration of a step, and the beams' kinetic and strain energy at the output times.
 //!
@@ -132,7 +132,7 @@ flexstar_numerics::dispatch_avx2! {
 }
 
 /// The batches of [`add_forces`], damped (Eqs. D7, D9) or not (two separate copies, so that the
-/// undamped one is the code before issue 22).
+/// undamped one is the code as it was before damping was added).
 #[inline(always)]
 fn add_all<const DAMPED: bool>(
     elements: &[Element],

@@ -1,7 +1,7 @@
 //! # flexstar-fem
 //!
 //! The independent finite-element reference model of the flexible star-triangle robot
-//! (docs/paper-defects.md, "independent reference"; issue 5): three co-rotational Euler-Bernoulli beams in absolute
+//! (docs/paper-defects.md, "independent reference"): three co-rotational Euler-Bernoulli beams in absolute
 //! coordinates welded at one node G ([`element`]), three rigid sleeves with inertia Jp pinned at
 //! the revolute points of Eqs. 1-3 through which the beams slide without friction, index-3
 //! generalized-alpha integration with a structured direct solver (banded beam blocks and a dense
@@ -9,10 +9,10 @@
 //! reactions (Eq. 33). Its equations use only the robot parameters, `s_i(t)` and the start
 //! configuration; the rigid (Fermat-point) kinematics appears only as initial data and in the
 //! post-processing of [`solve`] (projection onto the rigid frames). [`solve`] with a law solves the
-//! direct problem (issue 10): the sliders, bodies of mass `mpp + mpa`, move under an actuator law
+//! direct problem (`docs/fem.md` section 8): the sliders, bodies of mass `mpp + mpa`, move under an actuator law
 //! (`flexstar_drive`), their coordinates unknowns of the same equations. Both carry an
-//! experiment's payload at G, Kelvin-Voigt damping of the beams and load at G (issue 22,
-//! `docs/fem.md` section 9), skipped at their zero defaults. The formulation, the
+//! experiment's payload at G, Kelvin-Voigt damping of the beams and load at G
+//! (`docs/fem.md` section 9), skipped at their zero defaults. The formulation, the
 //! convergence study behind the defaults and the deviations are in `docs/fem.md`.
 
 #![allow(clippy::needless_range_loop)] // index loops over DOFs read like the equations

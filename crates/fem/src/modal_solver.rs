@@ -1,5 +1,5 @@
-//! Lowest modes of the constrained FEM at a pose without a dense null-space basis (issue 11,
-//! speed): shift-invert subspace iteration on the bordered (saddle-point) system
+//! Lowest modes of the constrained FEM at a pose without a dense null-space basis
+//! (`docs/modes.md`, speed): shift-invert subspace iteration on the bordered (saddle-point) system
 //!
 //! ```text
 //! [K + sigma M   Phi_q^T] [y]   [M x]

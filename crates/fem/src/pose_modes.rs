@@ -1,4 +1,4 @@
-//! Vibration modes of the star held at rest at one pose (issue 11): the mass matrix and the
+//! Vibration modes of the star held at rest at one pose (`docs/modes.md`): the mass matrix and the
 //! tangent stiffness of the co-rotational model at the undeformed configuration, and the
 //! Jacobian `Phi_q` of the sleeve constraints (module docs of `star`), solved on the null space
 //! of the constraints ([`flexstar_numerics::eigen::constrained_modes`]).
@@ -252,7 +252,7 @@ pub fn pose_system(
     Ok(pose_triplets(params, pose, sliders, elements)?.to_dense())
 }
 
-/// [`pose_system`] of the robot carrying `payload` at G (issue 22).
+/// [`pose_system`] of the robot carrying `payload` at G (`docs/fem.md` section 9).
 pub fn pose_system_with(
     params: &RobotParams,
     payload: &Payload,
@@ -415,7 +415,7 @@ pub fn pose_modes(
     pose_modes_with(params, &Payload::default(), pose, sliders, elements, count)
 }
 
-/// [`pose_modes`] of the robot carrying `payload` at G (issue 22).
+/// [`pose_modes`] of the robot carrying `payload` at G (`docs/fem.md` section 9).
 pub fn pose_modes_with(
     params: &RobotParams,
     payload: &Payload,

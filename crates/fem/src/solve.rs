@@ -87,7 +87,7 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 ///   sleeve rotations, sliders and strain energy [J]), `W` (work of the drivers since t = 0 [J]),
 ///   `slopeG` (elastic slope of the beams at G: rotation of the weld node minus the rigid
 ///   rotation theta(t) - theta(0) [rad]; the junction measure of Table I);
-/// - issue 22, each only when its section is present (so a run at the defaults writes the
+/// - payload, damping and load, each only when its section is present (so a run at the defaults writes the
 ///   columns above and nothing else): `Ek_payload` (kinetic energy of the payload [J]) with a
 ///   `[payload]`, `W_load` (work of the load at G since t = 0 [J], trapezoidal rule on the steps)
 ///   with a `[load]`, `E_d` (energy dissipated by the beams' Kelvin-Voigt damping since t = 0
@@ -411,8 +411,8 @@ fn add_shapes(
 /// An optional column: whether the run has it, its name, its value in a sample.
 type OptionalColumn = (bool, &'static str, fn(&Sample) -> f64);
 
-/// Issue 22's columns after the others, each only when the run had its section: `Ek_payload`,
-/// `W_load`, `E_d` [J] (see [`solve`]).
+/// The payload's, load's and damping's columns after the others, each only when the run had its
+/// section: `Ek_payload`, `W_load`, `E_d` [J] (see [`solve`]).
 fn attachment_columns(hist: &History, names: &mut Vec<&str>, cols: &mut Vec<Vec<f64>>) {
     let present: [OptionalColumn; 3] = [
         (hist.payload, "Ek_payload", |s: &Sample| s.ke_payload),

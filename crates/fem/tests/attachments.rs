@@ -1,4 +1,4 @@
-//! Issue 22 in the FEM's time-domain equations (`docs/fem.md` section 9): a payload welded at G
+//! Payload, damping and load in the FEM's time-domain equations (`docs/fem.md` section 9): a payload welded at G
 //! (Eqs. P10-P12), Kelvin-Voigt damping of the beams (Eqs. D6-D10) and a load at G (Eq. L2),
 //! in the inverse and the direct problem, against references independent of the FEM: the
 //! Newton-Euler rigid-body inverse dynamics with payload and load (`flexstar-kinematics`, Eqs.

@@ -1,6 +1,6 @@
 //! Single-beam self-checks of the co-rotational element against outside references.
 
-// the single-beam models are test code: they live in the test tree (issue 25 item 4)
+// the single-beam models are test code: they live in the test tree
 #[path = "support/beam.rs"]
 mod beam;
 

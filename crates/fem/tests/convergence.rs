@@ -5,8 +5,8 @@
 //! Error of a run: for each of the six histories `w1tip..w3tip, w1G..w3G`, the largest
 //! difference from the reference over the committed samples divided by the reference's peak
 //! `max |w_ref|`; the worst history. Measured (this test): 1.05 % at (150 elements, 1 ms), 0.367 %
-//! at the default (300, 0.5 ms), observed order 1.52; since Eq. S9 of the tangent rows (issue 21,
-//! `docs/fem.md` section 2.1; the reference is from before it, whose own mesh error at 4800
+//! at the default (300, 0.5 ms), observed order 1.52; since Eq. S9 of the tangent rows
+//! (`docs/fem.md` section 2.1; the reference is from before it, whose own mesh error at 4800
 //! elements is first order) 1.08 %, 0.407 % and 1.40. Further down the sequence (elements and
 //! step refined together, `reference_values/README.md`) the orders are 1.09, 1.65, 1.91:
 //! pre-asymptotic, tending to the second order of the generalized-alpha scheme (Chung & Hulbert
@@ -79,7 +79,7 @@ fn default_mesh_and_step_converge_to_the_refined_reference() {
     let coarse = error(&run(150, 2.0 * flexstar_fem::DEFAULT_DT), &reference);
     let order = (coarse / default).log2();
     eprintln!("error vs the refined reference: (150, 1 ms) {coarse:.3e}, default (300, 0.5 ms) {default:.3e}, order {order:.2}");
-    // the default meets the 0.5 % target of issue 5 (docs/fem.md section 4), measured 0.407 %
+    // the default meets the 0.5 % target (docs/fem.md section 4), measured 0.407 %
     assert!(default < 5e-3, "default error {default:e}");
     // halving elements and step together: measured order 1.40 here (module docs); below 1.25
     // the scheme has lost its accuracy, above 2.5 the measure would be suspicious
@@ -94,7 +94,7 @@ fn paper_cases_work_counts_and_accuracy() {
     // exact work of the four paper cases at the defaults (300 elements, 0.5 ms, rho_inf 0.7;
     // docs/fem.md section 6): one factorisation per step, 2.0-2.2 Newton iterations per step
     // [steps, Newton iterations, factorisations, sparse fallbacks, sparsity patterns]
-    // (issue 21: Eq. S9 of the tangent rows took the iterations from 2188 / 1805 / 2113 / 2311)
+    // (Eq. S9 of the tangent rows, docs/fem.md 2.1, took the iterations from 2188 / 1805 / 2113 / 2311)
     let pinned = [
         (1, [1000, 2124, 1000, 0, 13]),
         (2, [800, 1679, 800, 0, 13]),
@@ -130,7 +130,7 @@ fn paper_cases_work_counts_and_accuracy() {
                 let text = if case == 2 { CASE2 } else { CASE3 };
                 let e = error(&r, &reference(text));
                 eprintln!("case {case}: {e:.3e} of the peak off the refined run");
-                // the 0.5 % target of issue 5; measured 0.407 % and 0.237 %
+                // the 0.5 % target (docs/fem.md section 4); measured 0.407 % and 0.237 %
                 assert!(e < 5e-3, "case {case}: {e:e}");
             }
             // s3 = 0, s2 = -s1: mirror symmetry about beam 3 (its deflection stays zero, beams

@@ -1,4 +1,4 @@
-//! Direct dynamics of the FEM (issue 10) against independent references: the round trip (an
+//! Direct dynamics of the FEM (`docs/fem.md` section 8) against independent references: the round trip (an
 //! inverse run's Fa fed back must give its motion back), the energy balance of the driven star
 //! (work of the actuator forces = kinetic + strain energy), a stiff servo against the prescribed
 //! motion, the stiff limit against the rigid-body forward dynamics of `flexstar-drive` (RK4 on the

@@ -1,6 +1,6 @@
-//! The FEM as a reference on a robot unlike the paper's (issue 21 item 2; `docs/fem.md` sections
+//! The FEM as a reference on a robot unlike the paper's (`docs/fem.md` sections
 //! 2.1 and 4.1, `docs/validation.md` "FEM convergence on other robots"): the sleeve-heavy robot 1
-//! of the issue (`reference_values/robot1.toml`: Jp / (rho L^3) = 0.078, eleven times the paper
+//! (`reference_values/robot1.toml`: Jp / (rho L^3) = 0.078, eleven times the paper
 //! robot's), against a refined run of the FEM whose histories are committed
 //! (`reference_values/robot1_refined.csv`, provenance in `reference_values/README.md`).
 //!
@@ -8,7 +8,7 @@
 //! C and G at every output time) of a run against the reference, or between two runs.
 //!
 //! - the defaults (300 elements, the robot-dependent step of Eq. S10) are within 0.1 % of the
-//!   reference (measured 0.085 %; 0.62 % with the paper's fixed 5e-4 s before issue 21);
+//!   reference (measured 0.085 %; 0.62 % with the paper's fixed 5e-4 s before Eq. S10);
 //! - the mesh converges at second order (Eq. S9 of the tangent rows; the pointwise row before
 //!   it gave 1.4 and worsening, a first-order discretisation): observed orders against the
 //!   reference and, Richardson's way, from three meshes alone;
@@ -73,7 +73,7 @@ fn defaults_are_within_a_tenth_of_a_percent_of_the_converged_limit() {
     assert_eq!(default.info.dt, dt);
     let e = evp(&default, &reference);
     eprintln!("defaults (300 elements, dt {dt:e} s): mean EVP {e:.4} % from the refined run");
-    // issue 21 item 2's target; measured 0.0852 %
+    // the 0.1 % target (docs/validation.md section 7); measured 0.0852 %
     assert!(e <= 0.1, "defaults {e} % from the converged limit");
 }
 

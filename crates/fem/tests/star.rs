@@ -234,7 +234,7 @@ fn bad_input_stops_with_time_and_reason() {
     .unwrap_err();
     assert!(matches!(err, FemError::Input(_)), "{err}");
     // case 2 past its end of travel: sleeve 2 (J) runs into G shortly after 0.4 s; refused by
-    // the feasibility scan before any step (issue 14), with the time and the sleeve
+    // the feasibility scan before any step (docs/conventions.md, feasible range), with the time and the sleeve
     let exp = experiment(RobotParams::paper(), Trajectory::quadratic([1.0, -0.5, -0.5]), 0.5);
     match flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
         .map(|s| s.response)

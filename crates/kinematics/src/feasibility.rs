@@ -189,7 +189,7 @@ pub fn preflight_step(dt_out: f64) -> f64 {
 }
 
 /// A motion that [`check_motion`] found feasible over `[0, t_end]`: the proof a solver takes in
-/// place of its own scan (issue 25 item 7: the preflight runs once). It holds what was checked
+/// place of its own scan (the preflight runs once). It holds what was checked
 /// (robot, trajectory, span, scan step), so that a solver can tell whether it covers the run it
 /// is given; it can only be made by the check.
 #[derive(Debug, Clone, PartialEq)]

@@ -14,7 +14,7 @@
 //! `Fa_i = (mpp + mpa) s_i'' + f_i e_wi . u_i`.
 //!
 //! With a payload welded at G (mass m, inertia J about its centre of mass at `r = ox e_x1 +
-//! oy e_w1` from G) and a load `(F, Mz)` at G (issue 22), Newton for the whole and Euler about G
+//! oy e_w1` from G) and a load `(F, Mz)` at G, Newton for the whole and Euler about G
 //! (`docs/amm.md` 11.1, Eqs. P7-P8):
 //!
 //! ```text

@@ -10,9 +10,10 @@ use crate::inverse_dynamics::rigid_inverse_dynamics_with;
 use crate::state::RigidState;
 use crate::KinematicsError;
 
-/// Column header of `kinematics.csv` (issue contract): the pose and its derivatives, then the
-/// slider velocities `sd_i` [m/s] and accelerations `sdd_i` [m/s^2] and the rigid driving forces
-/// `Fa_i` [N] of [`rigid_inverse_dynamics_with`] (issue 24; the payload and load included, issue 22). Units: `flexstar_model::response::COLUMN_UNITS`.
+/// Column header of `kinematics.csv` (a file contract, `docs/outputs.md`): the pose and its
+/// derivatives, then the slider velocities `sd_i` [m/s] and accelerations `sdd_i` [m/s^2] and the
+/// rigid driving forces `Fa_i` [N] of [`rigid_inverse_dynamics_with`] (the payload and load
+/// included). Units: `flexstar_model::response::COLUMN_UNITS`.
 pub const KINEMATICS_HEADER: [&str; 23] = [
     "t",
     "s1",

@@ -1,4 +1,4 @@
-//! Feasibility of the trajectory kinds of issue 26 (`docs/motions.md` 1.6): an infeasible table
+//! Feasibility of the trajectory kinds of `docs/motions.md` (1.6): an infeasible table
 //! row or via point is named, and so is a limit reached between two points.
 
 use flexstar_kinematics::{check_configuration, check_trajectory, Violation};

@@ -180,7 +180,7 @@ fn rigid_point_accelerations_match_eqs_11_12() {
 
 #[test]
 fn case2_leaves_the_feasible_range_when_sleeve_j_reaches_g() {
-    // docs/paper-defects.md (the four cases) / issue 3: refused with a time between 0.40 and 0.44 s.
+    // docs/paper-defects.md (the four cases): refused with a time between 0.40 and 0.44 s.
     let p = paper();
     let err = check_trajectory(&p, &Trajectory::quadratic([1.0, -0.5, -0.5]), 0.5, 1e-3).unwrap_err();
     assert!(err.t > 0.40 && err.t < 0.44, "t = {}", err.t);

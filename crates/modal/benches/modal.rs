@@ -1,4 +1,4 @@
-//! Speed of the modal analyses (issue 11 item 6), the paper's robot with the enriched family at
+//! Speed of the modal analyses (`docs/modes.md`, "Speed"), the paper's robot with the enriched family at
 //! N = 60 modes per beam (the modal default):
 //! - AMM modes at one pose, target at most 5 ms: the per-pose cost of a map (mode set built
 //!   once: `PoseModel::frequencies_at`, values only, and `PoseModel::modes_at`, with the

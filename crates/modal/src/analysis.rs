@@ -7,14 +7,15 @@ use flexstar_model::{Experiment, RestPose, Sliders};
 
 use crate::ModalError;
 
-/// Header of `modal.csv` (issue 11, exactly).
+/// Header of `modal.csv` (exactly; `docs/outputs.md`).
 pub const MODAL_HEADER: &str = "mode,f_amm_hz,f_fem_hz,rel_diff";
 
 /// The columns `modal.csv` gains after [`MODAL_HEADER`] when the experiment has a `[damping]`
-/// section (issue 22): each model's damping ratio of the mode, `beta omega_k / 2` (Eq. D11).
+/// section (`docs/modes.md`, payload, damping and loads): each model's damping ratio of the mode,
+/// `beta omega_k / 2` (Eq. D11).
 pub const DAMPING_COLUMNS: &str = "zeta_amm,zeta_fem";
 
-/// The AMM basis of the modal analyses: always the accurate one (issue 9's enriched family),
+/// The AMM basis of the modal analyses: always the accurate one (the enriched family, `docs/amm.md` section 7),
 /// whatever family `[amm]` asks for the time-domain runs (the paper's families miss the modes
 /// badly at some poses: pinned-free puts f1 79 % above the FEM at case 4's end pose). N per beam:
 /// `[amm] modes` when the config itself asks for the enriched family with a fixed N, else
@@ -28,7 +29,7 @@ pub fn amm_basis(exp: &Experiment) -> (ModeFamily, usize) {
 }
 
 /// The AMM's model at a pose for an experiment: the basis of [`amm_basis`] and the experiment's
-/// payload at G (issue 22).
+/// payload at G (`docs/amm.md` 11.4).
 pub fn amm_pose_model(exp: &Experiment) -> Result<flexstar_amm::pose_modes::PoseModel, ModalError> {
     let (family, nm) = amm_basis(exp);
     Ok(flexstar_amm::pose_modes::PoseModel::with_payload(

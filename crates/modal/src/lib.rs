@@ -1,6 +1,6 @@
 //! # flexstar-modal
 //!
-//! Vibration modes of the star over the workspace and linear models for control (issue 11),
+//! Vibration modes of the star over the workspace and linear models for control (`docs/modes.md`),
 //! above both solvers and below the CLI:
 //!
 //! - [`pose`]: the rest pose from a time of the experiment's trajectory or a task-space pose,

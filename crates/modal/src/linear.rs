@@ -1,4 +1,4 @@
-//! Linear state-space model of the small motion about a pose (issue 11, settings of issue 24):
+//! Linear state-space model of the small motion about a pose (`docs/modes.md`, linear model and its settings):
 //!
 //! ```text
 //! x' = A x + B u,   y = C x + D u
@@ -26,11 +26,12 @@
 //!   S^T]`); outputs those of the free model and the tracking errors `e1..e3 = s_ref - s` [m]
 //!   (`D` = 1 from `s_iref`).
 //!
-//! Issue 22: the payload is in M (so in the shapes and Omega); Kelvin-Voigt damping adds
-//! `Phi^T (beta K) Phi = beta Omega^2` to the velocity block, `A = [[0, I], [-Omega^2,
-//! -beta Omega^2]]` (Eq. D13; with the servo's `-kd S^T S` besides); with a `[load]` section the
-//! inputs end with the load at G, `Fx`, `Fy` [N] and `Mz` [N m], `B_load = [0; Phi^T P_L]`
-//! (Eq. L4, `P_L` the junction rows of Eq. L1 at the pose), D gaining zero columns.
+//! Payload, damping and load (`docs/amm.md` 11.4): the payload is in M (so in the shapes and
+//! Omega); Kelvin-Voigt damping adds `Phi^T (beta K) Phi = beta Omega^2` to the velocity block,
+//! `A = [[0, I], [-Omega^2, -beta Omega^2]]` (Eq. D13; with the servo's `-kd S^T S` besides);
+//! with a `[load]` section the inputs end with the load at G, `Fx`, `Fy` [N] and `Mz` [N m],
+//! `B_load = [0; Phi^T P_L]` (Eq. L4, `P_L` the junction rows of Eq. L1 at the pose), D gaining
+//! zero columns.
 
 use std::path::Path;
 
@@ -108,7 +109,7 @@ pub struct LinearSettings {
 }
 
 impl Default for LinearSettings {
-    /// [`ELASTIC_MODES`] elastic modes, sliders free, open loop (the model of issue 11).
+    /// [`ELASTIC_MODES`] elastic modes, sliders free, open loop (the default model of `docs/modes.md`).
     fn default() -> Self {
         LinearSettings {
             modes: ELASTIC_MODES,
@@ -322,7 +323,7 @@ impl Blocks {
 }
 
 /// The linear model about `pose` with free sliders, [`ELASTIC_MODES`] elastic modes, open loop
-/// (the model of issue 11; [`linearize_with`] takes other settings).
+/// (the default model of `docs/modes.md`; [`linearize_with`] takes other settings).
 pub fn linearize(exp: &Experiment, pose: &RestPose) -> Result<StateSpace, ModalError> {
     linearize_with(exp, pose, &LinearSettings::default())
 }
@@ -616,7 +617,7 @@ pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(),
     );
     let coordinates = fem_coordinates_csv(&fem.coordinates(ss.pose.xp, exp.robot.lp));
     let json = statespace_json(exp, ss, &fem);
-    // the seven matrices, the coordinates and the JSON are published together (issue 24)
+    // the seven matrices, the coordinates and the JSON are published together (a run set, `docs/outputs.md`)
     let mut set = flexstar_model::run_set::RunSet::begin(&dir.join("linear"))?;
     for (name, m) in [
         ("A", &ss.a),

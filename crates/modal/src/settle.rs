@@ -1,5 +1,5 @@
-//! The residual vibration of a run after its motion has come to rest (issue 26 item 2,
-//! `docs/motions.md` 2.2-2.3): the measures of [`flexstar_model::residual`] with the settling
+//! The residual vibration of a run after its motion has come to rest
+//! (`docs/motions.md` 2.2-2.3): the measures of [`flexstar_model::residual`] with the settling
 //! hold of section 2.3, one period of the first elastic mode at the final pose.
 
 use flexstar_model::residual::{residual_after, Residual};

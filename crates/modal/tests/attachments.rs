@@ -1,4 +1,4 @@
-//! Issue 22 at a pose: the payload, the damping and the load in the modal analysis and the linear
+//! Payload, damping and load at a pose: the payload, the damping and the load in the modal analysis and the linear
 //! model, against references independent of both solvers' assembly (docs/amm.md 11.5, Eqs.
 //! C1-C4; docs/modes.md, Eqs. D11-D13, L4).
 
@@ -32,9 +32,9 @@ fn supported_payload_frequencies(exp: &Experiment, m: f64, j: f64) -> (f64, f64)
 }
 
 /// A heavy payload at G, sliders locked, centre pose: the translational pair and the rotation
-/// against Eqs. C3-C4 within 1 % (issue 22), for both the AMM (enriched, N = 60) and the FEM
+/// against Eqs. C3-C4 within 1 % (`docs/amm.md` 11.5), for both the AMM (enriched, N = 60) and the FEM
 /// (300 elements). The references were confirmed on a one-beam Hermite model to 2e-4
-/// (docs/derivations/issue22_supports.py). Measured: AMM +1.6e-5 (pair) and +2.8e-5 (rotation),
+/// (docs/derivations/payload_supports.py). Measured: AMM +1.6e-5 (pair) and +2.8e-5 (rotation),
 /// FEM +7e-6 and +8e-6.
 #[test]
 fn heavy_payload_frequencies_match_the_elastic_supports() {

@@ -1,5 +1,6 @@
-//! Issue 11 checks against analytic references: the sleeve's textbook limit (Jp -> infinity) for
-//! both solvers, and the AMM's convergence in N up to N = 200 (no drift, no spurious mode).
+//! Checks of the modal analyses (`docs/modes.md`) against analytic references: the sleeve's
+//! textbook limit (Jp -> infinity) for both solvers, and the AMM's convergence in N up to N = 200
+//! (no drift, no spurious mode).
 
 use flexstar_model::{ModeFamily, RestPose, RobotParams, Sliders};
 

@@ -1,4 +1,4 @@
-//! Issue 11 checks of the linear model (A, B, C) against references independent of it: the FEM's
+//! Checks of the linear model (A, B, C; `docs/modes.md`) against references independent of it: the FEM's
 //! modal analysis (eigenvalues of A), the rigid robot's mass matrix from the drive crate's
 //! forward dynamics (the rigid modes' residue of B and C).
 
@@ -127,7 +127,7 @@ impl flexstar_drive::ActuatorLaw for Pulse {
 }
 
 /// The linear model's response to a small force pulse against the nonlinear direct AMM run
-/// (`flexstar_amm::solve` under a law, issue 10: sliders free under prescribed forces, exact
+/// (`flexstar_amm::solve` under a law, `docs/amm.md` section 10: sliders free under prescribed forces, exact
 /// Fermat-point kinematics, generalized-alpha in time, same N): EVP (Eq. 45) of the slider
 /// displacements and of the tip and G deflections within 1 %. The linear response is integrated
 /// here mode by mode (`eta'' + omega^2 eta = B eta-row . Fa`, RK4 at 1e-5 s) from A, B, C alone.

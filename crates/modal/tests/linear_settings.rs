@@ -1,4 +1,4 @@
-//! Issue 24 checks of the linear model's settings (`--modes`, `--sliders`, the servo loop), each
+//! Checks of the linear model's settings (`docs/modes.md`) (`--modes`, `--sliders`, the servo loop), each
 //! against a reference independent of the model's assembly: the modal analysis of both solvers
 //! (eigenvalues), the free-slider model with very heavy sliders (the locked model's base
 //! excitation), the rigid robot's mass matrix with the PD gains (closed-loop poles in the stiff

@@ -1,4 +1,4 @@
-//! Issue 11 checks: AMM against FEM at three poses, Matrix Market round trip, bad input.
+//! Checks of the modal analyses (`docs/modes.md`): AMM against FEM at three poses, Matrix Market round trip, bad input.
 
 use flexstar_modal::freqmap::{check_grid, Axis};
 use flexstar_modal::linear::{dense, read_mtx, write_mtx};

@@ -1,5 +1,6 @@
-//! What issue 22 adds to the paper's robot: a payload welded at the junction G (`[payload]`),
-//! Kelvin-Voigt material damping of the beams (`[damping]`) and an external load at G (`[load]`).
+//! What flexstar adds to the paper's robot (`docs/amm.md` section 11, `docs/fem.md` section 9): a
+//! payload welded at the junction G (`[payload]`), Kelvin-Voigt material damping of the beams
+//! (`[damping]`) and an external load at G (`[load]`).
 //!
 //! ```toml
 //! [payload]            # a rigid body welded at G (docs/amm.md 11.1, docs/fem.md 9.1)

@@ -171,11 +171,11 @@ impl std::fmt::Display for AmmModel {
 /// Default modes per beam of the paper's families (paper, section 8).
 pub const PAPER_MODES: usize = 25;
 
-/// Default error tolerance of the enriched family [%] (issue 9): the automatic N stops when the
+/// Default error tolerance of the enriched family [%] (`docs/amm.md` section 9): the automatic N stops when the
 /// estimated EVP of the truncation is below it.
 pub const DEFAULT_TOL_PERCENT: f64 = 0.5;
 
-/// Smallest error tolerance [%] the automatic N accepts (issue 24). The estimator of
+/// Smallest error tolerance [%] the automatic N accepts. The estimator of
 /// `flexstar_amm::adaptive` resolves a truncation EVP only down to what N = 200
 /// (`MAX_AUTO_MODES`) reaches: from about 1 % at its first N (46 for the paper's robot,
 /// `2 L / Lp + 12`) the error falls like `N^-p` with p = 6.1-7.6 measured between N = 46 and 53,
@@ -366,23 +366,23 @@ pub struct Experiment {
     pub amm: AmmSettings,
     #[serde(default)]
     pub fem: FemSettings,
-    /// What moves the sliders (`[drive]`, issue 10): the trajectory (default), forces or a servo.
+    /// What moves the sliders (`[drive]`, `docs/drives.md`): the trajectory (default), forces or a servo.
     #[serde(default)]
     pub drive: DriveSettings,
-    /// A rigid body welded at G (`[payload]`, issue 22); none by default.
+    /// A rigid body welded at G (`[payload]`, `docs/amm.md` section 11); none by default.
     #[serde(default)]
     pub payload: Payload,
-    /// Kelvin-Voigt damping of the beams (`[damping]`, issue 22); none by default.
+    /// Kelvin-Voigt damping of the beams (`[damping]`, `docs/amm.md` section 11); none by default.
     #[serde(default)]
     pub damping: Damping,
-    /// Force and moment at G (`[load]`, issue 22); none by default.
+    /// Force and moment at G (`[load]`, `docs/amm.md` section 11); none by default.
     #[serde(default)]
     pub load: LoadSettings,
-    /// Input shaping of the motion (`[shaper]`, issue 26, `docs/motions.md` 3.7); none by
+    /// Input shaping of the motion (`[shaper]`, `docs/motions.md` 3.7); none by
     /// default. Applied when the file is read ([`Experiment::apply_shaper`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shaper: Option<crate::shaper::ShaperSection>,
-    /// How reports measure the run (`[report]`, issue 26: the settling band).
+    /// How reports measure the run (`[report]`: the settling band, `docs/motions.md` 2.3).
     #[serde(default)]
     pub report: crate::residual::ReportSettings,
     /// Where the experiment was read from (not a TOML key).
@@ -702,7 +702,7 @@ s3 = [0.0, 0.0, 1.0]
             "{err}"
         );
         // one that starts before t_end and ends after it would be cut off mid-move: refused too
-        // (issue 26), naming both times
+        // (`docs/motions.md` 1.7), naming both times
         let cut = text.replace("t0 = 0.6", "t0 = 0.4");
         let err = Experiment::from_toml_str(&cut, Path::new("q.toml"))
             .unwrap_err()

@@ -1,4 +1,4 @@
-//! `[drive]` section of an experiment (issue 10): what moves the sliders.
+//! `[drive]` section of an experiment (`docs/drives.md`): what moves the sliders.
 //!
 //! ```toml
 //! [drive]

@@ -1,4 +1,4 @@
-//! The validation envelope of the accurate AMM (issue 21 item 3-4, `docs/validation.md`): the
+//! The validation envelope of the accurate AMM (`docs/validation.md` section 8): the
 //! ranges of robot parameters over which the accurate model (enriched family, full model,
 //! automatic N) and its error estimate were checked against the FEM by
 //! `configs/studies/envelope.toml`. A run outside them, or outside the small-deflection range,
@@ -32,7 +32,7 @@ struct Range {
     hi: f64,
 }
 
-/// The ranges of `configs/studies/envelope.toml` (issue 21 item 4); the last, `EA L^2 / EI` (the
+/// The ranges of `configs/studies/envelope.toml`; the last, `EA L^2 / EI` (the
 /// axial against the bending stiffness, which sets the axial flexibility's share, Eq. A2 of
 /// `docs/amm.md` 12.12), spans what the draw's ranges give with the default `EA = E rho / 7800`
 /// at E = 200 GPa: from 0.05 kg/m, 0.3 m, 2 N m^2 to 0.5 kg/m, 0.8 m, 0.1 N m^2.

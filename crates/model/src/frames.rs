@@ -1,4 +1,4 @@
-//! Animation frames (`docs/motions.md` section 5, issue 26 item 5): the deformed star recorded at
+//! Animation frames (`docs/motions.md` section 5): the deformed star recorded at
 //! a frame rate (`[amm] frames`, `[fem] frames`, per second), with the rigid pose of each frame,
 //! written as `<stem>-frames.csv` and `<stem>-frames-pose.csv`.
 

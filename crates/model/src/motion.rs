@@ -1,4 +1,4 @@
-//! The trajectory kinds users run (issue 26, `docs/motions.md` sections 1.2-1.6): `kind = "via"`
+//! The trajectory kinds users run (`docs/motions.md` sections 1.2-1.6): `kind = "via"`
 //! (task-space poses with times) and `kind = "table"` (a CSV of task-space poses or slider
 //! positions), both through a [`PiecewiseQuintic`], at rest before the first and after the last
 //! time.

@@ -208,7 +208,7 @@ mod tests {
 
     #[test]
     fn numbers_for_people_are_rounded_and_have_no_negative_zero() {
-        // the paper robot's EI: E I computed in floating point (issue 24)
+        // the paper robot's EI: E I computed in floating point
         assert_eq!(fmt_display(0.49999999999999994), "0.5");
         assert_eq!(fmt_display(0.1 + 0.2), "0.3");
         assert_eq!(fmt_display(-0.0), "0");

@@ -1,5 +1,5 @@
-//! Residual vibration and settling after a rest-to-rest motion (issue 26 item 2,
-//! `docs/motions.md` sections 2.1-2.3), computed from the fixed columns every solver writes, so
+//! Residual vibration and settling after a rest-to-rest motion
+//! (`docs/motions.md` sections 2.1-2.3), computed from the fixed columns every solver writes, so
 //! that the AMM and the FEM are measured by the same code.
 //!
 //! The elastic displacement of G is one vector `dG` of the fixed frame whose projections on the
@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::ModelError;
 use crate::response::Response;
 
-/// Default `[report] settle_tol` [m]: the settling band on |dG| (issue 26).
+/// Default `[report] settle_tol` [m]: the settling band on |dG| (`docs/motions.md` 2.3).
 pub const DEFAULT_SETTLE_TOL: f64 = 1e-4;
 
 /// The `[report]` section: how reports measure the run.
@@ -152,7 +152,7 @@ fn rms(t: &[f64], f: &[f64]) -> f64 {
     (integral / span).sqrt()
 }
 
-/// The sidecar's top-level keys of a residual (issue 26 item 2; `docs/outputs.md`): `t_rest`,
+/// The sidecar's top-level keys of a residual (`docs/outputs.md`): `t_rest`,
 /// `residual_G_peak_m`, `residual_G_rms_m`, `residual_tip_peak_m`, `residual_tip_rms_m`,
 /// `settle_s` (null when not settled), `settled`, `settle_tol`, `settle_hold_s`. Without a
 /// residual (no rest before `t_end`) every key is null but `settle_tol`. `g_pinned`: the run's

@@ -12,7 +12,7 @@ use crate::output::{fmt_number, Dest};
 use crate::run_set::RunSet;
 pub use crate::validity::{small_deflection_check, Provenance, ValidityExceeded};
 
-/// Fixed leading CSV columns of every solver result (issue contract).
+/// Fixed leading CSV columns of every solver result (a file contract, `docs/outputs.md`).
 pub const RESPONSE_HEADER: [&str; 10] = ["t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3"];
 
 /// Unit of every column of every CSV flexstar writes for a run or a motion (SI; `docs/outputs.md`
@@ -71,7 +71,7 @@ pub const COLUMN_UNITS: &[(&str, &str)] = &[
     ("U", "J"),
     ("W", "J"),
     ("slopeG", "rad"),
-    // issue 22's energies (FEM), each only with its section
+    // the energies of the payload, damping and load (FEM), each only with its section
     ("Ek_payload", "J"),
     ("W_load", "J"),
     ("E_d", "J"),
@@ -322,7 +322,7 @@ impl Response {
 
     /// Write the response as CSV with a chosen column order, whole or not at all: `t`, the extra
     /// columns `leading`, the fixed columns (`w_iG`, tips, `Fa_i`), the extra columns `after`, then
-    /// every other extra column in its order. A direct run's file (issue 10) is written with
+    /// every other extra column in its order. A direct run's file (`docs/drives.md`) is written with
     /// `leading = [s1, s2, s3]`, `after = [Gx, Gy, theta, (e1, e2, e3)]`. A named column that is
     /// missing is an error.
     pub fn write_csv_ordered(&self, path: &Path, leading: &[&str], after: &[&str]) -> Result<(), ModelError> {

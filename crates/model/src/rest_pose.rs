@@ -1,4 +1,4 @@
-//! A pose of the robot at rest, as data for the modal analyses of both solvers (issue 11).
+//! A pose of the robot at rest, as data for the modal analyses of both solvers (`docs/modes.md`).
 
 /// How the sliders are held in a modal analysis or a linear model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

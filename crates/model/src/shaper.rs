@@ -1,4 +1,4 @@
-//! Input shapers (issue 26 item 3, `docs/motions.md` section 3): the ZV and ZVD shapers of
+//! Input shapers (`docs/motions.md` section 3): the ZV and ZVD shapers of
 //! Singer and Seering (ASME J. Dyn. Syst. Meas. Control 112(1), 76-82, 1990), the EI shaper of
 //! Singhose, Seering and Singer (ASME J. Mech. Des. 116(2), 654-659, 1994), their convolution
 //! for several modes (section 3.3), their residual vibration (section 3.2), and the `[shaper]`

@@ -1,6 +1,6 @@
 //! Actuator trajectories `s_i(t)` (paper, section 8): polynomials in t, a rest-to-rest quintic
-//! between two task-space poses mapped through the inverse kinematics, and the kinds of issue 26
-//! (`docs/motions.md` section 1): via points and tables.
+//! between two task-space poses mapped through the inverse kinematics, and the kinds of
+//! `docs/motions.md` section 1: via points and tables.
 
 use num_dual::Dual2;
 

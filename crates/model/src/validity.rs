@@ -14,8 +14,8 @@
 //! - the elastic displacement of the junction `|w_iG|` against [`G_BOUND`] `* L` = 0.05 L: the
 //!   AMM places the sleeves and the star at the rigid configuration (Fermat point G, `xp_i`), so
 //!   a junction that moves off it by a share of L moves every contact point along its beam by as
-//!   much, a geometric change of first order that the linear model does not see (issue 21:
-//!   *measured* on the envelope's first draw, `docs/validation.md` section 8, the one case in the
+//!   much, a geometric change of first order that the linear model does not see
+//!   (*measured* on the envelope's first draw, `docs/validation.md` section 8, the one case in the
 //!   tips' range above 1 % mean EVP had `|w_G|` = 9.9 % of L; the 47 with `|w_G|` <= 5 % of L
 //!   stayed below 0.45 %).
 //!

@@ -1,4 +1,4 @@
-//! The trajectory kinds of issue 26 (`docs/motions.md` section 1) through `Trajectory::jets`, the
+//! The trajectory kinds of `docs/motions.md` section 1 through `Trajectory::jets`, the
 //! dual-number path every solver uses, against independent references: the closed-form quintic
 //! `10 tau^3 - 15 tau^4 + 6 tau^5`, the inverse kinematics of the given poses, and finite
 //! differences of the left and right limits at the knots.

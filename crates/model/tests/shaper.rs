@@ -1,4 +1,4 @@
-//! `[shaper]` on an experiment (issue 26 item 3, docs/motions.md 3.4, 3.7): the shaped motion's
+//! `[shaper]` on an experiment (docs/motions.md 3.4, 3.7): the shaped motion's
 //! pose is the impulse-weighted sum of the unshaped one's, its t_rest is later by the shaper's
 //! duration, and bad sections are refused by key.
 

@@ -1,4 +1,4 @@
-//! Motion planning for the star robot (issue 26 item 4, `docs/motions.md` section 4): a
+//! Motion planning for the star robot (`docs/motions.md` section 4): a
 //! rest-to-rest motion between two poses that minimises the residual vibration of G after the
 //! move, as the accurate AMM computes it, within slider speed, acceleration and force limits and
 //! the feasible workspace; or, with `objective = "time"`, the shortest such motion whose residual

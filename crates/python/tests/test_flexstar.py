@@ -150,7 +150,7 @@ def test_compare_writes_the_cli_table(root, tmp_path):
 
 
 def test_linearize_settings_and_names(root):
-    """linearize's settings (issue 24): K elastic modes and locked sliders give 2 K states
+    """linearize's settings (docs/modes.md): K elastic modes and locked sliders give 2 K states
     named eta1..etaK, etad1..etadK; the names are those of the Rust model (the CLI's
     statespace.json); the eigenvalues of A equal +- i omega of `modal`'s locked frequencies; a
     servo experiment is closed-loop by default, and ``loop="closed"`` without a servo is refused."""

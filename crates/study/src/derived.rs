@@ -1,5 +1,5 @@
 //! Derived keys of a study (`docs/studies.md`, "Derived keys"): robot parameters given as the
-//! dimensionless groups a validation envelope is drawn in (issue 21 item 4,
+//! dimensionless groups a validation envelope is drawn in (`docs/validation.md` section 8,
 //! `configs/studies/envelope.toml`), and a motion scaled to the robot. They are applied after the
 //! plain keys, in the order of [`DERIVED`], each reading the values set before it.
 //!

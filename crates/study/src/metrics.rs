@@ -51,8 +51,8 @@ pub fn residual_columns(
     }
 }
 
-/// Largest point EVP [%] over A, B, C, G of the points that have one (Eq. 45; issue 21 item 4's
-/// "largest point"); `None` when no point has one.
+/// Largest point EVP [%] over A, B, C, G of the points that have one (Eq. 45; the "largest
+/// point" target of `docs/validation.md` section 8); `None` when no point has one.
 pub fn largest_point_evp(e: &flexstar_model::evp::PointEvps) -> Option<f64> {
     e.points.iter().flatten().copied().reduce(f64::max)
 }

@@ -143,7 +143,7 @@ fn make_plots(table: &Table, meta: &Meta) -> Result<Vec<Plot>, StudyError> {
     Ok(plots)
 }
 
-/// The AMM's error estimate against its true mean EVP (issue 21 item 3), both as log10 of the
+/// The AMM's error estimate against its true mean EVP (`docs/validation.md` section 8), both as log10 of the
 /// percentage (the runs span decades): one point per AMM run of a study that runs both solvers
 /// (positive values), with the guides estimate = EVP / 2, EVP and 2 EVP (the target band) drawn
 /// as dotted lines; every `stride`-th row drawn, as in the other plots; `None` when the table
@@ -190,7 +190,7 @@ fn estimate_plot(table: &Table, ok: &[&Vec<String>], stride: usize) -> Result<Op
     };
     Ok(Some(Plot {
         file: "estimate-vs-evp.svg".to_string(),
-        caption: format!("The AMM's error estimate against its mean EVP against the FEM (log10 of the percentages), one point per AMM run; between the outer guides the estimate is within a factor 2 of the truth (issue 21's target){}", thinned(stride)),
+        caption: format!("The AMM's error estimate against its mean EVP against the FEM (log10 of the percentages), one point per AMM run; between the outer guides the estimate is within a factor 2 of the truth (the target){}", thinned(stride)),
         svg: scatter.to_svg()?,
     }))
 }

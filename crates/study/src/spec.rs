@@ -11,7 +11,7 @@
 //! key = "robot.Jp"
 //! linspace = [1e-4, 4e-4, 4]       # n points from a to b; or logspace = [a, b, n] (geometric)
 //! # sampling = "grid" (default, full factorial) or "lhs" with samples = 200 and seed = 1
-//! # fem_reference = "defaults" (the case's [fem] settings) or "refined" (issue 21)
+//! # fem_reference = "defaults" (the case's [fem] settings) or "refined" (docs/validation.md section 8)
 //! ```
 //! Unknown keys are rejected; every error names the study file, the key and the reason.
 

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use crate::error::StudyError;
 
-/// The columns after the varied keys, in this order (the issue's contract).
+/// The columns after the varied keys, in this order (a file contract, `docs/studies.md`).
 pub const METRIC_COLUMNS: [&str; 7] = [
     "solver",
     "status",
@@ -18,9 +18,9 @@ pub const METRIC_COLUMNS: [&str; 7] = [
 ];
 
 /// Further columns: residual tip vibration after a rest-to-rest motion [m], AMM modes per beam,
-/// the AMM's own estimate of its truncation error [%], then (issue 26) the residual peak of
+/// the AMM's own estimate of its truncation error [%], then the residual peak of
 /// |dG| after the motion [m] and the settling time [s, absolute; `inf` when not settled by
-/// `t_end`] (`docs/motions.md` 2.2-2.4), then (issue 21) the largest point EVP of the AMM
+/// `t_end`] (`docs/motions.md` 2.2-2.4), then the largest point EVP of the AMM
 /// against the FEM [%].
 pub const MORE_COLUMNS: [&str; 6] = [
     "residual_tip_m",

@@ -1,5 +1,5 @@
-//! Issue 21 item 4: a subset of the validation envelope (`configs/studies/envelope.toml`, the
-//! seed-21 draw of `docs/validation.md` section 8) run in the test suite with the issue's bounds.
+//! A subset of the validation envelope (`configs/studies/envelope.toml`, the seed-21 draw of
+//! `docs/validation.md` section 8) run in the test suite with that section's bounds.
 //!
 //! The cases are drawn by the study file itself (same Latin hypercube, same run ids), each run by
 //! the accurate AMM and by the refined FEM (`fem_reference = "refined"`), the independent

@@ -294,7 +294,7 @@ fn interrupted_study_resumes_and_ends_with_the_same_table() {
     assert!(msg.contains("another study"), "{msg}");
 }
 
-/// Issue 24, item 2: the study hash covers the forces tables a case reads, by content: the base's
+/// The study hash covers the forces tables a case reads, by content: the base's
 /// table and each table a varied key names; a study that reads no table keeps the hash of its
 /// two texts (FNV-1a of `study \0 base`, as before), so that existing results still resume.
 #[test]

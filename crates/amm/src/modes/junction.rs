@@ -1,4 +1,4 @@
-//! The junction shapes of the enriched family (issue 9; `docs/amm.md` section 7).
+//! The junction shapes of the enriched family (`docs/amm.md` section 7).
 //!
 //! Free-free modes have `w'' = w''' = 0` at G, so no combination of them carries the bending moment
 //! and shear that the weld at G transmits: the AMM reaches those forces only as N grows (a natural

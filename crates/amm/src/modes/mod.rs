@@ -31,7 +31,7 @@ use crate::error::AmmError;
 mod junction;
 use junction::JunctionShape;
 
-/// Largest number of modes per beam accepted (issue 4: "absurdly large" beyond this).
+/// Largest number of modes per beam accepted (beyond it a count is refused as absurdly large).
 pub const MAX_MODES: usize = 400;
 
 /// Shape of one mode on the unit interval, `Phi(xi)`.

@@ -1,4 +1,4 @@
-//! `flexstar modal`, `flexstar freqmap` and `flexstar linearize` (issue 11): modes at a pose,
+//! `flexstar modal`, `flexstar freqmap` and `flexstar linearize` (`docs/modes.md`): modes at a pose,
 //! frequency maps and linear models (thin layer over `flexstar_modal`).
 
 use std::path::PathBuf;

@@ -1,4 +1,4 @@
-//! `flexstar plan CONFIG [--out DIR]` (issue 26 item 4, `docs/motions.md` section 4): a
+//! `flexstar plan CONFIG [--out DIR]` (`docs/motions.md` section 4): a
 //! rest-to-rest motion that minimises the residual vibration of G after the move.
 
 use std::path::PathBuf;

@@ -1,9 +1,9 @@
-//! Structured direct solver of the Newton matrix of the star (issue 13): three banded beam blocks
+//! Structured direct solver of the Newton matrix of the star (`docs/fem.md` section 6): three banded beam blocks
 //! coupled only through a small border (the weld node G, and per sleeve its 7 multipliers, 3
 //! contact coordinates and its rotation).
 //!
 //! With the unknowns split into beam DOFs `b` (nodes 1..ne of each beam) and border DOFs `s`
-//! (36: `[nu_i (7), xi_i (3), psi_i]` per sleeve, then G; 39 in the direct problem of issue 10,
+//! (36: `[nu_i (7), xi_i (3), psi_i]` per sleeve, then G; 39 in the direct problem (`docs/fem.md` section 8),
 //! whose slider coordinates `s_i` couple only with their sleeve's multipliers and join the border
 //! last), the symmetric matrix is
 //!

@@ -80,7 +80,7 @@ pub(crate) struct History {
     pub snapshots: Vec<Snapshot>,
     pub node_x: Vec<f64>,
     pub stats: Stats,
-    /// Which of issue 22's additions the run had: payload, load, damping (their columns).
+    /// Which of the additions of `docs/fem.md` section 9 the run had: payload, load, damping (their columns).
     pub payload: bool,
     pub load: bool,
     pub damping: bool,
@@ -323,7 +323,7 @@ impl Stepper<'_, '_> {
 }
 
 /// Integrate from the initial state to the last output time, the star carrying `attached`'s
-/// payload, damping and load (issue 22).
+/// payload, damping and load (`docs/fem.md` section 9).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn integrate(
     params: &RobotParams,

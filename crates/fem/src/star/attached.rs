@@ -1,4 +1,4 @@
-//! What issue 22 attaches to the star (`docs/fem.md` section 9): a rigid payload welded to node G
+//! What an experiment attaches to the star (`docs/fem.md` section 9): a rigid payload welded to node G
 //! (Eqs. P10-P12), the beams' Kelvin-Voigt retardation time (Eqs. D6-D10, evaluated in the
 //! element pass) and a load at G (Eq. L2). Absent (the defaults), each adds nothing: its code path
 //! is skipped, so the run is the bare star's bit for bit.
@@ -74,7 +74,7 @@ impl PayloadAtG {
     }
 }
 
-/// The additions of issue 22 to one run: payload, damping, load (each absent by default).
+/// The additions to one run (`docs/fem.md` section 9): payload, damping, load (each absent by default).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Attached {
     /// The payload welded to G.

@@ -32,7 +32,7 @@
 //! beam with the point forces `-lambda_c`, `-lambda_l`, `-lambda_r`, and the beam pushes the sleeve,
 //! hence its pin and slider, with `F_i = lambda_c + lambda_l + lambda_r`.
 //!
-//! **Direct problem** (issue 10): the slider coordinates `s_i` [m] become three more unknowns
+//! **Direct problem** (`docs/fem.md` section 8): the slider coordinates `s_i` [m] become three more unknowns
 //! after the sleeve coordinates, the pins move with them (`P_i = P_i(s_i)`, linear, Eqs. 1-3, so
 //! the position rows gain the gradient `-u_i`), and each slider, a body of mass `mpp + mpa` on its
 //! rail pushed along `+u_i` by `Fa_i(t, s_i, s_i')`, adds the equation
@@ -167,7 +167,7 @@ pub(crate) struct Star {
     off_sl: usize,
     /// Offset of the tangent rows' multiplier block (Eq. S9, [`NU_SLOTS`] per sleeve).
     off_nu: usize,
-    /// Payload, damping and load (issue 22; none by default).
+    /// Payload, damping and load (`docs/fem.md` section 9; none by default).
     pub attached: Attached,
 }
 
@@ -343,7 +343,7 @@ impl Star {
     /// ```
     /// (Hessian terms of the constraints, the velocity and q dependence of the inertia are left
     /// out of the matrix: they are `O(h^2)` against the kept terms, see docs/fem.md.)
-    /// Issue 22 (`docs/fem.md` section 9): the payload adds `cf f_p` (Eq. P11) to G's rows and
+    /// Payload, damping and load (`docs/fem.md` section 9): the payload adds `cf f_p` (Eq. P11) to G's rows and
     /// `M_p` to the matrix, the load subtracts `cf (Fx, Fy, Mz)` from G's rows (Eq. L2), damping
     /// enters the element forces (Eqs. D7, D9; `fac.cv` the velocity factor gamma').
     /// Direct problem: `res[s_i] = cf ((mpp + mpa) s_i'' - Fa_i) - u_i . (nu_c + nu_l + nu_r)`,

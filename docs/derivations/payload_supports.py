@@ -11,7 +11,7 @@ carrying m / (3/2) + rho L there; for rotation, one beam with G fixed carrying J
 frequency by inverse iteration on the constrained saddle-point system (a dense generalized
 eigensolver is not reliable at this conditioning).
 
-Run: python3 docs/derivations/issue22_supports.py (numpy, scipy).
+Run: python3 docs/derivations/payload_supports.py (numpy, scipy).
 """
 import numpy as np
 import scipy.linalg as sl

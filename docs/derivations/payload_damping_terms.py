@@ -10,7 +10,7 @@ first order).
 D8: d p'/dq of the co-rotational element (p = (u, th1, th2), p' = B q') against central
 differences.
 
-Run: python3 docs/derivations/issue22_payload_terms.py (numpy).
+Run: python3 docs/derivations/payload_damping_terms.py (numpy).
 """
 import numpy as np
 

@@ -1,4 +1,4 @@
-//! Cost of issue 22's attachments (docs/amm.md 11): `issue22_cost bare|loaded K` solves paper
+//! Cost of the payload, damping and load (docs/amm.md 11.7): `attachments_cost bare|loaded K` solves paper
 //! case 3 with the accurate model at N = 53 K times, bare or with a payload off G, damping and a
 //! load (for instruction counts, e.g. `perf stat -e instructions:u`, on a shared machine where
 //! wall times are noisy).

@@ -30,7 +30,7 @@ impl ExperimentDoc {
 
     /// Parse and check TOML text (`source` names it in messages).
     pub fn from_toml(text: &str, source: &Path) -> Result<Self> {
-        let exp = Experiment::from_toml_str(text, source)?;
+        let exp = flexstar_shaping::shape_loaded(Experiment::from_toml_str(text, source)?)?;
         let doc: toml::Table =
             toml::from_str(text).map_err(|e| ApiError::config(source.display(), None, e.to_string()))?;
         Ok(ExperimentDoc {

@@ -15,7 +15,6 @@ pub mod plan;
 mod plan_figures;
 mod plan_report;
 pub mod run;
-pub mod shaper_auto;
 pub mod sidecar;
 mod solver_errors;
 pub mod study;
@@ -26,12 +25,13 @@ pub use document::ExperimentDoc;
 pub use error::{ApiError, Result};
 pub use flexstar_model::{Experiment, Provenance};
 pub use run::{Forces, Prepared, RunOutcome, RunSettings, Solver};
-pub use shaper_auto::register_auto_shaper;
 
 /// Load and validate an experiment file (errors name the file, the key and the reason).
+///
+/// A `[shaper]` is applied to the motion here, `f_hz = "auto"` resolved from the accurate AMM
+/// (`flexstar_shaping::shape`: reading the file alone never runs a solver).
 pub fn load(config: &Path) -> Result<Experiment> {
-    register_auto_shaper();
-    Ok(Experiment::load(config)?)
+    Ok(flexstar_shaping::shape_loaded(Experiment::load(config)?)?)
 }
 
 /// `DIR/<name>/`, created and checked writable (before any work is done).

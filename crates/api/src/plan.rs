@@ -57,7 +57,6 @@ fn from_plan(source: &str, e: PlanError) -> ApiError {
 
 /// Read and check a plan file (every check of 4.8 that needs no solver).
 pub fn load_plan(config: &Path) -> Result<PlanConfig> {
-    crate::register_auto_shaper();
     flexstar_plan::read_plan_config(config).map_err(|e| from_plan(&config.display().to_string(), e))
 }
 

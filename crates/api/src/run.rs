@@ -303,6 +303,7 @@ pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Re
         flexstar_solve::SolveError::Fem(e) => from_fem(&p.source, e),
         flexstar_solve::SolveError::Drive(e) => ApiError::config(&p.source, Some("drive"), e.to_string()),
         flexstar_solve::SolveError::Tracking(e) => ApiError::solver(&p.source, e),
+        e @ flexstar_solve::SolveError::Unshaped => ApiError::config(&p.source, Some("shaper.f_hz"), e.to_string()),
     })
 }
 

@@ -49,7 +49,6 @@ enum Command {
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    flexstar_api::register_auto_shaper();
     let result = match cli.command {
         Command::Kinematics(args) => commands::kinematics::run(args),
         Command::Run(args) => commands::run::run(args),

@@ -86,7 +86,7 @@ fn check_flags(exp: &Experiment, modes: Option<usize>) -> Result<(), Error> {
 /// then the solves in parallel, then the outputs.
 pub fn run_compare(opts: &CompareOptions, progress: Option<ProgressFn>) -> Result<CompareOutcome, Error> {
     let start = Instant::now();
-    let exp = Experiment::load(&opts.config)?;
+    let exp = flexstar_shaping::shape_loaded(Experiment::load(&opts.config)?)?;
     check_flags(&exp, opts.modes)?;
     let spec = CaseSpec {
         amm: compare_runs(&exp, &opts.families, opts.modes),

@@ -254,6 +254,10 @@ fn run_error(file: String, label: &str, e: SolveError) -> RunError {
             file,
             reason: e.to_string(),
         },
+        e @ SolveError::Unshaped => RunError::Input {
+            file,
+            reason: e.to_string(),
+        },
     }
 }
 

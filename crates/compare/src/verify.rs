@@ -133,7 +133,10 @@ pub fn run_verify(opts: &VerifyOptions, progress: Option<ProgressFn>) -> Result<
 /// with the runs of [`verify_spec`].
 fn load_specs(opts: &VerifyOptions, thresholds: &Thresholds) -> Result<Vec<CaseSpec>, Error> {
     let exps: Vec<Experiment> = match &opts.configs {
-        Some(files) => files.iter().map(|c| Experiment::load(c)).collect::<Result<_, _>>()?,
+        Some(files) => files
+            .iter()
+            .map(|c| Experiment::load(c).and_then(flexstar_shaping::shape_loaded))
+            .collect::<Result<_, _>>()?,
         None => paper_experiments(),
     };
     let n_study: &[usize] = if opts.n_study { &thresholds.n_study } else { &[] };

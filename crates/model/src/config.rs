@@ -379,7 +379,8 @@ pub struct Experiment {
     #[serde(default)]
     pub load: LoadSettings,
     /// Input shaping of the motion (`[shaper]`, `docs/motions.md` 3.7); none by
-    /// default. Applied when the file is read ([`Experiment::apply_shaper`]).
+    /// default. Given frequencies are applied when the file is read ([`Experiment::apply_shaper`]);
+    /// `f_hz = "auto"` waits for the explicit step `flexstar_shaping::shape`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shaper: Option<crate::shaper::ShaperSection>,
     /// How reports measure the run (`[report]`: the settling band, `docs/motions.md` 2.3).

@@ -172,19 +172,6 @@ pub struct AutoChoice {
     pub method: String,
 }
 
-/// The resolver of `f_hz = "auto"` (`docs/motions.md` 3.5): given the experiment with its
-/// unshaped, validated rest-to-rest motion and its `[shaper]` section, the frequencies chosen.
-/// It needs the solvers and the modal analysis, which this crate cannot call: the layer above
-/// (`flexstar_api::register_auto_shaper`) registers it once per process.
-pub type AutoResolver = fn(&crate::Experiment) -> Result<AutoChoice, String>;
-
-static AUTO_RESOLVER: std::sync::OnceLock<AutoResolver> = std::sync::OnceLock::new();
-
-/// Register the resolver of `f_hz = "auto"` (the first registration wins; later ones are no-ops).
-pub fn register_auto_resolver(f: AutoResolver) {
-    let _ = AUTO_RESOLVER.set(f);
-}
-
 /// What `f_hz` asks for.
 #[derive(Debug, Clone, PartialEq)]
 pub enum FrequencySpec {
@@ -301,25 +288,54 @@ impl crate::Experiment {
     /// the motion can be shaped (rest-to-rest, in task space, not a forces drive), resolve the
     /// impulses (`zeta` defaults to `[damping]`'s `zeta_at(f)`), and replace `trajectory` by the
     /// [`Trajectory::Shaped`] motion. A no-op without `[shaper]` or when already shaped.
+    ///
+    /// `f_hz = "auto"` needs the accurate AMM, which this crate does not run: it is checked here
+    /// (a prescribed motion, not a servo) and left pending ([`Self::shaper_pending`]) for the
+    /// explicit step `flexstar_shaping::shape`, which calls [`Self::apply_auto_shaper`].
     pub fn apply_shaper(&mut self) -> Result<(), ModelError> {
-        let Some(mut section) = self.shaper.clone() else {
+        let Some(section) = self.shaper.clone() else {
             return Ok(());
         };
         if matches!(self.trajectory, Trajectory::Shaped(_)) {
             return Ok(());
         }
         self.check_shapeable()?;
-        let f_hz = match section.frequency_spec()? {
-            FrequencySpec::Given(f) => f,
+        match section.frequency_spec()? {
+            FrequencySpec::Given(f_hz) => self.shape_with(section, &f_hz),
             FrequencySpec::Auto => {
-                let choice = self.auto_frequencies()?;
-                let f = choice.frequencies_hz.clone();
-                section.auto = Some(choice);
-                f
+                section.v_tol()?;
+                self.check_auto()
             }
+        }
+    }
+
+    /// Whether `[shaper] f_hz = "auto"` still waits for its frequencies (the motion unshaped):
+    /// what `flexstar_shaping::shape` resolves, and what the solvers refuse to run.
+    pub fn shaper_pending(&self) -> bool {
+        !matches!(self.trajectory, Trajectory::Shaped(_))
+            && self
+                .shaper
+                .as_ref()
+                .is_some_and(|s| matches!(s.frequency_spec(), Ok(FrequencySpec::Auto)))
+    }
+
+    /// Apply a pending `f_hz = "auto"` shaper with the frequencies `choice` found
+    /// (`docs/motions.md` 3.5; `flexstar_shaping::shape`), recorded in the section's `auto`.
+    pub fn apply_auto_shaper(&mut self, choice: AutoChoice) -> Result<(), ModelError> {
+        let Some(mut section) = self.shaper.clone() else {
+            return Err(ModelError::invalid("shaper", "no [shaper] section to apply"));
         };
+        self.check_shapeable()?;
+        self.check_auto()?;
+        let f_hz = choice.frequencies_hz.clone();
+        section.auto = Some(choice);
+        self.shape_with(section, &f_hz)
+    }
+
+    /// Resolve `section` at the frequencies `f_hz` [Hz] and shape the motion with it.
+    fn shape_with(&mut self, mut section: ShaperSection, f_hz: &[f64]) -> Result<(), ModelError> {
         let damping = self.damping;
-        section.resolve(&f_hz, |f| damping.zeta_at(f))?;
+        section.resolve(f_hz, |f| damping.zeta_at(f))?;
         self.trajectory = Trajectory::Shaped(ShapedMotion {
             base: Box::new(self.trajectory.clone()),
             impulses: section.impulses.clone(),
@@ -328,9 +344,8 @@ impl crate::Experiment {
         Ok(())
     }
 
-    /// `f_hz = "auto"` resolved by the registered [`AutoResolver`] (key `shaper.f_hz`): refused
-    /// with a servo (`docs/motions.md` 8.5) and when no resolver is registered.
-    fn auto_frequencies(&self) -> Result<AutoChoice, ModelError> {
+    /// `f_hz = "auto"` is refused with a servo (`docs/motions.md` 8.5; key `shaper.f_hz`).
+    fn check_auto(&self) -> Result<(), ModelError> {
         if self.drive.kind != crate::DriveKind::Motion {
             return Err(ModelError::invalid(
                 "shaper.f_hz",
@@ -338,14 +353,7 @@ impl crate::Experiment {
                  frequencies [Hz]",
             ));
         }
-        let Some(resolve) = AUTO_RESOLVER.get() else {
-            return Err(ModelError::invalid(
-                "shaper.f_hz",
-                "\"auto\" needs the modal analysis, which this program did not register \
-                 (flexstar_api::register_auto_shaper); give the frequencies [Hz]",
-            ));
-        };
-        resolve(self).map_err(|e| ModelError::invalid("shaper.f_hz", format!("\"auto\": {e}")))
+        Ok(())
     }
 
     /// The motion a shaper may act on: valid, rest-to-rest, with a task-space pose, and moved by

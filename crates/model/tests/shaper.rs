@@ -81,13 +81,16 @@ fn bad_sections_are_refused_by_key() {
     assert!(err.contains("rest-to-rest"), "{err}");
 }
 
-/// Without a registered resolver (this crate alone cannot run the modal analysis),
-/// `f_hz = "auto"` is refused by key with what to do instead.
+/// Reading a file never runs a solver: `f_hz = "auto"` is checked (with a servo it is refused by
+/// key) and left pending, the motion unshaped, for the explicit step `flexstar_shaping::shape`.
 #[test]
-fn auto_without_a_resolver_is_refused_by_key() {
-    let err = load("[shaper]\nkind = \"zvd\"\nf_hz = \"auto\"\n").unwrap_err();
-    assert!(
-        err.contains("shaper.f_hz") && err.contains("register_auto_shaper"),
-        "{err}"
-    );
+fn auto_is_left_pending_when_read() {
+    let plain = load("").unwrap();
+    let e = load("[shaper]\nkind = \"zvd\"\nf_hz = \"auto\"\n").unwrap();
+    assert!(e.shaper_pending());
+    assert_eq!(e.trajectory, plain.trajectory);
+    assert!(!plain.shaper_pending());
+    assert!(!load("[shaper]\nkind = \"zv\"\nf_hz = 4.0\n").unwrap().shaper_pending());
+    let err = load("[shaper]\nkind = \"zvd\"\nf_hz = \"auto\"\nv_tol = 0.1\n").unwrap_err();
+    assert!(err.contains("shaper.v_tol"), "{err}");
 }

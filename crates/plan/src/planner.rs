@@ -185,7 +185,7 @@ pub fn zvd_experiment(exp: &Experiment, base: Trajectory) -> Result<Experiment, 
     let t_base = base.t_rest().unwrap_or(0.0);
     x.trajectory = base;
     x.shaper = Some(ShaperSection::auto(ShaperKind::Zvd));
-    x.apply_shaper()
+    flexstar_shaping::shape(&mut x)
         .map_err(|e| PlanError::Solver(format!("the ZVD-shaped quintic: {}", e.detail())))?;
     let t_rest = x.trajectory.t_rest().unwrap_or(f64::INFINITY);
     if t_rest > exp.time.t_end {

@@ -318,7 +318,6 @@ fn sweep(py: Python<'_>, study: PathBuf, out: PathBuf, jobs: Option<usize>, prog
 #[pymodule]
 fn _flexstar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
-    flexstar_api::register_auto_shaper();
     m.add("ConfigError", py.get_type::<ConfigError>())?;
     m.add("InfeasibleMotion", py.get_type::<InfeasibleMotion>())?;
     m.add("SolverError", py.get_type::<SolverError>())?;

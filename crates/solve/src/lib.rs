@@ -96,6 +96,9 @@ pub enum SolveError {
     /// A servo's tracking errors could not be evaluated (its reference, at a time).
     #[error(transparent)]
     Tracking(flexstar_drive::DriveError),
+    /// `[shaper] f_hz = "auto"` is still pending: the motion would run unshaped.
+    #[error("shaper.f_hz = \"auto\" is not resolved yet: apply the shaper first (flexstar_shaping::shape)")]
+    Unshaped,
 }
 
 /// Solve `exp` with `settings` for the experiment's drive: the prescribed motion (inverse
@@ -111,6 +114,9 @@ pub fn solve(
     proof: Option<&CheckedMotion>,
     progress: Option<Progress>,
 ) -> Result<Solved<Stats>, SolveError> {
+    if exp.shaper_pending() {
+        return Err(SolveError::Unshaped);
+    }
     let law = flexstar_drive::law_for(exp)?;
     let mut solved = solve_under(exp, settings, law.as_deref(), proof, progress)?;
     if law.is_some() && exp.drive.kind == DriveKind::Servo {
@@ -184,5 +190,20 @@ mod tests {
             assert_eq!(s.to_string(), s.name());
         }
         assert!("abaqus".parse::<Solver>().unwrap_err().contains("expected amm or fem"));
+    }
+
+    /// A loaded `f_hz = "auto"` waits for the explicit shaping step: solving it before would run
+    /// the unshaped motion, so both solvers refuse it (and nothing is integrated).
+    #[test]
+    fn a_pending_shaper_is_refused() {
+        let text = "name = \"q\"\n[time]\nt_end = 0.6\ndt_out = 0.001\n[trajectory]\nkind = \"quintic\"\n\
+                    from = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\nto = { Gx = 0.05, Gy = 0.0, theta = 0.0 }\n\
+                    t0 = 0.0\nt1 = 0.3\n[shaper]\nkind = \"zvd\"\nf_hz = \"auto\"\n";
+        let exp = Experiment::from_toml_str(text, std::path::Path::new("q.toml")).unwrap();
+        assert!(exp.shaper_pending());
+        for solver in Solver::ALL {
+            let e = solve(&exp, Settings::of(&exp, solver), None, None).unwrap_err();
+            assert!(matches!(e, SolveError::Unshaped), "{solver}: {e}");
+        }
     }
 }

@@ -278,7 +278,8 @@ impl Study {
     fn experiment_with(&self, keys: &[String], values: &[toml::Value]) -> Result<Experiment, String> {
         let doc = patch::case_document(&self.base, keys, values)?;
         let text = toml::to_string(&doc).map_err(|e| e.to_string())?;
-        Experiment::from_toml_str(&text, &self.base_file).map_err(|e| e.to_string())
+        let exp = Experiment::from_toml_str(&text, &self.base_file).map_err(|e| e.to_string())?;
+        flexstar_shaping::shape_loaded(exp).map_err(|e| e.to_string())
     }
 }
 

@@ -95,7 +95,7 @@ pub struct FreqmapArgs {
     k: usize,
     /// Solver of the map
     #[arg(long, value_enum, default_value = "amm")]
-    solver: flexstar_api::Solver,
+    solver: flexstar_solve::Solver,
     /// How the sliders are held (free: f1 is the first elastic frequency, the rigid modes left out)
     #[arg(long, value_enum, default_value = "locked")]
     sliders: SlidersArg,

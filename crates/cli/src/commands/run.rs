@@ -18,7 +18,7 @@ pub struct Args {
     config: PathBuf,
     /// Which model to run
     #[arg(long, value_enum)]
-    solver: flexstar_api::Solver,
+    solver: flexstar_solve::Solver,
     /// AMM mode family (overrides [amm] family): pinned-free, slide-free, free-free, clamped-free, enriched
     #[arg(long)]
     family: Option<ModeFamily>,
@@ -81,7 +81,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let cfg = args.config.display().to_string();
     let settings = args.settings();
     let started = std::time::Instant::now();
-    let fem = settings.solver == flexstar_api::Solver::Fem;
+    let fem = settings.solver == flexstar_solve::Solver::Fem;
     let outcome = if fem && std::io::stderr().is_terminal() {
         let bar = indicatif::ProgressBar::new(1000);
         bar.set_style(

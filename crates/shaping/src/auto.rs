@@ -1,7 +1,5 @@
-//! `[shaper] f_hz = "auto"` (`docs/motions.md` 3.5): the shaper frequencies from
-//! the accurate AMM, resolved when the experiment is read. The model crate cannot call the
-//! solvers or the modal analysis, so it asks the resolver registered here
-//! ([`register_auto_shaper`]; the command line and the Python package register it at start).
+//! `[shaper] f_hz = "auto"` (`docs/motions.md` 3.5): the shaper frequencies from the accurate AMM,
+//! resolved by the explicit step [`crate::shape`].
 //!
 //! The rule (3.5 as implemented): the frequencies of the accurate AMM at the final pose (sliders
 //! locked) are grouped where the fit below cannot tell them apart; one accurate AMM run of the
@@ -10,7 +8,7 @@
 //! per group gives each group's amplitude at G, `|a_g|`; the shapers are chosen greedily against
 //! the LTI prediction (3.5 step 4).
 
-use flexstar_model::shaper::{multi, register_auto_resolver, residual, AutoChoice, AutoMode, ShaperKind};
+use flexstar_model::shaper::{multi, residual, AutoChoice, AutoMode, ShaperKind};
 use flexstar_model::{AmmSettings, Experiment, ModeFamily, ShaperSection};
 
 /// Elastic modes of the final pose looked at.
@@ -24,11 +22,6 @@ const MAX_SHAPERS: usize = 4;
 /// share of the largest one's.
 const MERGE_SHARE: f64 = 0.5;
 
-/// Register the resolver of `f_hz = "auto"` with the model crate (idempotent).
-pub fn register_auto_shaper() {
-    register_auto_resolver(resolve_auto);
-}
-
 /// The largest ratio `f_hi / f_lo` of two modes that one shaper at their mean keeps below 5 %
 /// residual (the table of `docs/motions.md` 3.2).
 fn merge_ratio(kind: ShaperKind) -> f64 {
@@ -39,8 +32,8 @@ fn merge_ratio(kind: ShaperKind) -> f64 {
     }
 }
 
-/// The resolver: modes, the unshaped AMM run, the fit, the greedy choice.
-fn resolve_auto(exp: &Experiment) -> Result<AutoChoice, String> {
+/// The choice of `f_hz = "auto"`: modes, the unshaped AMM run, the fit, the greedy choice.
+pub(crate) fn resolve_auto(exp: &Experiment) -> Result<AutoChoice, String> {
     let section = exp.shaper.as_ref().ok_or("no [shaper] section")?;
     let t_rest = exp.trajectory.t_rest().ok_or("the motion never comes to rest")?;
     let freqs = flexstar_modal::analysis::final_pose_frequencies(exp, MODES)

@@ -100,7 +100,7 @@ impl Fixture {
     /// After the next start (the recovery every writer and reader of flexstar runs first): the
     /// old or the new set whole, and nothing of flexstar's own left.
     fn assert_whole(&self, run_dir: &Path, what: &str) -> bool {
-        flexstar_model::run_set::recover(run_dir).unwrap();
+        flexstar_io::run_set::recover(run_dir).unwrap();
         let set = read_set(run_dir);
         let is_new = set.as_ref() == Some(&self.new);
         assert!(

@@ -47,6 +47,13 @@ pub fn animate(dir: &Path, out: Option<&Path>, magnify: Option<f64>) -> Result<(
     let runs = read_dir(dir)?;
     let html = build_page(&runs, magnify)?;
     let path = out.map_or_else(|| dir.join("animate.html"), Path::to_path_buf);
-    flexstar_model::output::write_string_atomically(&path, &html)?;
+    flexstar_io::output::write_string_atomically(&path, &html)?;
     Ok((path, runs.into_iter().map(|r| r.name).collect()))
+}
+
+impl From<flexstar_io::WriteError> for AnimateError {
+    /// A result file that could not be written, as the model's `ModelError::Write` (same message).
+    fn from(e: flexstar_io::WriteError) -> Self {
+        flexstar_model::ModelError::from(e).into()
+    }
 }

@@ -157,3 +157,10 @@ impl From<flexstar_plot::FigureError> for ApiError {
 
 /// The result of every command of [`crate`].
 pub type Result<T> = std::result::Result<T, ApiError>;
+
+impl From<flexstar_io::WriteError> for ApiError {
+    /// A result file that could not be written, as the model's `ModelError::Write` (same message).
+    fn from(e: flexstar_io::WriteError) -> Self {
+        flexstar_model::ModelError::from(e).into()
+    }
+}

@@ -37,8 +37,8 @@ pub fn load(config: &Path) -> Result<Experiment> {
 /// `DIR/<name>/`, created and checked writable (before any work is done).
 pub fn case_dir(out: &Path, exp: &Experiment) -> Result<PathBuf> {
     let dir = out.join(&exp.name);
-    flexstar_model::output::ensure_writable_dir(out)?;
-    flexstar_model::output::ensure_writable_dir(&dir)?;
+    flexstar_io::output::ensure_writable_dir(out)?;
+    flexstar_io::output::ensure_writable_dir(&dir)?;
     Ok(dir)
 }
 

@@ -3,14 +3,14 @@
 
 use std::path::{Path, PathBuf};
 
+use flexstar_io::output::{fmt_display, fmt_fixed, Dest};
+use flexstar_io::run_set::RunSet;
 use flexstar_modal::analysis::{amm_modes_per_beam, write_modal_csv, Modal};
 use flexstar_modal::freqmap::{check_grid, stage_freqmap_csv, Axis, Grid};
 use flexstar_modal::linear::{Holding, LinearSettings, StateSpace};
 use flexstar_modal::plots::{mode_shapes_figure, trajectory_path, FreqMapFigure};
 use flexstar_modal::pose::{pose_at_time, pose_from_task};
 use flexstar_modal::ModalError;
-use flexstar_model::output::{fmt_display, fmt_fixed, Dest};
-use flexstar_model::run_set::RunSet;
 use flexstar_model::{DriveKind, Experiment, ModeFamily, RestPose, Sliders};
 use flexstar_plot::write_svg_png;
 use serde_json::{json, Map, Value};

@@ -1,6 +1,6 @@
 //! `modes`: the assumed modes of a family (Eq. 34-1), rigid modes included.
 
-use flexstar_model::output::fmt_display;
+use flexstar_io::output::fmt_display;
 use flexstar_model::{ModeFamily, RobotParams};
 
 use crate::{ApiError, Result};

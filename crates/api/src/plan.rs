@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use flexstar_model::run_set::RunSet;
+use flexstar_io::run_set::RunSet;
 use flexstar_model::{Experiment, TableMotion, TableSpace, Trajectory};
 use flexstar_plan::{PlanConfig, PlanError, Planned};
 
@@ -161,7 +161,7 @@ fn write_runs(motions: &[MotionRuns], dir: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for m in motions {
         let sub = dir.join(m.key);
-        flexstar_model::output::ensure_writable_dir(&sub)?;
+        flexstar_io::output::ensure_writable_dir(&sub)?;
         for run in [&m.amm, &m.fem] {
             let mut out = run.clone();
             crate::run::write_run(&mut out, &sub, false)?;

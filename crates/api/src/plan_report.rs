@@ -288,7 +288,7 @@ fn per_motion_panels(o: &PlanOutcome, y_label: &str, scale: f64, f: fn(&Response
 /// The figures of 4.7, written to `dir/figures/`.
 pub fn write_figures(exp: &Experiment, o: &PlanOutcome) -> Result<Vec<PathBuf>> {
     let dir = o.dir.join("figures");
-    flexstar_model::output::ensure_writable_dir(&dir)?;
+    flexstar_io::output::ensure_writable_dir(&dir)?;
     let n = &exp.name;
     let figures = [
         Figure {

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use flexstar_kinematics::CheckedMotion;
 
+use flexstar_io::run_set::RunSet;
 use flexstar_model::config::check_step;
 use flexstar_model::response::sidecar_text;
-use flexstar_model::run_set::RunSet;
 use flexstar_model::{AmmModel, DriveKind, DriveSettings, Experiment, ForceSamples, ModeFamily, Response};
 
 use crate::solver_errors::{from_amm, from_fem};

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use flexstar_model::run_set::RunSet;
+use flexstar_io::run_set::RunSet;
 use flexstar_model::{Experiment, ModelError};
 use serde_json::{Map, Value};
 

@@ -6,8 +6,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use flexstar_io::run_set::RunSet;
 use flexstar_kinematics::{rigid_inverse_dynamics_with, RigidState};
-use flexstar_model::run_set::RunSet;
 use flexstar_model::{
     small_deflection_check, DriveKind, Experiment, Feedforward, ModeFamily, Provenance, Response, ValidityExceeded,
 };

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use flexstar_model::output::{ensure_writable_dir, write_string_atomically};
+use flexstar_io::output::{ensure_writable_dir, write_string_atomically};
 use flexstar_model::{AmmSettings, Experiment, ModeFamily, Provenance};
 
 use crate::case_output::{write_case, ValidityWarning};

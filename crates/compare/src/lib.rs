@@ -54,3 +54,10 @@ pub enum Error {
     #[error("{file}: {reason}")]
     Input { file: String, reason: String },
 }
+
+impl From<flexstar_io::WriteError> for Error {
+    /// A result file that could not be written, as the model's `ModelError::Write` (same message).
+    fn from(e: flexstar_io::WriteError) -> Self {
+        flexstar_model::ModelError::from(e).into()
+    }
+}

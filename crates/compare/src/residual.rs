@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use flexstar_model::output::fmt_number;
+use flexstar_io::output::fmt_number;
 use flexstar_model::residual::{residual_after, settle_text, Residual};
 use flexstar_model::{Experiment, ModeFamily};
 use flexstar_plot::{Figure, Series, MARK_STYLE};

@@ -169,8 +169,7 @@ fn pct(v: Option<f64>) -> String {
 
 /// A value for a CSV file: the shortest exact form, or `n/a`.
 pub fn opt_number(v: Option<f64>) -> String {
-    v.map(flexstar_model::output::fmt_number)
-        .unwrap_or_else(|| "n/a".into())
+    v.map(flexstar_io::output::fmt_number).unwrap_or_else(|| "n/a".into())
 }
 
 /// One case's line of the summary table: ours beside the paper's values; a paper-specific finding

@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use flexstar_model::output::{ensure_writable_dir, write_string_atomically};
+use flexstar_io::output::{ensure_writable_dir, write_string_atomically};
 use flexstar_model::{Experiment, ModeFamily, Provenance};
 use rayon::prelude::*;
 

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use flexstar_model::output::{fmt_number, write_atomically};
+use flexstar_io::output::{fmt_number, write_atomically};
 use flexstar_model::{Attachments, Experiment, RobotParams};
 
 use crate::feasibility::check_trajectory;
@@ -96,7 +96,7 @@ pub fn write_kinematics_csv(
         out.flush()?;
         Ok(())
     })
-    .map_err(KinematicsError::Write)
+    .map_err(|e| KinematicsError::Write(e.into()))
 }
 
 #[cfg(test)]

@@ -9,9 +9,9 @@
 //! defaults (the paper's families are for the time-domain comparison, not for modes).
 
 use flexstar_amm::pose_modes::{PoseModel, DEFAULT_MODAL_MODES};
+use flexstar_io::output::{fmt_number, write_atomically};
 use flexstar_modal::plots::PATH_COLORS;
 use flexstar_modal::pose::pose_at_time;
-use flexstar_model::output::{fmt_number, write_atomically};
 use flexstar_model::{AmmSettings, Sliders};
 use flexstar_plot::{Figure, Panel, Series, Style};
 
@@ -19,7 +19,7 @@ const STEP: f64 = 0.005;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::path::PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| "out/f1-paths".into()));
-    flexstar_model::output::ensure_writable_dir(&out)?;
+    flexstar_io::output::ensure_writable_dir(&out)?;
     let mut rows = Vec::new();
     let mut panels: Vec<Panel> = ["f1", "f2"]
         .iter()

@@ -1,7 +1,7 @@
 //! Modes at one pose from both solvers, side by side (`modal.csv`).
 
 use flexstar_amm::pose_modes::DEFAULT_MODAL_MODES;
-use flexstar_model::output::{fmt_number, Dest};
+use flexstar_io::output::{fmt_number, Dest};
 use flexstar_model::ModeFamily;
 use flexstar_model::{Experiment, RestPose, Sliders};
 

@@ -16,3 +16,10 @@ pub enum ModalError {
     #[error(transparent)]
     Model(#[from] flexstar_model::ModelError),
 }
+
+impl From<flexstar_io::WriteError> for ModalError {
+    /// A result file that could not be written, as the model's `ModelError::Write` (same message).
+    fn from(e: flexstar_io::WriteError) -> Self {
+        flexstar_model::ModelError::from(e).into()
+    }
+}

@@ -3,8 +3,8 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use flexstar_amm::pose_modes::PoseModel;
-use flexstar_model::output::fmt_number;
-use flexstar_model::run_set::RunSet;
+use flexstar_io::output::fmt_number;
+use flexstar_io::run_set::RunSet;
 use flexstar_model::{Experiment, Sliders};
 use rayon::prelude::*;
 

@@ -36,8 +36,8 @@
 use std::path::Path;
 
 use flexstar_amm::pose_modes::{PoseModes, PoseSystem};
+use flexstar_io::output::write_atomically;
 use flexstar_kinematics::RigidState;
-use flexstar_model::output::write_atomically;
 use flexstar_model::{DriveKind, Experiment, RestPose, Sliders};
 use num_dual::Dual2;
 use sprs::{CsMat, TriMat};
@@ -534,7 +534,7 @@ pub fn fem_coordinates_csv(coords: &[flexstar_fem::pose_modes::Coordinate]) -> S
     let opt = |v: Option<usize>| v.map_or(String::new(), |v| v.to_string());
     let mut text = format!("{FEM_COORDINATES_HEADER}\n");
     for c in coords {
-        let x = c.x.map_or(String::new(), flexstar_model::output::fmt_number);
+        let x = c.x.map_or(String::new(), flexstar_io::output::fmt_number);
         text.push_str(&format!(
             "{},{},{},{},{x}\n",
             c.index + 1,
@@ -605,7 +605,7 @@ fn damping_json(exp: &Experiment) -> serde_json::Value {
 /// Write `dir/linear/`: A, B, C, D, statespace.json, the FEM's M, K, Phi_q at the pose (sliders
 /// held as the model's) and `fem-coordinates.csv` (what their rows are). Everything is computed
 /// before the first file is written, and the files are published as one set
-/// ([`flexstar_model::run_set::RunSet`]).
+/// ([`flexstar_io::run_set::RunSet`]).
 pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(), ModalError> {
     let sliders = ss.settings.holding.sliders();
     let fem =
@@ -618,7 +618,7 @@ pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(),
     let coordinates = fem_coordinates_csv(&fem.coordinates(ss.pose.xp, exp.robot.lp));
     let json = statespace_json(exp, ss, &fem);
     // the seven matrices, the coordinates and the JSON are published together (a run set, `docs/outputs.md`)
-    let mut set = flexstar_model::run_set::RunSet::begin(&dir.join("linear"))?;
+    let mut set = flexstar_io::run_set::RunSet::begin(&dir.join("linear"))?;
     for (name, m) in [
         ("A", &ss.a),
         ("B", &ss.b),

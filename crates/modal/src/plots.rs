@@ -206,7 +206,7 @@ pub fn trajectory_path(exp: &flexstar_model::Experiment) -> Option<MapPath> {
         label: format!(
             "{what} of {}, t = 0 .. {} s",
             exp.name,
-            flexstar_model::output::fmt_display(exp.time.t_end)
+            flexstar_io::output::fmt_display(exp.time.t_end)
         ),
         points: states.iter().map(|s| (s.g[0].v, s.g[1].v)).collect(),
         style: Style {

@@ -193,11 +193,11 @@ pub enum ModeCount {
 }
 
 impl std::fmt::Display for ModeCount {
-    /// `N = 25` or `tol = 0.5 %` (the number as [`crate::output::fmt_display`] writes it).
+    /// `N = 25` or `tol = 0.5 %` (the number as [`flexstar_io::output::fmt_display`] writes it).
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             ModeCount::Fixed(n) => write!(f, "N = {n}"),
-            ModeCount::Tolerance(p) => write!(f, "tol = {} %", crate::output::fmt_display(*p)),
+            ModeCount::Tolerance(p) => write!(f, "tol = {} %", flexstar_io::output::fmt_display(*p)),
         }
     }
 }

@@ -114,7 +114,7 @@ impl ForceSamples {
         let expected = format!("t,{}", columns.join(","));
         // a solver output of flexstar's own: its folder recovered from an interrupted writer first
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            crate::run_set::recover(dir)?;
+            flexstar_io::run_set::recover(dir)?;
         }
         let mut rd = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)

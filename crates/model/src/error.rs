@@ -79,3 +79,13 @@ pub enum SampleError {
     #[error("samples span [{first}, {last}] s but the run needs [{t0}, {t1}] s")]
     Span { first: f64, last: f64, t0: f64, t1: f64 },
 }
+
+impl From<flexstar_io::WriteError> for ModelError {
+    /// A result file that could not be written, as [`ModelError::Write`] (the same message).
+    fn from(e: flexstar_io::WriteError) -> Self {
+        ModelError::Write {
+            file: e.file,
+            reason: e.reason,
+        }
+    }
+}

@@ -4,9 +4,9 @@
 
 use crate::error::ModelError;
 use crate::geometry::e_x;
-use crate::output::{fmt_number, Dest};
 use crate::response::StarShape;
-use crate::run_set::RunSet;
+use flexstar_io::output::{fmt_number, Dest};
+use flexstar_io::run_set::RunSet;
 
 /// Largest frame rate `frames` accepted [1/s].
 pub const MAX_FRAME_RATE: usize = 1000;
@@ -143,6 +143,7 @@ fn emit_frames_csv(frames: &[Frame], dest: Dest<'_>) -> Result<(), ModelError> {
         out.flush()?;
         Ok(())
     })
+    .map_err(ModelError::from)
 }
 
 fn emit_pose_csv(frames: &[Frame], dest: Dest<'_>) -> Result<(), ModelError> {
@@ -157,6 +158,7 @@ fn emit_pose_csv(frames: &[Frame], dest: Dest<'_>) -> Result<(), ModelError> {
         out.flush()?;
         Ok(())
     })
+    .map_err(ModelError::from)
 }
 
 #[cfg(test)]

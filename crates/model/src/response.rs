@@ -8,9 +8,9 @@
 use std::path::Path;
 
 use crate::error::ModelError;
-use crate::output::{fmt_number, Dest};
-use crate::run_set::RunSet;
 pub use crate::validity::{small_deflection_check, Provenance, ValidityExceeded};
+use flexstar_io::output::{fmt_number, Dest};
+use flexstar_io::run_set::RunSet;
 
 /// Fixed leading CSV columns of every solver result (a file contract, `docs/outputs.md`).
 pub const RESPONSE_HEADER: [&str; 10] = ["t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3"];
@@ -318,6 +318,7 @@ impl Response {
             out.flush()?;
             Ok(())
         })
+        .map_err(ModelError::from)
     }
 
     /// Write the response as CSV with a chosen column order, whole or not at all: `t`, the extra
@@ -381,6 +382,7 @@ impl Response {
             out.flush()?;
             Ok(())
         })
+        .map_err(ModelError::from)
     }
 
     /// The experiment as this run used it: `experiment` with the values the run took written in
@@ -528,6 +530,7 @@ impl Response {
             out.flush()?;
             Ok(())
         })
+        .map_err(ModelError::from)
     }
 }
 
@@ -718,5 +721,5 @@ pub fn sidecar_text(path: &Path, doc: &serde_json::Value) -> Result<String, Mode
 
 /// Write a sidecar document ([`sidecar_text`]), whole or not at all.
 pub fn write_sidecar_value(path: &Path, doc: &serde_json::Value) -> Result<(), ModelError> {
-    crate::output::write_string_atomically(path, &sidecar_text(path, doc)?)
+    flexstar_io::output::write_string_atomically(path, &sidecar_text(path, doc)?).map_err(ModelError::from)
 }

@@ -49,11 +49,11 @@ pub fn write_svg_png<D: Drawing>(d: &D, dir: &Path) -> Result<String, FigureErro
         reason,
     };
     let svg = svg_string(d)?;
-    flexstar_model::output::write_string_atomically(&dir.join(format!("{}.svg", d.name())), &svg)
+    flexstar_io::output::write_string_atomically(&dir.join(format!("{}.svg", d.name())), &svg)
         .map_err(|e| err(e.to_string()))?;
     // PNG: drawn into a temporary file beside the target, renamed when complete
     let png = dir.join(format!("{}.png", d.name()));
-    let tmp = flexstar_model::output::temp_file_in(dir, ".png").map_err(|e| err(e.to_string()))?;
+    let tmp = flexstar_io::output::temp_file_in(dir, ".png").map_err(|e| err(e.to_string()))?;
     {
         let root = BitMapBackend::new(tmp.path(), d.size()).into_drawing_area();
         d.draw_on(root).map_err(err)?;

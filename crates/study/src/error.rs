@@ -65,3 +65,10 @@ impl StudyError {
         }
     }
 }
+
+impl From<flexstar_io::WriteError> for StudyError {
+    /// A result file that could not be written, as the model's `ModelError::Write` (same message).
+    fn from(e: flexstar_io::WriteError) -> Self {
+        flexstar_model::ModelError::from(e).into()
+    }
+}

@@ -56,7 +56,7 @@ pub fn merge(dir: &Path) -> Result<MergeReport, StudyError> {
         dir: dir.to_path_buf(),
         reason,
     };
-    flexstar_model::run_set::recover(dir)?;
+    flexstar_io::run_set::recover(dir)?;
     let entries = std::fs::read_dir(dir).map_err(|source| StudyError::Read {
         file: dir.to_path_buf(),
         source,

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use flexstar_model::output::write_string_atomically;
+use flexstar_io::output::write_string_atomically;
 
 use crate::error::StudyError;
 use crate::plots::{solver_color, Heat, PointSet, Scatter};

@@ -174,7 +174,7 @@ fn prepare_table(
 ) -> Result<HashSet<(String, String)>, StudyError> {
     let meta_path = meta_file(results);
     if let Some(dir) = results.parent() {
-        flexstar_model::run_set::recover(dir)?;
+        flexstar_io::run_set::recover(dir)?;
     }
     if !results.exists() {
         let empty = Table {

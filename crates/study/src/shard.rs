@@ -62,7 +62,7 @@ pub fn meta_file(results: &Path) -> PathBuf {
 pub fn write_pair(results: &Path, table: &crate::table::Table, meta: &Meta) -> Result<(), StudyError> {
     let dir = results.parent().unwrap_or(Path::new("."));
     let name = |p: &Path| p.file_name().and_then(|s| s.to_str()).unwrap_or_default().to_string();
-    let mut set = flexstar_model::run_set::RunSet::begin(dir)?;
+    let mut set = flexstar_io::run_set::RunSet::begin(dir)?;
     table.stage(&mut set, &name(results))?;
     meta.stage(&mut set, &name(&meta_file(results)))?;
     set.commit()?;
@@ -107,12 +107,12 @@ impl Meta {
 
     /// Write a sidecar, whole or not at all.
     pub fn write(&self, path: &Path) -> Result<(), StudyError> {
-        flexstar_model::output::write_string_atomically(path, &self.text())?;
+        flexstar_io::output::write_string_atomically(path, &self.text())?;
         Ok(())
     }
 
     /// Stage the sidecar as file `name` of a run set (published with its table).
-    pub fn stage(&self, set: &mut flexstar_model::run_set::RunSet, name: &str) -> Result<(), StudyError> {
+    pub fn stage(&self, set: &mut flexstar_io::run_set::RunSet, name: &str) -> Result<(), StudyError> {
         set.text(name, &self.text())?;
         Ok(())
     }

@@ -161,15 +161,15 @@ impl Table {
 
     /// Write the whole table, whole or not at all.
     pub fn write(&self, path: &Path) -> Result<(), StudyError> {
-        self.emit(flexstar_model::output::Dest::File(path))
+        self.emit(flexstar_io::output::Dest::File(path))
     }
 
     /// Stage the table as file `name` of a run set (published with its sidecar).
-    pub fn stage(&self, set: &mut flexstar_model::run_set::RunSet, name: &str) -> Result<(), StudyError> {
-        self.emit(flexstar_model::output::Dest::Set(set, name))
+    pub fn stage(&self, set: &mut flexstar_io::run_set::RunSet, name: &str) -> Result<(), StudyError> {
+        self.emit(flexstar_io::output::Dest::Set(set, name))
     }
 
-    fn emit(&self, dest: flexstar_model::output::Dest<'_>) -> Result<(), StudyError> {
+    fn emit(&self, dest: flexstar_io::output::Dest<'_>) -> Result<(), StudyError> {
         dest.write(|w| {
             w.write_all(&records_bytes(std::iter::once(&self.header).chain(&self.rows))?)?;
             Ok(())

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use flexstar_model::output::fmt_fixed;
+use flexstar_io::output::fmt_fixed;
 
 /// Rigid kinematics of an experiment (Eqs. 1-12): G, theta, xp_i and their derivatives.
 #[derive(clap::Args)]

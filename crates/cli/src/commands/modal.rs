@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use flexstar_api::modal::{FreqmapSettings, LinearizeOptions, LoopKind, PoseSpec};
-use flexstar_model::output::fmt_fixed;
+use flexstar_io::output::fmt_fixed;
 use flexstar_model::{Experiment, Sliders};
 
 use crate::progress::Reporter;

@@ -19,7 +19,7 @@ use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::error::ModelError;
+use crate::WriteError;
 
 /// Name of the journal of a commit in progress.
 pub const JOURNAL: &str = ".flexstar-journal";
@@ -40,7 +40,7 @@ pub struct RunSet {
 
 impl RunSet {
     /// Lock `dir` (created if needed) for writing and recover it (see the module docs).
-    pub fn begin(dir: &Path) -> Result<RunSet, ModelError> {
+    pub fn begin(dir: &Path) -> Result<RunSet, WriteError> {
         std::fs::create_dir_all(dir).map_err(|e| write_error(dir, format!("cannot create the folder: {e}")))?;
         let lock = FolderLock::acquire(dir)?;
         recover_locked(dir)?;
@@ -63,7 +63,7 @@ impl RunSet {
     }
 
     /// Stage file `name` (a plain file name in the folder) written by `fill`.
-    pub fn file<F>(&mut self, name: &str, fill: F) -> Result<&mut RunSet, ModelError>
+    pub fn file<F>(&mut self, name: &str, fill: F) -> Result<&mut RunSet, WriteError>
     where
         F: FnOnce(&mut dyn Write) -> Result<(), Box<dyn std::error::Error + Send + Sync>>,
     {
@@ -82,7 +82,7 @@ impl RunSet {
     }
 
     /// Stage a text file.
-    pub fn text(&mut self, name: &str, text: &str) -> Result<&mut RunSet, ModelError> {
+    pub fn text(&mut self, name: &str, text: &str) -> Result<&mut RunSet, WriteError> {
         self.file(name, |w| {
             w.write_all(text.as_bytes())?;
             Ok(())
@@ -91,13 +91,13 @@ impl RunSet {
 
     /// Remove file `name` of an older set when this one is published (a file the new run does not
     /// write); a missing file is no error.
-    pub fn remove(&mut self, name: &str) -> Result<&mut RunSet, ModelError> {
+    pub fn remove(&mut self, name: &str) -> Result<&mut RunSet, WriteError> {
         self.checked(name)?;
         self.removals.push(name.to_string());
         Ok(self)
     }
 
-    fn checked(&self, name: &str) -> Result<PathBuf, ModelError> {
+    fn checked(&self, name: &str) -> Result<PathBuf, WriteError> {
         let plain = !name.is_empty()
             && !name.starts_with(".flexstar")
             && !name.contains(['/', '\\', '\t', '\n'])
@@ -114,7 +114,7 @@ impl RunSet {
     }
 
     /// Publish every staged file together (see the module docs) and release the folder.
-    pub fn commit(mut self) -> Result<(), ModelError> {
+    pub fn commit(mut self) -> Result<(), WriteError> {
         let mut journal = String::new();
         for (tmp, name) in &self.staged {
             let t = tmp.file_name().and_then(|s| s.to_str()).unwrap_or_default();
@@ -157,7 +157,7 @@ impl Drop for RunSet {
 /// Bring `dir` to a consistent state before reading it: roll a leftover journal forward and remove
 /// dead writers' temporaries. A folder that does not exist, or that this process cannot write and
 /// that holds no journal, is left as it is.
-pub fn recover(dir: &Path) -> Result<(), ModelError> {
+pub fn recover(dir: &Path) -> Result<(), WriteError> {
     if !dir.is_dir() {
         return Ok(());
     }
@@ -172,7 +172,7 @@ pub fn recover(dir: &Path) -> Result<(), ModelError> {
     }
 }
 
-fn recover_locked(dir: &Path) -> Result<(), ModelError> {
+fn recover_locked(dir: &Path) -> Result<(), WriteError> {
     let jpath = dir.join(JOURNAL);
     match std::fs::read_to_string(&jpath) {
         Ok(text) => roll_forward(dir, &text)?,
@@ -189,7 +189,7 @@ fn recover_locked(dir: &Path) -> Result<(), ModelError> {
 }
 
 /// Do the renames and removals of `journal` not yet done, then remove the journal.
-fn roll_forward(dir: &Path, journal: &str) -> Result<(), ModelError> {
+fn roll_forward(dir: &Path, journal: &str) -> Result<(), WriteError> {
     let jpath = dir.join(JOURNAL);
     let bad = |line: &str| write_error(&jpath, format!("unreadable journal line {line:?}"));
     if journal.lines().last() != Some("end") {
@@ -261,8 +261,8 @@ fn sync_dir(dir: &Path) {
     }
 }
 
-fn write_error(file: &Path, reason: String) -> ModelError {
-    ModelError::Write {
+fn write_error(file: &Path, reason: String) -> WriteError {
+    WriteError {
         file: file.to_path_buf(),
         reason,
     }
@@ -276,7 +276,7 @@ struct FolderLock {
 }
 
 impl FolderLock {
-    fn acquire(dir: &Path) -> Result<FolderLock, ModelError> {
+    fn acquire(dir: &Path) -> Result<FolderLock, WriteError> {
         let path = dir.join(LOCK);
         let err = |e: std::io::Error| write_error(&path, format!("cannot lock the folder: {e}"));
         loop {

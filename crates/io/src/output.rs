@@ -5,8 +5,8 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::error::ModelError;
 use crate::run_set::RunSet;
+use crate::WriteError;
 
 /// A temporary file `dir/.flexstar-<pid>-XXXXXX<suffix>`, created with mode `0666` less the
 /// process umask (as `File::create` would), so that the result it becomes has normal permissions.
@@ -25,11 +25,11 @@ pub fn temp_file_in(dir: &Path, suffix: &str) -> std::io::Result<tempfile::Named
 }
 
 /// Write `path` through `fill`; on any error nothing is left at `path` (an older file is kept).
-pub fn write_atomically<F>(path: &Path, fill: F) -> Result<(), ModelError>
+pub fn write_atomically<F>(path: &Path, fill: F) -> Result<(), WriteError>
 where
     F: FnOnce(&mut dyn Write) -> Result<(), Box<dyn std::error::Error + Send + Sync>>,
 {
-    let err = |reason: String| ModelError::Write {
+    let err = |reason: String| WriteError {
         file: path.to_path_buf(),
         reason,
     };
@@ -64,7 +64,7 @@ impl Dest<'_> {
     }
 
     /// Write (or stage) the file through `fill`.
-    pub fn write<F>(self, fill: F) -> Result<(), ModelError>
+    pub fn write<F>(self, fill: F) -> Result<(), WriteError>
     where
         F: FnOnce(&mut dyn Write) -> Result<(), Box<dyn std::error::Error + Send + Sync>>,
     {
@@ -83,7 +83,7 @@ fn parent_dir(path: &Path) -> std::path::PathBuf {
 }
 
 /// Write a string to `path`, whole or not at all.
-pub fn write_string_atomically(path: &Path, text: &str) -> Result<(), ModelError> {
+pub fn write_string_atomically(path: &Path, text: &str) -> Result<(), WriteError> {
     write_atomically(path, |w| {
         w.write_all(text.as_bytes())?;
         Ok(())
@@ -94,8 +94,8 @@ pub fn write_string_atomically(path: &Path, text: &str) -> Result<(), ModelError
 /// that a run fails before any work instead of after it (e.g. `--out` names an existing file, or
 /// a read-only place). The probe file is removed again, and the folder is recovered from an
 /// interrupted writer ([`crate::run_set::recover`]).
-pub fn ensure_writable_dir(dir: &Path) -> Result<(), ModelError> {
-    let err = |reason: String| ModelError::Write {
+pub fn ensure_writable_dir(dir: &Path) -> Result<(), WriteError> {
+    let err = |reason: String| WriteError {
         file: dir.to_path_buf(),
         reason,
     };

@@ -2,7 +2,7 @@
 //! [`crate::solve`] of a prescribed motion, and the direct run, [`crate::solve`] under a law).
 
 use flexstar_kinematics::RigidState;
-use flexstar_model::frames::ShapeTimes;
+use flexstar_model::animation::ShapeTimes;
 use flexstar_model::geometry::slider_direction;
 use flexstar_model::{AmmModel, AmmSettings, BeamShape, Frame, FramePose, Response, RobotParams, StarShape};
 

@@ -13,8 +13,8 @@ use flexstar_drive::{Drive, SolveRequest, Solved};
 use flexstar_kinematics::{
     check_configuration, check_trajectory, preflight_step, CheckedMotion, Infeasible, RigidState,
 };
+use flexstar_model::animation::{frame_times, ShapeTimes};
 use flexstar_model::config::check_step;
-use flexstar_model::frames::{frame_times, ShapeTimes};
 use flexstar_model::{AmmSettings, DriveKind, Experiment, ModeCount, ModeFamily, Response, RunInfo};
 use flexstar_numerics::GenAlpha;
 
@@ -133,7 +133,7 @@ pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, s
             format!("snapshot times must lie in [0, t_end = {}], got {bad}", exp.time.t_end),
         ));
     }
-    flexstar_model::frames::check_frames("amm.frames", settings.frames, exp.time.t_end).map_err(|e| match e {
+    flexstar_model::animation::check_frames("amm.frames", settings.frames, exp.time.t_end).map_err(|e| match e {
         flexstar_model::ModelError::Invalid { key, reason, .. } => AmmError::invalid(key, reason),
         other => other.into(),
     })?;

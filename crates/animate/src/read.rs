@@ -106,7 +106,7 @@ type Frames = (Vec<f64>, Vec<[BeamPoints; 3]>);
 
 /// `t,beam,x,w,X,Y,Xr,Yr` rows grouped by time (consecutive rows of equal `t`).
 fn read_frames(file: &Path) -> Result<Frames, AnimateError> {
-    let rows = numeric_rows(file, &flexstar_model::frames::FRAMES_HEADER)?;
+    let rows = numeric_rows(file, &flexstar_model::animation::FRAMES_HEADER)?;
     let (mut times, mut beams): (Vec<f64>, Vec<[BeamPoints; 3]>) = (Vec::new(), Vec::new());
     for (k, r) in rows.iter().enumerate() {
         if times.last() != Some(&r[0]) {
@@ -131,7 +131,7 @@ fn read_frames(file: &Path) -> Result<Frames, AnimateError> {
 }
 
 fn read_pose(file: &Path) -> Result<Vec<[f64; 6]>, AnimateError> {
-    let rows = numeric_rows(file, &flexstar_model::frames::FRAMES_POSE_HEADER)?;
+    let rows = numeric_rows(file, &flexstar_model::animation::FRAMES_POSE_HEADER)?;
     Ok(rows.iter().map(|r| [r[1], r[2], r[3], r[4], r[5], r[6]]).collect())
 }
 

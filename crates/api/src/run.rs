@@ -451,7 +451,7 @@ fn stage_frames(set: &mut RunSet, r: &Response, stem: &str) -> Result<Vec<PathBu
         }
         return Ok(Vec::new());
     }
-    flexstar_model::frames::stage_frames(&r.frames, set, stem)?;
+    flexstar_model::animation::stage_frames(&r.frames, set, stem)?;
     Ok(names.iter().map(|n| set.path(n)).collect())
 }
 

@@ -101,9 +101,9 @@ pub struct Servo {
 impl Servo {
     /// Gains from a closed-loop bandwidth `f_bw` [Hz] and damping ratio `zeta` for a slider of
     /// mass `m` [kg] treated as a free mass: `kp = m (2 pi f_bw)^2`, `kd = 2 zeta m (2 pi f_bw)`.
-    /// ([`flexstar_model::drive::gains_from_bandwidth`]).
+    /// ([`flexstar_model::drive_section::gains_from_bandwidth`]).
     pub fn gains_from_bandwidth(m: f64, f_bw: f64, zeta: f64) -> (f64, f64) {
-        flexstar_model::drive::gains_from_bandwidth(m, f_bw, zeta)
+        flexstar_model::drive_section::gains_from_bandwidth(m, f_bw, zeta)
     }
 
     /// Reference `s_ref`, `s_ref'` and the feedforward at time `t`; errors if the reference

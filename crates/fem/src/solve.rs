@@ -4,7 +4,7 @@
 
 use flexstar_drive::{ActuatorLaw, Drive, SolveRequest, Solved};
 use flexstar_kinematics::{check_trajectory, direct_kinematics, preflight_step, CheckedMotion, RigidState};
-use flexstar_model::frames::{frame_times, ShapeTimes};
+use flexstar_model::animation::{frame_times, ShapeTimes};
 use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::{BeamShape, Experiment, FemSettings, FramePose, Response, RobotParams, RunInfo, StarShape};
 
@@ -261,7 +261,7 @@ fn validate(exp: &Experiment, settings: &FemSettings) -> Result<RunSettings, Fem
             "fem.snapshots must lie in [0, t_end = {t_end}], got {bad}"
         )));
     }
-    flexstar_model::frames::check_frames("fem.frames", settings.frames, t_end)
+    flexstar_model::animation::check_frames("fem.frames", settings.frames, t_end)
         .map_err(|e| FemError::Input(e.to_string()))?;
     Ok(RunSettings {
         ne: settings.elements / 3,

@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::drive::ForceSamples;
+use crate::drive_section::ForceSamples;
 use crate::error::ModelError;
 
 /// `[payload]`: a rigid body welded to the junction G (`docs/amm.md` 11.1, Eqs. P1-P9).

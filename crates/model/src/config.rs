@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::attachments::{Damping, LoadSettings, Payload};
-use crate::drive::DriveSettings;
+use crate::drive_section::DriveSettings;
 use crate::error::ModelError;
 use crate::params::RobotParams;
 use crate::trajectory::Trajectory;
@@ -477,8 +477,8 @@ impl Experiment {
                 ));
             }
         }
-        crate::frames::check_frames("amm.frames", self.amm.frames, self.time.t_end)?;
-        crate::frames::check_frames("fem.frames", self.fem.frames, self.time.t_end)?;
+        crate::animation::check_frames("amm.frames", self.amm.frames, self.time.t_end)?;
+        crate::animation::check_frames("fem.frames", self.fem.frames, self.time.t_end)?;
         for (key, snaps) in [
             ("amm.snapshots", &self.amm.snapshots),
             ("fem.snapshots", &self.fem.snapshots),

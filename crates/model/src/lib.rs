@@ -7,15 +7,15 @@
 //! Conventions (frames, signs, units) are written once, in `docs/conventions.md`; the items here
 //! follow them. All quantities are SI: metres, seconds, kilograms, newtons, radians.
 
+pub mod animation;
 pub mod attachments;
 pub mod cancel;
 pub mod catalogue;
 pub mod config;
-pub mod drive;
+pub mod drive_section;
 pub mod envelope;
 pub mod error;
 pub mod evp;
-pub mod frames;
 pub mod geometry;
 pub mod motion;
 pub mod params;
@@ -27,12 +27,12 @@ pub mod spline;
 pub mod trajectory;
 pub mod validity;
 
+pub use animation::{Frame, FramePose};
 pub use attachments::{Attachments, Damping, LoadSettings, Payload};
 pub use cancel::Cancel;
 pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, ModeFamily, TimeSpan};
-pub use drive::{DriveKind, DriveSettings, Feedforward, ForceSamples};
+pub use drive_section::{DriveKind, DriveSettings, Feedforward, ForceSamples};
 pub use error::{ModelError, SampleError};
-pub use frames::{Frame, FramePose};
 pub use motion::{TableMotion, TableSpace, ViaMotion, ViaPoint};
 pub use params::RobotParams;
 pub use residual::{ReportSettings, Residual};

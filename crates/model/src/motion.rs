@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::drive::ForceSamples;
+use crate::drive_section::ForceSamples;
 use crate::error::ModelError;
 use crate::geometry::{inverse_kinematics, Scalar};
 use crate::params::RobotParams;

@@ -184,7 +184,7 @@ pub struct Response {
     /// Deformed star at the requested instants.
     pub shapes: Vec<StarShape>,
     /// Animation frames (`[amm] frames`, `[fem] frames`; empty without), `docs/motions.md` 5.
-    pub frames: Vec<crate::frames::Frame>,
+    pub frames: Vec<crate::animation::Frame>,
 }
 
 impl Response {

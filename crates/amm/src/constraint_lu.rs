@@ -29,9 +29,7 @@
 use nalgebra::{DMatrix, DVector, Matrix4, Matrix6, SMatrix, Vector4, Vector6, LU, U6};
 
 use crate::error::RankError;
-
-/// Rows of one beam's sleeve block (Eqs. 41-43: Fp, FR, FL, Mp).
-pub(crate) const SLEEVE_ROWS: usize = 4;
+use crate::sleeve::SLEEVE_ROWS;
 /// Largest number of junction rows (three Fix, Fw, two slope equalities).
 pub(crate) const MAX_JUNCTION_ROWS: usize = 6;
 /// A pivot of the dense LU at or below this fraction of the largest entry of A is rank deficiency.

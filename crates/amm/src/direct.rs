@@ -175,10 +175,10 @@ fn coupled_step(
     let mut a = [[0.0; 4]; 3];
     for (i, row) in a.iter_mut().enumerate() {
         for (k, dlam) in buf.dlam.iter().enumerate() {
-            row[k] = rec.sleeve_push(i, &st, &buf.qnew, dlam, &sys.sleeve_axial);
+            row[k] = rec.sleeve_push(i, &st, &buf.qnew, dlam, sys.sleeves.axial());
         }
         row[i] += m + kp[i] * bp + kd[i] * gp;
-        row[3] = fa[i] - m * x_pred[i] - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, &sys.sleeve_axial);
+        row[3] = fa[i] - m * x_pred[i] - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
     }
     let dx = solve3(a).ok_or(AmmError::SingularConstraints {
         t,
@@ -409,7 +409,7 @@ impl DirectOutput {
             .force(t, s, sd)
             .map_err(|source| AmmError::Drive { t, source })?;
         self.rec
-            .record(&st, stop, &x.q, &ctx.sys.lam, &ctx.sys.sleeve_axial, Some(fa));
+            .record(&st, stop, &x.q, &ctx.sys.lam, ctx.sys.sleeves.axial(), Some(fa));
         if stop.output.is_some() {
             let vals = [s[0], s[1], s[2], sd[0], sd[1], sd[2], st.g[0].v, st.g[1].v, st.theta.v];
             for (c, v) in self.cols.iter_mut().zip(vals) {

@@ -8,6 +8,9 @@
 //!   evaluated stably to hundreds of modes;
 //! - `system` (private): the constrained linear time-varying equations (Eqs. 37, 44, 31 with the
 //!   constraints of Eqs. 38-43) and their per-step linear solve;
+//! - `sleeve` (private): the passive prismatic joint, its rows (Eqs. 41-43) and multipliers, the
+//!   full model's material point in it and the residual flexibility seen there (`docs/amm.md`
+//!   section 1, 12.3, 12.11);
 //! - [`pose_modes`]: the modes of the star held at rest at one pose, and its linearised system;
 //! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]);
 //! - [`direct`]: the direct problem, sliders driven by forces or a servo ([`solve`] with `Drive::Law`, `docs/amm.md` section 10).
@@ -20,7 +23,6 @@
 
 pub mod adaptive;
 mod attach;
-mod compliance;
 mod constraint_lu;
 pub mod direct;
 pub mod error;
@@ -29,7 +31,7 @@ mod geometric;
 pub mod modes;
 pub mod pose_modes;
 mod record;
-mod sleeve_shift;
+mod sleeve;
 pub mod solver;
 mod system;
 

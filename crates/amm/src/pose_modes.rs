@@ -32,6 +32,7 @@ use flexstar_numerics::eigen::{constrained_modes, rigid_shift};
 
 use crate::error::AmmError;
 use crate::modes::ModeSet;
+use crate::sleeve::SleeveRow;
 use crate::system::{Row, System};
 use flexstar_numerics::NumericsError;
 
@@ -208,7 +209,7 @@ impl PoseModel {
                 m[(n_beams + i) * n + n_beams + i] = params.mpp_mpa;
             }
             for (r, row) in sys.rows.iter().enumerate() {
-                if let Row::Fp(i) | Row::FR(i) | Row::FL(i) = *row {
+                if let Row::Sleeve(i, SleeveRow::Fp | SleeveRow::FR | SleeveRow::FL) = *row {
                     c[r * n + n_beams + i] = -cos_th;
                 }
             }

@@ -3,9 +3,9 @@
 
 use flexstar_kinematics::RigidState;
 use flexstar_model::animation::ShapeTimes;
-use flexstar_model::geometry::slider_direction;
 use flexstar_model::{AmmModel, AmmSettings, BeamShape, Frame, FramePose, Response, RobotParams, StarShape};
 
+use crate::sleeve::{self, SleeveRow};
 use crate::solver::{Stop, EXTRA_COLUMNS, SHAPE_POINTS};
 use crate::system::{Row, System};
 
@@ -64,27 +64,24 @@ impl Recorder {
             })
             .collect();
         let lam_index = |r: Row| sys.rows.iter().position(|x| *x == r);
-        let col_rows: [Option<usize>; 19] = [
-            lam_index(Row::Fix(0)),
-            lam_index(Row::Fix(1)),
-            lam_index(Row::Fix(2)),
-            lam_index(Row::M1G),
+        // the junction's multipliers, then the sleeves' in the columns' order Fp1..3, FLp1..3,
+        // FRp1..3, Mp1..3 of EXTRA_COLUMNS
+        let junction = [
+            Some(Row::Fix(0)),
+            Some(Row::Fix(1)),
+            Some(Row::Fix(2)),
+            Some(Row::M1G),
             None, // M2G = -M1G - M3G (Eq. 25-1)
-            lam_index(Row::M3G),
-            lam_index(Row::Fw),
-            lam_index(Row::Fp(0)),
-            lam_index(Row::Fp(1)),
-            lam_index(Row::Fp(2)),
-            lam_index(Row::FL(0)),
-            lam_index(Row::FL(1)),
-            lam_index(Row::FL(2)),
-            lam_index(Row::FR(0)),
-            lam_index(Row::FR(1)),
-            lam_index(Row::FR(2)),
-            lam_index(Row::Mp(0)),
-            lam_index(Row::Mp(1)),
-            lam_index(Row::Mp(2)),
+            Some(Row::M3G),
+            Some(Row::Fw),
         ];
+        let sleeves = [SleeveRow::Fp, SleeveRow::FL, SleeveRow::FR, SleeveRow::Mp]
+            .into_iter()
+            .flat_map(|r| (0..3).map(move |i| Some(Row::Sleeve(i, r))));
+        let mut col_rows = [None; 19];
+        for (c, row) in col_rows.iter_mut().zip(junction.into_iter().chain(sleeves)) {
+            *c = row.and_then(lam_index);
+        }
         Recorder {
             resp: Response::with_capacity(String::new(), n_out),
             extra,
@@ -109,25 +106,16 @@ impl Recorder {
     }
 
     /// Eq. 33 without the slider's inertia: the component along `+u_i` of the force of sleeve i on
-    /// beam i [N], linear in the multipliers `lam`. Paper model: `(Fp + FL + FR) cos(theta + thp_i)`;
-    /// full model: along the forces its sleeve rows carry, each row's force on the beam being
-    /// `lambda (e_w + c_u e_x)` with `c_u` its u gradient (`axial`, -w').
+    /// beam i [N] ([`sleeve::rows::push`]), linear in the multipliers `lam`, with the sleeve
+    /// rotation of `q` and the u gradients `axial` of the sleeve rows (-w', full model).
     pub(crate) fn sleeve_push(&self, i: usize, st: &RigidState, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]) -> f64 {
-        let (fp, fl, fr) = (
+        let forces = [
             self.lam_of(lam, 7 + i),
             self.lam_of(lam, 10 + i),
             self.lam_of(lam, 13 + i),
-        );
-        if self.full {
-            let d = slider_direction(i);
-            let (ew, ex) = (st.e_w(i), st.e_x(i));
-            let (wd, xd) = (ew[0] * d[0] + ew[1] * d[1], ex[0] * d[0] + ex[1] * d[1]);
-            let [cp, cr, cl] = axial[i];
-            (fp + fl + fr) * wd + (fp * cp + fr * cr + fl * cl) * xd
-        } else {
-            let thp = q[i * self.nb + self.nm + 1];
-            (fp + fl + fr) * (st.theta.v + thp).cos()
-        }
+        ];
+        let thp = q[i * self.nb + self.nm + 1];
+        sleeve::rows::push(self.full, i, st, thp, forces, axial[i])
     }
 
     /// Record the state at `stop`: a snapshot of the deformed star and/or an output row. `fa`:

@@ -436,7 +436,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
         rec.record(st, stop, q, lam, axial, None);
     };
 
-    record(&st, &stops[0], &q, &sys.lam, &sys.sleeve_axial);
+    record(&st, &stops[0], &q, &sys.lam, sys.sleeves.axial());
     for w in stops.windows(2) {
         let (t0, t1) = (w[0].t, w[1].t);
         let nsub = (((t1 - t0) / dt_max) - 1e-9).ceil().max(1.0) as usize;
@@ -466,7 +466,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
             }
             observe(&sys, &q);
         }
-        record(&st, &w[1], &q, &sys.lam, &sys.sleeve_axial);
+        record(&st, &w[1], &q, &sys.lam, sys.sleeves.axial());
         if flexstar_model::cancel::cancelled() {
             return Err(AmmError::Cancelled { t: t1 });
         }

@@ -21,16 +21,15 @@
 //! are eliminated by the Schur complement `A = C S^-1 C^T`, a small dense LU per step.
 
 use flexstar_kinematics::RigidState;
-use flexstar_model::{AmmModel, Damping, LoadSettings, ModeFamily, Payload, RobotParams};
+use flexstar_model::{AmmModel, Damping, LoadSettings, Payload, RobotParams};
 
 use crate::attach::{Mat3, PayloadTerms, RigidTerms};
-use crate::compliance::SleeveCompliance;
-use crate::constraint_lu::ConstraintLu;
+use crate::constraint_lu::{ConstraintLu, MAX_JUNCTION_ROWS};
 use crate::error::{AmmError, RankError};
 use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
 use crate::geometric::{self, GeometricStiffness};
-use crate::modes::{dot, ModeSet, SleeveBending, Triplet};
-use crate::sleeve_shift::SleeveShift;
+use crate::modes::{dot, ModeSet};
+use crate::sleeve::{SleeveRow, Sleeves, B_MID, B_MSLOPE, SLEEVE_ROWS};
 use flexstar_numerics::vector::dots;
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
@@ -47,115 +46,58 @@ pub(crate) enum Row {
     M1G,
     /// Eq. 39: `w_3'(0) - w_2'(0) = 0`; multiplier `M3G`.
     M3G,
-    /// Eq. 41: `w_i(xp_i) = 0`; multiplier `Fp_i`.
-    Fp(usize),
-    /// Eq. 42: `w_i(xp_i + Lp/2) - Lp/2 thp_i = 0`; multiplier `FR_pi`.
-    FR(usize),
-    /// Eq. 42: `w_i(xp_i - Lp/2) + Lp/2 thp_i = 0`; multiplier `FL_pi`.
-    FL(usize),
-    /// Eq. 43: `thp_i - w_i'(xp_i) = 0`; multiplier `Mp_i`.
-    Mp(usize),
+    /// Eqs. 41-43: row `row` of sleeve i (`crate::sleeve::rows`): `w_i(xp_i) = 0` (`Fp_i`),
+    /// `w_i(xp_i +- Lp/2) -+ Lp/2 thp_i = 0` (`FR_pi`, `FL_pi`), `thp_i - w_i'(xp_i) = 0` (`Mp_i`).
+    Sleeve(usize, SleeveRow),
 }
 
 /// Basis vectors of the alpha parts of the constraint rows of one beam: every row's alpha part is
-/// one of them times a scalar.
+/// one of them times a scalar. The junction's two here, then the sleeve's four, `B_MID` (Fp),
+/// `B_RIGHT` (FR), `B_LEFT` (FL), `B_MSLOPE` (Mp) of `crate::sleeve::rows`.
 const B_PHI0: usize = 0; // phi_j(0)          (Fix, Fw)
 const B_DPHI0: usize = 1; // phi_j'(0)        (MiG)
-const B_MID: usize = 2; // phi_j(xp)          (Fp)
-const B_RIGHT: usize = 3; // phi_j(xp + Lp/2) (FR)
-const B_LEFT: usize = 4; // phi_j(xp - Lp/2)  (FL)
-const B_MSLOPE: usize = 5; // -phi_j'(xp)     (Mp)
-const NB: usize = 6;
+const NB: usize = B_MSLOPE + 1;
 /// Most constraint rows that touch one beam (three Fix, Fw, two slope rows, four sleeve rows).
-const MAX_BEAM_ROWS: usize = 10;
+const MAX_BEAM_ROWS: usize = MAX_JUNCTION_ROWS + SLEEVE_ROWS;
 /// "This row has no alpha part."
 const NONE: usize = usize::MAX;
 
 /// A row of the form of [`BeamRows`]: (basis vector, its factor, u coefficient, thp coefficient).
-type RowForm = (usize, f64, f64, f64);
+pub(crate) type RowForm = (usize, f64, f64, f64);
 
 /// The payload's three rows P of Eq. P1 in that form: `u_1`, `phi(0) . alpha_1`, `phi'(0) . alpha_1`.
 const PAYLOAD_ROWS: [RowForm; 3] = [(NONE, 0.0, 1.0, 0.0), (B_PHI0, 1.0, 0.0, 0.0), (B_DPHI0, 1.0, 0.0, 0.0)];
 
 /// The rows of C that touch one beam: row k is `sc[k] * B[basis[k]]` on alpha, `cu[k]` on u_i and
-/// `ct[k]` on thp_i.
+/// `ct[k]` on thp_i. The sleeve's rows are refreshed per step by `crate::sleeve::Sleeves::update`.
 #[derive(Debug, Clone, Default)]
-struct BeamRows {
+pub(crate) struct BeamRows {
     /// Global row index of each local row.
-    ids: Vec<usize>,
-    basis: Vec<usize>,
-    sc: Vec<f64>,
+    pub(crate) ids: Vec<usize>,
+    pub(crate) basis: Vec<usize>,
+    pub(crate) sc: Vec<f64>,
     /// Gradient of the row in u_i (the Jacobian column; per step for the full model's sleeve rows).
-    cu: Vec<f64>,
+    pub(crate) cu: Vec<f64>,
     /// Coefficient of u_i in the row's own value (1 for the Fix rows; 0 for the sleeve rows, where
     /// u_i enters the full model only through the material point xp_i - u_i).
     gu: Vec<f64>,
-    ct: Vec<f64>,
+    pub(crate) ct: Vec<f64>,
     /// The part of each row's value at the predictor that its Jacobian entries do not give:
     /// `r(qhat) - c . qhat` (0 but for the full model's sleeve rows, Eqs. S3-S4 of `docs/amm.md`
     /// 12.11, where the gradient carries the foreshortening and the edges turn by `sin thp`).
-    gv: Vec<f64>,
+    pub(crate) gv: Vec<f64>,
     /// The sleeve basis vectors B_MID..B_MSLOPE of this beam (refreshed per step), N each.
-    sleeve: [Vec<f64>; 4],
+    pub(crate) sleeve: [Vec<f64>; 4],
     // per-step workspace
     /// `D^-1 B_a` for the sleeve vectors.
     scaled: [Vec<f64>; 4],
     /// Gram matrix `B_a . D^-1 B_b` of the six basis vectors.
     gram: [[f64; NB]; NB],
-    /// Full model: mode slopes at the sleeve edges and curvature at its centre.
-    bent: SleeveBending,
     /// `B_a . D^-1 Phi`.
     g: [f64; NB],
-    /// Full model, enriched family: the residual flexibility `R_ab` of the sleeve rows (Eq. R3,
-    /// `docs/amm.md` 12), a, b over `B_MID..=B_MSLOPE`, at the last sleeve update.
-    res: [[f64; 4]; 4],
-}
-
-/// What [`BeamRows::shift_sleeve_rows`] needs of a beam's foreshortening at the predictor.
-struct ShiftTerms<'a> {
-    /// The kept modes of `g` (indices into the beam's alpha).
-    kept: &'a [usize],
-    /// `g = F(x_c) alpha` (Eq. S3) on them [-].
-    g: &'a [f64],
-    /// `2 f(x_c) = g . alpha` [m].
-    two_f: f64,
-    /// The sleeve rotation at the predictor [rad].
-    thp: f64,
-    /// Half the sleeve length [m].
-    hp: f64,
-    /// The beam's slope `w'` at the pin and at the right and left edges [-].
-    slopes: [f64; 3],
 }
 
 impl BeamRows {
-    /// Eqs. S3-S4 (`docs/amm.md` 12.11), after the rows' vectors were set at the material point
-    /// `x_c`: each sleeve row `r(x_c)` gains the alpha gradient `r'(x_c) g` (`w'` at the pin and
-    /// the edges, `-w''` for the slope row) and the edges' rows `w(x_c +- hp) -+ hp sin thp` their
-    /// exact thp gradient `-+ hp cos thp`; the rows' values stay `r(qhat)` through `gv`.
-    fn shift_sleeve_rows(&mut self, rows: &[Row], t: ShiftTerms) {
-        let [slope_mid, slope_right, slope_left] = t.slopes;
-        let coef = [slope_mid, slope_right, slope_left, -self.bent.curvature];
-        for (v, c) in self.sleeve.iter_mut().zip(coef) {
-            for (&j, g) in t.kept.iter().zip(t.g) {
-                v[j] += c * g;
-            }
-        }
-        let (sin, cos) = t.thp.sin_cos();
-        for (k, id) in self.ids.iter().enumerate() {
-            let (c, edge) = match rows[*id] {
-                Row::Fp(_) => (coef[0], 0.0),
-                Row::FR(_) => (coef[1], -1.0),
-                Row::FL(_) => (coef[2], 1.0),
-                Row::Mp(_) => (coef[3], 0.0),
-                _ => continue,
-            };
-            self.gv[k] = -self.sc[k] * c * t.two_f;
-            if edge != 0.0 {
-                self.ct[k] = edge * t.hp * cos;
-                self.gv[k] += edge * t.hp * (sin - t.thp * cos);
-            }
-        }
-    }
     /// The products of this beam's rows with the payload's rows P (Eq. P1) at the prepared step:
     /// `H = P S^-1 P^T`, `C S^-1 P^T` (row k: `cross[k]`) and `P S^-1 C^T` (column k: `back[k]`),
     /// by the formula of [`BeamRows::add_block`], `c_k S^-1 c_s^T = (cu_k - p g_k)(cu_s + p g_s)
@@ -276,7 +218,6 @@ pub(crate) struct System {
     rho: f64,
     l: f64,
     jp: f64,
-    tri: Triplet,
     lambda_m: Vec<f64>,
     phi: Vec<f64>,
     psi: Vec<f64>,
@@ -285,29 +226,20 @@ pub(crate) struct System {
     pub(crate) phil: Vec<f64>,
     pub(crate) rows: Vec<Row>,
     beams: [BeamRows; 3],
-    model: AmmModel,
     /// Full model: the geometric stiffness of the axial inertia force (Eq. 23) on the modes
     /// that carry it, and its products with the predicted modal coordinates.
     geometric: Option<GeometricStiffness>,
-    /// Full model: u_i-gradients of the rows Fp_i, FR_i, FL_i at the last solve (`-w'` at the
-    /// material point in the sleeve; 0 in the paper's model): the axial direction of their forces.
-    pub(crate) sleeve_axial: [[f64; 3]; 3],
+    /// The sleeves (`crate::sleeve`): what their rows need per step (material point, shift,
+    /// residual flexibility) and the axial direction of their forces.
+    pub(crate) sleeves: Sleeves,
     /// Full model: the axial acceleration u_i'' of each beam at the last solve, part of the axial
     /// inertia force of Eq. 23 (the whole axially rigid beam accelerates with it).
     udd: [f64; 3],
-    /// Sleeve positions xp_i of the last solve [m].
-    xp: [f64; 3],
     /// Full model: the foreshortening inertia of the bent beams in the u rows (`foreshortening`).
     fore: Option<Foreshortening>,
-    /// Full model: the material point in the sleeve drawn out by the foreshortening
-    /// (`sleeve_shift`, Eqs. S1-S3).
-    shift: Option<SleeveShift>,
     /// Full model: the axial flexibility `L / (3 EA)` [m/N] between a beam's root at G and its
     /// mean axial displacement u_i (Eq. A2, `docs/amm.md` 12.12); 0 in the paper's model.
     axial_flex: f64,
-    /// Full model, enriched family: the residual flexibility of the sleeves (Eqs. R3-R4,
-    /// `docs/amm.md` 12); `None` otherwise.
-    compliance: Option<SleeveCompliance>,
     // arrowhead data of S (the same for the three beams)
     inv_d: Vec<f64>,
     w: Vec<f64>,
@@ -365,14 +297,14 @@ fn constraint_rows(has_w0: bool, has_slope0: bool) -> Vec<Row> {
         rows.push(Row::M3G);
     }
     for i in 0..3 {
-        rows.extend([Row::Fp(i), Row::FR(i), Row::FL(i), Row::Mp(i)]);
+        rows.extend(SleeveRow::ALL.map(|r| Row::Sleeve(i, r)));
     }
     rows
 }
 
 /// Block of constraint row `row` on beam b: (basis vector, its factor, u coefficient, thp
 /// coefficient), `None` where the block is zero; `hp` is half the sleeve length [m].
-fn row_entry(row: Row, b: usize, has_w0: bool, hp: f64) -> Option<(usize, f64, f64, f64)> {
+fn row_entry(row: Row, b: usize, has_w0: bool, hp: f64) -> Option<RowForm> {
     match row {
         Row::Fix(i) if b == i => Some((NONE, 0.0, 1.0, 0.0)),
         Row::Fix(i) if has_w0 => Some((
@@ -391,17 +323,13 @@ fn row_entry(row: Row, b: usize, has_w0: bool, hp: f64) -> Option<(usize, f64, f
                 _ => None,
             }
         }
-        Row::Fp(i) if b == i => Some((B_MID, 1.0, 0.0, 0.0)),
-        Row::FR(i) if b == i => Some((B_RIGHT, 1.0, 0.0, -hp)),
-        Row::FL(i) if b == i => Some((B_LEFT, 1.0, 0.0, hp)),
-        Row::Mp(i) if b == i => Some((B_MSLOPE, 1.0, 0.0, 1.0)),
-        Row::Fp(_) | Row::FR(_) | Row::FL(_) | Row::Mp(_) => None,
+        Row::Sleeve(i, row) => (b == i).then(|| row.form(hp)),
     }
 }
 
 /// The rows of each beam: which constraint rows touch it and how ([`row_entry`]), with the
-/// workspaces for `nm` modes (`n_bent` analytic modes for the full model's sleeve bending).
-fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize, n_bent: usize) -> [BeamRows; 3] {
+/// workspaces for `nm` modes.
+fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize) -> [BeamRows; 3] {
     let mut beams: [BeamRows; 3] = std::array::from_fn(|_| BeamRows {
         ids: Vec::new(),
         basis: Vec::new(),
@@ -413,9 +341,7 @@ fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize, n_bent: usize) -> [
         sleeve: std::array::from_fn(|_| vec![0.0; nm]),
         scaled: std::array::from_fn(|_| vec![0.0; nm]),
         gram: [[0.0; NB]; NB],
-        bent: SleeveBending::new(n_bent),
         g: [0.0; NB],
-        res: [[0.0; 4]; 4],
     });
     for (k, row) in rows.iter().enumerate() {
         for (b, beam) in beams.iter_mut().enumerate() {
@@ -452,46 +378,33 @@ impl System {
 
         let rows = constraint_rows(has_w0, has_slope0);
         let hp = 0.5 * params.lp;
-        let n_bent = if model == AmmModel::Full {
-            modes.analytic_len()
-        } else {
-            0
-        };
-        let beams = beam_rows(&rows, has_w0, hp, nm, n_bent);
+        let beams = beam_rows(&rows, has_w0, hp, nm);
         debug_assert!(beams.iter().all(|b| b.ids.len() <= MAX_BEAM_ROWS));
         let m = rows.len();
         let n = 3 * nb;
-        let (geometric, fore, shift) = match model {
+        let (geometric, fore) = match model {
             AmmModel::Full => {
                 let geo = GeometricStiffness::new(&modes, geometric::KEPT_ANALYTIC);
                 let fore = Foreshortening::new(&modes, geo.kept(), &geo.g2(), KEPT_ANALYTIC);
-                let shift = SleeveShift::new(&modes, &GeometricStiffness::kept_modes(&modes, KEPT_ANALYTIC));
-                (Some(geo), Some(fore), Some(shift))
+                (Some(geo), Some(fore))
             }
-            AmmModel::Paper => (None, None, None),
+            AmmModel::Paper => (None, None),
         };
-        let compliance = (model == AmmModel::Full && modes.family() == ModeFamily::Enriched)
-            .then(|| SleeveCompliance::new(l, hp, params.ei(), params.rho, modes.lambda()));
         let axial_flex = match model {
             AmmModel::Full => l / (3.0 * params.ea()),
             AmmModel::Paper => 0.0,
         };
         System {
             fore,
-            shift,
+            sleeves: Sleeves::new(&modes, params, model),
             axial_flex,
-            compliance,
-            model,
             geometric,
-            sleeve_axial: [[0.0; 3]; 3],
             udd: [0.0; 3],
-            xp: [0.0; 3],
             nm,
             nb,
             rho: params.rho,
             l,
             jp: params.jp,
-            tri: modes.triplet(hp),
             lambda_m: modes.lambda().to_vec(),
             phi: modes.phi_integral().to_vec(),
             psi: modes.x_phi_integral().to_vec(),
@@ -551,59 +464,10 @@ impl System {
         }
     }
 
-    /// Eqs. 41-43: refresh the sleeve rows for the sleeve positions xp_i(t).
-    ///
-    /// Paper model: the rows at the rigid material points xp_i, xp_i +- Lp/2, constant in u_i.
-    /// Full model (`docs/amm.md` section 8): at the material point that sits in the sleeve,
-    /// `xp_i - u_i`, linearised about the predictor `qhat` (one Newton step of the nonlinear rows
-    /// per time step, exact to O(h^4)): alpha part `phi(xp - u^ + e)`, u gradient `-w^'(xp - u^ + e)`
-    /// (`+w^''` for the slope row), while the rows' values keep no u term. The material point is
-    /// drawn out by the foreshortening, `e = f(xp - u^)` (Eq. S1, `docs/amm.md` 12.11), and the
-    /// rows gain its gradient and the edges' `sin thp` ([`BeamRows::shift_sleeve_rows`]).
+    /// Eqs. 41-43: refresh the sleeve rows for the sleeve positions xp_i(t) [m], about the
+    /// predictor `qhat` in the full model ([`Sleeves::update`]).
     pub(crate) fn update_sleeve_rows(&mut self, xp: [f64; 3], qhat: &[f64]) {
-        let (nm, nb) = (self.nm, self.nb);
-        let full = self.model == AmmModel::Full;
-        self.xp = xp;
-        for (i, (beam, &x)) in self.beams.iter_mut().zip(&xp).enumerate() {
-            let alpha = &qhat[i * nb..i * nb + nm];
-            let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
-            let shift = self.shift.as_mut().map_or(0.0, |s| s.evaluate(i, x - u_hat, alpha));
-            let xc = x - u_hat + shift;
-            let [mid, right, left, mslope] = &mut beam.sleeve;
-            let bent = if full { Some((alpha, &mut beam.bent)) } else { None };
-            self.modes.triplet_at(&self.tri, xc, left, mid, right, mslope, bent);
-            if full {
-                let slope_mid = dot(mslope, alpha);
-                let (slope_right, slope_left) = (beam.bent.slope_right, beam.bent.slope_left);
-                let curvature = beam.bent.curvature;
-                for (k, id) in beam.ids.iter().enumerate() {
-                    let c = match self.rows[*id] {
-                        Row::Fp(_) => -slope_mid,
-                        Row::FR(_) => -slope_right,
-                        Row::FL(_) => -slope_left,
-                        Row::Mp(_) => curvature,
-                        _ => continue,
-                    };
-                    beam.cu[k] = c;
-                }
-                self.sleeve_axial[i] = [-slope_mid, -slope_right, -slope_left];
-            }
-            mslope.iter_mut().for_each(|v| *v = -*v);
-            if let Some(c) = self.compliance.as_mut() {
-                beam.res = c.block(xc, [mid, right, left, mslope]);
-            }
-            if let Some(s) = self.shift.as_ref() {
-                let terms = ShiftTerms {
-                    kept: s.kept(),
-                    g: s.gradient(i),
-                    two_f: 2.0 * shift,
-                    thp: qhat[i * nb + nm + 1],
-                    hp: self.tri.half_length(),
-                    slopes: self.sleeve_axial[i].map(|c| -c),
-                };
-                beam.shift_sleeve_rows(&self.rows, terms);
-            }
-        }
+        self.sleeves.update(&mut self.beams, &self.rows, &self.modes, xp, qhat);
     }
 
     /// Eq. A3 (`docs/amm.md` 12.12): the beams' axial flexibility on the Fix rows, whose
@@ -619,32 +483,6 @@ impl System {
         for (k, row) in self.rows.iter().enumerate() {
             if let Row::Fix(_) = row {
                 self.a[k * m + k] += self.axial_flex / bp;
-            }
-        }
-    }
-
-    /// Eq. R4 (`docs/amm.md` 12): the residual flexibility of the sleeve rows, `R / bp` on their
-    /// block of the Schur complement (`C q + R lambda = 0` at `q = qhat + bp qdd`). No-op without
-    /// it, and for the consistent initial accelerations (`bp = 0`: the rows hold at rest).
-    fn add_compliance(&mut self, bp: f64) {
-        if self.compliance.is_none() || bp <= 0.0 {
-            return;
-        }
-        let m = self.rows.len();
-        for beam in &self.beams {
-            // the (global row, sleeve functional, factor) of the beam's four sleeve rows
-            let mut sleeve = [(0, 0, 0.0); 4];
-            let mut n = 0;
-            for k in 0..beam.ids.len() {
-                if (B_MID..=B_MSLOPE).contains(&beam.basis[k]) && n < 4 {
-                    sleeve[n] = (beam.ids[k], beam.basis[k] - B_MID, beam.sc[k]);
-                    n += 1;
-                }
-            }
-            for &(gk, a, sk) in &sleeve[..n] {
-                for &(gs, b, ss) in &sleeve[..n] {
-                    self.a[gk * m + gs] += sk * ss * beam.res[a][b] / bp;
-                }
             }
         }
     }
@@ -943,7 +781,7 @@ impl System {
             beam.fill_gram([g00, g01, g11], [w0, w1], inv_d, [phi0, dphi0, phi]);
             beam.add_block(a_mat, m, p, inv_sigma, inv_jp);
         }
-        self.add_compliance(bp);
+        self.sleeves.add_compliance(&mut self.a, m, &self.beams, bp);
         self.add_axial_flexibility(bp);
         if self.payload.is_some() {
             self.payload_block(st, Self::payload_motion(st), bp, gp)?;
@@ -1124,61 +962,10 @@ impl System {
         self.payload_correct(&mut qdd[..nb]);
     }
 
-    /// The sleeve rows of Eqs. 41-42 evaluated exactly at the state q, for tests, with the
-    /// foreshortening computed here by brute force (Gauss quadrature of `1/2 int_0^x w'^2` over
-    /// every mode, not the table of `sleeve_shift`): largest `|w_i(x_c + e) - sin(thp_i) e|` over
-    /// the beams and e in {0, +-Lp/2}, at the material point `x_c = xp - u + f(x_c)` of Eq. S1;
-    /// the same at `xp - u` (no foreshortening, as before Eq. S1); and `|w_i(xp_i + e) - e thp_i|`
-    /// (the rigid material points, as the paper takes them) [m].
+    /// The sleeve rows evaluated exactly at the state q, for tests ([`Sleeves::gaps`]) [m].
     #[cfg(test)]
     pub(crate) fn sleeve_gaps(&self, q: &[f64], lp: f64) -> [f64; 3] {
-        let (nm, nb) = (self.nm, self.nb);
-        let mut v = vec![0.0; nm];
-        let mut gaps = [0.0f64; 3];
-        for i in 0..3 {
-            let o = i * nb;
-            let (alpha, u, thp) = (&q[o..o + nm], q[o + nm], q[o + nm + 1]);
-            let mut xc = self.xp[i] - u;
-            for _ in 0..3 {
-                xc = self.xp[i] - u + self.modes.half_squared_slope_integral(alpha, xc);
-            }
-            // the residual flexibility's deflection at the left edge, centre, right edge (Eq. R4)
-            let res = self.residual_deflection(i);
-            for (e, r) in [-0.5 * lp, 0.0, 0.5 * lp].into_iter().zip([res[2], res[0], res[1]]) {
-                for (gap, x, side, rr) in [
-                    (0, xc + e, e * thp.sin(), r),
-                    (1, self.xp[i] - u + e, e * thp, r),
-                    (2, self.xp[i] + e, e * thp, 0.0),
-                ] {
-                    self.modes.values_at(x, &mut v, None);
-                    gaps[gap] = gaps[gap].max((dot(&v, alpha) + rr - side).abs());
-                }
-            }
-        }
-        gaps
-    }
-
-    /// Eq. R4 (`docs/amm.md` 12): the deflection `sum_b R_ab lambda_b` that the modes left out
-    /// of the basis add at beam `i`'s sleeve under the multipliers of the last solve, for the
-    /// functionals `[w(xc), w(xc + Lp/2), w(xc - Lp/2), -w'(xc)]` [m, m, m, rad]; zeros without the
-    /// residual flexibility.
-    #[cfg(test)]
-    pub(crate) fn residual_deflection(&self, i: usize) -> [f64; 4] {
-        let mut out = [0.0; 4];
-        if self.compliance.is_none() {
-            return out;
-        }
-        let beam = &self.beams[i];
-        let mut force = [0.0; 4];
-        for (k, &g) in beam.ids.iter().enumerate() {
-            if (B_MID..=B_MSLOPE).contains(&beam.basis[k]) {
-                force[beam.basis[k] - B_MID] += beam.sc[k] * self.lam[g];
-            }
-        }
-        for (o, row) in out.iter_mut().zip(&beam.res) {
-            *o = row.iter().zip(&force).map(|(r, f)| r * f).sum();
-        }
-        out
+        self.sleeves.gaps(&self.modes, &self.beams, &self.lam, q, lp)
     }
 
     /// The constraint Jacobian C (rows x 3 (N + 2), row-major) at the last sleeve update: the

@@ -108,7 +108,8 @@ impl Bordered {
         if let Some(off) = l.off_sl {
             self.slider_border(off, vals);
         }
-        // the tangent rows' compliance of the interior field (Eq. S9), within each sleeve's block
+        // the tangent rows' compliance of the interior field (Eq. S9, `Star::interior_compliance`
+        // of `crate::star::sleeve`), within each sleeve's block
         for i in 0..3 {
             let row = border_nu(i, ROWS - 1);
             for (k, &r) in NU_COLUMNS.iter().enumerate() {

@@ -1,6 +1,7 @@
 //! Structured direct solver of the Newton matrix of the star (`docs/fem.md` section 6): three banded beam blocks
 //! coupled only through a small border (the weld node G, and per sleeve its 7 multipliers, 3
-//! contact coordinates and its rotation).
+//! contact coordinates and its rotation). What those border rows and unknowns mean, the sleeve's
+//! constraint rows and coordinates, is said in `crate::star::sleeve`; this module only solves.
 //!
 //! With the unknowns split into beam DOFs `b` (nodes 1..ne of each beam) and border DOFs `s`
 //! (36: `[nu_i (7), xi_i (3), psi_i]` per sleeve, then G; 39 in the direct problem (`docs/fem.md` section 8),
@@ -46,7 +47,8 @@ use crate::error::PivotError;
 const HB: usize = 5;
 /// Beams, one per lane of [`F64x4`] (lane 3 is idle).
 const BEAMS: usize = 3;
-/// Border unknowns per sleeve: 7 multipliers, 3 contact coordinates, 1 rotation.
+/// Border unknowns per sleeve: 7 multipliers, 3 contact coordinates, 1 rotation (the rows and
+/// coordinates of `crate::star::sleeve`).
 const SLEEVE_BORDER: usize = 11;
 /// Border size of the inverse problem: G and three sleeves.
 const NS_STAR: usize = 3 + 3 * SLEEVE_BORDER;
@@ -55,7 +57,7 @@ const NS_MAX: usize = NS_STAR + 3;
 /// Values per slider in the slider slot group: the diagonal, then `(row r, s_i)` and
 /// `(s_i, row r)` for the 6 position rows r of sleeve i.
 pub(crate) const SLIDER_SLOTS: usize = 13;
-/// Constraint rows per sleeve, hence multiplier columns of `W_i`.
+/// Constraint rows per sleeve (`crate::star::sleeve::ROWS`), hence multiplier columns of `W_i`.
 const ROWS: usize = 7;
 /// Entries of the upper triangle of the symmetric `ROWS x ROWS` block `W_i^T W_i`.
 const TRI: usize = ROWS * (ROWS + 1) / 2;
@@ -73,10 +75,12 @@ pub(crate) struct Layout {
     /// Nodes (1 + 3 ne) and generalized coordinates.
     pub n_nodes: usize,
     pub n_dof: usize,
-    /// Offset of the sleeve diagonals `[psi_i, xi_i0, xi_i1, xi_i2]` (4 per sleeve).
+    /// Offset of the sleeve diagonals `[psi_i, xi_i0, xi_i1, xi_i2]` (4 per sleeve): the sleeve's
+    /// inertia Jp, and 0 for the massless contact coordinates (`crate::star::sleeve`).
     pub off_psi: usize,
-    /// Offset of the constraint rows: per row `2 ncol` values, the row block then its transpose,
-    /// columns = the window's node DOFs, then `xi`, then `psi`.
+    /// Offset of the constraint rows (the sleeves' rows of `crate::star::sleeve`, 7 per sleeve):
+    /// per row `2 ncol` values, the row block then its transpose, columns = the window's node
+    /// DOFs, then `xi`, then `psi`.
     pub off_con: usize,
     pub ncol: usize,
     /// Window width in elements (the window covers nodes `lo..=lo + ww`).
@@ -91,8 +95,9 @@ pub(crate) struct Layout {
 
 /// Values per sleeve in the multiplier-block slot group (see [`Layout::off_nu`]).
 pub(crate) const NU_SLOTS: usize = 3;
-/// Constraint rows (of the sleeve's 7) that the tangent row's multiplier block couples with:
-/// the tangent row itself, then the centre's two position rows.
+/// Constraint rows (of the sleeve's 7, in the order of `crate::star::sleeve`) that the tangent
+/// row's multiplier block couples with: the tangent row itself, then the centre's two position
+/// rows.
 pub(crate) const NU_COLUMNS: [usize; NU_SLOTS] = [6, 0, 1];
 
 /// The factorisation and its workspaces. Beam rows are tip-first and stored `HB` rows further
@@ -123,7 +128,8 @@ pub(crate) struct Bordered {
     y: Vec<VecRow>,
 }
 
-/// Border index of multiplier r, contact coordinate p and rotation of sleeve i.
+/// Border index of multiplier r (row r of `crate::star::sleeve`), contact coordinate p and
+/// rotation of sleeve i.
 fn border_nu(i: usize, r: usize) -> usize {
     SLEEVE_BORDER * i + r
 }
@@ -199,6 +205,7 @@ impl Bordered {
             for r in 0..ROWS {
                 global[border_nu(i, r)] = lay.n_dof + ROWS * i + r;
             }
+            // the sleeve coordinates as `Star::xi`, `Star::psi` number them (`crate::star::sleeve`)
             for p in 0..3 {
                 global[border_xi(i, p)] = 3 * lay.n_nodes + 3 + 3 * i + p;
             }

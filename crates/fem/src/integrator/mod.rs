@@ -20,7 +20,7 @@ use flexstar_model::{RobotParams, Trajectory};
 use flexstar_numerics::GenAlpha;
 
 use crate::error::PivotError;
-use crate::star::{Attached, Factors, InitialState, Iterate, Pins, SliderRows, Star, ROWS};
+use crate::star::{pin_forces, Attached, Factors, InitialState, Iterate, Pins, SliderRows, Star, ROWS};
 use crate::{FemError, NewtonFailure};
 
 mod motion;
@@ -244,25 +244,6 @@ fn convective_accelerations(
     Ok(conv)
 }
 
-/// The sleeves must stay on their beams: every contact point inside (0, L).
-fn check_sleeves(star: &Star, q: &[f64], l: f64, t: f64) -> Result<(), FemError> {
-    for i in 0..3 {
-        for (p, name) in [(0, "centre"), (1, "left edge"), (2, "right edge")] {
-            let xi = q[star.xi(i, p)];
-            if !(xi > 0.0 && xi < l) {
-                return Err(FemError::SleeveOffBeam {
-                    t,
-                    sleeve: i + 1,
-                    point: name,
-                    xi,
-                    l,
-                });
-            }
-        }
-    }
-    Ok(())
-}
-
 /// How many times a step whose Newton iteration fails is halved before the run stops: a step
 /// of `dt / 2^MAX_HALVINGS` at the least. A load that jumps on a bare G (docs/fem.md 9.3) excites
 /// the weld's highest modes; a shorter step resolves their first instants.
@@ -313,7 +294,7 @@ impl Stepper<'_, '_> {
     /// The checks, works and records after a converged step ending at `t` [s] of length `h`.
     fn finish(&mut self, t: f64, h: f64) -> Result<(), FemError> {
         let (params, st) = (self.params, &*self.st);
-        check_sleeves(self.star, &st.q, params.l, t)?;
+        self.star.check_on_beams(&st.q, t)?;
         self.motion.check_feasible(params, &st.pins, t)?;
         let (fa, pf) = self.motion.forces(params, &st.pins, &st.lam, t)?;
         self.works.advance(self.star, st, &fa, t, h);

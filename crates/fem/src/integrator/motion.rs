@@ -10,15 +10,6 @@ pub(super) fn pins_at(params: &RobotParams, traj: &Trajectory, t: f64) -> Result
     Ok(Pins::new(params, j.map(|x| [x.v, x.d1, x.d2])))
 }
 
-/// Force `F_i = lambda_c + lambda_l + lambda_r` the beam exerts on sleeve i, hence on its pin
-/// and slider [N], fixed frame.
-pub(super) fn pin_forces(lam: &[f64]) -> [[f64; 2]; 3] {
-    [0, 1, 2].map(|i| {
-        let l = &lam[ROWS * i..ROWS * i + ROWS];
-        [l[0] + l[2] + l[4], l[1] + l[3] + l[5]]
-    })
-}
-
 /// Driving force (Eq. 33): `Fa_i = (mpp + mpa) s_i'' - F_i . u_i`, F_i the force of the beam on
 /// sleeve i (the sleeve is translationally massless: F_i passes through the pin to the slider).
 pub(super) fn driving_forces(params: &RobotParams, pins: &Pins, lam: &[f64]) -> ([f64; 3], [[f64; 2]; 3]) {

@@ -4,33 +4,15 @@
 //! Unknowns (all in the fixed XY frame, SI units):
 //! - node j: `[x, y, phi]` (position [m], cross-section rotation increment [rad]); node 0 is G,
 //!   beam i (0-based) has nodes `1 + i ne + (k - 1)` at material coordinates `k h`, k = 1..ne;
-//! - sleeve i: rotation increment `psi_i` [rad] of its axis from the initial beam direction
-//!   `gamma0_i` (the angle of `e_xi(theta0)`), inertia Jp;
-//! - sleeve i: material coordinates `xi_ic, xi_il, xi_ir` [m] of its centre and its two edges on
-//!   beam i (massless: fixed by the constraints, frictionless because nothing else acts on them).
+//! - sleeve i: its rotation `psi_i` and the material coordinates `xi_ic, xi_il, xi_ir` of its
+//!   centre and edges on beam i ([`sleeve`], which says what a sleeve is: its coordinates, its 7
+//!   constraint rows and their Jacobian blocks, the forces it transmits, where friction would enter).
 //!
-//! Constraints of sleeve i (7 rows, multipliers `lambda`), with `a = [cos, sin](gamma0_i + psi_i)`:
-//!
-//! ```text
-//! r_i(xi_c) - P_i(t)              = 0   (2)  centre on the pin
-//! r_i(xi_l) - P_i(t) + Lp/2 a     = 0   (2)  left edge on the beam
-//! r_i(xi_r) - P_i(t) - Lp/2 a     = 0   (2)  right edge on the beam
-//! alpha_i(xi_c) - gamma0_i - psi_i = 0   (1)  beam tangent along the sleeve axis
-//! ```
-//!
-//! The tangent row carries the interior-field correction of Eq. S9 (`docs/fem.md` section 2.1,
-//! [`Star::interior_compliance`]): the slope that the point moment and force of the sleeve add
-//! inside the centre's element, `F_ut P + F_tt C` with the multipliers as loads, which makes the
-//! mesh converge at second order where the sleeve's moment is large.
-//!
-//! `r_i(xi)` and `alpha_i(xi)` are the element interpolations of [`crate::element`] in the element
-//! that contains `xi`; they are continuous (position and angle) across element boundaries, so a
-//! contact point slides from one element into the next without a jump.
-//!
-//! Equations of motion (Lagrange): `M(q) q_dd + f_conv(q, q_d) + f_int(q) + Phi_q^T lambda = 0`.
-//! The generalized force of the constraints on the beam is `-Phi_q^T lambda`: sleeve i pushes the
-//! beam with the point forces `-lambda_c`, `-lambda_l`, `-lambda_r`, and the beam pushes the sleeve,
-//! hence its pin and slider, with `F_i = lambda_c + lambda_l + lambda_r`.
+//! Equations of motion (Lagrange): `M(q) q_dd + f_conv(q, q_d) + f_int(q) + Phi_q^T lambda = 0`,
+//! `Phi(q, t) = 0` the sleeves' rows. This module assembles them: the element pass
+//! ([`crate::element_pass`]), the payload and load ([`attached`]), the sleeves' rows
+//! ([`Star::sleeve_rows`]), the sliders' rows of the direct problem; `pattern` lays out the
+//! matrix's slots, and [`crate::bordered`] factors it.
 //!
 //! **Direct problem** (`docs/fem.md` section 8): the slider coordinates `s_i` [m] become three more unknowns
 //! after the sleeve coordinates, the pins move with them (`P_i = P_i(s_i)`, linear, Eqs. 1-3, so
@@ -57,15 +39,14 @@ use crate::FemError;
 
 mod attached;
 mod pattern;
+pub(crate) mod sleeve;
 
 pub(crate) use attached::Attached;
+use sleeve::{initial_sleeves, SLEEVE_COORDINATES};
+pub(crate) use sleeve::{pin_forces, ROWS, ROW_POINT};
 
 /// Elements per contact-point window of the sparsity pattern.
 const WINDOW: usize = 8;
-/// Constraint rows per sleeve.
-pub(crate) const ROWS: usize = 7;
-/// Contact point of each constraint row: 0 centre, 1 left edge, 2 right edge.
-pub(crate) const ROW_POINT: [usize; ROWS] = [0, 0, 1, 1, 2, 2, 0];
 
 /// Initial state of the star: undeformed, moving rigidly (initial data from the rigid
 /// kinematics at t = 0: this is allowed, the equations never use it again).
@@ -217,29 +198,6 @@ fn initial_beams(ne: usize, h: f64, init: &InitialState, q: &mut [f64], v: &mut 
     (elements, gamma0)
 }
 
-/// The sleeves' initial coordinates (from `psi0`: three rotations, then the three contact points
-/// of each sleeve at xp_i and xp_i -+ Lp/2) and, in the direct problem, the sliders'.
-fn initial_sleeves(
-    params: &RobotParams,
-    psi0: usize,
-    init: &InitialState,
-    sliders: Option<[[f64; 2]; 3]>,
-    q: &mut [f64],
-    v: &mut [f64],
-) {
-    for i in 0..3 {
-        v[psi0 + i] = init.theta_dot;
-        for (p, off) in [0.0, -0.5 * params.lp, 0.5 * params.lp].iter().enumerate() {
-            q[psi0 + 3 + 3 * i + p] = init.xp[i] + off;
-            v[psi0 + 3 + 3 * i + p] = init.xp_dot[i];
-        }
-        if let Some(sl) = sliders {
-            q[psi0 + 12 + i] = sl[i][0];
-            v[psi0 + 12 + i] = sl[i][1];
-        }
-    }
-}
-
 impl Star {
     /// Mesh the star with `ne` elements per beam around the initial pose. With `sliders`
     /// (`[s_i, s_i']` [m, m/s] at t = 0) the slider coordinates are unknowns too (direct problem).
@@ -252,12 +210,18 @@ impl Star {
         let h = params.l / ne as f64;
         check_mesh(params, ne, h)?;
         let n_nodes = 1 + 3 * ne;
-        let n_dof = 3 * n_nodes + 12 + if sliders.is_some() { 3 } else { 0 };
+        let n_dof = 3 * n_nodes + SLEEVE_COORDINATES + if sliders.is_some() { 3 } else { 0 };
         let n_sys = n_dof + 3 * ROWS;
         let mut q = vec![0.0; n_dof];
         let mut v = vec![0.0; n_dof];
         let (elements, gamma0) = initial_beams(ne, h, init, &mut q, &mut v);
-        initial_sleeves(params, 3 * n_nodes, init, sliders, &mut q, &mut v);
+        initial_sleeves(params, 3 * n_nodes, init, &mut q, &mut v);
+        if let Some(sl) = sliders {
+            for i in 0..3 {
+                q[3 * n_nodes + SLEEVE_COORDINATES + i] = sl[i][0];
+                v[3 * n_nodes + SLEEVE_COORDINATES + i] = sl[i][1];
+            }
+        }
         let star = Star {
             params: *params,
             ne,
@@ -288,19 +252,9 @@ impl Star {
         Ok((star, q, v))
     }
 
-    /// Index of the sleeve rotation psi_i.
-    pub fn psi(&self, i: usize) -> usize {
-        3 * self.n_nodes + i
-    }
-
-    /// Index of contact coordinate `p` (0 centre, 1 left, 2 right) of sleeve i.
-    pub fn xi(&self, i: usize, p: usize) -> usize {
-        3 * self.n_nodes + 3 + 3 * i + p
-    }
-
     /// Index of the slider coordinate s_i (direct problem only).
     pub fn slider(&self, i: usize) -> usize {
-        3 * self.n_nodes + 12 + i
+        3 * self.n_nodes + SLEEVE_COORDINATES + i
     }
 
     /// Direct problem: pin kinematics from the slider unknowns (`[s, s', s'']` of each slider).
@@ -409,99 +363,6 @@ impl Star {
         Ok(matrix)
     }
 
-    /// The sleeve part of [`Star::assemble`] for sleeve i: the rotation's inertia, then per
-    /// constraint row its value, its gradient times the multiplier into the residual and, with
-    /// `matrix`, its slots (row block, then transposed block).
-    #[inline]
-    fn sleeve_rows(&mut self, i: usize, it: &Iterate, cf: f64, compliance: Option<f64>, res: &mut [f64], matrix: bool) {
-        let Iterate { q, qdd, lam, pins, .. } = *it;
-        let ps = self.psi(i);
-        res[ps] += cf * self.params.jp * qdd[ps];
-        if matrix {
-            self.vals[self.off_psi + 4 * i] = self.params.jp;
-            for p in 0..3 {
-                self.vals[self.off_psi + 4 * i + 1 + p] = 0.0;
-            }
-        }
-        // per contact point: the element holding it, its local coordinate and the element's
-        // state (recomputed: cheaper than storing every element's state, which at 3000
-        // elements leaves the cache)
-        let points: [(usize, f64, ElementState); 3] = [0, 1, 2].map(|p| {
-            let (e, z) = self.locate(q[self.xi(i, p)]);
-            let el = &self.elements[i * self.ne + e];
-            (e, z, ElementState::new(el, &self.element_q(el, q)))
-        });
-        for r in 0..ROWS {
-            let p = ROW_POINT[r];
-            let xi_idx = self.xi(i, p);
-            let (e, z, st) = points[p];
-            let ge = i * self.ne + e;
-            let na = self.node(i, e);
-            let (phi, grad, gxi, gpsi) = self.row_terms(&st, [q[3 * na], q[3 * na + 1]], i, q[ps], pins.p[i], r, z);
-            let row = self.n_dof + ROWS * i + r;
-            let l = lam[ROWS * i + r];
-            res[row] = phi;
-            if r == ROWS - 1 {
-                if let Some(scale) = compliance {
-                    res[row] += self.interior_compliance(i, &st, z, lam, scale, matrix);
-                }
-            }
-            let d = dofs(&self.elements[ge]);
-            for a in 0..6 {
-                res[d[a]] += grad[a] * l;
-            }
-            res[xi_idx] += gxi * l;
-            res[ps] += gpsi * l;
-            if !matrix {
-                continue;
-            }
-            // matrix slots: row block then transposed block
-            let base = self.off_con + (ROWS * i + r) * 2 * self.ncol_c;
-            let lo = self.win[i][p];
-            let nc = self.ncol_c;
-            self.vals[base..base + 2 * nc].iter_mut().for_each(|x| *x = 0.0);
-            let c0 = 3 * (e - lo);
-            for a in 0..6 {
-                self.vals[base + c0 + a] = grad[a];
-                self.vals[base + nc + c0 + a] = grad[a];
-            }
-            self.vals[base + nc - 2] = gxi;
-            self.vals[base + 2 * nc - 2] = gxi;
-            self.vals[base + nc - 1] = gpsi;
-            self.vals[base + 2 * nc - 1] = gpsi;
-        }
-    }
-
-    /// Eq. S9 (`docs/fem.md` section 2.1): the slope that the interior field of the centre's
-    /// element adds at the contact point under the point moment `C = -lambda_7` and the normal
-    /// point force `P = -lambda_c . e2` that the sleeve applies there, `F_ut P + F_tt C`, with the
-    /// flexibilities of the element clamped at both nodes (length h, contact at `a = z h`,
-    /// `b = h - a`): `F_tt = a b (a^2 - a b + b^2) / (EI h^3)`, `F_ut = a^2 b^2 (b - a) / (2 EI h^3)`.
-    /// `scale = 1 / cf` turns the scaled multipliers into forces. With `matrix`, writes the
-    /// row's derivatives with respect to the multipliers into the slot group `off_nu`. Returns
-    /// the term to add to the tangent row's value [rad].
-    fn interior_compliance(
-        &mut self,
-        i: usize,
-        st: &ElementState,
-        z: f64,
-        lam: &[f64],
-        scale: f64,
-        matrix: bool,
-    ) -> f64 {
-        let (f_ut, f_tt) = interior_flexibilities(z, self.h, self.params.ei());
-        let e2 = [-st.s, st.c];
-        let k = ROWS * i;
-        // the row's derivatives with respect to (nu_7, nu_cx, nu_cy)
-        let d = [-f_tt * scale, -f_ut * e2[0] * scale, -f_ut * e2[1] * scale];
-        if matrix {
-            for (c, v) in d.iter().enumerate() {
-                self.vals[self.off_nu + NU_SLOTS * i + c] = *v;
-            }
-        }
-        NU_COLUMNS.iter().zip(d).map(|(&r, dv)| dv * lam[k + r]).sum()
-    }
-
     /// A residual with a non-finite entry is an error naming the row (and the element of a DOF row).
     #[inline]
     fn check_residual(&self, res: &[f64], t: f64) -> Result<(), FemError> {
@@ -519,40 +380,6 @@ impl Star {
             });
         }
         Ok(())
-    }
-
-    /// Value, element gradient, contact-coordinate derivative and sleeve-rotation derivative of
-    /// constraint row `r` of sleeve i (module docs), for the state `st` of the element holding the
-    /// contact point at local coordinate `z`, its first node at `node_a`, the sleeve rotation
-    /// `psi` (axis at the angle `gamma0_i + psi`) and the pin `pin`.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn row_terms(
-        &self,
-        st: &ElementState,
-        node_a: [f64; 2],
-        i: usize,
-        psi: f64,
-        pin: [f64; 2],
-        r: usize,
-        z: f64,
-    ) -> (f64, [f64; 6], f64, f64) {
-        if r < 6 {
-            let (k, lp2) = (r % 2, 0.5 * self.params.lp);
-            let ang = self.gamma0[i] + psi;
-            let (a, aperp) = ([ang.cos(), ang.sin()], [-ang.sin(), ang.cos()]);
-            let pos = st.position(node_a, z);
-            let jac = st.jacobian(z);
-            let rz = st.dr_dzeta(z);
-            let (off, gpsi) = match ROW_POINT[r] {
-                0 => (0.0, 0.0),
-                1 => (lp2 * a[k], lp2 * aperp[k]),
-                _ => (-lp2 * a[k], -lp2 * aperp[k]),
-            };
-            (pos[k] - pin[k] + off, jac[k], rz[k] / self.h, gpsi)
-        } else {
-            let (al, g, az) = st.angle(z);
-            (al - psi, g, az / self.h, -1.0)
-        }
     }
 
     /// The sliders' equations of the direct problem (see [`Star::assemble`]).
@@ -617,36 +444,6 @@ impl Star {
         }
     }
 
-    /// Constraint values `Phi(q, t)` (21), for the consistent initial accelerations.
-    pub fn constraints(&self, q: &[f64], pins: &Pins) -> Vec<f64> {
-        let lp2 = 0.5 * self.params.lp;
-        let mut out = vec![0.0; 3 * ROWS];
-        for i in 0..3 {
-            let ang = self.gamma0[i] + q[self.psi(i)];
-            let a = [ang.cos(), ang.sin()];
-            for r in 0..ROWS {
-                let p = ROW_POINT[r];
-                let (e, z) = self.locate(q[self.xi(i, p)]);
-                let el = &self.elements[i * self.ne + e];
-                let st = ElementState::new(el, &self.element_q(el, q));
-                let na = self.node(i, e);
-                out[ROWS * i + r] = if r < 6 {
-                    let k = r % 2;
-                    let pos = st.position([q[3 * na], q[3 * na + 1]], z);
-                    let off = match p {
-                        0 => 0.0,
-                        1 => lp2 * a[k],
-                        _ => -lp2 * a[k],
-                    };
-                    pos[k] - pins.p[i][k] + off
-                } else {
-                    st.angle(z).0 - q[self.psi(i)]
-                };
-            }
-        }
-        out
-    }
-
     /// Kinetic and strain energy of the beams [J] at coordinates `q` and velocities `v` (the
     /// element interpolation's, exact: [`ElementState::kinetic_energy`],
     /// [`ElementState::strain_energy`]), in one pass over the elements.
@@ -668,20 +465,6 @@ impl Star {
     pub fn node_x(&self) -> Vec<f64> {
         (0..=self.ne).map(|k| k as f64 * self.h).collect()
     }
-}
-
-/// Flexibilities `(F_ut, F_tt)` of Eq. S9 (`docs/fem.md` section 2.1): the slope at the load
-/// point of an element of length `h` [m] and bending stiffness `ei` [N m^2] clamped at both ends,
-/// per unit point force (`F_ut` [1/N]) and per unit point moment (`F_tt` [1/(N m)]) at the local
-/// coordinate `z` (`a = z h`, `b = h - a`): `F_ut = a^2 b^2 (b - a) / (2 EI h^3)`,
-/// `F_tt = a b (a^2 - a b + b^2) / (EI h^3)`; zero at the nodes.
-pub(crate) fn interior_flexibilities(z: f64, h: f64, ei: f64) -> (f64, f64) {
-    let (a, b) = (z.clamp(0.0, 1.0) * h, (1.0 - z).clamp(0.0, 1.0) * h);
-    let den = ei * h * h * h;
-    (
-        a * a * b * b * (b - a) / (2.0 * den),
-        a * b * (a * a - a * b + b * b) / den,
-    )
 }
 
 /// Global node index of node k (0 = G) of beam i with `ne` elements per beam.
@@ -785,104 +568,6 @@ mod tests {
         star.use_sparse
     }
 
-    /// The slope at the load point `z` of a clamped-clamped beam (length `h`, stiffness `ei`)
-    /// under the point force `force` and moment `moment`, by minimising the discrete energy
-    /// `sum EI/2 (second difference)^2 dx - P w(a) - C w'(a)` on `n` intervals (clamped ends by
-    /// mirrored ghost nodes; `w'(a)` by a central difference, also for the slope measured).
-    fn finite_difference_slope(h: f64, ei: f64, n: usize, z: f64, force: f64, moment: f64) -> f64 {
-        let dx = h / n as f64;
-        // energy Hessian on the unknowns w_1..w_{n-1} (w_0 = w_n = 0, w_-1 = w_1, w_n+1 = w_n-1)
-        let m = n - 1;
-        let mut k = vec![vec![0.0; m]; m];
-        for node in 0..=n {
-            // curvature at `node` as coefficients on the unknowns
-            let mut c: Vec<(usize, f64)> = Vec::new();
-            let mut add = |j: isize, v: f64| {
-                let j = if j < 0 {
-                    -j
-                } else if j > n as isize {
-                    2 * n as isize - j
-                } else {
-                    j
-                };
-                if j > 0 && (j as usize) < n {
-                    c.push((j as usize - 1, v / (dx * dx)));
-                }
-            };
-            let j = node as isize;
-            add(j - 1, 1.0);
-            add(j, -2.0);
-            add(j + 1, 1.0);
-            let w = if node == 0 || node == n { 0.5 } else { 1.0 } * ei * dx;
-            for &(p, vp) in &c {
-                for &(q, vq) in &c {
-                    k[p][q] += w * vp * vq;
-                }
-            }
-        }
-        // node `at` is unknown at - 1
-        let at = (z * n as f64).round() as usize;
-        let mut f = vec![0.0; m];
-        f[at - 1] += force;
-        f[at] += moment / (2.0 * dx);
-        f[at - 2] -= moment / (2.0 * dx);
-        let w = solve_dense(k, f);
-        (w[at] - w[at - 2]) / (2.0 * dx)
-    }
-
-    /// Eq. S9's flexibilities against an independent solution of the clamped-clamped beam
-    /// ([`finite_difference_slope`]) for a unit force and a unit moment at four points. The
-    /// finite differences err by `O(dx)` (the moment is a dipole over `2 dx`): extrapolated
-    /// from 200 and 400 intervals (Richardson, first order), they agree to 1e-3 relative; a
-    /// wrong coefficient or sign fails by far more.
-    #[test]
-    fn interior_flexibilities_match_a_finite_difference_beam() {
-        let (h, ei) = (0.004, 0.35);
-        for z in [0.1, 0.3, 0.5, 0.8] {
-            let (f_ut, f_tt) = interior_flexibilities(z, h, ei);
-            for (force, moment) in [(1.0, 0.0), (0.0, 1.0)] {
-                let coarse = finite_difference_slope(h, ei, 200, z, force, moment);
-                let fine = finite_difference_slope(h, ei, 400, z, force, moment);
-                let extrapolated = 2.0 * fine - coarse;
-                let want = force * f_ut + moment * f_tt;
-                let scale = f_tt * if force != 0.0 { h } else { 1.0 };
-                let rel = (extrapolated - want).abs() / scale;
-                eprintln!("z {z}, P {force}, C {moment}: {extrapolated:e} against {want:e}, {rel:.1e}");
-                assert!(
-                    rel <= 1e-3,
-                    "z = {z}, P = {force}, C = {moment}: finite differences {fine:e} (extrapolated {extrapolated:e}), Eq. S9 {want:e}"
-                );
-            }
-        }
-        assert_eq!(interior_flexibilities(0.0, h, ei), (0.0, 0.0));
-        assert_eq!(interior_flexibilities(1.0, h, ei).1, 0.0);
-    }
-
-    /// Gaussian elimination with partial pivoting (the test's small dense systems).
-    fn solve_dense(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
-        let n = b.len();
-        for c in 0..n {
-            let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs())).unwrap();
-            a.swap(c, p);
-            b.swap(c, p);
-            for r in c + 1..n {
-                let f = a[r][c] / a[c][c];
-                if f != 0.0 {
-                    for j in c..n {
-                        a[r][j] -= f * a[c][j];
-                    }
-                    b[r] -= f * b[c];
-                }
-            }
-        }
-        let mut x = vec![0.0; n];
-        for r in (0..n).rev() {
-            let s: f64 = (r + 1..n).map(|j| a[r][j] * x[j]).sum();
-            x[r] = (b[r] - s) / a[r][r];
-        }
-        x
-    }
-
     #[test]
     fn bordered_solver_matches_sparse_lu_and_residual() {
         // strains ~1e-5: the beam blocks are positive definite, the structured solver takes them
@@ -917,94 +602,5 @@ mod tests {
         // strains ~1e-2 (compressive forces ~4e4 N): the geometric stiffness makes a beam block
         // indefinite, the banded Cholesky refuses it and the sparse LU solves instead
         assert!(solve_and_check(1e-4, false), "expected the fallback");
-    }
-
-    /// The constraint Jacobian of [`Star::row_terms`] (the rows' element gradients, contact
-    /// coordinate and sleeve-rotation derivatives, assembled as [`Star::assemble`] does) against
-    /// central differences of the constraint residual [`Star::constraints`] (Eq. 21), column by
-    /// column over every coordinate, at three states of paper case 3 (rigid poses at t = 0.1, 0.3,
-    /// 0.5 s, the nodes displaced by up to 2 mm and 0.02 rad, the sleeves turned): two
-    /// independent codes (values against derivatives).
-    ///
-    /// Tolerance: with the step `h = 1e-6` (metres or radians) the central difference errs by
-    /// `h^2 |d3 Phi| / 6 + eps |Phi| / h`; the rows are positions of order 0.5 m and angles of
-    /// order 1 rad, cubic in the element's local coordinate, so their third derivatives are of
-    /// order 1 / h_el^2 ~ 1e4 at 40 elements per beam: a truncation below ~2e-9, a round-off
-    /// ~2e-16 / 1e-6 ~ 2e-10. `1e-6 (1 + |J|)` holds both with margin, while a wrong or missing
-    /// derivative (entries of order 1e-3 to 1) is far above it.
-    #[test]
-    fn row_terms_match_central_differences_of_the_constraints() {
-        let exp = flexstar_model::catalogue::paper_case(3);
-        let params = exp.robot;
-        let ne = 40;
-        let h = 1e-6;
-        let mut checked = 0;
-        for (n, &t) in [0.1, 0.3, 0.5].iter().enumerate() {
-            let r = flexstar_kinematics::RigidState::at(&params, &exp.trajectory, t).unwrap();
-            let init = InitialState {
-                g: [r.g[0].v, r.g[1].v],
-                g_dot: [0.0; 2],
-                theta: r.theta.v,
-                theta_dot: 0.0,
-                xp: r.xp.map(|x| x.v),
-                xp_dot: [0.0; 3],
-            };
-            let pins = Pins::new(&params, r.s.map(|s| [s.v, s.d1, s.d2]));
-            let (star, mut q, _) = Star::new(&params, ne, &init, None).unwrap();
-            for (j, x) in q.iter_mut().enumerate().take(3 * star.n_nodes) {
-                let amp = if j % 3 == 2 { 0.02 } else { 2e-3 };
-                *x += amp * (0.7 * j as f64 + n as f64).sin();
-            }
-            for i in 0..3 {
-                q[star.psi(i)] += 0.01 * (i as f64 + 1.0);
-                // contact points well inside their elements (the Jacobian jumps at nodes)
-                for p in 0..3 {
-                    let (_, z) = star.locate(q[star.xi(i, p)]);
-                    if !(0.05..=0.95).contains(&z) {
-                        q[star.xi(i, p)] += 0.3 * star.h;
-                    }
-                }
-            }
-            // analytic Jacobian: 3 ROWS rows, n_dof columns
-            let nd = star.n_dof;
-            let mut jac = vec![vec![0.0; nd]; 3 * ROWS];
-            for i in 0..3 {
-                let ps = star.psi(i);
-                for r in 0..ROWS {
-                    let p = ROW_POINT[r];
-                    let (e, z) = star.locate(q[star.xi(i, p)]);
-                    let el = &star.elements[i * star.ne + e];
-                    let st = ElementState::new(el, &star.element_q(el, &q));
-                    let na = star.node(i, e);
-                    let (_, grad, gxi, gpsi) =
-                        star.row_terms(&st, [q[3 * na], q[3 * na + 1]], i, q[ps], pins.p[i], r, z);
-                    let row = &mut jac[ROWS * i + r];
-                    for (a, &d) in dofs(el).iter().enumerate() {
-                        row[d] += grad[a];
-                    }
-                    row[star.xi(i, p)] += gxi;
-                    row[ps] += gpsi;
-                }
-            }
-            for c in 0..nd {
-                let (mut qp, mut qm) = (q.clone(), q.clone());
-                qp[c] += h;
-                qm[c] -= h;
-                let (fp, fm) = (star.constraints(&qp, &pins), star.constraints(&qm, &pins));
-                for k in 0..3 * ROWS {
-                    let fd = (fp[k] - fm[k]) / (2.0 * h);
-                    let an = jac[k][c];
-                    assert!(
-                        (fd - an).abs() <= 1e-6 * (1.0 + an.abs()),
-                        "t = {t} s, row {k}, column {c}: analytic {an:e}, central difference {fd:e}"
-                    );
-                    if an.abs() > 1e-3 {
-                        checked += 1;
-                    }
-                }
-            }
-        }
-        // every row has its 6 element entries, the contact coordinate and psi, at three states
-        assert!(checked >= 3 * 3 * ROWS * 6, "only {checked} entries above 1e-3");
     }
 }

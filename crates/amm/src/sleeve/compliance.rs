@@ -12,9 +12,13 @@
 //! R_ab = h(l_a, l_b) / EI - sum_{m: lambda_m > 0} l_a(phi_m) l_b(phi_m) / (rho lambda_m)     (Eq. R3)
 //! ```
 //! for the sleeve rows' functionals `l_a` (value at the centre and the two edges, minus the
-//! slope at the centre), and each sleeve row becomes `c_a q + sum_b R_ab lambda_b = 0` (Eq. R4).
+//! slope at the centre), and each sleeve row becomes `c_a q + sum_b R_ab lambda_b = 0` (Eq. R4):
+//! [`Sleeves::add_compliance`] in the step's Schur complement.
 
 use flexstar_numerics::vector::dots;
+
+use super::{Sleeves, B_MID, B_MSLOPE};
+use crate::system::BeamRows;
 
 /// The free-free beam (length `l`, EI = 1, unit mass density) on its elastic subspace under a
 /// unit point force (`couple = false`) or a unit point couple (the functional `v -> v'(y)`,
@@ -90,7 +94,7 @@ pub(crate) fn free_free_green(l: f64, x: f64, y: f64) -> [f64; 4] {
 }
 
 /// The sleeve rows' functionals, in the order of the basis vectors `B_MID, B_RIGHT, B_LEFT,
-/// B_MSLOPE` of `system`: (offset from the sleeve centre in units of Lp/2, derivative order, sign).
+/// B_MSLOPE` of [`super::rows`]: (offset from the sleeve centre in units of Lp/2, derivative order, sign).
 const FUNCTIONALS: [(f64, usize, f64); 4] = [(0.0, 0, 1.0), (1.0, 0, 1.0), (-1.0, 0, 1.0), (0.0, 1, -1.0)];
 
 /// The residual flexibility of one robot's beams at their sleeves (Eq. R3), for a basis whose
@@ -150,6 +154,56 @@ impl SleeveCompliance {
             }
         }
         r
+    }
+}
+
+impl Sleeves {
+    /// Eq. R4 (`docs/amm.md` 12): the residual flexibility of the sleeve rows of `beams`, `R / bp`
+    /// on their block of the Schur complement `a` (m x m, row-major; `C q + R lambda = 0` at
+    /// `q = qhat + bp qdd`). No-op without it, and for the consistent initial accelerations
+    /// (`bp = 0`: the rows hold at rest).
+    pub(crate) fn add_compliance(&self, a: &mut [f64], m: usize, beams: &[BeamRows; 3], bp: f64) {
+        if self.compliance.is_none() || bp <= 0.0 {
+            return;
+        }
+        for (beam, res) in beams.iter().zip(&self.res) {
+            // the (global row, sleeve functional, factor) of the beam's four sleeve rows
+            let mut sleeve = [(0, 0, 0.0); 4];
+            let mut n = 0;
+            for k in 0..beam.ids.len() {
+                if (B_MID..=B_MSLOPE).contains(&beam.basis[k]) && n < 4 {
+                    sleeve[n] = (beam.ids[k], beam.basis[k] - B_MID, beam.sc[k]);
+                    n += 1;
+                }
+            }
+            for &(gk, fa, sk) in &sleeve[..n] {
+                for &(gs, fb, ss) in &sleeve[..n] {
+                    a[gk * m + gs] += sk * ss * res[fa][fb] / bp;
+                }
+            }
+        }
+    }
+
+    /// Eq. R4 (`docs/amm.md` 12): the deflection `sum_b R_ab lambda_b` that the modes left out
+    /// of the basis add at beam `i`'s sleeve (its rows `beam`) under the multipliers `lam` of the
+    /// last solve, for the functionals `[w(xc), w(xc + Lp/2), w(xc - Lp/2), -w'(xc)]` [m, m, m,
+    /// rad]; zeros without the residual flexibility.
+    #[cfg(test)]
+    pub(crate) fn residual_deflection(&self, i: usize, beam: &BeamRows, lam: &[f64]) -> [f64; 4] {
+        let mut out = [0.0; 4];
+        if self.compliance.is_none() {
+            return out;
+        }
+        let mut force = [0.0; 4];
+        for (k, &g) in beam.ids.iter().enumerate() {
+            if (B_MID..=B_MSLOPE).contains(&beam.basis[k]) {
+                force[beam.basis[k] - B_MID] += beam.sc[k] * lam[g];
+            }
+        }
+        for (o, row) in out.iter_mut().zip(&self.res[i]) {
+            *o = row.iter().zip(&force).map(|(r, f)| r * f).sum();
+        }
+        out
     }
 }
 

@@ -1,0 +1,214 @@
+//! The sleeve: the passive prismatic joint through which beam i slides, pinned at the revolute
+//! point `P_i` of slider i (Eqs. 1-3) and free to turn about it.
+//!
+//! **In the AMM.** The sleeve's position on its beam, `xp_i(t)` [m] from G along `e_xi`, is the
+//! rigid kinematics' (prescribed, not an unknown). Its one unknown is its rotation `thp_i` [rad]
+//! relative to the rigid beam direction, the last coordinate of beam i's block (`alpha_i, u_i,
+//! thp_i`, `system`), with the equation `Jp thp'' = -Jp th'' + (C^T lambda)_thp` (Eq. 31,
+//! `Jp` [kg m^2]). The sleeve holds the beam by four constraint rows ([`rows`], Eqs. 41-43,
+//! `docs/amm.md` section 1), homogeneous and linear in the beam's coordinates, whose multipliers
+//! are the forces of the sleeve on the beam: the normal forces `Fp_i` at the pin, `FR_pi`, `FL_pi`
+//! at the edges [N] along `+e_wi`, and the couple `Mp_i` [N m]. Frames: the moving beam frame
+//! `(e_xi, e_wi)` of Eqs. 11-12 (`docs/conventions.md`); SI units.
+//!
+//! - paper model: the rows at the rigid material points `xp_i`, `xp_i +- Lp/2`, no u_i term;
+//! - full model (`docs/amm.md` section 8): at the material point that sits in the sleeve, drawn
+//!   out by the foreshortening, `x_c = xp_i - u_i + f(x_c)` ([`shift`], Eqs. S1-S4,
+//!   `docs/amm.md` 12.11), linearised about the step's predictor ([`Sleeves::update`]); each
+//!   normal force then acts along `e_w - w' e_x` (the u gradient `-w'`, [`Sleeves::axial`]);
+//! - full model with the enriched family: the residual flexibility of the modes left out of the
+//!   basis, seen at the sleeve's four functionals ([`compliance`], Eqs. R1-R4, `docs/amm.md` 12.3),
+//!   `C q + R lambda = 0`.
+//!
+//! The force the sleeve passes through its pin to the slider enters the driving force of Eq. 33
+//! ([`rows::push`]).
+//!
+//! **Where friction would enter.** The sleeve transmits no force along the beam: none of its
+//! rows has a multiplier along `e_xi`, and the beam's axial coordinate u_i (its sliding through
+//! the sleeve together with `xp_i(t)`) is held only by the weld rows at G (Eq. 38). The sleeve's
+//! part of the u row (Eqs. 30, 44: `(C^T lambda)_u`, the sleeve rows' `cu` of `system::BeamRows`)
+//! is zero in the paper model and `-w' (Fp, FR, FL)` in the full one, the axial components of the
+//! normal forces, never a tangential force. A friction force `F_t,i` along `e_xi` on beam i at
+//! `x_c` would add `F_t,i` to beam i's u row of the step's forcing (`System::forcing`,
+//! `resid[i * nb + nm]`; in the full model also `-F_t,i g` on the kept modes of [`shift`], since
+//! the material point's axial position is `x + u - f(x)`), and `F_t,i (e_xi . u_i)` to
+//! [`rows::push`] (Eq. 33); in slip it is `mu |normal force|` against the beam's sliding speed
+//! through the sleeve, `u_i' - xp_i'` along `e_xi`. Stick is a fifth sleeve row
+//! ([`rows::SleeveRow`]), `u_i - xp_i(t) = const` (u coefficient 1, its value's time part carried
+//! like the full model's `gv`), whose multiplier is the friction force; the sleeve blocks of
+//! `constraint_lu`, sized by [`SLEEVE_ROWS`] but written as 4 x 4 (`Matrix4`), then grow to 5 x 5.
+
+mod compliance;
+pub(crate) mod rows;
+mod shift;
+
+use flexstar_model::{AmmModel, ModeFamily, RobotParams};
+
+use crate::foreshortening::KEPT_ANALYTIC;
+use crate::geometric::GeometricStiffness;
+use crate::modes::{dot, ModeSet, SleeveBending, Triplet};
+use crate::system::{BeamRows, Row};
+use compliance::SleeveCompliance;
+use rows::ShiftTerms;
+pub(crate) use rows::{SleeveRow, B_MID, B_MSLOPE, SLEEVE_ROWS};
+use shift::SleeveShift;
+
+/// The three sleeves of a system: what their rows need beyond the rows' form (`system::BeamRows`),
+/// refreshed per step by [`Sleeves::update`].
+#[derive(Debug, Clone)]
+pub(crate) struct Sleeves {
+    /// Full model: the rows at the material point in the sleeve.
+    full: bool,
+    /// Factors of the modes' values at the sleeve's centre and edges and slope at its centre
+    /// (half-width Lp/2).
+    tri: Triplet,
+    /// Full model, per beam: the beam's slopes at the sleeve's edges and curvature at its centre.
+    bent: [SleeveBending; 3],
+    /// Full model: the material point in the sleeve drawn out by the foreshortening
+    /// ([`shift`], Eqs. S1-S3).
+    shift: Option<SleeveShift>,
+    /// Full model, enriched family: the residual flexibility of the sleeves (Eqs. R3-R4,
+    /// `docs/amm.md` 12); `None` otherwise.
+    compliance: Option<SleeveCompliance>,
+    /// Per beam: the residual flexibility `R_ab` of the sleeve rows (Eq. R3, `docs/amm.md` 12), a,
+    /// b over `B_MID..=B_MSLOPE`, at the last update (with [`Sleeves::compliance`]).
+    res: [[[f64; 4]; 4]; 3],
+    /// Sleeve positions xp_i of the last update [m].
+    xp: [f64; 3],
+    /// Full model: u_i-gradients of the rows Fp_i, FR_i, FL_i at the last update (`-w'` at the
+    /// material point in the sleeve; 0 in the paper's model): the axial direction of their forces.
+    axial: [[f64; 3]; 3],
+}
+
+impl Sleeves {
+    /// The sleeves of beams of `params` on `modes`, in `model`.
+    pub(crate) fn new(modes: &ModeSet, params: &RobotParams, model: AmmModel) -> Self {
+        let hp = 0.5 * params.lp;
+        let full = model == AmmModel::Full;
+        let n_bent = if full { modes.analytic_len() } else { 0 };
+        let shift = full.then(|| SleeveShift::new(modes, &GeometricStiffness::kept_modes(modes, KEPT_ANALYTIC)));
+        let compliance = (full && modes.family() == ModeFamily::Enriched)
+            .then(|| SleeveCompliance::new(params.l, hp, params.ei(), params.rho, modes.lambda()));
+        Sleeves {
+            full,
+            tri: modes.triplet(hp),
+            bent: std::array::from_fn(|_| SleeveBending::new(n_bent)),
+            shift,
+            compliance,
+            res: [[[0.0; 4]; 4]; 3],
+            xp: [0.0; 3],
+            axial: [[0.0; 3]; 3],
+        }
+    }
+
+    /// Full model: the u_i-gradients `[c_Fp, c_FR, c_FL]` of each beam's rows at the last update
+    /// (`-w'`; zeros in the paper's model), the axial direction of the sleeve forces (Eq. 33,
+    /// [`rows::push`]).
+    pub(crate) fn axial(&self) -> &[[f64; 3]; 3] {
+        &self.axial
+    }
+
+    /// Eqs. 41-43: refresh the sleeve rows of `beams` (the rows `rows`, on `modes`) for the
+    /// sleeve positions xp_i(t) [m].
+    ///
+    /// Paper model: the rows at the rigid material points xp_i, xp_i +- Lp/2, constant in u_i.
+    /// Full model (`docs/amm.md` section 8): at the material point that sits in the sleeve,
+    /// `xp_i - u_i`, linearised about the predictor `qhat` (one Newton step of the nonlinear rows
+    /// per time step, exact to O(h^4)): alpha part `phi(xp - u^ + e)`, u gradient
+    /// `-w^'(xp - u^ + e)` (`+w^''` for the slope row), while the rows' values keep no u term.
+    /// The material point is drawn out by the foreshortening, `e = f(xp - u^)` (Eq. S1,
+    /// `docs/amm.md` 12.11), and the rows gain its gradient and the edges' `sin thp`
+    /// ([`rows::shift_rows`]).
+    pub(crate) fn update(
+        &mut self,
+        beams: &mut [BeamRows; 3],
+        rows: &[Row],
+        modes: &ModeSet,
+        xp: [f64; 3],
+        qhat: &[f64],
+    ) {
+        let nm = modes.len();
+        let nb = nm + 2;
+        let full = self.full;
+        self.xp = xp;
+        for (i, (beam, &x)) in beams.iter_mut().zip(&xp).enumerate() {
+            let alpha = &qhat[i * nb..i * nb + nm];
+            let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
+            let shift = self.shift.as_mut().map_or(0.0, |s| s.evaluate(i, x - u_hat, alpha));
+            let xc = x - u_hat + shift;
+            let [mid, right, left, mslope] = &mut beam.sleeve;
+            let bent = &mut self.bent[i];
+            modes.triplet_at(
+                &self.tri,
+                xc,
+                left,
+                mid,
+                right,
+                mslope,
+                full.then_some((alpha, &mut *bent)),
+            );
+            if full {
+                let slope_mid = dot(mslope, alpha);
+                let slopes = [slope_mid, bent.slope_right, bent.slope_left];
+                for (k, id) in beam.ids.iter().enumerate() {
+                    if let Row::Sleeve(_, row) = rows[*id] {
+                        beam.cu[k] = rows::u_gradient(row, slopes, bent.curvature);
+                    }
+                }
+                self.axial[i] = slopes.map(|s| -s);
+            }
+            mslope.iter_mut().for_each(|v| *v = -*v);
+            if let Some(c) = self.compliance.as_mut() {
+                self.res[i] = c.block(xc, [mid, right, left, mslope]);
+            }
+            if let Some(s) = self.shift.as_ref() {
+                let terms = ShiftTerms {
+                    kept: s.kept(),
+                    g: s.gradient(i),
+                    two_f: 2.0 * shift,
+                    thp: qhat[i * nb + nm + 1],
+                    hp: self.tri.half_length(),
+                    slopes: self.axial[i].map(|c| -c),
+                    curvature: bent.curvature,
+                };
+                rows::shift_rows(beam, rows, terms);
+            }
+        }
+    }
+
+    /// The sleeve rows of Eqs. 41-42 evaluated exactly at the state q, for tests, with the
+    /// foreshortening computed here by brute force (Gauss quadrature of `1/2 int_0^x w'^2` over
+    /// every mode, not the table of [`shift`]): largest `|w_i(x_c + e) - sin(thp_i) e|` over
+    /// the beams and e in {0, +-Lp/2}, at the material point `x_c = xp - u + f(x_c)` of Eq. S1;
+    /// the same at `xp - u` (no foreshortening, as before Eq. S1); and `|w_i(xp_i + e) - e thp_i|`
+    /// (the rigid material points, as the paper takes them) [m]. `beams`, `lam`: the rows and the
+    /// multipliers of the last solve (for the residual flexibility's deflection).
+    #[cfg(test)]
+    pub(crate) fn gaps(&self, modes: &ModeSet, beams: &[BeamRows; 3], lam: &[f64], q: &[f64], lp: f64) -> [f64; 3] {
+        let nm = modes.len();
+        let nb = nm + 2;
+        let mut v = vec![0.0; nm];
+        let mut gaps = [0.0f64; 3];
+        for (i, beam) in beams.iter().enumerate() {
+            let o = i * nb;
+            let (alpha, u, thp) = (&q[o..o + nm], q[o + nm], q[o + nm + 1]);
+            let mut xc = self.xp[i] - u;
+            for _ in 0..3 {
+                xc = self.xp[i] - u + modes.half_squared_slope_integral(alpha, xc);
+            }
+            // the residual flexibility's deflection at the left edge, centre, right edge (Eq. R4)
+            let res = self.residual_deflection(i, beam, lam);
+            for (e, r) in [-0.5 * lp, 0.0, 0.5 * lp].into_iter().zip([res[2], res[0], res[1]]) {
+                for (gap, x, side, rr) in [
+                    (0, xc + e, e * thp.sin(), r),
+                    (1, self.xp[i] - u + e, e * thp, r),
+                    (2, self.xp[i] + e, e * thp, 0.0),
+                ] {
+                    modes.values_at(x, &mut v, None);
+                    gaps[gap] = gaps[gap].max((dot(&v, alpha) + rr - side).abs());
+                }
+            }
+        }
+        gaps
+    }
+}

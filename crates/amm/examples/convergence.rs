@@ -39,20 +39,8 @@ fn main() {
             for fam in ModeFamily::PAPER {
                 let n = std::env::var("AMM_N").ok().and_then(|s| s.parse().ok()).unwrap_or(25);
                 for &h in &steps {
-                    let a = flexstar_amm::solve(
-                        &exp,
-                        &common::settings(fam, n, Some(h)),
-                        flexstar_drive::SolveRequest::motion(),
-                    )
-                    .map(|s| s.response)
-                    .unwrap();
-                    let b = flexstar_amm::solve(
-                        &exp,
-                        &common::settings(fam, n, Some(h / 2.0)),
-                        flexstar_drive::SolveRequest::motion(),
-                    )
-                    .map(|s| s.response)
-                    .unwrap();
+                    let a = common::motion_response(&exp, &common::settings(fam, n, Some(h))).unwrap();
+                    let b = common::motion_response(&exp, &common::settings(fam, n, Some(h / 2.0))).unwrap();
                     let (cells, _) = row(&a, &b);
                     println!("| {case} | {fam} | {h:.3e} | {} |", cells.join(" | "));
                 }
@@ -77,9 +65,7 @@ fn main() {
                         dt: Some(dt),
                         ..flexstar_model::AmmSettings::accurate()
                     };
-                    flexstar_amm::solve(&exp, &s, flexstar_drive::SolveRequest::motion())
-                        .map(|s| s.response)
-                        .unwrap()
+                    common::motion_response(&exp, &s).unwrap()
                 };
                 let p = flexstar_model::evp::point_evps(&at(h), &at(h / 2.0)).unwrap();
                 let cells: Vec<String> = p
@@ -103,9 +89,7 @@ fn main() {
                 dt: Some(flexstar_amm::TOLERANCE_DT),
                 ..flexstar_model::AmmSettings::accurate()
             };
-            flexstar_amm::solve(exp, &s, flexstar_drive::SolveRequest::motion())
-                .map(|s| s.response)
-                .unwrap()
+            common::motion_response(exp, &s).unwrap()
         };
         let mean = |a: &Response, b: &Response| flexstar_model::evp::point_evps(a, b).unwrap().mean.unwrap();
         println!("| case | N | true truncation (vs N = 150) [%] | estimate (vs previous N) [%] | ratio |");
@@ -129,13 +113,7 @@ fn main() {
             let exp = common::paper_case(case);
             for fam in ModeFamily::PAPER {
                 for n in [25, 50, 100] {
-                    let r = flexstar_amm::solve(
-                        &exp,
-                        &common::settings(fam, n, None),
-                        flexstar_drive::SolveRequest::motion(),
-                    )
-                    .map(|s| s.response)
-                    .unwrap();
+                    let r = common::motion_response(&exp, &common::settings(fam, n, None)).unwrap();
                     let mm = |v: &[f64]| format!("{:.3}", common::max_abs(v) * 1e3);
                     let cells: Vec<String> = r.w_tip.iter().chain(r.w_g.iter()).map(|v| mm(v)).collect();
                     let fa = r.fa.iter().map(|v| common::max_abs(v)).fold(0.0, f64::max);
@@ -150,21 +128,9 @@ fn main() {
         for case in 1..=4 {
             let exp = common::paper_case(case);
             for fam in ModeFamily::PAPER {
-                let reference = flexstar_amm::solve(
-                    &exp,
-                    &common::settings(fam, 100, None),
-                    flexstar_drive::SolveRequest::motion(),
-                )
-                .map(|s| s.response)
-                .unwrap();
+                let reference = common::motion_response(&exp, &common::settings(fam, 100, None)).unwrap();
                 for n in [25, 50] {
-                    let r = flexstar_amm::solve(
-                        &exp,
-                        &common::settings(fam, n, None),
-                        flexstar_drive::SolveRequest::motion(),
-                    )
-                    .map(|s| s.response)
-                    .unwrap();
+                    let r = common::motion_response(&exp, &common::settings(fam, n, None)).unwrap();
                     let (cells, _) = row(&r, &reference);
                     println!("| {case} | {fam} | {n} | {} |", cells.join(" | "));
                 }
@@ -179,15 +145,7 @@ fn main() {
             for fam in ModeFamily::PAPER {
                 let runs: Vec<Response> = ns
                     .iter()
-                    .map(|&n| {
-                        flexstar_amm::solve(
-                            &exp,
-                            &common::settings(fam, n, None),
-                            flexstar_drive::SolveRequest::motion(),
-                        )
-                        .map(|s| s.response)
-                        .unwrap()
-                    })
+                    .map(|&n| common::motion_response(&exp, &common::settings(fam, n, None)).unwrap())
                     .collect();
                 for k in 0..ns.len() - 1 {
                     let (cells, _) = row(&runs[k], &runs[k + 1]);

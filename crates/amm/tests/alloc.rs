@@ -42,9 +42,7 @@ fn allocations(dt: f64, model: AmmModel) -> usize {
     }
     s.snapshots = vec![0.2];
     let before = COUNT.with(|c| c.get());
-    let r = flexstar_amm::solve(&exp, &s, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let r = common::motion_response(&exp, &s).unwrap();
     let after = COUNT.with(|c| c.get());
     assert_eq!(r.len(), 501);
     after - before

@@ -83,12 +83,8 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
         zero.damping = Damping::with_beta(0.0);
         zero.load = LoadSettings::default();
         let (a, b) = (
-            flexstar_amm::solve(&plain, &settings, flexstar_drive::SolveRequest::motion())
-                .map(|s| s.response)
-                .unwrap(),
-            flexstar_amm::solve(&zero, &settings, flexstar_drive::SolveRequest::motion())
-                .map(|s| s.response)
-                .unwrap(),
+            common::motion_response(&plain, &settings).unwrap(),
+            common::motion_response(&zero, &settings).unwrap(),
         );
         assert_eq!(bits(&a), bits(&b), "{} {}", settings.family, settings.model);
         let law = RigidInverseForces {
@@ -107,13 +103,9 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
         assert_eq!(bits(&a), bits(&b), "direct {} {}", settings.family, settings.model);
         // a zero load given as polynomials runs the load's path: the same values
         zero.load = LoadSettings::polynomials(Some(vec![0.0]), None, None);
-        let c = flexstar_amm::solve(&zero, &settings, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let c = common::motion_response(&zero, &settings).unwrap();
         let same = |x: &[f64], y: &[f64]| x.iter().zip(y).all(|(p, q)| p == q);
-        let plain_run = flexstar_amm::solve(&plain, &settings, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let plain_run = common::motion_response(&plain, &settings).unwrap();
         assert!((0..3).all(|i| same(&c.fa[i], &plain_run.fa[i]) && same(&c.w_tip[i], &plain_run.w_tip[i])));
     }
 }
@@ -129,9 +121,7 @@ fn stiff_inverse_error(settings: &AmmSettings, a: &Attachments) -> f64 {
     let mut p = RobotParams::paper();
     p.e *= STIFF;
     let exp = with(common::quintic(p, 0.5), a);
-    let r = flexstar_amm::solve(&exp, settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let r = common::motion_response(&exp, settings).unwrap();
     let (mut err, mut scale) = (0.0f64, 0.0f64);
     for k in 0..r.len() {
         let st = RigidState::at(&p, &exp.trajectory, r.t[k]).unwrap();
@@ -183,9 +173,7 @@ fn stiff_limit_inverse_forces_match_newton_euler_with_payload_and_load() {
     let mut p = RobotParams::paper();
     p.e *= STIFF;
     let exp = with(common::quintic(p, 0.5), &a);
-    let r = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let r = common::motion_response(&exp, &settings).unwrap();
     let st = RigidState::at(&p, &exp.trajectory, r.t[100]).unwrap();
     let bare = flexstar_kinematics::rigid_inverse_dynamics(&p, &st);
     assert!((0..3).any(|i| (r.fa[i][100] - bare.fa[i]).abs() > 0.05 * bare.fa[i].abs().max(1.0)));
@@ -296,9 +284,7 @@ fn free_decay_gives_the_first_modes_damping_ratio() {
             model,
             ..AmmSettings::paper(family, 25)
         };
-        let r = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let r = common::motion_response(&exp, &settings).unwrap();
         for i in 0..3 {
             let pk = peaks(&r.t, &r.w_tip[i], t1 + 1.5);
             let (first, last) = (pk[0], pk[pk.len() - 1]);
@@ -346,16 +332,12 @@ fn direct_run_inverts_the_inverse_run_with_payload_damping_and_load() {
         };
         let mut fine = exp.clone();
         fine.time.dt_out = flexstar_amm::DEFAULT_DT;
-        let inverse_fine = flexstar_amm::solve(&fine, &settings, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let inverse_fine = common::motion_response(&fine, &settings).unwrap();
         let fa = (0..inverse_fine.len())
             .map(|k| [inverse_fine.fa[0][k], inverse_fine.fa[1][k], inverse_fine.fa[2][k]])
             .collect();
         let table = ForceTable::new(inverse_fine.t.clone(), fa).unwrap();
-        let inverse = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let inverse = common::motion_response(&exp, &settings).unwrap();
         let direct = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&table))
             .map(|s| s.response)
             .unwrap();
@@ -384,12 +366,8 @@ fn every_family_accepts_the_attachments() {
         let mut loaded = with(bare.clone(), &attached());
         loaded.damping = Damping::with_beta(1e-3);
         let (a, b) = (
-            flexstar_amm::solve(&bare, &settings, flexstar_drive::SolveRequest::motion())
-                .map(|s| s.response)
-                .unwrap(),
-            flexstar_amm::solve(&loaded, &settings, flexstar_drive::SolveRequest::motion())
-                .map(|s| s.response)
-                .unwrap(),
+            common::motion_response(&bare, &settings).unwrap(),
+            common::motion_response(&loaded, &settings).unwrap(),
         );
         assert!(b.fa.iter().chain(&b.w_tip).flatten().all(|v| v.is_finite()), "{family}");
         let moved = (0..3).any(|i| (0..a.len()).any(|k| (a.fa[i][k] - b.fa[i][k]).abs() > 1e-3));

@@ -13,16 +13,10 @@ fn a_set_cancel_token_stops_the_run_at_the_first_output_time() {
     let token = Cancel::new();
     token.cancel();
     let settings = common::settings(ModeFamily::SlideFree, 4, None);
-    match cancel::with_cancel(Some(&token), || {
-        flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion()).map(|s| s.response)
-    }) {
+    match cancel::with_cancel(Some(&token), || common::motion_response(&exp, &settings)) {
         Err(AmmError::Cancelled { t }) => assert_eq!(t, exp.time.dt_out),
         other => panic!("expected Cancelled, got {:?}", other.map(|r| r.t.len())),
     }
     // without the token the same run completes
-    assert!(
-        flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .is_ok()
-    );
+    assert!(common::motion_response(&exp, &settings).is_ok());
 }

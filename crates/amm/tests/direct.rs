@@ -42,13 +42,9 @@ fn slider_error(exp: &Experiment, direct: &Response) -> f64 {
 
 /// Round trip of one case: inverse run with output every `dt_fa`, its Fa fed back.
 fn round_trip(k: usize, settings: &AmmSettings, t_end: f64, dt_fa: f64) -> (f64, f64) {
-    let inverse_fine = flexstar_amm::solve(&case(k, t_end, dt_fa), settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let inverse_fine = common::motion_response(&case(k, t_end, dt_fa), settings).unwrap();
     let exp = case(k, t_end, 1e-3);
-    let inverse = flexstar_amm::solve(&exp, settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let inverse = common::motion_response(&exp, settings).unwrap();
     let direct = flexstar_amm::solve(&exp, settings, flexstar_drive::SolveRequest::law(&table(&inverse_fine)))
         .map(|s| s.response)
         .unwrap();
@@ -76,12 +72,8 @@ fn round_trip_gives_the_motion_back_in_every_paper_case() {
 fn round_trip_exp(exp: &Experiment, settings: &AmmSettings, dt_fa: f64) -> (f64, f64) {
     let mut fine = exp.clone();
     fine.time.dt_out = dt_fa;
-    let inverse_fine = flexstar_amm::solve(&fine, settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
-    let inverse = flexstar_amm::solve(exp, settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let inverse_fine = common::motion_response(&fine, settings).unwrap();
+    let inverse = common::motion_response(exp, settings).unwrap();
     let direct = flexstar_amm::solve(exp, settings, flexstar_drive::SolveRequest::law(&table(&inverse_fine)))
         .map(|s| s.response)
         .unwrap();
@@ -134,9 +126,7 @@ fn stiff_servo_reproduces_the_prescribed_motion() {
             params: exp.robot,
             attached: Default::default(),
         };
-        let inverse = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let inverse = common::motion_response(&exp, &exp.amm).unwrap();
         let direct = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::law(&servo))
             .map(|s| s.response)
             .unwrap();
@@ -200,9 +190,7 @@ fn automatic_n_runs_the_direct_problem_too() {
     // inverse run's forces (every solver step) picks the same N and gives the same vibration
     let mut exp = case(3, 0.1, DEFAULT_DT);
     exp.amm = AmmSettings::accurate();
-    let inverse = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let inverse = common::motion_response(&exp, &exp.amm).unwrap();
     let direct = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::law(&table(&inverse)))
         .map(|s| s.response)
         .unwrap();

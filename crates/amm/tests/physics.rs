@@ -30,9 +30,7 @@ fn case1_is_symmetric_in_every_family() {
     // In-place rotation: G stays put and the three beams deform alike (paper section 8.1).
     let exp = paper_case(1);
     for fam in ALL {
-        let r = flexstar_amm::solve(&exp, &settings(fam, 25, None), flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let r = common::motion_response(&exp, &settings(fam, 25, None)).unwrap();
         let s = tip_scale(&r);
         assert!(s > 1e-3, "{fam}: tip amplitude {s}");
         for i in 0..3 {
@@ -70,9 +68,7 @@ fn case4_beam3_only_slides() {
     // beams 1 and 2 mirror each other.
     let exp = paper_case(4);
     for fam in ModeFamily::PAPER {
-        let r = flexstar_amm::solve(&exp, &settings(fam, 25, None), flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let r = common::motion_response(&exp, &settings(fam, 25, None)).unwrap();
         let s = tip_scale(&r);
         assert!(s > 1e-3, "{fam}");
         assert!(
@@ -103,13 +99,7 @@ fn case4_beam3_only_slides() {
 fn pinned_free_never_moves_g() {
     // Pinned-free modes vanish at G, so w_iG = 0 and (Eq. 38) u_i = 0 in every case.
     for case in 1..=4 {
-        let r = flexstar_amm::solve(
-            &paper_case(case),
-            &settings(ModeFamily::PinnedFree, 25, None),
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let r = common::motion_response(&paper_case(case), &settings(ModeFamily::PinnedFree, 25, None)).unwrap();
         for i in 0..3 {
             assert!(max_abs(&r.w_g[i]) < 1e-14, "case {case}: w{}G", i + 1);
             assert!(
@@ -124,24 +114,12 @@ fn pinned_free_never_moves_g() {
 
 #[test]
 fn slide_free_has_no_slope_moments_and_free_free_balances_them() {
-    let r = flexstar_amm::solve(
-        &paper_case(3),
-        &settings(ModeFamily::SlideFree, 25, None),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let r = common::motion_response(&paper_case(3), &settings(ModeFamily::SlideFree, 25, None)).unwrap();
     for name in ["M1G", "M2G", "M3G"] {
         assert_eq!(max_abs(col(&r, name)), 0.0, "slide-free: {name}");
     }
     // Eq. 25-1: M1G + M2G + M3G = 0
-    let r = flexstar_amm::solve(
-        &paper_case(3),
-        &settings(ModeFamily::FreeFree, 25, None),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let r = common::motion_response(&paper_case(3), &settings(ModeFamily::FreeFree, 25, None)).unwrap();
     let (m1, m2, m3) = (col(&r, "M1G"), col(&r, "M2G"), col(&r, "M3G"));
     assert!(max_abs(m1) > 1e-4);
     for k in 0..r.len() {
@@ -168,9 +146,7 @@ fn stiff_limit_error_with(amm: &flexstar_model::AmmSettings, to: Pose) -> f64 {
         t0: 0.0,
         t1: 0.5,
     };
-    let r = flexstar_amm::solve(&exp, amm, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let r = common::motion_response(&exp, amm).unwrap();
     let (mut err, mut scale) = (0.0f64, 0.0f64);
     for k in 0..r.len() {
         let st = RigidState::at(&p, &exp.trajectory, r.t[k]).unwrap();
@@ -287,11 +263,7 @@ fn responses_converge_with_the_number_of_modes() {
     for fam in [ModeFamily::PinnedFree, ModeFamily::SlideFree, ModeFamily::FreeFree] {
         let runs: Vec<Response> = [10, 20, 40, 80]
             .iter()
-            .map(|&n| {
-                flexstar_amm::solve(&exp, &settings(fam, n, None), flexstar_drive::SolveRequest::motion())
-                    .map(|s| s.response)
-                    .unwrap()
-            })
+            .map(|&n| common::motion_response(&exp, &settings(fam, n, None)).unwrap())
             .collect();
         for i in 0..3 {
             let d: Vec<f64> = (0..3).map(|k| evp(&runs[k].w_tip[i], &runs[k + 1].w_tip[i])).collect();
@@ -307,16 +279,8 @@ fn default_step_meets_the_study_criterion() {
     // the worst of the study (slide-free at N = 25, pinned-free at N = 50).
     let exp = paper_case(2);
     for (fam, n) in [(ModeFamily::SlideFree, 25), (ModeFamily::PinnedFree, 50)] {
-        let a = flexstar_amm::solve(&exp, &settings(fam, n, None), flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
-        let b = flexstar_amm::solve(
-            &exp,
-            &settings(fam, n, Some(DEFAULT_DT / 2.0)),
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let a = common::motion_response(&exp, &settings(fam, n, None)).unwrap();
+        let b = common::motion_response(&exp, &settings(fam, n, Some(DEFAULT_DT / 2.0))).unwrap();
         for i in 0..3 {
             let e = evp(&a.w_tip[i], &b.w_tip[i]);
             assert!(e < 0.1, "{fam}, N = {n}, tip {}: EVP {e:.4} %", i + 1);
@@ -329,9 +293,7 @@ fn outputs_have_the_contract_shape() {
     let mut s = settings(ModeFamily::FreeFree, 25, None);
     s.snapshots = vec![0.1, 0.25];
     let exp = paper_case(3);
-    let r = flexstar_amm::solve(&exp, &s, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let r = common::motion_response(&exp, &s).unwrap();
     assert_eq!(r.label, "amm-free-free");
     assert_eq!(r.t, exp.time.output_times());
     let header = r.header();
@@ -369,13 +331,7 @@ fn bad_input_is_rejected_before_any_work() {
         other => panic!("unexpected {other}"),
     };
     for n in [0, 401] {
-        let e = flexstar_amm::solve(
-            &exp,
-            &settings(ModeFamily::FreeFree, n, None),
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .unwrap_err();
+        let e = common::motion_response(&exp, &settings(ModeFamily::FreeFree, n, None)).unwrap_err();
         assert_eq!(key_of(e), "amm.modes");
     }
     // a tolerance that is not a positive finite percentage, or given with modes
@@ -385,11 +341,7 @@ fn bad_input_is_rejected_before_any_work() {
             ..flexstar_model::AmmSettings::accurate()
         };
         assert_eq!(
-            key_of(
-                flexstar_amm::solve(&exp, &s, flexstar_drive::SolveRequest::motion())
-                    .map(|s| s.response)
-                    .unwrap_err()
-            ),
+            key_of(common::motion_response(&exp, &s).unwrap_err()),
             "amm.tol",
             "tol = {tol}"
         );
@@ -398,65 +350,24 @@ fn bad_input_is_rejected_before_any_work() {
         tol: Some(0.5),
         ..settings(ModeFamily::Enriched, 50, None)
     };
-    assert_eq!(
-        key_of(
-            flexstar_amm::solve(&exp, &s, flexstar_drive::SolveRequest::motion())
-                .map(|s| s.response)
-                .unwrap_err()
-        ),
-        "amm.tol"
-    );
-    let e = flexstar_amm::solve(
-        &exp,
-        &settings(ModeFamily::FreeFree, 25, Some(2e-3)),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap_err();
+    assert_eq!(key_of(common::motion_response(&exp, &s).unwrap_err()), "amm.tol");
+    let e = common::motion_response(&exp, &settings(ModeFamily::FreeFree, 25, Some(2e-3))).unwrap_err();
     assert!(key_of(e).contains("amm.dt"));
-    let e = flexstar_amm::solve(
-        &exp,
-        &settings(ModeFamily::FreeFree, 25, Some(-1e-4)),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap_err();
+    let e = common::motion_response(&exp, &settings(ModeFamily::FreeFree, 25, Some(-1e-4))).unwrap_err();
     assert!(key_of(e).contains("amm.dt"));
     let mut s = settings(ModeFamily::FreeFree, 25, None);
     s.snapshots = vec![0.7];
-    assert_eq!(
-        key_of(
-            flexstar_amm::solve(&exp, &s, flexstar_drive::SolveRequest::motion())
-                .map(|s| s.response)
-                .unwrap_err()
-        ),
-        "amm.snapshots"
-    );
+    assert_eq!(key_of(common::motion_response(&exp, &s).unwrap_err()), "amm.snapshots");
     let mut no_jp = exp.clone();
     no_jp.robot.jp = 0.0;
     assert_eq!(
-        key_of(
-            flexstar_amm::solve(
-                &no_jp,
-                &settings(ModeFamily::FreeFree, 25, None),
-                flexstar_drive::SolveRequest::motion()
-            )
-            .map(|s| s.response)
-            .unwrap_err()
-        ),
+        key_of(common::motion_response(&no_jp, &settings(ModeFamily::FreeFree, 25, None)).unwrap_err()),
         "robot.Jp"
     );
     // case 2 run past 0.4 s: sleeve J reaches G (docs/paper-defects.md)
     let mut long = paper_case(2);
     long.time.t_end = 0.5;
-    match flexstar_amm::solve(
-        &long,
-        &settings(ModeFamily::SlideFree, 25, None),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap_err()
-    {
+    match common::motion_response(&long, &settings(ModeFamily::SlideFree, 25, None)).unwrap_err() {
         AmmError::Infeasible(inf) => {
             assert!(inf.t > 0.4 && inf.t < 0.5, "{inf}");
             assert!(inf.to_string().contains("sleeve 2"), "{inf}");
@@ -480,14 +391,7 @@ fn bad_input_is_rejected_before_any_work() {
         other => panic!("{other}"),
     }
     // too few modes for the twelve sleeve constraints: a clear error, not a panic
-    match flexstar_amm::solve(
-        &exp,
-        &settings(ModeFamily::PinnedFree, 2, None),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap_err()
-    {
+    match common::motion_response(&exp, &settings(ModeFamily::PinnedFree, 2, None)).unwrap_err() {
         e @ AmmError::TooFewModes { t, modes: 2, .. } => assert!(t == 0.0 && e.to_string().contains("too few"), "{e}"),
         other => panic!("{other}"),
     }

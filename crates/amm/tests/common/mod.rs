@@ -33,3 +33,12 @@ pub fn evp(a: &[f64], b: &[f64]) -> f64 {
     let t: Vec<f64> = (0..a.len()).map(|k| k as f64).collect();
     flexstar_numerics::measures::evp(&t, a, b).unwrap_or(f64::NAN)
 }
+
+/// The AMM's response to the experiment's prescribed motion: `flexstar_amm::solve` with
+/// `SolveRequest::motion()` (the solver scans the motion itself), the work counters dropped.
+pub fn motion_response(
+    exp: &Experiment,
+    settings: &AmmSettings,
+) -> Result<flexstar_model::Response, flexstar_amm::AmmError> {
+    flexstar_amm::solve(exp, settings, flexstar_drive::SolveRequest::motion()).map(|s| s.response)
+}

@@ -205,3 +205,106 @@ fn runs_with_different_frame_times_are_not_overlaid() {
     );
     assert!(!tmp.path().join("p.html").exists());
 }
+
+/// `compare` writes the frames its runs were asked for (`[amm] frames`, `[fem] frames`), and
+/// every command replaces or removes the frames of the runs it writes: an animation never shows
+/// frames of an earlier run beside a newer run's sidecar (docs/outputs.md, frames files).
+#[test]
+fn compare_writes_frames_and_no_command_leaves_stale_ones() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let dir = out.join("case3");
+    let o = flexstar(&[
+        "compare",
+        &config(tmp.path(), "f.toml", 100, 100, 0.05),
+        "--no-figures",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let kin_cfg = config(tmp.path(), "k.toml", 0, 0, 0.05);
+    let o = flexstar(&[
+        "kinematics",
+        &kin_cfg,
+        "--out",
+        tmp.path().join("kin").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let kin = columns(&tmp.path().join("kin/case3/kinematics.csv"));
+    for stem in ["amm-enriched", "fem"] {
+        check_frames(&dir, stem, &kin, 6);
+        let side: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{stem}.json"))).unwrap()).unwrap();
+        assert!(side["frames_hash"].is_string(), "{stem}: {side}");
+    }
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let data = page_data(&std::fs::read_to_string(dir.join("animate.html")).unwrap());
+    let names: Vec<&str> = (data["runs"].as_array().unwrap().iter())
+        .map(|r| r["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["amm-enriched", "fem"]);
+
+    // a compare without frames removes the frames of its runs that the first one left
+    let o = flexstar(&[
+        "compare",
+        &config(tmp.path(), "n.toml", 0, 0, 0.05),
+        "--no-figures",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for stem in ["amm-enriched", "fem"] {
+        for f in [format!("{stem}-frames.csv"), format!("{stem}-frames-pose.csv")] {
+            assert!(!dir.join(&f).exists(), "{f} left behind");
+        }
+    }
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("no *-frames.csv"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// `animate` refuses frames files that the run's sidecar does not vouch for (`frames_hash`):
+/// frames of an earlier run put back beside a newer run, or a newer run's sidecar without frames.
+#[test]
+fn animate_refuses_frames_of_another_run_than_the_sidecar() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let dir = out.join("case3");
+    run(&config(tmp.path(), "a.toml", 100, 0, 0.05), "amm", &out);
+    let keep = tmp.path().join("old-frames.csv");
+    std::fs::copy(dir.join("amm-enriched-frames.csv"), &keep).unwrap();
+    // the same run with softer beams: new frames and sidecar
+    let heavy = std::fs::read_to_string(tmp.path().join("a.toml"))
+        .unwrap()
+        .replace("E = 200e9", "E = 150e9");
+    assert!(heavy.contains("E = 150e9"));
+    std::fs::write(tmp.path().join("h.toml"), heavy).unwrap();
+    run(tmp.path().join("h.toml").to_str().unwrap(), "amm", &out);
+    assert!(flexstar(&["animate", dir.to_str().unwrap()]).status.success());
+    std::fs::remove_file(dir.join("animate.html")).unwrap();
+    // the old frames put back: refused, naming the file and the sidecar
+    std::fs::copy(&keep, dir.join("amm-enriched-frames.csv")).unwrap();
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(
+        !o.status.success() && err.contains("amm-enriched-frames.csv") && err.contains("amm-enriched.json"),
+        "{err}"
+    );
+    assert!(err.contains("frames_hash"), "{err}");
+    // a sidecar that records no frames (a run without them) beside frames files: refused
+    let side = dir.join("amm-enriched.json");
+    let mut doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&side).unwrap()).unwrap();
+    doc.as_object_mut().unwrap().remove("frames_hash");
+    std::fs::write(&side, doc.to_string()).unwrap();
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("earlier run"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.join("animate.html").exists());
+}

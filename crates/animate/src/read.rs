@@ -62,7 +62,9 @@ fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
             format!("{} rows, but {stem}-frames.csv has {} frames", pose.len(), times.len()),
         ));
     }
-    let (t_rest, l, d) = sidecar_facts(&dir.join(format!("{stem}.json")));
+    let sidecar = dir.join(format!("{stem}.json"));
+    check_frames_hash(dir, stem, &sidecar)?;
+    let (t_rest, l, d) = sidecar_facts(&sidecar);
     Ok(RunFrames {
         name: stem.to_string(),
         times,
@@ -72,6 +74,52 @@ fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
         l,
         d,
     })
+}
+
+/// Refuse frames files that are not the ones the run's sidecar vouches for (its
+/// `frames_hash`, `flexstar_model::frames::FRAMES_HASH_KEY`): frames an earlier run of `stem`
+/// left beside a newer run's files would show another robot or motion than the sidecar says.
+fn check_frames_hash(dir: &Path, stem: &str, sidecar: &Path) -> Result<(), AnimateError> {
+    let frames = dir.join(format!("{stem}-frames.csv"));
+    let again = "run it again with `frames` set, or delete these frames files";
+    let doc: serde_json::Value = match std::fs::read_to_string(sidecar) {
+        Ok(text) => serde_json::from_str(&text).map_err(|e| read_err(sidecar, e))?,
+        Err(e) => {
+            return Err(read_err(
+                &frames,
+                format!(
+                    "cannot read its run's sidecar {} ({e}), so which run these frames are cannot be told; {again}",
+                    sidecar.display()
+                ),
+            ))
+        }
+    };
+    let Some(want) = doc
+        .get(flexstar_model::frames::FRAMES_HASH_KEY)
+        .and_then(|v| v.as_str())
+    else {
+        return Err(read_err(
+            &frames,
+            format!(
+                "left by an earlier run: the sidecar {} of the run now in the folder records no frames                  (no `{}`); {again}",
+                sidecar.display(),
+                flexstar_model::frames::FRAMES_HASH_KEY
+            ),
+        ));
+    };
+    let have = flexstar_model::frames::frames_hash(dir, stem).map_err(|e| read_err(&frames, e))?;
+    if have != want {
+        return Err(read_err(
+            &frames,
+            format!(
+                "not the frames of the run in {} (its {} is {want}, these files hash to {have}): left by an \
+                 earlier run or edited; {again}",
+                sidecar.display(),
+                flexstar_model::frames::FRAMES_HASH_KEY
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The rows of a CSV file as numbers, after checking its header is `header`.

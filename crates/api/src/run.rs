@@ -455,36 +455,24 @@ pub fn write_run(out: &mut RunOutcome, dir: &Path, figures: bool) -> Result<()> 
     }
     let shapes = dir.join(format!("{stem}-shapes.csv"));
     r.stage_shapes_csv(&mut set, &format!("{stem}-shapes.csv"))?;
+    let frames_hash = flexstar_model::frames::stage_run_frames(&r.frames, &mut set, stem)?;
+    if let (Some(hash), serde_json::Value::Object(doc)) = (&frames_hash, &mut out.meta) {
+        doc.insert(flexstar_model::frames::FRAMES_HASH_KEY.into(), hash.clone().into());
+    }
     let json = dir.join(format!("{stem}.json"));
     set.text(&format!("{stem}.json"), &sidecar_text(&json, &out.meta)?)?;
-    let frames = stage_frames(&mut set, r, stem)?;
     set.commit()?;
     out.files.extend([csv.clone(), shapes, json]);
-    out.files.extend(frames);
+    if frames_hash.is_some() {
+        out.files
+            .extend(flexstar_model::frames::frames_file_names(stem).map(|n| dir.join(n)));
+    }
     if figures {
         let figs = crate::figures::run_figures(exp, stem, r, direct, dir)?;
         out.files.extend(figs);
     }
     out.csv = Some(csv);
     Ok(())
-}
-
-/// Stage the animation frames of `r` (`<stem>-frames.csv`, `<stem>-frames-pose.csv`,
-/// `docs/motions.md` section 5) when it has any, and return their paths; without frames, the
-/// frames files an earlier run of `stem` left are removed with the publication (an animation
-/// never shows an older run's frames with this one's other files).
-fn stage_frames(set: &mut RunSet, r: &Response, stem: &str) -> Result<Vec<PathBuf>> {
-    let names = [format!("{stem}-frames.csv"), format!("{stem}-frames-pose.csv")];
-    if r.frames.is_empty() {
-        for name in &names {
-            if set.path(name).exists() {
-                set.remove(name)?;
-            }
-        }
-        return Ok(Vec::new());
-    }
-    flexstar_model::frames::stage_frames(&r.frames, set, stem)?;
-    Ok(names.iter().map(|n| set.path(n)).collect())
 }
 
 /// The whole `flexstar run`: prepare, create `out/<name>/` (checked writable before any work),

@@ -17,6 +17,7 @@ pub mod error;
 pub mod evp;
 pub mod frames;
 pub mod geometry;
+pub mod hash;
 pub mod motion;
 pub mod output;
 pub mod params;

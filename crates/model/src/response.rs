@@ -482,7 +482,9 @@ impl Response {
     /// into `set`; `order`: the `(leading, after)` columns of [`Response::write_csv_ordered`]
     /// (a direct run's file), `None` for the plain order of [`Response::write_csv`]; `fields`:
     /// further top-level keys of the sidecar (a compared run's residual keys,
-    /// `crate::residual::sidecar_fields`).
+    /// `crate::residual::sidecar_fields`). The run's animation frames are staged too when it has
+    /// any (the sidecar then records their hash), else frames an earlier run of `stem` left are
+    /// removed ([`crate::frames::stage_run_frames`]).
     pub fn stage_run(
         &self,
         set: &mut RunSet,
@@ -497,11 +499,15 @@ impl Response {
             None => self.stage_csv(set, &csv)?,
         }
         self.stage_shapes_csv(set, &format!("{stem}-shapes.csv"))?;
+        let frames = crate::frames::stage_run_frames(&self.frames, set, stem)?;
         let name = format!("{stem}.json");
         let path = set.path(&name);
         let mut doc = self.sidecar(&path, experiment, provenance)?;
         if let serde_json::Value::Object(map) = &mut doc {
             map.extend(fields);
+            if let Some(hash) = frames {
+                map.insert(crate::frames::FRAMES_HASH_KEY.into(), hash.into());
+            }
         }
         set.text(&name, &sidecar_text(&path, &doc)?)?;
         Ok(())

@@ -308,3 +308,26 @@ fn animate_refuses_frames_of_another_run_than_the_sidecar() {
     );
     assert!(!dir.join("animate.html").exists());
 }
+
+/// Frames of two experiments with the same name (a copied file with softer beams) in one folder
+/// are not overlaid: the error names both runs and both files.
+#[test]
+fn runs_of_different_experiments_are_not_overlaid() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    run(&config(tmp.path(), "a.toml", 100, 100, 0.05), "amm", &out);
+    let soft = std::fs::read_to_string(tmp.path().join("a.toml"))
+        .unwrap()
+        .replace("E = 200e9", "E = 150e9");
+    std::fs::write(tmp.path().join("b.toml"), soft).unwrap();
+    run(tmp.path().join("b.toml").to_str().unwrap(), "fem", &out);
+    let o = flexstar(&["animate", out.join("case3").to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(
+        !o.status.success()
+            && err.contains("different experiments")
+            && err.contains("a.toml")
+            && err.contains("b.toml"),
+        "{err}"
+    );
+}

@@ -874,3 +874,51 @@ fn the_sidecar_says_whether_the_run_lies_in_the_validated_envelope() {
         }
     }
 }
+
+/// Two experiment files with the same `name` share `out/<name>/`: a command that replaces results
+/// of another experiment there (another file with another hash) says so on stderr, naming the
+/// other file (docs/outputs.md, "Whose folder"); the same file again, edited or not, and an
+/// identical copy (the same results) pass without a word.
+#[test]
+fn replacing_results_of_another_experiment_with_the_same_name_is_said() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let (a, b, c) = (tmp.path().join("a"), tmp.path().join("b"), tmp.path().join("c"));
+    for d in [&a, &b, &c] {
+        std::fs::create_dir_all(d).unwrap();
+    }
+    let tiny = common::TINY;
+    let copied = tiny.replace("[time]", "[robot]\nE = 150e9\n[time]");
+    let fa = write(&a, "tiny.toml", tiny);
+    let fb = write(&b, "tiny.toml", &copied);
+    let fc = write(&c, "copy.toml", &copied);
+    let note = "holds results of another experiment named `tiny`";
+    let run = |cfg: &str| {
+        let o = flexstar(&["run", cfg, "--solver", "amm", "--out", out_s]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    assert!(!run(&fa).contains(note));
+    let err = run(&fb);
+    let a_abs = std::fs::canonicalize(&fa).unwrap();
+    assert!(err.contains(note) && err.contains(a_abs.to_str().unwrap()), "{err}");
+    assert!(err.contains("--out DIR"), "{err}");
+    // the same file again: its own results
+    assert!(!run(&fb).contains(note));
+    // an identical copy elsewhere: the same experiment hash, the same results
+    assert!(!run(&fc).contains(note));
+    // the first file again: the folder holds the copy's results now
+    let err = run(&fa);
+    assert!(err.contains(note), "{err}");
+    let o = flexstar(&["compare", &fb, "--no-figures", "--out", out_s]);
+    assert!(o.status.success() && stderr(&o).contains(note), "{}", stderr(&o));
+    let o = flexstar(&["kinematics", &fa, "--out", out_s]);
+    assert!(o.status.success() && stderr(&o).contains(note), "{}", stderr(&o));
+    // every run sidecar records the experiment file and hash
+    let side: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("tiny/amm-free-free.json")).unwrap()).unwrap();
+    let b_abs = std::fs::canonicalize(&fb).unwrap();
+    assert_eq!(side["experiment_file"], b_abs.to_str().unwrap());
+    assert_eq!(side["experiment_hash"].as_str().unwrap().len(), 16);
+}

@@ -194,6 +194,7 @@ mod tests {
             t_rest: None,
             l: Some(0.5),
             d: None,
+            experiment: None,
         }
     }
 

@@ -28,6 +28,8 @@ pub struct RunFrames {
     /// Beam length L [m] and base size d [m] from the sidecar's experiment, when present.
     pub l: Option<f64>,
     pub d: Option<f64>,
+    /// The experiment (file, hash) its sidecar records (`flexstar_model::identity`).
+    pub experiment: Option<(String, String)>,
 }
 
 fn read_err(file: &Path, reason: impl std::fmt::Display) -> AnimateError {
@@ -49,7 +51,27 @@ pub fn read_dir(dir: &Path) -> Result<Vec<RunFrames>, AnimateError> {
     if stems.is_empty() {
         return Err(AnimateError::NoFrames(dir.to_path_buf()));
     }
-    stems.iter().map(|s| read_run(dir, s)).collect()
+    let runs: Vec<RunFrames> = stems.iter().map(|s| read_run(dir, s)).collect::<Result<_, _>>()?;
+    check_one_experiment(&runs)?;
+    Ok(runs)
+}
+
+/// Refuse to overlay runs whose sidecars record different experiments (another file with another
+/// hash, `flexstar_model::identity`): frames of a robot run earlier beside a newer one's.
+fn check_one_experiment(runs: &[RunFrames]) -> Result<(), AnimateError> {
+    let first = &runs[0];
+    for r in &runs[1..] {
+        if let (Some(a), Some(b)) = (&first.experiment, &r.experiment) {
+            if a.1 != b.1 {
+                return Err(AnimateError::ExperimentsDiffer(format!(
+                    "{} is of {} (experiment hash {}), {} of {} ({}); run both from one experiment, or \
+                     animate them from different folders",
+                    first.name, a.0, a.1, r.name, b.0, b.1
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
@@ -63,7 +85,7 @@ fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
         ));
     }
     let sidecar = dir.join(format!("{stem}.json"));
-    check_frames_hash(dir, stem, &sidecar)?;
+    let doc = check_frames_hash(dir, stem, &sidecar)?;
     let (t_rest, l, d) = sidecar_facts(&sidecar);
     Ok(RunFrames {
         name: stem.to_string(),
@@ -73,13 +95,14 @@ fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
         t_rest,
         l,
         d,
+        experiment: flexstar_model::identity::recorded(&doc),
     })
 }
 
-/// Refuse frames files that are not the ones the run's sidecar vouches for (its
+/// The run's sidecar document, after refusing frames files that are not the ones it vouches for (its
 /// `frames_hash`, `flexstar_model::frames::FRAMES_HASH_KEY`): frames an earlier run of `stem`
 /// left beside a newer run's files would show another robot or motion than the sidecar says.
-fn check_frames_hash(dir: &Path, stem: &str, sidecar: &Path) -> Result<(), AnimateError> {
+fn check_frames_hash(dir: &Path, stem: &str, sidecar: &Path) -> Result<serde_json::Value, AnimateError> {
     let frames = dir.join(format!("{stem}-frames.csv"));
     let again = "run it again with `frames` set, or delete these frames files";
     let doc: serde_json::Value = match std::fs::read_to_string(sidecar) {
@@ -119,7 +142,7 @@ fn check_frames_hash(dir: &Path, stem: &str, sidecar: &Path) -> Result<(), Anima
             ),
         ));
     }
-    Ok(())
+    Ok(doc)
 }
 
 /// The rows of a CSV file as numbers, after checking its header is `header`.

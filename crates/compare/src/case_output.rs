@@ -376,6 +376,9 @@ pub fn compare_json(
         "runs": runs,
     });
     let mut doc = doc;
+    for (k, v) in flexstar_model::identity::fields(exp) {
+        doc[k] = v;
+    }
     if let Some(res) = residuals {
         let list: Vec<_> = res
             .iter()

@@ -388,6 +388,11 @@ pub struct Experiment {
     /// Where the experiment was read from (not a TOML key).
     #[serde(skip)]
     pub source: PathBuf,
+    /// The experiment hash: of its text and the files it reads
+    /// ([`crate::identity::experiment_hash`]; not a TOML key, empty for an experiment built in
+    /// code).
+    #[serde(skip)]
+    pub hash: String,
 }
 
 impl Experiment {
@@ -413,6 +418,7 @@ impl Experiment {
         exp.trajectory.read_file(path, &exp.robot)?;
         exp.apply_shaper().map_err(|e| e.in_file(path))?;
         exp.validate().map_err(|e| e.in_file(path))?;
+        exp.hash = crate::identity::experiment_hash(text, &exp.input_files());
         Ok(exp)
     }
 

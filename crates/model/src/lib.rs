@@ -18,6 +18,7 @@ pub mod evp;
 pub mod frames;
 pub mod geometry;
 pub mod hash;
+pub mod identity;
 pub mod motion;
 pub mod output;
 pub mod params;

@@ -430,6 +430,7 @@ impl Response {
             reason: e.to_string(),
         };
         let mut doc = provenance.fields();
+        doc.extend(crate::identity::fields(experiment));
         doc.insert("label".into(), self.label.clone().into());
         if let serde_json::Value::Object(fields) = serde_json::to_value(&self.info).map_err(fail)? {
             doc.extend(fields);

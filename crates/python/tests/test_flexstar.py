@@ -230,3 +230,19 @@ def test_plan_matches_the_cli_contract(root, tmp_path):
     with pytest.raises(flexstar.ConfigError) as e:
         flexstar.plan(bad, tmp_path / "out")
     assert "plan.points" in str(e.value) and "bad.toml" in str(e.value)
+
+
+def test_saving_over_another_experiment_with_the_same_name_warns(root, tmp_path):
+    """Two experiments with the same `name` share out/<name>/: saving over the other one's results
+    warns (as the CLI says so on stderr); saving the same one again does not."""
+    import warnings
+
+    text = (root / "configs/case3.toml").read_text()
+    a = flexstar.Experiment.from_toml(text, source=str(tmp_path / "a.toml"))
+    b = flexstar.Experiment.from_toml(text.replace("E = 200e9", "E = 150e9"), source=str(tmp_path / "b.toml"))
+    flexstar.run(a, solver="amm").save(tmp_path / "out")
+    with pytest.warns(UserWarning, match="another experiment named `case3`"):
+        flexstar.run(b, solver="amm").save(tmp_path / "out")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        flexstar.run(b, solver="amm").save(tmp_path / "out")

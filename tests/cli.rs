@@ -130,11 +130,51 @@ fn bad_input_is_refused_with_file_key_and_reason() {
         &case1_with("kind = \"polynomial\"", "kind = \"spline\""),
         &["bad.toml", "spline"],
     );
+    // values whose derived quantities overflow: refused before any work, not NaN/inf in the table
+    refused(
+        &case1_with("L = 0.5", "L = 1e300"),
+        &["bad.toml", "robot.L", "1e300", "overflow"],
+    );
+    refused(
+        &case1_with("mpp_mpa = 0.2", "mpp_mpa = 1e308"),
+        &["bad.toml", "Fa1", "not finite"],
+    );
     // infeasible from the start: slider 1 beyond the base side
     refused(
         &case1_with("s1 = [0.0, 0.0, 1.0]", "s1 = [0.5]"),
         &["t = 0.0000", "slider 1"],
     );
+}
+
+/// A slider mass that makes the driving forces overflow is refused by the solvers too, with
+/// nothing written (the inverse problem's `Fa = mpp_mpa s'' + ...` is infinite).
+#[test]
+fn runs_whose_values_overflow_are_refused_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(
+        dir.path(),
+        "heavy.toml",
+        &common::TINY.replace("[time]", "[robot]\nmpp_mpa = 1e308\n[time]"),
+    );
+    let (out, c) = (dir.path().join("out"), cfg.as_str());
+    for mut args in [
+        vec!["run", c, "--solver", "amm"],
+        vec!["run", c, "--solver", "fem", "--elements", "120"],
+        vec!["compare", c, "--no-figures"],
+    ] {
+        args.extend(["--out", out.to_str().unwrap()]);
+        let o = flexstar(&args);
+        let err = stderr(&o);
+        assert!(
+            !o.status.success() && err.contains("heavy.toml") && err.contains("Fa1") && err.contains("not finite"),
+            "{args:?}: {err}"
+        );
+        let written: Vec<_> = std::fs::read_dir(out.join("tiny"))
+            .map(|d| d.count())
+            .into_iter()
+            .collect();
+        assert!(written.iter().all(|n| *n == 0), "{args:?}: files written");
+    }
 }
 
 #[test]

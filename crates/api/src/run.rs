@@ -336,6 +336,9 @@ pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Re
     if p.direct && exp.drive.kind == DriveKind::Servo {
         flexstar_drive::add_tracking_errors(&mut r, exp).map_err(|e| ApiError::solver(&p.source, e))?;
     }
+    if let Some(reason) = r.not_finite_reason() {
+        return Err(ApiError::config(&p.source, Some("robot"), reason));
+    }
     Ok(r)
 }
 

@@ -278,6 +278,40 @@ impl Response {
             .collect()
     }
 
+    /// The first value that is not finite, row by row in the order of the CSV: `(t, column,
+    /// value)`; `None` when every value is finite. A robot whose values overflow a derived
+    /// quantity (a slider mass of 1e308 kg makes `Fa` infinite) gives one: the commands refuse to
+    /// write such a run ([`Response::not_finite_reason`]).
+    pub fn first_not_finite(&self) -> Option<(f64, String, f64)> {
+        let fixed = self.w_g.iter().chain(&self.w_tip).chain(&self.fa);
+        let columns: Vec<&[f64]> = std::iter::once(&self.t)
+            .chain(fixed)
+            .map(Vec::as_slice)
+            .chain(self.extra.iter().map(|c| c.values.as_slice()))
+            .collect();
+        let header = self.header();
+        for k in 0..self.t.len() {
+            if let Some(c) = columns
+                .iter()
+                .position(|col| col.get(k).is_some_and(|v| !v.is_finite()))
+            {
+                return Some((self.t[k], header[c].clone(), columns[c][k]));
+            }
+        }
+        None
+    }
+
+    /// Why the run is refused when a value is not finite ([`Response::first_not_finite`]).
+    pub fn not_finite_reason(&self) -> Option<String> {
+        self.first_not_finite().map(|(t, column, v)| {
+            format!(
+                "t = {} s: {column} = {v} is not finite: the robot's values (lengths, masses, stiffnesses) \
+                 overflow it; give physical values (nothing written)",
+                crate::output::fmt_display(t)
+            )
+        })
+    }
+
     /// Write the response as CSV, whole or not at all.
     pub fn write_csv(&self, path: &Path) -> Result<(), ModelError> {
         self.emit_csv(Dest::File(path))

@@ -962,3 +962,32 @@ fn replacing_results_of_another_experiment_with_the_same_name_is_said() {
     assert_eq!(side["experiment_file"], b_abs.to_str().unwrap());
     assert_eq!(side["experiment_hash"].as_str().unwrap().len(), 16);
 }
+
+/// A damped move cut short is not settled by its `t_end`; the message names the decay rate seen
+/// and a `t_end` to set, and a run to that `t_end` (the solver's own measurement, independent of
+/// the extrapolation) settles (docs/usage.md, Residual vibration and settling).
+#[test]
+fn not_settled_says_which_t_end_lets_the_run_settle() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = |t_end: &str| {
+        format!(
+            "name = \"damped\"\n[time]\nt_end = {t_end}\ndt_out = 0.001\n[trajectory]\nkind = \"quintic\"\n\
+             from = {{ Gx = 0.0, Gy = 0.0, theta = 0.0 }}\nto = {{ Gx = 0.03, Gy = -0.02, theta = 0.1 }}\n\
+             t0 = 0.0\nt1 = 0.25\n[damping]\nzeta = 0.03\nf_hz = 4.0\n"
+        )
+    };
+    let out = dir.path().join("out");
+    let short = write(dir.path(), "short.toml", &text("1.5"));
+    let o = flexstar(&["run", &short, "--solver", "amm", "--out", out.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("not settled by t_end = 1.5 s: |dG| decays at"), "{err}");
+    let at = err.find("set time.t_end >= ").expect(&err) + "set time.t_end >= ".len();
+    let suggested: f64 = err[at..].split(' ').next().unwrap().parse().unwrap();
+    assert!(suggested > 1.5 && suggested < 10.0, "{suggested}");
+    let long = write(dir.path(), "long.toml", &text(&suggested.to_string()));
+    let o = flexstar(&["run", &long, "--solver", "amm", "--out", out.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(o.status.success() && err.contains("settled at"), "{err}");
+    assert!(!err.contains("not settled"), "{err}");
+}

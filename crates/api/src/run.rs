@@ -421,7 +421,13 @@ pub fn residual_line(meta: &serde_json::Value) -> Option<String> {
     let tip = meta["residual_tip_peak_m"].as_f64().unwrap_or(f64::NAN);
     let settle = match meta["settle_s"].as_f64() {
         Some(t) => format!("settled at {t:.3} s"),
-        None if meta["settled"] == false => "not settled by t_end".to_string(),
+        None if meta["settled"] == false => flexstar_model::residual::not_settled_text(
+            t_rest,
+            meta["experiment"]["time"]["t_end"].as_f64().unwrap_or(f64::NAN),
+            meta["residual_G_decay_per_s"].as_f64(),
+            meta["settle_predicted_s"].as_f64(),
+            meta["settle_hold_s"].as_f64().unwrap_or(f64::NAN),
+        ),
         None => "settling n/a".to_string(),
     };
     Some(format!(

@@ -119,6 +119,14 @@ pub fn residual_markdown(runs: &[RunResidual]) -> String {
         );
     }
     s.push('\n');
+    for r in runs.iter().filter(|r| !r.g_pinned) {
+        if let Some(hint) = flexstar_model::residual::not_settled_hint(&r.residual) {
+            let _ = writeln!(s, "- {}: {hint}.", r.run);
+        }
+    }
+    if runs.iter().any(|r| !r.g_pinned && !r.residual.settled()) {
+        s.push('\n');
+    }
     s
 }
 

@@ -991,3 +991,71 @@ fn not_settled_says_which_t_end_lets_the_run_settle() {
     assert!(o.status.success() && err.contains("settled at"), "{err}");
     assert!(!err.contains("not settled"), "{err}");
 }
+
+/// Numbers on stderr carry the digits that mean something (the files keep every digit), and a
+/// servo's run reports its sliders' tracking error after the motion next to the settling time.
+#[test]
+fn stderr_numbers_are_rounded_and_a_servo_reports_its_sliders_after_the_move() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let quintic = "[trajectory]\nkind = \"quintic\"\nfrom = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\n\
+                   to = { Gx = 0.03, Gy = -0.02, theta = 0.1 }\nt0 = 0.0\n";
+    // a ZVD at 3.9 Hz after a 0.3 s quintic ends at t_rest = 0.3 + 1/3.9 = 0.556410256... s
+    let shaped = |t_end: &str| {
+        format!("name = \"shaped\"\n[time]\nt_end = {t_end}\n{quintic}t1 = 0.3\n[shaper]\nkind = \"zvd\"\nf_hz = 3.9\n")
+    };
+    let cfg = write(dir.path(), "shaped.toml", &shaped("0.5"));
+    let o = flexstar(&["kinematics", &cfg, "--out", out.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(!o.status.success() && err.contains("t_rest = 0.55641 s"), "{err}");
+    assert!(!err.contains("0.5564102"), "unrounded: {err}");
+    let at = err.find("at least ").expect(&err) + "at least ".len();
+    let bound = err[at..].split(' ').next().unwrap();
+    assert!(bound.len() <= 8, "{bound}");
+    // the bound shown is enough: a file with t_end = that value is accepted
+    let cfg = write(dir.path(), "shaped.toml", &shaped(bound));
+    let o = flexstar(&["kinematics", &cfg, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "t_end = {bound}: {}", stderr(&o));
+
+    let servo = format!(
+        "name = \"servo-move\"\n[time]\nt_end = 0.6\ndt_out = 0.001\n{quintic}t1 = 0.25\n[drive]\nkind = \"servo\"\n\
+         bandwidth_hz = 20.0\ndamping_ratio = 0.7\n"
+    );
+    let cfg = write(dir.path(), "servo.toml", &servo);
+    let o = flexstar(&["run", &cfg, "--solver", "amm", "--out", out.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("after t_rest = 0.25 s:"), "{err}");
+    let side: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("servo-move/amm-enriched-direct.json")).unwrap())
+            .unwrap();
+    // the sidecar's values against the run's own e1..e3 columns after t_rest
+    let (h, rows) = common::table(&out.join("servo-move/amm-enriched-direct.csv"));
+    let (t, e) = (common::col(&h, "t"), ["e1", "e2", "e3"].map(|c| common::col(&h, c)));
+    let after = rows.iter().filter(|r| r[t] >= 0.25 - 1e-12);
+    let peak = after.flat_map(|r| e.map(|k| r[k].abs())).fold(0.0f64, f64::max);
+    let end = e
+        .map(|k| rows.last().unwrap()[k].abs())
+        .into_iter()
+        .fold(0.0f64, f64::max);
+    assert_eq!(side["residual_tracking_peak_m"].as_f64().unwrap(), peak);
+    assert_eq!(side["residual_tracking_end_m"].as_f64().unwrap(), end);
+    let line = format!(
+        "sliders off their reference by up to {} mm after t_rest, {} mm at t_end",
+        flexstar_model_fmt(peak * 1e3),
+        flexstar_model_fmt(end * 1e3)
+    );
+    assert!(err.contains(&line), "{line} not in {err}");
+}
+
+/// Three significant digits, as a person reads them (written out here, independently of the
+/// library's formatter).
+fn flexstar_model_fmt(v: f64) -> String {
+    let digits = 2 - v.abs().log10().floor() as i32;
+    let s = format!("{:.*}", digits.max(0) as usize, v);
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}

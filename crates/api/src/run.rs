@@ -430,9 +430,18 @@ pub fn residual_line(meta: &serde_json::Value) -> Option<String> {
         ),
         None => "settling n/a".to_string(),
     };
+    let sliders = match (
+        meta["residual_tracking_peak_m"].as_f64(),
+        meta["residual_tracking_end_m"].as_f64(),
+    ) {
+        (Some(peak), Some(end)) => format!("; {}", flexstar_model::residual::tracking_text(peak, end)),
+        _ => String::new(),
+    };
+    let tol = meta["settle_tol"].as_f64().unwrap_or(f64::NAN);
     Some(format!(
-        "after t_rest = {t_rest} s: peak |dG| = {g}, peak |tip| = {tip:.3e} m, {settle} (band {} m)",
-        meta["settle_tol"]
+        "after t_rest = {} s: peak |dG| = {g}, peak |tip| = {tip:.3e} m, {settle} (band {} m){sliders}",
+        flexstar_model::output::fmt_sig(t_rest, 5),
+        flexstar_model::output::fmt_display(tol)
     ))
 }
 

@@ -96,11 +96,13 @@ pub fn residual_markdown(runs: &[RunResidual]) -> String {
     };
     let m0 = &first.residual;
     let mut s = format!(
-        "## Residual vibration after the motion (t_rest = {:.4} s)\n\ndG is the length of G's elastic displacement, \
+        "## Residual vibration after the motion (t_rest = {} s)\n\ndG is the length of G's elastic displacement, \
          sqrt(2/3 sum w_iG^2); tips: the largest of w_i(L) in magnitude, RMS of the three. Settled: the last time \
          dG exceeds settle_tol = {:e} m, when the run then stays below it for at least one period of the first \
          mode at the final pose ({:.3} s).\n\n",
-        m0.t_rest, m0.settle_tol, m0.hold_s
+        flexstar_model::output::fmt_sig(m0.t_rest, 5),
+        m0.settle_tol,
+        m0.hold_s
     );
     s.push_str("| run | peak dG [mm] | RMS dG [mm] | peak tip [mm] | RMS tip [mm] | settled at |\n");
     s.push_str("|---|---|---|---|---|---|\n");
@@ -119,13 +121,23 @@ pub fn residual_markdown(runs: &[RunResidual]) -> String {
         );
     }
     s.push('\n');
-    for r in runs.iter().filter(|r| !r.g_pinned) {
-        if let Some(hint) = flexstar_model::residual::not_settled_hint(&r.residual) {
-            let _ = writeln!(s, "- {}: {hint}.", r.run);
+    let mut notes = Vec::new();
+    for r in runs {
+        let m = &r.residual;
+        if let (Some(peak), Some(end)) = (m.tracking_peak_m, m.tracking_end_m) {
+            notes.push(format!(
+                "- {}: {}.",
+                r.run,
+                flexstar_model::residual::tracking_text(peak, end)
+            ));
+        }
+        if let Some(hint) = flexstar_model::residual::not_settled_hint(m).filter(|_| !r.g_pinned) {
+            notes.push(format!("- {}: {hint}.", r.run));
         }
     }
-    if runs.iter().any(|r| !r.g_pinned && !r.residual.settled()) {
-        s.push('\n');
+    if !notes.is_empty() {
+        s.push_str(&notes.join("\n"));
+        s.push_str("\n\n");
     }
     s
 }

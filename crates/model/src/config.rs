@@ -510,7 +510,8 @@ impl Experiment {
             return Ok(());
         };
         let t_end = self.time.t_end;
-        if t_rest <= t_end {
+        // rounding noise of the motion's own sums (a shaper's impulse times) is no overrun
+        if t_rest <= t_end * (1.0 + 1e-12) {
             return Ok(());
         }
         let (key, parts) = match &self.trajectory {
@@ -521,8 +522,8 @@ impl Experiment {
                 "shaper",
                 format!(
                     " (the unshaped motion's t_rest = {} s plus the shaper's {} s)",
-                    sh.base.t_rest().unwrap_or(f64::NAN),
-                    crate::shaper::duration(&sh.impulses)
+                    crate::output::fmt_sig(sh.base.t_rest().unwrap_or(f64::NAN), 6),
+                    crate::output::fmt_sig(crate::shaper::duration(&sh.impulses), 6)
                 ),
             ),
             Trajectory::Polynomial { .. } => ("trajectory", String::new()),
@@ -530,8 +531,10 @@ impl Experiment {
         Err(ModelError::invalid(
             key,
             format!(
-                "the motion ends at t_rest = {t_rest} s{parts}, after time.t_end = {t_end} s \
-                 (it would be cut off mid-move); raise time.t_end to at least {t_rest} s"
+                "the motion ends at t_rest = {} s{parts}, after time.t_end = {t_end} s \
+                 (it would be cut off mid-move); raise time.t_end to at least {} s",
+                crate::output::fmt_sig(t_rest, 6),
+                crate::output::fmt_at_least(t_rest, 6)
             ),
         ))
     }

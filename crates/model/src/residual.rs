@@ -96,6 +96,12 @@ pub struct Residual {
     /// the last excursion seen); the run settles when `t_end` is at least this plus `hold_s`.
     /// `None` when settled or when |dG| does not decay ([`DECAY_SEEN`]).
     pub settle_predicted_s: Option<f64>,
+    /// A servo's run (columns `e1..e3`): the largest tracking error `|s_ref,i - s_i|` of the
+    /// three sliders at `t >= t_rest` [m]; `None` for other runs.
+    pub tracking_peak_m: Option<f64>,
+    /// A servo's run: the largest of the three tracking errors at `t_end` [m]: how far the
+    /// sliders still are from where the motion put them.
+    pub tracking_end_m: Option<f64>,
 }
 
 impl Residual {
@@ -137,6 +143,7 @@ pub fn residual_after(r: &Response, t_rest: f64, settle_tol: f64, hold_s: f64) -
     let t_last = last_out.unwrap_or(t_rest);
     let settled = t_end - t_last >= hold_s - 1e-12;
     let decay = envelope_decay(t, &dg, hold_s);
+    let tracking = tracking_after(r, first);
     let settle_predicted_s = match decay {
         Some((sigma, a)) if !settled && sigma * (t_end - t_rest) >= DECAY_SEEN => {
             Some(((a - settle_tol.ln()) / sigma).max(t_last))
@@ -155,7 +162,21 @@ pub fn residual_after(r: &Response, t_rest: f64, settle_tol: f64, hold_s: f64) -
         t_end,
         decay_per_s: decay.map(|(sigma, _)| sigma),
         settle_predicted_s,
+        tracking_peak_m: tracking.map(|(peak, _)| peak),
+        tracking_end_m: tracking.map(|(_, end)| end),
     })
+}
+
+/// The tracking errors `e1..e3` of a servo's run after index `first`: (largest |e_i| from there
+/// on, largest |e_i| at the last output time) [m]; `None` without the columns.
+fn tracking_after(r: &Response, first: usize) -> Option<(f64, f64)> {
+    let cols: Vec<&[f64]> = ["e1", "e2", "e3"].iter().map(|c| r.column(c)).collect::<Option<_>>()?;
+    let peak = cols
+        .iter()
+        .flat_map(|c| c.get(first..).unwrap_or_default())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let end = cols.iter().filter_map(|c| c.last()).fold(0.0f64, |m, v| m.max(v.abs()));
+    Some((peak, end))
 }
 
 /// The least decay counted as decay: the fitted envelope falls by at least this much of its log
@@ -283,6 +304,16 @@ pub fn sidecar_fields(
     let opt = |f: fn(&Residual) -> Option<f64>| res.and_then(f).map_or(Value::Null, num);
     m.insert("residual_G_decay_per_s".into(), opt(|r| r.decay_per_s));
     m.insert("settle_predicted_s".into(), opt(|r| r.settle_predicted_s));
+    if let Some(r) = res.filter(|r| r.tracking_peak_m.is_some()) {
+        m.insert(
+            "residual_tracking_peak_m".into(),
+            r.tracking_peak_m.map_or(Value::Null, num),
+        );
+        m.insert(
+            "residual_tracking_end_m".into(),
+            r.tracking_end_m.map_or(Value::Null, num),
+        );
+    }
     if g_pinned && res.is_some() {
         for key in [
             "residual_G_peak_m",
@@ -306,6 +337,16 @@ pub fn settle_text(res: &Residual) -> String {
         Some(t) => format!("{t:.3} s"),
         None => "not settled by t_end".to_string(),
     }
+}
+
+/// What a servo's sliders still do after the motion, next to the settling time: `sliders off
+/// their reference by up to 0.3 mm after t_rest, 0.075 mm at t_end` (errors `peak`, `end` [m]).
+pub fn tracking_text(peak: f64, end: f64) -> String {
+    format!(
+        "sliders off their reference by up to {} mm after t_rest, {} mm at t_end",
+        crate::output::fmt_sig(peak * 1e3, 3),
+        crate::output::fmt_sig(end * 1e3, 3)
+    )
 }
 
 /// [`not_settled_text`] of a residual that did not settle; `None` when it settled.
@@ -442,6 +483,41 @@ mod tests {
         let flat = residual_after(&r, t_rest, tol, 1.0 / f).unwrap();
         assert!(flat.decay_per_s.unwrap().abs() < 1e-3 && flat.settle_predicted_s.is_none());
         assert!(not_settled_hint(&flat).unwrap().contains("add [damping]"));
+    }
+
+    #[test]
+    fn a_servo_run_reports_its_sliders_tracking_error_after_the_motion() {
+        // e1 = 3e-4 exp(-20 (t - 0.5)) after t_rest = 0.5 (1 mm before), e2 = -7.5e-5, e3 = 0: the
+        // peak after t_rest is e1 at t_rest, the largest at t_end the constant e2
+        let ts = grid(1.0, 1e-3);
+        let mut r = response(&ts, |_| [0.0, 0.0], |_| 0.0);
+        let e1: Vec<f64> = ts
+            .iter()
+            .map(|t| {
+                if *t < 0.5 {
+                    1e-3
+                } else {
+                    3e-4 * (-20.0 * (t - 0.5)).exp()
+                }
+            })
+            .collect();
+        r.set_extra(
+            &["e1", "e2", "e3"],
+            vec![e1, vec![-7.5e-5; ts.len()], vec![0.0; ts.len()]],
+        );
+        let res = residual_after(&r, 0.5, 1e-4, 0.1).unwrap();
+        assert_eq!(res.tracking_peak_m, Some(3e-4));
+        assert_eq!(res.tracking_end_m, Some(7.5e-5));
+        let keys = sidecar_fields(Some(&res), 1e-4, false);
+        assert_eq!(keys["residual_tracking_end_m"], 7.5e-5);
+        assert_eq!(
+            tracking_text(3e-4, 7.5e-5),
+            "sliders off their reference by up to 0.3 mm after t_rest, 0.075 mm at t_end"
+        );
+        // a run without servo columns has neither value nor key
+        let plain = residual_after(&response(&ts, |_| [0.0, 0.0], |_| 0.0), 0.5, 1e-4, 0.1).unwrap();
+        assert!(plain.tracking_peak_m.is_none());
+        assert!(!sidecar_fields(Some(&plain), 1e-4, false).contains_key("residual_tracking_end_m"));
     }
 
     #[test]

@@ -116,8 +116,8 @@ pub fn outside_envelope(
                 "{} = {} is outside the validated range {}-{}",
                 r.name,
                 crate::output::fmt_sig(v, 4),
-                r.lo,
-                r.hi
+                crate::output::fmt_sig(r.lo, 4),
+                crate::output::fmt_sig(r.hi, 4)
             ));
         }
     }

@@ -146,7 +146,12 @@ pub fn fmt_sig(v: f64, sig: usize) -> String {
         return fmt_number(v);
     }
     let rounded: f64 = format!("{v:.*e}", sig - 1).parse().unwrap_or(v);
-    fmt_number(rounded)
+    // plain for magnitudes a person reads as plain numbers (5000, not 5e3)
+    if (1e-4..1e7).contains(&rounded.abs()) {
+        format!("{rounded}")
+    } else {
+        fmt_number(rounded)
+    }
 }
 
 /// A bound the user must reach ("raise t_end to at least ..."), shown with `sig` significant
@@ -181,6 +186,7 @@ mod tests {
         assert_eq!(fmt_sig(1.2908680383436644, 5), "1.2909");
         assert_eq!(fmt_sig(0.3, 5), "0.3");
         assert_eq!(fmt_sig(1e308, 4), "1e308");
+        assert_eq!(fmt_sig(4999.99, 4), "5000");
         assert_eq!(fmt_sig(-2.65050407285505e-9, 3), "-2.65e-9");
         // a bound rounds up, never below the value
         assert_eq!(fmt_at_least(1.2908680383436644, 5), "1.2909");

@@ -331,3 +331,29 @@ fn runs_of_different_experiments_are_not_overlaid() {
         "{err}"
     );
 }
+
+/// The page draws the base triangle with its sliders and the payload at G: the data it draws
+/// them from are the run's (d, L and the payload from the sidecar's experiment).
+#[test]
+fn the_page_has_the_base_triangle_and_the_payload() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let cfg = config(tmp.path(), "p.toml", 100, 0, 0.05);
+    let mut text = std::fs::read_to_string(&cfg).unwrap();
+    text.push_str("\n[payload]\nmass = 0.5\nJ = 1e-4\noffset = [0.01, 0.0]\n");
+    std::fs::write(&cfg, text).unwrap();
+    run(&cfg, "amm", &out);
+    let dir = out.join("case3");
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let data = page_data(&std::fs::read_to_string(dir.join("animate.html")).unwrap());
+    assert_eq!(data["payload"]["mass"], 0.5);
+    assert_eq!(data["payload"]["offset"], serde_json::json!([10_000, 0]));
+    // L from the sidecar: 0.5 m; the base triangle's corners at 2 d = 0.36 m from O
+    assert_eq!(data["L_um"], 500_000);
+    for c in data["base"].as_array().unwrap() {
+        let (x, y) = (c[0].as_f64().unwrap(), c[1].as_f64().unwrap());
+        assert!((x.hypot(y) - 360_000.0).abs() <= 1.5, "{c}");
+    }
+    assert_eq!(data["sliders"].as_array().unwrap().len(), 6);
+}

@@ -1064,3 +1064,40 @@ fn flexstar_model_fmt(v: f64) -> String {
         s
     }
 }
+
+/// A short move in a long run: compare's time figures get a row on the motion and a row on the
+/// two periods of the first mode after it, the window the sidecar's `settle_hold_s` (one period,
+/// from the modal analysis at the final pose) gives.
+#[test]
+fn compare_zooms_on_the_motion_and_the_residual_window() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(
+        dir.path(),
+        "short.toml",
+        "name = \"short-move\"\n[time]\nt_end = 1.2\ndt_out = 0.001\n[trajectory]\nkind = \"quintic\"\n\
+         from = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\nto = { Gx = 0.03, Gy = -0.02, theta = 0.1 }\nt0 = 0.0\nt1 = 0.25\n\
+         [fem]\nelements = 120\n",
+    );
+    let out = dir.path().join("out");
+    let o = flexstar(&["compare", &cfg, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let case = out.join("short-move");
+    let side: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(case.join("fem.json")).unwrap()).unwrap();
+    let hold = side["settle_hold_s"].as_f64().unwrap();
+    let end = 0.25 + 2.0 * hold;
+    let secs = |t: f64| {
+        // four significant digits, trailing zeros dropped
+        let s = format!("{:.*}", (3 - t.log10().floor() as i32).max(0) as usize, t);
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    for fig in ["wG", "tips", "forces"] {
+        let svg = std::fs::read_to_string(case.join(format!("figures/short-move-{fig}.svg"))).unwrap();
+        assert!(svg.contains("the motion, 0-0.25 s"), "{fig}");
+        let after = format!("after it, 2 periods of mode 1, 0.25-{} s", secs(end));
+        assert!(svg.contains(&after), "{fig}: no {after}");
+    }
+    // the star is not a time figure
+    let star = std::fs::read_to_string(case.join("figures/short-move-star.svg")).unwrap();
+    assert!(!star.contains("the motion,"));
+}

@@ -1,6 +1,6 @@
 //! Reading a run folder's frames files back (`docs/outputs.md`, frames files).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::AnimateError;
 
@@ -25,9 +25,13 @@ pub struct RunFrames {
     pub pose: Vec<[f64; 6]>,
     /// End of the motion `t_rest` [s] when the sidecar knows it.
     pub t_rest: Option<f64>,
-    /// Beam length L [m] and base size d [m] from the sidecar's experiment, when present.
+    /// Beam length L [m] and base size d [m] (the base triangle's in-radius) from the sidecar's
+    /// experiment, when present.
     pub l: Option<f64>,
     pub d: Option<f64>,
+    /// The payload welded at G (`[payload]`): mass [kg] and offset of its centre of mass from G
+    /// in the star's rigid frame [m]; `None` without one.
+    pub payload: Option<(f64, [f64; 2])>,
     /// The experiment (file, hash) its sidecar records (`flexstar_model::identity`).
     pub experiment: Option<(String, String)>,
 }
@@ -86,15 +90,16 @@ fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
     }
     let sidecar = dir.join(format!("{stem}.json"));
     let doc = check_frames_hash(dir, stem, &sidecar)?;
-    let (t_rest, l, d) = sidecar_facts(&sidecar);
+    let facts = sidecar_facts(&doc);
     Ok(RunFrames {
         name: stem.to_string(),
         times,
         beams,
         pose,
-        t_rest,
-        l,
-        d,
+        t_rest: facts.t_rest,
+        l: facts.l,
+        d: facts.d,
+        payload: facts.payload,
         experiment: flexstar_model::identity::recorded(&doc),
     })
 }
@@ -206,15 +211,18 @@ fn read_pose(file: &Path) -> Result<Vec<[f64; 6]>, AnimateError> {
     Ok(rows.iter().map(|r| [r[1], r[2], r[3], r[4], r[5], r[6]]).collect())
 }
 
-/// `t_rest` [s] (a top-level `t_rest` key, else the experiment's trajectory), L and d [m] from a
-/// sidecar; `None` for what it does not say (or when there is no sidecar).
-fn sidecar_facts(file: &PathBuf) -> (Option<f64>, Option<f64>, Option<f64>) {
-    let Some(doc) = std::fs::read_to_string(file)
-        .ok()
-        .and_then(|s| serde_json::from_str::<serde_json::Value>(&s).ok())
-    else {
-        return (None, None, None);
-    };
+/// What a run's sidecar says that the page draws.
+#[derive(Default)]
+struct Facts {
+    t_rest: Option<f64>,
+    l: Option<f64>,
+    d: Option<f64>,
+    payload: Option<(f64, [f64; 2])>,
+}
+
+/// `t_rest` [s] (a top-level `t_rest` key, else the experiment's trajectory), L and d [m] and
+/// the payload from a sidecar document; `None` for what it does not say.
+fn sidecar_facts(doc: &serde_json::Value) -> Facts {
     let exp = doc
         .get("experiment")
         .and_then(|e| serde_json::from_value::<flexstar_model::Experiment>(e.clone()).ok());
@@ -222,7 +230,26 @@ fn sidecar_facts(file: &PathBuf) -> (Option<f64>, Option<f64>, Option<f64>) {
         .get("t_rest")
         .and_then(serde_json::Value::as_f64)
         .or_else(|| exp.as_ref().and_then(|e| e.trajectory.t_rest()));
-    let robot = doc.get("experiment").and_then(|e| e.get("robot"));
-    let num = |k: &str| robot.and_then(|r| r.get(k)).and_then(serde_json::Value::as_f64);
-    (t_rest, num("l"), num("d"))
+    // read from the JSON itself: an experiment that does not read back (a table file relative to
+    // a folder elsewhere) still gives its robot and payload
+    let e = doc.get("experiment");
+    let num = |section: &str, k: &str| {
+        e.and_then(|e| e.get(section))
+            .and_then(|r| r.get(k))
+            .and_then(serde_json::Value::as_f64)
+    };
+    let offset = e
+        .and_then(|e| e.get("payload"))
+        .and_then(|p| p.get("offset"))
+        .and_then(|o| Some([o.get(0)?.as_f64()?, o.get(1)?.as_f64()?]))
+        .unwrap_or([0.0; 2]);
+    let payload = num("payload", "mass")
+        .filter(|m| *m > 0.0 || num("payload", "J").is_some_and(|j| j > 0.0))
+        .map(|m| (m, offset));
+    Facts {
+        t_rest,
+        l: num("robot", "L"),
+        d: num("robot", "d"),
+        payload,
+    }
 }

@@ -202,7 +202,7 @@ impl RobotParams {
                 .collect();
             let how = if v.is_finite() { "underflow to 0" } else { "overflow" };
             return Err(ModelError::invalid(
-                &format!("robot.{key}"),
+                format!("robot.{key}"),
                 format!(
                     "{} makes {what} {how} (with {}); every quantity derived from the robot must be a finite, \
                      positive number: give a physical value (SI units: m, kg/m, Pa, m^4)",

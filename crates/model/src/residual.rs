@@ -190,7 +190,7 @@ pub const DECAY_SEEN: f64 = 0.05;
 /// three whole windows or a window whose largest value is 0.
 pub fn envelope_decay(t: &[f64], dg: &[f64], window: f64) -> Option<(f64, f64)> {
     let (t0, t_end) = (*t.first()?, *t.last()?);
-    if !(window > 0.0) {
+    if window.is_nan() || window <= 0.0 {
         return None;
     }
     let n = ((t_end - t0) / window + 1e-9).floor() as usize;

@@ -205,3 +205,155 @@ fn runs_with_different_frame_times_are_not_overlaid() {
     );
     assert!(!tmp.path().join("p.html").exists());
 }
+
+/// `compare` writes the frames its runs were asked for (`[amm] frames`, `[fem] frames`), and
+/// every command replaces or removes the frames of the runs it writes: an animation never shows
+/// frames of an earlier run beside a newer run's sidecar (docs/outputs.md, frames files).
+#[test]
+fn compare_writes_frames_and_no_command_leaves_stale_ones() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let dir = out.join("case3");
+    let o = flexstar(&[
+        "compare",
+        &config(tmp.path(), "f.toml", 100, 100, 0.05),
+        "--no-figures",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let kin_cfg = config(tmp.path(), "k.toml", 0, 0, 0.05);
+    let o = flexstar(&[
+        "kinematics",
+        &kin_cfg,
+        "--out",
+        tmp.path().join("kin").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let kin = columns(&tmp.path().join("kin/case3/kinematics.csv"));
+    for stem in ["amm-enriched", "fem"] {
+        check_frames(&dir, stem, &kin, 6);
+        let side: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{stem}.json"))).unwrap()).unwrap();
+        assert!(side["frames_hash"].is_string(), "{stem}: {side}");
+    }
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let data = page_data(&std::fs::read_to_string(dir.join("animate.html")).unwrap());
+    let names: Vec<&str> = (data["runs"].as_array().unwrap().iter())
+        .map(|r| r["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["amm-enriched", "fem"]);
+
+    // a compare without frames removes the frames of its runs that the first one left
+    let o = flexstar(&[
+        "compare",
+        &config(tmp.path(), "n.toml", 0, 0, 0.05),
+        "--no-figures",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for stem in ["amm-enriched", "fem"] {
+        for f in [format!("{stem}-frames.csv"), format!("{stem}-frames-pose.csv")] {
+            assert!(!dir.join(&f).exists(), "{f} left behind");
+        }
+    }
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("no *-frames.csv"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// `animate` refuses frames files that the run's sidecar does not vouch for (`frames_hash`):
+/// frames of an earlier run put back beside a newer run, or a newer run's sidecar without frames.
+#[test]
+fn animate_refuses_frames_of_another_run_than_the_sidecar() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let dir = out.join("case3");
+    run(&config(tmp.path(), "a.toml", 100, 0, 0.05), "amm", &out);
+    let keep = tmp.path().join("old-frames.csv");
+    std::fs::copy(dir.join("amm-enriched-frames.csv"), &keep).unwrap();
+    // the same run with softer beams: new frames and sidecar
+    let heavy = std::fs::read_to_string(tmp.path().join("a.toml"))
+        .unwrap()
+        .replace("E = 200e9", "E = 150e9");
+    assert!(heavy.contains("E = 150e9"));
+    std::fs::write(tmp.path().join("h.toml"), heavy).unwrap();
+    run(tmp.path().join("h.toml").to_str().unwrap(), "amm", &out);
+    assert!(flexstar(&["animate", dir.to_str().unwrap()]).status.success());
+    std::fs::remove_file(dir.join("animate.html")).unwrap();
+    // the old frames put back: refused, naming the file and the sidecar
+    std::fs::copy(&keep, dir.join("amm-enriched-frames.csv")).unwrap();
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(
+        !o.status.success() && err.contains("amm-enriched-frames.csv") && err.contains("amm-enriched.json"),
+        "{err}"
+    );
+    assert!(err.contains("frames_hash"), "{err}");
+    // a sidecar that records no frames (a run without them) beside frames files: refused
+    let side = dir.join("amm-enriched.json");
+    let mut doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&side).unwrap()).unwrap();
+    doc.as_object_mut().unwrap().remove("frames_hash");
+    std::fs::write(&side, doc.to_string()).unwrap();
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("earlier run"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.join("animate.html").exists());
+}
+
+/// Frames of two experiments with the same name (a copied file with softer beams) in one folder
+/// are not overlaid: the error names both runs and both files.
+#[test]
+fn runs_of_different_experiments_are_not_overlaid() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    run(&config(tmp.path(), "a.toml", 100, 100, 0.05), "amm", &out);
+    let soft = std::fs::read_to_string(tmp.path().join("a.toml"))
+        .unwrap()
+        .replace("E = 200e9", "E = 150e9");
+    std::fs::write(tmp.path().join("b.toml"), soft).unwrap();
+    run(tmp.path().join("b.toml").to_str().unwrap(), "fem", &out);
+    let o = flexstar(&["animate", out.join("case3").to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(
+        !o.status.success()
+            && err.contains("different experiments")
+            && err.contains("a.toml")
+            && err.contains("b.toml"),
+        "{err}"
+    );
+}
+
+/// The page draws the base triangle with its sliders and the payload at G: the data it draws
+/// them from are the run's (d, L and the payload from the sidecar's experiment).
+#[test]
+fn the_page_has_the_base_triangle_and_the_payload() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let cfg = config(tmp.path(), "p.toml", 100, 0, 0.05);
+    let mut text = std::fs::read_to_string(&cfg).unwrap();
+    text.push_str("\n[payload]\nmass = 0.5\nJ = 1e-4\noffset = [0.01, 0.0]\n");
+    std::fs::write(&cfg, text).unwrap();
+    run(&cfg, "amm", &out);
+    let dir = out.join("case3");
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let data = page_data(&std::fs::read_to_string(dir.join("animate.html")).unwrap());
+    assert_eq!(data["payload"]["mass"], 0.5);
+    assert_eq!(data["payload"]["offset"], serde_json::json!([10_000, 0]));
+    // L from the sidecar: 0.5 m; the base triangle's corners at 2 d = 0.36 m from O
+    assert_eq!(data["L_um"], 500_000);
+    for c in data["base"].as_array().unwrap() {
+        let (x, y) = (c[0].as_f64().unwrap(), c[1].as_f64().unwrap());
+        assert!((x.hypot(y) - 360_000.0).abs() <= 1.5, "{c}");
+    }
+    assert_eq!(data["sliders"].as_array().unwrap().len(), 6);
+}

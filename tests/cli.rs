@@ -130,11 +130,51 @@ fn bad_input_is_refused_with_file_key_and_reason() {
         &case1_with("kind = \"polynomial\"", "kind = \"spline\""),
         &["bad.toml", "spline"],
     );
+    // values whose derived quantities overflow: refused before any work, not NaN/inf in the table
+    refused(
+        &case1_with("L = 0.5", "L = 1e300"),
+        &["bad.toml", "robot.L", "1e300", "overflow"],
+    );
+    refused(
+        &case1_with("mpp_mpa = 0.2", "mpp_mpa = 1e308"),
+        &["bad.toml", "Fa1", "not finite"],
+    );
     // infeasible from the start: slider 1 beyond the base side
     refused(
         &case1_with("s1 = [0.0, 0.0, 1.0]", "s1 = [0.5]"),
         &["t = 0.0000", "slider 1"],
     );
+}
+
+/// A slider mass that makes the driving forces overflow is refused by the solvers too, with
+/// nothing written (the inverse problem's `Fa = mpp_mpa s'' + ...` is infinite).
+#[test]
+fn runs_whose_values_overflow_are_refused_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(
+        dir.path(),
+        "heavy.toml",
+        &common::TINY.replace("[time]", "[robot]\nmpp_mpa = 1e308\n[time]"),
+    );
+    let (out, c) = (dir.path().join("out"), cfg.as_str());
+    for mut args in [
+        vec!["run", c, "--solver", "amm"],
+        vec!["run", c, "--solver", "fem", "--elements", "120"],
+        vec!["compare", c, "--no-figures"],
+    ] {
+        args.extend(["--out", out.to_str().unwrap()]);
+        let o = flexstar(&args);
+        let err = stderr(&o);
+        assert!(
+            !o.status.success() && err.contains("heavy.toml") && err.contains("Fa1") && err.contains("not finite"),
+            "{args:?}: {err}"
+        );
+        let written: Vec<_> = std::fs::read_dir(out.join("tiny"))
+            .map(|d| d.count())
+            .into_iter()
+            .collect();
+        assert!(written.iter().all(|n| *n == 0), "{args:?}: files written");
+    }
 }
 
 #[test]
@@ -839,7 +879,12 @@ fn the_sidecar_says_whether_the_run_lies_in_the_validated_envelope() {
         // EA L^2 / EI = 3.8e6, all inside
         ("other-robot", "[robot]\nrho = 0.3\n", true, None),
         // EA L^2 / EI = 1e4 * 0.25 / 0.5 = 5000, below the draw's 5.8e4
-        ("soft-axis", "[robot]\nEA = 1e4\n", false, Some("EA L^2/EI = 5000.0000")),
+        (
+            "soft-axis",
+            "[robot]\nEA = 1e4\n",
+            false,
+            Some("EA L^2/EI = 5000 is outside"),
+        ),
         (
             "paper-model",
             "[amm]\nfamily = \"free-free\"\nmodel = \"paper\"\nmodes = 10\n",
@@ -873,4 +918,186 @@ fn the_sidecar_says_whether_the_run_lies_in_the_validated_envelope() {
             assert!(reasons.contains(r), "{name}: {reasons}");
         }
     }
+}
+
+/// Two experiment files with the same `name` share `out/<name>/`: a command that replaces results
+/// of another experiment there (another file with another hash) says so on stderr, naming the
+/// other file (docs/outputs.md, "Whose folder"); the same file again, edited or not, and an
+/// identical copy (the same results) pass without a word.
+#[test]
+fn replacing_results_of_another_experiment_with_the_same_name_is_said() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let (a, b, c) = (tmp.path().join("a"), tmp.path().join("b"), tmp.path().join("c"));
+    for d in [&a, &b, &c] {
+        std::fs::create_dir_all(d).unwrap();
+    }
+    let tiny = common::TINY;
+    let copied = tiny.replace("[time]", "[robot]\nE = 150e9\n[time]");
+    let fa = write(&a, "tiny.toml", tiny);
+    let fb = write(&b, "tiny.toml", &copied);
+    let fc = write(&c, "copy.toml", &copied);
+    let note = "holds results of another experiment named `tiny`";
+    let run = |cfg: &str| {
+        let o = flexstar(&["run", cfg, "--solver", "amm", "--out", out_s]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    assert!(!run(&fa).contains(note));
+    let err = run(&fb);
+    let a_abs = std::fs::canonicalize(&fa).unwrap();
+    assert!(err.contains(note) && err.contains(a_abs.to_str().unwrap()), "{err}");
+    assert!(err.contains("--out DIR"), "{err}");
+    // the same file again: its own results
+    assert!(!run(&fb).contains(note));
+    // an identical copy elsewhere: the same experiment hash, the same results
+    assert!(!run(&fc).contains(note));
+    // the first file again: the folder holds the copy's results now
+    let err = run(&fa);
+    assert!(err.contains(note), "{err}");
+    let o = flexstar(&["compare", &fb, "--no-figures", "--out", out_s]);
+    assert!(o.status.success() && stderr(&o).contains(note), "{}", stderr(&o));
+    let o = flexstar(&["kinematics", &fa, "--out", out_s]);
+    assert!(o.status.success() && stderr(&o).contains(note), "{}", stderr(&o));
+    // every run sidecar records the experiment file and hash
+    let side: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("tiny/amm-free-free.json")).unwrap()).unwrap();
+    let b_abs = std::fs::canonicalize(&fb).unwrap();
+    assert_eq!(side["experiment_file"], b_abs.to_str().unwrap());
+    assert_eq!(side["experiment_hash"].as_str().unwrap().len(), 16);
+}
+
+/// A damped move cut short is not settled by its `t_end`; the message names the decay rate seen
+/// and a `t_end` to set, and a run to that `t_end` (the solver's own measurement, independent of
+/// the extrapolation) settles (docs/usage.md, Residual vibration and settling).
+#[test]
+fn not_settled_says_which_t_end_lets_the_run_settle() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = |t_end: &str| {
+        format!(
+            "name = \"damped\"\n[time]\nt_end = {t_end}\ndt_out = 0.001\n[trajectory]\nkind = \"quintic\"\n\
+             from = {{ Gx = 0.0, Gy = 0.0, theta = 0.0 }}\nto = {{ Gx = 0.03, Gy = -0.02, theta = 0.1 }}\n\
+             t0 = 0.0\nt1 = 0.25\n[damping]\nzeta = 0.03\nf_hz = 4.0\n"
+        )
+    };
+    let out = dir.path().join("out");
+    let short = write(dir.path(), "short.toml", &text("1.5"));
+    let o = flexstar(&["run", &short, "--solver", "amm", "--out", out.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("not settled by t_end = 1.5 s: |dG| decays at"), "{err}");
+    let at = err.find("set time.t_end >= ").expect(&err) + "set time.t_end >= ".len();
+    let suggested: f64 = err[at..].split(' ').next().unwrap().parse().unwrap();
+    assert!(suggested > 1.5 && suggested < 10.0, "{suggested}");
+    let long = write(dir.path(), "long.toml", &text(&suggested.to_string()));
+    let o = flexstar(&["run", &long, "--solver", "amm", "--out", out.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(o.status.success() && err.contains("settled at"), "{err}");
+    assert!(!err.contains("not settled"), "{err}");
+}
+
+/// Numbers on stderr carry the digits that mean something (the files keep every digit), and a
+/// servo's run reports its sliders' tracking error after the motion next to the settling time.
+#[test]
+fn stderr_numbers_are_rounded_and_a_servo_reports_its_sliders_after_the_move() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let quintic = "[trajectory]\nkind = \"quintic\"\nfrom = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\n\
+                   to = { Gx = 0.03, Gy = -0.02, theta = 0.1 }\nt0 = 0.0\n";
+    // a ZVD at 3.9 Hz after a 0.3 s quintic ends at t_rest = 0.3 + 1/3.9 = 0.556410256... s
+    let shaped = |t_end: &str| {
+        format!("name = \"shaped\"\n[time]\nt_end = {t_end}\n{quintic}t1 = 0.3\n[shaper]\nkind = \"zvd\"\nf_hz = 3.9\n")
+    };
+    let cfg = write(dir.path(), "shaped.toml", &shaped("0.5"));
+    let o = flexstar(&["kinematics", &cfg, "--out", out.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(!o.status.success() && err.contains("t_rest = 0.55641 s"), "{err}");
+    assert!(!err.contains("0.5564102"), "unrounded: {err}");
+    let at = err.find("at least ").expect(&err) + "at least ".len();
+    let bound = err[at..].split(' ').next().unwrap();
+    assert!(bound.len() <= 8, "{bound}");
+    // the bound shown is enough: a file with t_end = that value is accepted
+    let cfg = write(dir.path(), "shaped.toml", &shaped(bound));
+    let o = flexstar(&["kinematics", &cfg, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "t_end = {bound}: {}", stderr(&o));
+
+    let servo = format!(
+        "name = \"servo-move\"\n[time]\nt_end = 0.6\ndt_out = 0.001\n{quintic}t1 = 0.25\n[drive]\nkind = \"servo\"\n\
+         bandwidth_hz = 20.0\ndamping_ratio = 0.7\n"
+    );
+    let cfg = write(dir.path(), "servo.toml", &servo);
+    let o = flexstar(&["run", &cfg, "--solver", "amm", "--out", out.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("after t_rest = 0.25 s:"), "{err}");
+    let side: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("servo-move/amm-enriched-direct.json")).unwrap())
+            .unwrap();
+    // the sidecar's values against the run's own e1..e3 columns after t_rest
+    let (h, rows) = common::table(&out.join("servo-move/amm-enriched-direct.csv"));
+    let (t, e) = (common::col(&h, "t"), ["e1", "e2", "e3"].map(|c| common::col(&h, c)));
+    let after = rows.iter().filter(|r| r[t] >= 0.25 - 1e-12);
+    let peak = after.flat_map(|r| e.map(|k| r[k].abs())).fold(0.0f64, f64::max);
+    let end = e
+        .map(|k| rows.last().unwrap()[k].abs())
+        .into_iter()
+        .fold(0.0f64, f64::max);
+    assert_eq!(side["residual_tracking_peak_m"].as_f64().unwrap(), peak);
+    assert_eq!(side["residual_tracking_end_m"].as_f64().unwrap(), end);
+    let line = format!(
+        "sliders off their reference by up to {} mm after t_rest, {} mm at t_end",
+        flexstar_model_fmt(peak * 1e3),
+        flexstar_model_fmt(end * 1e3)
+    );
+    assert!(err.contains(&line), "{line} not in {err}");
+}
+
+/// Three significant digits, as a person reads them (written out here, independently of the
+/// library's formatter).
+fn flexstar_model_fmt(v: f64) -> String {
+    let digits = 2 - v.abs().log10().floor() as i32;
+    let s = format!("{:.*}", digits.max(0) as usize, v);
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// A short move in a long run: compare's time figures get a row on the motion and a row on the
+/// two periods of the first mode after it, the window the sidecar's `settle_hold_s` (one period,
+/// from the modal analysis at the final pose) gives.
+#[test]
+fn compare_zooms_on_the_motion_and_the_residual_window() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(
+        dir.path(),
+        "short.toml",
+        "name = \"short-move\"\n[time]\nt_end = 1.2\ndt_out = 0.001\n[trajectory]\nkind = \"quintic\"\n\
+         from = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\nto = { Gx = 0.03, Gy = -0.02, theta = 0.1 }\nt0 = 0.0\nt1 = 0.25\n\
+         [fem]\nelements = 120\n",
+    );
+    let out = dir.path().join("out");
+    let o = flexstar(&["compare", &cfg, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let case = out.join("short-move");
+    let side: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(case.join("fem.json")).unwrap()).unwrap();
+    let hold = side["settle_hold_s"].as_f64().unwrap();
+    let end = 0.25 + 2.0 * hold;
+    let secs = |t: f64| {
+        // four significant digits, trailing zeros dropped
+        let s = format!("{:.*}", (3 - t.log10().floor() as i32).max(0) as usize, t);
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    for fig in ["wG", "tips", "forces"] {
+        let svg = std::fs::read_to_string(case.join(format!("figures/short-move-{fig}.svg"))).unwrap();
+        assert!(svg.contains("the motion, 0-0.25 s"), "{fig}");
+        let after = format!("after it, 2 periods of mode 1, 0.25-{} s", secs(end));
+        assert!(svg.contains(&after), "{fig}: no {after}");
+    }
+    // the star is not a time figure
+    let star = std::fs::read_to_string(case.join("figures/short-move-star.svg")).unwrap();
+    assert!(!star.contains("the motion,"));
 }

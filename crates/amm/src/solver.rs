@@ -518,6 +518,7 @@ mod tests {
             shaper: None,
             report: Default::default(),
             source: Default::default(),
+            hash: String::new(),
         }
     }
 

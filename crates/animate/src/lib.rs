@@ -27,6 +27,9 @@ pub enum AnimateError {
     /// The runs' frame times differ: they cannot be overlaid.
     #[error("the frame times of the runs differ, they cannot be overlaid: {0}")]
     TimesDiffer(String),
+    /// The runs' sidecars record different experiments: they are not one robot's.
+    #[error("the runs are of different experiments, they cannot be overlaid: {0}")]
+    ExperimentsDiffer(String),
     /// `--magnify` not a positive number.
     #[error("--magnify: need a positive finite magnification, got {0}")]
     Magnify(f64),

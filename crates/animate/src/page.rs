@@ -121,7 +121,30 @@ fn run_json(r: &RunFrames, k: usize) -> Value {
         })
         .collect();
     let g: Vec<[i64; 2]> = r.pose.iter().map(|p| [micro(p[0]), micro(p[1])]).collect();
-    json!({ "name": r.name, "colour": colour(&r.name, k), "rigid": rigid, "elastic": elastic, "G": g })
+    // the star's orientation per frame [microradians]: the payload turns with it
+    let theta: Vec<i64> = r.pose.iter().map(|p| micro(p[2])).collect();
+    json!({ "name": r.name, "colour": colour(&r.name, k), "rigid": rigid, "elastic": elastic, "G": g, "theta": theta })
+}
+
+/// The base triangle [um]: its three corners, where the sides (the sliders' rails, at distance d
+/// from O) meet, `s_i = +-sqrt(3) d`; empty without d.
+fn base_json(r: &RunFrames) -> Value {
+    let Some(d) = r.d else {
+        return json!([]);
+    };
+    let corners: Vec<[i64; 2]> = (0..3)
+        .map(|i| revolute_point(i, d, 3f64.sqrt() * d).map(micro))
+        .collect();
+    json!(corners)
+}
+
+/// The payload of the first run that has one: its mass [kg] and offset from G in the star's
+/// frame [um]; `null` without one.
+fn payload_json(runs: &[RunFrames]) -> Value {
+    match runs.iter().find_map(|r| r.payload) {
+        Some((mass, o)) => json!({ "mass": mass, "offset": [micro(o[0]), micro(o[1])] }),
+        None => Value::Null,
+    }
 }
 
 /// The rails (segments over the sliders' travel, 10 % of d beyond) and the slider points per
@@ -160,6 +183,8 @@ pub fn build_page(runs: &[RunFrames], magnify: Option<f64>) -> Result<String, An
         "runs": runs.iter().enumerate().map(|(k, r)| run_json(r, k)).collect::<Vec<_>>(),
         "rails": rails,
         "sliders": sliders,
+        "base": base_json(&runs[0]),
+        "payload": payload_json(runs),
     });
     // `</` inside the JSON would end the script element; `<\/` is the same JSON string
     let text = data.to_string().replace("</", "<\\/");
@@ -194,6 +219,8 @@ mod tests {
             t_rest: None,
             l: Some(0.5),
             d: None,
+            payload: None,
+            experiment: None,
         }
     }
 
@@ -216,6 +243,29 @@ mod tests {
             e.contains("amm-enriched (3 frames, 100 per second)") && e.contains("fem (2 frames, 50 per second)"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn the_page_draws_the_base_triangle_and_the_payload() {
+        let mut r = run("amm-enriched", &[0.0, 0.1], 1e-3);
+        r.d = Some(0.18);
+        r.payload = Some((0.5, [0.01, 0.0]));
+        let html = build_page(&[r], None).unwrap();
+        let start = html.find("id=\"frames-data\">").unwrap() + "id=\"frames-data\">".len();
+        let end = start + html[start..].find("</script>").unwrap();
+        let v: Value = serde_json::from_str(&html[start..end]).unwrap();
+        // the corners of an equilateral triangle of in-radius d about O: at distance 2 d from O,
+        // 120 degrees apart (independent of the geometry module: the in-radius of an
+        // equilateral triangle is half its circumradius)
+        let corners = v["base"].as_array().unwrap();
+        assert_eq!(corners.len(), 3);
+        for c in corners {
+            let (x, y) = (c[0].as_f64().unwrap(), c[1].as_f64().unwrap());
+            assert!((x.hypot(y) - 0.36e6).abs() <= 1.5, "{x}, {y}");
+        }
+        assert_eq!(v["payload"]["mass"], 0.5);
+        assert_eq!(v["payload"]["offset"][0], 10_000);
+        assert_eq!(v["runs"][0]["theta"].as_array().unwrap().len(), 2);
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! Reading a run folder's frames files back (`docs/outputs.md`, frames files).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::AnimateError;
 
@@ -25,9 +25,15 @@ pub struct RunFrames {
     pub pose: Vec<[f64; 6]>,
     /// End of the motion `t_rest` [s] when the sidecar knows it.
     pub t_rest: Option<f64>,
-    /// Beam length L [m] and base size d [m] from the sidecar's experiment, when present.
+    /// Beam length L [m] and base size d [m] (the base triangle's in-radius) from the sidecar's
+    /// experiment, when present.
     pub l: Option<f64>,
     pub d: Option<f64>,
+    /// The payload welded at G (`[payload]`): mass [kg] and offset of its centre of mass from G
+    /// in the star's rigid frame [m]; `None` without one.
+    pub payload: Option<(f64, [f64; 2])>,
+    /// The experiment (file, hash) its sidecar records (`flexstar_model::identity`).
+    pub experiment: Option<(String, String)>,
 }
 
 fn read_err(file: &Path, reason: impl std::fmt::Display) -> AnimateError {
@@ -49,7 +55,27 @@ pub fn read_dir(dir: &Path) -> Result<Vec<RunFrames>, AnimateError> {
     if stems.is_empty() {
         return Err(AnimateError::NoFrames(dir.to_path_buf()));
     }
-    stems.iter().map(|s| read_run(dir, s)).collect()
+    let runs: Vec<RunFrames> = stems.iter().map(|s| read_run(dir, s)).collect::<Result<_, _>>()?;
+    check_one_experiment(&runs)?;
+    Ok(runs)
+}
+
+/// Refuse to overlay runs whose sidecars record different experiments (another file with another
+/// hash, `flexstar_model::identity`): frames of a robot run earlier beside a newer one's.
+fn check_one_experiment(runs: &[RunFrames]) -> Result<(), AnimateError> {
+    let first = &runs[0];
+    for r in &runs[1..] {
+        if let (Some(a), Some(b)) = (&first.experiment, &r.experiment) {
+            if a.1 != b.1 {
+                return Err(AnimateError::ExperimentsDiffer(format!(
+                    "{} is of {} (experiment hash {}), {} of {} ({}); run both from one experiment, or \
+                     animate them from different folders",
+                    first.name, a.0, a.1, r.name, b.0, b.1
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
@@ -62,16 +88,66 @@ fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
             format!("{} rows, but {stem}-frames.csv has {} frames", pose.len(), times.len()),
         ));
     }
-    let (t_rest, l, d) = sidecar_facts(&dir.join(format!("{stem}.json")));
+    let sidecar = dir.join(format!("{stem}.json"));
+    let doc = check_frames_hash(dir, stem, &sidecar)?;
+    let facts = sidecar_facts(&doc);
     Ok(RunFrames {
         name: stem.to_string(),
         times,
         beams,
         pose,
-        t_rest,
-        l,
-        d,
+        t_rest: facts.t_rest,
+        l: facts.l,
+        d: facts.d,
+        payload: facts.payload,
+        experiment: flexstar_model::identity::recorded(&doc),
     })
+}
+
+/// The run's sidecar document, after refusing frames files that are not the ones it vouches for (its
+/// `frames_hash`, `flexstar_model::animation::FRAMES_HASH_KEY`): frames an earlier run of `stem`
+/// left beside a newer run's files would show another robot or motion than the sidecar says.
+fn check_frames_hash(dir: &Path, stem: &str, sidecar: &Path) -> Result<serde_json::Value, AnimateError> {
+    let frames = dir.join(format!("{stem}-frames.csv"));
+    let again = "run it again with `frames` set, or delete these frames files";
+    let doc: serde_json::Value = match std::fs::read_to_string(sidecar) {
+        Ok(text) => serde_json::from_str(&text).map_err(|e| read_err(sidecar, e))?,
+        Err(e) => {
+            return Err(read_err(
+                &frames,
+                format!(
+                    "cannot read its run's sidecar {} ({e}), so which run these frames are cannot be told; {again}",
+                    sidecar.display()
+                ),
+            ))
+        }
+    };
+    let Some(want) = doc
+        .get(flexstar_model::animation::FRAMES_HASH_KEY)
+        .and_then(|v| v.as_str())
+    else {
+        return Err(read_err(
+            &frames,
+            format!(
+                "left by an earlier run: the sidecar {} of the run now in the folder records no frames                  (no `{}`); {again}",
+                sidecar.display(),
+                flexstar_model::animation::FRAMES_HASH_KEY
+            ),
+        ));
+    };
+    let have = flexstar_model::animation::frames_hash(dir, stem).map_err(|e| read_err(&frames, e))?;
+    if have != want {
+        return Err(read_err(
+            &frames,
+            format!(
+                "not the frames of the run in {} (its {} is {want}, these files hash to {have}): left by an \
+                 earlier run or edited; {again}",
+                sidecar.display(),
+                flexstar_model::animation::FRAMES_HASH_KEY
+            ),
+        ));
+    }
+    Ok(doc)
 }
 
 /// The rows of a CSV file as numbers, after checking its header is `header`.
@@ -135,15 +211,18 @@ fn read_pose(file: &Path) -> Result<Vec<[f64; 6]>, AnimateError> {
     Ok(rows.iter().map(|r| [r[1], r[2], r[3], r[4], r[5], r[6]]).collect())
 }
 
-/// `t_rest` [s] (a top-level `t_rest` key, else the experiment's trajectory), L and d [m] from a
-/// sidecar; `None` for what it does not say (or when there is no sidecar).
-fn sidecar_facts(file: &PathBuf) -> (Option<f64>, Option<f64>, Option<f64>) {
-    let Some(doc) = std::fs::read_to_string(file)
-        .ok()
-        .and_then(|s| serde_json::from_str::<serde_json::Value>(&s).ok())
-    else {
-        return (None, None, None);
-    };
+/// What a run's sidecar says that the page draws.
+#[derive(Default)]
+struct Facts {
+    t_rest: Option<f64>,
+    l: Option<f64>,
+    d: Option<f64>,
+    payload: Option<(f64, [f64; 2])>,
+}
+
+/// `t_rest` [s] (a top-level `t_rest` key, else the experiment's trajectory), L and d [m] and
+/// the payload from a sidecar document; `None` for what it does not say.
+fn sidecar_facts(doc: &serde_json::Value) -> Facts {
     let exp = doc
         .get("experiment")
         .and_then(|e| serde_json::from_value::<flexstar_model::Experiment>(e.clone()).ok());
@@ -151,7 +230,26 @@ fn sidecar_facts(file: &PathBuf) -> (Option<f64>, Option<f64>, Option<f64>) {
         .get("t_rest")
         .and_then(serde_json::Value::as_f64)
         .or_else(|| exp.as_ref().and_then(|e| e.trajectory.t_rest()));
-    let robot = doc.get("experiment").and_then(|e| e.get("robot"));
-    let num = |k: &str| robot.and_then(|r| r.get(k)).and_then(serde_json::Value::as_f64);
-    (t_rest, num("l"), num("d"))
+    // read from the JSON itself: an experiment that does not read back (a table file relative to
+    // a folder elsewhere) still gives its robot and payload
+    let e = doc.get("experiment");
+    let num = |section: &str, k: &str| {
+        e.and_then(|e| e.get(section))
+            .and_then(|r| r.get(k))
+            .and_then(serde_json::Value::as_f64)
+    };
+    let offset = e
+        .and_then(|e| e.get("payload"))
+        .and_then(|p| p.get("offset"))
+        .and_then(|o| Some([o.get(0)?.as_f64()?, o.get(1)?.as_f64()?]))
+        .unwrap_or([0.0; 2]);
+    let payload = num("payload", "mass")
+        .filter(|m| *m > 0.0 || num("payload", "J").is_some_and(|j| j > 0.0))
+        .map(|m| (m, offset));
+    Facts {
+        t_rest,
+        l: num("robot", "L"),
+        d: num("robot", "d"),
+        payload,
+    }
 }

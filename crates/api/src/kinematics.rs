@@ -15,6 +15,7 @@ fn from_kinematics(source: &str, e: KinematicsError) -> ApiError {
         KinematicsError::NoSolution { t, .. } | KinematicsError::Trajectory { t, .. } => {
             ApiError::infeasible(source, *t, &e)
         }
+        KinematicsError::NotFinite { .. } => ApiError::config(source, Some("robot"), e.to_string()),
         KinematicsError::Write(_) => ApiError::Output(e.to_string()),
     }
 }
@@ -29,6 +30,6 @@ pub fn table(exp: &Experiment, source: &str) -> Result<Vec<RigidState>> {
 pub fn write(out: &Path, exp: &Experiment, states: &[RigidState]) -> Result<PathBuf> {
     let path = crate::case_dir(out, exp)?.join("kinematics.csv");
     write_kinematics_csv(&path, &exp.robot, &flexstar_model::Attachments::of(exp), states)
-        .map_err(|e| ApiError::Output(e.to_string()))?;
+        .map_err(|e| from_kinematics(&exp.source.display().to_string(), e))?;
     Ok(path)
 }

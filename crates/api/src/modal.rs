@@ -314,7 +314,7 @@ fn freqmap_figure(exp: &Experiment, s: &FreqmapSettings, points: Vec<MapPoint>) 
         gy: s.gy,
         points,
         shown: s.k.min(2),
-        paths: trajectory_path(exp).into_iter().collect(),
+        paths: trajectory_path(exp, s.theta).into_iter().collect(),
     }
 }
 

@@ -42,6 +42,9 @@ pub struct PlanOutcome {
     /// `DIR/<name>/`.
     pub dir: PathBuf,
     pub files: Vec<PathBuf>,
+    /// Notes for the user: the output folder held results of another experiment with the same
+    /// name ([`flexstar_model::identity::other_experiment_note`]).
+    pub notes: Vec<String>,
     /// Wall time of the whole command [s] and of the planning alone.
     pub wall_s: f64,
 }
@@ -67,6 +70,9 @@ pub fn plan_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Planned))
     let cfg = load_plan(config)?;
     let source = config.display().to_string();
     let dir = crate::case_dir(out, &cfg.exp)?;
+    let notes = flexstar_model::identity::other_experiment_note(&dir, &cfg.exp)
+        .into_iter()
+        .collect();
     let planned = flexstar_plan::plan(&cfg).map_err(|e| from_plan(&source, e))?;
     on_planned(&planned);
     let rows = plan_rows(&cfg.exp, &planned)?;
@@ -79,6 +85,7 @@ pub fn plan_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Planned))
         motions,
         dir: dir.clone(),
         files: Vec::new(),
+        notes,
         wall_s,
     };
     files.extend(write_plan_files(&cfg, &outcome, &rows)?);

@@ -75,6 +75,7 @@ pub fn sliders_figure(exp: &Experiment, o: &PlanOutcome) -> Figure {
         panels.push(panel(title, unit, series));
     }
     Figure {
+        zooms: Vec::new(),
         name: format!("{}-plan-sliders", exp.name),
         title: format!("{}: slider speeds and accelerations", exp.name),
         caption:
@@ -106,6 +107,7 @@ pub fn forces_figure(exp: &Experiment, o: &PlanOutcome) -> Figure {
         series.push(limit_line("Fa_max", max, 0.0, exp.time.t_end));
     }
     Figure {
+        zooms: Vec::new(),
         name: format!("{}-plan-forces", exp.name),
         title: format!("{}: driving forces", exp.name),
         caption: "max_i |Fa_i| (Eq. 33) of the three motions, AMM solid and FEM dashed; grey: Fa_max.".into(),
@@ -136,6 +138,7 @@ pub fn path_figure(exp: &Experiment, o: &PlanOutcome) -> Figure {
         })
         .collect();
     Figure {
+        zooms: Vec::new(),
         name: format!("{}-plan-path", exp.name),
         title: format!("{}: path of G", exp.name),
         caption: "G in the fixed frame (rigid); a timing plan keeps the straight segment, a path plan may leave it."

@@ -285,6 +285,31 @@ fn per_motion_panels(o: &PlanOutcome, y_label: &str, scale: f64, f: fn(&Response
         .collect()
 }
 
+/// The zoom rows of the per-motion figures: each motion (column) on its own move, `0..t_rest`,
+/// and on the planner's window after it, `t_rest .. t_rest + window_s` (two periods of the first
+/// mode at the final pose, docs/motions.md 4), cut at `t_end`.
+pub(crate) fn plan_zooms(o: &PlanOutcome) -> Vec<flexstar_plot::Zoom> {
+    let t_end = o.motions.first().map_or(f64::INFINITY, |m| m.exp.time.t_end);
+    let rests: Vec<f64> = o
+        .motions
+        .iter()
+        .map(|m| m.exp.trajectory.t_rest().unwrap_or(t_end))
+        .collect();
+    vec![
+        flexstar_plot::Zoom {
+            label: "the move".into(),
+            windows: rests.iter().map(|&t| (0.0, t)).collect(),
+        },
+        flexstar_plot::Zoom {
+            label: "the planner's window".into(),
+            windows: rests
+                .iter()
+                .map(|&t| (t, (t + o.planned.window_s).min(t_end)))
+                .collect(),
+        },
+    ]
+}
+
 /// The figures of 4.7, written to `dir/figures/`.
 pub fn write_figures(exp: &Experiment, o: &PlanOutcome) -> Result<Vec<PathBuf>> {
     let dir = o.dir.join("figures");
@@ -296,12 +321,14 @@ pub fn write_figures(exp: &Experiment, o: &PlanOutcome) -> Result<Vec<PathBuf>> 
             title: format!("{n}: elastic displacement of G, |dG|"),
             caption: "The three motions on the AMM (colour) and the FEM (black); after t_rest (dashed) what is left is the residual vibration.".into(),
             panels: per_motion_panels(o, "|dG| [mm]", 1e3, dg_series),
+            zooms: plan_zooms(o),
         },
         Figure {
             name: format!("{n}-plan-tips"),
             title: format!("{n}: tip deflection, RMS over the three tips"),
             caption: "The planner minimises the residual at G only; the tips' residual is shown for judgement.".into(),
             panels: per_motion_panels(o, "tips RMS [mm]", 1e3, tip_series),
+            zooms: plan_zooms(o),
         },
         crate::plan_figures::sliders_figure(exp, o),
         crate::plan_figures::forces_figure(exp, o),

@@ -298,13 +298,17 @@ fn apply_fem(exp: &mut Experiment, source: &str, s: &RunSettings) -> Result<Stri
 pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Response> {
     let exp = &p.exp;
     let settings = flexstar_solve::Settings::of(exp, p.solver);
-    flexstar_solve::response(exp, settings, p.checked.as_ref(), progress).map_err(|e| match e {
+    let r = flexstar_solve::response(exp, settings, p.checked.as_ref(), progress).map_err(|e| match e {
         flexstar_solve::SolveError::Amm(e) => p.amm_error(e),
         flexstar_solve::SolveError::Fem(e) => from_fem(&p.source, e),
         flexstar_solve::SolveError::Drive(e) => ApiError::config(&p.source, Some("drive"), e.to_string()),
         flexstar_solve::SolveError::Tracking(e) => ApiError::solver(&p.source, e),
         e @ flexstar_solve::SolveError::Unshaped => ApiError::config(&p.source, Some("shaper.f_hz"), e.to_string()),
-    })
+    })?;
+    if let Some(reason) = r.not_finite_reason() {
+        return Err(ApiError::config(&p.source, Some("robot"), reason));
+    }
+    Ok(r)
 }
 
 /// Solve a prepared run and build its outcome (sidecar document, validity warning); nothing is
@@ -386,12 +390,27 @@ pub fn residual_line(meta: &serde_json::Value) -> Option<String> {
     let tip = meta["residual_tip_peak_m"].as_f64().unwrap_or(f64::NAN);
     let settle = match meta["settle_s"].as_f64() {
         Some(t) => format!("settled at {t:.3} s"),
-        None if meta["settled"] == false => "not settled by t_end".to_string(),
+        None if meta["settled"] == false => flexstar_model::residual::not_settled_text(
+            t_rest,
+            meta["experiment"]["time"]["t_end"].as_f64().unwrap_or(f64::NAN),
+            meta["residual_G_decay_per_s"].as_f64(),
+            meta["settle_predicted_s"].as_f64(),
+            meta["settle_hold_s"].as_f64().unwrap_or(f64::NAN),
+        ),
         None => "settling n/a".to_string(),
     };
+    let sliders = match (
+        meta["residual_tracking_peak_m"].as_f64(),
+        meta["residual_tracking_end_m"].as_f64(),
+    ) {
+        (Some(peak), Some(end)) => format!("; {}", flexstar_model::residual::tracking_text(peak, end)),
+        _ => String::new(),
+    };
+    let tol = meta["settle_tol"].as_f64().unwrap_or(f64::NAN);
     Some(format!(
-        "after t_rest = {t_rest} s: peak |dG| = {g}, peak |tip| = {tip:.3e} m, {settle} (band {} m)",
-        meta["settle_tol"]
+        "after t_rest = {} s: peak |dG| = {g}, peak |tip| = {tip:.3e} m, {settle} (band {} m){sliders}",
+        flexstar_io::output::fmt_sig(t_rest, 5),
+        flexstar_io::output::fmt_display(tol)
     ))
 }
 
@@ -423,36 +442,24 @@ pub fn write_run(out: &mut RunOutcome, dir: &Path, figures: bool) -> Result<()> 
     }
     let shapes = dir.join(format!("{stem}-shapes.csv"));
     r.stage_shapes_csv(&mut set, &format!("{stem}-shapes.csv"))?;
+    let frames_hash = flexstar_model::animation::stage_run_frames(&r.frames, &mut set, stem)?;
+    if let (Some(hash), serde_json::Value::Object(doc)) = (&frames_hash, &mut out.meta) {
+        doc.insert(flexstar_model::animation::FRAMES_HASH_KEY.into(), hash.clone().into());
+    }
     let json = dir.join(format!("{stem}.json"));
     set.text(&format!("{stem}.json"), &sidecar_text(&json, &out.meta)?)?;
-    let frames = stage_frames(&mut set, r, stem)?;
     set.commit()?;
     out.files.extend([csv.clone(), shapes, json]);
-    out.files.extend(frames);
+    if frames_hash.is_some() {
+        out.files
+            .extend(flexstar_model::animation::frames_file_names(stem).map(|n| dir.join(n)));
+    }
     if figures {
         let figs = crate::figures::run_figures(exp, stem, r, direct, dir)?;
         out.files.extend(figs);
     }
     out.csv = Some(csv);
     Ok(())
-}
-
-/// Stage the animation frames of `r` (`<stem>-frames.csv`, `<stem>-frames-pose.csv`,
-/// `docs/motions.md` section 5) when it has any, and return their paths; without frames, the
-/// frames files an earlier run of `stem` left are removed with the publication (an animation
-/// never shows an older run's frames with this one's other files).
-fn stage_frames(set: &mut RunSet, r: &Response, stem: &str) -> Result<Vec<PathBuf>> {
-    let names = [format!("{stem}-frames.csv"), format!("{stem}-frames-pose.csv")];
-    if r.frames.is_empty() {
-        for name in &names {
-            if set.path(name).exists() {
-                set.remove(name)?;
-            }
-        }
-        return Ok(Vec::new());
-    }
-    flexstar_model::animation::stage_frames(&r.frames, set, stem)?;
-    Ok(names.iter().map(|n| set.path(n)).collect())
 }
 
 /// The whole `flexstar run`: prepare, create `out/<name>/` (checked writable before any work),

@@ -32,6 +32,7 @@ impl TableSidecar<'_> {
     /// `table`, every setting, the resolved `experiment`.
     pub fn document(&self, path: &Path) -> Result<Value> {
         let mut doc = crate::provenance().fields();
+        doc.extend(flexstar_model::identity::fields(self.experiment));
         doc.insert("command".into(), self.command.into());
         doc.insert("table".into(), self.csv.into());
         doc.extend(self.settings.clone());

@@ -172,6 +172,7 @@ fn bandwidth_figure(curves: &[(String, Vec<Outcome>)], f1_locked: f64) -> Figure
         min_y_span: 0.1,
     };
     Figure {
+        zooms: Vec::new(),
         name: "servo-bandwidth".into(),
         title: "Servo bandwidth against tracking error and tip vibration (paper cases, AMM)".into(),
         caption: "Both axes logarithmic. Left: largest tracking error. Right: how far the tip vibration is from the \

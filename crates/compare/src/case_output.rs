@@ -93,8 +93,10 @@ fn run_style(family: ModeFamily, used: &mut Vec<ModeFamily>) -> Style {
 }
 
 /// The figure set of one case: w_G, tips, the deformed star at its last snapshot, and the driving
-/// forces over the rigid-body inverse dynamics.
-pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>, Error> {
+/// forces over the rigid-body inverse dynamics. `hold` [s]: one period of the first mode at the
+/// final pose when the motion rests before `t_end` (the settling hold): the time figures then get
+/// zoom rows on the motion and on the residual window after it ([`crate::residual::time_zooms`]).
+pub fn case_figures(exp: &Experiment, case: &CaseResults, hold: Option<f64>) -> Result<Vec<Figure>, Error> {
     let mut runs = vec![Run {
         label: "FEM".into(),
         response: &case.fem,
@@ -147,9 +149,11 @@ pub fn case_figures(exp: &Experiment, case: &CaseResults) -> Result<Vec<Figure>,
         figs.push(figure_sliders(&exp.name, &runs, t, &reference));
     }
     if let Some(t_rest) = flexstar_modal::settle::motion_end(exp) {
-        figs.iter_mut()
-            .filter(|f| !f.name.ends_with("-star"))
-            .for_each(|f| mark_t_rest(f, t_rest));
+        let zooms = hold.map_or_else(Vec::new, |h| crate::residual::time_zooms(t_rest, h, exp.time.t_end));
+        for f in figs.iter_mut().filter(|f| !f.name.ends_with("-star")) {
+            mark_t_rest(f, t_rest);
+            f.zooms = zooms.clone();
+        }
     }
     figs.extend(crate::sensitivity::figure_sensitivity(exp)?);
     Ok(figs)
@@ -376,6 +380,9 @@ pub fn compare_json(
         "runs": runs,
     });
     let mut doc = doc;
+    for (k, v) in flexstar_model::identity::fields(exp) {
+        doc[k] = v;
+    }
     if let Some(res) = residuals {
         let list: Vec<_> = res
             .iter()
@@ -414,13 +421,18 @@ pub fn write_case(
     prov: &Provenance,
     figures: bool,
 ) -> Result<WrittenCase, Error> {
-    let drawn = if figures { case_figures(exp, case)? } else { Vec::new() };
+    let residuals = case_residuals(exp, case)?;
+    let hold = residuals.iter().flatten().next().map(|r| r.residual.hold_s);
+    let drawn = if figures {
+        case_figures(exp, case, hold)?
+    } else {
+        Vec::new()
+    };
     let figdir = dir.join("figures");
     let figs = drawn.iter().map(|f| f.write(&figdir)).collect::<Result<Vec<_>, _>>()?;
     let csv = compare_csv(row);
     let checks = run_checks(exp, case);
     let warnings = validity_warnings(exp, &checks);
-    let residuals = case_residuals(exp, case)?;
     // every run's files and the EVP files are published together (a run set, `docs/outputs.md`)
     let mut set = RunSet::begin(dir)?;
     for (stem, r) in runs_of(case) {

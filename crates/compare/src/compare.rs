@@ -44,6 +44,9 @@ pub struct CompareOutcome {
     pub compare_csv: String,
     /// The servo and each run's tracking error, for an experiment driven by a servo.
     pub servo: Option<ServoSummary>,
+    /// Notes for the user: the output folder held results of another experiment with the same
+    /// name ([`flexstar_model::identity::other_experiment_note`]).
+    pub notes: Vec<String>,
     /// Wall time of the solves and of the whole command [s].
     pub solve_seconds: f64,
     pub total_seconds: f64,
@@ -98,6 +101,9 @@ pub fn run_compare(opts: &CompareOptions, progress: Option<ProgressFn>) -> Resul
     let dir = opts.out.join(&spec.exp.name);
     ensure_writable_dir(&opts.out)?;
     ensure_writable_dir(&dir)?;
+    let notes = flexstar_model::identity::other_experiment_note(&dir, &spec.exp)
+        .into_iter()
+        .collect();
     let cases = run_cases(checked, progress)?;
     let solve_seconds = start.elapsed().as_secs_f64();
     let case = &cases[0];
@@ -111,6 +117,7 @@ pub fn run_compare(opts: &CompareOptions, progress: Option<ProgressFn>) -> Resul
     Ok(CompareOutcome {
         servo: servo_summary(&spec.exp, case),
         warnings: written.warnings,
+        notes,
         compare_csv: written.compare_csv,
         dir,
         row: row.clone(),

@@ -70,6 +70,7 @@ pub fn direct_figures(exp: &Experiment, stem: &str, r: &Response) -> Vec<Figure>
         })
         .collect();
     let mut figs = vec![Figure {
+        zooms: Vec::new(),
         name: format!("{stem}-sliders"),
         title: format!("{}: slider positions of the direct run", exp.name),
         caption: "Where the drive took the sliders (colour) against the [trajectory] of the config (grey dashed): \
@@ -79,6 +80,7 @@ pub fn direct_figures(exp: &Experiment, stem: &str, r: &Response) -> Vec<Figure>
     }];
     if r.column("e1").is_some() {
         figs.push(Figure {
+            zooms: Vec::new(),
             name: format!("{stem}-tracking"),
             title: format!("{}: servo tracking errors", exp.name),
             caption: "Tracking error e_i = s_ref,i - s_i of each servo axis. With rigid feedforward it is the part of \

@@ -43,6 +43,7 @@ fn per_beam(runs: &[Run], title: &str, y_label: &str, pick: impl Fn(&Response, u
 /// Elastic displacement of G in the three rigid frames, w_iG [mm].
 pub fn figure_w_g(case: &str, runs: &[Run]) -> Figure {
     Figure {
+        zooms: Vec::new(),
         name: format!("{case}-wG"),
         title: format!("{case}: elastic displacement of G in the rigid frames x_i w_i"),
         caption: "The junction G's elastic displacement seen from each beam's rigid frame, every AMM run against \
@@ -56,6 +57,7 @@ pub fn figure_w_g(case: &str, runs: &[Run]) -> Figure {
 /// Elastic tip displacements w_i(L) [mm] (points A, B, C).
 pub fn figure_tips(case: &str, runs: &[Run]) -> Figure {
     let mut f = Figure {
+        zooms: Vec::new(),
         name: format!("{case}-tips"),
         title: format!("{case}: elastic tip displacements w_i(L) (A, B, C)"),
         caption: "Tip deflections of the three beams, the responses behind the EVPs at A, B and C. Compare each \
@@ -83,6 +85,7 @@ pub fn figure_forces(case: &str, runs: &[Run], rigid: Option<(&[f64], &[[f64; 3]
         }
     }
     Figure {
+        zooms: Vec::new(),
         name: format!("{case}-forces"),
         title: format!("{case}: driving forces Fa_i (Eq. 33)"),
         caption: "Actuator forces against the rigid-body inverse dynamics (grey dashed): the elastic star adds an \
@@ -109,6 +112,7 @@ pub fn figure_sliders(case: &str, runs: &[Run], t: &[f64], reference: &[[f64; 3]
         });
     }
     Figure {
+        zooms: Vec::new(),
         name: format!("{case}-sliders"),
         title: format!("{case}: slider positions s_i against the servo's reference"),
         caption: "Where the servo took each slider in every run, against the ideal motion it was asked to follow \
@@ -182,6 +186,7 @@ pub fn figure_star(case: &str, runs: &[Run], rigid: &RigidState, magnify: f64) -
     }
     deflection.push(absolute);
     Some(Figure {
+        zooms: Vec::new(),
         name: format!("{case}-star"),
         title: format!("{case}: beam shapes at t = {t:.3} s (deflection in the rigid frames; star magnified)"),
         caption: format!(

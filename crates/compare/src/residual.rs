@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use flexstar_io::output::fmt_number;
 use flexstar_model::residual::{residual_after, settle_text, Residual};
 use flexstar_model::{Experiment, ModeFamily};
-use flexstar_plot::{Figure, Series, MARK_STYLE};
+use flexstar_plot::{Figure, Series, Zoom, MARK_STYLE};
 
 use crate::case_output::runs_of;
 use crate::runs::CaseResults;
@@ -96,11 +96,13 @@ pub fn residual_markdown(runs: &[RunResidual]) -> String {
     };
     let m0 = &first.residual;
     let mut s = format!(
-        "## Residual vibration after the motion (t_rest = {:.4} s)\n\ndG is the length of G's elastic displacement, \
+        "## Residual vibration after the motion (t_rest = {} s)\n\ndG is the length of G's elastic displacement, \
          sqrt(2/3 sum w_iG^2); tips: the largest of w_i(L) in magnitude, RMS of the three. Settled: the last time \
          dG exceeds settle_tol = {:e} m, when the run then stays below it for at least one period of the first \
          mode at the final pose ({:.3} s).\n\n",
-        m0.t_rest, m0.settle_tol, m0.hold_s
+        flexstar_io::output::fmt_sig(m0.t_rest, 5),
+        m0.settle_tol,
+        m0.hold_s
     );
     s.push_str("| run | peak dG [mm] | RMS dG [mm] | peak tip [mm] | RMS tip [mm] | settled at |\n");
     s.push_str("|---|---|---|---|---|---|\n");
@@ -119,7 +121,46 @@ pub fn residual_markdown(runs: &[RunResidual]) -> String {
         );
     }
     s.push('\n');
+    let mut notes = Vec::new();
+    for r in runs {
+        let m = &r.residual;
+        if let (Some(peak), Some(end)) = (m.tracking_peak_m, m.tracking_end_m) {
+            notes.push(format!(
+                "- {}: {}.",
+                r.run,
+                flexstar_model::residual::tracking_text(peak, end)
+            ));
+        }
+        if let Some(hint) = flexstar_model::residual::not_settled_hint(m).filter(|_| !r.g_pinned) {
+            notes.push(format!("- {}: {hint}.", r.run));
+        }
+    }
+    if !notes.is_empty() {
+        s.push_str(&notes.join("\n"));
+        s.push_str("\n\n");
+    }
     s
+}
+
+/// The zoom rows of a time figure whose motion comes to rest at `t_rest` [s] within the first
+/// half of a run to `t_end` [s] (else none: the whole run shows the motion well enough): the
+/// motion, `0..t_rest`, and the residual window after it, `t_rest .. t_rest + 2 hold` (two
+/// periods of the first mode at the final pose, the window the planner judges a motion by,
+/// docs/motions.md 4), cut at `t_end`.
+pub fn time_zooms(t_rest: f64, hold: f64, t_end: f64) -> Vec<Zoom> {
+    if !(t_rest > 0.0 && t_rest <= 0.5 * t_end && hold > 0.0) {
+        return Vec::new();
+    }
+    vec![
+        Zoom {
+            label: "the motion".into(),
+            windows: vec![(0.0, t_rest)],
+        },
+        Zoom {
+            label: "after it, 2 periods of mode 1".into(),
+            windows: vec![(t_rest, (t_rest + 2.0 * hold).min(t_end))],
+        },
+    ]
 }
 
 /// Mark `t_rest` [s] on every panel of a time figure: a dashed vertical line over the panel's
@@ -141,5 +182,21 @@ pub fn mark_t_rest(fig: &mut Figure, t_rest: f64) {
             y: vec![lo, hi],
             style: MARK_STYLE,
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn zooms_cover_the_motion_and_two_periods_after_it() {
+        let z = time_zooms(0.3, 0.2167, 6.0);
+        assert_eq!(z.len(), 2);
+        assert_eq!(z[0].windows, vec![(0.0, 0.3)]);
+        assert_eq!(z[1].windows, vec![(0.3, 0.3 + 2.0 * 0.2167)]);
+        // cut at t_end; none when the motion fills more than half the run
+        assert_eq!(time_zooms(0.3, 0.2, 0.6)[1].windows, vec![(0.3, 0.6)]);
+        assert!(time_zooms(0.4, 0.2, 0.6).is_empty());
     }
 }

@@ -357,6 +357,12 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
                         .map_err(|e| run_error(file(k), &run.label, e))
                 }
             })?;
+            if let Some(reason) = r.not_finite_reason() {
+                let k = match *job {
+                    Job::Fem(k) | Job::Reference(k) | Job::Amm(k, _) | Job::Extra(k, _) => k,
+                };
+                return Err(RunError::Input { file: file(k), reason });
+            }
             tracker.set(j, 1.0, true);
             Ok(r)
         })

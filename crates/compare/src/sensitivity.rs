@@ -59,6 +59,7 @@ pub fn figure_sensitivity(exp: &Experiment) -> Result<Option<Figure>, Error> {
     }];
     panels.extend(error_panel(&measured, &modes, lo, hi, sh));
     Ok(Some(Figure {
+        zooms: Vec::new(),
         name: format!("{}-sensitivity", exp.name),
         title: format!("{}: shaper sensitivity (residual vs mode frequency)", exp.name),
         caption: caption(&sh.frequencies_hz, &modes, lo, hi, &v) + &measured_caption(&measured),

@@ -138,6 +138,34 @@ pub fn fmt_display(v: f64) -> String {
     fmt_number(rounded)
 }
 
+/// A measured or derived number as shown to a person (stderr, reports): rounded to `sig`
+/// significant digits, then as [`fmt_number`] (`1.2908680383436644` with 5 reads `1.2909`,
+/// `5.2620000000000005` reads `5.262`). Files keep [`fmt_number`].
+pub fn fmt_sig(v: f64, sig: usize) -> String {
+    if v == 0.0 || !v.is_finite() || sig == 0 {
+        return fmt_number(v);
+    }
+    let rounded: f64 = format!("{v:.*e}", sig - 1).parse().unwrap_or(v);
+    // plain for magnitudes a person reads as plain numbers (5000, not 5e3)
+    if (1e-4..1e7).contains(&rounded.abs()) {
+        format!("{rounded}")
+    } else {
+        fmt_number(rounded)
+    }
+}
+
+/// A bound the user must reach ("raise t_end to at least ..."), shown with `sig` significant
+/// digits and rounded *up*, so that the value shown still satisfies the bound (up to a relative
+/// 1e-15 of rounding noise: `0.30000000000000004` reads `0.3`).
+pub fn fmt_at_least(v: f64, sig: usize) -> String {
+    if v <= 0.0 || !v.is_finite() || sig == 0 {
+        return fmt_sig(v, sig.max(1));
+    }
+    let scale = 10f64.powi(sig as i32 - 1 - v.log10().floor() as i32);
+    let up = (v * scale * (1.0 - 1e-15)).ceil() / scale;
+    fmt_sig(up.max(v), sig + 1)
+}
+
 /// `v` with `digits` decimals as shown to a person, without the sign of a value that rounds to
 /// zero (`-0.000001` with 5 decimals reads `0.00000`, not `-0.00000`).
 pub fn fmt_fixed(v: f64, digits: usize) -> String {
@@ -151,6 +179,25 @@ pub fn fmt_fixed(v: f64, digits: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_for_people_keep_the_digits_that_mean_something() {
+        assert_eq!(fmt_sig(5.2620000000000005, 5), "5.262");
+        assert_eq!(fmt_sig(1.2908680383436644, 5), "1.2909");
+        assert_eq!(fmt_sig(0.3, 5), "0.3");
+        assert_eq!(fmt_sig(1e308, 4), "1e308");
+        assert_eq!(fmt_sig(4999.99, 4), "5000");
+        assert_eq!(fmt_sig(-2.65050407285505e-9, 3), "-2.65e-9");
+        // a bound rounds up, never below the value
+        assert_eq!(fmt_at_least(1.2908680383436644, 5), "1.2909");
+        assert_eq!(fmt_at_least(1.29081, 5), "1.2909");
+        assert_eq!(fmt_at_least(0.5, 5), "0.5");
+        for v in [1.2908680383436644, 0.30000000000000004, 12.07351, 9.99999999] {
+            let shown: f64 = fmt_at_least(v, 5).parse().unwrap();
+            // up to rounding noise (1e-12 relative), which the bounds checked allow
+            assert!(shown >= v * (1.0 - 1e-12), "{v} shown as {shown}");
+        }
+    }
 
     #[test]
     fn failed_fill_leaves_nothing() {

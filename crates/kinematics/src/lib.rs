@@ -43,6 +43,12 @@ pub enum KinematicsError {
     /// The trajectory leaves the feasible range.
     #[error(transparent)]
     Infeasible(#[from] Infeasible),
+    /// A value of the table is not finite: the robot's values overflow it.
+    #[error(
+        "t = {t:.6} s: {column} = {value} is not finite: the robot's values (lengths, masses, stiffnesses) \
+         overflow it; give physical values"
+    )]
+    NotFinite { t: f64, column: &'static str, value: f64 },
     /// Writing a result file failed.
     #[error(transparent)]
     Write(flexstar_model::ModelError),

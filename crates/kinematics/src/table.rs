@@ -80,18 +80,44 @@ pub fn row(params: &RobotParams, attached: &Attachments, st: &RigidState) -> [f6
     ]
 }
 
-/// Write the table of the robot `params` carrying `attached` as CSV, whole or not at all.
+/// The rows of the table ([`row`]), refused at the first value that is not finite (a robot whose
+/// values overflow a derived quantity, e.g. a slider mass that makes `Fa` infinite): the error
+/// names the time and the column.
+pub fn kinematics_rows(
+    params: &RobotParams,
+    attached: &Attachments,
+    states: &[RigidState],
+) -> Result<Vec<[f64; 23]>, KinematicsError> {
+    states
+        .iter()
+        .map(|st| {
+            let r = row(params, attached, st);
+            match r.iter().position(|v| !v.is_finite()) {
+                None => Ok(r),
+                Some(k) => Err(KinematicsError::NotFinite {
+                    t: st.t,
+                    column: KINEMATICS_HEADER[k],
+                    value: r[k],
+                }),
+            }
+        })
+        .collect()
+}
+
+/// Write the table of the robot `params` carrying `attached` as CSV, whole or not at all; nothing
+/// is written when a value is not finite ([`kinematics_rows`]).
 pub fn write_kinematics_csv(
     path: &Path,
     params: &RobotParams,
     attached: &Attachments,
     states: &[RigidState],
 ) -> Result<(), KinematicsError> {
+    let rows = kinematics_rows(params, attached, states)?;
     write_atomically(path, |w| {
         let mut out = csv::Writer::from_writer(w);
         out.write_record(KINEMATICS_HEADER)?;
-        for st in states {
-            out.write_record(row(params, attached, st).iter().map(|v| fmt_number(*v)))?;
+        for r in &rows {
+            out.write_record(r.iter().map(|v| fmt_number(*v)))?;
         }
         out.flush()?;
         Ok(())

@@ -88,6 +88,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Ok(())
     })?;
     Figure {
+        zooms: Vec::new(),
         name: "f1-paths".into(),
         title: "First two frequencies of the star along the paper's four motions (AMM, N = 60)".into(),
         caption: String::new(),

@@ -5,7 +5,7 @@
 use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::RestPose;
 use flexstar_plot::{
-    colormap, draw_legend, tick, Drawing, Figure, GridFigure, Panel, Series, Style, FEM_STYLE, RIGID_STYLE,
+    axis_ticks, colormap, draw_legend, Drawing, Figure, GridFigure, Panel, Series, Style, FEM_STYLE, RIGID_STYLE,
 };
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -151,6 +151,7 @@ pub fn mode_shapes_figure(name: &str, modal: &Modal, pose: &RestPose, l: f64) ->
         })
         .collect();
     let figure = Figure {
+        zooms: Vec::new(),
         name: name.to_string(),
         title: format!(
             "mode shapes at G = ({:.4}, {:.4}) m, theta = {:.4} rad, sliders {}",
@@ -191,8 +192,10 @@ pub const PATH_COLOR: RGBColor = RGBColor(214, 39, 40);
 /// G(t) of the experiment over `[0, t_end]` at its output times (rigid kinematics), the path
 /// drawn over its frequency map; `None` when the experiment has no prescribed path (a forces
 /// drive: the motion is what the solver finds) or its trajectory leaves the feasible range. A
-/// servo's path is its reference. The path's theta(t) varies; the map is at one theta.
-pub fn trajectory_path(exp: &flexstar_model::Experiment) -> Option<MapPath> {
+/// servo's path is its reference. The map holds at one orientation `map_theta` [rad]; when the
+/// path turns away from it (by more than 1e-3 rad), its label says how far, so that the figure
+/// never suggests the frequencies along a turning move.
+pub fn trajectory_path(exp: &flexstar_model::Experiment, map_theta: f64) -> Option<MapPath> {
     if exp.drive.kind == flexstar_model::DriveKind::Forces {
         return None;
     }
@@ -202,9 +205,24 @@ pub fn trajectory_path(exp: &flexstar_model::Experiment) -> Option<MapPath> {
     } else {
         "G(t)"
     };
+    // round-off (2e-16 rad at a start from theta = 0) reads 0
+    let (lo, hi) = states
+        .iter()
+        .map(|s| if s.theta.v.abs() < 1e-9 { 0.0 } else { s.theta.v })
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    let turns = if (lo - map_theta).abs().max((hi - map_theta).abs()) > 1e-3 {
+        format!(
+            "; its theta runs {} .. {} rad, the map holds at theta = {} rad only",
+            flexstar_io::output::fmt_sig(lo, 3),
+            flexstar_io::output::fmt_sig(hi, 3),
+            flexstar_io::output::fmt_sig(map_theta, 3)
+        )
+    } else {
+        String::new()
+    };
     Some(MapPath {
         label: format!(
-            "{what} of {}, t = 0 .. {} s",
+            "{what} of {}, t = 0 .. {} s{turns}",
             exp.name,
             flexstar_io::output::fmt_display(exp.time.t_end)
         ),
@@ -297,14 +315,15 @@ impl FreqMapFigure {
             .y_label_area_size(64)
             .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
             .map_err(|x| e(&x))?;
+        let (x_ticks, y_ticks) = (axis_ticks(xr.0, xr.1), axis_ticks(yr.0, yr.1));
         chart
             .configure_mesh()
             .disable_mesh()
             .x_desc("Gx [m]")
             .y_desc("Gy [m]")
             .label_style(("sans-serif", 12))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
+            .x_label_formatter(&x_ticks)
+            .y_label_formatter(&y_ticks)
             .draw()
             .map_err(|x| e(&x))?;
         let cells = (0..self.gy.n).flat_map(|iy| (0..self.gx.n).map(move |ix| (ix, iy)));
@@ -396,7 +415,7 @@ fn draw_colour_bar<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, lo: f64, h
         .disable_mesh()
         .disable_x_axis()
         .label_style(("sans-serif", 11))
-        .y_label_formatter(&tick)
+        .y_label_formatter(&axis_ticks(lo, top))
         .draw()
         .map_err(|x| x.to_string())?;
     const STEPS: usize = 64;
@@ -443,14 +462,44 @@ mod tests {
     #[test]
     fn the_map_shows_the_experiments_own_path() {
         let mut exp = flexstar_model::catalogue::paper_case(3);
-        let path = trajectory_path(&exp).expect("a motion has a path");
-        assert_eq!(path.label, "G(t) of case3, t = 0 .. 0.5 s");
+        // case 3 turns the star (general plane motion): the label says so, with its range of
+        // theta from the rigid kinematics at the output times (independent of the map)
+        let path = trajectory_path(&exp, 0.0).expect("a motion has a path");
+        let thetas: Vec<f64> = (exp.time.output_times().iter())
+            .map(|&t| {
+                flexstar_kinematics::RigidState::at(&exp.robot, &exp.trajectory, t)
+                    .unwrap()
+                    .theta
+                    .v
+            })
+            .collect();
+        let (lo, hi) = thetas
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(*v), b.max(*v)));
+        assert!(hi - lo > 1e-2, "case 3 turns: {lo} .. {hi}");
+        assert_eq!(
+            path.label,
+            format!(
+                "G(t) of case3, t = 0 .. 0.5 s; its theta runs {} .. {} rad, the map holds at theta = 0 rad only",
+                flexstar_io::output::fmt_sig(lo, 3),
+                flexstar_io::output::fmt_sig(hi, 3)
+            )
+        );
+        // case 2 translates only: nothing to say
+        let c2 = flexstar_model::catalogue::paper_case(2);
+        assert_eq!(
+            trajectory_path(&c2, 0.0).unwrap().label,
+            "G(t) of case2, t = 0 .. 0.4 s"
+        );
         // one point per output time, from G(0) (independent: the rigid kinematics at t = 0)
         assert_eq!(path.points.len(), exp.time.output_times().len());
         let g0 = flexstar_kinematics::RigidState::at(&exp.robot, &exp.trajectory, 0.0).unwrap();
         assert_eq!(path.points[0], (g0.g[0].v, g0.g[1].v));
         exp.drive.kind = flexstar_model::DriveKind::Forces;
-        assert!(trajectory_path(&exp).is_none(), "a forces drive has no prescribed path");
+        assert!(
+            trajectory_path(&exp, 0.0).is_none(),
+            "a forces drive has no prescribed path"
+        );
     }
 
     #[test]

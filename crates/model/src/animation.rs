@@ -4,6 +4,7 @@
 
 use crate::error::ModelError;
 use crate::geometry::e_x;
+use crate::hash::{Fnv1a64, HashingWriter};
 use crate::response::StarShape;
 use flexstar_io::output::{fmt_number, Dest};
 use flexstar_io::run_set::RunSet;
@@ -108,18 +109,54 @@ impl ShapeTimes {
     }
 }
 
-/// Stage `<stem>-frames.csv` and `<stem>-frames-pose.csv` of `frames` into `set`
-/// (columns [`FRAMES_HEADER`], [`FRAMES_POSE_HEADER`]).
-pub fn stage_frames(frames: &[Frame], set: &mut RunSet, stem: &str) -> Result<(), ModelError> {
-    let name = format!("{stem}-frames.csv");
-    emit_frames_csv(frames, Dest::Set(set, &name))?;
-    let name = format!("{stem}-frames-pose.csv");
-    emit_pose_csv(frames, Dest::Set(set, &name))
+/// The sidecar key that vouches for a run's frames: [`frames_hash`] of the two frames files
+/// written with it (absent from the sidecar of a run without frames). `flexstar animate` refuses
+/// frames files whose hash is not this one: frames an earlier run left beside a newer sidecar.
+pub const FRAMES_HASH_KEY: &str = "frames_hash";
+
+/// The names of the two frames files of run `stem`.
+pub fn frames_file_names(stem: &str) -> [String; 2] {
+    [format!("{stem}-frames.csv"), format!("{stem}-frames-pose.csv")]
 }
 
-fn emit_frames_csv(frames: &[Frame], dest: Dest<'_>) -> Result<(), ModelError> {
+/// FNV-1a 64 (16 hex digits) of the bytes of `<stem>-frames.csv` followed by those of
+/// `<stem>-frames-pose.csv` in `dir`: what the sidecar's [`FRAMES_HASH_KEY`] records.
+pub fn frames_hash(dir: &std::path::Path, stem: &str) -> std::io::Result<String> {
+    let mut h = Fnv1a64::default();
+    for name in frames_file_names(stem) {
+        h.update_file(&dir.join(name))?;
+    }
+    Ok(h.hex())
+}
+
+/// Stage `<stem>-frames.csv` and `<stem>-frames-pose.csv` of `frames` into `set`
+/// (columns [`FRAMES_HEADER`], [`FRAMES_POSE_HEADER`]); returns their [`frames_hash`].
+pub fn stage_frames(frames: &[Frame], set: &mut RunSet, stem: &str) -> Result<String, ModelError> {
+    let [frames_name, pose_name] = frames_file_names(stem);
+    let mut hash = Fnv1a64::default();
+    emit_frames_csv(frames, Dest::Set(set, &frames_name), &mut hash)?;
+    emit_pose_csv(frames, Dest::Set(set, &pose_name), &mut hash)?;
+    Ok(hash.hex())
+}
+
+/// The frames files of run `stem` in `set`: staged when the run has frames (returns their
+/// [`frames_hash`]), else any that an earlier run of `stem` left are removed with the
+/// publication (`None`), so that a folder never holds frames of another run than its sidecar's.
+pub fn stage_run_frames(frames: &[Frame], set: &mut RunSet, stem: &str) -> Result<Option<String>, ModelError> {
+    if frames.is_empty() {
+        for name in frames_file_names(stem) {
+            if set.path(&name).exists() {
+                set.remove(&name)?;
+            }
+        }
+        return Ok(None);
+    }
+    stage_frames(frames, set, stem).map(Some)
+}
+
+fn emit_frames_csv(frames: &[Frame], dest: Dest<'_>, hash: &mut Fnv1a64) -> Result<(), ModelError> {
     dest.write(|w| {
-        let mut out = csv::Writer::from_writer(w);
+        let mut out = csv::Writer::from_writer(HashingWriter { inner: w, hash });
         out.write_record(FRAMES_HEADER)?;
         for f in frames {
             let (g, t) = (f.pose.g, f.shape.t);
@@ -146,9 +183,9 @@ fn emit_frames_csv(frames: &[Frame], dest: Dest<'_>) -> Result<(), ModelError> {
     .map_err(ModelError::from)
 }
 
-fn emit_pose_csv(frames: &[Frame], dest: Dest<'_>) -> Result<(), ModelError> {
+fn emit_pose_csv(frames: &[Frame], dest: Dest<'_>, hash: &mut Fnv1a64) -> Result<(), ModelError> {
     dest.write(|w| {
-        let mut out = csv::Writer::from_writer(w);
+        let mut out = csv::Writer::from_writer(HashingWriter { inner: w, hash });
         out.write_record(FRAMES_POSE_HEADER)?;
         for f in frames {
             let p = &f.pose;

@@ -42,6 +42,7 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         shaper: None,
         report: Default::default(),
         source: Default::default(),
+        hash: String::new(),
     }
 }
 

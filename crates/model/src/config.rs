@@ -389,6 +389,11 @@ pub struct Experiment {
     /// Where the experiment was read from (not a TOML key).
     #[serde(skip)]
     pub source: PathBuf,
+    /// The experiment hash: of its text and the files it reads
+    /// ([`crate::identity::experiment_hash`]; not a TOML key, empty for an experiment built in
+    /// code).
+    #[serde(skip)]
+    pub hash: String,
 }
 
 impl Experiment {
@@ -414,6 +419,7 @@ impl Experiment {
         exp.trajectory.read_file(path, &exp.robot)?;
         exp.apply_shaper().map_err(|e| e.in_file(path))?;
         exp.validate().map_err(|e| e.in_file(path))?;
+        exp.hash = crate::identity::experiment_hash(text, &exp.input_files());
         Ok(exp)
     }
 
@@ -505,7 +511,8 @@ impl Experiment {
             return Ok(());
         };
         let t_end = self.time.t_end;
-        if t_rest <= t_end {
+        // rounding noise of the motion's own sums (a shaper's impulse times) is no overrun
+        if t_rest <= t_end * (1.0 + 1e-12) {
             return Ok(());
         }
         let (key, parts) = match &self.trajectory {
@@ -516,8 +523,8 @@ impl Experiment {
                 "shaper",
                 format!(
                     " (the unshaped motion's t_rest = {} s plus the shaper's {} s)",
-                    sh.base.t_rest().unwrap_or(f64::NAN),
-                    crate::shaper::duration(&sh.impulses)
+                    flexstar_io::output::fmt_sig(sh.base.t_rest().unwrap_or(f64::NAN), 6),
+                    flexstar_io::output::fmt_sig(crate::shaper::duration(&sh.impulses), 6)
                 ),
             ),
             Trajectory::Polynomial { .. } => ("trajectory", String::new()),
@@ -525,8 +532,10 @@ impl Experiment {
         Err(ModelError::invalid(
             key,
             format!(
-                "the motion ends at t_rest = {t_rest} s{parts}, after time.t_end = {t_end} s \
-                 (it would be cut off mid-move); raise time.t_end to at least {t_rest} s"
+                "the motion ends at t_rest = {} s{parts}, after time.t_end = {t_end} s \
+                 (it would be cut off mid-move); raise time.t_end to at least {} s",
+                flexstar_io::output::fmt_sig(t_rest, 6),
+                flexstar_io::output::fmt_at_least(t_rest, 6)
             ),
         ))
     }

@@ -17,6 +17,8 @@ pub mod envelope;
 pub mod error;
 pub mod evp;
 pub mod geometry;
+pub mod hash;
+pub mod identity;
 pub mod motion;
 pub mod params;
 pub mod residual;

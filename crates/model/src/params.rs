@@ -128,12 +128,86 @@ impl RobotParams {
                 ),
             ));
         }
+        self.check_derived()?;
         if self.d + self.lp / 2.0 >= self.l {
             return Err(ModelError::invalid(
                 "robot.L",
                 format!(
                     "the beams must pass through the sleeves at the start: need d + Lp/2 < L, got d = {}, Lp = {}, L = {}",
                     self.d, self.lp, self.l
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Every quantity the solvers derive from the parameters must be a finite positive number:
+    /// a value that makes one overflow to infinity or underflow to zero (`L = 1e300`: `rho L^3`
+    /// is infinite) is refused, naming the key among those involved that lies farthest from the
+    /// paper's value (in decades) and the quantity.
+    fn check_derived(&self) -> Result<(), ModelError> {
+        let paper = RobotParams::paper();
+        let t_scale = self.l * self.l * (self.rho / self.ei()).sqrt();
+        let ea_keys: &[&str] = if self.ea.is_some() { &["EA"] } else { &["E", "rho"] };
+        let derived: [(&str, f64, &[&str]); 8] = [
+            ("E I (the bending stiffness)", self.ei(), &["E", "I"]),
+            ("EA (the axial stiffness)", self.ea(), ea_keys),
+            ("3 rho L (the star's mass)", self.star_mass(), &["rho", "L"]),
+            (
+                "rho L^3 (the star's inertia about G)",
+                self.star_inertia(),
+                &["rho", "L"],
+            ),
+            (
+                "L^2 sqrt(rho / EI) (a beam's time scale)",
+                t_scale,
+                &["L", "rho", "E", "I"],
+            ),
+            (
+                "EI / L^3 (a beam's stiffness)",
+                self.ei() / self.l.powi(3),
+                &["E", "I", "L"],
+            ),
+            (
+                "EA / L (the axial stiffness per length)",
+                self.ea() / self.l,
+                &["E", "rho", "L"],
+            ),
+            ("2 sqrt(3) d (the base triangle's side)", 2.0 * self.half_side(), &["d"]),
+        ];
+        for (what, v, keys) in derived {
+            if v.is_finite() && v > 0.0 {
+                continue;
+            }
+            let value = |k: &str| match k {
+                "E" => (self.e, paper.e),
+                "I" => (self.i, paper.i),
+                "rho" => (self.rho, paper.rho),
+                "L" => (self.l, paper.l),
+                "d" => (self.d, paper.d),
+                _ => (self.ea(), paper.ea()),
+            };
+            let decades = |k: &&str| {
+                let (v, p) = value(k);
+                (v / p).log10().abs()
+            };
+            let key = keys
+                .iter()
+                .copied()
+                .max_by(|a, b| decades(a).total_cmp(&decades(b)))
+                .unwrap_or("L");
+            let given: Vec<String> = keys
+                .iter()
+                .map(|k| format!("{k} = {}", flexstar_io::output::fmt_display(value(k).0)))
+                .collect();
+            let how = if v.is_finite() { "underflow to 0" } else { "overflow" };
+            return Err(ModelError::invalid(
+                format!("robot.{key}"),
+                format!(
+                    "{} makes {what} {how} (with {}); every quantity derived from the robot must be a finite, \
+                     positive number: give a physical value (SI units: m, kg/m, Pa, m^4)",
+                    flexstar_io::output::fmt_display(value(key).0),
+                    given.join(", ")
                 ),
             ));
         }
@@ -162,5 +236,29 @@ mod tests {
         let mut p = RobotParams::paper();
         p.l = -1.0;
         assert!(p.validate().unwrap_err().to_string().contains("robot.L"));
+    }
+
+    #[test]
+    fn values_whose_derived_quantities_overflow_are_refused_naming_the_key() {
+        // L = 1e300: rho L^3 = 0.234e900 is beyond the largest double (1.8e308)
+        let mut p = RobotParams::paper();
+        p.l = 1e300;
+        let e = p.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("robot.L") && e.contains("1e300") && e.contains("overflow"),
+            "{e}"
+        );
+        // E I = 1e-320 Pa m^4 underflows (below the smallest normal double), naming I (further
+        // from the paper's 2.5e-12 than E from 200e9)
+        let mut p = RobotParams::paper();
+        p.e = 1e-150;
+        p.i = 1e-200;
+        let e = p.validate().unwrap_err().to_string();
+        assert!(e.contains("robot.I") && e.contains("underflow"), "{e}");
+        // large but representable values pass: L = 1e100 m with d and Lp of its size
+        let mut p = RobotParams::paper();
+        p.l = 1e100;
+        p.d = 1e99;
+        assert!(p.validate().is_ok());
     }
 }

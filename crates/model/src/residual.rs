@@ -86,6 +86,22 @@ pub struct Residual {
     pub settle_tol: f64,
     /// The quiet time the run must end with to count as settled [s] (motions.md 2.3).
     pub hold_s: f64,
+    /// The last output time [s].
+    pub t_end: f64,
+    /// The decay rate `sigma` [1/s] of the envelope `A exp(-sigma t)` of |dG| after `t_rest`
+    /// ([`envelope_decay`]); `None` when fewer than three periods of the first mode follow
+    /// `t_rest`.
+    pub decay_per_s: Option<f64>,
+    /// Not settled, |dG| decaying: the time [s] the fitted envelope enters the band (not before
+    /// the last excursion seen); the run settles when `t_end` is at least this plus `hold_s`.
+    /// `None` when settled or when |dG| does not decay ([`DECAY_SEEN`]).
+    pub settle_predicted_s: Option<f64>,
+    /// A servo's run (columns `e1..e3`): the largest tracking error `|s_ref,i - s_i|` of the
+    /// three sliders at `t >= t_rest` [m]; `None` for other runs.
+    pub tracking_peak_m: Option<f64>,
+    /// A servo's run: the largest of the three tracking errors at `t_end` [m]: how far the
+    /// sliders still are from where the motion put them.
+    pub tracking_end_m: Option<f64>,
 }
 
 impl Residual {
@@ -126,6 +142,14 @@ pub fn residual_after(r: &Response, t_rest: f64, settle_tol: f64, hold_s: f64) -
         .next_back();
     let t_last = last_out.unwrap_or(t_rest);
     let settled = t_end - t_last >= hold_s - 1e-12;
+    let decay = envelope_decay(t, &dg, hold_s);
+    let tracking = tracking_after(r, first);
+    let settle_predicted_s = match decay {
+        Some((sigma, a)) if !settled && sigma * (t_end - t_rest) >= DECAY_SEEN => {
+            Some(((a - settle_tol.ln()) / sigma).max(t_last))
+        }
+        _ => None,
+    };
     Some(Residual {
         t_rest,
         g_peak_m: dg.iter().fold(0.0, |m: f64, v| m.max(*v)),
@@ -135,7 +159,107 @@ pub fn residual_after(r: &Response, t_rest: f64, settle_tol: f64, hold_s: f64) -
         settle_s: settled.then_some(t_last),
         settle_tol,
         hold_s,
+        t_end,
+        decay_per_s: decay.map(|(sigma, _)| sigma),
+        settle_predicted_s,
+        tracking_peak_m: tracking.map(|(peak, _)| peak),
+        tracking_end_m: tracking.map(|(_, end)| end),
     })
+}
+
+/// The tracking errors `e1..e3` of a servo's run after index `first`: (largest |e_i| from there
+/// on, largest |e_i| at the last output time) [m]; `None` without the columns.
+fn tracking_after(r: &Response, first: usize) -> Option<(f64, f64)> {
+    let cols: Vec<&[f64]> = ["e1", "e2", "e3"].iter().map(|c| r.column(c)).collect::<Option<_>>()?;
+    let peak = cols
+        .iter()
+        .flat_map(|c| c.get(first..).unwrap_or_default())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let end = cols.iter().filter_map(|c| c.last()).fold(0.0f64, |m, v| m.max(v.abs()));
+    Some((peak, end))
+}
+
+/// The least decay counted as decay: the fitted envelope falls by at least this much of its log
+/// (5 %) over the window after `t_rest`; below it a longer run is not predicted to settle.
+pub const DECAY_SEEN: f64 = 0.05;
+
+/// The envelope of a vibration `dg` >= 0 sampled at `t` (from `t_rest` on): the largest value in
+/// each whole window of length `window` [s] (one period of the first mode), at the time it occurs,
+/// over the later half of the windows (at least three), fitted by least squares as
+/// `ln dg = a - sigma t`; `(sigma [1/s], a)`. `None` with fewer than
+/// three whole windows or a window whose largest value is 0.
+pub fn envelope_decay(t: &[f64], dg: &[f64], window: f64) -> Option<(f64, f64)> {
+    let (t0, t_end) = (*t.first()?, *t.last()?);
+    if window.is_nan() || window <= 0.0 {
+        return None;
+    }
+    let n = ((t_end - t0) / window + 1e-9).floor() as usize;
+    if n < 3 {
+        return None;
+    }
+    let mut peaks: Vec<(f64, f64)> = vec![(f64::NAN, 0.0); n];
+    for (ti, v) in t.iter().zip(dg) {
+        let k = ((ti - t0) / window).floor() as usize;
+        if k < n && *v > peaks[k].1 {
+            peaks[k] = (*ti, *v);
+        }
+    }
+    if peaks.iter().any(|p| p.1 <= 0.0) {
+        return None;
+    }
+    // the later half of the windows (at least three): higher modes, damped faster, have died
+    // out there, and the slowest decay, which decides the settling, is left
+    let peaks = &peaks[n - (n / 2).max(3)..];
+    let m = peaks.len() as f64;
+    let (mx, my) = peaks
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / m, b + y.ln() / m));
+    let (sxy, sxx) = peaks.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
+        (a + (x - mx) * (y.ln() - my), b + (x - mx) * (x - mx))
+    });
+    let sigma = -sxy / sxx;
+    Some((sigma, my + sigma * mx))
+}
+
+/// The share of the extrapolated time still to run that the suggested `t_end` adds as a margin.
+/// A rate fitted over a short run is too fast when higher modes, damped faster, still take part:
+/// on the damped move of `tests/cli.rs` (Kelvin-Voigt, zeta = 0.03 at 4 Hz) 1.5 s give
+/// 0.78 1/s against 0.66 1/s over 4.2 s, and the band is entered at 3.94 s predicted, 4.30 s
+/// run; 25 % more of the 2.4 s still to run covers it.
+pub const PREDICTION_MARGIN: f64 = 0.25;
+
+/// The `t_end` [s] a run that stopped at `t_end` needs to see |dG| settle, from the predicted
+/// entry into the band `predicted` [s]: the extrapolation, [`PREDICTION_MARGIN`] more of the time
+/// still to run, and the hold `hold` [s].
+pub fn suggested_t_end(t_end: f64, predicted: f64, hold: f64) -> f64 {
+    predicted + PREDICTION_MARGIN * (predicted - t_end).max(0.0) + hold
+}
+
+/// What a report says of a run that did not settle by `t_end` [s]: the decay rate `decay` [1/s]
+/// seen after `t_rest` [s] and, when |dG| decays, the `t_end` it needs ([`suggested_t_end`]);
+/// when it does not, that a longer run will not help.
+pub fn not_settled_text(t_rest: f64, t_end: f64, decay: Option<f64>, predicted: Option<f64>, hold: f64) -> String {
+    let head = format!("not settled by t_end = {} s", flexstar_io::output::fmt_display(t_end));
+    match (decay, predicted) {
+        (Some(sigma), Some(t_in)) => format!(
+            "{head}: |dG| decays at {sigma:.3} 1/s (halves every {:.3} s), so at that rate it enters the band \
+             near t = {t_in:.2} s; set time.t_end >= {:.2} s to see it settle (that time, {:.0} % more of the time \
+             still to run, and one period of the first mode, {hold:.3} s)",
+            std::f64::consts::LN_2 / sigma,
+            suggested_t_end(t_end, t_in, hold),
+            100.0 * PREDICTION_MARGIN
+        ),
+        (Some(sigma), None) => format!(
+            "{head}: |dG| does not decay (fitted rate {sigma:.2e} 1/s over the {:.3} s after t_rest), so a \
+             longer t_end will not help: add [damping] (docs/usage.md)",
+            t_end - t_rest
+        ),
+        (None, _) => format!(
+            "{head}: fewer than three periods of the first mode ({hold:.3} s) after t_rest, too short to \
+             see a decay; set time.t_end >= {:.2} s to measure it",
+            t_rest + 3.0 * hold
+        ),
+    }
 }
 
 /// `sqrt(1/(t_n - t_0) int f^2 dt)`, trapezoidal rule over the samples (the rule of the EVP).
@@ -177,8 +301,28 @@ pub fn sidecar_fields(
     m.insert("settled".into(), res.map_or(Value::Null, |r| Value::Bool(r.settled())));
     m.insert("settle_tol".into(), num(settle_tol));
     m.insert("settle_hold_s".into(), get(|r| r.hold_s));
+    let opt = |f: fn(&Residual) -> Option<f64>| res.and_then(f).map_or(Value::Null, num);
+    m.insert("residual_G_decay_per_s".into(), opt(|r| r.decay_per_s));
+    m.insert("settle_predicted_s".into(), opt(|r| r.settle_predicted_s));
+    if let Some(r) = res.filter(|r| r.tracking_peak_m.is_some()) {
+        m.insert(
+            "residual_tracking_peak_m".into(),
+            r.tracking_peak_m.map_or(Value::Null, num),
+        );
+        m.insert(
+            "residual_tracking_end_m".into(),
+            r.tracking_end_m.map_or(Value::Null, num),
+        );
+    }
     if g_pinned && res.is_some() {
-        for key in ["residual_G_peak_m", "residual_G_rms_m", "settle_s", "settled"] {
+        for key in [
+            "residual_G_peak_m",
+            "residual_G_rms_m",
+            "settle_s",
+            "settled",
+            "residual_G_decay_per_s",
+            "settle_predicted_s",
+        ] {
             m.insert(key.into(), Value::Null);
         }
         m.insert("residual_note".into(), "G is pinned in this family".into());
@@ -186,12 +330,36 @@ pub fn sidecar_fields(
     m
 }
 
-/// The words a report prints for a settling time: `0.532 s`, or `not settled by t_end`.
+/// The words a report prints for a settling time: `0.532 s`, or `not settled by t_end`
+/// ([`not_settled_text`] says more).
 pub fn settle_text(res: &Residual) -> String {
     match res.settle_s {
         Some(t) => format!("{t:.3} s"),
         None => "not settled by t_end".to_string(),
     }
+}
+
+/// What a servo's sliders still do after the motion, next to the settling time: `sliders off
+/// their reference by up to 0.3 mm after t_rest, 0.075 mm at t_end` (errors `peak`, `end` [m]).
+pub fn tracking_text(peak: f64, end: f64) -> String {
+    format!(
+        "sliders off their reference by up to {} mm after t_rest, {} mm at t_end",
+        flexstar_io::output::fmt_sig(peak * 1e3, 3),
+        flexstar_io::output::fmt_sig(end * 1e3, 3)
+    )
+}
+
+/// [`not_settled_text`] of a residual that did not settle; `None` when it settled.
+pub fn not_settled_hint(res: &Residual) -> Option<String> {
+    res.settle_s.is_none().then(|| {
+        not_settled_text(
+            res.t_rest,
+            res.t_end,
+            res.decay_per_s,
+            res.settle_predicted_s,
+            res.hold_s,
+        )
+    })
 }
 
 #[cfg(test)]
@@ -276,6 +444,80 @@ mod tests {
             .unwrap()
             .settle_s
             .is_none());
+    }
+
+    #[test]
+    fn a_run_cut_short_predicts_the_t_end_at_which_it_settles() {
+        // a damped sine |dG| = A exp(-s (t - t_rest)) |sin(w t)| along one axis: the fitted rate
+        // is s, and the predicted entry into the band is where the envelope crosses it,
+        // t* = t_rest + ln(A / tol) / s (analytic), to within a period
+        let (a, s, tol, t_rest, f) = (1e-3, 0.8, 1e-4, 0.5, 4.0);
+        let w = 2.0 * std::f64::consts::PI * f;
+        let env = |t: f64| if t < t_rest { a } else { a * (-s * (t - t_rest)).exp() };
+        let ts = grid(2.5, 1e-3);
+        let r = response(&ts, |t| [env(t) * (w * t).sin(), 0.0], |_| 0.0);
+        let res = residual_after(&r, t_rest, tol, 1.0 / f).unwrap();
+        assert!(!res.settled());
+        let sigma = res.decay_per_s.unwrap();
+        assert!((sigma - s).abs() < 0.01 * s, "rate {sigma} vs {s}");
+        let t_star = t_rest + (a / tol).ln() / s;
+        let predicted = res.settle_predicted_s.unwrap();
+        assert!((predicted - t_star).abs() < 1.0 / f, "{predicted} vs {t_star}");
+        let hint = not_settled_hint(&res).unwrap();
+        assert!(
+            hint.contains("not settled by t_end = 2.5 s") && hint.contains("decays at 0.80"),
+            "{hint}"
+        );
+        let suggested = suggested_t_end(2.5, predicted, 0.25);
+        assert!((suggested - (predicted + 0.25 * (predicted - 2.5) + 0.25)).abs() < 1e-12);
+        assert!(hint.contains(&format!("time.t_end >= {suggested:.2}")), "{hint}");
+        // and a run to that t_end settles, within a period of the predicted time
+        let ts = grid(suggested, 1e-3);
+        let r = response(&ts, |t| [env(t) * (w * t).sin(), 0.0], |_| 0.0);
+        let long = residual_after(&r, t_rest, tol, 1.0 / f).unwrap();
+        let settle = long.settle_s.expect("settles with the predicted t_end");
+        assert!((settle - t_star).abs() < 1.0 / f, "{settle} vs {t_star}");
+        assert!(not_settled_hint(&long).is_none());
+        // undamped: no decay, the hint says a longer run will not help
+        let r = response(&ts, |t| [a * (w * t).sin(), 0.0], |_| 0.0);
+        let flat = residual_after(&r, t_rest, tol, 1.0 / f).unwrap();
+        assert!(flat.decay_per_s.unwrap().abs() < 1e-3 && flat.settle_predicted_s.is_none());
+        assert!(not_settled_hint(&flat).unwrap().contains("add [damping]"));
+    }
+
+    #[test]
+    fn a_servo_run_reports_its_sliders_tracking_error_after_the_motion() {
+        // e1 = 3e-4 exp(-20 (t - 0.5)) after t_rest = 0.5 (1 mm before), e2 = -7.5e-5, e3 = 0: the
+        // peak after t_rest is e1 at t_rest, the largest at t_end the constant e2
+        let ts = grid(1.0, 1e-3);
+        let mut r = response(&ts, |_| [0.0, 0.0], |_| 0.0);
+        let e1: Vec<f64> = ts
+            .iter()
+            .map(|t| {
+                if *t < 0.5 {
+                    1e-3
+                } else {
+                    3e-4 * (-20.0 * (t - 0.5)).exp()
+                }
+            })
+            .collect();
+        r.set_extra(
+            &["e1", "e2", "e3"],
+            vec![e1, vec![-7.5e-5; ts.len()], vec![0.0; ts.len()]],
+        );
+        let res = residual_after(&r, 0.5, 1e-4, 0.1).unwrap();
+        assert_eq!(res.tracking_peak_m, Some(3e-4));
+        assert_eq!(res.tracking_end_m, Some(7.5e-5));
+        let keys = sidecar_fields(Some(&res), 1e-4, false);
+        assert_eq!(keys["residual_tracking_end_m"], 7.5e-5);
+        assert_eq!(
+            tracking_text(3e-4, 7.5e-5),
+            "sliders off their reference by up to 0.3 mm after t_rest, 0.075 mm at t_end"
+        );
+        // a run without servo columns has neither value nor key
+        let plain = residual_after(&response(&ts, |_| [0.0, 0.0], |_| 0.0), 0.5, 1e-4, 0.1).unwrap();
+        assert!(plain.tracking_peak_m.is_none());
+        assert!(!sidecar_fields(Some(&plain), 1e-4, false).contains_key("residual_tracking_end_m"));
     }
 
     #[test]

@@ -278,6 +278,40 @@ impl Response {
             .collect()
     }
 
+    /// The first value that is not finite, row by row in the order of the CSV: `(t, column,
+    /// value)`; `None` when every value is finite. A robot whose values overflow a derived
+    /// quantity (a slider mass of 1e308 kg makes `Fa` infinite) gives one: the commands refuse to
+    /// write such a run ([`Response::not_finite_reason`]).
+    pub fn first_not_finite(&self) -> Option<(f64, String, f64)> {
+        let fixed = self.w_g.iter().chain(&self.w_tip).chain(&self.fa);
+        let columns: Vec<&[f64]> = std::iter::once(&self.t)
+            .chain(fixed)
+            .map(Vec::as_slice)
+            .chain(self.extra.iter().map(|c| c.values.as_slice()))
+            .collect();
+        let header = self.header();
+        for k in 0..self.t.len() {
+            if let Some(c) = columns
+                .iter()
+                .position(|col| col.get(k).is_some_and(|v| !v.is_finite()))
+            {
+                return Some((self.t[k], header[c].clone(), columns[c][k]));
+            }
+        }
+        None
+    }
+
+    /// Why the run is refused when a value is not finite ([`Response::first_not_finite`]).
+    pub fn not_finite_reason(&self) -> Option<String> {
+        self.first_not_finite().map(|(t, column, v)| {
+            format!(
+                "t = {} s: {column} = {v} is not finite: the robot's values (lengths, masses, stiffnesses) \
+                 overflow it; give physical values (nothing written)",
+                flexstar_io::output::fmt_display(t)
+            )
+        })
+    }
+
     /// Write the response as CSV, whole or not at all.
     pub fn write_csv(&self, path: &Path) -> Result<(), ModelError> {
         self.emit_csv(Dest::File(path))
@@ -432,6 +466,7 @@ impl Response {
             reason: e.to_string(),
         };
         let mut doc = provenance.fields();
+        doc.extend(crate::identity::fields(experiment));
         doc.insert("label".into(), self.label.clone().into());
         if let serde_json::Value::Object(fields) = serde_json::to_value(&self.info).map_err(fail)? {
             doc.extend(fields);
@@ -484,7 +519,9 @@ impl Response {
     /// into `set`; `order`: the `(leading, after)` columns of [`Response::write_csv_ordered`]
     /// (a direct run's file), `None` for the plain order of [`Response::write_csv`]; `fields`:
     /// further top-level keys of the sidecar (a compared run's residual keys,
-    /// `crate::residual::sidecar_fields`).
+    /// `crate::residual::sidecar_fields`). The run's animation frames are staged too when it has
+    /// any (the sidecar then records their hash), else frames an earlier run of `stem` left are
+    /// removed ([`crate::animation::stage_run_frames`]).
     pub fn stage_run(
         &self,
         set: &mut RunSet,
@@ -499,11 +536,15 @@ impl Response {
             None => self.stage_csv(set, &csv)?,
         }
         self.stage_shapes_csv(set, &format!("{stem}-shapes.csv"))?;
+        let frames = crate::animation::stage_run_frames(&self.frames, set, stem)?;
         let name = format!("{stem}.json");
         let path = set.path(&name);
         let mut doc = self.sidecar(&path, experiment, provenance)?;
         if let serde_json::Value::Object(map) = &mut doc {
             map.extend(fields);
+            if let Some(hash) = frames {
+                map.insert(crate::animation::FRAMES_HASH_KEY.into(), hash.into());
+            }
         }
         set.text(&name, &sidecar_text(&path, &doc)?)?;
         Ok(())

@@ -6,15 +6,30 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::style::Style;
 
+const SAMPLE: i32 = 28;
+const GAP: i32 = 8;
+/// Space between two legend entries [px].
+pub(crate) const SPACING: i32 = 26;
+const FONT_SIZE: f64 = 14.0;
+
+/// Width of one legend entry [px]: the line sample, the gap and the label in the bundled font.
+pub(crate) fn entry_width(label: &str) -> i32 {
+    crate::drawing::register_font();
+    let text = ("sans-serif", FONT_SIZE)
+        .into_font()
+        .box_size(label)
+        .map(|(w, _)| w as i32)
+        // without the font: a generous 0.62 em per character
+        .unwrap_or((0.62 * FONT_SIZE * label.chars().count() as f64) as i32);
+    SAMPLE + GAP + text
+}
+
 /// One row of legend entries, centred: a line sample in the run's style, then its label.
 pub fn draw_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[(String, Style)],
 ) -> Result<(), String> {
-    const SAMPLE: i32 = 28;
-    const GAP: i32 = 8;
-    const SPACING: i32 = 26;
-    let font: TextStyle = ("sans-serif", 14).into_font().into();
+    let font: TextStyle = ("sans-serif", FONT_SIZE).into_font().into();
     let widths: Vec<i32> = entries
         .iter()
         .map(|(l, _)| {

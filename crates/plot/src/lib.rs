@@ -15,7 +15,7 @@ pub mod panel;
 pub mod style;
 
 pub use drawing::{register_font, svg_string, write_svg_png, Drawing, FigureError};
-pub use figure::{Figure, GridFigure, Panel, RenderedFigure, Series};
+pub use figure::{legend_rows, Figure, GridFigure, Panel, RenderedFigure, Series, Zoom};
 pub use legend::draw_legend;
-pub use panel::tick;
+pub use panel::{axis_ticks, min_max_thin, tick};
 pub use style::{colormap, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE, MARK_STYLE, RIGID_STYLE};

@@ -175,6 +175,11 @@ impl PyRun {
     #[pyo3(signature = (out, figures = false))]
     fn save(&self, py: Python<'_>, out: PathBuf, figures: bool) -> PyResult<Vec<String>> {
         let mut o = self.inner.clone();
+        // a folder of another experiment with the same name is replaced: say so, as the CLI does
+        if let Some(note) = flexstar_model::identity::other_experiment_note(&out.join(&o.exp.name), &o.exp) {
+            let text = std::ffi::CString::new(note.trim_start_matches("note: ")).unwrap_or_default();
+            PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &text, 1)?;
+        }
         py.detach(|| {
             let dir = flexstar_api::case_dir(&out, &o.exp)?;
             flexstar_api::run::write_run(&mut o, &dir, figures)

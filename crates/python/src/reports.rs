@@ -39,6 +39,10 @@ pub fn compare<'py>(
         compare_api(&opts, Some(&tick))
     })?
     .map_err(py_err)?;
+    for note in &o.notes {
+        let text = std::ffi::CString::new(note.trim_start_matches("note: ")).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &text, 1)?;
+    }
     let d = PyDict::new(py);
     d.set_item("dir", o.dir.display().to_string())?;
     d.set_item("compare_csv", o.dir.join("compare.csv").display().to_string())?;
@@ -141,6 +145,10 @@ pub fn plan<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bou
         flexstar_api::plan::plan_to_dir(&config, &out, |_| {})
     })?
     .map_err(py_err)?;
+    for note in &o.notes {
+        let text = std::ffi::CString::new(note.trim_start_matches("note: ")).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &text, 1)?;
+    }
     let d = PyDict::new(py);
     d.set_item("dir", o.dir.display().to_string())?;
     d.set_item("plan_toml", o.dir.join("plan.toml").display().to_string())?;

@@ -1,6 +1,7 @@
 """The Python package against the CLI (the same library): files equal to the last digit, every
 exception type, nothing written on bad input, a study, the linear model's poles."""
 
+import os
 import pathlib
 import subprocess
 
@@ -230,3 +231,33 @@ def test_plan_matches_the_cli_contract(root, tmp_path):
     with pytest.raises(flexstar.ConfigError) as e:
         flexstar.plan(bad, tmp_path / "out")
     assert "plan.points" in str(e.value) and "bad.toml" in str(e.value)
+
+
+def test_saving_over_another_experiment_with_the_same_name_warns(root, tmp_path):
+    """Two experiments with the same `name` share out/<name>/: saving over the other one's results
+    warns (as the CLI says so on stderr); saving the same one again does not."""
+    import warnings
+
+    text = (root / "configs/case3.toml").read_text()
+    a = flexstar.Experiment.from_toml(text, source=str(tmp_path / "a.toml"))
+    b = flexstar.Experiment.from_toml(text.replace("E = 200e9", "E = 150e9"), source=str(tmp_path / "b.toml"))
+    flexstar.run(a, solver="amm").save(tmp_path / "out")
+    with pytest.warns(UserWarning, match="another experiment named `case3`"):
+        flexstar.run(b, solver="amm").save(tmp_path / "out")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        flexstar.run(b, solver="amm").save(tmp_path / "out")
+
+
+@pytest.mark.skipif(not os.environ.get("FLEXSTAR_EXPECT_WHEEL"), reason="only where CI installed the wheel")
+def test_the_package_is_the_installed_wheel_and_needs_no_rust():
+    """CI (.ci/run) installs the abi3 wheel into a fresh environment without cargo on PATH: the
+    extension imported is the installed one, and no Rust toolchain is reachable."""
+    import shutil
+    import sysconfig
+
+    site = pathlib.Path(sysconfig.get_paths()["purelib"]).resolve()
+    ext = pathlib.Path(flexstar._flexstar.__file__).resolve()
+    assert site in ext.parents, f"{ext} is not under {site}"
+    assert ".abi3." in ext.name, ext.name
+    assert shutil.which("cargo") is None and shutil.which("rustc") is None

@@ -15,7 +15,9 @@
 
 pub mod derived;
 pub mod error;
-pub mod hash;
+/// The hash of run ids and study fingerprints (it lives in the model crate, shared with the
+/// sidecars).
+pub use flexstar_model::hash;
 pub mod merge;
 pub mod metrics;
 pub mod patch;

@@ -1,6 +1,7 @@
 //! The study's plots (plotters, SVG): a metric against a varied key, and a heat map of a metric
 //! over two gridded keys.
 
+use flexstar_plot::axis_ticks;
 use plotters::prelude::*;
 
 use crate::error::StudyError;
@@ -103,8 +104,8 @@ impl Scatter {
                 .x_desc(self.x_label.as_str())
                 .y_desc(self.y_label.as_str())
                 .label_style(("sans-serif", 12))
-                .x_label_formatter(&tick)
-                .y_label_formatter(&tick)
+                .x_label_formatter(&axis_ticks(xr.0, xr.1))
+                .y_label_formatter(&axis_ticks(yr.0, yr.1))
                 .light_line_style(RGBColor(235, 235, 235))
                 .draw()
                 .map_err(|x| e(x.to_string()))?;

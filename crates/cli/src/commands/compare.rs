@@ -43,6 +43,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let outcome = run_compare(&opts, Some(&tick));
     reporter.finish();
     let outcome = outcome?;
+    for n in &outcome.notes {
+        eprintln!("{n}");
+    }
     super::print_warnings(&outcome.warnings);
     println!("{}", outcome.compare_csv.trim_end());
     if let Some(servo) = &outcome.servo {

@@ -16,6 +16,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let exp = super::load(&args.config)?;
+    super::note_other_experiment(&args.out, &exp);
     let states = flexstar_api::kinematics::table(&exp, &args.config.display().to_string())?;
     let path = flexstar_api::kinematics::write(&args.out, &exp, &states)?;
     let last = states.last().expect("output times are never empty");

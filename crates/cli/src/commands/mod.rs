@@ -24,6 +24,14 @@ pub fn provenance() -> Provenance {
     flexstar_api::provenance()
 }
 
+/// Say on stderr when `out/<name>/` holds results of another experiment with the same `name`
+/// (a copied file): what this command writes there replaces theirs.
+pub fn note_other_experiment(out: &Path, exp: &Experiment) {
+    if let Some(note) = flexstar_model::identity::other_experiment_note(&out.join(&exp.name), exp) {
+        eprintln!("{note}");
+    }
+}
+
 /// Print the small-deflection warnings of a command on stderr.
 pub fn print_warnings<W: std::fmt::Display>(warnings: &[W]) {
     for w in warnings {

@@ -149,6 +149,7 @@ fn load(config: &std::path::Path) -> anyhow::Result<(Experiment, String)> {
 
 pub fn run_modal(args: ModalArgs) -> anyhow::Result<()> {
     let (exp, source) = load(&args.config)?;
+    super::note_other_experiment(&args.out, &exp);
     let sliders = Sliders::from(args.sliders);
     flexstar_api::modal::check_k(args.k)?;
     let spec = args.pose.spec(&args.config)?;
@@ -174,6 +175,7 @@ pub fn run_modal(args: ModalArgs) -> anyhow::Result<()> {
 
 pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
     let (exp, source) = load(&args.config)?;
+    super::note_other_experiment(&args.out, &exp);
     let settings = FreqmapSettings {
         gx: flexstar_api::modal::parse_axis("--gx", &args.gx)?,
         gy: flexstar_api::modal::parse_axis("--gy", &args.gy)?,
@@ -209,6 +211,7 @@ pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
 
 pub fn run_linearize(args: LinearizeArgs) -> anyhow::Result<()> {
     let (exp, source) = load(&args.config)?;
+    super::note_other_experiment(&args.out, &exp);
     let spec = args.pose.spec(&args.config)?;
     let opts = LinearizeOptions {
         modes: Some(args.k),

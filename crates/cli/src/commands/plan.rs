@@ -29,6 +29,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             p.reason
         );
     })?;
+    for n in &outcome.notes {
+        eprintln!("{n}");
+    }
     for m in &outcome.motions {
         let peak = |o: &flexstar_api::RunOutcome| o.meta["residual_G_peak_m"].as_f64().unwrap_or(f64::NAN);
         eprintln!(

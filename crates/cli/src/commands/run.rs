@@ -78,6 +78,7 @@ fn announce(p: &Prepared) {
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let exp = super::load(&args.config)?;
+    super::note_other_experiment(&args.out, &exp);
     let cfg = args.config.display().to_string();
     let settings = args.settings();
     let started = std::time::Instant::now();

@@ -73,17 +73,7 @@ pub fn axis_ticks(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
             return "0".into();
         }
         if plain {
-            let s = format!("{v:.decimals$}");
-            let s = if s.contains('.') {
-                s.trim_end_matches('0').trim_end_matches('.')
-            } else {
-                &s
-            };
-            if s == "-0" {
-                "0".into()
-            } else {
-                s.to_string()
-            }
+            plain_decimal(*v, decimals)
         } else {
             format!("{v:.mantissa$e}")
         }
@@ -136,15 +126,24 @@ pub fn tick(v: &f64) -> String {
         return "0".into();
     }
     if (1e-2..1e4).contains(&a) {
-        let s = format!("{v:.3}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        if s == "-0" {
-            "0".into()
-        } else {
-            s.to_string()
-        }
+        plain_decimal(*v, 3)
     } else {
         format!("{v:.1e}")
+    }
+}
+
+/// `v` with `decimals` decimals, trailing zeros (and a bare point) dropped, `-0` read as `0`.
+fn plain_decimal(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.to_string()
     }
 }
 

@@ -26,12 +26,20 @@ const LOAD: &str = "[load]\nFx = [0.0, 2.0]\nFy = [0.0, -1.0]\nMz = [0.0, 0.0, 0
 fn compare(base: &str, name: &str, sections: &str) -> (f64, [Option<f64>; 4]) {
     let text = format!("{base}\n{sections}");
     let exp = Experiment::from_toml_str(&text, Path::new("attached.toml")).unwrap();
-    let fem = flexstar_fem::solve(&exp, &FemSettings::default(), flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
-    let amm = flexstar_amm::solve(&exp, &AmmSettings::accurate(), flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let fem = flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &FemSettings::default(),
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
+    let amm = flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        &AmmSettings::accurate(),
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let e = point_evps(&amm, &fem).unwrap();
     let mean = e.mean.expect("the tips move");
     eprintln!(

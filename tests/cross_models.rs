@@ -41,12 +41,20 @@ const TARGETS: Bounds = Bounds {
 
 fn check(text: &str, t_move: f64, bounds: Bounds) {
     let exp = Experiment::from_toml_str(text, Path::new("own.toml")).unwrap();
-    let fem = flexstar_fem::solve(&exp, &FemSettings::default(), flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
-    let amm = flexstar_amm::solve(&exp, &AmmSettings::accurate(), flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let fem = flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &FemSettings::default(),
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
+    let amm = flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        &AmmSettings::accurate(),
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let e = point_evps(&amm, &fem).unwrap();
     let mean = e.mean.expect("the tips move");
     let estimate = amm
@@ -120,16 +128,24 @@ fn foreshortening_inertia_holds_at_twice_brisks_amplitude() {
     } else {
         panic!("brisk is a quintic");
     }
-    let fem = flexstar_fem::solve(&exp, &FemSettings::default(), flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let fem = flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &FemSettings::default(),
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let settings = AmmSettings {
         modes: Some(53),
         ..AmmSettings::accurate()
     };
-    let amm = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let amm = flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let e = point_evps(&amm, &fem).unwrap();
     eprintln!("brisk x 2: EVP A/B/C/G = {:?}", e.points);
     let g = e.points[3].expect("G moves");

@@ -17,8 +17,9 @@ fn paper_cases(c: &mut Criterion) {
             let exp = common::paper_case(case);
             let settings = common::settings(fam, 25, None);
             group.bench_function(format!("case{case}_{fam}"), |b| {
+                let problem = exp.problem().unwrap();
                 b.iter(|| {
-                    flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+                    flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
                         .map(|s| s.response)
                         .unwrap()
                 })
@@ -38,8 +39,9 @@ fn accurate_model(c: &mut Criterion) {
         let exp = common::paper_case(case);
         let settings = flexstar_model::AmmSettings::accurate();
         group.bench_function(format!("case{case}_auto"), |b| {
+            let problem = exp.problem().unwrap();
             b.iter(|| {
-                flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+                flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
                     .map(|s| s.response)
                     .unwrap()
             })
@@ -51,8 +53,9 @@ fn accurate_model(c: &mut Criterion) {
         ..flexstar_model::AmmSettings::accurate()
     };
     group.bench_function("case3_n53", |b| {
+        let problem = exp.problem().unwrap();
         b.iter(|| {
-            flexstar_amm::solve(&exp, &fixed, flexstar_drive::SolveRequest::motion())
+            flexstar_amm::solve(&problem, &fixed, flexstar_drive::SolveRequest::motion())
                 .map(|s| s.response)
                 .unwrap()
         })
@@ -74,9 +77,13 @@ fn direct_vs_inverse(c: &mut Criterion) {
     };
     for (label, settings) in [("n25_free-free", paper), ("n53_accurate", accurate)] {
         let exp = common::paper_case(3);
-        let inverse = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let inverse = flexstar_amm::solve(
+            &exp.problem().unwrap(),
+            &settings,
+            flexstar_drive::SolveRequest::motion(),
+        )
+        .map(|s| s.response)
+        .unwrap();
         let fa = (0..inverse.len())
             .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
             .collect();
@@ -91,22 +98,25 @@ fn direct_vs_inverse(c: &mut Criterion) {
             attached: Default::default(),
         };
         group.bench_function(format!("case3_{label}_inverse"), |b| {
+            let problem = exp.problem().unwrap();
             b.iter(|| {
-                flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+                flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
                     .map(|s| s.response)
                     .unwrap()
             })
         });
         group.bench_function(format!("case3_{label}_direct_forces"), |b| {
+            let problem = exp.problem().unwrap();
             b.iter(|| {
-                flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&table))
+                flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&table))
                     .map(|s| s.response)
                     .unwrap()
             })
         });
         group.bench_function(format!("case3_{label}_direct_servo"), |b| {
+            let problem = exp.problem().unwrap();
             b.iter(|| {
-                flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&servo))
+                flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&servo))
                     .map(|s| s.response)
                     .unwrap()
             })
@@ -137,8 +147,9 @@ fn attachments(c: &mut Criterion) {
     };
     for (label, exp) in [("bare", &bare), ("payload_damping_load", &loaded)] {
         group.bench_function(format!("case3_n53_{label}"), |b| {
+            let problem = exp.problem().unwrap();
             b.iter(|| {
-                flexstar_amm::solve(exp, &fixed, flexstar_drive::SolveRequest::motion())
+                flexstar_amm::solve(&problem, &fixed, flexstar_drive::SolveRequest::motion())
                     .map(|s| s.response)
                     .unwrap()
             })

@@ -20,9 +20,13 @@ fn main() {
         modes: args.get(2).map(|n| n.parse().expect(usage)),
         ..AmmSettings::accurate()
     };
-    let r = flexstar_amm::solve(&paper_case(case), &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .expect("solve");
+    let r = flexstar_amm::solve(
+        &paper_case(case).problem().unwrap(),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .expect("solve");
     println!(
         "case {case}: N = {:?}, estimate {:?} %, {} output rows",
         r.info.modes,

@@ -27,7 +27,9 @@ fn subsample(r: &flexstar_model::Response, every: usize) -> flexstar_model::Resp
 
 /// Mean EVP of the N-run at step `k h` against the same N at `h` (the time error of the coarse step).
 fn time_error(exp: &Experiment, k: usize) -> f64 {
-    let n = next_modes(first_modes(exp));
+    let n = next_modes(first_modes(
+        &exp.problem().expect("valid problem").equal_beams().expect("paper form"),
+    ));
     let run = |dt: f64, dt_out: f64| {
         let mut e = exp.clone();
         e.time.dt_out = dt_out;
@@ -36,7 +38,7 @@ fn time_error(exp: &Experiment, k: usize) -> f64 {
             dt: Some(dt),
             ..AmmSettings::default()
         };
-        flexstar_amm::solve(&e, &s, flexstar_drive::SolveRequest::motion())
+        flexstar_amm::solve(&e.problem().unwrap(), &s, flexstar_drive::SolveRequest::motion())
             .map(|s| s.response)
             .expect("solve")
     };
@@ -52,7 +54,7 @@ fn time_error(exp: &Experiment, k: usize) -> f64 {
 fn pair_difference(exp: &Experiment, dt: f64) -> (f64, f64) {
     let mut e = exp.clone();
     e.time.dt_out = e.time.dt_out.max(dt);
-    let n = first_modes(&e);
+    let n = first_modes(&e.problem().expect("valid problem").equal_beams().expect("paper form"));
     let run = |m: usize| {
         let s = AmmSettings {
             modes: Some(m),
@@ -60,7 +62,7 @@ fn pair_difference(exp: &Experiment, dt: f64) -> (f64, f64) {
             ..AmmSettings::default()
         };
         let t = std::time::Instant::now();
-        let r = flexstar_amm::solve(&e, &s, flexstar_drive::SolveRequest::motion())
+        let r = flexstar_amm::solve(&e.problem().unwrap(), &s, flexstar_drive::SolveRequest::motion())
             .map(|s| s.response)
             .expect("solve");
         (r, t.elapsed().as_secs_f64())

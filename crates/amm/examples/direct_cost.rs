@@ -31,9 +31,13 @@ fn main() {
             ..AmmSettings::accurate()
         },
     };
-    let inverse = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let inverse = flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let fa = (0..inverse.len())
         .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
         .collect();
@@ -49,9 +53,24 @@ fn main() {
     };
     let r = match kind.as_str() {
         "setup" => Ok(inverse),
-        "inverse" => flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::motion()).map(|s| s.response),
-        "forces" => flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&table)).map(|s| s.response),
-        _ => flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&servo)).map(|s| s.response),
+        "inverse" => flexstar_amm::solve(
+            &exp.problem().unwrap(),
+            &settings,
+            flexstar_drive::SolveRequest::motion(),
+        )
+        .map(|s| s.response),
+        "forces" => flexstar_amm::solve(
+            &exp.problem().unwrap(),
+            &settings,
+            flexstar_drive::SolveRequest::law(&table),
+        )
+        .map(|s| s.response),
+        _ => flexstar_amm::solve(
+            &exp.problem().unwrap(),
+            &settings,
+            flexstar_drive::SolveRequest::law(&servo),
+        )
+        .map(|s| s.response),
     }
     .unwrap();
     eprintln!("{} rows", r.len());

@@ -23,11 +23,17 @@ fn main() {
         let path = std::path::Path::new(&file);
         let text = std::fs::read_to_string(path).expect("readable file");
         let exp = Experiment::from_toml_str(&text, path).expect("valid experiment");
-        let auto = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .expect("automatic choice");
+        let auto = flexstar_amm::solve(
+            &exp.problem().unwrap(),
+            &exp.amm,
+            flexstar_drive::SolveRequest::motion(),
+        )
+        .map(|s| s.response)
+        .expect("automatic choice");
         let (n, h) = (auto.info.modes.expect("N"), auto.info.dt);
-        let coarse = estimate_grid(&exp, h).expect("a span long enough for the estimate's grid");
+        let problem = exp.problem().expect("valid problem");
+        let equal = problem.equal_beams().expect("the paper's robot form");
+        let coarse = estimate_grid(&equal, h).expect("a span long enough for the estimate's grid");
         let run = |step: f64, every: usize| {
             let mut e = exp.clone();
             e.time.dt_out = every as f64 * exp.time.dt_out;
@@ -38,11 +44,11 @@ fn main() {
                 frames: 0,
                 ..exp.amm.clone()
             };
-            flexstar_amm::solve(&e, &s, flexstar_drive::SolveRequest::motion())
+            flexstar_amm::solve(&e.problem().unwrap(), &s, flexstar_drive::SolveRequest::motion())
                 .map(|s| s.response)
                 .expect("solve")
         };
-        let check = time_check_grid(&exp, h);
+        let check = time_check_grid(&equal, h);
         let [e_check, e2] = {
             let delivered = run(h, check);
             [

@@ -24,7 +24,7 @@
 //! geometric part the AMM leaves out ([`geometric_part`], Eq. G1, 12.9).
 
 use flexstar_model::evp::point_evps;
-use flexstar_model::{Experiment, Response};
+use flexstar_model::{EqualBeams, Response};
 
 use crate::error::AmmError;
 
@@ -77,10 +77,10 @@ pub fn time_error_estimate(e_check: f64) -> f64 {
 pub const GEOMETRIC_COEFF: f64 = 0.5;
 
 /// Eq. G1 [%]: the estimate's part for the geometric nonlinearity the AMM leaves out, from the
-/// run `r` of `exp` (tips w_i(L) and junction values w_iG [m], the robot's L [m]).
-pub fn geometric_part(exp: &Experiment, r: &Response) -> f64 {
+/// run `r` of `problem` (tips w_i(L) and junction values w_iG [m], the robot's L [m]).
+pub fn geometric_part(problem: &EqualBeams, r: &Response) -> f64 {
     let largest = |h: &[Vec<f64>; 3]| h.iter().flatten().fold(0.0f64, |m, w| m.max(w.abs()));
-    let a = largest(&r.w_tip).max(largest(&r.w_g)) / exp.robot.l;
+    let a = largest(&r.w_tip).max(largest(&r.w_g)) / problem.robot.l;
     GEOMETRIC_COEFF * 100.0 * a * a
 }
 
@@ -89,12 +89,12 @@ pub fn geometric_part(exp: &Experiment, r: &Response) -> f64 {
 pub const MIN_ESTIMATE_ROWS: usize = 20;
 
 /// The coarse output grid of the estimate's runs for a delivered step `h` [s]: its interval is
-/// `every` times `exp.time.dt_out`, the first multiple at least [`ESTIMATE_STEP_FACTOR`] h, so that
+/// `every` times `problem.time.dt_out`, the first multiple at least [`ESTIMATE_STEP_FACTOR`] h, so that
 /// its times are a subset of the delivered ones. `None` (pairs at the delivered step) when that grid
 /// would have fewer than [`MIN_ESTIMATE_ROWS`] rows.
-pub fn estimate_grid(exp: &Experiment, h: f64) -> Option<usize> {
-    let every = output_multiple(exp, ESTIMATE_STEP_FACTOR * h);
-    let rows = (exp.time.t_end / (every as f64 * exp.time.dt_out) - 1e-9).ceil() + 1.0;
+pub fn estimate_grid(problem: &EqualBeams, h: f64) -> Option<usize> {
+    let every = output_multiple(problem, ESTIMATE_STEP_FACTOR * h);
+    let rows = (problem.time.t_end / (every as f64 * problem.time.dt_out) - 1e-9).ceil() + 1.0;
     (rows >= MIN_ESTIMATE_ROWS as f64).then_some(every)
 }
 
@@ -103,14 +103,14 @@ pub fn estimate_grid(exp: &Experiment, h: f64) -> Option<usize> {
 /// Its EVP is measured where the delivered run's own EVP is: on the estimate's coarser grid a
 /// response with fast components (w_G) can read a difference 1.5 times larger or smaller
 /// (`docs/amm.md` 12.10).
-pub fn time_check_grid(exp: &Experiment, h: f64) -> usize {
-    output_multiple(exp, TIME_CHECK_STEP_FACTOR * h)
+pub fn time_check_grid(problem: &EqualBeams, h: f64) -> usize {
+    output_multiple(problem, TIME_CHECK_STEP_FACTOR * h)
 }
 
-/// The smallest k >= 1 with `k exp.time.dt_out >= step` (to round-off): the output grid, a
+/// The smallest k >= 1 with `k problem.time.dt_out >= step` (to round-off): the output grid, a
 /// subset of the delivered one, that a run at `step` [s] can fill.
-fn output_multiple(exp: &Experiment, step: f64) -> usize {
-    ((step / exp.time.dt_out) - 1e-9).ceil().max(1.0) as usize
+fn output_multiple(problem: &EqualBeams, step: f64) -> usize {
+    ((step / problem.time.dt_out) - 1e-9).ceil().max(1.0) as usize
 }
 
 /// Modes beyond the sleeve resolution `2 L / Lp` with which the automatic choice starts: at
@@ -120,8 +120,8 @@ pub const START_MARGIN: usize = 12;
 
 /// First N of the automatic choice: the modes resolve the sleeve (`2 L / Lp`) plus
 /// [`START_MARGIN`], at least 8 and at most [`MAX_AUTO_MODES`].
-pub fn first_modes(exp: &Experiment) -> usize {
-    let resolve = (2.0 * exp.robot.l / exp.robot.lp).ceil();
+pub fn first_modes(problem: &EqualBeams) -> usize {
+    let resolve = (2.0 * problem.robot.l / problem.robot.lp).ceil();
     let n = if resolve.is_finite() {
         resolve as usize
     } else {
@@ -159,7 +159,7 @@ pub(crate) enum Pass {
 /// The estimate's pair at N_prev and N, found by raising N from [`first_modes`] at `pass` until
 /// the estimate of the N-run is below `tol`: `(N, estimate, the N-run, wall time of all runs)`.
 fn raise_until_below<F>(
-    exp: &Experiment,
+    problem: &EqualBeams,
     tol: f64,
     pass: Pass,
     run: &mut F,
@@ -167,7 +167,7 @@ fn raise_until_below<F>(
 where
     F: FnMut(usize, Pass) -> Result<Response, AmmError>,
 {
-    let mut n = first_modes(exp);
+    let mut n = first_modes(problem);
     let mut prev = run(n, pass)?;
     let mut wall = prev.info.wall_s;
     let mut reached = f64::NAN;
@@ -203,7 +203,7 @@ where
 /// `info.tol_percent` set, its wall time the sum over the runs. Fails with the estimate reached
 /// when the tolerance is not met at [`MAX_AUTO_MODES`].
 pub(crate) fn solve_to_tolerance<F>(
-    exp: &Experiment,
+    problem: &EqualBeams,
     tol: f64,
     every: Option<usize>,
     check_every: usize,
@@ -217,7 +217,7 @@ where
     let mut time_part = 0.0;
     if let Some(every) = every {
         let pass = Pass::Estimate { every };
-        let (n, estimate, coarse, pair_wall) = raise_until_below(exp, tol, pass, &mut run)?;
+        let (n, estimate, coarse, pair_wall) = raise_until_below(problem, tol, pass, &mut run)?;
         // the time check before the delivered run, so that the delivered run is the last one
         let check = run(n, Pass::TimeCheck { every: check_every })?;
         let delivered = run(n, Pass::Deliver)?;
@@ -227,11 +227,11 @@ where
         // (also the fallback's time part: its delivered run takes the same step h)
         time_part = time_error_estimate(mean_evp(&check, &delivered.every_nth(check_every)));
         if time_error <= MAX_ESTIMATE_TIME_ERROR {
-            return Ok(finish(exp, delivered, estimate + time_part, tol, wall));
+            return Ok(finish(problem, delivered, estimate + time_part, tol, wall));
         }
     }
-    let (_, estimate, delivered, pair_wall) = raise_until_below(exp, tol, Pass::Deliver, &mut run)?;
-    Ok(finish(exp, delivered, estimate + time_part, tol, wall + pair_wall))
+    let (_, estimate, delivered, pair_wall) = raise_until_below(problem, tol, Pass::Deliver, &mut run)?;
+    Ok(finish(problem, delivered, estimate + time_part, tol, wall + pair_wall))
 }
 
 /// Mean EVP [%] (Eq. 45) of `run` against `reference` on the reference's times; `None` when the
@@ -248,8 +248,8 @@ fn mean_evp(run: &Response, reference: &Response) -> f64 {
 
 /// The delivered run with the automatic choice's report: `estimate` (truncation and time) plus
 /// the geometric part of the delivered run ([`geometric_part`]).
-fn finish(exp: &Experiment, mut delivered: Response, estimate: f64, tol: f64, wall: f64) -> Response {
-    let geometric = geometric_part(exp, &delivered);
+fn finish(problem: &EqualBeams, mut delivered: Response, estimate: f64, tol: f64, wall: f64) -> Response {
+    let geometric = geometric_part(problem, &delivered);
     delivered.info.error_estimate_percent = Some(estimate + geometric);
     delivered.info.tol_percent = Some(tol);
     delivered.info.wall_s = wall;
@@ -265,6 +265,8 @@ mod tests {
     fn sequence_starts_at_the_sleeve_resolution_and_ends_at_the_cap() {
         // paper robot: 2 L / Lp = 2 * 0.5 / 0.03 = 33.3 -> 34 modes resolve the sleeve
         let exp = paper_case(1);
+        let problem = exp.problem().unwrap();
+        let exp = problem.equal_beams().unwrap();
         assert_eq!(first_modes(&exp), 34 + START_MARGIN);
         let mut n = first_modes(&exp);
         let mut steps = 0;
@@ -280,7 +282,7 @@ mod tests {
     /// A model response on `exp`'s grid (every `every`-th row): tips `(1 + e) sin(2 pi t)` with a
     /// truncation error e = 0.3 % (53 / N)^7 (so that N = 53 is the first whose estimate, exactly
     /// 0.3 % for a pure power law, is below 0.5 %) plus `time_error`.
-    fn model(exp: &Experiment, every: usize, n: usize, time_error: f64) -> Response {
+    fn model(exp: &EqualBeams, every: usize, n: usize, time_error: f64) -> Response {
         let e = 0.003 * (53.0 / n as f64).powi(7) + time_error;
         let mut r = Response::with_capacity("model", 0);
         for t in exp.time.output_times() {
@@ -293,6 +295,8 @@ mod tests {
     #[test]
     fn coarse_pairs_then_one_delivered_run_or_the_fallback_when_the_coarse_step_is_too_rough() {
         let exp = paper_case(3);
+        let problem = exp.problem().unwrap();
+        let exp = problem.equal_beams().unwrap();
         let every = estimate_grid(&exp, 5e-4).expect("0.5 s at 1 ms outputs gives a coarse grid");
         assert_eq!(every, 4, "8 x 0.5 ms = 4 ms on a 1 ms output grid");
         // time error c (k h)^p, 2^p - 1 = TIME_CHECK_RATIO, c set by the coarse run's E(8 h, h)
@@ -333,6 +337,7 @@ mod tests {
         // too short a span for 20 coarse rows: pairs at the delivered step
         let mut short = paper_case(3);
         short.time.t_end = 0.05;
-        assert_eq!(estimate_grid(&short, 5e-4), None);
+        let problem = short.problem().unwrap();
+        assert_eq!(estimate_grid(&problem.equal_beams().unwrap(), 5e-4), None);
     }
 }

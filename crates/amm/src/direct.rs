@@ -21,7 +21,7 @@
 
 use flexstar_drive::ActuatorLaw;
 use flexstar_kinematics::{check_configuration, direct_kinematics, RigidState};
-use flexstar_model::{AmmSettings, Experiment, ModeCount, Response, RobotParams};
+use flexstar_model::{AmmSettings, EqualBeams, ModeCount, Response, RobotParams};
 use flexstar_numerics::GenAlpha;
 use num_dual::{Dual2, HyperDual64};
 
@@ -37,7 +37,7 @@ use crate::system::System;
 pub const DIRECT_COLUMNS: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "Gy", "theta"];
 
 /// The direct problem (`crate::solve` with `Drive::Law`): the sliders driven by `law`, from `s(0)`,
-/// `s'(0)` of `exp.trajectory` at t = 0 with the star at rest elastically (as an inverse run
+/// `s'(0)` of `problem.trajectory` at t = 0 with the star at rest elastically (as an inverse run
 /// starts).
 ///
 /// Returns the response labelled `amm-<family>-direct` (`info.solver = "amm-direct"`): the
@@ -49,21 +49,21 @@ pub const DIRECT_COLUMNS: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "G
 /// else its start only. The configuration reached is checked at every step: leaving the feasible
 /// range stops the run with the time (to one step) and the reason.
 pub(crate) fn solve_direct_scanned(
-    exp: &Experiment,
+    problem: &EqualBeams,
     settings: &AmmSettings,
     law: &dyn ActuatorLaw,
     scan: bool,
 ) -> Result<(Response, Stats), AmmError> {
     let mut runs = Vec::new();
     let response = match settings.mode_count() {
-        ModeCount::Fixed(n) => integrate_direct(exp, settings, law, n, scan, &mut runs)?,
+        ModeCount::Fixed(n) => integrate_direct(problem, settings, law, n, scan, &mut runs)?,
         ModeCount::Tolerance(tol) => {
-            validate(exp, settings, adaptive::first_modes(exp), scan)?;
+            validate(problem, settings, adaptive::first_modes(problem), scan)?;
             // the pairs at the delivered step: the coarse-step estimate (`adaptive`) is measured
             // on inverse runs only, and a servo's loop may not tolerate the coarse step
             // (the reference was scanned once just above: not again per N)
-            adaptive::solve_to_tolerance(exp, tol, None, 1, |n, _| {
-                integrate_direct(exp, settings, law, n, false, &mut runs)
+            adaptive::solve_to_tolerance(problem, tol, None, 1, |n, _| {
+                integrate_direct(problem, settings, law, n, false, &mut runs)
             })?
         }
     };
@@ -211,7 +211,7 @@ fn solve3(a: [[f64; 4]; 3]) -> Option<[f64; 3]> {
 /// [`solve_direct_scanned`] at N = `n_modes`: the system and recorder set up, the consistent start, then
 /// generalized-alpha substeps between consecutive stops (output times and snapshots).
 fn integrate_direct(
-    exp: &Experiment,
+    problem: &EqualBeams,
     settings: &AmmSettings,
     law: &dyn ActuatorLaw,
     n_modes: usize,
@@ -219,15 +219,15 @@ fn integrate_direct(
     runs: &mut Vec<(usize, usize)>,
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
-    let dt_max = validate(exp, settings, n_modes, scan)?;
-    let params = &exp.robot;
+    let dt_max = validate(problem, settings, n_modes, scan)?;
+    let params = &problem.robot;
     let mut steps = 0;
-    let mut sys = crate::solver::build_system(settings, n_modes, exp)?;
+    let mut sys = crate::solver::build_system(settings, n_modes, problem)?;
     let n = sys.dim();
 
-    let out_times = exp.time.output_times();
-    let times = shape_times(exp, settings);
-    let stops = stops(&out_times, &times.all, 1e-9 * exp.time.dt_out);
+    let out_times = problem.time.output_times();
+    let times = shape_times(problem, settings);
+    let stops = stops(&out_times, &times.all, 1e-9 * problem.time.dt_out);
     let mut out = DirectOutput {
         rec: Recorder::new(&sys, settings, params, out_times.len(), times),
         cols: (0..DIRECT_COLUMNS.len())
@@ -242,7 +242,7 @@ fn integrate_direct(
         params,
     };
 
-    let mut state = initial_state(exp, &mut ctx, &out.rec, n)?;
+    let mut state = initial_state(problem, &mut ctx, &out.rec, n)?;
     out.record(&ctx, &stops[0], 0.0, &state)?;
 
     let ga = GenAlpha::new(RHO_INF);
@@ -307,10 +307,15 @@ impl Predictors {
 
 /// The initial state: s, s' of the trajectory at t = 0, the star at rest elastically; consistent
 /// accelerations of both (bp = gp = 0: the step is linear, the solve exact).
-fn initial_state(exp: &Experiment, ctx: &mut StepContext, rec: &Recorder, n: usize) -> Result<DirectState, AmmError> {
+fn initial_state(
+    problem: &EqualBeams,
+    ctx: &mut StepContext,
+    rec: &Recorder,
+    n: usize,
+) -> Result<DirectState, AmmError> {
     let (q, v) = (vec![0.0; n], vec![0.0; n]);
     let mut qdd = vec![0.0; n];
-    let jets = exp.trajectory.jets(ctx.params, 0.0)?;
+    let jets = problem.trajectory.jets(ctx.params, 0.0)?;
     let (s, sd) = (jets.map(|j| j.v), jets.map(|j| j.d1));
     let sdd = coupled_step(
         ctx.sys,

@@ -114,6 +114,8 @@ mod tests {
             std::path::Path::new("brisk.toml"),
         )
         .unwrap();
+        let problem = exp.problem().unwrap();
+        let exp = problem.equal_beams().unwrap();
         let n = 53;
         let settings = AmmSettings {
             modes: Some(n),

@@ -9,7 +9,7 @@
 //! - `system` (private): the constrained linear time-varying equations (Eqs. 37, 44, 31 with the
 //!   constraints of Eqs. 38-43) and their per-step linear solve;
 //! - `sleeve` (private): the passive prismatic joint, its rows (Eqs. 41-43) and multipliers, the
-//!   full model's material point in it and the residual flexibility seen there (`docs/amm.md`
+//!   full model's material point in it and the truncation flexibility seen there (`docs/amm.md`
 //!   section 1, 12.3, 12.11);
 //! - [`pose_modes`]: the modes of the star held at rest at one pose, and its linearised system;
 //! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]);
@@ -48,9 +48,9 @@ pub use solver::{
 /// payload's translation, slide-free (`phi'(0) = 0`) the moment and the payload's rotation,
 /// clamped-free both. `None` for free-free and enriched, which carry them completely, or when
 /// the experiment has neither a payload nor a load.
-pub fn attachments_lost(family: flexstar_model::ModeFamily, exp: &flexstar_model::Experiment) -> Option<String> {
+pub fn attachments_lost(family: flexstar_model::ModeFamily, problem: &flexstar_model::Problem) -> Option<String> {
     use flexstar_model::ModeFamily;
-    if exp.payload.is_none() && exp.load.is_none() {
+    if problem.payload().is_none() && problem.load().is_none() {
         return None;
     }
     let lost = match family {

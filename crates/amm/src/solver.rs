@@ -15,7 +15,9 @@ use flexstar_kinematics::{
 };
 use flexstar_model::animation::{frame_times, ShapeTimes};
 use flexstar_model::config::check_step;
-use flexstar_model::{AmmSettings, DriveKind, Experiment, ModeCount, ModeFamily, Response, RunInfo};
+#[cfg(test)]
+use flexstar_model::Experiment;
+use flexstar_model::{AmmSettings, DriveKind, EqualBeams, ModeCount, ModeFamily, Problem, Response, RunInfo};
 use flexstar_numerics::GenAlpha;
 
 use crate::adaptive::{self, Pass};
@@ -77,17 +79,17 @@ pub const EXTRA_COLUMNS: [&str; 27] = [
     "FRp3", "Mp1", "Mp2", "Mp3", "thp1", "thp2", "thp3", "u1", "u2", "u3", "dGx", "dGy",
 ];
 
-/// Check everything the solver needs before any work; returns the step ceiling [s].
+/// Check the settings against the problem (validated when it was built) before any work; returns
+/// the step ceiling [s].
 /// `scan`: check the trajectory's feasibility over the whole span (an inverse run, or a servo's
 /// reference); otherwise only its start configuration (a forces-driven run).
-pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, scan: bool) -> Result<f64, AmmError> {
-    exp.robot.validate()?;
-    exp.time.validate()?;
-    exp.trajectory.validate(&exp.robot)?;
-    exp.payload.validate()?;
-    exp.damping.validate()?;
-    exp.load.validate(exp.time.t_end)?;
-    settings.validate(exp.time.dt_out).map_err(|e| match e {
+pub(crate) fn validate(
+    problem: &EqualBeams,
+    settings: &AmmSettings,
+    modes: usize,
+    scan: bool,
+) -> Result<f64, AmmError> {
+    settings.validate(problem.time.dt_out).map_err(|e| match e {
         flexstar_model::ModelError::Invalid { key, reason, .. } => AmmError::invalid(key, reason),
         other => other.into(),
     })?;
@@ -97,56 +99,61 @@ pub(crate) fn validate(exp: &Experiment, settings: &AmmSettings, modes: usize, s
             format!("need 1 <= modes <= {MAX_MODES}, got {modes}"),
         ));
     }
-    if exp.robot.jp <= 0.0 {
+    if problem.robot.jp <= 0.0 {
         return Err(AmmError::invalid(
             "robot.Jp",
             format!(
                 "the AMM needs a sleeve with rotational inertia (Eq. 31): Jp > 0, got {}",
-                exp.robot.jp
+                problem.robot.jp
             ),
         ));
     }
     let dt = match settings.dt {
         Some(dt) => {
-            check_step("amm.dt", dt, exp.time.dt_out)?;
+            check_step("amm.dt", dt, problem.time.dt_out)?;
             dt
         }
         None => match settings.mode_count() {
-            ModeCount::Tolerance(tol) => tolerance_step(tol) * robot_step_factor(&exp.robot),
+            ModeCount::Tolerance(tol) => tolerance_step(tol) * robot_step_factor(&problem.robot),
             ModeCount::Fixed(_) => DEFAULT_DT,
         }
-        .min(exp.time.dt_out),
+        .min(problem.time.dt_out),
     };
-    if exp.time.t_end / dt > 1e8 {
+    if problem.time.t_end / dt > 1e8 {
         return Err(AmmError::invalid(
             "amm.dt",
-            format!("more than 1e8 steps ({} s / {dt} s)", exp.time.t_end),
+            format!("more than 1e8 steps ({} s / {dt} s)", problem.time.t_end),
         ));
     }
     if let Some(bad) = settings
         .snapshots
         .iter()
-        .find(|t| !t.is_finite() || **t < 0.0 || **t > exp.time.t_end)
+        .find(|t| !t.is_finite() || **t < 0.0 || **t > problem.time.t_end)
     {
         return Err(AmmError::invalid(
             "amm.snapshots",
-            format!("snapshot times must lie in [0, t_end = {}], got {bad}", exp.time.t_end),
+            format!(
+                "snapshot times must lie in [0, t_end = {}], got {bad}",
+                problem.time.t_end
+            ),
         ));
     }
-    flexstar_model::animation::check_frames("amm.frames", settings.frames, exp.time.t_end).map_err(|e| match e {
-        flexstar_model::ModelError::Invalid { key, reason, .. } => AmmError::invalid(key, reason),
-        other => other.into(),
-    })?;
+    flexstar_model::animation::check_frames("amm.frames", settings.frames, problem.time.t_end).map_err(
+        |e| match e {
+            flexstar_model::ModelError::Invalid { key, reason, .. } => AmmError::invalid(key, reason),
+            other => other.into(),
+        },
+    )?;
     if scan {
         check_trajectory(
-            &exp.robot,
-            &exp.trajectory,
-            exp.time.t_end,
-            preflight_step(exp.time.dt_out),
+            &problem.robot,
+            &problem.trajectory,
+            problem.time.t_end,
+            preflight_step(problem.time.dt_out),
         )?;
     } else {
-        let s0 = exp.trajectory.s(&exp.robot, 0.0)?;
-        check_configuration(&exp.robot, s0).map_err(|violation| Infeasible { t: 0.0, violation })?;
+        let s0 = problem.trajectory.s(&problem.robot, 0.0)?;
+        check_configuration(&problem.robot, s0).map_err(|violation| Infeasible { t: 0.0, violation })?;
     }
     Ok(dt)
 }
@@ -186,12 +193,12 @@ pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 /// Solve the paper's constrained assumed-modes model (Eqs. 30-44) for one experiment: the one
 /// entry point of the AMM, for both drives of `request` (`flexstar_drive::SolveRequest`).
 ///
-/// `settings` are the `[amm]` settings after command-line overrides (`exp.amm` is not read).
+/// `settings` are the `[amm]` settings after command-line overrides (`problem.amm` is not read).
 /// `request.proof`: the trajectory is scanned for feasibility only when the preflight's proof does
 /// not cover this experiment's robot, trajectory and span. `request.progress` is called once, with
 /// 1, when the solve has finished.
 ///
-/// The prescribed motion ([`Drive::Motion`], the inverse problem) returns the response at `exp.time.output_times()`, labelled `amm-<family>`: `w_iG = w_i(0)`,
+/// The prescribed motion ([`Drive::Motion`], the inverse problem) returns the response at `problem.time.output_times()`, labelled `amm-<family>`: `w_iG = w_i(0)`,
 /// tip `w_i(L)` (rigid beam frames, `docs/conventions.md`) [m], `Fa_i` (Eq. 33) [N], then the
 /// columns [`EXTRA_COLUMNS`]: every multiplier (Fix [N], MiG [N m], Fw, Fp, FLp, FRp [N],
 /// Mp [N m]), the sleeve rotations thp_i [rad] and the axial displacements u_i [m]; and the
@@ -207,14 +214,15 @@ pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 ///
 /// An actuator law ([`Drive::Law`], the direct problem) returns the response described in
 /// [`crate::direct`] (labelled `amm-<family>-direct`).
-pub fn solve(exp: &Experiment, settings: &AmmSettings, request: SolveRequest) -> Result<Solved<Stats>, AmmError> {
-    let covered = request.proof.is_some_and(|c| covers(c, exp));
+pub fn solve(problem: &Problem, settings: &AmmSettings, request: SolveRequest) -> Result<Solved<Stats>, AmmError> {
+    let problem = &problem.equal_beams()?;
+    let covered = request.proof.is_some_and(|c| covers(c, problem));
     let (response, stats) = match request.drive {
-        Drive::Motion => solve_scanned(exp, settings, !covered)?,
+        Drive::Motion => solve_scanned(problem, settings, !covered)?,
         Drive::Law(law) => {
             // the direct problem scans a servo's reference (its motion), else the start only
-            let scan = exp.drive.kind == DriveKind::Servo && !covered;
-            crate::direct::solve_direct_scanned(exp, settings, law, scan)?
+            let scan = problem.drive.kind == DriveKind::Servo && !covered;
+            crate::direct::solve_direct_scanned(problem, settings, law, scan)?
         }
     };
     if let Some(progress) = request.progress {
@@ -258,27 +266,27 @@ impl Stats {
     }
 }
 
-/// Does `checked` cover the scan a run of `exp` would make?
-pub(crate) fn covers(checked: &CheckedMotion, exp: &Experiment) -> bool {
+/// Does `checked` cover the scan a run of `problem` would make?
+pub(crate) fn covers(checked: &CheckedMotion, problem: &EqualBeams) -> bool {
     checked.covers(
-        &exp.robot,
-        &exp.trajectory,
-        exp.time.t_end,
-        preflight_step(exp.time.dt_out),
+        &problem.robot,
+        &problem.trajectory,
+        problem.time.t_end,
+        preflight_step(problem.time.dt_out),
     )
 }
 
 /// [`solve`] of the prescribed motion; `scan`: check the trajectory's feasibility over the whole span first.
-fn solve_scanned(exp: &Experiment, settings: &AmmSettings, scan: bool) -> Result<(Response, Stats), AmmError> {
+fn solve_scanned(problem: &EqualBeams, settings: &AmmSettings, scan: bool) -> Result<(Response, Stats), AmmError> {
     let mut runs = Vec::new();
     let resp = match settings.mode_count() {
         ModeCount::Fixed(n) => {
             let mut steps = 0;
-            let r = integrate(exp, settings, n, scan, |_, _| steps += 1)?;
+            let r = integrate(problem, settings, n, scan, |_, _| steps += 1)?;
             runs.push((n, steps));
             r
         }
-        ModeCount::Tolerance(tol) => solve_to_tolerance(exp, settings, tol, scan, &mut runs)?,
+        ModeCount::Tolerance(tol) => solve_to_tolerance(problem, settings, tol, scan, &mut runs)?,
     };
     Ok((resp, Stats::from_runs(&runs)))
 }
@@ -288,7 +296,7 @@ fn solve_scanned(exp: &Experiment, settings: &AmmSettings, scan: bool) -> Result
 /// system of the last N is built once and reused by its runs at both steps. `runs` receives
 /// `(N, steps)` of every integration run, in order.
 fn solve_to_tolerance(
-    exp: &Experiment,
+    problem: &EqualBeams,
     settings: &AmmSettings,
     tol: f64,
     scan: bool,
@@ -296,31 +304,31 @@ fn solve_to_tolerance(
 ) -> Result<Response, AmmError> {
     // every input error before any work, at the first N; the trajectory is scanned once here
     // (unless the caller has)
-    let h = validate(exp, settings, adaptive::first_modes(exp), scan)?;
-    let every = adaptive::estimate_grid(exp, h);
-    let check_every = adaptive::time_check_grid(exp, h);
+    let h = validate(problem, settings, adaptive::first_modes(problem), scan)?;
+    let every = adaptive::estimate_grid(problem, h);
+    let check_every = adaptive::time_check_grid(problem, h);
     let mut built: Option<(usize, System)> = None;
-    adaptive::solve_to_tolerance(exp, tol, every, check_every, |n, pass| {
+    adaptive::solve_to_tolerance(problem, tol, every, check_every, |n, pass| {
         let started = std::time::Instant::now();
         let sys = match &built {
             Some((m, sys)) if *m == n => sys.clone(),
             _ => {
-                validate(exp, settings, n, false)?;
-                let sys = build_system(settings, n, exp)?;
+                validate(problem, settings, n, false)?;
+                let sys = build_system(settings, n, problem)?;
                 built = Some((n, sys.clone()));
                 sys
             }
         };
         let mut steps = 0;
         let resp = match pass {
-            Pass::Deliver => integrate_system(exp, settings, sys, h, started, |_, _| steps += 1),
+            Pass::Deliver => integrate_system(problem, settings, sys, h, started, |_, _| steps += 1),
             Pass::Estimate { every } => {
                 let factor = adaptive::ESTIMATE_STEP_FACTOR;
-                integrate_coarse(exp, settings, sys, h, factor, every, started, |_, _| steps += 1)
+                integrate_coarse(problem, settings, sys, h, factor, every, started, |_, _| steps += 1)
             }
             Pass::TimeCheck { every } => {
                 let factor = adaptive::TIME_CHECK_STEP_FACTOR;
-                integrate_coarse(exp, settings, sys, h, factor, every, started, |_, _| steps += 1)
+                integrate_coarse(problem, settings, sys, h, factor, every, started, |_, _| steps += 1)
             }
         };
         runs.push((n, steps));
@@ -329,11 +337,11 @@ fn solve_to_tolerance(
 }
 
 /// A run of the automatic choice at `factor` times the delivered step `h` [s] (at most the
-/// coarse output interval), output on a grid `every` times `exp.time.dt_out` (the estimate's or
+/// coarse output interval), output on a grid `every` times `problem.time.dt_out` (the estimate's or
 /// the time check's), no snapshots or frames.
 #[allow(clippy::too_many_arguments)]
 fn integrate_coarse<F: FnMut(&System, &[f64])>(
-    exp: &Experiment,
+    problem: &EqualBeams,
     settings: &AmmSettings,
     sys: System,
     h: f64,
@@ -342,8 +350,8 @@ fn integrate_coarse<F: FnMut(&System, &[f64])>(
     started: std::time::Instant,
     observe: F,
 ) -> Result<Response, AmmError> {
-    let mut coarse = exp.clone();
-    coarse.time.dt_out = every as f64 * exp.time.dt_out;
+    let mut coarse = *problem;
+    coarse.time.dt_out = every as f64 * problem.time.dt_out;
     let step = (factor * h).min(coarse.time.dt_out);
     let pair_settings = AmmSettings {
         dt: Some(step),
@@ -354,12 +362,12 @@ fn integrate_coarse<F: FnMut(&System, &[f64])>(
     integrate_system(&coarse, &pair_settings, sys, step, started, observe)
 }
 
-/// The constrained system of N = `n_modes` modes of `settings.family` for the robot of `exp`,
+/// The constrained system of N = `n_modes` modes of `settings.family` for the robot of `problem`,
 /// with its payload, damping and load (`docs/amm.md` section 11; nothing added at their defaults).
-pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, exp: &Experiment) -> Result<System, AmmError> {
-    let modes = ModeSet::new(settings.family, n_modes, &exp.robot)?;
-    let mut sys = System::new(modes, &exp.robot, settings.model);
-    sys.attach(&exp.payload, &exp.damping, &exp.load);
+pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, problem: &EqualBeams) -> Result<System, AmmError> {
+    let modes = ModeSet::new(settings.family, n_modes, &problem.robot)?;
+    let mut sys = System::new(modes, &problem.robot, settings.model);
+    sys.attach(&problem.payload, &problem.damping, &problem.load);
     Ok(sys)
 }
 
@@ -367,57 +375,58 @@ pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, exp: &Experim
 /// coordinates q; `scan`: check the trajectory's feasibility over the whole span first (off when
 /// the caller has, as the automatic N does once for all its runs).
 pub(crate) fn integrate<F: FnMut(&System, &[f64])>(
-    exp: &Experiment,
+    problem: &EqualBeams,
     settings: &AmmSettings,
     n_modes: usize,
     scan: bool,
     observe: F,
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
-    let dt_max = validate(exp, settings, n_modes, scan)?;
-    let sys = build_system(settings, n_modes, exp)?;
-    integrate_system(exp, settings, sys, dt_max, started, observe)
+    let dt_max = validate(problem, settings, n_modes, scan)?;
+    let sys = build_system(settings, n_modes, problem)?;
+    integrate_system(problem, settings, sys, dt_max, started, observe)
 }
 
 /// The snapshot times of the shapes file: the requested ones and `t_end`, sorted, duplicates
 /// (within 1e-9 of the output step) merged.
-pub(crate) fn snapshot_times(exp: &Experiment, settings: &AmmSettings) -> Vec<f64> {
+pub(crate) fn snapshot_times(problem: &EqualBeams, settings: &AmmSettings) -> Vec<f64> {
     let mut snaps: Vec<f64> = settings.snapshots.clone();
-    snaps.push(exp.time.t_end);
+    snaps.push(problem.time.t_end);
     snaps.sort_by(|a, b| a.total_cmp(b));
-    snaps.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * exp.time.dt_out);
+    snaps.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * problem.time.dt_out);
     snaps
 }
 
 /// The times at which the deformed star is recorded: the snapshots ([`snapshot_times`]) and the
 /// animation frames of `settings.frames` (`docs/motions.md` section 5), merged.
-pub(crate) fn shape_times(exp: &Experiment, settings: &AmmSettings) -> ShapeTimes {
-    let frames = frame_times(exp.time.t_end, settings.frames);
-    ShapeTimes::merge(&snapshot_times(exp, settings), &frames, 1e-9 * exp.time.dt_out)
+pub(crate) fn shape_times(problem: &EqualBeams, settings: &AmmSettings) -> ShapeTimes {
+    let frames = frame_times(problem.time.t_end, settings.frames);
+    ShapeTimes::merge(&snapshot_times(problem, settings), &frames, 1e-9 * problem.time.dt_out)
 }
 
 /// [`integrate`] with the system `sys` built (fresh, not yet stepped) and the inputs validated:
 /// steps of at most `dt_max` [s]; the reported wall time counts from `started`.
 pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
-    exp: &Experiment,
+    problem: &EqualBeams,
     settings: &AmmSettings,
     mut sys: System,
     dt_max: f64,
     started: std::time::Instant,
     mut observe: F,
 ) -> Result<Response, AmmError> {
-    let params = &exp.robot;
+    let params = &problem.robot;
     let n_modes = sys.modes.len();
     let (nm, n) = (sys.nm, sys.dim());
 
-    let out_times = exp.time.output_times();
-    let times = shape_times(exp, settings);
-    let stops = stops(&out_times, &times.all, 1e-9 * exp.time.dt_out);
+    let out_times = problem.time.output_times();
+    let times = shape_times(problem, settings);
+    let stops = stops(&out_times, &times.all, 1e-9 * problem.time.dt_out);
     let mut rec = Recorder::new(&sys, settings, params, out_times.len(), times);
     let ga = GenAlpha::new(RHO_INF);
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let kin = |t: f64| RigidState::at(params, &exp.trajectory, t).map_err(|source| AmmError::Kinematics { t, source });
+    let kin =
+        |t: f64| RigidState::at(params, &problem.trajectory, t).map_err(|source| AmmError::Kinematics { t, source });
 
     // consistent initial accelerations: M qdd = f + C^T lambda, C qdd = 0 (q = q' = 0)
     let mut st = kin(0.0)?;
@@ -528,8 +537,9 @@ mod tests {
         for fam in ModeFamily::PAPER {
             let settings = AmmSettings::paper(fam, 20);
             let (mut worst, mut qmax, mut steps) = (0.0f64, 0.0f64, 0);
-            integrate(&case([1.0, 0.0, 0.5], 0.2), &settings, 20, true, |sys, q| {
-                worst = worst.max(sys.constraint_residual(q));
+            let problem = case([1.0, 0.0, 0.5], 0.2).problem().unwrap();
+            integrate(&problem.equal_beams().unwrap(), &settings, 20, true, |sys, q| {
+                worst = worst.max(sys.constraint_violation(q));
                 qmax = qmax.max(q.iter().fold(0.0f64, |m, v| m.max(v.abs())));
                 steps += 1;
             })
@@ -548,6 +558,8 @@ mod tests {
         // better than the shift u w' that the paper's rows neglect and than the foreshortening
         // shift f w' that the rows at xp - u neglected (docs/amm.md 12.11)
         let exp = case([1.0, 0.0, 0.5], 0.3);
+        let problem = exp.problem().unwrap();
+        let exp = problem.equal_beams().unwrap();
         let settings = AmmSettings {
             modes: Some(30),
             ..AmmSettings::accurate()

@@ -230,7 +230,7 @@ pub(crate) struct System {
     /// that carry it, and its products with the predicted modal coordinates.
     geometric: Option<GeometricStiffness>,
     /// The sleeves (`crate::sleeve`): what their rows need per step (material point, shift,
-    /// residual flexibility) and the axial direction of their forces.
+    /// truncation flexibility) and the axial direction of their forces.
     pub(crate) sleeves: Sleeves,
     /// Full model: the axial acceleration u_i'' of each beam at the last solve, part of the axial
     /// inertia force of Eq. 23 (the whole axially rigid beam accelerates with it).
@@ -989,9 +989,9 @@ impl System {
         c
     }
 
-    /// Largest |C q| over the rows (constraint residual, for tests).
+    /// Largest |C q| over the rows (constraint violation, for tests).
     #[cfg(test)]
-    pub(crate) fn constraint_residual(&self, q: &[f64]) -> f64 {
+    pub(crate) fn constraint_violation(&self, q: &[f64]) -> f64 {
         let (nm, nb) = (self.nm, self.nb);
         let mut r = vec![0.0; self.rows.len()];
         for (i, beam) in self.beams.iter().enumerate() {
@@ -1040,6 +1040,8 @@ mod tests {
             Some(vec![0.0, 0.0, -60.0, 80.0]),
             Some(vec![0.0, 0.0, 8.0, -12.0]),
         );
+        let problem = exp.problem().unwrap();
+        let exp = problem.equal_beams().unwrap();
         let settings = AmmSettings::paper(ModeFamily::FreeFree, 20);
         let mut qs: Vec<Vec<f64>> = vec![vec![0.0; 3 * 22]];
         let mut sys_copy = None;

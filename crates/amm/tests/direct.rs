@@ -45,9 +45,13 @@ fn round_trip(k: usize, settings: &AmmSettings, t_end: f64, dt_fa: f64) -> (f64,
     let inverse_fine = common::motion_response(&case(k, t_end, dt_fa), settings).unwrap();
     let exp = case(k, t_end, 1e-3);
     let inverse = common::motion_response(&exp, settings).unwrap();
-    let direct = flexstar_amm::solve(&exp, settings, flexstar_drive::SolveRequest::law(&table(&inverse_fine)))
-        .map(|s| s.response)
-        .unwrap();
+    let direct = flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        settings,
+        flexstar_drive::SolveRequest::law(&table(&inverse_fine)),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let ds = slider_error(&exp, &direct);
     let evp = point_evps(&direct, &inverse).unwrap();
     let worst = evp.points.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
@@ -74,9 +78,13 @@ fn round_trip_exp(exp: &Experiment, settings: &AmmSettings, dt_fa: f64) -> (f64,
     fine.time.dt_out = dt_fa;
     let inverse_fine = common::motion_response(&fine, settings).unwrap();
     let inverse = common::motion_response(exp, settings).unwrap();
-    let direct = flexstar_amm::solve(exp, settings, flexstar_drive::SolveRequest::law(&table(&inverse_fine)))
-        .map(|s| s.response)
-        .unwrap();
+    let direct = flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        settings,
+        flexstar_drive::SolveRequest::law(&table(&inverse_fine)),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let ds = slider_error(exp, &direct);
     let evp = point_evps(&direct, &inverse).unwrap();
     let worst = evp.points.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
@@ -127,9 +135,13 @@ fn stiff_servo_reproduces_the_prescribed_motion() {
             attached: Default::default(),
         };
         let inverse = common::motion_response(&exp, &exp.amm).unwrap();
-        let direct = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::law(&servo))
-            .map(|s| s.response)
-            .unwrap();
+        let direct = flexstar_amm::solve(
+            &exp.problem().unwrap(),
+            &exp.amm,
+            flexstar_drive::SolveRequest::law(&servo),
+        )
+        .map(|s| s.response)
+        .unwrap();
         let ds = slider_error(&exp, &direct);
         let evp = point_evps(&direct, &inverse).unwrap();
         let tips = evp.points[..3].iter().flatten().fold(0.0f64, |m, v| m.max(*v));
@@ -172,9 +184,13 @@ fn leaving_the_feasible_range_stops_with_time_and_reason() {
     let push = flexstar_drive::ForcePolynomials {
         coefficients: [vec![50.0], vec![0.0], vec![0.0]],
     };
-    let err = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::law(&push))
-        .map(|s| s.response)
-        .unwrap_err();
+    let err = flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        &exp.amm,
+        flexstar_drive::SolveRequest::law(&push),
+    )
+    .map(|s| s.response)
+    .unwrap_err();
     let msg = err.to_string();
     eprintln!("{msg}");
     match err {
@@ -191,9 +207,13 @@ fn automatic_n_runs_the_direct_problem_too() {
     let mut exp = case(3, 0.1, DEFAULT_DT);
     exp.amm = AmmSettings::accurate();
     let inverse = common::motion_response(&exp, &exp.amm).unwrap();
-    let direct = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::law(&table(&inverse)))
-        .map(|s| s.response)
-        .unwrap();
+    let direct = flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        &exp.amm,
+        flexstar_drive::SolveRequest::law(&table(&inverse)),
+    )
+    .map(|s| s.response)
+    .unwrap();
     assert_eq!(direct.info.modes, inverse.info.modes);
     assert!(direct.info.error_estimate_percent.is_some());
     assert_eq!(direct.info.solver, "amm-direct");
@@ -223,9 +243,13 @@ fn stiff_limit_matches_the_rigid_forward_dynamics() {
             attached: Default::default(),
         };
         let settings = AmmSettings::paper(flexstar_model::ModeFamily::FreeFree, 25);
-        let r = flexstar_amm::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&law))
-            .map(|s| s.response)
-            .unwrap();
+        let r = flexstar_amm::solve(
+            &exp.problem().unwrap(),
+            &settings,
+            flexstar_drive::SolveRequest::law(&law),
+        )
+        .map(|s| s.response)
+        .unwrap();
         let s0 = exp.trajectory.s(&robot, 0.0).unwrap();
         let v0 = exp.trajectory.jets(&robot, 0.0).unwrap().map(|j| j.d1);
         let reference = rigid_forward_dynamics(&robot, s0, v0, &law, exp.time.t_end, exp.time.dt_out, 1e-4).unwrap();

@@ -380,7 +380,7 @@ fn bad_input_is_rejected_before_any_work() {
     let step = flexstar_kinematics::preflight_step(short.time.dt_out);
     let proof = flexstar_kinematics::check_motion(&short.robot, &short.trajectory, short.time.t_end, step).unwrap();
     match flexstar_amm::solve(
-        &long,
+        &long.problem().unwrap(),
         &settings(ModeFamily::SlideFree, 25, None),
         flexstar_drive::SolveRequest::motion().with_proof(Some(&proof)),
     )

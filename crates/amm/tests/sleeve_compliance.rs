@@ -1,8 +1,8 @@
-//! The residual flexibility of the sleeves (`docs/amm.md` section 12), isolated on the first robot
+//! The truncation flexibility of the sleeves (`docs/amm.md` section 12), isolated on the first robot
 //! of that section (short, light, sleeve-heavy; `tests/other_robots/robot1.toml`).
 //!
 //! Both runs take the FEM's step (1e-4 s), so the AMM's time error is out of the comparison and
-//! what is left is its modal truncation and its model. Without the residual flexibility the
+//! what is left is its modal truncation and its model. Without the truncation flexibility the
 //! accurate model at N = 46 was 1.20 % from this FEM and still 0.29 % at N = 100 (the slope under
 //! the sleeve's couple converges like 1/N, Eq. R1); with it N = 33 and N = 100 agree to 0.001 %
 //! and both are 0.035 % from the FEM (which is itself 0.047 % from 2400 elements at 5e-5 s).
@@ -20,17 +20,25 @@ fn accurate_at(exp: &Experiment, n: usize) -> flexstar_model::Response {
         dt: Some(1e-4),
         ..AmmSettings::accurate()
     };
-    flexstar_amm::solve(exp, &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap()
+    flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap()
 }
 
 #[test]
-fn residual_flexibility_removes_the_truncation_at_the_sleeves() {
+fn truncation_flexibility_removes_the_truncation_at_the_sleeves() {
     let exp = Experiment::from_toml_str(ROBOT1, Path::new("robot1.toml")).unwrap();
-    let fem = flexstar_fem::solve(&exp, &exp.fem, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let fem = flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &exp.fem,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let (coarse, fine) = (accurate_at(&exp, 33), accurate_at(&exp, 100));
     let between = point_evps(&coarse, &fine).unwrap().mean.unwrap();
     let e33 = point_evps(&coarse, &fem).unwrap();

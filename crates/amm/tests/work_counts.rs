@@ -21,9 +21,13 @@ fn paper_setting_runs_once_at_the_default_step() {
     // each config's [amm]: slide-free, N = 25, the default step 1/6 ms: t_end / dt steps
     for (case, steps) in [(1, 3000), (2, 2400), (3, 3000), (4, 3000)] {
         let exp = catalogue::paper_case(case);
-        let (r, s) = flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
-            .map(|s| (s.response, s.stats))
-            .unwrap();
+        let (r, s) = flexstar_amm::solve(
+            &exp.problem().unwrap(),
+            &exp.amm,
+            flexstar_drive::SolveRequest::motion(),
+        )
+        .map(|s| (s.response, s.stats))
+        .unwrap();
         assert_eq!(s, stats(25, &[25], steps, steps), "case {case}");
         assert_eq!(s.solves, steps + 1, "the initial accelerations and one solve per step");
         assert_eq!(r.info.modes, Some(25));
@@ -37,9 +41,13 @@ fn automatic_n_tries_46_and_53_then_delivers_53() {
     // same grid, then N = 53 at 0.5 ms (adaptive module)
     for (case, steps) in [(1, 1000), (2, 800), (3, 1000), (4, 1000)] {
         let exp = catalogue::paper_case(case);
-        let (r, s) = flexstar_amm::solve(&exp, &AmmSettings::accurate(), flexstar_drive::SolveRequest::motion())
-            .map(|s| (s.response, s.stats))
-            .unwrap();
+        let (r, s) = flexstar_amm::solve(
+            &exp.problem().unwrap(),
+            &AmmSettings::accurate(),
+            flexstar_drive::SolveRequest::motion(),
+        )
+        .map(|s| (s.response, s.stats))
+        .unwrap();
         let pair = steps / 8;
         assert_eq!(
             s,
@@ -53,9 +61,13 @@ fn automatic_n_tries_46_and_53_then_delivers_53() {
     // itself delivered
     let mut short = catalogue::paper_case(3);
     short.time.t_end = 0.05;
-    let (_, s) = flexstar_amm::solve(&short, &AmmSettings::accurate(), flexstar_drive::SolveRequest::motion())
-        .map(|s| (s.response, s.stats))
-        .unwrap();
+    let (_, s) = flexstar_amm::solve(
+        &short.problem().unwrap(),
+        &AmmSettings::accurate(),
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| (s.response, s.stats))
+    .unwrap();
     assert_eq!(s, stats(53, &[46, 53], 100, 200));
 }
 
@@ -87,9 +99,13 @@ fn automatic_n_is_within_half_a_percent_of_the_refined_fem() {
     // measured 0.374 % (w1tip); by the same measure the paper's setting (slide-free, N = 25, the
     // printed equations) is 32-67 % off this reference
     let exp = catalogue::paper_case(2);
-    let (r, _) = flexstar_amm::solve(&exp, &AmmSettings::accurate(), flexstar_drive::SolveRequest::motion())
-        .map(|s| (s.response, s.stats))
-        .unwrap();
+    let (r, _) = flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        &AmmSettings::accurate(),
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| (s.response, s.stats))
+    .unwrap();
     let e = error_against_refined_fem(&r);
     eprintln!("case 2, accurate AMM vs refined FEM: {:.3} % of the peak", 100.0 * e);
     assert!(e < 5e-3, "{e:e}");

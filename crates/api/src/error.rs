@@ -126,6 +126,7 @@ impl ApiError {
                 Self::config_text(file.display(), Some(&key), &reason, message)
             }
             ModelError::InverseKinematics(r) => Self::config_text("", None, &r, message),
+            ModelError::Unsupported { what } => Self::config_text("", Some("robot"), &what, message),
             ModelError::Write { .. } => ApiError::Output(message),
         }
     }

@@ -69,6 +69,8 @@ impl RunSettings {
 pub struct Prepared {
     /// The resolved experiment (what the sidecar records).
     pub exp: Experiment,
+    /// Its physics, as the solver takes it (built once, here).
+    pub problem: flexstar_model::Problem,
     pub solver: Solver,
     /// The file stem of the run: `amm-<family>`, `fem`, `amm-<family>-direct`, `fem-direct`.
     pub stem: String,
@@ -163,13 +165,17 @@ pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Res
         }
     })?;
     let stem = if direct { format!("{stem}-direct") } else { stem };
+    let problem = exp
+        .problem()
+        .map_err(|e| ApiError::model_in(source, Path::new(source), e))?;
     if settings.solver == Solver::Amm {
-        if let Some(lost) = flexstar_amm::attachments_lost(exp.amm.family, &exp) {
+        if let Some(lost) = flexstar_amm::attachments_lost(exp.amm.family, &problem) {
             notes.push(format!("note: {source}: {lost}"));
         }
     }
     Ok(Prepared {
         exp,
+        problem,
         solver: settings.solver,
         stem,
         direct,
@@ -298,12 +304,12 @@ fn apply_fem(exp: &mut Experiment, source: &str, s: &RunSettings) -> Result<Stri
 pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Response> {
     let exp = &p.exp;
     let settings = flexstar_solve::Settings::of(exp, p.solver);
-    let r = flexstar_solve::response(exp, settings, p.checked.as_ref(), progress).map_err(|e| match e {
+    let r = flexstar_solve::response(&p.problem, settings, p.checked.as_ref(), progress).map_err(|e| match e {
         flexstar_solve::SolveError::Amm(e) => p.amm_error(e),
         flexstar_solve::SolveError::Fem(e) => from_fem(&p.source, e),
         flexstar_solve::SolveError::Drive(e) => ApiError::config(&p.source, Some("drive"), e.to_string()),
         flexstar_solve::SolveError::Tracking(e) => ApiError::solver(&p.source, e),
-        e @ flexstar_solve::SolveError::Unshaped => ApiError::config(&p.source, Some("shaper.f_hz"), e.to_string()),
+        flexstar_solve::SolveError::Robot(e) => ApiError::from_model(e),
     })?;
     if let Some(reason) = r.not_finite_reason() {
         return Err(ApiError::config(&p.source, Some("robot"), reason));

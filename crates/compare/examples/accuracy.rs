@@ -29,7 +29,7 @@ fn main() {
     let fems: Vec<_> = cases
         .par_iter()
         .map(|e| {
-            flexstar_fem::solve(e, &e.fem, flexstar_drive::SolveRequest::motion())
+            flexstar_fem::solve(&e.problem().unwrap(), &e.fem, flexstar_drive::SolveRequest::motion())
                 .map(|s| s.response)
                 .expect("fem")
         })
@@ -52,7 +52,9 @@ fn main() {
         for (e, fem) in cases.iter().zip(&fems) {
             let started = std::time::Instant::now();
             let amm =
-                match flexstar_amm::solve(e, &settings, flexstar_drive::SolveRequest::motion()).map(|s| s.response) {
+                match flexstar_amm::solve(&e.problem().unwrap(), &settings, flexstar_drive::SolveRequest::motion())
+                    .map(|s| s.response)
+                {
                     Ok(r) => r,
                     Err(err) => {
                         println!("{} {spec}: {err}", e.name);

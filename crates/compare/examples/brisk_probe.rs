@@ -46,9 +46,13 @@ fn amm(exp: &Experiment, n: usize, model: AmmModel) -> Response {
         model,
         ..AmmSettings::accurate()
     };
-    flexstar_amm::solve(exp, &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .expect("amm")
+    flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .expect("amm")
 }
 
 fn fem(exp: &Experiment, elements: usize, dt: Option<f64>) -> Response {
@@ -57,9 +61,13 @@ fn fem(exp: &Experiment, elements: usize, dt: Option<f64>) -> Response {
         dt,
         ..FemSettings::default()
     };
-    flexstar_fem::solve(exp, &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .expect("fem")
+    flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .expect("fem")
 }
 
 fn show(what: &str, test: &Response, reference: &Response) {

@@ -135,6 +135,8 @@ pub struct Checked<'a> {
     specs: &'a [CaseSpec],
     /// Per spec: the proof of its feasibility scan, handed to the solvers.
     motions: Vec<CheckedMotion>,
+    /// Per spec: the problem the solvers take, built once from its experiment.
+    problems: Vec<flexstar_model::Problem>,
 }
 
 impl<'a> Checked<'a> {
@@ -149,6 +151,7 @@ impl<'a> Checked<'a> {
 /// feasibility of the trajectory over the whole span.
 pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
     let mut motions = Vec::with_capacity(specs.len());
+    let mut problems = Vec::with_capacity(specs.len());
     for spec in specs {
         let exp = &spec.exp;
         let file = exp.source.display().to_string();
@@ -177,8 +180,13 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
             source,
         })?;
         motions.push(motion);
+        problems.push(exp.problem().map_err(|e| input(e.detail()))?);
     }
-    Ok(Checked { specs, motions })
+    Ok(Checked {
+        specs,
+        motions,
+        problems,
+    })
 }
 
 enum Job {
@@ -254,7 +262,7 @@ fn run_error(file: String, label: &str, e: SolveError) -> RunError {
             file,
             reason: e.to_string(),
         },
-        e @ SolveError::Unshaped => RunError::Input {
+        SolveError::Robot(e) => RunError::Input {
             file,
             reason: e.to_string(),
         },
@@ -337,14 +345,16 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
                 Job::Fem(k) => {
                     let exp = &specs[k].exp;
                     let tick = |f: f64| tracker.set(j, f, false);
-                    flexstar_solve::response(exp, Settings::Fem(&exp.fem), Some(&checked.motions[k]), Some(&tick))
+                    let problem = &checked.problems[k];
+                    flexstar_solve::response(problem, Settings::Fem(&exp.fem), Some(&checked.motions[k]), Some(&tick))
                         .map_err(|e| run_error(file(k), "fem", e))
                 }
                 Job::Reference(k) => {
                     let exp = &specs[k].exp;
                     let settings = specs[k].reference.as_ref().unwrap_or(&exp.fem);
                     let tick = |f: f64| tracker.set(j, f, false);
-                    flexstar_solve::response(exp, Settings::Fem(settings), Some(&checked.motions[k]), Some(&tick))
+                    let problem = &checked.problems[k];
+                    flexstar_solve::response(problem, Settings::Fem(settings), Some(&checked.motions[k]), Some(&tick))
                         .map_err(|e| run_error(file(k), "fem (refined reference)", e))
                 }
                 Job::Amm(k, i) | Job::Extra(k, i) => {
@@ -353,7 +363,7 @@ pub fn run_cases(checked: Checked, progress: Option<ProgressFn>) -> Result<Vec<C
                         _ => &specs[k].extra[i],
                     };
                     let settings = Settings::Amm(&run.settings);
-                    flexstar_solve::response(&specs[k].exp, settings, Some(&checked.motions[k]), None)
+                    flexstar_solve::response(&checked.problems[k], settings, Some(&checked.motions[k]), None)
                         .map_err(|e| run_error(file(k), &run.label, e))
                 }
             })?;

@@ -163,7 +163,8 @@ fn measured_points(exp: &Experiment, sh: &ShaperSection) -> Result<Vec<(f64, f64
     let peaks: Vec<f64> = jobs
         .par_iter()
         .map(|(_, x, t_rest)| {
-            flexstar_solve::response(x, flexstar_solve::Settings::Amm(&settings), None, None)
+            let problem = x.problem().map_err(flexstar_solve::SolveError::from)?;
+            flexstar_solve::response(&problem, flexstar_solve::Settings::Amm(&settings), None, None)
                 .map(|r| residual_peak(&r, *t_rest))
         })
         .collect::<Result<_, _>>()

@@ -33,19 +33,18 @@ mod request;
 pub use laws::{ForcePolynomials, ForceTable, ReferencePoint, RigidInverseForces, Servo};
 pub use request::{Drive, Progress, SolveRequest, Solved};
 
-use flexstar_model::{DriveKind, Experiment, Feedforward};
+use flexstar_model::{DriveKind, EqualBeams, Feedforward};
 
-/// The actuator law of an experiment's `[drive]` (`docs/drives.md`): `None` for `kind = "motion"` (the
+/// The actuator law of a problem's drive (`docs/drives.md`): `None` for `kind = "motion"` (the
 /// trajectory is imposed), else the forces (table or polynomials) or the servo tracking
-/// `exp.trajectory` with its gains resolved (`bandwidth_hz` with the slider mass `mpp_mpa`).
-/// Errors name the `drive.` key.
-pub fn law_for(exp: &Experiment) -> Result<Option<Box<dyn ActuatorLaw>>, DriveError> {
-    let d = &exp.drive;
+/// the problem's trajectory with its gains resolved (`bandwidth_hz` with the slider mass
+/// `mpp_mpa`). The drive was validated with the problem; errors name the `drive.` key.
+pub fn law_for(problem: &EqualBeams) -> Result<Option<Box<dyn ActuatorLaw>>, DriveError> {
+    let d = problem.drive;
     let invalid = |e: flexstar_model::ModelError| match e {
         flexstar_model::ModelError::Invalid { key, reason, .. } => DriveError::Config(format!("key `{key}`: {reason}")),
         other => DriveError::Config(other.to_string()),
     };
-    d.validate(exp.time.t_end, exp.robot.mpp_mpa).map_err(invalid)?;
     Ok(match d.kind {
         DriveKind::Motion => None,
         DriveKind::Forces => match (&d.samples, &d.fa1, &d.fa2, &d.fa3) {
@@ -60,14 +59,17 @@ pub fn law_for(exp: &Experiment) -> Result<Option<Box<dyn ActuatorLaw>>, DriveEr
             }
         },
         DriveKind::Servo => {
-            let g = d.servo_gains(exp.robot.mpp_mpa).map_err(invalid)?;
+            let g = d.servo_gains(problem.robot.mpp_mpa).map_err(invalid)?;
             Some(Box::new(Servo {
                 kp: [g.kp; 3],
                 kd: [g.kd; 3],
                 rigid_feedforward: d.feedforward.unwrap_or_default() == Feedforward::Rigid,
-                reference: exp.trajectory.clone(),
-                params: exp.robot,
-                attached: flexstar_model::Attachments::of(exp),
+                reference: problem.trajectory.clone(),
+                params: *problem.robot,
+                attached: flexstar_model::Attachments {
+                    payload: *problem.payload,
+                    load: problem.load.clone(),
+                },
             }))
         }
     })
@@ -89,8 +91,8 @@ pub enum DriveError {
 
 /// Add the servo's tracking errors `e_i = s_ref,i(t) - s_i(t)` [m] to a direct run's response
 /// as columns `e1, e2, e3` (after its other columns), from its `s1, s2, s3` columns and the
-/// reference `exp.trajectory`.
-pub fn add_tracking_errors(resp: &mut flexstar_model::Response, exp: &Experiment) -> Result<(), DriveError> {
+/// reference, the problem's trajectory.
+pub fn add_tracking_errors(resp: &mut flexstar_model::Response, problem: &EqualBeams) -> Result<(), DriveError> {
     let mut cols = [Vec::new(), Vec::new(), Vec::new()];
     for (i, col) in cols.iter_mut().enumerate() {
         let name = ["s1", "s2", "s3"][i];
@@ -99,10 +101,13 @@ pub fn add_tracking_errors(resp: &mut flexstar_model::Response, exp: &Experiment
             .ok_or_else(|| DriveError::Config(format!("the direct run has no column {name}")))?;
         *col = Vec::with_capacity(s.len());
         for (&t, &si) in resp.t.iter().zip(s) {
-            let r = exp.trajectory.s(&exp.robot, t).map_err(|e| DriveError::Reference {
-                t,
-                reason: e.to_string(),
-            })?;
+            let r = problem
+                .trajectory
+                .s(problem.robot, t)
+                .map_err(|e| DriveError::Reference {
+                    t,
+                    reason: e.to_string(),
+                })?;
             col.push(r[i] - si);
         }
     }
@@ -137,27 +142,33 @@ mod tests {
         assert!(ForceTable::new(vec![0.0, f64::NAN], vec![[0.0; 3]; 2]).is_err());
     }
 
+    /// The law of an experiment's drive, through its problem (where the drive is validated).
+    fn law_of(exp: &flexstar_model::Experiment) -> Result<Option<Box<dyn ActuatorLaw>>, String> {
+        let problem = exp.problem().map_err(|e| e.to_string())?;
+        law_for(&problem.equal_beams().map_err(|e| e.to_string())?).map_err(|e| e.to_string())
+    }
+
     #[test]
     fn law_for_builds_each_kind() {
         let mut exp = flexstar_model::catalogue::paper_case(1);
-        assert!(law_for(&exp).unwrap().is_none());
+        assert!(law_of(&exp).unwrap().is_none());
         exp.drive.kind = DriveKind::Forces;
         exp.drive.fa1 = Some(vec![1.0, 2.0]);
         exp.drive.fa2 = Some(vec![0.0]);
         exp.drive.fa3 = Some(vec![0.0, 0.0, 3.0]);
-        let law = law_for(&exp).unwrap().unwrap();
+        let law = law_of(&exp).unwrap().unwrap();
         assert_eq!(law.force(2.0, [0.0; 3], [0.0; 3]).unwrap(), [5.0, 0.0, 12.0]);
         assert_eq!(law.stiffness(), [0.0; 3]);
         let mut exp = flexstar_model::catalogue::paper_case(1);
         exp.drive.kind = DriveKind::Servo;
         exp.drive.bandwidth_hz = Some(20.0);
         exp.drive.damping_ratio = Some(0.7);
-        let law = law_for(&exp).unwrap().unwrap();
+        let law = law_of(&exp).unwrap().unwrap();
         let (kp, kd) = Servo::gains_from_bandwidth(exp.robot.mpp_mpa, 20.0, 0.7);
         assert_eq!((law.stiffness()[1], law.damping()[2]), (kp, kd));
         exp.drive.kp = Some(1.0);
         exp.drive.kd = Some(1.0);
-        let e = law_for(&exp).err().unwrap().to_string();
+        let e = law_of(&exp).err().unwrap();
         assert!(e.contains("drive.bandwidth_hz"), "{e}");
     }
 

@@ -34,8 +34,9 @@ fn bench(c: &mut Criterion) {
             ..FemSettings::default()
         };
         g.bench_function(name, |b| {
+            let problem = exp.problem().unwrap();
             b.iter(|| {
-                flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+                flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
                     .map(|s| s.response)
                     .unwrap()
             })
@@ -55,8 +56,9 @@ fn bench(c: &mut Criterion) {
     );
     let settings = FemSettings::default();
     g.bench_function("case2_0.4s_300el_payload_damping_load", |b| {
+        let problem = attached.problem().unwrap();
         b.iter(|| {
-            flexstar_fem::solve(&attached, &settings, flexstar_drive::SolveRequest::motion())
+            flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
                 .map(|s| s.response)
                 .unwrap()
         })
@@ -64,23 +66,29 @@ fn bench(c: &mut Criterion) {
     let mut exp = catalogue::paper_case(2);
     exp.time.dt_out = flexstar_fem::DEFAULT_DT;
     let settings = FemSettings::default();
-    let inverse = flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let inverse = flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let rows = (0..inverse.len())
         .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
         .collect();
     let table = ForceTable::new(inverse.t.clone(), rows).unwrap();
     g.bench_function("case2_0.4s_300el_inverse_every_step", |b| {
+        let problem = exp.problem().unwrap();
         b.iter(|| {
-            flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
+            flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
                 .map(|s| s.response)
                 .unwrap()
         })
     });
     g.bench_function("case2_0.4s_300el_direct_forces", |b| {
+        let problem = exp.problem().unwrap();
         b.iter(|| {
-            flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&table))
+            flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&table))
                 .map(|s| s.response)
                 .unwrap()
         })
@@ -95,8 +103,9 @@ fn bench(c: &mut Criterion) {
         attached: Default::default(),
     };
     g.bench_function("case2_0.4s_300el_direct_servo20hz", |b| {
+        let problem = exp.problem().unwrap();
         b.iter(|| {
-            flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::law(&servo))
+            flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&servo))
                 .map(|s| s.response)
                 .unwrap()
         })

@@ -27,7 +27,7 @@ fn run(exp: &Experiment, n: usize, dt: f64, rho: f64) -> (Response, f64) {
         frames: 0,
     };
     let t0 = Instant::now();
-    let r = flexstar_fem::solve(exp, &s, flexstar_drive::SolveRequest::motion())
+    let r = flexstar_fem::solve(&exp.problem().unwrap(), &s, flexstar_drive::SolveRequest::motion())
         .map(|s| s.response)
         .unwrap();
     (r, t0.elapsed().as_secs_f64())

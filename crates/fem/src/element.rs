@@ -279,7 +279,7 @@ impl<T: Real> ElementState<T> {
     }
 
     /// Internal force vector `f = B^T [N, M1, M2]` alone (the first half of
-    /// [`ElementState::internal`], for residual-only evaluations).
+    /// [`ElementState::internal`], for imbalance-only evaluations).
     #[inline(always)]
     pub fn internal_force(&self, ea: f64, ei: f64) -> [T; 6] {
         self.force_of(self.local_forces(ea, ei))

@@ -1,12 +1,12 @@
 //! The element loops of the time step (`docs/fem.md` section 6): every beam element's inertia and internal
-//! forces into the residual, with its block `M + beta' K` of the Newton matrix at the first
+//! forces into the imbalance, with its block `M + beta' K` of the Newton matrix at the first
 //! iteration of a step, and the beams' kinetic and strain energy at the output times.
 //!
 //! Four consecutive elements are evaluated at once, one per lane of
 //! [`flexstar_numerics::lanes::F64x4`], by the same [`ElementState`] methods as one element
 //! (the last `n mod 4` elements take the one-element path). The lanes' arithmetic is that of one
 //! element, operation for operation, so the results are bit for bit those of the element-by-element
-//! loop (unit test below); the sums into the residual are taken in element order, as before. The
+//! loop (unit test below); the sums into the imbalance are taken in element order, as before. The
 //! loops are compiled twice, for baseline x86-64 and for AVX2 (256-bit lanes), and the processor
 //! picks at run time ([`flexstar_numerics::dispatch_avx2`]).
 
@@ -25,7 +25,7 @@ pub(crate) struct Section {
     pub beta: f64,
 }
 
-/// Factors of the residual and of the Newton matrix: `cf` on the dynamic part of the residual,
+/// Factors of the imbalance and of the Newton matrix: `cf` on the dynamic part of the imbalance,
 /// `ck` on the stiffness in the matrix `M + ck K`, `cv` on the velocity derivative of the forces
 /// (the damping matrix `beta K_mat`, Eq. D9). In a step `cf = ck = beta'` [s^2] and `cv = gamma'`
 /// [s]; for the consistent initial accelerations `cf = 1`, `ck = cv = 0`.
@@ -265,7 +265,7 @@ fn states<T: Real>(elements: &[Element], start: usize, chain: Option<usize>, q: 
 }
 
 /// What [`add_forces`] evaluates every batch at: the nodes' state, the section, and the scales
-/// of the residual (`cf`) and of the stiffness in the matrix (`ck`).
+/// of the imbalance (`cf`) and of the stiffness in the matrix (`ck`).
 #[derive(Clone, Copy)]
 struct Terms<'a> {
     nodes: NodeState<'a>,
@@ -461,7 +461,7 @@ mod tests {
             m1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
             m2.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
         );
-        // the residual-only pass adds the same forces
+        // the imbalance-only pass adds the same forces
         let mut r3 = vec![0.0; q.len()];
         add_forces(&elements, nodes, sec, fac, &mut r3, None).unwrap();
         assert_eq!(r1, r3);
@@ -571,7 +571,7 @@ mod tests {
         let mut r3 = vec![0.0; q.len()];
         add_forces(&elements, nodes, sec, fac, &mut r3, None).unwrap();
         assert_eq!(r1, r3);
-        // damping changes the residual (the chain deforms at a rate) and the power sums
+        // damping changes the imbalance (the chain deforms at a rate) and the power sums
         let mut r4 = vec![0.0; q.len()];
         add_forces(&elements, nodes, Section { beta: 0.0, ..sec }, fac, &mut r4, None).unwrap();
         assert!(r1.iter().zip(&r4).any(|(x, y)| x != y));

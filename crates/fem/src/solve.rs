@@ -6,7 +6,9 @@ use flexstar_drive::{ActuatorLaw, Drive, SolveRequest, Solved};
 use flexstar_kinematics::{check_trajectory, direct_kinematics, preflight_step, CheckedMotion, RigidState};
 use flexstar_model::animation::{frame_times, ShapeTimes};
 use flexstar_model::geometry::{e_w, e_x};
-use flexstar_model::{BeamShape, Experiment, FemSettings, FramePose, Response, RobotParams, RunInfo, StarShape};
+use flexstar_model::{
+    BeamShape, EqualBeams, FemSettings, FramePose, Problem, Response, RobotParams, RunInfo, StarShape,
+};
 
 use crate::integrator::{integrate, History, Motion, RunSettings, Sample, Snapshot, Stats};
 use crate::star::{Attached, InitialState};
@@ -72,9 +74,9 @@ const EXTRA: [&str; 17] = [
 /// Extra columns a direct run writes first (see [`solve`] with [`Drive::Law`]).
 const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "Gy", "theta"];
 
-/// Run the finite-element reference on `exp` with `settings` (which override `exp.fem`).
+/// Run the finite-element reference on `problem` with `settings` (which override `problem.fem`).
 ///
-/// Returns the response labelled `fem` at `exp.time.output_times()`:
+/// Returns the response labelled `fem` at `problem.time.output_times()`:
 /// - `w_iG = (G_fem - G_rigid) . e_wi` and the tip value `w_i(L) = (tip_fem - (G_rigid + L e_xi)) . e_wi`
 ///   [m], projected on the rigid frames of Eqs. 11-12 (post-processing only);
 /// - `Fa_i` [N], Eq. 33, from the pin reactions: `Fa_i = (mpp + mpa) s_i'' + F_i . u_i` with `F_i`
@@ -102,36 +104,39 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 /// unless `request.proof` covers the run) or an actuator law ([`Drive::Law`], see
 /// the direct dynamics below). `request.progress` receives the fraction of the time span done, in [0, 1].
 /// Returns the response and the work counters (steps, Newton iterations, factorisations).
-pub fn solve(exp: &Experiment, settings: &FemSettings, request: SolveRequest) -> Result<Solved<Stats>, FemError> {
+pub fn solve(problem: &Problem, settings: &FemSettings, request: SolveRequest) -> Result<Solved<Stats>, FemError> {
+    let problem = &problem.equal_beams().map_err(|e| FemError::Input(e.to_string()))?;
     let (response, stats) = match request.drive {
-        Drive::Motion => solve_prescribed(exp, settings, request.proof, request.progress)?,
-        Drive::Law(law) => solve_direct(exp, settings, law, request.progress)?,
+        Drive::Motion => solve_prescribed(problem, settings, request.proof, request.progress)?,
+        Drive::Law(law) => solve_direct(problem, settings, law, request.progress)?,
     };
     Ok(Solved { response, stats })
 }
 
 /// [`solve`] of the prescribed motion, the feasibility scan skipped when `checked` covers the run.
 fn solve_prescribed(
-    exp: &Experiment,
+    problem: &EqualBeams,
     settings: &FemSettings,
     checked: Option<&CheckedMotion>,
     progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> Result<(Response, Stats), FemError> {
     let started = std::time::Instant::now();
-    let params = &exp.robot;
-    let run = validate(exp, settings)?;
+    let params = &problem.robot;
+    let run = validate(problem, settings)?;
     // the same feasibility scan as the AMM and the kinematics, before any work: a pre-flight check
     // of the requested motion only (the FEM's equations never use the rigid kinematics)
-    let step = preflight_step(exp.time.dt_out);
-    if !checked.is_some_and(|c| c.covers(params, &exp.trajectory, exp.time.t_end, step)) {
-        check_trajectory(params, &exp.trajectory, exp.time.t_end, step).map_err(|e| FemError::Input(e.to_string()))?;
+    let step = preflight_step(problem.time.dt_out);
+    if !checked.is_some_and(|c| c.covers(params, &problem.trajectory, problem.time.t_end, step)) {
+        check_trajectory(params, &problem.trajectory, problem.time.t_end, step)
+            .map_err(|e| FemError::Input(e.to_string()))?;
     }
-    let rigid =
-        |t: f64| RigidState::at(params, &exp.trajectory, t).map_err(|source| FemError::PostProcessing { t, source });
+    let rigid = |t: f64| {
+        RigidState::at(params, &problem.trajectory, t).map_err(|source| FemError::PostProcessing { t, source })
+    };
     let r0 = rigid(0.0)?;
-    let (t_out, shape_times) = times(exp, settings);
-    let motion = Motion::Prescribed(&exp.trajectory);
-    let attached = Attached::of(exp, r0.theta.v);
+    let (t_out, shape_times) = times(problem, settings);
+    let motion = Motion::Prescribed(&problem.trajectory);
+    let attached = Attached::of(problem, r0.theta.v);
     let hist = integrate(
         params,
         &motion,
@@ -161,15 +166,15 @@ fn solve_prescribed(
 }
 
 /// Direct dynamics ([`solve`] with [`Drive::Law`]): the sliders move under the actuator law `law` instead of
-/// following `exp.trajectory`.
+/// following `problem.trajectory`.
 ///
 /// Each slider is a body of mass `mpp + mpa` on its rail, pushed along `+u_i` by
 /// `Fa_i(t, s_i, s_i')` and by the beam through the sleeve's pin (Eq. 33 read the other way
 /// round, `docs/fem.md` section 8); its coordinate `s_i` is an unknown of the FEM, and the servo's
 /// `kp`, `kd` (`law.stiffness()`, `law.damping()`) enter the iteration matrix. Initial state:
-/// `s(0)`, `s'(0)` from `exp.trajectory` at t = 0, the star undeformed and moving rigidly (as
+/// `s(0)`, `s'(0)` from `problem.trajectory` at t = 0, the star undeformed and moving rigidly (as
 /// [`solve`] starts), so that the `Fa` of an inverse run fed back reproduces that run. The
-/// payload, damping and load of `exp` act as in [`solve`] (`docs/fem.md` section 9).
+/// payload, damping and load of `problem` act as in [`solve`] (`docs/fem.md` section 9).
 ///
 /// The configuration is checked at every step (sleeves on their beams, then the limits of
 /// `flexstar_kinematics::feasibility` on the simulated `s`): leaving the feasible range stops the
@@ -177,28 +182,28 @@ fn solve_prescribed(
 /// output.
 ///
 /// Returns the response and the work counters; the response labelled `fem-direct` (`info.solver = "fem-direct"`) at
-/// `exp.time.output_times()`: `w_iG`, `w_i(L)` projected on the rigid frames of the *simulated*
+/// `problem.time.output_times()`: `w_iG`, `w_i(L)` projected on the rigid frames of the *simulated*
 /// sliders' direct kinematics (post-processing only), `Fa_i` [N] the law's forces at the output
 /// time, then the extra columns `s1..3` [m], `sd1..3` [m/s] (simulated sliders), `Gx, Gy` [m],
 /// `theta` [rad] (their rigid pose, Eqs. 4-9), then those of [`solve`] (with `dGx, dGy` and
 /// `slopeG` relative to that pose, `W` the work of the law's forces).
 fn solve_direct(
-    exp: &Experiment,
+    problem: &EqualBeams,
     settings: &FemSettings,
     law: &dyn ActuatorLaw,
     progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> Result<(Response, Stats), FemError> {
     let started = std::time::Instant::now();
-    let params = &exp.robot;
-    let run = validate(exp, settings)?;
-    let r0 = RigidState::at(params, &exp.trajectory, 0.0).map_err(|e| FemError::Input(e.to_string()))?;
-    let (t_out, shape_times) = times(exp, settings);
+    let params = &problem.robot;
+    let run = validate(problem, settings)?;
+    let r0 = RigidState::at(params, &problem.trajectory, 0.0).map_err(|e| FemError::Input(e.to_string()))?;
+    let (t_out, shape_times) = times(problem, settings);
     let motion = Motion::Driven {
         law,
         s0: r0.s.map(|s| s.v),
         v0: r0.s.map(|s| s.d1),
     };
-    let attached = Attached::of(exp, r0.theta.v);
+    let attached = Attached::of(problem, r0.theta.v);
     let hist = integrate(
         params,
         &motion,
@@ -227,21 +232,17 @@ fn solve_direct(
     Ok((resp, hist.stats))
 }
 
-/// Check the experiment and the settings; the run's numerical settings.
-fn validate(exp: &Experiment, settings: &FemSettings) -> Result<RunSettings, FemError> {
-    let params = &exp.robot;
-    params.validate().map_err(|e| FemError::Input(e.to_string()))?;
-    exp.time.validate().map_err(|e| FemError::Input(e.to_string()))?;
-    exp.trajectory
-        .validate(params)
-        .map_err(|e| FemError::Input(e.to_string()))?;
+/// Check the settings against the problem (validated when it was built); the run's numerical
+/// settings.
+fn validate(problem: &EqualBeams, settings: &FemSettings) -> Result<RunSettings, FemError> {
+    let params = problem.robot;
     if settings.elements < 3 || !settings.elements.is_multiple_of(3) {
         return Err(FemError::Input(format!(
             "fem.elements must be a positive multiple of 3 (three equal beams), got {}",
             settings.elements
         )));
     }
-    let dt = settings.dt.unwrap_or(default_dt(params).min(exp.time.dt_out));
+    let dt = settings.dt.unwrap_or(default_dt(params).min(problem.time.dt_out));
     if !(dt.is_finite() && dt > 0.0) {
         return Err(FemError::Input(format!("fem.dt must be positive, got {dt}")));
     }
@@ -251,7 +252,7 @@ fn validate(exp: &Experiment, settings: &FemSettings) -> Result<RunSettings, Fem
             "fem.rho_inf must lie in [0, 1], got {rho_inf}"
         )));
     }
-    let t_end = exp.time.t_end;
+    let t_end = problem.time.t_end;
     if let Some(bad) = settings
         .snapshots
         .iter()
@@ -284,13 +285,13 @@ fn initial_state(r0: &RigidState) -> InitialState {
 
 /// Output times and the shape times: the snapshots (t_end always among them) and the animation
 /// frames of `settings.frames` (`docs/motions.md` section 5).
-fn times(exp: &Experiment, settings: &FemSettings) -> (Vec<f64>, ShapeTimes) {
+fn times(problem: &EqualBeams, settings: &FemSettings) -> (Vec<f64>, ShapeTimes) {
     let mut snaps = settings.snapshots.clone();
-    snaps.push(exp.time.t_end);
+    snaps.push(problem.time.t_end);
     snaps.sort_by(|a, b| a.total_cmp(b));
     snaps.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
-    let frames = frame_times(exp.time.t_end, settings.frames);
-    (exp.time.output_times(), ShapeTimes::merge(&snaps, &frames, 1e-12))
+    let frames = frame_times(problem.time.t_end, settings.frames);
+    (problem.time.output_times(), ShapeTimes::merge(&snaps, &frames, 1e-12))
 }
 
 fn run_info(solver: &str, settings: &FemSettings, run: &RunSettings, started: std::time::Instant) -> RunInfo {

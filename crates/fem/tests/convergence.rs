@@ -45,7 +45,7 @@ fn run(elements: usize, dt: f64) -> Response {
         frames: 0,
     };
     flexstar_fem::solve(
-        &catalogue::paper_case(2),
+        &catalogue::paper_case(2).problem().unwrap(),
         &settings,
         flexstar_drive::SolveRequest::motion(),
     )
@@ -103,9 +103,13 @@ fn paper_cases_work_counts_and_accuracy() {
     ];
     for (case, want) in pinned {
         let exp = catalogue::paper_case(case);
-        let (r, s) = flexstar_fem::solve(&exp, &exp.fem, flexstar_drive::SolveRequest::motion())
-            .map(|s| (s.response, s.stats))
-            .expect("FEM run");
+        let (r, s) = flexstar_fem::solve(
+            &exp.problem().unwrap(),
+            &exp.fem,
+            flexstar_drive::SolveRequest::motion(),
+        )
+        .map(|s| (s.response, s.stats))
+        .expect("FEM run");
         let got = [
             s.steps,
             s.newton_iterations,

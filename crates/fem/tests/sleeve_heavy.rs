@@ -48,9 +48,13 @@ fn run(exp: &Experiment, elements: usize, dt: Option<f64>) -> Response {
         snapshots: vec![],
         frames: 0,
     };
-    flexstar_fem::solve(exp, &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .expect("FEM run")
+    flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .expect("FEM run")
 }
 
 /// Mean EVP [%] of `a` against `b` (Eq. 45).

@@ -45,9 +45,13 @@ fn case1_is_symmetric() {
     // Case 1 (s_i = t^2, 0.5 s): in-place rotation; by symmetry G does not move and the three
     // tips vibrate identically (paper, section 8.1). Paper mesh (300 elements), default step.
     let exp = experiment(RobotParams::paper(), Trajectory::quadratic([1.0, 1.0, 1.0]), 0.5);
-    let (r, stats) = flexstar_fem::solve(&exp, &FemSettings::default(), flexstar_drive::SolveRequest::motion())
-        .map(|s| (s.response, s.stats))
-        .unwrap();
+    let (r, stats) = flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &FemSettings::default(),
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| (s.response, s.stats))
+    .unwrap();
     // work counts at the defaults (dt = 5e-4 s): 1000 steps, about 3 Newton iterations each, and
     // a new symbolic factorisation each time a contact point leaves its window of elements
     eprintln!("{stats:?}");
@@ -104,9 +108,13 @@ fn stiff_limit_follows_rigid_kinematics_and_inverse_dynamics() {
         dt: Some(flexstar_fem::DEFAULT_DT),
         ..coarse()
     };
-    let r = flexstar_fem::solve(&exp, &settings, flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap();
+    let r = flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap();
     let (dgx, dgy) = (col(&r, "dGx"), col(&r, "dGy"));
     let mut fa_rigid = [vec![], vec![], vec![]];
     for (k, &t) in r.t.iter().enumerate() {
@@ -164,9 +172,13 @@ fn energy_balance_holds_at_paper_stiffness() {
         (moving, 0.3),
     ] {
         let exp = experiment(RobotParams::paper(), traj, t_end);
-        let r = flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .unwrap();
+        let r = flexstar_fem::solve(
+            &exp.problem().unwrap(),
+            &coarse(),
+            flexstar_drive::SolveRequest::motion(),
+        )
+        .map(|s| s.response)
+        .unwrap();
         let w = col(&r, "W");
         let wmax = max_abs(w);
         assert!(wmax > 1e-3, "the drivers must do work");
@@ -201,7 +213,7 @@ fn bad_input_stops_with_time_and_reason() {
     let exp = experiment(RobotParams::paper(), Trajectory::quadratic([1.0, 1.0, 1.0]), 0.1);
     // mesh too coarse: 10 elements per beam, h = 5 cm > Lp / 2
     let err = flexstar_fem::solve(
-        &exp,
+        &exp.problem().unwrap(),
         &FemSettings {
             elements: 30,
             ..Default::default()
@@ -212,7 +224,7 @@ fn bad_input_stops_with_time_and_reason() {
     .unwrap_err();
     assert!(matches!(err, FemError::MeshTooCoarse { per_beam: 10, .. }), "{err}");
     let err = flexstar_fem::solve(
-        &exp,
+        &exp.problem().unwrap(),
         &FemSettings {
             elements: 100,
             ..Default::default()
@@ -223,7 +235,7 @@ fn bad_input_stops_with_time_and_reason() {
     .unwrap_err();
     assert!(matches!(err, FemError::Input(_)), "{err}");
     let err = flexstar_fem::solve(
-        &exp,
+        &exp.problem().unwrap(),
         &FemSettings {
             dt: Some(-1.0),
             ..coarse()
@@ -236,9 +248,13 @@ fn bad_input_stops_with_time_and_reason() {
     // case 2 past its end of travel: sleeve 2 (J) runs into G shortly after 0.4 s; refused by
     // the feasibility scan before any step (docs/conventions.md, feasible range), with the time and the sleeve
     let exp = experiment(RobotParams::paper(), Trajectory::quadratic([1.0, -0.5, -0.5]), 0.5);
-    match flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion())
-        .map(|s| s.response)
-        .unwrap_err()
+    match flexstar_fem::solve(
+        &exp.problem().unwrap(),
+        &coarse(),
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .map(|s| s.response)
+    .unwrap_err()
     {
         FemError::Input(msg) => {
             assert!(msg.contains("sleeve 2 reaches the junction G"), "{msg}");
@@ -261,7 +277,7 @@ fn progress_reaches_one_and_rows_match_output_times() {
     let seen = Mutex::new(Vec::new());
     let cb = |f: f64| seen.lock().unwrap().push(f);
     let r = flexstar_fem::solve(
-        &exp,
+        &exp.problem().unwrap(),
         &FemSettings {
             snapshots: vec![0.01],
             ..coarse()
@@ -286,7 +302,12 @@ fn a_set_cancel_token_stops_the_run_at_the_first_output_time() {
     let token = flexstar_model::Cancel::new();
     token.cancel();
     let r = flexstar_model::cancel::with_cancel(Some(&token), || {
-        flexstar_fem::solve(&exp, &coarse(), flexstar_drive::SolveRequest::motion()).map(|s| s.response)
+        flexstar_fem::solve(
+            &exp.problem().unwrap(),
+            &coarse(),
+            flexstar_drive::SolveRequest::motion(),
+        )
+        .map(|s| s.response)
     });
     match r {
         Err(FemError::Cancelled { t }) => assert_eq!(t, exp.time.dt_out),

@@ -453,15 +453,8 @@ impl Experiment {
                 ),
             ));
         }
-        self.robot.validate()?;
-        self.time.validate()?;
-        self.trajectory.validate(&self.robot)?;
-        self.check_motion_fits()?;
+        crate::problem::check_physics(self)?;
         self.amm.validate(self.time.dt_out)?;
-        self.drive.validate(self.time.t_end, self.robot.mpp_mpa)?;
-        self.payload.validate()?;
-        self.damping.validate()?;
-        self.load.validate(self.time.t_end)?;
         self.report.validate()?;
         if self.fem.elements < 3 || !self.fem.elements.is_multiple_of(3) || self.fem.elements > 30_000 {
             return Err(ModelError::invalid(
@@ -506,7 +499,7 @@ impl Experiment {
 impl Experiment {
     /// A rest-to-rest motion must end by `time.t_end` (`docs/motions.md` section 1.5): one that
     /// ends later would be cut off mid-move.
-    fn check_motion_fits(&self) -> Result<(), ModelError> {
+    pub(crate) fn check_motion_fits(&self) -> Result<(), ModelError> {
         let Some(t_rest) = self.trajectory.t_rest() else {
             return Ok(());
         };

@@ -21,6 +21,10 @@ pub enum ModelError {
     /// The inverse kinematics of a task-space pose has no solution (a beam parallel to its slider).
     #[error("inverse kinematics: {0}")]
     InverseKinematics(String),
+    /// A robot the solvers' equal-beam models do not take (`docs/architecture.md`, "The robot
+    /// description"): `what` names the datum that makes it other than the paper's.
+    #[error("{what}: the solvers model three equal beams welded 120 degrees apart on an equilateral base")]
+    Unsupported { what: String },
     /// A result file could not be written (nothing is left behind).
     #[error("{file}: cannot write: {reason}")]
     Write { file: PathBuf, reason: String },

@@ -1,8 +1,9 @@
 //! # flexstar-model
 //!
-//! The data every other flexstar crate shares: the robot's parameters (paper, section 8), the
-//! base geometry (Eqs. 1-3), the actuator trajectories `s_i(t)`, the TOML experiment files and
-//! the [`Response`] that every solver returns. No solver code lives here.
+//! The data every other flexstar crate shares: the robot description ([`Robot`], per beam) and
+//! the validated [`Problem`] the solvers take, the robot's parameters in the paper's form
+//! (section 8), the base geometry (Eqs. 1-3), the actuator trajectories `s_i(t)`, the TOML
+//! experiment files and the [`Response`] that every solver returns. No solver code lives here.
 //!
 //! Conventions (frames, signs, units) are written once, in `docs/conventions.md`; the items here
 //! follow them. All quantities are SI: metres, seconds, kilograms, newtons, radians.
@@ -21,9 +22,11 @@ pub mod hash;
 pub mod identity;
 pub mod motion;
 pub mod params;
+pub mod problem;
 pub mod residual;
 pub mod response;
 pub mod rest_pose;
+pub mod robot;
 pub mod shaper;
 pub mod spline;
 pub mod trajectory;
@@ -37,9 +40,11 @@ pub use drive_section::{DriveKind, DriveSettings, Feedforward, ForceSamples};
 pub use error::{ModelError, SampleError};
 pub use motion::{TableMotion, TableSpace, ViaMotion, ViaPoint};
 pub use params::RobotParams;
+pub use problem::{EqualBeams, Problem};
 pub use residual::{ReportSettings, Residual};
 pub use response::{BeamShape, Column, Response, RunInfo, StarShape};
 pub use rest_pose::{RestPose, Sliders};
+pub use robot::{ActuatorAxis, Beam, Robot};
 pub use shaper::{Impulse, ShaperKind, ShaperSection};
 pub use trajectory::{Pose, ShapedMotion, Trajectory};
 pub use validity::{small_deflection_check, Provenance, ValidityExceeded};

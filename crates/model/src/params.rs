@@ -4,7 +4,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::ModelError;
 
-/// Physical parameters of the star-triangle robot. All three beams are identical.
+/// The `[robot]` section: the paper's compact form of the robot, one set of beam values for the
+/// three beams and the in-radius `d` of the equilateral base. The solvers read the per-beam
+/// [`crate::Robot`] built from it ([`crate::Robot::from_params`]; `docs/architecture.md`, "The
+/// robot description").
 ///
 /// TOML keys keep the paper's symbols (`E`, `I`, `rho`, `L`, `d`, `Lp`, `mpp_mpa`, `Jp`); every
 /// key is optional and defaults to the paper's value (section 8).

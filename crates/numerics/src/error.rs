@@ -20,8 +20,8 @@ pub enum NumericsError {
     #[error("non-finite entry in M, K or C, or a negative shift")]
     NonFinite,
     /// Constraint row `row` (1-based, of `rows`) is numerically a combination of the rows before
-    /// it: its residual norm after the projection is `norm`.
-    #[error("constraint row {row} of {rows} is a combination of the others (residual norm {norm:e})")]
+    /// it: the norm left after the projection is `norm`.
+    #[error("constraint row {row} of {rows} is a combination of the others (norm left after the projection {norm:e})")]
     DependentRow { row: usize, rows: usize, norm: f64 },
     /// `K + shift M` has a pivot that is not positive on the constrained motions.
     #[error("K + {shift:e} M is not positive definite on the constrained motions ({source:?}): a mechanism, or too small a shift")]

@@ -115,8 +115,9 @@ impl Evaluator {
         let step = flexstar_kinematics::preflight_step(exp.time.dt_out);
         let checked = flexstar_kinematics::check_motion(&exp.robot, traj, t_end, step)
             .map_err(|e| Rejected::Infeasible(format!("t = {:.4} s: {}", e.t, e.violation)))?;
+        let problem = exp.problem().map_err(|e| Rejected::Infeasible(e.detail()))?;
         let r = flexstar_amm::solve(
-            &exp,
+            &problem,
             &self.settings,
             flexstar_drive::SolveRequest::motion().with_proof(Some(&checked)),
         )

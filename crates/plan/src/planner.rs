@@ -147,7 +147,7 @@ pub fn setup(cfg: &PlanConfig, t_ref: f64, started: Instant) -> Result<Setup, Pl
     exp.trajectory = family.quintic(t_ref);
     let modes = match exp.amm.modes {
         Some(n) => n,
-        None => flexstar_amm::solve(&exp, &exp.amm, flexstar_drive::SolveRequest::motion())
+        None => flexstar_amm::solve(&problem_of(&exp)?, &exp.amm, flexstar_drive::SolveRequest::motion())
             .map(|s| s.response)
             .map_err(|e| PlanError::Solver(format!("the plain quintic's AMM run: {e}")))?
             .info
@@ -253,4 +253,10 @@ pub fn evaluate(ev: &Evaluator, family: &Family, x: &[f64], t_move: f64) -> Resu
     let traj = family.trajectory(x, t_move);
     let knots = knot_times(family, t_move);
     ev.eval(&traj, family.t0 + t_move, &knots)
+}
+
+/// The problem of a planner's experiment (its trajectory replaced by a candidate).
+pub(crate) fn problem_of(exp: &flexstar_model::Experiment) -> Result<flexstar_model::Problem, PlanError> {
+    exp.problem()
+        .map_err(|e| PlanError::Solver(format!("the planned experiment: {}", e.detail())))
 }

@@ -243,7 +243,8 @@ fn fem_verified(
     for cand in &successes {
         let mut exp = cfg.exp.clone();
         exp.trajectory = s.family.trajectory(&cand.1 .0, cand.0);
-        let r = flexstar_fem::solve(&exp, &exp.fem, flexstar_drive::SolveRequest::motion())
+        let problem = crate::planner::problem_of(&exp)?;
+        let r = flexstar_fem::solve(&problem, &exp.fem, flexstar_drive::SolveRequest::motion())
             .map(|s| s.response)
             .map_err(|e| PlanError::Solver(format!("the FEM check: {e}")))?;
         let peak = window_peak(&r, cfg.plan.t0 + cand.0);

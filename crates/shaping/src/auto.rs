@@ -76,7 +76,8 @@ fn unshaped_run(exp: &Experiment, t_end: f64) -> Result<flexstar_model::Response
         snapshots: Vec::new(),
         ..exp.amm.clone()
     };
-    flexstar_amm::solve(&x, &settings, flexstar_drive::SolveRequest::motion())
+    let problem = x.problem().map_err(|e| format!("the unshaped AMM run: {e}"))?;
+    flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
         .map(|s| s.response)
         .map_err(|e| format!("the unshaped AMM run: {e}"))
 }

@@ -8,7 +8,7 @@
 
 use flexstar_drive::{ActuatorLaw, Drive, Progress, SolveRequest, Solved};
 use flexstar_kinematics::CheckedMotion;
-use flexstar_model::{AmmSettings, DriveKind, Experiment, FemSettings, Response};
+use flexstar_model::{AmmSettings, DriveKind, Experiment, FemSettings, ModelError, Problem, Response};
 
 /// Which model solves an experiment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
@@ -96,12 +96,12 @@ pub enum SolveError {
     /// A servo's tracking errors could not be evaluated (its reference, at a time).
     #[error(transparent)]
     Tracking(flexstar_drive::DriveError),
-    /// `[shaper] f_hz = "auto"` is still pending: the motion would run unshaped.
-    #[error("shaper.f_hz = \"auto\" is not resolved yet: apply the shaper first (flexstar_shaping::shape)")]
-    Unshaped,
+    /// The problem's robot is not one the solvers model (`Problem::equal_beams`).
+    #[error(transparent)]
+    Robot(#[from] ModelError),
 }
 
-/// Solve `exp` with `settings` for the experiment's drive: the prescribed motion (inverse
+/// Solve `problem` with `settings` for its drive: the prescribed motion (inverse
 /// problem) when `[drive]` is a motion, else the direct problem under its actuator law (forces or
 /// a servo; a servo's response gains its tracking errors `e1..e3` [m], after its other columns).
 ///
@@ -109,25 +109,23 @@ pub enum SolveError {
 /// (the solver then does not scan it again); `None`: the solver scans it. `progress` receives the
 /// fraction of the span done (see `flexstar_drive::SolveRequest`).
 pub fn solve(
-    exp: &Experiment,
+    problem: &Problem,
     settings: Settings,
     proof: Option<&CheckedMotion>,
     progress: Option<Progress>,
 ) -> Result<Solved<Stats>, SolveError> {
-    if exp.shaper_pending() {
-        return Err(SolveError::Unshaped);
-    }
-    let law = flexstar_drive::law_for(exp)?;
-    let mut solved = solve_under(exp, settings, law.as_deref(), proof, progress)?;
-    if law.is_some() && exp.drive.kind == DriveKind::Servo {
-        flexstar_drive::add_tracking_errors(&mut solved.response, exp).map_err(SolveError::Tracking)?;
+    let equal = problem.equal_beams()?;
+    let law = flexstar_drive::law_for(&equal)?;
+    let mut solved = solve_under(problem, settings, law.as_deref(), proof, progress)?;
+    if law.is_some() && equal.drive.kind == DriveKind::Servo {
+        flexstar_drive::add_tracking_errors(&mut solved.response, &equal).map_err(SolveError::Tracking)?;
     }
     Ok(solved)
 }
 
 /// [`solve`] with the drive given: `law` (the direct problem) or `None` (the prescribed motion).
 fn solve_under(
-    exp: &Experiment,
+    problem: &Problem,
     settings: Settings,
     law: Option<&dyn ActuatorLaw>,
     proof: Option<&CheckedMotion>,
@@ -137,14 +135,14 @@ fn solve_under(
     let request = SolveRequest { drive, proof, progress };
     Ok(match settings {
         Settings::Amm(s) => {
-            let r = flexstar_amm::solve(exp, s, request)?;
+            let r = flexstar_amm::solve(problem, s, request)?;
             Solved {
                 response: r.response,
                 stats: Stats::Amm(r.stats),
             }
         }
         Settings::Fem(s) => {
-            let r = flexstar_fem::solve(exp, s, request)?;
+            let r = flexstar_fem::solve(problem, s, request)?;
             Solved {
                 response: r.response,
                 stats: Stats::Fem(r.stats),
@@ -155,12 +153,12 @@ fn solve_under(
 
 /// [`solve`]'s response only.
 pub fn response(
-    exp: &Experiment,
+    problem: &Problem,
     settings: Settings,
     proof: Option<&CheckedMotion>,
     progress: Option<Progress>,
 ) -> Result<Response, SolveError> {
-    solve(exp, settings, proof, progress).map(|s| s.response)
+    solve(problem, settings, proof, progress).map(|s| s.response)
 }
 
 /// The refined FEM that the accurate model's error estimate is judged against
@@ -192,8 +190,8 @@ mod tests {
         assert!("abaqus".parse::<Solver>().unwrap_err().contains("expected amm or fem"));
     }
 
-    /// A loaded `f_hz = "auto"` waits for the explicit shaping step: solving it before would run
-    /// the unshaped motion, so both solvers refuse it (and nothing is integrated).
+    /// A loaded `f_hz = "auto"` waits for the explicit shaping step: it does not become a
+    /// problem before (the solvers would run the unshaped motion), and the error names the key.
     #[test]
     fn a_pending_shaper_is_refused() {
         let text = "name = \"q\"\n[time]\nt_end = 0.6\ndt_out = 0.001\n[trajectory]\nkind = \"quintic\"\n\
@@ -201,9 +199,28 @@ mod tests {
                     t0 = 0.0\nt1 = 0.3\n[shaper]\nkind = \"zvd\"\nf_hz = \"auto\"\n";
         let exp = Experiment::from_toml_str(text, std::path::Path::new("q.toml")).unwrap();
         assert!(exp.shaper_pending());
+        let e = exp.problem().unwrap_err();
+        assert!(e.to_string().contains("shaper.f_hz"), "{e}");
+    }
+
+    /// A robot other than the paper's form (here beam 3 shorter) is refused by both solvers
+    /// before any work, naming the datum.
+    #[test]
+    fn an_unequal_robot_is_refused_with_the_datum() {
+        let exp = Experiment::from_toml_str(
+            "name = \"p\"\n[time]\nt_end = 0.01\n[trajectory]\nkind = \"polynomial\"\n\
+             s1 = [0.0]\ns2 = [0.0]\ns3 = [0.0]\n",
+            std::path::Path::new("p.toml"),
+        )
+        .unwrap();
+        let paper = exp.problem().unwrap();
+        let mut beams = *paper.robot().beams();
+        beams[2].length -= 0.002;
+        let robot = flexstar_model::Robot::new(beams, *paper.robot().axes()).unwrap();
+        let problem = paper.with_robot(robot).unwrap();
         for solver in Solver::ALL {
-            let e = solve(&exp, Settings::of(&exp, solver), None, None).unwrap_err();
-            assert!(matches!(e, SolveError::Unshaped), "{solver}: {e}");
+            let e = solve(&problem, Settings::of(&exp, solver), None, None).unwrap_err();
+            assert!(e.to_string().contains("beam 3 differs from beam 1"), "{solver}: {e}");
         }
     }
 }

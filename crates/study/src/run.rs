@@ -264,10 +264,14 @@ fn solve(exp: &Experiment, solver: Solver, fem_reference: FemReference) -> Solve
         FemReference::Defaults => exp.fem.clone(),
         FemReference::Refined => flexstar_solve::reference_fem(exp),
     };
+    let problem = match exp.problem() {
+        Ok(p) => p,
+        Err(e) => return (Err(Failure::Invalid(e.detail())), started.elapsed().as_secs_f64()),
+    };
     let result = catch_unwind(AssertUnwindSafe(|| match solver {
         // each solver scans the case's motion itself: a case's solvers may run in different shards
-        Solver::Amm => flexstar_solve::response(exp, Settings::Amm(&exp.amm), None, None),
-        Solver::Fem => flexstar_solve::response(exp, Settings::Fem(&fem), None, None),
+        Solver::Amm => flexstar_solve::response(&problem, Settings::Amm(&exp.amm), None, None),
+        Solver::Fem => flexstar_solve::response(&problem, Settings::Fem(&fem), None, None),
     }));
     let result = match result {
         Ok(r) => r.map_err(Failure::from),

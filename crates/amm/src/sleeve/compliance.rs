@@ -1,4 +1,4 @@
-//! The residual flexibility of the sleeves (`docs/amm.md` section 12, Eqs. R1-R6): the
+//! The truncation flexibility of the sleeves (`docs/amm.md` section 12, Eqs. R1-R6): the
 //! quasi-static deflection that the modes left out of the basis add under the sleeve's point
 //! forces and couple.
 //!
@@ -97,7 +97,7 @@ pub(crate) fn free_free_green(l: f64, x: f64, y: f64) -> [f64; 4] {
 /// B_MSLOPE` of [`super::rows`]: (offset from the sleeve centre in units of Lp/2, derivative order, sign).
 const FUNCTIONALS: [(f64, usize, f64); 4] = [(0.0, 0, 1.0), (1.0, 0, 1.0), (-1.0, 0, 1.0), (0.0, 1, -1.0)];
 
-/// The residual flexibility of one robot's beams at their sleeves (Eq. R3), for a basis whose
+/// The truncation flexibility of one robot's beams at their sleeves (Eq. R3), for a basis whose
 /// span holds the free-free beam's rigid motions (free-free and enriched families).
 #[derive(Debug, Clone)]
 pub(crate) struct SleeveCompliance {
@@ -158,7 +158,7 @@ impl SleeveCompliance {
 }
 
 impl Sleeves {
-    /// Eq. R4 (`docs/amm.md` 12): the residual flexibility of the sleeve rows of `beams`, `R / bp`
+    /// Eq. R4 (`docs/amm.md` 12): the truncation flexibility of the sleeve rows of `beams`, `R / bp`
     /// on their block of the Schur complement `a` (m x m, row-major; `C q + R lambda = 0` at
     /// `q = qhat + bp qdd`). No-op without it, and for the consistent initial accelerations
     /// (`bp = 0`: the rows hold at rest).
@@ -187,9 +187,9 @@ impl Sleeves {
     /// Eq. R4 (`docs/amm.md` 12): the deflection `sum_b R_ab lambda_b` that the modes left out
     /// of the basis add at beam `i`'s sleeve (its rows `beam`) under the multipliers `lam` of the
     /// last solve, for the functionals `[w(xc), w(xc + Lp/2), w(xc - Lp/2), -w'(xc)]` [m, m, m,
-    /// rad]; zeros without the residual flexibility.
+    /// rad]; zeros without the truncation flexibility.
     #[cfg(test)]
-    pub(crate) fn residual_deflection(&self, i: usize, beam: &BeamRows, lam: &[f64]) -> [f64; 4] {
+    pub(crate) fn truncation_deflection(&self, i: usize, beam: &BeamRows, lam: &[f64]) -> [f64; 4] {
         let mut out = [0.0; 4];
         if self.compliance.is_none() {
             return out;
@@ -263,7 +263,7 @@ mod tests {
     }
 
     #[test]
-    fn the_residual_flexibility_is_what_the_modes_left_out_add() {
+    fn the_truncation_flexibility_is_what_the_modes_left_out_add() {
         // Eq. R3: the compliance left by 30 free-free modes minus the one left by 400 is the
         // modal sum over modes 31..400 (to round-off), and the one left by 400 is small
         let p = RobotParams::paper();

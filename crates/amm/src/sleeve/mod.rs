@@ -16,7 +16,7 @@
 //!   out by the foreshortening, `x_c = xp_i - u_i + f(x_c)` ([`shift`], Eqs. S1-S4,
 //!   `docs/amm.md` 12.11), linearised about the step's predictor ([`Sleeves::update`]); each
 //!   normal force then acts along `e_w - w' e_x` (the u gradient `-w'`, [`Sleeves::axial`]);
-//! - full model with the enriched family: the residual flexibility of the modes left out of the
+//! - full model with the enriched family: the truncation flexibility of the modes left out of the
 //!   basis, seen at the sleeve's four functionals ([`compliance`], Eqs. R1-R4, `docs/amm.md` 12.3),
 //!   `C q + R lambda = 0`.
 //!
@@ -67,10 +67,10 @@ pub(crate) struct Sleeves {
     /// Full model: the material point in the sleeve drawn out by the foreshortening
     /// ([`shift`], Eqs. S1-S3).
     shift: Option<SleeveShift>,
-    /// Full model, enriched family: the residual flexibility of the sleeves (Eqs. R3-R4,
+    /// Full model, enriched family: the truncation flexibility of the sleeves (Eqs. R3-R4,
     /// `docs/amm.md` 12); `None` otherwise.
     compliance: Option<SleeveCompliance>,
-    /// Per beam: the residual flexibility `R_ab` of the sleeve rows (Eq. R3, `docs/amm.md` 12), a,
+    /// Per beam: the truncation flexibility `R_ab` of the sleeve rows (Eq. R3, `docs/amm.md` 12), a,
     /// b over `B_MID..=B_MSLOPE`, at the last update (with [`Sleeves::compliance`]).
     res: [[[f64; 4]; 4]; 3],
     /// Sleeve positions xp_i of the last update [m].
@@ -182,7 +182,7 @@ impl Sleeves {
     /// the beams and e in {0, +-Lp/2}, at the material point `x_c = xp - u + f(x_c)` of Eq. S1;
     /// the same at `xp - u` (no foreshortening, as before Eq. S1); and `|w_i(xp_i + e) - e thp_i|`
     /// (the rigid material points, as the paper takes them) [m]. `beams`, `lam`: the rows and the
-    /// multipliers of the last solve (for the residual flexibility's deflection).
+    /// multipliers of the last solve (for the truncation flexibility's deflection).
     #[cfg(test)]
     pub(crate) fn gaps(&self, modes: &ModeSet, beams: &[BeamRows; 3], lam: &[f64], q: &[f64], lp: f64) -> [f64; 3] {
         let nm = modes.len();
@@ -196,8 +196,8 @@ impl Sleeves {
             for _ in 0..3 {
                 xc = self.xp[i] - u + modes.half_squared_slope_integral(alpha, xc);
             }
-            // the residual flexibility's deflection at the left edge, centre, right edge (Eq. R4)
-            let res = self.residual_deflection(i, beam, lam);
+            // the truncation flexibility's deflection at the left edge, centre, right edge (Eq. R4)
+            let res = self.truncation_deflection(i, beam, lam);
             for (e, r) in [-0.5 * lp, 0.0, 0.5 * lp].into_iter().zip([res[2], res[0], res[1]]) {
                 for (gap, x, side, rr) in [
                     (0, xc + e, e * thp.sin(), r),

@@ -40,5 +40,5 @@ pub fn motion_response(
     exp: &Experiment,
     settings: &AmmSettings,
 ) -> Result<flexstar_model::Response, flexstar_amm::AmmError> {
-    flexstar_amm::solve(exp, settings, flexstar_drive::SolveRequest::motion()).map(|s| s.response)
+    flexstar_amm::solve(&exp.problem()?, settings, flexstar_drive::SolveRequest::motion()).map(|s| s.response)
 }

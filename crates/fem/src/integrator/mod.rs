@@ -48,7 +48,7 @@ pub(crate) struct RunSettings {
 pub struct Stats {
     /// Time steps taken.
     pub steps: usize,
-    /// Newton iterations (residual evaluations and solves) in all.
+    /// Newton iterations (imbalance evaluations and solves) in all.
     pub newton_iterations: usize,
     /// Sparsity patterns built (one at the start, a new one when a sleeve's contact point leaves
     /// its window of elements); the sparse LU fallback redoes its symbolic factorisation on these.
@@ -159,7 +159,7 @@ fn initial_state(
     let worst = phi0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     if worst > 1e-9 * l {
         return Err(FemError::Input(format!(
-            "the initial pose does not pass through the pins (largest constraint residual {worst:.3e})"
+            "the initial pose does not pass through the pins (largest constraint violation {worst:.3e})"
         )));
     }
     let mut res = vec![0.0; n_sys];

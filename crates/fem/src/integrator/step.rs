@@ -6,7 +6,7 @@ use super::*;
 /// Newton iterations allowed per step.
 const MAX_ITER: usize = 30;
 /// Guard of the reused factorisation: the matrix is assembled and factorised at the first
-/// iteration of every step and reused by the following ones (residual only) while each Newton
+/// iteration of every step and reused by the following ones (imbalance only) while each Newton
 /// increment, measured against the convergence tolerances, is at most this fraction of the
 /// previous one; otherwise the next iteration assembles and factorises afresh. (Reusing it across
 /// steps too was measured to double the iterations, 4.2 per step, for a smaller gain.)
@@ -184,7 +184,7 @@ flexstar_numerics::dispatch_avx2! {
 /// rows (direct problem) and the load at G.
 type Drive<'a> = (&'a Pins, Option<&'a SliderRows>, Option<[f64; 3]>);
 
-/// Assemble the residual (and, when `stale`, the matrix, then factorise it) at the Newton
+/// Assemble the imbalance (and, when `stale`, the matrix, then factorise it) at the Newton
 /// iterate and solve for the increment `dx = -A^{-1} res`; whether the matrix was fresh.
 /// `(bp, gp)` = `(beta', gamma')` of the step.
 #[allow(clippy::too_many_arguments)]

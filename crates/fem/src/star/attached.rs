@@ -4,7 +4,7 @@
 //! is skipped, so the run is the bare star's bit for bit.
 
 use flexstar_model::geometry::{e_w, e_x};
-use flexstar_model::{Experiment, LoadSettings, Payload};
+use flexstar_model::{EqualBeams, LoadSettings, Payload};
 
 use super::*;
 
@@ -88,7 +88,7 @@ pub(crate) struct Attached {
 impl Attached {
     /// The `[payload]`, `[damping]` and `[load]` of `exp` for a star starting at the
     /// orientation `theta0` [rad].
-    pub fn of(exp: &Experiment, theta0: f64) -> Self {
+    pub fn of(exp: &EqualBeams, theta0: f64) -> Self {
         Attached {
             payload: PayloadAtG::new(&exp.payload, theta0),
             beta: exp.damping.beta(),
@@ -103,7 +103,7 @@ impl Attached {
 }
 
 impl Star {
-    /// The payload's part of [`Star::assemble`] (Eq. P11): `cf f_p` into node G's residual rows
+    /// The payload's part of [`Star::assemble`] (Eq. P11): `cf f_p` into node G's imbalance rows
     /// and, with `matrix`, `M_p` into the G-G part of element 0's block (the border sums the
     /// three beams' G-G parts; the sparse LU sums repeated slots). Its tangents (Eq. P12) are
     /// left out, like the beams' `dM/dq` and gyroscopic terms.

@@ -90,7 +90,7 @@ pub(crate) struct SliderRows {
     pub diag: [f64; 3],
 }
 
-/// The Newton iterate at which [`Star::assemble`] evaluates the residual and the matrix:
+/// The Newton iterate at which [`Star::assemble`] evaluates the imbalance and the matrix:
 /// coordinates, velocities, accelerations and (scaled) multipliers in the star's global
 /// ordering, the pins of the same iterate and, in the direct problem, the sliders' rows.
 #[derive(Clone, Copy)]
@@ -285,7 +285,7 @@ impl Star {
         (e, x - e as f64)
     }
 
-    /// Assemble the residual and the iteration matrix at coordinates `q`, velocities `v`,
+    /// Assemble the imbalance and the iteration matrix at coordinates `q`, velocities `v`,
     /// accelerations `qdd` and multipliers `lam` (21), for pins `pins` (in the direct problem:
     /// [`Star::pins_of`] the same iterate, with the sliders' rows `sliders`):
     ///
@@ -302,7 +302,7 @@ impl Star {
     /// enters the element forces (Eqs. D7, D9; `fac.cv` the velocity factor gamma').
     /// Direct problem: `res[s_i] = cf ((mpp + mpa) s_i'' - Fa_i) - u_i . (nu_c + nu_l + nu_r)`,
     /// matrix diagonal `sliders.diag`, coupling `-u_i` with the sleeve's position rows.
-    /// With `matrix == false` only the residual is evaluated (for a modified Newton iteration with
+    /// With `matrix == false` only the imbalance is evaluated (for a modified Newton iteration with
     /// the last factorisation, `crate::integrator`), unless the pattern had to be rebuilt. Returns
     /// whether the matrix was assembled (and must be factorised before the next solve).
     pub fn assemble(
@@ -359,13 +359,13 @@ impl Star {
                 ))
             }
         }
-        self.check_residual(res, t)?;
+        self.check_imbalance(res, t)?;
         Ok(matrix)
     }
 
-    /// A residual with a non-finite entry is an error naming the row (and the element of a DOF row).
+    /// An imbalance with a non-finite entry is an error naming the row (and the element of a DOF row).
     #[inline]
-    fn check_residual(&self, res: &[f64], t: f64) -> Result<(), FemError> {
+    fn check_imbalance(&self, res: &[f64], t: f64) -> Result<(), FemError> {
         // one pass without early exit (vectorised), the position only when there is one
         let any_bad = res.iter().fold(false, |bad, r| bad | !r.is_finite());
         if let Some(k) = any_bad.then(|| res.iter().position(|r| !r.is_finite())).flatten() {
@@ -376,7 +376,7 @@ impl Star {
                 } else {
                     0
                 },
-                reason: format!("residual row {k}"),
+                reason: format!("imbalance row {k}"),
             });
         }
         Ok(())
@@ -487,7 +487,7 @@ mod tests {
 
     /// Solve `A x = b` with `Star::factor`/`Star::solve` on a deformed (node perturbation of
     /// amplitude `amp` [m, rad]), moving star whose sleeve 1 window holds G; check against the
-    /// general sparse LU and against the residual `A x - b` computed from the slots. Returns
+    /// general sparse LU and against the equations `A x = b` themselves, from the slots. Returns
     /// whether `Star::factor` fell back to the sparse LU. `direct`: with the slider unknowns and
     /// rows of the direct problem (three more border unknowns).
     fn solve_and_check(amp: f64, direct: bool) -> bool {
@@ -559,7 +559,7 @@ mod tests {
         for k in 0..star.n_sys {
             assert!(
                 (ax[k] - b[k]).abs() < 1e-9 * abs[k],
-                "residual row {k}: {} vs {}",
+                "equation {k}: A x = {} vs b = {}",
                 ax[k],
                 b[k]
             );
@@ -569,7 +569,7 @@ mod tests {
     }
 
     #[test]
-    fn bordered_solver_matches_sparse_lu_and_residual() {
+    fn bordered_solver_matches_sparse_lu_and_its_equations() {
         // strains ~1e-5: the beam blocks are positive definite, the structured solver takes them
         assert!(
             !solve_and_check(1e-7, false),

@@ -24,7 +24,7 @@
 //! (position and angle) across element boundaries, so a contact point slides from one element
 //! into the next without a jump. [`Star::row_terms`] gives each row's value and its Jacobian
 //! blocks (element DOFs, contact coordinate, sleeve rotation), [`Star::constraints`] the values
-//! alone; [`Star::sleeve_rows`] adds the sleeve's part to the Newton residual and matrix (the slot
+//! alone; [`Star::sleeve_rows`] adds the sleeve's part to the Newton imbalance and matrix (the slot
 //! layout of its rows is `pattern.rs`'s, their place in the border `crate::bordered`'s).
 //!
 //! The tangent row carries the interior-field correction of Eq. S9 (`docs/fem.md` section 2.1,
@@ -40,7 +40,7 @@
 //! `gamma0_i + psi_i` ([`Star::sleeve_angle`]) less the rigid beam direction, and `Fn_i = -F_i . e_wi`.
 //!
 //! **Frictionless, and where friction would enter.** Nothing but the constraints acts on the
-//! contact coordinates: the equation of `xi_p` in the Newton residual is
+//! contact coordinates: the equation of `xi_p` in the Newton imbalance is
 //! `res[xi_p] = sum_r (d Phi_r / d xi_p) lambda_r = lambda_p . dr/dxi` (the `gxi * l` terms of
 //! [`Star::sleeve_rows`]), which sets to zero the component of each contact force along the beam,
 //! and its diagonal slot in the matrix (`vals[off_psi + 4 i + 1 + p]`) is 0. A friction force
@@ -134,7 +134,7 @@ impl Star {
     }
 
     /// The sleeve part of [`Star::assemble`] for sleeve i: the rotation's inertia, then per
-    /// constraint row its value, its gradient times the multiplier into the residual and, with
+    /// constraint row its value, its gradient times the multiplier into the imbalance and, with
     /// `matrix`, its slots (row block, then transposed block).
     #[inline]
     pub(super) fn sleeve_rows(
@@ -417,7 +417,7 @@ mod tests {
 
     /// The constraint Jacobian of [`Star::row_terms`] (the rows' element gradients, contact
     /// coordinate and sleeve-rotation derivatives, assembled as [`Star::assemble`] does) against
-    /// central differences of the constraint residual [`Star::constraints`] (Eq. 21), column by
+    /// central differences of the constraint violation [`Star::constraints`] (Eq. 21), column by
     /// column over every coordinate, at three states of paper case 3 (rigid poses at t = 0.1, 0.3,
     /// 0.5 s, the nodes displaced by up to 2 mm and 0.02 rad, the sleeves turned): two
     /// independent codes (values against derivatives).

@@ -1,0 +1,160 @@
+//! What a solver solves: the robot and its run, validated once and immutable
+//! (`docs/architecture.md`, "The robot description").
+//!
+//! An [`Experiment`] is what a TOML file says (names, solver settings, reports, all public and
+//! mutable); a [`Problem`] is the part of it that is physics: the [`Robot`], the time span, the
+//! trajectory, the drive and the attachments. [`Problem::new`] is the one validating conversion
+//! (the keys named as in the file); the solvers take a `&Problem` and never check it again.
+
+use crate::attachments::{Damping, LoadSettings, Payload};
+use crate::config::{Experiment, TimeSpan};
+use crate::drive_section::DriveSettings;
+use crate::error::ModelError;
+use crate::params::RobotParams;
+use crate::robot::Robot;
+use crate::trajectory::Trajectory;
+
+/// The robot and its run, validated (see the module doc).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    robot: Robot,
+    /// The robot in the paper's form when it is the paper's robot (see [`Robot::equal_beams`]).
+    params: Option<RobotParams>,
+    time: TimeSpan,
+    trajectory: Trajectory,
+    drive: DriveSettings,
+    payload: Payload,
+    damping: Damping,
+    load: LoadSettings,
+}
+
+impl Problem {
+    /// The physics of `exp`, every value checked: the robot, the time span, the trajectory (and
+    /// that a rest-to-rest motion ends by `t_end`), the drive, the payload, the damping and the
+    /// load. A pending `[shaper] f_hz = "auto"` is refused: the motion would run unshaped (apply
+    /// it first, `flexstar_shaping::shape`). Errors name the key; the file is added by the loader.
+    pub fn new(exp: &Experiment) -> Result<Self, ModelError> {
+        if exp.shaper_pending() {
+            return Err(ModelError::invalid(
+                "shaper.f_hz",
+                "\"auto\" is not resolved yet: apply the shaper first (flexstar_shaping::shape)",
+            ));
+        }
+        let robot = check_physics(exp)?;
+        Ok(Problem {
+            params: robot.equal_beams().ok().copied(),
+            robot,
+            time: exp.time,
+            trajectory: exp.trajectory.clone(),
+            drive: exp.drive.clone(),
+            payload: exp.payload.clone(),
+            damping: exp.damping,
+            load: exp.load.clone(),
+        })
+    }
+
+    /// The robot: per-beam data and the actuator axes.
+    pub fn robot(&self) -> &Robot {
+        &self.robot
+    }
+
+    /// The problem as the solvers' equal-beam models read it: its parts, with the robot in the
+    /// paper's form. This is the explicit check of [`Robot::equal_beams`]; its error names the
+    /// datum that makes the robot other than the paper's.
+    pub fn equal_beams(&self) -> Result<EqualBeams<'_>, ModelError> {
+        let robot = match &self.params {
+            Some(p) => p,
+            None => self.robot.equal_beams()?,
+        };
+        Ok(EqualBeams {
+            robot,
+            time: self.time,
+            trajectory: &self.trajectory,
+            drive: &self.drive,
+            payload: &self.payload,
+            damping: &self.damping,
+            load: &self.load,
+        })
+    }
+
+    /// The same run on another robot. The checks that depend on the robot (the trajectory's
+    /// start, the servo's slider mass) are run again where they can be: on a robot in the paper's
+    /// form; a robot of another form is refused by the solvers anyway ([`Problem::equal_beams`]).
+    pub fn with_robot(&self, robot: Robot) -> Result<Self, ModelError> {
+        let params = robot.equal_beams().ok().copied();
+        if let Some(p) = &params {
+            self.trajectory.validate(p)?;
+            self.drive.validate(self.time.t_end, p.mpp_mpa)?;
+        }
+        Ok(Problem {
+            robot,
+            params,
+            ..self.clone()
+        })
+    }
+
+    /// Simulated span and output step.
+    pub fn time(&self) -> &TimeSpan {
+        &self.time
+    }
+
+    /// The actuator motion `s_i(t)` (already shaped, when the experiment has a shaper).
+    pub fn trajectory(&self) -> &Trajectory {
+        &self.trajectory
+    }
+
+    /// What moves the sliders: the trajectory, forces or a servo.
+    pub fn drive(&self) -> &DriveSettings {
+        &self.drive
+    }
+
+    /// The rigid body welded at G (zero mass: none).
+    pub fn payload(&self) -> &Payload {
+        &self.payload
+    }
+
+    /// The beams' damping.
+    pub fn damping(&self) -> &Damping {
+        &self.damping
+    }
+
+    /// The force and moment at G.
+    pub fn load(&self) -> &LoadSettings {
+        &self.load
+    }
+}
+
+/// Check every physical value of `exp` (all but a pending shaper): the robot it describes.
+pub(crate) fn check_physics(exp: &Experiment) -> Result<Robot, ModelError> {
+    let robot = Robot::from_params(&exp.robot)?;
+    exp.time.validate()?;
+    exp.trajectory.validate(&exp.robot)?;
+    exp.check_motion_fits()?;
+    exp.drive.validate(exp.time.t_end, exp.robot.mpp_mpa)?;
+    exp.payload.validate()?;
+    exp.damping.validate()?;
+    exp.load.validate(exp.time.t_end)?;
+    Ok(robot)
+}
+
+/// A [`Problem`] whose robot is the paper's: three equal beams welded 120 degrees apart on an
+/// equilateral base ([`Problem::equal_beams`]). The parts of the problem by reference, the time
+/// span by value (a solver's coarse internal runs change its output step).
+#[derive(Debug, Clone, Copy)]
+pub struct EqualBeams<'a> {
+    /// The robot in the paper's form (section 8 keys).
+    pub robot: &'a RobotParams,
+    pub time: TimeSpan,
+    pub trajectory: &'a Trajectory,
+    pub drive: &'a DriveSettings,
+    pub payload: &'a Payload,
+    pub damping: &'a Damping,
+    pub load: &'a LoadSettings,
+}
+
+impl Experiment {
+    /// The physics of this experiment as the solvers take it ([`Problem::new`]).
+    pub fn problem(&self) -> Result<Problem, ModelError> {
+        Problem::new(self)
+    }
+}

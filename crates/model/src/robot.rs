@@ -1,0 +1,285 @@
+//! The robot as data: three beams, each with its own section, sleeve and weld angle, and three
+//! actuator axes (`docs/architecture.md`, "The robot description").
+//!
+//! Frames and signs follow `docs/conventions.md`: the fixed XY frame with origin O at the centre
+//! of the base triangle; beam i's rigid axis `e_xi` at the angle `theta + weld_i` of Eq. 11.
+//! The paper's robot (section 8: three equal beams welded 120 degrees apart on an equilateral base)
+//! is one value of this data; whether a robot is that one is an explicit check on the data
+//! ([`Robot::equal_beams`]), which the solvers' equal-beam fast paths (one mode set for the three
+//! beams, the FEM's three SIMD lanes) rely on.
+
+use crate::error::ModelError;
+use crate::geometry::{beam_offset, revolute_origin, slider_direction};
+use crate::params::RobotParams;
+
+/// One flexible beam of the star with its sleeve (the passive prismatic joint it slides through).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Beam {
+    /// Young's modulus E [Pa].
+    pub youngs_modulus: f64,
+    /// Second moment of area I of the section [m^4].
+    pub second_moment: f64,
+    /// Axial stiffness EA [N].
+    pub axial_stiffness: f64,
+    /// Mass per unit length rho [kg/m].
+    pub mass_per_length: f64,
+    /// Length L, junction G to free tip [m].
+    pub length: f64,
+    /// Sleeve length Lp [m].
+    pub sleeve_length: f64,
+    /// Mass of the sleeve and its slider, mpp + mpa [kg] (Eq. 33).
+    pub sleeve_mass: f64,
+    /// Rotational inertia Jp of the sleeve about its pin [kg m^2] (Eq. 31).
+    pub sleeve_inertia: f64,
+    /// Angle of the beam's rigid axis at the weld, from beam 1's [rad]: the offset
+    /// `(i - 1) 2 pi / 3` of Eqs. 11-12 on the paper's robot.
+    pub weld_angle: f64,
+}
+
+impl Beam {
+    /// Bending stiffness EI [N m^2].
+    pub fn bending_stiffness(&self) -> f64 {
+        self.youngs_modulus * self.second_moment
+    }
+}
+
+/// The line an actuated slider moves along: its revolute point is `origin + s direction`
+/// (Eqs. 1-3 on the paper's base) [m], fixed frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ActuatorAxis {
+    /// The revolute point at `s = 0` [m].
+    pub origin: [f64; 2],
+    /// Unit direction of increasing `s`.
+    pub direction: [f64; 2],
+}
+
+impl ActuatorAxis {
+    /// Axis i of the paper's equilateral base of in-radius `d` [m] (Eqs. 1-3).
+    pub fn paper(i: usize, d: f64) -> Self {
+        ActuatorAxis {
+            origin: revolute_origin(i, d),
+            direction: slider_direction(i),
+        }
+    }
+}
+
+/// The robot: its three beams and three actuator axes, validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Robot {
+    beams: [Beam; 3],
+    axes: [ActuatorAxis; 3],
+    /// The paper-form parameters when the data is the paper's robot (equal beams, 120-degree
+    /// welds, equilateral base), found by [`Robot::check_equal`].
+    equal: Option<RobotParams>,
+}
+
+impl Robot {
+    /// A robot from its beams and axes, each value checked (`robot.<key>` names the beam:
+    /// `robot.L[2]`).
+    pub fn new(beams: [Beam; 3], axes: [ActuatorAxis; 3]) -> Result<Self, ModelError> {
+        for (i, b) in beams.iter().enumerate() {
+            check_beam(i, b)?;
+        }
+        for (i, a) in axes.iter().enumerate() {
+            let norm = a.direction[0].hypot(a.direction[1]);
+            if !(a.origin.iter().all(|v| v.is_finite()) && (norm - 1.0).abs() < 1e-9) {
+                return Err(ModelError::invalid(
+                    format!("base.axes[{}]", i + 1),
+                    format!("need a finite origin and a unit direction, got {a:?}"),
+                ));
+            }
+        }
+        let equal = Self::check_equal(&beams, &axes);
+        Ok(Robot { beams, axes, equal })
+    }
+
+    /// The paper's form: three equal beams of `params`, welded 120 degrees apart, on the
+    /// equilateral base of in-radius `params.d` (every value checked by [`RobotParams::validate`]).
+    pub fn from_params(params: &RobotParams) -> Result<Self, ModelError> {
+        params.validate()?;
+        let beam = |i: usize| Beam {
+            youngs_modulus: params.e,
+            second_moment: params.i,
+            axial_stiffness: params.ea(),
+            mass_per_length: params.rho,
+            length: params.l,
+            sleeve_length: params.lp,
+            sleeve_mass: params.mpp_mpa,
+            sleeve_inertia: params.jp,
+            weld_angle: beam_offset(i),
+        };
+        let mut robot = Self::new(
+            [beam(0), beam(1), beam(2)],
+            std::array::from_fn(|i| ActuatorAxis::paper(i, params.d)),
+        )?;
+        // the check found the paper's robot; keep the caller's own form of it (`EA` given or
+        // defaulted), so that it compares equal with the parameters it came from
+        if robot.equal.is_some() {
+            robot.equal = Some(*params);
+        }
+        Ok(robot)
+    }
+
+    /// The three beams, beam 1 first.
+    pub fn beams(&self) -> &[Beam; 3] {
+        &self.beams
+    }
+
+    /// The three actuator axes, slider 1 first.
+    pub fn axes(&self) -> &[ActuatorAxis; 3] {
+        &self.axes
+    }
+
+    /// The robot in the paper's form, when it is the paper's robot: three equal beams welded at
+    /// 0, 120 and 240 degrees on an equilateral base centred at O. Otherwise the error says which
+    /// datum differs: the solvers' equal-beam models refuse such a robot with it.
+    pub fn equal_beams(&self) -> Result<&RobotParams, ModelError> {
+        self.equal.as_ref().ok_or_else(|| ModelError::Unsupported {
+            what: self.first_difference(),
+        })
+    }
+
+    /// Is the data the paper's robot? Its parameters when it is (with `EA` as given).
+    fn check_equal(beams: &[Beam; 3], axes: &[ActuatorAxis; 3]) -> Option<RobotParams> {
+        let b = beams[0];
+        let d = -axes[0].origin[1];
+        let same_beams = beams.iter().all(|x| {
+            Beam {
+                weld_angle: b.weld_angle,
+                ..*x
+            } == b
+        });
+        let welds = (0..3).all(|i| close(beams[i].weld_angle, beam_offset(i)));
+        let base = d > 0.0 && (0..3).all(|i| close_axis(&axes[i], &ActuatorAxis::paper(i, d)));
+        (same_beams && welds && base).then_some(RobotParams {
+            e: b.youngs_modulus,
+            i: b.second_moment,
+            rho: b.mass_per_length,
+            l: b.length,
+            d,
+            lp: b.sleeve_length,
+            mpp_mpa: b.sleeve_mass,
+            jp: b.sleeve_inertia,
+            ea: Some(b.axial_stiffness),
+        })
+    }
+
+    /// Which datum makes this robot other than the paper's (for [`Robot::equal_beams`]).
+    fn first_difference(&self) -> String {
+        let b = self.beams[0];
+        if let Some(i) = (1..3).find(|&i| {
+            Beam {
+                weld_angle: b.weld_angle,
+                ..self.beams[i]
+            } != b
+        }) {
+            return format!("beam {} differs from beam 1", i + 1);
+        }
+        if let Some(i) = (0..3).find(|&i| !close(self.beams[i].weld_angle, beam_offset(i))) {
+            return format!(
+                "beam {} is welded at {} degrees, not {}",
+                i + 1,
+                self.beams[i].weld_angle.to_degrees(),
+                beam_offset(i).to_degrees()
+            );
+        }
+        "the base is not the equilateral triangle centred at O".to_string()
+    }
+}
+
+/// Equal to rounding: angles and lengths built by different sums of the same numbers.
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * (1.0 + b.abs())
+}
+
+fn close_axis(a: &ActuatorAxis, b: &ActuatorAxis) -> bool {
+    (0..2).all(|k| close(a.origin[k], b.origin[k]) && close(a.direction[k], b.direction[k]))
+}
+
+/// Every value of one beam finite and positive (the sleeve's mass and inertia may be 0), the
+/// sleeve shorter than the beam.
+fn check_beam(i: usize, b: &Beam) -> Result<(), ModelError> {
+    let key = |name: &str| format!("robot.{name}[{}]", i + 1);
+    let positive = [
+        ("E", b.youngs_modulus),
+        ("I", b.second_moment),
+        ("EA", b.axial_stiffness),
+        ("rho", b.mass_per_length),
+        ("L", b.length),
+        ("Lp", b.sleeve_length),
+    ];
+    for (name, v) in positive {
+        if !v.is_finite() || v <= 0.0 {
+            return Err(ModelError::invalid(
+                key(name),
+                format!("must be a positive finite number, got {v}"),
+            ));
+        }
+    }
+    for (name, v) in [
+        ("mpp_mpa", b.sleeve_mass),
+        ("Jp", b.sleeve_inertia),
+        ("weld_deg", b.weld_angle),
+    ] {
+        if !v.is_finite() || v < 0.0 {
+            return Err(ModelError::invalid(
+                key(name),
+                format!("must be a finite number >= 0, got {v}"),
+            ));
+        }
+    }
+    if b.sleeve_length >= b.length {
+        return Err(ModelError::invalid(
+            key("Lp"),
+            format!(
+                "the sleeve must be shorter than the beam: 0 < Lp < L = {}, got {}",
+                b.length, b.sleeve_length
+            ),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_paper_robot_is_found_equal_and_keeps_its_parameters() {
+        let p = RobotParams::paper();
+        let r = Robot::from_params(&p).unwrap();
+        assert_eq!(*r.equal_beams().unwrap(), p);
+        // the same data built beam by beam is recognised by the check alone, EA made explicit
+        let again = Robot::new(*r.beams(), *r.axes()).unwrap();
+        assert_eq!(again.equal_beams().unwrap().ea(), p.ea());
+        assert_eq!(again.equal_beams().unwrap().d, p.d);
+    }
+
+    #[test]
+    fn any_difference_in_the_data_is_named() {
+        let r = Robot::from_params(&RobotParams::paper()).unwrap();
+        let mut beams = *r.beams();
+        beams[2].length = 0.48;
+        let e = Robot::new(beams, *r.axes()).unwrap().equal_beams().unwrap_err();
+        assert!(e.to_string().contains("beam 3 differs from beam 1"), "{e}");
+
+        let mut beams = *r.beams();
+        beams[1].weld_angle += 1f64.to_radians();
+        let e = Robot::new(beams, *r.axes()).unwrap().equal_beams().unwrap_err();
+        assert!(e.to_string().contains("beam 2 is welded at 121"), "{e}");
+
+        let mut axes = *r.axes();
+        axes[1].origin[0] += 1e-3;
+        let e = Robot::new(*r.beams(), axes).unwrap().equal_beams().unwrap_err();
+        assert!(e.to_string().contains("equilateral"), "{e}");
+    }
+
+    #[test]
+    fn bad_beam_values_name_the_beam() {
+        let r = Robot::from_params(&RobotParams::paper()).unwrap();
+        let mut beams = *r.beams();
+        beams[1].sleeve_length = 0.6;
+        let e = Robot::new(beams, *r.axes()).unwrap_err();
+        assert!(e.to_string().contains("robot.Lp[2]"), "{e}");
+    }
+}

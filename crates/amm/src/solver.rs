@@ -509,6 +509,19 @@ pub(crate) fn run_info(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every column the AMM writes is declared once in `flexstar_model::quantity` (its unit in
+    /// the sidecar, its row in `docs/outputs.md`).
+    #[test]
+    fn every_column_is_a_declared_quantity() {
+        let fixed = flexstar_model::response::RESPONSE_HEADER;
+        for name in fixed.iter().chain(&EXTRA_COLUMNS) {
+            assert!(
+                flexstar_model::quantity::quantity_of(name).is_some(),
+                "{name} is not declared"
+            );
+        }
+    }
     use flexstar_model::{AmmModel, FemSettings, RobotParams, TimeSpan, Trajectory};
 
     fn case(k: [f64; 3], t_end: f64) -> Experiment {

@@ -44,23 +44,26 @@ pub struct MotionRow {
 
 /// The row of one motion.
 pub fn motion_row(m: &MotionRuns) -> MotionRow {
-    let key = |o: &crate::run::RunOutcome, k: &str| o.meta[k].as_f64();
-    let both = |k: &str| [key(&m.amm, k), key(&m.fem, k)];
+    // a value the sidecar writes as null (absent or not finite) reads as absent
+    let both = |k: fn(&flexstar_model::ResidualKeys) -> Option<f64>| {
+        let key = |o: &crate::run::RunOutcome| o.sidecar.residual.as_ref().and_then(k).filter(|v| v.is_finite());
+        [key(&m.amm), key(&m.fem)]
+    };
     let t_rest = m.exp.trajectory.t_rest().unwrap_or(f64::NAN);
     let t0 = m.exp.trajectory.t_start();
     let (v, a) = kinematic_peaks(&m.exp.robot, &m.exp.trajectory, (t0, t_rest), m.exp.time.dt_out, &[])
         .unwrap_or((zero_peak(), zero_peak()));
-    let g = both("residual_G_peak_m");
+    let g = both(|r| r.g_peak_m);
     let shaper = m.exp.shaper.as_ref();
     MotionRow {
         motion: m.label.to_string(),
         move_s: t_rest - t0,
         t_rest,
         g_peak_m: g,
-        g_rms_m: both("residual_G_rms_m"),
-        tip_peak_m: both("residual_tip_peak_m"),
-        tip_rms_m: both("residual_tip_rms_m"),
-        settle_s: both("settle_s"),
+        g_rms_m: both(|r| r.g_rms_m),
+        tip_peak_m: both(|r| r.tip_peak_m),
+        tip_rms_m: both(|r| r.tip_rms_m),
+        settle_s: both(|r| r.settle_s),
         fa_peak_n: [force_peak(&m.amm.response).value, force_peak(&m.fem.response).value],
         v_peak: v.value,
         a_peak: a.value,

@@ -120,7 +120,7 @@ impl Prepared {
 pub struct RunOutcome {
     pub response: Response,
     /// The sidecar JSON as written next to the CSV (provenance, run info, validity, experiment).
-    pub meta: serde_json::Value,
+    pub sidecar: flexstar_model::RunSidecar,
     /// The file stem (`amm-enriched`, `fem-direct`, ...).
     pub stem: String,
     /// The resolved experiment.
@@ -131,6 +131,22 @@ pub struct RunOutcome {
     pub files: Vec<PathBuf>,
     /// The main CSV (set by [`write_run`]).
     pub csv: Option<PathBuf>,
+}
+
+impl RunOutcome {
+    /// The residual peak of |dG| after the motion [m] (the sidecar's `residual_G_peak_m`);
+    /// `None` when there is none (no rest before `t_end`, G pinned by the family).
+    pub fn residual_g_peak_m(&self) -> Option<f64> {
+        self.sidecar.residual.as_ref()?.g_peak_m.filter(|v| v.is_finite())
+    }
+
+    /// The sidecar document as written (keys in alphabetical order).
+    pub fn sidecar_json(&self) -> Result<serde_json::Value> {
+        Ok(flexstar_model::response::sidecar_value(
+            std::path::Path::new(&format!("{}.json", self.stem)),
+            &self.sidecar,
+        )?)
+    }
 }
 
 /// Apply `settings` to `exp` (from `source`) and check everything before any work: the step,
@@ -321,16 +337,18 @@ pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Re
 /// written.
 pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunOutcome> {
     let response = solve(p, progress)?;
-    let mut meta = response.sidecar(Path::new(&format!("{}.json", p.stem)), &p.exp, &crate::provenance())?;
-    add_residual(&mut meta, p, &response)?;
+    let mut sidecar = response.sidecar(&p.exp, &crate::provenance());
+    sidecar.residual = Some(residual_keys(p, &response)?);
     let warning = flexstar_model::small_deflection_check(&response, p.exp.robot.l)
         .map(|v| format!("{}: {} {v}", p.source, p.stem));
     if p.solver == Solver::Amm {
-        add_envelope(&mut meta, &p.exp, warning.is_none());
+        let why = outside_envelope(&p.exp, warning.is_none());
+        sidecar.validated_envelope = Some(why.is_empty());
+        sidecar.validated_envelope_reasons = Some(why);
     }
     Ok(RunOutcome {
         response,
-        meta,
+        sidecar,
         stem: p.stem.clone(),
         exp: p.exp.clone(),
         warning,
@@ -339,47 +357,33 @@ pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunO
     })
 }
 
-/// The residual vibration after the motion's end (`docs/motions.md` section 2) as top-level keys of the
-/// sidecar ([`flexstar_model::residual::sidecar_fields`]). An AMM run of the pinned-free family
-/// has G pinned by its modes (`phi(0) = 0`): its residual of G is null, with a note.
-fn add_residual(meta: &mut serde_json::Value, p: &Prepared, r: &Response) -> Result<()> {
+/// The residual vibration after the motion's end (`docs/motions.md` section 2) as the sidecar's
+/// keys ([`flexstar_model::ResidualKeys`]). An AMM run of the pinned-free family has G pinned by
+/// its modes (`phi(0) = 0`): its residual of G is null, with a note.
+fn residual_keys(p: &Prepared, r: &Response) -> Result<flexstar_model::ResidualKeys> {
     let res = flexstar_modal::settle::run_residual(&p.exp, r).map_err(|e| ApiError::solver(&p.source, e))?;
     let pinned = p.solver == Solver::Amm && p.exp.amm.family == ModeFamily::PinnedFree;
-    let fields = flexstar_model::residual::sidecar_fields(res.as_ref(), p.exp.report.settle_tol, pinned);
-    if let serde_json::Value::Object(doc) = meta {
-        doc.extend(fields);
-    }
-    Ok(())
+    Ok(flexstar_model::ResidualKeys::new(
+        res.as_ref(),
+        p.exp.report.settle_tol,
+        pinned,
+    ))
 }
 
-/// `validated_envelope` (bool) and `validated_envelope_reasons` (the list of why not) of an AMM
-/// run's sidecar (`docs/validation.md` section 8, [`flexstar_model::envelope`]).
-fn add_envelope(meta: &mut serde_json::Value, exp: &Experiment, small_deflection: bool) {
+/// Why an AMM run is outside the validated envelope of the accurate model (`docs/validation.md`
+/// section 8, [`flexstar_model::envelope`]); empty inside it.
+fn outside_envelope(exp: &Experiment, small_deflection: bool) -> Vec<String> {
     let attachments = !(exp.payload.is_none() && exp.damping.beta() == 0.0 && exp.load.is_none());
-    let why = flexstar_model::envelope::outside_envelope(
-        &exp.robot,
-        exp.amm.model,
-        exp.amm.family,
-        attachments,
-        small_deflection,
-    );
-    if let serde_json::Value::Object(doc) = meta {
-        doc.insert("validated_envelope".into(), why.is_empty().into());
-        doc.insert("validated_envelope_reasons".into(), why.into());
-    }
+    flexstar_model::envelope::outside_envelope(&exp.robot, exp.amm.model, exp.amm.family, attachments, small_deflection)
 }
 
 /// The line `flexstar run` prints for an AMM run outside the validated envelope (`None` inside
 /// it or for an FEM run).
-pub fn envelope_line(meta: &serde_json::Value) -> Option<String> {
-    if meta["validated_envelope"] != false {
+pub fn envelope_line(sidecar: &flexstar_model::RunSidecar) -> Option<String> {
+    if sidecar.validated_envelope != Some(false) {
         return None;
     }
-    let why: Vec<&str> = meta["validated_envelope_reasons"]
-        .as_array()?
-        .iter()
-        .filter_map(|v| v.as_str())
-        .collect();
+    let why = sidecar.validated_envelope_reasons.as_deref().unwrap_or_default();
     Some(format!(
         "outside the validated envelope of the accurate AMM (docs/validation.md): {}; the error estimate is not vouched for here",
         why.join("; ")
@@ -388,31 +392,33 @@ pub fn envelope_line(meta: &serde_json::Value) -> Option<String> {
 
 /// The sidecar's residual after the motion in one line (`None` when the motion does not rest
 /// before `t_end`): peak |dG| and tip after `t_rest`, and the settling time.
-pub fn residual_line(meta: &serde_json::Value) -> Option<String> {
-    let t_rest = meta["t_rest"].as_f64()?;
-    let g = meta["residual_G_peak_m"]
-        .as_f64()
-        .map_or("n/a (G pinned)".to_string(), |v| format!("{v:.3e} m"));
-    let tip = meta["residual_tip_peak_m"].as_f64().unwrap_or(f64::NAN);
-    let settle = match meta["settle_s"].as_f64() {
+pub fn residual_line(sidecar: &flexstar_model::RunSidecar) -> Option<String> {
+    // a value the document would write as null (absent or not finite) reads as absent
+    let finite = |v: Option<f64>| v.filter(|x| x.is_finite());
+    let keys = sidecar.residual.as_ref()?;
+    let t_rest = finite(keys.t_rest)?;
+    let g = finite(keys.g_peak_m).map_or("n/a (G pinned)".to_string(), |v| format!("{v:.3e} m"));
+    let tip = finite(keys.tip_peak_m).unwrap_or(f64::NAN);
+    let settle = match finite(keys.settle_s) {
         Some(t) => format!("settled at {t:.3} s"),
-        None if meta["settled"] == false => flexstar_model::residual::not_settled_text(
+        None if keys.settled == Some(false) => flexstar_model::residual::not_settled_text(
             t_rest,
-            meta["experiment"]["time"]["t_end"].as_f64().unwrap_or(f64::NAN),
-            meta["residual_G_decay_per_s"].as_f64(),
-            meta["settle_predicted_s"].as_f64(),
-            meta["settle_hold_s"].as_f64().unwrap_or(f64::NAN),
+            sidecar.experiment.time.t_end,
+            finite(keys.g_decay_per_s),
+            finite(keys.settle_predicted_s),
+            finite(keys.settle_hold_s).unwrap_or(f64::NAN),
         ),
         None => "settling n/a".to_string(),
     };
-    let sliders = match (
-        meta["residual_tracking_peak_m"].as_f64(),
-        meta["residual_tracking_end_m"].as_f64(),
-    ) {
+    let tracking = (
+        finite(keys.tracking_peak_m.flatten()),
+        finite(keys.tracking_end_m.flatten()),
+    );
+    let sliders = match tracking {
         (Some(peak), Some(end)) => format!("; {}", flexstar_model::residual::tracking_text(peak, end)),
         _ => String::new(),
     };
-    let tol = meta["settle_tol"].as_f64().unwrap_or(f64::NAN);
+    let tol = finite(keys.settle_tol).unwrap_or(f64::NAN);
     Some(format!(
         "after t_rest = {} s: peak |dG| = {g}, peak |tip| = {tip:.3e} m, {settle} (band {} m){sliders}",
         flexstar_io::output::fmt_sig(t_rest, 5),
@@ -449,11 +455,10 @@ pub fn write_run(out: &mut RunOutcome, dir: &Path, figures: bool) -> Result<()> 
     let shapes = dir.join(format!("{stem}-shapes.csv"));
     r.stage_shapes_csv(&mut set, &format!("{stem}-shapes.csv"))?;
     let frames_hash = flexstar_model::animation::stage_run_frames(&r.frames, &mut set, stem)?;
-    if let (Some(hash), serde_json::Value::Object(doc)) = (&frames_hash, &mut out.meta) {
-        doc.insert(flexstar_model::animation::FRAMES_HASH_KEY.into(), hash.clone().into());
-    }
+    out.sidecar.frames_hash.clone_from(&frames_hash);
     let json = dir.join(format!("{stem}.json"));
-    set.text(&format!("{stem}.json"), &sidecar_text(&json, &out.meta)?)?;
+    let doc = flexstar_model::response::sidecar_value(&json, &out.sidecar)?;
+    set.text(&format!("{stem}.json"), &sidecar_text(&json, &doc)?)?;
     set.commit()?;
     out.files.extend([csv.clone(), shapes, json]);
     if frames_hash.is_some() {

@@ -27,6 +27,9 @@ pub fn from_fem(file: &str, e: FemError) -> ApiError {
     let message = format!("{file}: {e}");
     match &e {
         FemError::Input(reason) => ApiError::config_text(file, None, reason, message),
+        FemError::Problem(inner) => ApiError::config_text(file, None, &inner.to_string(), message),
+        FemError::Scan(inner) => ApiError::config_text(file, None, &inner.to_string(), message),
+        FemError::Start(inner) => ApiError::config_text(file, None, &inner.to_string(), message),
         FemError::Cancelled { t } => ApiError::Cancelled {
             file: file.to_string(),
             t: *t,

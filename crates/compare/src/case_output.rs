@@ -387,7 +387,7 @@ pub fn compare_json(
         let list: Vec<_> = res
             .iter()
             .map(|r| {
-                let fields = crate::residual::sidecar_fields_of(r);
+                let fields = crate::residual::sidecar_keys_of(r);
                 serde_json::json!({ "run": r.run, "g_pinned": r.g_pinned, "residual": fields })
             })
             .collect();
@@ -437,11 +437,11 @@ pub fn write_case(
     let mut set = RunSet::begin(dir)?;
     for (stem, r) in runs_of(case) {
         let res = residuals.iter().flatten().find(|x| x.run == stem);
-        let fields = match res {
-            Some(x) => crate::residual::sidecar_fields_of(x),
-            None => flexstar_model::residual::sidecar_fields(None, exp.report.settle_tol, false),
+        let keys = match res {
+            Some(x) => crate::residual::sidecar_keys_of(x),
+            None => flexstar_model::ResidualKeys::new(None, exp.report.settle_tol, false),
         };
-        r.stage_run(&mut set, &stem, None, (exp, prov), fields)?;
+        r.stage_run(&mut set, &stem, None, (exp, prov), Some(keys))?;
     }
     set.text("compare.csv", &csv)?;
     set.text(

@@ -58,8 +58,8 @@ pub fn case_residuals(exp: &Experiment, case: &CaseResults) -> Result<Option<Vec
 }
 
 /// The sidecar's residual keys of one compared run, as `flexstar run` writes them.
-pub fn sidecar_fields_of(r: &RunResidual) -> serde_json::Map<String, serde_json::Value> {
-    flexstar_model::residual::sidecar_fields(Some(&r.residual), r.residual.settle_tol, r.g_pinned)
+pub fn sidecar_keys_of(r: &RunResidual) -> flexstar_model::ResidualKeys {
+    flexstar_model::ResidualKeys::new(Some(&r.residual), r.residual.settle_tol, r.g_pinned)
 }
 
 fn g_value(r: &RunResidual, v: f64) -> Option<f64> {

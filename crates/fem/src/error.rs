@@ -15,6 +15,16 @@ pub enum FemError {
     /// The experiment or the settings are unusable (message names the key and the bound).
     #[error("invalid FEM input: {0}")]
     Input(String),
+    /// The problem's robot is not the FEM's equal-beam robot, or a setting fails a model check
+    /// (animation frames); the model's error, with its key.
+    #[error("invalid FEM input: {0}")]
+    Problem(#[source] ModelError),
+    /// The feasibility scan before any step refused the motion: its time and violation.
+    #[error("invalid FEM input: {0}")]
+    Scan(#[source] flexstar_kinematics::Infeasible),
+    /// The rigid state at the start could not be evaluated.
+    #[error("invalid FEM input: {0}")]
+    Start(#[source] KinematicsError),
     /// The mesh is too coarse to hold a sleeve: fewer than 2 elements across Lp.
     #[error(
         "mesh too coarse: {per_beam} elements per beam give an element length {h:.4e} m, but a sleeve of length Lp = {lp} m needs at least 2 elements across it (at least {needed} elements per beam, {} in all)",

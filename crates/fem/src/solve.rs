@@ -71,6 +71,9 @@ const EXTRA: [&str; 17] = [
     "slopeG",
 ];
 
+/// The energies of the payload, the load and the damping, each written only with its section.
+const ATTACHED: [&str; 3] = ["Ek_payload", "W_load", "E_d"];
+
 /// Extra columns a direct run writes first (see [`solve`] with [`Drive::Law`]).
 const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "Gy", "theta"];
 
@@ -105,7 +108,7 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 /// the direct dynamics below). `request.progress` receives the fraction of the time span done, in [0, 1].
 /// Returns the response and the work counters (steps, Newton iterations, factorisations).
 pub fn solve(problem: &Problem, settings: &FemSettings, request: SolveRequest) -> Result<Solved<Stats>, FemError> {
-    let problem = &problem.equal_beams().map_err(|e| FemError::Input(e.to_string()))?;
+    let problem = &problem.equal_beams().map_err(FemError::Problem)?;
     let (response, stats) = match request.drive {
         Drive::Motion => solve_prescribed(problem, settings, request.proof, request.progress)?,
         Drive::Law(law) => solve_direct(problem, settings, law, request.progress)?,
@@ -127,8 +130,7 @@ fn solve_prescribed(
     // of the requested motion only (the FEM's equations never use the rigid kinematics)
     let step = preflight_step(problem.time.dt_out);
     if !checked.is_some_and(|c| c.covers(params, &problem.trajectory, problem.time.t_end, step)) {
-        check_trajectory(params, &problem.trajectory, problem.time.t_end, step)
-            .map_err(|e| FemError::Input(e.to_string()))?;
+        check_trajectory(params, &problem.trajectory, problem.time.t_end, step).map_err(FemError::Scan)?;
     }
     let rigid = |t: f64| {
         RigidState::at(params, &problem.trajectory, t).map_err(|source| FemError::PostProcessing { t, source })
@@ -196,7 +198,7 @@ fn solve_direct(
     let started = std::time::Instant::now();
     let params = &problem.robot;
     let run = validate(problem, settings)?;
-    let r0 = RigidState::at(params, &problem.trajectory, 0.0).map_err(|e| FemError::Input(e.to_string()))?;
+    let r0 = RigidState::at(params, &problem.trajectory, 0.0).map_err(FemError::Start)?;
     let (t_out, shape_times) = times(problem, settings);
     let motion = Motion::Driven {
         law,
@@ -262,8 +264,7 @@ fn validate(problem: &EqualBeams, settings: &FemSettings) -> Result<RunSettings,
             "fem.snapshots must lie in [0, t_end = {t_end}], got {bad}"
         )));
     }
-    flexstar_model::animation::check_frames("fem.frames", settings.frames, t_end)
-        .map_err(|e| FemError::Input(e.to_string()))?;
+    flexstar_model::animation::check_frames("fem.frames", settings.frames, t_end).map_err(FemError::Problem)?;
     Ok(RunSettings {
         ne: settings.elements / 3,
         dt,
@@ -416,9 +417,9 @@ type OptionalColumn = (bool, &'static str, fn(&Sample) -> f64);
 /// section: `Ek_payload`, `W_load`, `E_d` [J] (see [`solve`]).
 fn attachment_columns(hist: &History, names: &mut Vec<&str>, cols: &mut Vec<Vec<f64>>) {
     let present: [OptionalColumn; 3] = [
-        (hist.payload, "Ek_payload", |s: &Sample| s.ke_payload),
-        (hist.load, "W_load", |s: &Sample| s.w_load),
-        (hist.damping, "E_d", |s: &Sample| s.e_d),
+        (hist.payload, ATTACHED[0], |s: &Sample| s.ke_payload),
+        (hist.load, ATTACHED[1], |s: &Sample| s.w_load),
+        (hist.damping, ATTACHED[2], |s: &Sample| s.e_d),
     ];
     for (on, name, value) in present {
         if on {
@@ -461,4 +462,22 @@ fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
 fn wrap(a: f64) -> f64 {
     use std::f64::consts::PI;
     flexstar_numerics::angle::wrap((a + PI) - PI)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every column the FEM writes (a direct run's first, its own, the attachments' energies) is
+    /// declared once in `flexstar_model::quantity`.
+    #[test]
+    fn every_column_is_a_declared_quantity() {
+        let own = DIRECT_EXTRA.iter().chain(&EXTRA).chain(&ATTACHED);
+        for name in own {
+            assert!(
+                flexstar_model::quantity::quantity_of(name).is_some(),
+                "{name} is not declared"
+            );
+        }
+    }
 }

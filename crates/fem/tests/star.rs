@@ -256,15 +256,10 @@ fn bad_input_stops_with_time_and_reason() {
     .map(|s| s.response)
     .unwrap_err()
     {
-        FemError::Input(msg) => {
+        FemError::Scan(infeasible) => {
+            let msg = infeasible.to_string();
             assert!(msg.contains("sleeve 2 reaches the junction G"), "{msg}");
-            let t: f64 = msg
-                .split("t = ")
-                .nth(1)
-                .and_then(|r| r.split(' ').next())
-                .and_then(|v| v.parse().ok())
-                .expect(&msg);
-            assert!(t > 0.4 && t < 0.5, "t = {t}");
+            assert!(infeasible.t > 0.4 && infeasible.t < 0.5, "t = {}", infeasible.t);
         }
         e => panic!("expected the feasibility scan to refuse, got: {e}"),
     }

@@ -13,7 +13,7 @@ use crate::KinematicsError;
 /// Column header of `kinematics.csv` (a file contract, `docs/outputs.md`): the pose and its
 /// derivatives, then the slider velocities `sd_i` [m/s] and accelerations `sdd_i` [m/s^2] and the
 /// rigid driving forces `Fa_i` [N] of [`rigid_inverse_dynamics_with`] (the payload and load
-/// included). Units: `flexstar_model::response::COLUMN_UNITS`.
+/// included). Units: `flexstar_model::quantity::QUANTITIES`.
 pub const KINEMATICS_HEADER: [&str; 23] = [
     "t",
     "s1",
@@ -134,7 +134,7 @@ mod tests {
     fn every_column_has_a_unit_and_the_forces_are_the_rigid_inverse_dynamics() {
         for name in KINEMATICS_HEADER {
             assert!(
-                flexstar_model::response::column_unit(name).is_some(),
+                flexstar_model::quantity::column_unit(name).is_some(),
                 "{name} has no unit"
             );
         }

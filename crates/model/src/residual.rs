@@ -276,60 +276,6 @@ fn rms(t: &[f64], f: &[f64]) -> f64 {
     (integral / span).sqrt()
 }
 
-/// The sidecar's top-level keys of a residual (`docs/outputs.md`): `t_rest`,
-/// `residual_G_peak_m`, `residual_G_rms_m`, `residual_tip_peak_m`, `residual_tip_rms_m`,
-/// `settle_s` (null when not settled), `settled`, `settle_tol`, `settle_hold_s`. Without a
-/// residual (no rest before `t_end`) every key is null but `settle_tol`. `g_pinned`: the run's
-/// modes pin G (the AMM's pinned-free family, `phi(0) = 0`), so it has no residual of G: those
-/// keys are null, with `residual_note`.
-pub fn sidecar_fields(
-    res: Option<&Residual>,
-    settle_tol: f64,
-    g_pinned: bool,
-) -> serde_json::Map<String, serde_json::Value> {
-    use serde_json::Value;
-    let num = |v: f64| serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number);
-    let mut m = serde_json::Map::new();
-    let get = |f: fn(&Residual) -> f64| res.map_or(Value::Null, |r| num(f(r)));
-    m.insert("t_rest".into(), get(|r| r.t_rest));
-    m.insert("residual_G_peak_m".into(), get(|r| r.g_peak_m));
-    m.insert("residual_G_rms_m".into(), get(|r| r.g_rms_m));
-    m.insert("residual_tip_peak_m".into(), get(|r| r.tip_peak_m));
-    m.insert("residual_tip_rms_m".into(), get(|r| r.tip_rms_m));
-    let settle = res.and_then(|r| r.settle_s).map_or(Value::Null, num);
-    m.insert("settle_s".into(), settle);
-    m.insert("settled".into(), res.map_or(Value::Null, |r| Value::Bool(r.settled())));
-    m.insert("settle_tol".into(), num(settle_tol));
-    m.insert("settle_hold_s".into(), get(|r| r.hold_s));
-    let opt = |f: fn(&Residual) -> Option<f64>| res.and_then(f).map_or(Value::Null, num);
-    m.insert("residual_G_decay_per_s".into(), opt(|r| r.decay_per_s));
-    m.insert("settle_predicted_s".into(), opt(|r| r.settle_predicted_s));
-    if let Some(r) = res.filter(|r| r.tracking_peak_m.is_some()) {
-        m.insert(
-            "residual_tracking_peak_m".into(),
-            r.tracking_peak_m.map_or(Value::Null, num),
-        );
-        m.insert(
-            "residual_tracking_end_m".into(),
-            r.tracking_end_m.map_or(Value::Null, num),
-        );
-    }
-    if g_pinned && res.is_some() {
-        for key in [
-            "residual_G_peak_m",
-            "residual_G_rms_m",
-            "settle_s",
-            "settled",
-            "residual_G_decay_per_s",
-            "settle_predicted_s",
-        ] {
-            m.insert(key.into(), Value::Null);
-        }
-        m.insert("residual_note".into(), "G is pinned in this family".into());
-    }
-    m
-}
-
 /// The words a report prints for a settling time: `0.532 s`, or `not settled by t_end`
 /// ([`not_settled_text`] says more).
 pub fn settle_text(res: &Residual) -> String {
@@ -365,6 +311,11 @@ pub fn not_settled_hint(res: &Residual) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sidecar keys of a residual, as written ([`crate::sidecar::ResidualKeys`]).
+    fn keys_of(res: Option<&Residual>, tol: f64, pinned: bool) -> serde_json::Value {
+        serde_json::to_value(crate::sidecar::ResidualKeys::new(res, tol, pinned)).unwrap()
+    }
 
     /// A response whose elastic displacement of G is the vector `d(t)` (projected on the three
     /// frames of theta = 0.3) and whose tip 1 is `tip(t)`.
@@ -508,7 +459,7 @@ mod tests {
         let res = residual_after(&r, 0.5, 1e-4, 0.1).unwrap();
         assert_eq!(res.tracking_peak_m, Some(3e-4));
         assert_eq!(res.tracking_end_m, Some(7.5e-5));
-        let keys = sidecar_fields(Some(&res), 1e-4, false);
+        let keys = keys_of(Some(&res), 1e-4, false);
         assert_eq!(keys["residual_tracking_end_m"], 7.5e-5);
         assert_eq!(
             tracking_text(3e-4, 7.5e-5),
@@ -517,7 +468,9 @@ mod tests {
         // a run without servo columns has neither value nor key
         let plain = residual_after(&response(&ts, |_| [0.0, 0.0], |_| 0.0), 0.5, 1e-4, 0.1).unwrap();
         assert!(plain.tracking_peak_m.is_none());
-        assert!(!sidecar_fields(Some(&plain), 1e-4, false).contains_key("residual_tracking_end_m"));
+        assert!(keys_of(Some(&plain), 1e-4, false)
+            .get("residual_tracking_end_m")
+            .is_none());
     }
 
     #[test]
@@ -527,12 +480,12 @@ mod tests {
         let res = residual_after(&r, 0.4, 1e-4, 0.1).unwrap();
         assert_eq!(res.settle_s, Some(0.4));
         assert!(residual_after(&r, 1.0, 1e-4, 0.1).is_none());
-        let keys = sidecar_fields(None, 1e-4, false);
+        let keys = keys_of(None, 1e-4, false);
         assert!(keys["t_rest"].is_null() && keys["settled"].is_null() && keys["settle_tol"] == 1e-4);
-        let keys = sidecar_fields(Some(&res), 1e-4, false);
+        let keys = keys_of(Some(&res), 1e-4, false);
         assert_eq!(keys["settle_s"], 0.4);
         assert_eq!(keys["settled"], true);
-        let keys = sidecar_fields(Some(&res), 1e-4, true);
+        let keys = keys_of(Some(&res), 1e-4, true);
         assert!(keys["settle_s"].is_null() && keys["residual_G_peak_m"].is_null());
         assert_eq!(keys["residual_note"], "G is pinned in this family");
     }

@@ -3,11 +3,13 @@
 //! Elastic outputs follow `docs/conventions.md`: `w_iG` is the elastic displacement of G projected
 //! on `e_wi`; the tip value `w_i(L)` is `(tip - (G_rigid + L e_xi)) . e_wi` [m]; `Fa_i` is the force
 //! the actuator applies to slider i along its +s direction [N] (Eq. 33). Every column of every
-//! file is listed with its unit in `docs/outputs.md`.
+//! file is declared once, with its unit and meaning, in [`crate::quantity`] and listed in
+//! `docs/outputs.md`.
 
 use std::path::Path;
 
 use crate::error::ModelError;
+use crate::sidecar::RunSidecar;
 pub use crate::validity::{small_deflection_check, Provenance, ValidityExceeded};
 use flexstar_io::output::{fmt_number, Dest};
 use flexstar_io::run_set::RunSet;
@@ -15,105 +17,7 @@ use flexstar_io::run_set::RunSet;
 /// Fixed leading CSV columns of every solver result (a file contract, `docs/outputs.md`).
 pub const RESPONSE_HEADER: [&str; 10] = ["t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3"];
 
-/// Unit of every column of every CSV flexstar writes for a run or a motion (SI; `docs/outputs.md`
-/// lists the same): the solver results (fixed columns, the AMM's and the FEM's extra columns), a
-/// direct run's file and `kinematics.csv`. The sidecar's `column_units` is drawn from here.
-pub const COLUMN_UNITS: &[(&str, &str)] = &[
-    ("t", "s"),
-    // fixed columns of every solver result
-    ("w1G", "m"),
-    ("w2G", "m"),
-    ("w3G", "m"),
-    ("w1tip", "m"),
-    ("w2tip", "m"),
-    ("w3tip", "m"),
-    ("Fa1", "N"),
-    ("Fa2", "N"),
-    ("Fa3", "N"),
-    // the AMM's multipliers and coordinates
-    ("Fix1", "N"),
-    ("Fix2", "N"),
-    ("Fix3", "N"),
-    ("M1G", "N m"),
-    ("M2G", "N m"),
-    ("M3G", "N m"),
-    ("Fw", "N"),
-    ("Fp1", "N"),
-    ("Fp2", "N"),
-    ("Fp3", "N"),
-    ("FLp1", "N"),
-    ("FLp2", "N"),
-    ("FLp3", "N"),
-    ("FRp1", "N"),
-    ("FRp2", "N"),
-    ("FRp3", "N"),
-    ("Mp1", "N m"),
-    ("Mp2", "N m"),
-    ("Mp3", "N m"),
-    ("thp1", "rad"),
-    ("thp2", "rad"),
-    ("thp3", "rad"),
-    ("u1", "m"),
-    ("u2", "m"),
-    ("u3", "m"),
-    // the FEM's columns (thp1..3 as above)
-    ("xp1", "m"),
-    ("xp2", "m"),
-    ("xp3", "m"),
-    ("Fn1", "N"),
-    ("Fn2", "N"),
-    ("Fn3", "N"),
-    ("dGx", "m"),
-    ("dGy", "m"),
-    ("Ek_star", "J"),
-    ("Ek_sleeves", "J"),
-    ("Ek_sliders", "J"),
-    ("U", "J"),
-    ("W", "J"),
-    ("slopeG", "rad"),
-    // the energies of the payload, damping and load (FEM), each only with its section
-    ("Ek_payload", "J"),
-    ("W_load", "J"),
-    ("E_d", "J"),
-    // a direct run's columns and kinematics.csv (xp1..3, Fa1..3 as above)
-    ("s1", "m"),
-    ("s2", "m"),
-    ("s3", "m"),
-    ("sd1", "m/s"),
-    ("sd2", "m/s"),
-    ("sd3", "m/s"),
-    ("sdd1", "m/s^2"),
-    ("sdd2", "m/s^2"),
-    ("sdd3", "m/s^2"),
-    ("Gx", "m"),
-    ("Gy", "m"),
-    ("theta", "rad"),
-    ("e1", "m"),
-    ("e2", "m"),
-    ("e3", "m"),
-    ("aGx", "m/s^2"),
-    ("aGy", "m/s^2"),
-    ("thetadot", "rad/s"),
-    ("thetaddot", "rad/s^2"),
-];
-
-/// The unit of column `name` in [`COLUMN_UNITS`], `None` for a name flexstar does not write.
-pub fn column_unit(name: &str) -> Option<&'static str> {
-    COLUMN_UNITS.iter().find(|(n, _)| *n == name).map(|(_, u)| *u)
-}
-
-/// `{column: unit}` for the columns `names` (the sidecar's `column_units`); a column without an
-/// entry in [`COLUMN_UNITS`] gets `null` (the tests keep the table complete).
-pub fn column_units<S: AsRef<str>>(names: &[S]) -> serde_json::Value {
-    let map = names
-        .iter()
-        .map(|n| {
-            let unit = column_unit(n.as_ref()).map_or(serde_json::Value::Null, |u| u.into());
-            (n.as_ref().to_string(), unit)
-        })
-        .collect::<serde_json::Map<_, _>>();
-    serde_json::Value::Object(map)
-}
+pub use crate::quantity::{column_unit, column_units};
 
 /// A named extra output column (multipliers, sleeve rotations, ...), one value per output time.
 #[derive(Debug, Clone, PartialEq)]
@@ -448,35 +352,31 @@ impl Response {
         exp
     }
 
-    /// The sidecar document of a run (what [`Response::write_sidecar`] writes):
-    /// `flexstar_version`, `commit` (when known), `date` (UTC, of the run), the `label`, every field
-    /// of [`RunInfo`], `small_deflection` (the check of [`small_deflection_check`]: `null` when the
-    /// run stays in range, else the first time, the quantity, its value and the bound),
-    /// `column_units` (`{column: unit}` for every column of the run's CSV, [`COLUMN_UNITS`]) and
-    /// the resolved `experiment` ([`Response::resolved_experiment`]). Fields are listed in
-    /// `docs/outputs.md`; `path` only names errors.
-    pub fn sidecar(
-        &self,
-        path: &Path,
-        experiment: &crate::Experiment,
-        provenance: &Provenance,
-    ) -> Result<serde_json::Value, ModelError> {
-        let fail = |e: serde_json::Error| ModelError::Write {
-            file: path.to_path_buf(),
-            reason: e.to_string(),
-        };
-        let mut doc = provenance.fields();
-        doc.extend(crate::identity::fields(experiment));
-        doc.insert("label".into(), self.label.clone().into());
-        if let serde_json::Value::Object(fields) = serde_json::to_value(&self.info).map_err(fail)? {
-            doc.extend(fields);
+    /// The sidecar of a run ([`RunSidecar`], what [`Response::write_sidecar`] writes):
+    /// `flexstar_version`, `commit` (when known), `date` (UTC, of the run), the experiment's file
+    /// and hash, the `label`, every field of [`RunInfo`], `small_deflection` (the check of
+    /// [`small_deflection_check`]: `null` when the run stays in range, else the first time, the
+    /// quantity, its value and the bound), `column_units` (`{column: unit}` for every column of
+    /// the run's CSV, [`crate::quantity`]) and the resolved `experiment`
+    /// ([`Response::resolved_experiment`]); no residual, frames or envelope keys (the caller sets
+    /// them). Fields are listed in `docs/outputs.md`.
+    pub fn sidecar(&self, experiment: &crate::Experiment, provenance: &Provenance) -> RunSidecar {
+        RunSidecar {
+            flexstar_version: provenance.version.clone(),
+            commit: provenance.commit.clone(),
+            date: provenance.date.clone(),
+            experiment_file: crate::identity::source_text(experiment),
+            experiment_hash: experiment.hash.clone(),
+            label: self.label.clone(),
+            info: self.info.clone(),
+            small_deflection: small_deflection_check(self, experiment.robot.l),
+            column_units: column_units(&self.header()),
+            experiment: self.resolved_experiment(experiment),
+            residual: None,
+            frames_hash: None,
+            validated_envelope: None,
+            validated_envelope_reasons: None,
         }
-        let validity = serde_json::to_value(small_deflection_check(self, experiment.robot.l)).map_err(fail)?;
-        doc.insert("small_deflection".into(), validity);
-        doc.insert("column_units".into(), column_units(&self.header()));
-        let resolved = self.resolved_experiment(experiment);
-        doc.insert("experiment".into(), serde_json::to_value(&resolved).map_err(fail)?);
-        Ok(serde_json::Value::Object(doc))
     }
 
     /// Write the sidecar JSON of a run (`<csv name>.json`, the document of
@@ -487,7 +387,7 @@ impl Response {
         experiment: &crate::Experiment,
         provenance: &Provenance,
     ) -> Result<(), ModelError> {
-        write_sidecar_value(path, &self.sidecar(path, experiment, provenance)?)
+        write_sidecar_value(path, &sidecar_value(path, &self.sidecar(experiment, provenance))?)
     }
 
     /// [`Response::write_sidecar`] into file `name` of a run set (published with the run's other
@@ -500,7 +400,7 @@ impl Response {
         provenance: &Provenance,
     ) -> Result<(), ModelError> {
         let path = set.path(name);
-        let doc = self.sidecar(&path, experiment, provenance)?;
+        let doc = sidecar_value(&path, &self.sidecar(experiment, provenance))?;
         set.text(name, &sidecar_text(&path, &doc)?)?;
         Ok(())
     }
@@ -517,18 +417,17 @@ impl Response {
 
     /// Stage the three files of run `stem` (`<stem>.csv`, `<stem>-shapes.csv`, `<stem>.json`)
     /// into `set`; `order`: the `(leading, after)` columns of [`Response::write_csv_ordered`]
-    /// (a direct run's file), `None` for the plain order of [`Response::write_csv`]; `fields`:
-    /// further top-level keys of the sidecar (a compared run's residual keys,
-    /// `crate::residual::sidecar_fields`). The run's animation frames are staged too when it has
-    /// any (the sidecar then records their hash), else frames an earlier run of `stem` left are
-    /// removed ([`crate::animation::stage_run_frames`]).
+    /// (a direct run's file), `None` for the plain order of [`Response::write_csv`]; `residual`:
+    /// the sidecar's residual keys (a compared run's). The run's animation frames are staged too
+    /// when it has any (the sidecar then records their hash), else frames an earlier run of
+    /// `stem` left are removed ([`crate::animation::stage_run_frames`]).
     pub fn stage_run(
         &self,
         set: &mut RunSet,
         stem: &str,
         order: Option<(&[&str], &[&str])>,
         (experiment, provenance): (&crate::Experiment, &Provenance),
-        fields: serde_json::Map<String, serde_json::Value>,
+        residual: Option<crate::sidecar::ResidualKeys>,
     ) -> Result<(), ModelError> {
         let csv = format!("{stem}.csv");
         match order {
@@ -539,14 +438,12 @@ impl Response {
         let frames = crate::animation::stage_run_frames(&self.frames, set, stem)?;
         let name = format!("{stem}.json");
         let path = set.path(&name);
-        let mut doc = self.sidecar(&path, experiment, provenance)?;
-        if let serde_json::Value::Object(map) = &mut doc {
-            map.extend(fields);
-            if let Some(hash) = frames {
-                map.insert(crate::animation::FRAMES_HASH_KEY.into(), hash.into());
-            }
-        }
-        set.text(&name, &sidecar_text(&path, &doc)?)?;
+        let sidecar = RunSidecar {
+            residual,
+            frames_hash: frames,
+            ..self.sidecar(experiment, provenance)
+        };
+        set.text(&name, &sidecar_text(&path, &sidecar_value(&path, &sidecar)?)?)?;
         Ok(())
     }
 
@@ -617,7 +514,11 @@ mod tests {
     #[test]
     fn every_column_unit_is_the_one_documented() {
         let documented = documented_units();
-        for (name, unit) in COLUMN_UNITS {
+        let declared: Vec<(String, &str)> = crate::quantity::QUANTITIES
+            .iter()
+            .flat_map(|q| q.columns().into_iter().map(|c| (c, q.unit)))
+            .collect();
+        for (name, unit) in &declared {
             let docs: Vec<&str> = documented
                 .iter()
                 .filter(|(n, _)| n == name)
@@ -629,22 +530,13 @@ mod tests {
                 "{name}: {unit} here, {docs:?} in docs/outputs.md"
             );
         }
-        // and every documented result column is in the table (the files' fields are not columns)
+        // and every documented result column is declared (the files' fields are not columns)
         for (name, unit) in &documented {
             assert!(
                 column_unit(name).is_some(),
-                "{name} [{unit}] documented but not in COLUMN_UNITS"
+                "{name} [{unit}] documented but not declared in flexstar_model::quantity"
             );
         }
-        let names: Vec<&str> = COLUMN_UNITS.iter().map(|(n, _)| *n).collect();
-        let mut unique = names.clone();
-        unique.sort();
-        unique.dedup();
-        assert_eq!(unique.len(), names.len(), "a column listed twice");
-        assert_eq!(
-            column_units(&["t", "nope"]),
-            serde_json::json!({"t": "s", "nope": null})
-        );
     }
 
     #[test]
@@ -682,7 +574,7 @@ mod tests {
             commit: None,
             date: "d".into(),
         };
-        let doc = r.sidecar(Path::new("fem.json"), &exp, &prov).unwrap();
+        let doc = r.sidecar(&exp, &prov).to_value().unwrap();
         let fem = doc["experiment"]["fem"].as_object().unwrap();
         assert!(fem.values().all(|v| !v.is_null()), "{fem:?}");
         assert_eq!(doc["experiment"]["robot"]["EA"], serde_json::json!(exp.robot.ea()));
@@ -701,7 +593,7 @@ mod tests {
             date: "2026-01-01T00:00:00Z".into(),
         };
         let dir = tempfile::tempdir().unwrap();
-        let doc = r.sidecar(Path::new("fem.json"), &exp, &prov).unwrap();
+        let doc = r.sidecar(&exp, &prov).to_value().unwrap();
         let want = sidecar_text(Path::new("fem.json"), &doc).unwrap();
         assert_eq!(
             want,
@@ -748,6 +640,14 @@ mod tests {
         assert_eq!(c.extra[0].values, vec![0.0, -4.0, -8.0, -11.0]);
         assert_eq!(r.every_nth(1), r);
     }
+}
+
+/// A run's sidecar as the JSON document written (`path` only names errors).
+pub fn sidecar_value(path: &Path, sidecar: &RunSidecar) -> Result<serde_json::Value, ModelError> {
+    sidecar.to_value().map_err(|e| ModelError::Write {
+        file: path.to_path_buf(),
+        reason: e.to_string(),
+    })
 }
 
 /// The text of a sidecar file: the document as pretty JSON with a final newline (the one place

@@ -155,8 +155,8 @@ impl PyRun {
     }
 
     /// The sidecar document as JSON text.
-    fn meta_json(&self) -> String {
-        self.inner.meta.to_string()
+    fn meta_json(&self) -> PyResult<String> {
+        self.inner.sidecar_json().map(|v| v.to_string()).map_err(py_err)
     }
 
     /// The file stem (`amm-enriched`, `fem-direct`, ...).

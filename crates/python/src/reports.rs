@@ -158,7 +158,7 @@ pub fn plan<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bou
     d.set_item("reason", o.planned.reason.clone())?;
     let peaks = PyDict::new(py);
     for m in &o.motions {
-        let peak = |r: &flexstar_api::RunOutcome| r.meta["residual_G_peak_m"].as_f64();
+        let peak = |r: &flexstar_api::RunOutcome| r.residual_g_peak_m();
         peaks.set_item(m.key, (peak(&m.amm), peak(&m.fem)))?;
     }
     d.set_item("residual_G_peak_m", peaks)?;

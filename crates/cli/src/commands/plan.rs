@@ -33,7 +33,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         eprintln!("{n}");
     }
     for m in &outcome.motions {
-        let peak = |o: &flexstar_api::RunOutcome| o.meta["residual_G_peak_m"].as_f64().unwrap_or(f64::NAN);
+        let peak = |o: &flexstar_api::RunOutcome| o.residual_g_peak_m().unwrap_or(f64::NAN);
         eprintln!(
             "plan: {:<8} residual peak of G after t_rest = {:.3} s: AMM {:.3e} m, FEM {:.3e} m",
             m.key,

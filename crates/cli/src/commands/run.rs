@@ -131,10 +131,10 @@ fn summary(o: &RunOutcome, figures: bool, seconds: f64) {
         peak(&r.w_tip[2]),
         (0..3).map(|i| peak(&r.w_g[i])).fold(0.0, f64::max)
     );
-    if let Some(line) = flexstar_api::run::residual_line(&o.meta) {
+    if let Some(line) = flexstar_api::run::residual_line(&o.sidecar) {
         eprintln!("{}: {line}", exp.name);
     }
-    if let Some(line) = flexstar_api::run::envelope_line(&o.meta) {
+    if let Some(line) = flexstar_api::run::envelope_line(&o.sidecar) {
         eprintln!("note: {}: {line}", exp.name);
     }
 }

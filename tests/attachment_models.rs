@@ -11,7 +11,7 @@
 
 use std::path::Path;
 
-use flexstar_model::evp::point_evps;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment, FemSettings};
 
 const SMOOTH: &str = include_str!("../configs/motions/smooth.toml");

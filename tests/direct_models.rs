@@ -65,7 +65,7 @@ fn amm_and_fem_under_the_same_forces_agree_as_their_inverse_runs_do() {
         .map(|s| s.response)
         .unwrap();
 
-        let summary = |p: flexstar_model::evp::PointEvps| {
+        let summary = |p: flexstar_metrics::evp::PointEvps| {
             (
                 p.mean.unwrap(),
                 p.points.iter().flatten().fold(0.0f64, |a, b| a.max(*b)),

@@ -6,8 +6,8 @@
 //! and prints the mean EVP between the two runs of each pair (Eq. 45) and their ratio.
 use flexstar_amm::adaptive::{first_modes, next_modes};
 use flexstar_amm::TOLERANCE_DT;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::catalogue::paper_case;
-use flexstar_model::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment};
 
 /// Every `every`-th row of `r` (the rows of a coarser output grid that is a subset of `r`'s).

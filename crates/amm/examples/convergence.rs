@@ -48,7 +48,7 @@ fn main() {
         }
     } else if what == "accurate-step" {
         // the accurate model (enriched, full) at N = AMM_N (default 53): EVP(h, h/2) per point and
-        // mean over A, B, C, G as in Table I (flexstar_model::evp), the four cases
+        // mean over A, B, C, G as in Table I (flexstar_metrics::evp), the four cases
         let steps: Vec<f64> = std::env::var("AMM_STEPS")
             .ok()
             .map(|s| s.split(",").map(|x| x.parse().unwrap()).collect())
@@ -67,7 +67,7 @@ fn main() {
                     };
                     common::motion_response(&exp, &s).unwrap()
                 };
-                let p = flexstar_model::evp::point_evps(&at(h), &at(h / 2.0)).unwrap();
+                let p = flexstar_metrics::evp::point_evps(&at(h), &at(h / 2.0)).unwrap();
                 let cells: Vec<String> = p
                     .points
                     .iter()
@@ -91,7 +91,7 @@ fn main() {
             };
             common::motion_response(exp, &s).unwrap()
         };
-        let mean = |a: &Response, b: &Response| flexstar_model::evp::point_evps(a, b).unwrap().mean.unwrap();
+        let mean = |a: &Response, b: &Response| flexstar_metrics::evp::point_evps(a, b).unwrap().mean.unwrap();
         println!("| case | N | true truncation (vs N = 150) [%] | estimate (vs previous N) [%] | ratio |");
         println!("|---|---|---|---|---|");
         for case in 1..=4 {

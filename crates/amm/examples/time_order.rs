@@ -7,7 +7,7 @@
 //! with their own e(h) on the grid of the 8 h run, the ratios E(k h, h) / e(h), and the error
 //! estimate the automatic choice reported.
 use flexstar_amm::adaptive::{estimate_grid, time_check_grid};
-use flexstar_model::evp::point_evps;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment, Response};
 
 /// Mean EVP (Eq. 45) of `a` against `b`.

@@ -1,7 +1,7 @@
 //! Error estimate and automatic number of modes (`docs/amm.md` section 9).
 //!
 //! The solver estimates the EVP (Eq. 45, mean over A, B, C and G with the n/a rule of
-//! `flexstar_model::evp`) of its own modal truncation from two runs: N_prev and N = ~1.15 N_prev.
+//! `flexstar_metrics::evp`) of its own modal truncation from two runs: N_prev and N = ~1.15 N_prev.
 //! If the error falls like N^-p, the difference d between the two runs is
 //! `e(N_prev) - e(N) = e(N) ((N / N_prev)^p - 1)`, so `e(N) = d / ((N / N_prev)^p - 1)`
 //! (Richardson). The rate [`RATE`] is measured: between N = 46 and 53 the truncation EVP of the
@@ -23,7 +23,7 @@
 //! of the chosen N at 2 h ([`time_error_estimate`], Eq. T1 of `docs/amm.md` 12.10), plus the
 //! geometric part the AMM leaves out ([`geometric_part`], Eq. G1, 12.9).
 
-use flexstar_model::evp::point_evps;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::{EqualBeams, Response};
 
 use crate::error::AmmError;

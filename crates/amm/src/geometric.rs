@@ -98,7 +98,7 @@ impl GeometricStiffness {
 
 #[cfg(test)]
 mod tests {
-    use flexstar_model::evp::point_evps;
+    use flexstar_metrics::evp::point_evps;
     use flexstar_model::{AmmSettings, Experiment};
 
     use crate::solver::{build_system, integrate_system};

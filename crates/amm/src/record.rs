@@ -158,7 +158,7 @@ impl Recorder {
                 [0, 1, 2].map(|i| self.mpp_mpa * st.s[i].d2 + self.sleeve_push(i, st, q, lam, axial))
             });
             self.resp.push(st.t, w_g, w_tip, fa);
-            let dg = flexstar_model::residual::dg_vector(w_g, [0, 1, 2].map(|i| st.e_w(i)));
+            let dg = flexstar_metrics::residual::dg_vector(w_g, [0, 1, 2].map(|i| st.e_w(i)));
             for k in 0..self.extra.len() {
                 let val = match k {
                     4 => -self.lam_of(lam, 3) - self.lam_of(lam, 5),

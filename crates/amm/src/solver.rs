@@ -73,7 +73,7 @@ pub fn parse_family(name: &str) -> Result<ModeFamily, AmmError> {
 
 /// Names of the extra output columns, in order (after the fixed `RESPONSE_HEADER`).
 /// `dGx, dGy` [m, fixed frame] are the elastic displacement of G, `2/3 sum_i w_iG e_wi`
-/// (`docs/motions.md` 2.1; [`flexstar_model::residual::dg_vector`]), as the FEM writes it.
+/// (`docs/motions.md` 2.1; [`flexstar_metrics::residual::dg_vector`]), as the FEM writes it.
 pub const EXTRA_COLUMNS: [&str; 27] = [
     "Fix1", "Fix2", "Fix3", "M1G", "M2G", "M3G", "Fw", "Fp1", "Fp2", "Fp3", "FLp1", "FLp2", "FLp3", "FRp1", "FRp2",
     "FRp3", "Mp1", "Mp2", "Mp3", "thp1", "thp2", "thp3", "u1", "u2", "u3", "dGx", "dGy",

@@ -331,7 +331,7 @@ fn direct_run_inverts_the_inverse_run_with_payload_damping_and_load() {
     // dependence on the sliders' accelerations (forcing_derivative), the damping and the load
     // in the coupled step
     use flexstar_drive::ForceTable;
-    use flexstar_model::evp::point_evps;
+    use flexstar_metrics::evp::point_evps;
     let mut exp = with(common::quintic(RobotParams::paper(), 0.15), &attached());
     exp.damping = Damping::with_beta(1e-3);
     for (family, model, n) in [

@@ -10,7 +10,7 @@ mod common;
 use common::paper_case;
 use flexstar_amm::DEFAULT_DT;
 use flexstar_drive::{ForceTable, Servo};
-use flexstar_model::evp::point_evps;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment, Response};
 
 /// Paper case `k` cut to `t_end` [s], with output step `dt_out` [s].

@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use flexstar_model::evp::point_evps;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::{AmmSettings, Experiment};
 
 const ROBOT1: &str = include_str!("other_robots/robot1.toml");

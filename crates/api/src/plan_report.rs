@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use serde_json::{json, Value};
 
-use flexstar_model::residual::dg_magnitude;
+use flexstar_metrics::residual::dg_magnitude;
 use flexstar_model::{Experiment, Response};
 use flexstar_plan::limits::{kinematic_peaks, Peak};
 use flexstar_plan::objective::force_peak;

@@ -337,10 +337,10 @@ pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Re
 /// written.
 pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunOutcome> {
     let response = solve(p, progress)?;
-    let mut sidecar = response.sidecar(&p.exp, &crate::provenance());
+    let check = flexstar_metrics::small_deflection_check(&response, p.exp.robot.l);
+    let warning = check.as_ref().map(|v| format!("{}: {} {v}", p.source, p.stem));
+    let mut sidecar = response.sidecar(&p.exp, &crate::provenance(), check);
     sidecar.residual = Some(residual_keys(p, &response)?);
-    let warning = flexstar_model::small_deflection_check(&response, p.exp.robot.l)
-        .map(|v| format!("{}: {} {v}", p.source, p.stem));
     if p.solver == Solver::Amm {
         let why = outside_envelope(&p.exp, warning.is_none());
         sidecar.validated_envelope = Some(why.is_empty());
@@ -363,7 +363,7 @@ pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunO
 fn residual_keys(p: &Prepared, r: &Response) -> Result<flexstar_model::ResidualKeys> {
     let res = flexstar_modal::settle::run_residual(&p.exp, r).map_err(|e| ApiError::solver(&p.source, e))?;
     let pinned = p.solver == Solver::Amm && p.exp.amm.family == ModeFamily::PinnedFree;
-    Ok(flexstar_model::ResidualKeys::new(
+    Ok(flexstar_metrics::residual::sidecar_keys(
         res.as_ref(),
         p.exp.report.settle_tol,
         pinned,
@@ -371,10 +371,16 @@ fn residual_keys(p: &Prepared, r: &Response) -> Result<flexstar_model::ResidualK
 }
 
 /// Why an AMM run is outside the validated envelope of the accurate model (`docs/validation.md`
-/// section 8, [`flexstar_model::envelope`]); empty inside it.
+/// section 8, [`flexstar_metrics::envelope`]); empty inside it.
 fn outside_envelope(exp: &Experiment, small_deflection: bool) -> Vec<String> {
     let attachments = !(exp.payload.is_none() && exp.damping.beta() == 0.0 && exp.load.is_none());
-    flexstar_model::envelope::outside_envelope(&exp.robot, exp.amm.model, exp.amm.family, attachments, small_deflection)
+    flexstar_metrics::envelope::outside_envelope(
+        &exp.robot,
+        exp.amm.model,
+        exp.amm.family,
+        attachments,
+        small_deflection,
+    )
 }
 
 /// The line `flexstar run` prints for an AMM run outside the validated envelope (`None` inside
@@ -401,7 +407,7 @@ pub fn residual_line(sidecar: &flexstar_model::RunSidecar) -> Option<String> {
     let tip = finite(keys.tip_peak_m).unwrap_or(f64::NAN);
     let settle = match finite(keys.settle_s) {
         Some(t) => format!("settled at {t:.3} s"),
-        None if keys.settled == Some(false) => flexstar_model::residual::not_settled_text(
+        None if keys.settled == Some(false) => flexstar_metrics::residual::not_settled_text(
             t_rest,
             sidecar.experiment.time.t_end,
             finite(keys.g_decay_per_s),
@@ -415,7 +421,7 @@ pub fn residual_line(sidecar: &flexstar_model::RunSidecar) -> Option<String> {
         finite(keys.tracking_end_m.flatten()),
     );
     let sliders = match tracking {
-        (Some(peak), Some(end)) => format!("; {}", flexstar_model::residual::tracking_text(peak, end)),
+        (Some(peak), Some(end)) => format!("; {}", flexstar_metrics::residual::tracking_text(peak, end)),
         _ => String::new(),
     };
     let tol = finite(keys.settle_tol).unwrap_or(f64::NAN);

@@ -7,8 +7,8 @@
 
 use flexstar_compare::figures::{figure_tips, Run};
 use flexstar_drive::Servo;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::catalogue::paper_case;
-use flexstar_model::evp::point_evps;
 use flexstar_model::rest_pose::{RestPose, Sliders};
 use flexstar_model::{AmmSettings, Experiment, ModeFamily, Response};
 use flexstar_plot::{Figure, Panel, Series, Style, FAMILY_COLORS, FEM_STYLE};

@@ -8,9 +8,8 @@ use std::path::Path;
 
 use flexstar_io::run_set::RunSet;
 use flexstar_kinematics::{rigid_inverse_dynamics_with, RigidState};
-use flexstar_model::{
-    small_deflection_check, DriveKind, Experiment, Feedforward, ModeFamily, Provenance, Response, ValidityExceeded,
-};
+use flexstar_metrics::small_deflection_check;
+use flexstar_model::{DriveKind, Experiment, Feedforward, ModeFamily, Provenance, Response, ValidityExceeded};
 use serde::Serialize;
 
 use flexstar_plot::{Figure, RenderedFigure, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE};
@@ -48,7 +47,7 @@ pub fn runs_of(case: &CaseResults) -> Vec<(String, &Response)> {
         .collect()
 }
 
-/// The small-deflection check of every run of a case (`flexstar_model::small_deflection_check`),
+/// The small-deflection check of every run of a case (`flexstar_metrics::small_deflection_check`),
 /// in the order of [`runs_of`]: computed once per case by [`write_case`] and shown from there in
 /// the tables, `compare.json`, the warnings and the report.
 pub type RunChecks = Vec<(String, Option<ValidityExceeded>)>;
@@ -439,9 +438,10 @@ pub fn write_case(
         let res = residuals.iter().flatten().find(|x| x.run == stem);
         let keys = match res {
             Some(x) => crate::residual::sidecar_keys_of(x),
-            None => flexstar_model::ResidualKeys::new(None, exp.report.settle_tol, false),
+            None => flexstar_metrics::residual::sidecar_keys(None, exp.report.settle_tol, false),
         };
-        r.stage_run(&mut set, &stem, None, (exp, prov), Some(keys))?;
+        let check = small_deflection_check(r, exp.robot.l);
+        r.stage_run(&mut set, &stem, None, (exp, prov), (check, Some(keys)))?;
     }
     set.text("compare.csv", &csv)?;
     set.text(

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use flexstar_io::output::fmt_number;
-use flexstar_model::residual::{residual_after, settle_text, Residual};
+use flexstar_metrics::residual::{residual_after, settle_text, Residual};
 use flexstar_model::{Experiment, ModeFamily};
 use flexstar_plot::{Figure, Series, Zoom, MARK_STYLE};
 
@@ -59,7 +59,7 @@ pub fn case_residuals(exp: &Experiment, case: &CaseResults) -> Result<Option<Vec
 
 /// The sidecar's residual keys of one compared run, as `flexstar run` writes them.
 pub fn sidecar_keys_of(r: &RunResidual) -> flexstar_model::ResidualKeys {
-    flexstar_model::ResidualKeys::new(Some(&r.residual), r.residual.settle_tol, r.g_pinned)
+    flexstar_metrics::residual::sidecar_keys(Some(&r.residual), r.residual.settle_tol, r.g_pinned)
 }
 
 fn g_value(r: &RunResidual, v: f64) -> Option<f64> {
@@ -128,10 +128,10 @@ pub fn residual_markdown(runs: &[RunResidual]) -> String {
             notes.push(format!(
                 "- {}: {}.",
                 r.run,
-                flexstar_model::residual::tracking_text(peak, end)
+                flexstar_metrics::residual::tracking_text(peak, end)
             ));
         }
-        if let Some(hint) = flexstar_model::residual::not_settled_hint(m).filter(|_| !r.g_pinned) {
+        if let Some(hint) = flexstar_metrics::residual::not_settled_hint(m).filter(|_| !r.g_pinned) {
             notes.push(format!("- {}: {hint}.", r.run));
         }
     }

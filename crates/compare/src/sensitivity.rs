@@ -126,7 +126,7 @@ fn list(f: &[f64]) -> String {
 fn residual_peak(r: &Response, t_rest: f64) -> f64 {
     (0..r.t.len())
         .filter(|&k| r.t[k] >= t_rest - 1e-12)
-        .map(|k| flexstar_model::residual::dg_magnitude([r.w_g[0][k], r.w_g[1][k], r.w_g[2][k]]))
+        .map(|k| flexstar_metrics::residual::dg_magnitude([r.w_g[0][k], r.w_g[1][k], r.w_g[2][k]]))
         .fold(0.0, f64::max)
 }
 

@@ -1,7 +1,7 @@
 //! Convergence study of the FEM on any experiment file (docs/fem.md section 4.1, docs/validation.md section 7):
 //! runs the FEM at each `ELEMENTS:DT` given (DT `auto`: the default step of the robot), caches
 //! each run's tip and G histories as CSV in `CACHE` (reused when present), and prints the mean
-//! EVP (Eq. 45, `flexstar_model::evp::point_evps`) of every run against the first one (the
+//! EVP (Eq. 45, `flexstar_metrics::evp::point_evps`) of every run against the first one (the
 //! reference), with the work counters and the run time.
 //!
 //! ```text
@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use flexstar_model::evp::point_evps;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::{Experiment, FemSettings, Response};
 
 /// One run of the study: elements, step (`None`: the default).

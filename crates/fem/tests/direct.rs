@@ -16,7 +16,7 @@ mod rigid_forward;
 
 use flexstar_drive::{ActuatorLaw, DriveError, ForcePolynomials, ForceTable, RigidInverseForces, Servo};
 use flexstar_fem::FemError;
-use flexstar_model::evp::point_evps;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::{catalogue, Experiment, FemSettings, Pose, Response, RobotParams, Trajectory};
 use flexstar_numerics::measures::max_abs;
 use rigid_forward::rigid_forward_dynamics;

@@ -4,7 +4,7 @@
 //! robot's), against a refined run of the FEM whose histories are committed
 //! (`reference_values/robot1_refined.csv`, provenance in `reference_values/README.md`).
 //!
-//! Error measure: the project's mean EVP (Eq. 45, `flexstar_model::evp::point_evps`, over A, B,
+//! Error measure: the project's mean EVP (Eq. 45, `flexstar_metrics::evp::point_evps`, over A, B,
 //! C and G at every output time) of a run against the reference, or between two runs.
 //!
 //! - the defaults (300 elements, the robot-dependent step of Eq. S10) are within 0.1 % of the
@@ -16,7 +16,7 @@
 
 use std::path::Path;
 
-use flexstar_model::evp::point_evps;
+use flexstar_metrics::evp::point_evps;
 use flexstar_model::{Experiment, FemSettings, Response};
 
 const CONFIG: &str = include_str!("reference_values/robot1.toml");

@@ -1,8 +1,8 @@
 //! The residual vibration of a run after its motion has come to rest
-//! (`docs/motions.md` 2.2-2.3): the measures of [`flexstar_model::residual`] with the settling
+//! (`docs/motions.md` 2.2-2.3): the measures of [`flexstar_metrics::residual`] with the settling
 //! hold of section 2.3, one period of the first elastic mode at the final pose.
 
-use flexstar_model::residual::{residual_after, Residual};
+use flexstar_metrics::residual::{residual_after, Residual};
 use flexstar_model::{Experiment, Response};
 
 use crate::analysis::final_pose_frequencies;

@@ -349,6 +349,43 @@ impl Default for FemSettings {
     }
 }
 
+/// Default `[report] settle_tol` [m]: the settling band on |dG| (`docs/motions.md` 2.3).
+pub const DEFAULT_SETTLE_TOL: f64 = 1e-4;
+
+/// The `[report]` section: how reports measure the run.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReportSettings {
+    /// Settling band on the elastic displacement of G, |dG| [m] (default 1e-4).
+    #[serde(default = "default_settle_tol")]
+    pub settle_tol: f64,
+}
+
+fn default_settle_tol() -> f64 {
+    DEFAULT_SETTLE_TOL
+}
+
+impl Default for ReportSettings {
+    fn default() -> Self {
+        ReportSettings {
+            settle_tol: DEFAULT_SETTLE_TOL,
+        }
+    }
+}
+
+impl ReportSettings {
+    /// `settle_tol` must be positive and finite.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        if !(self.settle_tol.is_finite() && self.settle_tol > 0.0) {
+            return Err(ModelError::invalid(
+                "report.settle_tol",
+                format!("need a positive, finite band in m, got {}", self.settle_tol),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// One experiment: what the TOML file says.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -385,7 +422,7 @@ pub struct Experiment {
     pub shaper: Option<crate::shaper::ShaperSection>,
     /// How reports measure the run (`[report]`: the settling band, `docs/motions.md` 2.3).
     #[serde(default)]
-    pub report: crate::residual::ReportSettings,
+    pub report: ReportSettings,
     /// Where the experiment was read from (not a TOML key).
     #[serde(skip)]
     pub source: PathBuf,
@@ -600,6 +637,15 @@ pub fn check_step(key: &str, dt: f64, dt_out: f64) -> Result<(), ModelError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn settle_tol_must_be_positive() {
+        for bad in [0.0, -1e-4, f64::NAN, f64::INFINITY] {
+            let e = ReportSettings { settle_tol: bad }.validate().unwrap_err().to_string();
+            assert!(e.contains("report.settle_tol"), "{e}");
+        }
+        ReportSettings::default().validate().unwrap();
+    }
 
     const CASE1: &str = r#"
 name = "case1"

@@ -9,8 +9,8 @@
 use std::path::Path;
 
 use crate::error::ModelError;
-use crate::sidecar::RunSidecar;
-pub use crate::validity::{small_deflection_check, Provenance, ValidityExceeded};
+use crate::provenance::Provenance;
+use crate::sidecar::{RunSidecar, ValidityExceeded};
 use flexstar_io::output::{fmt_number, Dest};
 use flexstar_io::run_set::RunSet;
 
@@ -45,7 +45,7 @@ pub struct StarShape {
 }
 
 /// What produced a response and at what cost: the solver's resolved settings, written to the
-/// sidecar JSON beside every solver CSV ([`Response::write_sidecar`]).
+/// sidecar JSON beside every solver CSV ([`Response::sidecar`]).
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct RunInfo {
     /// `amm` or `fem`.
@@ -352,15 +352,20 @@ impl Response {
         exp
     }
 
-    /// The sidecar of a run ([`RunSidecar`], what [`Response::write_sidecar`] writes):
+    /// The sidecar of a run ([`RunSidecar`], what [`Response::stage_run`] writes):
     /// `flexstar_version`, `commit` (when known), `date` (UTC, of the run), the experiment's file
-    /// and hash, the `label`, every field of [`RunInfo`], `small_deflection` (the check of
-    /// [`small_deflection_check`]: `null` when the run stays in range, else the first time, the
-    /// quantity, its value and the bound), `column_units` (`{column: unit}` for every column of
+    /// and hash, the `label`, every field of [`RunInfo`], `small_deflection` (the writer's check,
+    /// `flexstar_metrics::small_deflection_check`: `None` when the run stays in range, else the
+    /// first time, the quantity, its value and the bound), `column_units` (`{column: unit}` for every column of
     /// the run's CSV, [`crate::quantity`]) and the resolved `experiment`
     /// ([`Response::resolved_experiment`]); no residual, frames or envelope keys (the caller sets
     /// them). Fields are listed in `docs/outputs.md`.
-    pub fn sidecar(&self, experiment: &crate::Experiment, provenance: &Provenance) -> RunSidecar {
+    pub fn sidecar(
+        &self,
+        experiment: &crate::Experiment,
+        provenance: &Provenance,
+        small_deflection: Option<ValidityExceeded>,
+    ) -> RunSidecar {
         RunSidecar {
             flexstar_version: provenance.version.clone(),
             commit: provenance.commit.clone(),
@@ -369,7 +374,7 @@ impl Response {
             experiment_hash: experiment.hash.clone(),
             label: self.label.clone(),
             info: self.info.clone(),
-            small_deflection: small_deflection_check(self, experiment.robot.l),
+            small_deflection,
             column_units: column_units(&self.header()),
             experiment: self.resolved_experiment(experiment),
             residual: None,
@@ -377,32 +382,6 @@ impl Response {
             validated_envelope: None,
             validated_envelope_reasons: None,
         }
-    }
-
-    /// Write the sidecar JSON of a run (`<csv name>.json`, the document of
-    /// [`Response::sidecar`]), whole or not at all.
-    pub fn write_sidecar(
-        &self,
-        path: &Path,
-        experiment: &crate::Experiment,
-        provenance: &Provenance,
-    ) -> Result<(), ModelError> {
-        write_sidecar_value(path, &sidecar_value(path, &self.sidecar(experiment, provenance))?)
-    }
-
-    /// [`Response::write_sidecar`] into file `name` of a run set (published with the run's other
-    /// files by [`RunSet::commit`]).
-    pub fn stage_sidecar(
-        &self,
-        set: &mut RunSet,
-        name: &str,
-        experiment: &crate::Experiment,
-        provenance: &Provenance,
-    ) -> Result<(), ModelError> {
-        let path = set.path(name);
-        let doc = sidecar_value(&path, &self.sidecar(experiment, provenance))?;
-        set.text(name, &sidecar_text(&path, &doc)?)?;
-        Ok(())
     }
 
     /// Write the deformed-star snapshots as CSV (`t,beam,x,w,X,Y`), whole or not at all.
@@ -417,8 +396,8 @@ impl Response {
 
     /// Stage the three files of run `stem` (`<stem>.csv`, `<stem>-shapes.csv`, `<stem>.json`)
     /// into `set`; `order`: the `(leading, after)` columns of [`Response::write_csv_ordered`]
-    /// (a direct run's file), `None` for the plain order of [`Response::write_csv`]; `residual`:
-    /// the sidecar's residual keys (a compared run's). The run's animation frames are staged too
+    /// (a direct run's file), `None` for the plain order of [`Response::write_csv`]; the writer's
+    /// judgements for the sidecar: the small-deflection check and the residual keys. The run's animation frames are staged too
     /// when it has any (the sidecar then records their hash), else frames an earlier run of
     /// `stem` left are removed ([`crate::animation::stage_run_frames`]).
     pub fn stage_run(
@@ -427,7 +406,7 @@ impl Response {
         stem: &str,
         order: Option<(&[&str], &[&str])>,
         (experiment, provenance): (&crate::Experiment, &Provenance),
-        residual: Option<crate::sidecar::ResidualKeys>,
+        (small_deflection, residual): (Option<ValidityExceeded>, Option<crate::sidecar::ResidualKeys>),
     ) -> Result<(), ModelError> {
         let csv = format!("{stem}.csv");
         match order {
@@ -441,7 +420,7 @@ impl Response {
         let sidecar = RunSidecar {
             residual,
             frames_hash: frames,
-            ..self.sidecar(experiment, provenance)
+            ..self.sidecar(experiment, provenance, small_deflection)
         };
         set.text(&name, &sidecar_text(&path, &sidecar_value(&path, &sidecar)?)?)?;
         Ok(())
@@ -574,7 +553,7 @@ mod tests {
             commit: None,
             date: "d".into(),
         };
-        let doc = r.sidecar(&exp, &prov).to_value().unwrap();
+        let doc = r.sidecar(&exp, &prov, None).to_value().unwrap();
         let fem = doc["experiment"]["fem"].as_object().unwrap();
         assert!(fem.values().all(|v| !v.is_null()), "{fem:?}");
         assert_eq!(doc["experiment"]["robot"]["EA"], serde_json::json!(exp.robot.ea()));
@@ -593,7 +572,7 @@ mod tests {
             date: "2026-01-01T00:00:00Z".into(),
         };
         let dir = tempfile::tempdir().unwrap();
-        let doc = r.sidecar(&exp, &prov).to_value().unwrap();
+        let doc = r.sidecar(&exp, &prov, None).to_value().unwrap();
         let want = sidecar_text(Path::new("fem.json"), &doc).unwrap();
         assert_eq!(
             want,
@@ -601,11 +580,11 @@ mod tests {
             "pretty JSON, final newline"
         );
         let mut set = RunSet::begin(dir.path()).unwrap();
-        r.stage_sidecar(&mut set, "staged.json", &exp, &prov).unwrap();
+        r.stage_run(&mut set, "staged", None, (&exp, &prov), (None, None))
+            .unwrap();
         set.commit().unwrap();
-        r.write_sidecar(&dir.path().join("written.json"), &exp, &prov).unwrap();
         write_sidecar_value(&dir.path().join("value.json"), &doc).unwrap();
-        for f in ["staged.json", "written.json", "value.json"] {
+        for f in ["staged.json", "value.json"] {
             assert_eq!(std::fs::read_to_string(dir.path().join(f)).unwrap(), want, "{f}");
         }
     }

@@ -7,9 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::config::Experiment;
-use crate::residual::Residual;
 use crate::response::RunInfo;
-use crate::validity::ValidityExceeded;
 
 /// The residual vibration keys of a run's sidecar (`docs/motions.md` 2.4, `docs/outputs.md`):
 /// peaks and RMS of |dG| and of the tips after `t_rest` [m], the settling time [s] and the band
@@ -54,40 +52,29 @@ pub struct ResidualKeys {
     pub residual_note: Option<String>,
 }
 
-impl ResidualKeys {
-    /// The keys of a residual (`None`: the motion does not rest before `t_end`) measured in the
-    /// band `settle_tol` [m]. `g_pinned`: the run's modes pin G (the AMM's pinned-free family,
-    /// `phi(0) = 0`), so it has no residual of G: those keys are null, with `residual_note`.
-    pub fn new(res: Option<&Residual>, settle_tol: f64, g_pinned: bool) -> Self {
-        let get = |f: fn(&Residual) -> f64| res.map(f);
-        let opt = |f: fn(&Residual) -> Option<f64>| res.and_then(f);
-        let tracking = res.filter(|r| r.tracking_peak_m.is_some());
-        let mut keys = ResidualKeys {
-            t_rest: get(|r| r.t_rest),
-            g_peak_m: get(|r| r.g_peak_m),
-            g_rms_m: get(|r| r.g_rms_m),
-            tip_peak_m: get(|r| r.tip_peak_m),
-            tip_rms_m: get(|r| r.tip_rms_m),
-            settle_s: opt(|r| r.settle_s),
-            settled: res.map(Residual::settled),
-            settle_tol: Some(settle_tol),
-            settle_hold_s: get(|r| r.hold_s),
-            g_decay_per_s: opt(|r| r.decay_per_s),
-            settle_predicted_s: opt(|r| r.settle_predicted_s),
-            tracking_peak_m: tracking.map(|r| r.tracking_peak_m),
-            tracking_end_m: tracking.map(|r| r.tracking_end_m),
-            residual_note: None,
-        };
-        if g_pinned && res.is_some() {
-            keys.g_peak_m = None;
-            keys.g_rms_m = None;
-            keys.settle_s = None;
-            keys.settled = None;
-            keys.g_decay_per_s = None;
-            keys.settle_predicted_s = None;
-            keys.residual_note = Some("G is pinned in this family".into());
-        }
-        keys
+/// The first time a run leaves the small-deflection range.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ValidityExceeded {
+    /// First output time at which a bound is exceeded [s].
+    pub t: f64,
+    /// The quantity, e.g. `|w2tip| / L` or `|thp1|`.
+    pub quantity: String,
+    /// Its value at `t` (dimensionless or rad).
+    pub value: f64,
+    /// The bound it exceeds (same unit).
+    pub bound: f64,
+    /// Its peak over the run (same unit).
+    pub peak: f64,
+}
+
+impl std::fmt::Display for ValidityExceeded {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "leaves the small-deflection range the AMM assumes at t = {:.4} s: {} = {:.4} > {} (peak {:.4}); \
+             the AMM's results past that time are outside its model, the FEM (geometrically nonlinear) stays valid",
+            self.t, self.quantity, self.value, self.bound, self.peak
+        )
     }
 }
 

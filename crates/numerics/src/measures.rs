@@ -19,7 +19,7 @@ pub fn evp(t: &[f64], test: &[f64], reference: &[f64]) -> Option<f64> {
 
 /// Eq. 45 from the error history itself: `int |error| dt / int |reference| dt * 100` [%], for a
 /// caller whose error is not a plain difference (the norm of G's displacement difference,
-/// `flexstar_model::evp`); `None` when the reference integral vanishes. The one implementation of
+/// `flexstar_metrics::evp`); `None` when the reference integral vanishes. The one implementation of
 /// the ratio.
 pub fn evp_of_error(t: &[f64], error: &[f64], reference: &[f64]) -> Option<f64> {
     let den = integral_abs(t, reference);

@@ -5,7 +5,7 @@
 //! and i = 1..3, so that `|r|^2` is the mean square of |dG| over the window (Eq. R1 of 2.1).
 //! `r` is linear in the AMM's state, hence smooth in the variables.
 
-use flexstar_model::residual::dg_magnitude;
+use flexstar_metrics::residual::dg_magnitude;
 use flexstar_model::{AmmSettings, Experiment, Response, Trajectory};
 
 use crate::limits::{slider_samples, Peak};
@@ -123,7 +123,7 @@ impl Evaluator {
         )
         .map(|s| s.response)
         .map_err(|e| Rejected::Solver(e.to_string()))?;
-        if let Some(v) = flexstar_model::small_deflection_check(&r, exp.robot.l) {
+        if let Some(v) = flexstar_metrics::small_deflection_check(&r, exp.robot.l) {
             return Err(Rejected::Solver(format!("outside the small-deflection range: {v}")));
         }
         Ok(r)

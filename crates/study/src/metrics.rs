@@ -40,7 +40,7 @@ pub fn residual_columns(
     (t_rest, hold_s): (f64, f64),
     g_pinned: bool,
 ) -> (Option<f64>, Option<f64>, Option<f64>) {
-    match flexstar_model::residual::residual_after(r, t_rest, exp.report.settle_tol, hold_s) {
+    match flexstar_metrics::residual::residual_after(r, t_rest, exp.report.settle_tol, hold_s) {
         Some(res) if g_pinned => (Some(res.tip_peak_m), None, None),
         Some(res) => (
             Some(res.tip_peak_m),
@@ -53,6 +53,6 @@ pub fn residual_columns(
 
 /// Largest point EVP [%] over A, B, C, G of the points that have one (Eq. 45; the "largest
 /// point" target of `docs/validation.md` section 8); `None` when no point has one.
-pub fn largest_point_evp(e: &flexstar_model::evp::PointEvps) -> Option<f64> {
+pub fn largest_point_evp(e: &flexstar_metrics::evp::PointEvps) -> Option<f64> {
     e.points.iter().flatten().copied().reduce(f64::max)
 }

@@ -309,7 +309,7 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
             .and_then(|(_, (r, _))| r.as_ref().ok())
     };
     let evp = match (response(Solver::Amm), response(Solver::Fem)) {
-        (Some(a), Some(f)) => flexstar_model::evp::point_evps(a, f).ok(),
+        (Some(a), Some(f)) => flexstar_metrics::evp::point_evps(a, f).ok(),
         _ => None,
     };
     let exp = exp.as_ref().ok();

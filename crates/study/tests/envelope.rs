@@ -12,7 +12,7 @@
 
 use std::path::Path;
 
-use flexstar_model::validity::small_deflection_check;
+use flexstar_metrics::validity::small_deflection_check;
 use flexstar_study::run::run_case;
 use flexstar_study::Study;
 use rayon::prelude::*;

@@ -252,7 +252,7 @@ fn rows_match_direct_solves_and_bad_values_become_rows() {
         assert_eq!(f(&row[6]), peak(&r.w_g), "{solver} peak wG");
         assert_eq!(f(&row[7]), peak(&r.fa), "{solver} peak Fa");
     }
-    let evps = flexstar_model::evp::point_evps(&amm, &fem).unwrap();
+    let evps = flexstar_metrics::evp::point_evps(&amm, &fem).unwrap();
     assert_eq!(f(&row("amm")[8]), evps.mean.unwrap());
     assert_eq!(row("fem")[8], "");
     // the largest point: at least the mean of the four, and one of them

@@ -12,7 +12,7 @@
 //! - a point whose reference response is negligible (peak below [`NEGLIGIBLE`] times the largest
 //!   tip peak of the same case) has no EVP ("n/a") and leaves the mean.
 
-use crate::Response;
+use flexstar_model::Response;
 use flexstar_numerics::measures::{evp_of_error, max_abs};
 
 /// Relative size below which a reference response counts as zero (G in case 1 by symmetry, tip C

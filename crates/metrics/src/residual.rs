@@ -7,47 +7,10 @@
 //! `e_wi` are 120 degrees apart, so `sum_i (dG . e_wi)^2 = 3/2 |dG|^2` for every vector:
 //! `|dG| = sqrt(2/3 (w_1G^2 + w_2G^2 + w_3G^2))` [m], needing no frame (Eq. R1 of motions.md 2.1).
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
-use crate::error::ModelError;
-use crate::response::Response;
-
-/// Default `[report] settle_tol` [m]: the settling band on |dG| (`docs/motions.md` 2.3).
-pub const DEFAULT_SETTLE_TOL: f64 = 1e-4;
-
-/// The `[report]` section: how reports measure the run.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ReportSettings {
-    /// Settling band on the elastic displacement of G, |dG| [m] (default 1e-4).
-    #[serde(default = "default_settle_tol")]
-    pub settle_tol: f64,
-}
-
-fn default_settle_tol() -> f64 {
-    DEFAULT_SETTLE_TOL
-}
-
-impl Default for ReportSettings {
-    fn default() -> Self {
-        ReportSettings {
-            settle_tol: DEFAULT_SETTLE_TOL,
-        }
-    }
-}
-
-impl ReportSettings {
-    /// `settle_tol` must be positive and finite.
-    pub fn validate(&self) -> Result<(), ModelError> {
-        if !(self.settle_tol.is_finite() && self.settle_tol > 0.0) {
-            return Err(ModelError::invalid(
-                "report.settle_tol",
-                format!("need a positive, finite band in m, got {}", self.settle_tol),
-            ));
-        }
-        Ok(())
-    }
-}
+use flexstar_model::sidecar::ResidualKeys;
+use flexstar_model::Response;
 
 /// |dG| [m] from the projections `w_iG` [m] on the three rigid beam frames (Eq. R1).
 pub fn dg_magnitude(w_g: [f64; 3]) -> f64 {
@@ -308,13 +271,48 @@ pub fn not_settled_hint(res: &Residual) -> Option<String> {
     })
 }
 
+/// The sidecar keys ([`ResidualKeys`]) of a residual (`None`: the motion does not rest before `t_end`) measured in the
+/// band `settle_tol` [m]. `g_pinned`: the run's modes pin G (the AMM's pinned-free family,
+/// `phi(0) = 0`), so it has no residual of G: those keys are null, with `residual_note`.
+pub fn sidecar_keys(res: Option<&Residual>, settle_tol: f64, g_pinned: bool) -> ResidualKeys {
+    let get = |f: fn(&Residual) -> f64| res.map(f);
+    let opt = |f: fn(&Residual) -> Option<f64>| res.and_then(f);
+    let tracking = res.filter(|r| r.tracking_peak_m.is_some());
+    let mut keys = ResidualKeys {
+        t_rest: get(|r| r.t_rest),
+        g_peak_m: get(|r| r.g_peak_m),
+        g_rms_m: get(|r| r.g_rms_m),
+        tip_peak_m: get(|r| r.tip_peak_m),
+        tip_rms_m: get(|r| r.tip_rms_m),
+        settle_s: opt(|r| r.settle_s),
+        settled: res.map(Residual::settled),
+        settle_tol: Some(settle_tol),
+        settle_hold_s: get(|r| r.hold_s),
+        g_decay_per_s: opt(|r| r.decay_per_s),
+        settle_predicted_s: opt(|r| r.settle_predicted_s),
+        tracking_peak_m: tracking.map(|r| r.tracking_peak_m),
+        tracking_end_m: tracking.map(|r| r.tracking_end_m),
+        residual_note: None,
+    };
+    if g_pinned && res.is_some() {
+        keys.g_peak_m = None;
+        keys.g_rms_m = None;
+        keys.settle_s = None;
+        keys.settled = None;
+        keys.g_decay_per_s = None;
+        keys.settle_predicted_s = None;
+        keys.residual_note = Some("G is pinned in this family".into());
+    }
+    keys
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// The sidecar keys of a residual, as written ([`crate::sidecar::ResidualKeys`]).
+    /// The sidecar keys of a residual, as written ([`flexstar_model::sidecar::ResidualKeys`]).
     fn keys_of(res: Option<&Residual>, tol: f64, pinned: bool) -> serde_json::Value {
-        serde_json::to_value(crate::sidecar::ResidualKeys::new(res, tol, pinned)).unwrap()
+        serde_json::to_value(sidecar_keys(res, tol, pinned)).unwrap()
     }
 
     /// A response whose elastic displacement of G is the vector `d(t)` (projected on the three
@@ -488,14 +486,5 @@ mod tests {
         let keys = keys_of(Some(&res), 1e-4, true);
         assert!(keys["settle_s"].is_null() && keys["residual_G_peak_m"].is_null());
         assert_eq!(keys["residual_note"], "G is pinned in this family");
-    }
-
-    #[test]
-    fn settle_tol_must_be_positive() {
-        for bad in [0.0, -1e-4, f64::NAN, f64::INFINITY] {
-            let e = ReportSettings { settle_tol: bad }.validate().unwrap_err().to_string();
-            assert!(e.contains("report.settle_tol"), "{e}");
-        }
-        ReportSettings::default().validate().unwrap();
     }
 }

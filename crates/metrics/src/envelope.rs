@@ -16,8 +16,8 @@
 //! (`validated_envelope: true`); the paper's robot is also checked by `flexstar verify`'s four
 //! cases. Every other run gets `false` with the reasons, which name the ranges it leaves.
 
-use crate::config::{AmmModel, ModeFamily};
-use crate::params::RobotParams;
+use flexstar_model::config::{AmmModel, ModeFamily};
+use flexstar_model::params::RobotParams;
 
 /// Does the envelope study meet its targets on every in-range case (`docs/validation.md`
 /// section 8)? Yes since the model terms of `docs/amm.md` 12.11-12.12 and `C_G = 0.5`, on both

@@ -32,18 +32,44 @@ fn merge_ratio(kind: ShaperKind) -> f64 {
     }
 }
 
+/// Why `f_hz = "auto"` could not be resolved (`docs/motions.md` 3.5); each step's own error.
+#[derive(Debug, thiserror::Error)]
+pub enum AutoError {
+    #[error("no [shaper] section")]
+    NoSection,
+    #[error("the motion never comes to rest")]
+    NoRest,
+    #[error("modes at the final pose: {0}")]
+    Modes(#[source] flexstar_modal::ModalError),
+    #[error("no elastic mode at the final pose")]
+    NoElasticMode,
+    /// The unshaped experiment is not a problem the AMM can take.
+    #[error("the unshaped AMM run: {0}")]
+    Problem(#[source] flexstar_model::ModelError),
+    #[error("the unshaped AMM run: {0}")]
+    Run(#[source] flexstar_amm::AmmError),
+    /// The least-squares fit of the residual's modal amplitudes (3.5 step 2) is singular.
+    #[error("the residual fit is singular")]
+    SingularFit,
+    /// The shaper section's damping or tolerance cannot be used.
+    #[error("{0}")]
+    Section(#[source] flexstar_model::ModelError),
+    #[error("the unshaped motion leaves no residual at G to shape")]
+    NoResidual,
+}
+
 /// The choice of `f_hz = "auto"`: modes, the unshaped AMM run, the fit, the greedy choice.
-pub(crate) fn resolve_auto(exp: &Experiment) -> Result<AutoChoice, String> {
-    let section = exp.shaper.as_ref().ok_or("no [shaper] section")?;
-    let t_rest = exp.trajectory.t_rest().ok_or("the motion never comes to rest")?;
+pub(crate) fn resolve_auto(exp: &Experiment) -> Result<AutoChoice, AutoError> {
+    let section = exp.shaper.as_ref().ok_or(AutoError::NoSection)?;
+    let t_rest = exp.trajectory.t_rest().ok_or(AutoError::NoRest)?;
     let freqs = flexstar_modal::analysis::final_pose_frequencies(exp, MODES)
-        .map_err(|e| format!("modes at the final pose: {e}"))?
-        .ok_or("the motion never comes to rest")?;
+        .map_err(AutoError::Modes)?
+        .ok_or(AutoError::NoRest)?;
     let f1 = freqs
         .first()
         .copied()
         .filter(|f| *f > 0.0)
-        .ok_or("no elastic mode at the final pose")?;
+        .ok_or(AutoError::NoElasticMode)?;
     let window = (6.0 / f1).max(1.0);
     let f_max = 0.25 / exp.time.dt_out;
     let groups = group(&freqs, 1.0 / window, f_max);
@@ -67,7 +93,7 @@ fn group(freqs: &[f64], df: f64, f_max: f64) -> Vec<f64> {
 
 /// The accurate AMM (enriched family, the experiment's other `[amm]` settings) of the unshaped
 /// motion up to `t_end` [s].
-fn unshaped_run(exp: &Experiment, t_end: f64) -> Result<flexstar_model::Response, String> {
+fn unshaped_run(exp: &Experiment, t_end: f64) -> Result<flexstar_model::Response, AutoError> {
     let mut x = exp.clone();
     x.shaper = None;
     x.time.t_end = t_end;
@@ -76,17 +102,22 @@ fn unshaped_run(exp: &Experiment, t_end: f64) -> Result<flexstar_model::Response
         snapshots: Vec::new(),
         ..exp.amm.clone()
     };
-    let problem = x.problem().map_err(|e| format!("the unshaped AMM run: {e}"))?;
+    let problem = x.problem().map_err(AutoError::Problem)?;
     flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
         .map(|s| s.response)
-        .map_err(|e| format!("the unshaped AMM run: {e}"))
+        .map_err(AutoError::Run)
 }
 
 /// `|a_g|` [m] per group: the least-squares fit of `w_iG(t_rest + tau)`, tau in [0, window], by
 /// `c_0 + sum_g c_ig cos(w_g tau) + s_ig sin(w_g tau)`; `|a_g|^2 = 2/3 sum_i (c_ig^2 + s_ig^2)`,
 /// the squared norm of the group's complex amplitude `a_g` in C^2 of 3.5 step 2 (its part of dG
 /// has the mean square `|a_g|^2 / 2`, since `|dG|^2 = 2/3 sum w_iG^2`, docs/motions.md section 2).
-fn fit_amplitudes(r: &flexstar_model::Response, t_rest: f64, window: f64, groups: &[f64]) -> Result<Vec<f64>, String> {
+fn fit_amplitudes(
+    r: &flexstar_model::Response,
+    t_rest: f64,
+    window: f64,
+    groups: &[f64],
+) -> Result<Vec<f64>, AutoError> {
     let n = 1 + 2 * groups.len();
     let rows: Vec<usize> = (0..r.t.len())
         .filter(|&k| r.t[k] >= t_rest - 1e-12 && r.t[k] <= t_rest + window + 1e-12)
@@ -114,7 +145,7 @@ fn fit_amplitudes(r: &flexstar_model::Response, t_rest: f64, window: f64, groups
     }
     let mut amp2 = vec![0.0; groups.len()];
     for rhs in aty {
-        let c = solve_dense(n, ata.clone(), rhs).ok_or("the residual fit is singular")?;
+        let c = solve_dense(n, ata.clone(), rhs).ok_or(AutoError::SingularFit)?;
         for (g, a) in amp2.iter_mut().enumerate() {
             *a += 2.0 / 3.0 * (c[1 + 2 * g].powi(2) + c[2 + 2 * g].powi(2));
         }
@@ -151,11 +182,11 @@ fn solve_dense(n: usize, mut a: Vec<f64>, mut b: Vec<f64>) -> Option<Vec<f64>> {
 
 /// The LTI residual factor of each group after the shapers at `chosen` [Hz] (3.3: the convolved
 /// train's residual, the modes' damping from `[damping]`).
-fn factors(section: &ShaperSection, exp: &Experiment, chosen: &[f64], groups: &[f64]) -> Result<Vec<f64>, String> {
+fn factors(section: &ShaperSection, exp: &Experiment, chosen: &[f64], groups: &[f64]) -> Result<Vec<f64>, AutoError> {
     let zetas = section
         .zetas(chosen, |f| exp.damping.zeta_at(f))
-        .map_err(|e| e.to_string())?;
-    let v_tol = section.v_tol().map_err(|e| e.to_string())?;
+        .map_err(AutoError::Section)?;
+    let v_tol = section.v_tol().map_err(AutoError::Section)?;
     let modes: Vec<(f64, f64)> = chosen.iter().copied().zip(zetas).collect();
     let train = multi(section.kind, &modes, v_tol);
     Ok(groups
@@ -168,10 +199,10 @@ fn factors(section: &ShaperSection, exp: &Experiment, chosen: &[f64], groups: &[
 /// at the mean frequency with its neighbour when that neighbour keeps at least [`MERGE_SHARE`]
 /// of the amplitude and lies within [`merge_ratio`], else at its own frequency; until the
 /// predicted ratio is at most [`TARGET`] or [`MAX_SHAPERS`] shapers.
-fn greedy(section: &ShaperSection, exp: &Experiment, groups: &[f64], amps: &[f64]) -> Result<Vec<f64>, String> {
+fn greedy(section: &ShaperSection, exp: &Experiment, groups: &[f64], amps: &[f64]) -> Result<Vec<f64>, AutoError> {
     let r0 = amps.iter().map(|a| a * a).sum::<f64>().sqrt();
     if r0 == 0.0 {
-        return Err("the unshaped motion leaves no residual at G to shape".into());
+        return Err(AutoError::NoResidual);
     }
     let mut chosen: Vec<f64> = Vec::new();
     while chosen.len() < MAX_SHAPERS {
@@ -201,7 +232,7 @@ fn record(
     amps: &[f64],
     chosen: Vec<f64>,
     window: f64,
-) -> Result<AutoChoice, String> {
+) -> Result<AutoChoice, AutoError> {
     let v = factors(section, exp, &chosen, groups)?;
     let total: f64 = amps.iter().map(|a| a * a).sum();
     let pred: f64 = amps.iter().zip(&v).map(|(a, v)| (a * v).powi(2)).sum();

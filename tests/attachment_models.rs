@@ -9,6 +9,7 @@
 //! brisk, 0.163 % (0.180 %); load on pick-place, 0.430 % (0.783 % at tip C, the cycle's own
 //! level: 1.5 s with two stops); all three on brisk, 0.111 % (0.137 %).
 
+use flexstar_solve::Settings;
 use std::path::Path;
 
 use flexstar_metrics::evp::point_evps;
@@ -26,20 +27,9 @@ const LOAD: &str = "[load]\nFx = [0.0, 2.0]\nFy = [0.0, -1.0]\nMz = [0.0, 0.0, 0
 fn compare(base: &str, name: &str, sections: &str) -> (f64, [Option<f64>; 4]) {
     let text = format!("{base}\n{sections}");
     let exp = Experiment::from_toml_str(&text, Path::new("attached.toml")).unwrap();
-    let fem = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &FemSettings::default(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
-    let amm = flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        &AmmSettings::accurate(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let fem = flexstar_solve::response(&problem, Settings::Fem(&FemSettings::default()), None, None).unwrap();
+    let amm = flexstar_solve::response(&problem, Settings::Amm(&AmmSettings::accurate()), None, None).unwrap();
     let e = point_evps(&amm, &fem).unwrap();
     let mean = e.mean.expect("the tips move");
     eprintln!(

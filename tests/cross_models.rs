@@ -16,6 +16,7 @@
 //! A, B, C, G at most 1 %, no point above 2 %), its own error estimate must be within a factor of
 //! two of that true EVP, and the driving forces must agree while the robot moves.
 
+use flexstar_solve::Settings;
 use std::path::Path;
 
 use flexstar_compare::evp::point_evps;
@@ -41,20 +42,9 @@ const TARGETS: Bounds = Bounds {
 
 fn check(text: &str, t_move: f64, bounds: Bounds) {
     let exp = Experiment::from_toml_str(text, Path::new("own.toml")).unwrap();
-    let fem = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &FemSettings::default(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
-    let amm = flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        &AmmSettings::accurate(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let fem = flexstar_solve::response(&problem, Settings::Fem(&FemSettings::default()), None, None).unwrap();
+    let amm = flexstar_solve::response(&problem, Settings::Amm(&AmmSettings::accurate()), None, None).unwrap();
     let e = point_evps(&amm, &fem).unwrap();
     let mean = e.mean.expect("the tips move");
     let estimate = amm
@@ -128,24 +118,13 @@ fn foreshortening_inertia_holds_at_twice_brisks_amplitude() {
     } else {
         panic!("brisk is a quintic");
     }
-    let fem = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &FemSettings::default(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let fem = flexstar_solve::response(&problem, Settings::Fem(&FemSettings::default()), None, None).unwrap();
     let settings = AmmSettings {
         modes: Some(53),
         ..AmmSettings::accurate()
     };
-    let amm = flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let amm = flexstar_solve::response(&problem, Settings::Amm(&settings), None, None).unwrap();
     let e = point_evps(&amm, &fem).unwrap();
     eprintln!("brisk x 2: EVP A/B/C/G = {:?}", e.points);
     let g = e.points[3].expect("G moves");

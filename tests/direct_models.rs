@@ -35,35 +35,23 @@ fn amm_and_fem_under_the_same_forces_agree_as_their_inverse_runs_do() {
     };
     for case in 1..=4 {
         let exp = paper_case(case);
-        let fem_inv = flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &exp.fem,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .unwrap();
-        let amm_inv = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &amm_settings,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let fem_inv = flexstar_fem::solve(&problem, &exp.fem, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap();
+        let problem = exp.problem().unwrap();
+        let amm_inv = flexstar_amm::solve(&problem, &amm_settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap();
         let law = force_table(&fem_inv);
-        let fem_dir = flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &exp.fem,
-            flexstar_drive::SolveRequest::law(&law),
-        )
-        .map(|s| s.response)
-        .unwrap();
-        let amm_dir = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &amm_settings,
-            flexstar_drive::SolveRequest::law(&law),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let fem_dir = flexstar_fem::solve(&problem, &exp.fem, flexstar_drive::SolveRequest::law(&law))
+            .map(|s| s.response)
+            .unwrap();
+        let problem = exp.problem().unwrap();
+        let amm_dir = flexstar_amm::solve(&problem, &amm_settings, flexstar_drive::SolveRequest::law(&law))
+            .map(|s| s.response)
+            .unwrap();
 
         let summary = |p: flexstar_metrics::evp::PointEvps| {
             (

@@ -77,13 +77,10 @@ fn direct_vs_inverse(c: &mut Criterion) {
     };
     for (label, settings) in [("n25_free-free", paper), ("n53_accurate", accurate)] {
         let exp = common::paper_case(3);
-        let inverse = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let inverse = flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap();
         let fa = (0..inverse.len())
             .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
             .collect();

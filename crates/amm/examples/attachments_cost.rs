@@ -24,13 +24,10 @@ fn main() {
     };
     let mut sum = 0.0;
     for _ in 0..k {
-        let r = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .expect("solve");
+        let problem = exp.problem().unwrap();
+        let r = flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .expect("solve");
         sum += r.w_tip[0].iter().sum::<f64>();
     }
     println!("{sum:e}");

@@ -23,13 +23,10 @@ fn main() {
         let path = std::path::Path::new(&file);
         let text = std::fs::read_to_string(path).expect("readable file");
         let exp = Experiment::from_toml_str(&text, path).expect("valid experiment");
-        let auto = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &exp.amm,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .expect("automatic choice");
+        let problem = exp.problem().unwrap();
+        let auto = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .expect("automatic choice");
         let (n, h) = (auto.info.modes.expect("N"), auto.info.dt);
         let problem = exp.problem().expect("valid problem");
         let equal = problem.equal_beams().expect("the paper's robot form");

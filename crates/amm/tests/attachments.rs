@@ -92,21 +92,14 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
             params: plain.robot,
             attached: Default::default(),
         };
+        let (plain_problem, zero_problem) = (plain.problem().unwrap(), zero.problem().unwrap());
         let (a, b) = (
-            flexstar_amm::solve(
-                &plain.problem().unwrap(),
-                &settings,
-                flexstar_drive::SolveRequest::law(&law),
-            )
-            .map(|s| s.response)
-            .unwrap(),
-            flexstar_amm::solve(
-                &zero.problem().unwrap(),
-                &settings,
-                flexstar_drive::SolveRequest::law(&law),
-            )
-            .map(|s| s.response)
-            .unwrap(),
+            flexstar_amm::solve(&plain_problem, &settings, flexstar_drive::SolveRequest::law(&law))
+                .map(|s| s.response)
+                .unwrap(),
+            flexstar_amm::solve(&zero_problem, &settings, flexstar_drive::SolveRequest::law(&law))
+                .map(|s| s.response)
+                .unwrap(),
         );
         assert_eq!(bits(&a), bits(&b), "direct {} {}", settings.family, settings.model);
         // a zero load given as polynomials runs the load's path: the same values
@@ -215,13 +208,10 @@ fn stiff_limit_direct_run_follows_the_rigid_forward_dynamics() {
             },
         ),
     ] {
-        let r = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::law(&law),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let r = flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&law))
+            .map(|s| s.response)
+            .unwrap();
         let jets = trajectory.jets(&robot, 0.0).unwrap();
         let (s0, v0) = (jets.map(|j| j.v), jets.map(|j| j.d1));
         let reference =
@@ -350,13 +340,10 @@ fn direct_run_inverts_the_inverse_run_with_payload_damping_and_load() {
             .collect();
         let table = ForceTable::new(inverse_fine.t.clone(), fa).unwrap();
         let inverse = common::motion_response(&exp, &settings).unwrap();
-        let direct = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::law(&table),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let direct = flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&table))
+            .map(|s| s.response)
+            .unwrap();
         let mut ds = 0.0f64;
         for (k, &t) in direct.t.iter().enumerate() {
             let s = exp.trajectory.s(&exp.robot, t).unwrap();

@@ -42,44 +42,17 @@ fn slider_error(exp: &Experiment, direct: &Response) -> f64 {
 
 /// Round trip of one case: inverse run with output every `dt_fa`, its Fa fed back.
 fn round_trip(k: usize, settings: &AmmSettings, t_end: f64, dt_fa: f64) -> (f64, f64) {
-    let inverse_fine = common::motion_response(&case(k, t_end, dt_fa), settings).unwrap();
-    let exp = case(k, t_end, 1e-3);
-    let inverse = common::motion_response(&exp, settings).unwrap();
-    let direct = flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        settings,
-        flexstar_drive::SolveRequest::law(&table(&inverse_fine)),
-    )
-    .map(|s| s.response)
-    .unwrap();
-    let ds = slider_error(&exp, &direct);
-    let evp = point_evps(&direct, &inverse).unwrap();
-    let worst = evp.points.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
-    (ds, worst)
+    round_trip_exp(&case(k, t_end, 1e-3), settings, dt_fa)
 }
-
-#[test]
-fn round_trip_gives_the_motion_back_in_every_paper_case() {
-    // an inverse run's Fa with output at every solver step, fed back, gives s(t) within
-    // 1e-6 m and the tips and G within an EVP of 0.1 %
-    for k in 1..=4 {
-        let settings = paper_case(k).amm;
-        let (ds, evp) = round_trip(k, &settings, 0.2, DEFAULT_DT);
-        eprintln!("case {k}: |s - s_ref| <= {ds:.3e} m, worst point EVP {evp:.2e} %");
-        // (s'' is constant in the paper's cases, which the scheme integrates exactly)
-        assert!(ds < 1e-6, "case {k}: {ds:e} m");
-        assert!(evp < 0.1, "case {k}: {evp} %");
-    }
-}
-
 /// Round trip of an arbitrary experiment.
 fn round_trip_exp(exp: &Experiment, settings: &AmmSettings, dt_fa: f64) -> (f64, f64) {
     let mut fine = exp.clone();
     fine.time.dt_out = dt_fa;
     let inverse_fine = common::motion_response(&fine, settings).unwrap();
     let inverse = common::motion_response(exp, settings).unwrap();
+    let problem = exp.problem().unwrap();
     let direct = flexstar_amm::solve(
-        &exp.problem().unwrap(),
+        &problem,
         settings,
         flexstar_drive::SolveRequest::law(&table(&inverse_fine)),
     )
@@ -135,13 +108,10 @@ fn stiff_servo_reproduces_the_prescribed_motion() {
             attached: Default::default(),
         };
         let inverse = common::motion_response(&exp, &exp.amm).unwrap();
-        let direct = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &exp.amm,
-            flexstar_drive::SolveRequest::law(&servo),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let direct = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::law(&servo))
+            .map(|s| s.response)
+            .unwrap();
         let ds = slider_error(&exp, &direct);
         let evp = point_evps(&direct, &inverse).unwrap();
         let tips = evp.points[..3].iter().flatten().fold(0.0f64, |m, v| m.max(*v));
@@ -184,13 +154,10 @@ fn leaving_the_feasible_range_stops_with_time_and_reason() {
     let push = flexstar_drive::ForcePolynomials {
         coefficients: [vec![50.0], vec![0.0], vec![0.0]],
     };
-    let err = flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        &exp.amm,
-        flexstar_drive::SolveRequest::law(&push),
-    )
-    .map(|s| s.response)
-    .unwrap_err();
+    let problem = exp.problem().unwrap();
+    let err = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::law(&push))
+        .map(|s| s.response)
+        .unwrap_err();
     let msg = err.to_string();
     eprintln!("{msg}");
     match err {
@@ -207,13 +174,10 @@ fn automatic_n_runs_the_direct_problem_too() {
     let mut exp = case(3, 0.1, DEFAULT_DT);
     exp.amm = AmmSettings::accurate();
     let inverse = common::motion_response(&exp, &exp.amm).unwrap();
-    let direct = flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        &exp.amm,
-        flexstar_drive::SolveRequest::law(&table(&inverse)),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let direct = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::law(&table(&inverse)))
+        .map(|s| s.response)
+        .unwrap();
     assert_eq!(direct.info.modes, inverse.info.modes);
     assert!(direct.info.error_estimate_percent.is_some());
     assert_eq!(direct.info.solver, "amm-direct");
@@ -243,13 +207,10 @@ fn stiff_limit_matches_the_rigid_forward_dynamics() {
             attached: Default::default(),
         };
         let settings = AmmSettings::paper(flexstar_model::ModeFamily::FreeFree, 25);
-        let r = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::law(&law),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let r = flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&law))
+            .map(|s| s.response)
+            .unwrap();
         let s0 = exp.trajectory.s(&robot, 0.0).unwrap();
         let v0 = exp.trajectory.jets(&robot, 0.0).unwrap().map(|j| j.d1);
         let reference = rigid_forward_dynamics(&robot, s0, v0, &law, exp.time.t_end, exp.time.dt_out, 1e-4).unwrap();

@@ -379,8 +379,9 @@ fn bad_input_is_rejected_before_any_work() {
     let short = paper_case(2);
     let step = flexstar_kinematics::preflight_step(short.time.dt_out);
     let proof = flexstar_kinematics::check_motion(&short.robot, &short.trajectory, short.time.t_end, step).unwrap();
+    let problem = long.problem().unwrap();
     match flexstar_amm::solve(
-        &long.problem().unwrap(),
+        &problem,
         &settings(ModeFamily::SlideFree, 25, None),
         flexstar_drive::SolveRequest::motion().with_proof(Some(&proof)),
     )

@@ -20,25 +20,19 @@ fn accurate_at(exp: &Experiment, n: usize) -> flexstar_model::Response {
         dt: Some(1e-4),
         ..AmmSettings::accurate()
     };
-    flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap()
+    let problem = exp.problem().unwrap();
+    flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap()
 }
 
 #[test]
 fn truncation_flexibility_removes_the_truncation_at_the_sleeves() {
     let exp = Experiment::from_toml_str(ROBOT1, Path::new("robot1.toml")).unwrap();
-    let fem = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &exp.fem,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let fem = flexstar_fem::solve(&problem, &exp.fem, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let (coarse, fine) = (accurate_at(&exp, 33), accurate_at(&exp, 100));
     let between = point_evps(&coarse, &fine).unwrap().mean.unwrap();
     let e33 = point_evps(&coarse, &fem).unwrap();

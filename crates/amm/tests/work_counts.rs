@@ -21,13 +21,10 @@ fn paper_setting_runs_once_at_the_default_step() {
     // each config's [amm]: slide-free, N = 25, the default step 1/6 ms: t_end / dt steps
     for (case, steps) in [(1, 3000), (2, 2400), (3, 3000), (4, 3000)] {
         let exp = catalogue::paper_case(case);
-        let (r, s) = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &exp.amm,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| (s.response, s.stats))
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let (r, s) = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::motion())
+            .map(|s| (s.response, s.stats))
+            .unwrap();
         assert_eq!(s, stats(25, &[25], steps, steps), "case {case}");
         assert_eq!(s.solves, steps + 1, "the initial accelerations and one solve per step");
         assert_eq!(r.info.modes, Some(25));
@@ -41,8 +38,9 @@ fn automatic_n_tries_46_and_53_then_delivers_53() {
     // same grid, then N = 53 at 0.5 ms (adaptive module)
     for (case, steps) in [(1, 1000), (2, 800), (3, 1000), (4, 1000)] {
         let exp = catalogue::paper_case(case);
+        let problem = exp.problem().unwrap();
         let (r, s) = flexstar_amm::solve(
-            &exp.problem().unwrap(),
+            &problem,
             &AmmSettings::accurate(),
             flexstar_drive::SolveRequest::motion(),
         )
@@ -61,8 +59,9 @@ fn automatic_n_tries_46_and_53_then_delivers_53() {
     // itself delivered
     let mut short = catalogue::paper_case(3);
     short.time.t_end = 0.05;
+    let problem = short.problem().unwrap();
     let (_, s) = flexstar_amm::solve(
-        &short.problem().unwrap(),
+        &problem,
         &AmmSettings::accurate(),
         flexstar_drive::SolveRequest::motion(),
     )
@@ -99,8 +98,9 @@ fn automatic_n_is_within_half_a_percent_of_the_refined_fem() {
     // measured 0.374 % (w1tip); by the same measure the paper's setting (slide-free, N = 25, the
     // printed equations) is 32-67 % off this reference
     let exp = catalogue::paper_case(2);
+    let problem = exp.problem().unwrap();
     let (r, _) = flexstar_amm::solve(
-        &exp.problem().unwrap(),
+        &problem,
         &AmmSettings::accurate(),
         flexstar_drive::SolveRequest::motion(),
     )

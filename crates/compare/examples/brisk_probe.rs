@@ -46,13 +46,10 @@ fn amm(exp: &Experiment, n: usize, model: AmmModel) -> Response {
         model,
         ..AmmSettings::accurate()
     };
-    flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .expect("amm")
+    let problem = exp.problem().unwrap();
+    flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .expect("amm")
 }
 
 fn fem(exp: &Experiment, elements: usize, dt: Option<f64>) -> Response {
@@ -61,13 +58,10 @@ fn fem(exp: &Experiment, elements: usize, dt: Option<f64>) -> Response {
         dt,
         ..FemSettings::default()
     };
-    flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .expect("fem")
+    let problem = exp.problem().unwrap();
+    flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .expect("fem")
 }
 
 fn show(what: &str, test: &Response, reference: &Response) {

@@ -31,13 +31,10 @@ fn servo_run(exp: &Experiment, settings: &AmmSettings, f_bw: f64) -> Response {
         params: exp.robot,
         attached: Default::default(),
     };
-    flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        settings,
-        flexstar_drive::SolveRequest::law(&law),
-    )
-    .map(|s| s.response)
-    .expect("servo run")
+    let problem = exp.problem().unwrap();
+    flexstar_amm::solve(&problem, settings, flexstar_drive::SolveRequest::law(&law))
+        .map(|s| s.response)
+        .expect("servo run")
 }
 
 /// Largest |s_ref - s| [m] over the run.
@@ -107,13 +104,10 @@ fn main() {
     println!("|---|---|---|---|---|---|");
     let mut curves: Vec<(String, Vec<Outcome>)> = Vec::new();
     for (k, exp) in cases.iter().enumerate() {
-        let ideal = flexstar_amm::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .expect("ideal run");
+        let problem = exp.problem().unwrap();
+        let ideal = flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .expect("ideal run");
         let ideal_tip = (0..3).map(|i| peak(&ideal.w_tip[i])).fold(0.0, f64::max) * 1e3;
         let runs = study_case(exp, &settings, &ideal);
         for (o, _) in &runs {

@@ -66,13 +66,10 @@ fn bench(c: &mut Criterion) {
     let mut exp = catalogue::paper_case(2);
     exp.time.dt_out = flexstar_fem::DEFAULT_DT;
     let settings = FemSettings::default();
-    let inverse = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let inverse = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let rows = (0..inverse.len())
         .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
         .collect();

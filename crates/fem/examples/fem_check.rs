@@ -27,13 +27,10 @@ const ZERO_LIMIT: f64 = 1e-6;
 fn run(k: usize) -> (Experiment, Response, flexstar_fem::Stats, f64) {
     let exp = catalogue::paper_case(k);
     let t0 = Instant::now();
-    let (r, stats) = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &exp.fem,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| (s.response, s.stats))
-    .unwrap_or_else(|e| panic!("case {k}: {e}"));
+    let problem = exp.problem().unwrap();
+    let (r, stats) = flexstar_fem::solve(&problem, &exp.fem, flexstar_drive::SolveRequest::motion())
+        .map(|s| (s.response, s.stats))
+        .unwrap_or_else(|e| panic!("case {k}: {e}"));
     (exp, r, stats, t0.elapsed().as_secs_f64())
 }
 

@@ -27,13 +27,10 @@ fn main() {
         frames: 0,
     };
     let started = std::time::Instant::now();
-    let (r, stats) = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| (s.response, s.stats))
-    .expect("FEM run");
+    let problem = exp.problem().unwrap();
+    let (r, stats) = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| (s.response, s.stats))
+        .expect("FEM run");
     eprintln!(
         "case {case}, {elements} elements, dt {dt:e} s, rho_inf {}: {stats:?}, {:.1} s",
         flexstar_fem::DEFAULT_RHO_INF,

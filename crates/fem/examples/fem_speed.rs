@@ -33,12 +33,9 @@ fn main() -> ExitCode {
     let mut stats = None;
     for _ in 0..runs {
         let t0 = Instant::now();
-        match flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| (s.response, s.stats))
+        let problem = exp.problem().unwrap();
+        match flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| (s.response, s.stats))
         {
             Ok((_, s)) => stats = Some(s),
             Err(e) => {

@@ -71,13 +71,10 @@ fn run(exp: &Experiment, dir: &Path, stem: &str, set: Setting) -> Result<(Respon
         ..exp.fem.clone()
     };
     let t0 = Instant::now();
-    let (r, stats) = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| (s.response, s.stats))
-    .map_err(|e| e.to_string())?;
+    let problem = exp.problem().unwrap();
+    let (r, stats) = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| (s.response, s.stats))
+        .map_err(|e| e.to_string())?;
     let wall = t0.elapsed().as_secs_f64();
     eprintln!("{stem} {set:?}: dt {:e} s, {stats:?}, {wall:.2} s", r.info.dt);
     write(&path, &r).map_err(|e| e.to_string())?;

@@ -101,13 +101,10 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
     // every key at zero (an offset alone is no payload; zeta = 0 is beta = 0; an empty [load])
     let mut exp = catalogue::paper_case(3);
     exp.time.t_end = 0.1;
-    let bare = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let bare = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     exp.payload = Payload {
         mass: 0.0,
         j: 0.0,
@@ -119,13 +116,10 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
         f_hz: Some(4.0),
     };
     exp.load = LoadSettings::polynomials(None, None, None);
-    let zero = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let zero = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     assert_eq!(zero.header(), bare.header());
     assert_eq!(bits(&zero), bits(&bare));
     // the same in the direct problem
@@ -134,32 +128,23 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
         params: exp.robot,
         attached: Attachments::of(&exp),
     };
-    let d_zero = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::law(&law),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let d_zero = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::law(&law))
+        .map(|s| s.response)
+        .unwrap();
     let mut bare_exp = catalogue::paper_case(3);
     bare_exp.time.t_end = 0.1;
-    let d_bare = flexstar_fem::solve(
-        &bare_exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::law(&law),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = bare_exp.problem().unwrap();
+    let d_bare = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::law(&law))
+        .map(|s| s.response)
+        .unwrap();
     assert_eq!(bits(&d_zero), bits(&d_bare));
     // and each section present adds its column after today's, nothing else
     exp.damping = Damping::with_beta(1e-4);
-    let damped = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let damped = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let mut header = bare.header();
     header.push("E_d".into());
     assert_eq!(damped.header(), header);
@@ -203,13 +188,10 @@ fn stiff_limit_gives_the_newton_euler_forces_with_payload_and_load() {
             dt: Some(STIFF_DT),
             ..coarse()
         };
-        let r = flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let r = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap();
         let (err, evp, dg) = against_rigid_inverse_dynamics(&exp, &r);
         eprintln!(
             "beta {beta:e} s: largest Fa difference {:.4} % of the peak, EVP {evp:.4} %, |dG| {dg:.2e} m",
@@ -237,13 +219,10 @@ fn stiff_limit_direct_follows_the_motion_and_the_forward_dynamics() {
         dt: Some(STIFF_DT),
         ..coarse()
     };
-    let (r, stats) = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::law(&law),
-    )
-    .map(|s| (s.response, s.stats))
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let (r, stats) = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&law))
+        .map(|s| (s.response, s.stats))
+        .unwrap();
     let s0 = exp.trajectory.s(&exp.robot, 0.0).unwrap();
     let reference = rigid_forward_dynamics_with(
         &exp.robot,
@@ -296,13 +275,10 @@ fn energy_balance_with_payload_load_and_damping() {
     // the drivers' and the load's work = kinetic (beams, sleeves, sliders, payload) + strain
     // energy + dissipated energy. Measured: 9.0e-6 (inverse) and 9.8e-6 (direct) of the work.
     let exp = quintic_experiment(RobotParams::paper(), 0.5, 2e-3);
-    let (r, stats) = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| (s.response, s.stats))
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let (r, stats) = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| (s.response, s.stats))
+        .unwrap();
     let (defect, ed, wl) = energy_defect(&r);
     eprintln!(
         "inverse: Eq. C6 defect {defect:.2e} of the work, E_d {ed:.3e} J, W_load {wl:.3e} J, {:.2} Newton iterations per step",
@@ -315,24 +291,18 @@ fn energy_balance_with_payload_load_and_damping() {
     assert!(defect < 1e-4, "Eq. C6 off by {defect} of the work");
     let mut fed = exp.clone();
     fed.time.dt_out = 5e-4;
-    let inverse = flexstar_fem::solve(
-        &fed.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = fed.problem().unwrap();
+    let inverse = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let rows = (0..inverse.len())
         .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
         .collect();
     let table = flexstar_drive::ForceTable::new(inverse.t.clone(), rows).unwrap();
-    let d = flexstar_fem::solve(
-        &fed.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::law(&table),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = fed.problem().unwrap();
+    let d = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::law(&table))
+        .map(|s| s.response)
+        .unwrap();
     let (defect, ed, _) = energy_defect(&d);
     eprintln!("direct: Eq. C6 defect {defect:.2e} of the work, E_d {ed:.3e} J");
     assert!(defect < 1e-4, "direct: Eq. C6 off by {defect} of the work");
@@ -380,13 +350,10 @@ fn free_decay_gives_the_first_mode_damping_ratio() {
     let zeta_target = 0.02;
     let mut exp = catalogue::experiment("decay", params, traj, 3.0, 1e-3);
     exp.damping = Damping::with_beta(2.0 * zeta_target / omega1);
-    let r = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let r = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     for name in ["dGx", "dGy"] {
         let p = peaks(&r.t, col(&r, name), 1.0);
         assert!(p.len() >= 6, "{name}: too few peaks {p:?}");
@@ -421,13 +388,10 @@ fn a_load_step_on_a_bare_g_is_resolved_by_halving_the_step() {
             dt,
             ..FemSettings::default()
         };
-        flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .unwrap()
+        let problem = exp.problem().unwrap();
+        flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap()
     };
     let (default, fine) = (run(None), run(Some(2e-5)));
     let peak = max_abs(&fine.w_g[1]);

@@ -31,24 +31,18 @@ fn baseline_and_avx2_copies_give_the_same_run() {
         ..FemSettings::default()
     };
     force_baseline(false);
-    let (chosen, s1) = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| (s.response, s.stats))
-    .expect("run with the processor's copy");
+    let problem = exp.problem().unwrap();
+    let (chosen, s1) = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| (s.response, s.stats))
+        .expect("run with the processor's copy");
     force_baseline(true);
     // the switch the dispatched bodies read (the counters of numerics' own test show that they
     // obey it): every body below runs its baseline copy
     assert!(!flexstar_numerics::lanes::has_avx2());
-    let (baseline, s2) = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| (s.response, s.stats))
-    .expect("run with the baseline copy");
+    let problem = exp.problem().unwrap();
+    let (baseline, s2) = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| (s.response, s.stats))
+        .expect("run with the baseline copy");
     force_baseline(false);
     assert_eq!(s1, s2, "work counters");
     assert!(s1.steps == 100 && s1.newton_iterations >= 200);

@@ -103,13 +103,10 @@ fn paper_cases_work_counts_and_accuracy() {
     ];
     for (case, want) in pinned {
         let exp = catalogue::paper_case(case);
-        let (r, s) = flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &exp.fem,
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| (s.response, s.stats))
-        .expect("FEM run");
+        let problem = exp.problem().unwrap();
+        let (r, s) = flexstar_fem::solve(&problem, &exp.fem, flexstar_drive::SolveRequest::motion())
+            .map(|s| (s.response, s.stats))
+            .expect("FEM run");
         let got = [
             s.steps,
             s.newton_iterations,

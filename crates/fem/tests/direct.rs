@@ -71,15 +71,13 @@ fn round_trip(exp: &Experiment) -> (f64, f64, f64) {
         dt: Some(exp.time.dt_out.min(5e-4)),
         ..coarse()
     };
-    let inverse = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let inverse = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
+    let problem = exp.problem().unwrap();
     let direct = flexstar_fem::solve(
-        &exp.problem().unwrap(),
+        &problem,
         &settings,
         flexstar_drive::SolveRequest::law(&forces_of(&inverse)),
     )
@@ -160,13 +158,10 @@ fn driven_star_balances_work_and_energy_and_a_stiff_servo_tracks() {
     // and reproduce the prescribed-motion run within an EVP of 1 % at every point (measured
     // 0.018 % at most, tracking error 1.2e-7 m).
     let exp = quintic_experiment(RobotParams::paper(), 0.4, 1e-3);
-    let prescribed = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let prescribed = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     for bandwidth in [20.0, 1000.0] {
         let (kp, kd) = Servo::gains_from_bandwidth(exp.robot.mpp_mpa, bandwidth, 0.7);
         let servo = Servo {
@@ -177,13 +172,10 @@ fn driven_star_balances_work_and_energy_and_a_stiff_servo_tracks() {
             params: exp.robot,
             attached: Default::default(),
         };
-        let (r, stats) = flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &coarse(),
-            flexstar_drive::SolveRequest::law(&servo),
-        )
-        .map(|s| (s.response, s.stats))
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let (r, stats) = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::law(&servo))
+            .map(|s| (s.response, s.stats))
+            .unwrap();
         let (worst, umax) = energy_defect(&r);
         let wmax = max_abs(col(&r, "W"));
         let track = slider_error(&exp, &r);
@@ -242,13 +234,10 @@ fn stiff_limit_matches_the_rigid_forward_dynamics() {
             attached: Default::default(),
         };
         let settings = FemSettings { dt, ..coarse() };
-        let r = flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &settings,
-            flexstar_drive::SolveRequest::law(&law),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let r = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&law))
+            .map(|s| s.response)
+            .unwrap();
         let s0 = exp.trajectory.s(&robot, 0.0).unwrap();
         let reference =
             rigid_forward_dynamics(&robot, s0, [0.0; 3], &law, exp.time.t_end, exp.time.dt_out, 1e-4).unwrap();
@@ -288,13 +277,10 @@ fn leaving_the_feasible_range_stops_with_time_and_reason() {
     let law = ForcePolynomials {
         coefficients: [vec![5.0], vec![0.0], vec![0.0]],
     };
-    let err = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::law(&law),
-    )
-    .map(|s| s.response)
-    .unwrap_err();
+    let problem = exp.problem().unwrap();
+    let err = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::law(&law))
+        .map(|s| s.response)
+        .unwrap_err();
     let msg = err.to_string();
     eprintln!("{msg}");
     match err {
@@ -338,8 +324,9 @@ fn a_failing_law_stops_the_run_with_its_time() {
         0.05,
         1e-3,
     );
+    let problem = exp.problem().unwrap();
     let err = flexstar_fem::solve(
-        &exp.problem().unwrap(),
+        &problem,
         &coarse(),
         flexstar_drive::SolveRequest::law(&FailsLater { t_fail: 0.0102 }),
     )
@@ -361,21 +348,15 @@ fn direct_response_has_the_contract_columns() {
         0.02,
         1e-3,
     );
-    let (inverse, _) = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| (s.response, s.stats))
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let (inverse, _) = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| (s.response, s.stats))
+        .unwrap();
     let law = forces_of(&inverse);
-    let r = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::law(&law),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let r = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::law(&law))
+        .map(|s| s.response)
+        .unwrap();
     let header = r.header();
     let expected = [
         "t", "w1G", "w2G", "w3G", "w1tip", "w2tip", "w3tip", "Fa1", "Fa2", "Fa3", "s1", "s2", "s3", "sd1", "sd2",

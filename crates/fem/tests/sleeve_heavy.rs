@@ -48,13 +48,10 @@ fn run(exp: &Experiment, elements: usize, dt: Option<f64>) -> Response {
         snapshots: vec![],
         frames: 0,
     };
-    flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .expect("FEM run")
+    let problem = exp.problem().unwrap();
+    flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .expect("FEM run")
 }
 
 /// Mean EVP [%] of `a` against `b` (Eq. 45).

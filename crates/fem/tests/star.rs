@@ -45,8 +45,9 @@ fn case1_is_symmetric() {
     // Case 1 (s_i = t^2, 0.5 s): in-place rotation; by symmetry G does not move and the three
     // tips vibrate identically (paper, section 8.1). Paper mesh (300 elements), default step.
     let exp = experiment(RobotParams::paper(), Trajectory::quadratic([1.0, 1.0, 1.0]), 0.5);
+    let problem = exp.problem().unwrap();
     let (r, stats) = flexstar_fem::solve(
-        &exp.problem().unwrap(),
+        &problem,
         &FemSettings::default(),
         flexstar_drive::SolveRequest::motion(),
     )
@@ -108,13 +109,10 @@ fn stiff_limit_follows_rigid_kinematics_and_inverse_dynamics() {
         dt: Some(flexstar_fem::DEFAULT_DT),
         ..coarse()
     };
-    let r = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let r = flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let (dgx, dgy) = (col(&r, "dGx"), col(&r, "dGy"));
     let mut fa_rigid = [vec![], vec![], vec![]];
     for (k, &t) in r.t.iter().enumerate() {
@@ -172,13 +170,10 @@ fn energy_balance_holds_at_paper_stiffness() {
         (moving, 0.3),
     ] {
         let exp = experiment(RobotParams::paper(), traj, t_end);
-        let r = flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &coarse(),
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
-        .unwrap();
+        let problem = exp.problem().unwrap();
+        let r = flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+            .map(|s| s.response)
+            .unwrap();
         let w = col(&r, "W");
         let wmax = max_abs(w);
         assert!(wmax > 1e-3, "the drivers must do work");
@@ -212,8 +207,9 @@ fn energy_balance_holds_at_paper_stiffness() {
 fn bad_input_stops_with_time_and_reason() {
     let exp = experiment(RobotParams::paper(), Trajectory::quadratic([1.0, 1.0, 1.0]), 0.1);
     // mesh too coarse: 10 elements per beam, h = 5 cm > Lp / 2
+    let problem = exp.problem().unwrap();
     let err = flexstar_fem::solve(
-        &exp.problem().unwrap(),
+        &problem,
         &FemSettings {
             elements: 30,
             ..Default::default()
@@ -223,8 +219,9 @@ fn bad_input_stops_with_time_and_reason() {
     .map(|s| s.response)
     .unwrap_err();
     assert!(matches!(err, FemError::MeshTooCoarse { per_beam: 10, .. }), "{err}");
+    let problem = exp.problem().unwrap();
     let err = flexstar_fem::solve(
-        &exp.problem().unwrap(),
+        &problem,
         &FemSettings {
             elements: 100,
             ..Default::default()
@@ -234,8 +231,9 @@ fn bad_input_stops_with_time_and_reason() {
     .map(|s| s.response)
     .unwrap_err();
     assert!(matches!(err, FemError::Input(_)), "{err}");
+    let problem = exp.problem().unwrap();
     let err = flexstar_fem::solve(
-        &exp.problem().unwrap(),
+        &problem,
         &FemSettings {
             dt: Some(-1.0),
             ..coarse()
@@ -248,13 +246,10 @@ fn bad_input_stops_with_time_and_reason() {
     // case 2 past its end of travel: sleeve 2 (J) runs into G shortly after 0.4 s; refused by
     // the feasibility scan before any step (docs/conventions.md, feasible range), with the time and the sleeve
     let exp = experiment(RobotParams::paper(), Trajectory::quadratic([1.0, -0.5, -0.5]), 0.5);
-    match flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &coarse(),
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap_err()
+    let problem = exp.problem().unwrap();
+    match flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap_err()
     {
         FemError::Scan(infeasible) => {
             let msg = infeasible.to_string();
@@ -271,8 +266,9 @@ fn progress_reaches_one_and_rows_match_output_times() {
     let exp = experiment(RobotParams::paper(), Trajectory::quadratic([1.0, -0.5, -0.5]), 0.02);
     let seen = Mutex::new(Vec::new());
     let cb = |f: f64| seen.lock().unwrap().push(f);
+    let problem = exp.problem().unwrap();
     let r = flexstar_fem::solve(
-        &exp.problem().unwrap(),
+        &problem,
         &FemSettings {
             snapshots: vec![0.01],
             ..coarse()
@@ -297,12 +293,8 @@ fn a_set_cancel_token_stops_the_run_at_the_first_output_time() {
     let token = flexstar_model::Cancel::new();
     token.cancel();
     let r = flexstar_model::cancel::with_cancel(Some(&token), || {
-        flexstar_fem::solve(
-            &exp.problem().unwrap(),
-            &coarse(),
-            flexstar_drive::SolveRequest::motion(),
-        )
-        .map(|s| s.response)
+        let problem = exp.problem().unwrap();
+        flexstar_fem::solve(&problem, &coarse(), flexstar_drive::SolveRequest::motion()).map(|s| s.response)
     });
     match r {
         Err(FemError::Cancelled { t }) => assert_eq!(t, exp.time.dt_out),

@@ -152,13 +152,10 @@ fn pulse_response_matches_the_nonlinear_direct_run() {
         tol: None,
         ..exp.amm.clone()
     };
-    let direct = flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        &settings,
-        flexstar_drive::SolveRequest::law(&pulse),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let direct = flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::law(&pulse))
+        .map(|s| s.response)
+        .unwrap();
     // linear response, modal coordinates
     let (a, b, c) = (ss.a.to_dense(), ss.b.to_dense(), ss.c.to_dense());
     let nr = ss.a.rows() / 2;

@@ -45,13 +45,10 @@ fn nine_envelope_cases_meet_the_evp_bounds_and_their_estimates_are_within_a_fact
         .par_iter()
         .map(|case| {
             let exp = study.experiment(&case.values).expect("a valid case");
-            let amm = flexstar_amm::solve(
-                &exp.problem().unwrap(),
-                &exp.amm,
-                flexstar_drive::SolveRequest::motion(),
-            )
-            .map(|s| s.response)
-            .expect("the AMM run");
+            let problem = exp.problem().unwrap();
+            let amm = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::motion())
+                .map(|s| s.response)
+                .expect("the AMM run");
             let range = small_deflection_check(&amm, exp.robot.l);
             assert!(
                 range.is_none(),

@@ -223,20 +223,14 @@ fn rows_match_direct_solves_and_bad_values_become_rows() {
         .replace("s1 = [0.0, 0.0, 1.0]", "s1 = [0.0, 0.0, 0.25]")
         .replace("s3 = [0.0, 0.0, 0.5]", "s3 = [0.0, 0.0, 0.125]");
     let exp = flexstar_model::Experiment::from_toml_str(&text, Path::new("hand.toml")).unwrap();
-    let amm = flexstar_amm::solve(
-        &exp.problem().unwrap(),
-        &exp.amm,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
-    let fem = flexstar_fem::solve(
-        &exp.problem().unwrap(),
-        &exp.fem,
-        flexstar_drive::SolveRequest::motion(),
-    )
-    .map(|s| s.response)
-    .unwrap();
+    let problem = exp.problem().unwrap();
+    let amm = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
+    let problem = exp.problem().unwrap();
+    let fem = flexstar_fem::solve(&problem, &exp.fem, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .unwrap();
     let peak = |h: &[Vec<f64>; 3]| h.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
     let row = |solver: &str| {
         t.rows

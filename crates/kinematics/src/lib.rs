@@ -2,6 +2,8 @@
 //!
 //! Rigid kinematics of the star-triangle robot (paper, section 3; docs/conventions.md):
 //!
+//! - [`as_built`]: the same for any base and any weld angles (`docs/as-built.md` 3: G sees each
+//!   pair of revolute points under the gap between their beams);
 //! - [`direct`]: G as the Fermat point of the revolute points I, J, K (Eqs. 4-7), the orientation
 //!   theta (Eq. 9) and the sleeve positions xp_i (Eq. 10), generic over dual numbers so that
 //!   [`RigidState`] carries first and second time derivatives exact to round-off (Eq. 8);
@@ -13,6 +15,7 @@
 //! The closed-form inverse kinematics lives in `flexstar_model::geometry` (trajectories need it)
 //! and is re-exported here.
 
+pub mod as_built;
 pub mod direct;
 pub mod feasibility;
 pub mod inverse_dynamics;

@@ -9,7 +9,7 @@
 //! beams, the FEM's three SIMD lanes) rely on.
 
 use crate::error::ModelError;
-use crate::geometry::{beam_offset, revolute_origin, slider_direction};
+use crate::geometry::{beam_offset, revolute_origin, slider_direction, Scalar};
 use crate::params::RobotParams;
 
 /// One flexible beam of the star with its sleeve (the passive prismatic joint it slides through).
@@ -61,6 +61,36 @@ impl ActuatorAxis {
             direction: slider_direction(i),
         }
     }
+
+    /// The three axes on the sides of the triangle of side lengths `sides` [m]
+    /// (`docs/as-built.md` 2, Eq. B1): origin at the in-centre, side 1 below it parallel to X,
+    /// slider i along side i from A_i towards A_(i+1), `s_i = 0` where the in-circle touches it.
+    /// Errors name `base.sides` when the sides make no triangle.
+    pub fn from_sides(sides: [f64; 3]) -> Result<[ActuatorAxis; 3], ModelError> {
+        let [l1, l2, l3] = sides;
+        let p = 0.5 * (l1 + l2 + l3);
+        let (e1, e2, e3) = (p - l1, p - l2, p - l3);
+        if !sides.iter().all(|l| l.is_finite() && *l > 0.0) || e1 <= 0.0 || e2 <= 0.0 || e3 <= 0.0 {
+            return Err(ModelError::invalid(
+                "base.sides",
+                format!("need three positive lengths, each shorter than the sum of the other two, got {sides:?}"),
+            ));
+        }
+        // Heron's area, the in-radius and the tangent lengths from A_1, A_2, A_3
+        let r = (p * e1 * e2 * e3).sqrt() / p;
+        let t = [e2, e3, e1];
+        let cos_a1 = (l1 * l1 + l3 * l3 - l2 * l2) / (2.0 * l1 * l3);
+        let sin_a1 = (1.0 - cos_a1 * cos_a1).max(0.0).sqrt();
+        let a = [[-t[0], -r], [l1 - t[0], -r], [-t[0] + l3 * cos_a1, -r + l3 * sin_a1]];
+        Ok(std::array::from_fn(|i| {
+            let (from, to) = (a[i], a[(i + 1) % 3]);
+            let u = [(to[0] - from[0]) / sides[i], (to[1] - from[1]) / sides[i]];
+            ActuatorAxis {
+                origin: [from[0] + t[i] * u[0], from[1] + t[i] * u[1]],
+                direction: u,
+            }
+        }))
+    }
 }
 
 /// The robot: its three beams and three actuator axes, validated.
@@ -89,6 +119,7 @@ impl Robot {
                 ));
             }
         }
+        check_welds(&beams)?;
         let equal = Self::check_equal(&beams, &axes);
         Ok(Robot { beams, axes, equal })
     }
@@ -128,6 +159,67 @@ impl Robot {
     /// The three actuator axes, slider 1 first.
     pub fn axes(&self) -> &[ActuatorAxis; 3] {
         &self.axes
+    }
+
+    /// The weld angles phi_i [rad] (`docs/as-built.md` Eq. W1; phi_1 = 0).
+    pub fn weld_angles(&self) -> [f64; 3] {
+        self.beams.map(|b| b.weld_angle)
+    }
+
+    /// The gaps `[g_23, g_31, g_12]` [rad] between the beams (Eq. W2), each opposite the beam of
+    /// its index: `gaps()[k]` is the angle under which G sees the two revolute points other
+    /// than k's.
+    pub fn gaps(&self) -> [f64; 3] {
+        let phi = self.weld_angles();
+        [phi[2] - phi[1], std::f64::consts::TAU - phi[2], phi[1] - phi[0]]
+    }
+
+    /// Revolute point i at actuator coordinate `s` [m], fixed frame: `o_i + s u_i` (Eqs. 1-3 on
+    /// the paper's base).
+    pub fn revolute_point<D: Scalar>(&self, i: usize, s: D) -> [D; 2] {
+        let a = &self.axes[i];
+        [s * a.direction[0] + a.origin[0], s * a.direction[1] + a.origin[1]]
+    }
+
+    /// Unit vector `e_xi` along rigid beam i at orientation `theta` (Eq. W1).
+    pub fn e_x<D: Scalar>(&self, i: usize, theta: D) -> [D; 2] {
+        let a = theta + self.beams[i].weld_angle;
+        [a.sin(), -a.cos()]
+    }
+
+    /// The actuator coordinates that put G at `g` [m] with orientation `theta` [rad]
+    /// (`docs/as-built.md` 3, inverse kinematics): beam i's axis meets slider line i, on the
+    /// beam's positive side. Fails when a beam is parallel to its slider or points away from it.
+    pub fn inverse_kinematics<D: Scalar>(&self, g: [D; 2], theta: D) -> Result<[D; 3], ModelError> {
+        let mut s = [D::zero(); 3];
+        for (i, si) in s.iter_mut().enumerate() {
+            let ex = self.e_x(i, theta);
+            let (u, o) = (self.axes[i].direction, self.axes[i].origin);
+            // r e_x - s u = o - g, by Cramer's rule
+            let (bx, by) = (-g[0] + o[0], -g[1] + o[1]);
+            let det = ex[1] * u[0] - ex[0] * u[1];
+            if det.re().abs() < 1e-12 {
+                return Err(ModelError::InverseKinematics(format!(
+                    "beam {} is parallel to slider {} at theta = {} rad",
+                    i + 1,
+                    i + 1,
+                    theta.re()
+                )));
+            }
+            let r = (by * u[0] - bx * u[1]) / det;
+            if r.re() <= 0.0 {
+                return Err(ModelError::InverseKinematics(format!(
+                    "beam {} points away from slider {} (G = ({}, {}), theta = {})",
+                    i + 1,
+                    i + 1,
+                    g[0].re(),
+                    g[1].re(),
+                    theta.re()
+                )));
+            }
+            *si = (ex[0] * by - ex[1] * bx) / det;
+        }
+        Ok(s)
     }
 
     /// The robot in the paper's form, when it is the paper's robot: three equal beams welded at
@@ -194,6 +286,25 @@ fn close(a: f64, b: f64) -> bool {
 
 fn close_axis(a: &ActuatorAxis, b: &ActuatorAxis) -> bool {
     (0..2).all(|k| close(a.origin[k], b.origin[k]) && close(a.direction[k], b.direction[k]))
+}
+
+/// The weld angles: beam 1 at 0, then counter-clockwise `0 < phi_2 < phi_3 < 2 pi`, every gap
+/// below pi (`docs/as-built.md` 1: otherwise the beams do not surround G).
+fn check_welds(beams: &[Beam; 3]) -> Result<(), ModelError> {
+    let phi = beams.map(|b| b.weld_angle);
+    let gaps = [phi[1] - phi[0], phi[2] - phi[1], std::f64::consts::TAU - phi[2]];
+    let ordered = phi[0] == 0.0 && phi[1] < phi[2] && phi[2] < std::f64::consts::TAU;
+    if !ordered || gaps.iter().any(|g| !(*g > 0.0 && *g < std::f64::consts::PI)) {
+        let deg = phi.map(f64::to_degrees);
+        return Err(ModelError::invalid(
+            "robot.weld_deg",
+            format!(
+                "need beam 1 at 0 degrees and the beams counter-clockwise 1, 2, 3 with every gap between \
+                 neighbours below 180 degrees (otherwise they do not surround G), got {deg:?}"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Every value of one beam finite and positive (the sleeve's mass and inertia may be 0), the
@@ -272,6 +383,70 @@ mod tests {
         axes[1].origin[0] += 1e-3;
         let e = Robot::new(*r.beams(), axes).unwrap().equal_beams().unwrap_err();
         assert!(e.to_string().contains("equilateral"), "{e}");
+    }
+
+    /// Equal sides `2 sqrt(3) d` give the paper's base (Eqs. 1-3), to rounding.
+    #[test]
+    fn equal_sides_are_the_paper_base() {
+        let d = 0.18;
+        let axes = ActuatorAxis::from_sides([2.0 * 3f64.sqrt() * d; 3]).unwrap();
+        for (i, a) in axes.iter().enumerate() {
+            let p = ActuatorAxis::paper(i, d);
+            for k in 0..2 {
+                assert!((a.origin[k] - p.origin[k]).abs() < 1e-15, "{i}: {a:?} {p:?}");
+                assert!((a.direction[k] - p.direction[k]).abs() < 1e-15, "{i}: {a:?} {p:?}");
+            }
+        }
+        let e = ActuatorAxis::from_sides([1.0, 0.3, 0.6]).unwrap_err();
+        assert!(e.to_string().contains("base.sides"), "{e}");
+    }
+
+    /// An uneven base: each origin is the in-circle's touch point (at distance r from O, on its
+    /// side), consecutive sides meet at the triangle's corners, and the sides have their lengths.
+    #[test]
+    fn uneven_sides_make_the_triangle_with_its_in_circle() {
+        let sides = [0.62, 0.64, 0.61];
+        let axes = ActuatorAxis::from_sides(sides).unwrap();
+        let r = axes[0].origin[1].abs();
+        // each origin is the foot of the perpendicular from O; consecutive lines meet at the
+        // corners A_(i+1), with equal tangent lengths from each corner, and the corners are the
+        // side lengths apart
+        let mut corner = [[0.0; 2]; 3];
+        for i in 0..3 {
+            let (a, b) = (axes[i], axes[(i + 1) % 3]);
+            assert!((a.origin[0].hypot(a.origin[1]) - r).abs() < 1e-14);
+            assert!((a.origin[0] * a.direction[0] + a.origin[1] * a.direction[1]).abs() < 1e-14);
+            let cross = a.direction[0] * b.direction[1] - a.direction[1] * b.direction[0];
+            let w = [b.origin[0] - a.origin[0], b.origin[1] - a.origin[1]];
+            let along_a = (w[0] * b.direction[1] - w[1] * b.direction[0]) / cross;
+            let back_b = (w[0] * a.direction[1] - w[1] * a.direction[0]) / cross;
+            assert!((along_a + back_b).abs() < 1e-14, "equal tangents from corner {}", i + 2);
+            corner[(i + 1) % 3] = [
+                a.origin[0] + along_a * a.direction[0],
+                a.origin[1] + along_a * a.direction[1],
+            ];
+        }
+        for i in 0..3 {
+            let (c0, c1) = (corner[i], corner[(i + 1) % 3]);
+            assert!(
+                ((c1[0] - c0[0]).hypot(c1[1] - c0[1]) - sides[i]).abs() < 1e-14,
+                "side {}",
+                i + 1
+            );
+        }
+        let p = 0.5 * sides.iter().sum::<f64>();
+        let area = (p * (p - sides[0]) * (p - sides[1]) * (p - sides[2])).sqrt();
+        assert!((r - area / p).abs() < 1e-15);
+    }
+
+    #[test]
+    fn weld_angles_must_surround_g() {
+        let r = Robot::from_params(&RobotParams::paper()).unwrap();
+        let mut beams = *r.beams();
+        beams[2].weld_angle = 190f64.to_radians();
+        beams[1].weld_angle = 5f64.to_radians();
+        let e = Robot::new(beams, *r.axes()).unwrap_err();
+        assert!(e.to_string().contains("robot.weld_deg"), "{e}");
     }
 
     #[test]

@@ -529,6 +529,7 @@ mod tests {
             name: "t".into(),
             description: String::new(),
             robot: RobotParams::paper(),
+            base: None,
             time: TimeSpan { t_end, dt_out: 1e-3 },
             trajectory: Trajectory::quadratic(k),
             amm: AmmSettings::default(),

@@ -31,6 +31,7 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         name: name.into(),
         description: String::new(),
         robot,
+        base: None,
         time: TimeSpan { t_end, dt_out },
         trajectory,
         amm: AmmSettings::default(),

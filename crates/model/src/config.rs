@@ -397,6 +397,10 @@ pub struct Experiment {
     pub description: String,
     #[serde(default)]
     pub robot: RobotParams,
+    /// The actuator axes (`[base]`, `docs/as-built.md` 2); read into `robot.d` when the file is
+    /// read (the paper's equilateral base), not written back.
+    #[serde(default, skip_serializing)]
+    pub base: Option<crate::robot_section::BaseSection>,
     pub time: TimeSpan,
     pub trajectory: Trajectory,
     #[serde(default)]
@@ -450,6 +454,7 @@ impl Experiment {
             message: parse_message(text, e),
         })?;
         exp.source = path.to_path_buf();
+        exp.read_base(text).map_err(|e| e.in_file(path))?;
         exp.drive.read_file(path)?;
         exp.load.read_file(path)?;
         exp.robot.validate().map_err(|e| e.in_file(path))?;
@@ -534,6 +539,28 @@ impl Experiment {
 }
 
 impl Experiment {
+    /// `[base]` into `robot.d`: the in-radius of the equilateral base it describes (an uneven
+    /// base is refused until the solvers model it); giving `robot.d` too is refused.
+    fn read_base(&mut self, text: &str) -> Result<(), ModelError> {
+        let Some(base) = &self.base else {
+            return Ok(());
+        };
+        let d_given = toml::from_str::<toml::Table>(text)
+            .ok()
+            .and_then(|t| t.get("robot").and_then(|r| r.get("d")).cloned())
+            .is_some();
+        if d_given {
+            return Err(ModelError::invalid(
+                "robot.d",
+                "give the base once: robot.d (the paper's equilateral triangle of that in-radius) or [base]",
+            ));
+        }
+        self.robot.d = base
+            .paper_in_radius()
+            .map_err(|(key, reason)| ModelError::invalid(key, reason))?;
+        Ok(())
+    }
+
     /// A rest-to-rest motion must end by `time.t_end` (`docs/motions.md` section 1.5): one that
     /// ends later would be cut off mid-move.
     pub(crate) fn check_motion_fits(&self) -> Result<(), ModelError> {
@@ -637,6 +664,29 @@ pub fn check_step(key: &str, dt: f64, dt_out: f64) -> Result<(), ModelError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `[robot]` lists and `[base]` read from a file: equal lists are the paper's form, an
+    /// unequal one is refused naming the file and the key, `[base]` sets `d` and may not come with it.
+    #[test]
+    fn robot_lists_and_the_base_from_a_file() {
+        let body = "name = \"r\"\n[time]\nt_end = 0.1\n[trajectory]\nkind = \"polynomial\"\n\
+                    s1 = [0.0]\ns2 = [0.0]\ns3 = [0.0]\n";
+        let read = |extra: &str| Experiment::from_toml_str(&format!("{body}{extra}"), Path::new("r.toml"));
+        let plain = read("").unwrap();
+        let listed = read("[robot]\nL = [0.5, 0.5, 0.5]\nweld_deg = [0, 120, 240]\n").unwrap();
+        assert_eq!(listed.robot, plain.robot);
+        let e = read("[robot]\nL = [0.42, 0.42, 0.40]\n").unwrap_err().to_string();
+        assert!(e.contains("r.toml") && e.contains("robot.L"), "{e}");
+        let side = 2.0 * 3f64.sqrt() * 0.2;
+        let based = read(&format!("[base]\nsides = [{side}, {side}, {side}]\n")).unwrap();
+        assert!((based.robot.d - 0.2).abs() < 1e-15);
+        let e = read(&format!("[robot]\nd = 0.2\n[base]\nsides = [{side}, {side}, {side}]\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("robot.d") && e.contains("once"), "{e}");
+        let e = read("[base]\nsides = [0.62, 0.64, 0.61]\n").unwrap_err().to_string();
+        assert!(e.contains("r.toml") && e.contains("uneven base"), "{e}");
+    }
 
     #[test]
     fn settle_tol_must_be_positive() {

@@ -26,6 +26,7 @@ pub mod quantity;
 pub mod response;
 pub mod rest_pose;
 pub mod robot;
+pub mod robot_section;
 pub mod shaper;
 pub mod sidecar;
 pub mod spline;

@@ -11,8 +11,10 @@ use crate::error::ModelError;
 ///
 /// TOML keys keep the paper's symbols (`E`, `I`, `rho`, `L`, `d`, `Lp`, `mpp_mpa`, `Jp`); every
 /// key is optional and defaults to the paper's value (section 8).
+/// Read through [`crate::robot_section`]: a key may be a list of three equal values, `EA` may
+/// come from `A` or `density`, and `weld_deg` may be given (the paper's).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(try_from = "crate::robot_section::RobotSection")]
 pub struct RobotParams {
     /// Young's modulus E [Pa].
     #[serde(rename = "E")]

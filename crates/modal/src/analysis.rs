@@ -140,6 +140,14 @@ pub fn write_modal_csv(dest: Dest<'_>, modal: &Modal) -> Result<(), ModalError> 
 }
 
 /// The first `count` elastic natural frequencies [Hz] of the accurate AMM ([`amm_basis`], the
+/// payload at G) at the start pose of the experiment's motion (t = 0), sliders locked: the robot's
+/// own frequencies where every run begins (a tolerance study's `f1_hz`, `docs/studies.md`).
+pub fn start_pose_frequencies(exp: &Experiment, count: usize) -> Result<Vec<f64>, ModalError> {
+    let pose = crate::pose::pose_at_time(exp, 0.0)?;
+    Ok(amm_pose_model(exp)?.frequencies_at(&pose, Sliders::Locked, count)?)
+}
+
+/// The first `count` elastic natural frequencies [Hz] of the accurate AMM ([`amm_basis`], the
 /// payload at G) at the final pose of the experiment's rest-to-rest motion, sliders locked
 /// (`docs/motions.md` 3.5, 3.6: the modes a shaper is designed for and judged against);
 /// `None` when the motion never comes to rest.

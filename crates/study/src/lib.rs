@@ -28,6 +28,7 @@ pub mod sample;
 pub mod shard;
 pub mod spec;
 pub mod table;
+pub mod tie;
 
 pub use error::StudyError;
 pub use merge::{merge, MergeReport};

@@ -1,5 +1,5 @@
-//! The study's plots (plotters, SVG): a metric against a varied key, and a heat map of a metric
-//! over two gridded keys.
+//! The study's plots (plotters, SVG): a metric against a varied key, a heat map of a metric
+//! over two gridded keys, and the histogram of a metric over a sampled study's runs.
 
 use flexstar_plot::axis_ticks;
 use plotters::prelude::*;
@@ -41,6 +41,95 @@ pub struct Heat {
     pub x_levels: Vec<String>,
     pub y_levels: Vec<String>,
     pub values: Vec<Vec<Option<f64>>>,
+}
+
+/// The distribution of one metric over a sampled study's runs: `bins` equal bins from the
+/// smallest to the largest value, one bar series per solver (bars side by side in each bin).
+#[derive(Debug, Clone)]
+pub struct Histogram {
+    pub title: String,
+    pub x_label: String,
+    /// Per solver: its name, colour and values.
+    pub sets: Vec<(String, RGBColor, Vec<f64>)>,
+    pub bins: usize,
+}
+
+impl Histogram {
+    /// The counts of `values` in the bins of `[lo, hi]` (the largest value in the last bin).
+    pub fn counts(values: &[f64], lo: f64, hi: f64, bins: usize) -> Vec<usize> {
+        let mut c = vec![0; bins];
+        let width = (hi - lo) / bins as f64;
+        for v in values {
+            let k = if width > 0.0 { ((v - lo) / width) as usize } else { 0 };
+            c[k.min(bins - 1)] += 1;
+        }
+        c
+    }
+
+    /// The histogram as an SVG document.
+    pub fn to_svg(&self) -> Result<String, StudyError> {
+        flexstar_plot::register_font();
+        let e = err(&self.title);
+        let all = self.sets.iter().flat_map(|s| s.2.iter().copied());
+        let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        let (lo, hi) = if lo.is_finite() {
+            (lo, hi.max(lo + 1e-12 * (1.0 + lo.abs())))
+        } else {
+            (0.0, 1.0)
+        };
+        let counts: Vec<Vec<usize>> = self
+            .sets
+            .iter()
+            .map(|s| Self::counts(&s.2, lo, hi, self.bins))
+            .collect();
+        let top = counts.iter().flatten().copied().max().unwrap_or(1).max(1);
+        let width = (hi - lo) / self.bins as f64;
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
+            root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
+            let mut chart = ChartBuilder::on(&root)
+                .caption(&self.title, ("sans-serif", 15))
+                .margin(10)
+                .x_label_area_size(40)
+                .y_label_area_size(50)
+                .build_cartesian_2d(lo..hi, 0.0..top as f64 * 1.1)
+                .map_err(|x| e(x.to_string()))?;
+            chart
+                .configure_mesh()
+                .x_desc(self.x_label.as_str())
+                .y_desc("runs")
+                .label_style(("sans-serif", 12))
+                .x_label_formatter(&axis_ticks(lo, hi))
+                .y_label_formatter(&|v: &f64| format!("{v:.0}"))
+                .light_line_style(RGBColor(235, 235, 235))
+                .draw()
+                .map_err(|x| e(x.to_string()))?;
+            let n = self.sets.len().max(1) as f64;
+            for (j, ((label, color, _), c)) in self.sets.iter().zip(&counts).enumerate() {
+                let color = *color;
+                let bars = c.iter().enumerate().map(|(k, &count)| {
+                    let x0 = lo + width * (k as f64 + j as f64 / n);
+                    Rectangle::new([(x0, 0.0), (x0 + width / n, count as f64)], color.mix(0.7).filled())
+                });
+                chart
+                    .draw_series(bars)
+                    .map_err(|x| e(x.to_string()))?
+                    .label(label.as_str())
+                    .legend(move |(x, y)| Rectangle::new([(x + 2, y - 4), (x + 12, y + 4)], color.filled()));
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(RGBColor(180, 180, 180))
+                .label_font(("sans-serif", 12))
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(|x| e(x.to_string()))?;
+            root.present().map_err(|x| e(x.to_string()))?;
+        }
+        Ok(svg)
+    }
 }
 
 const W: u32 = 560;

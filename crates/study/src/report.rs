@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use flexstar_io::output::write_string_atomically;
 
 use crate::error::StudyError;
-use crate::plots::{solver_color, Heat, PointSet, Scatter};
+use crate::plots::{solver_color, Heat, Histogram, PointSet, Scatter};
 use crate::shard::{meta_file, results_file, Meta};
 use crate::table::{Table, OK};
 use plotters::style::RGBColor;
@@ -24,6 +24,7 @@ pub fn metric_labels() -> Vec<(&'static str, &'static str)> {
         ("peak_Fa_N", "peak |Fa_i| [N]"),
         ("evp_percent", "mean EVP of the AMM vs FEM [%]"),
         ("evp_max_percent", "largest point EVP of the AMM vs FEM [%]"),
+        ("f1_hz", "first frequency at the start pose [Hz]"),
         ("residual_tip_m", "residual |w_i(L)| after the motion [m]"),
         ("residual_G_m", "residual |dG| after the motion [m]"),
         ("settle_s", "settling time, absolute (not settled: not drawn) [s]"),
@@ -94,6 +95,9 @@ fn make_plots(table: &Table, meta: &Meta) -> Result<Vec<Plot>, StudyError> {
     let stride = ok.len().div_ceil(MAX_POINTS).max(1);
     let grid = !meta.grid_levels.is_empty();
     let mut plots: Vec<Plot> = estimate_plot(table, &ok, stride)?.into_iter().collect();
+    if !grid {
+        plots.extend(histograms(table, meta, &ok)?);
+    }
     for (mc, metric, label) in present_metrics(table) {
         for (j, key) in keys.iter().enumerate() {
             let kc = j + 1;
@@ -141,6 +145,57 @@ fn make_plots(table: &Table, meta: &Meta) -> Result<Vec<Plot>, StudyError> {
         }
     }
     Ok(plots)
+}
+
+/// The metrics whose distribution a sampled study (a tolerance study) shows as a histogram.
+pub const HISTOGRAM_METRICS: [&str; 5] = ["f1_hz", "residual_G_m", "settle_s", "peak_Fa_N", "peak_tip_m"];
+
+/// A histogram of each of [`HISTOGRAM_METRICS`] over the runs, the solvers side by side (a
+/// sampled study: Latin hypercube or random draws).
+fn histograms(table: &Table, meta: &Meta, ok: &[&Vec<String>]) -> Result<Vec<Plot>, StudyError> {
+    let sc = table.column("solver").unwrap_or(0);
+    let mut plots = Vec::new();
+    for (mc, metric, label) in present_metrics(table)
+        .into_iter()
+        .filter(|m| HISTOGRAM_METRICS.contains(&m.1))
+    {
+        let sets: Vec<(String, RGBColor, Vec<f64>)> = meta
+            .solvers
+            .iter()
+            .map(|s| {
+                let v: Vec<f64> = ok.iter().filter(|r| &r[sc] == s).filter_map(|r| num(&r[mc])).collect();
+                (s.clone(), solver_color(s), v)
+            })
+            .filter(|s| !s.2.is_empty())
+            .collect();
+        let runs = sets.iter().map(|s| s.2.len()).max().unwrap_or(0);
+        if runs < 2 {
+            continue;
+        }
+        let hist = Histogram {
+            title: format!("distribution of {metric}"),
+            x_label: label.to_string(),
+            bins: (runs as f64).sqrt().ceil().clamp(5.0, 30.0) as usize,
+            sets,
+        };
+        plots.push(Plot {
+            file: format!("hist-{}.svg", slug(metric)),
+            caption: format!("Distribution of {label} over the study's runs (the quantiles are in the summary)"),
+            svg: hist.to_svg()?,
+        });
+    }
+    Ok(plots)
+}
+
+/// The quantile `p` in [0, 1] of sorted values, linearly interpolated between order statistics
+/// (the value at rank `p (n - 1)`, Hyndman and Fan's definition 7, the default of R and numpy).
+pub fn quantile(sorted: &[f64], p: f64) -> f64 {
+    let h = p * (sorted.len() - 1) as f64;
+    let k = h.floor() as usize;
+    match sorted.get(k + 1) {
+        Some(next) => sorted[k] + (h - k as f64) * (next - sorted[k]),
+        None => sorted[k],
+    }
 }
 
 /// The AMM's error estimate against its true mean EVP (`docs/validation.md` section 8), both as log10 of the
@@ -243,7 +298,8 @@ fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
 
-/// Summary of one metric of one solver: count, min, median, max and the cases of the extremes.
+/// Summary of one metric of one solver: count, min, the 5, 50 and 95 % quantiles ([`quantile`]),
+/// max and the cases of the extremes.
 fn summary_rows(table: &Table, meta: &Meta) -> String {
     let keys = table.keys();
     let (sc, st) = (table.column("solver").unwrap_or(0), table.column("status").unwrap_or(0));
@@ -268,12 +324,16 @@ fn summary_rows(table: &Table, meta: &Meta) -> String {
             }
             v.sort_by(|a, b| a.0.total_cmp(&b.0));
             let (lo, hi) = (v[0], v[v.len() - 1]);
+            let sorted: Vec<f64> = v.iter().map(|x| x.0).collect();
+            let q = |p: f64| quantile(&sorted, p);
             let _ = writeln!(
                 h,
-                "<tr><td>{s}</td><td>{metric}</td><td>{}</td><td>{:.4e}</td><td>{:.4e}</td><td>{:.4e}</td><td>{}</td><td>{}</td></tr>",
+                "<tr><td>{s}</td><td>{metric}</td><td>{}</td><td>{:.4e}</td><td>{:.4e}</td><td>{:.4e}</td><td>{:.4e}</td><td>{:.4e}</td><td>{}</td><td>{}</td></tr>",
                 v.len(),
                 lo.0,
-                v[v.len() / 2].0,
+                q(0.05),
+                q(0.5),
+                q(0.95),
                 hi.0,
                 escape(&case(lo.1)),
                 escape(&case(hi.1))
@@ -299,13 +359,13 @@ fn html_page(table: &Table, meta: &Meta, plots: &[Plot]) -> String {
         meta.hash,
         meta.total_cases,
         meta.solvers.join(" + "),
-        if meta.grid_levels.is_empty() { "Latin hypercube".to_string() } else { format!("grid {:?}", meta.grid_levels) },
+        if meta.grid_levels.is_empty() { "sampled".to_string() } else { format!("grid {:?}", meta.grid_levels) },
         escape(&meta.keys.join(", ")),
         table.rows.len(),
         table.rows.len() - failed.len(),
         failed.len()
     );
-    h.push_str("<h2>Summary</h2>\n<table><tr><th>solver</th><th>metric</th><th>runs</th><th>min</th><th>median</th><th>max</th><th>case of the min</th><th>case of the max</th></tr>\n");
+    h.push_str("<h2>Summary</h2>\n<table><tr><th>solver</th><th>metric</th><th>runs</th><th>min</th><th>5 %</th><th>median</th><th>95 %</th><th>max</th><th>case of the min</th><th>case of the max</th></tr>\n");
     h.push_str(&summary_rows(table, meta));
     h.push_str("</table>\n");
     if !failed.is_empty() {
@@ -364,6 +424,26 @@ mod tests {
             }
         }
         Table { header, rows }
+    }
+
+    /// Quantiles against numpy's default (`numpy.quantile([1..=101], [0.05, 0.5, 0.95])` = 6, 51,
+    /// 96; of [1, 2, 3, 4]: 0.05 -> 1.15, 0.95 -> 3.85).
+    #[test]
+    fn quantiles_are_numpys_default() {
+        let v: Vec<f64> = (1..=101).map(f64::from).collect();
+        assert_eq!(
+            [quantile(&v, 0.05), quantile(&v, 0.5), quantile(&v, 0.95)],
+            [6.0, 51.0, 96.0]
+        );
+        let w = [1.0, 2.0, 3.0, 4.0];
+        assert!((quantile(&w, 0.05) - 1.15).abs() < 1e-12 && (quantile(&w, 0.95) - 3.85).abs() < 1e-12);
+        assert_eq!(quantile(&[7.0], 0.3), 7.0);
+    }
+
+    #[test]
+    fn histogram_counts_put_every_run_in_one_bin() {
+        let v = [0.0, 0.1, 0.5, 0.99, 1.0];
+        assert_eq!(Histogram::counts(&v, 0.0, 1.0, 2), vec![2, 3]);
     }
 
     #[test]

@@ -156,7 +156,7 @@ fn meta_of(study: &Study, total: usize, mine: &[Case], shard: Option<Shard>) -> 
         solvers: study.solvers.iter().map(|s| s.name().to_string()).collect(),
         grid_levels: match study.sampling {
             Sampling::Grid => study.vary.iter().map(|v| v.grid_values().len()).collect(),
-            Sampling::Lhs { .. } => Vec::new(),
+            Sampling::Lhs { .. } | Sampling::Random { .. } => Vec::new(),
         },
         shard: shard.map(|s| [s.k, s.n]),
         total_cases: total,
@@ -319,6 +319,13 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
         let hold = flexstar_modal::settle::settle_hold_s(e).ok().flatten()?;
         Some((t_rest, hold))
     });
+    // the robot's first frequency where the motion starts (one more modal analysis)
+    let f1_hz = exp.and_then(|e| {
+        flexstar_modal::analysis::start_pose_frequencies(e, 1)
+            .ok()?
+            .first()
+            .copied()
+    });
     solved
         .iter()
         .map(|(solver, (result, wall_s))| {
@@ -338,6 +345,7 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
                 residual_g_m: None,
                 settle_s: None,
                 evp_max_percent: None,
+                f1_hz,
             };
             match result {
                 Ok(r) => {

@@ -59,6 +59,8 @@ impl Vary {
                     pts.into_iter().map(toml::Value::Float).collect()
                 }
             }
+            Levels::Normal { mean, .. } => vec![toml::Value::Float(*mean)],
+            Levels::Uniform { lo, hi } => vec![toml::Value::Float(*lo), toml::Value::Float(*hi)],
             Levels::Logspace { a, b, n } => (0..*n)
                 .map(|k| {
                     if *n == 1 {
@@ -90,10 +92,18 @@ impl Vary {
         }
     }
 
-    /// The value at `u` in [0, 1) of the key's range: uniform for linspace, log-uniform for
-    /// logspace, the `floor(u * len)`-th entry of a values list.
+    /// The value at `u` in [0, 1) of the key's range: uniform for linspace and uniform,
+    /// log-uniform for logspace, the `floor(u * len)`-th entry of a values list, the quantile `u`
+    /// of a normal distribution (statrs' inverse CDF; `u = 0` is moved to the smallest positive
+    /// double, so every draw is finite).
     fn at(&self, u: f64) -> toml::Value {
         match &self.levels {
+            Levels::Normal { mean, sd } => {
+                use statrs::distribution::{ContinuousCDF, Normal};
+                let q = Normal::new(*mean, *sd).map_or(*mean, |n| n.inverse_cdf(u.max(f64::MIN_POSITIVE)));
+                toml::Value::Float(tidy(q))
+            }
+            Levels::Uniform { lo, hi } => toml::Value::Float(tidy(lo + (hi - lo) * u)),
             Levels::Values(v) => v[((u * v.len() as f64) as usize).min(v.len() - 1)].clone(),
             Levels::Linspace { a, b, .. } => toml::Value::Float(tidy(a + (b - a) * u)),
             Levels::Logspace { a, b, .. } => toml::Value::Float(tidy(a * (b / a).powf(u))),
@@ -148,6 +158,14 @@ pub fn latin_hypercube(vary: &[Vary], samples: usize, seed: u64) -> Vec<Vec<toml
         .collect()
 }
 
+/// Monte Carlo draws: `samples` rows, each key's value drawn independently at a uniform `u`.
+pub fn random_draws(vary: &[Vary], samples: usize, seed: u64) -> Vec<Vec<toml::Value>> {
+    let mut rng = SplitMix64(seed);
+    (0..samples)
+        .map(|_| vary.iter().map(|v| v.at(rng.unit())).collect())
+        .collect()
+}
+
 /// Every combination of the grid levels, the first key varying slowest.
 pub fn full_factorial(vary: &[Vary]) -> Vec<Vec<toml::Value>> {
     vary.iter().fold(vec![Vec::new()], |acc, v| {
@@ -179,7 +197,7 @@ impl Study {
     pub fn case_count(&self) -> usize {
         match self.sampling {
             Sampling::Grid => self.vary.iter().map(|v| v.grid_values().len()).product(),
-            Sampling::Lhs { .. } => self.cases().len(),
+            Sampling::Lhs { .. } | Sampling::Random { .. } => self.cases().len(),
         }
     }
 
@@ -216,6 +234,7 @@ impl Study {
         let points = match self.sampling {
             Sampling::Grid => return self.shard_cases(None).collect(),
             Sampling::Lhs { samples, seed } => latin_hypercube(&self.vary, samples, seed),
+            Sampling::Random { samples, seed } => random_draws(&self.vary, samples, seed),
         };
         let keys = self.keys();
         let mut seen = std::collections::HashSet::new();

@@ -52,6 +52,17 @@ pub enum Levels {
     Linspace { a: f64, b: f64, n: usize, integer: bool },
     /// `logspace = [a, b, n]`: n geometrically spaced points from a to b (both > 0).
     Logspace { a: f64, b: f64, n: usize },
+    /// `normal = [mean, sd]`: drawn from a normal distribution (sampled studies only).
+    Normal { mean: f64, sd: f64 },
+    /// `uniform = [lo, hi]`: drawn uniformly from `[lo, hi]` (sampled studies only).
+    Uniform { lo: f64, hi: f64 },
+}
+
+impl Levels {
+    /// A distribution to draw from, rather than levels to list: only a sampled study takes it.
+    pub fn is_distribution(&self) -> bool {
+        matches!(self, Levels::Normal { .. } | Levels::Uniform { .. })
+    }
 }
 
 /// One `[[vary]]` entry.
@@ -68,8 +79,12 @@ pub enum Sampling {
     /// Full factorial: every combination of levels, the first key varying slowest.
     Grid,
     /// Latin hypercube: `samples` points; each key's range (linspace/logspace bounds, uniform or
-    /// log-uniform; or its list of values) is cut into `samples` equal strata, each used once.
+    /// log-uniform; or its list of values; a distribution's probability) is cut into `samples`
+    /// equal strata, each used once.
     Lhs { samples: usize, seed: u64 },
+    /// Monte Carlo: `samples` points, each key drawn independently from its range or
+    /// distribution (a tolerance study as a production line sees it).
+    Random { samples: usize, seed: u64 },
 }
 
 /// A validated study.
@@ -88,6 +103,8 @@ pub struct Study {
     pub base_experiment: Experiment,
     pub solvers: Vec<Solver>,
     pub vary: Vec<Vary>,
+    /// Keys set by formulas of the others (`[[tie]]`), in evaluation order.
+    pub ties: Vec<crate::tie::Tie>,
     pub sampling: Sampling,
     /// The settings of the `fem` solver's runs.
     pub fem_reference: FemReference,
@@ -106,6 +123,8 @@ struct StudyFile {
     #[serde(default = "default_solvers")]
     solvers: Vec<String>,
     vary: Vec<VaryFile>,
+    #[serde(default)]
+    tie: Vec<TieFile>,
     sampling: Option<String>,
     samples: Option<usize>,
     seed: Option<u64>,
@@ -118,11 +137,20 @@ fn default_solvers() -> Vec<String> {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
+struct TieFile {
+    key: String,
+    formula: String,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct VaryFile {
     key: String,
     values: Option<Vec<toml::Value>>,
     linspace: Option<Vec<toml::Value>>,
     logspace: Option<Vec<toml::Value>>,
+    normal: Option<Vec<toml::Value>>,
+    uniform: Option<Vec<toml::Value>>,
 }
 
 impl Study {
@@ -157,6 +185,8 @@ impl Study {
                 message: e.to_string(),
             },
         })?;
+        let vary_list: Vec<Vary> = raw.vary.into_iter().map(|v| vary(path, v)).collect::<Result<_, _>>()?;
+        let ties = ties(path, raw.tie, &vary_list, &base)?;
         let study = Study {
             file: path.to_path_buf(),
             name,
@@ -165,7 +195,8 @@ impl Study {
             base,
             base_experiment,
             solvers: solvers(path, &raw.solvers)?,
-            vary: raw.vary.into_iter().map(|v| vary(path, v)).collect::<Result<_, _>>()?,
+            vary: vary_list,
+            ties,
             sampling: sampling(path, raw.sampling.as_deref(), raw.samples, raw.seed)?,
             fem_reference: fem_reference(path, raw.fem_reference.as_deref())?,
             hash: String::new(),
@@ -194,9 +225,16 @@ impl Study {
             if self.vary[..i].iter().any(|w| w.key == v.key) {
                 return Err(self.vary_error(&v.key, "the key is varied twice"));
             }
+            if v.levels.is_distribution() && self.sampling == Sampling::Grid {
+                return Err(self.vary_error(
+                    &v.key,
+                    "a distribution is drawn from, not listed: set sampling = \"random\" (independent draws) \
+                     or \"lhs\" (stratified), with samples",
+                ));
+            }
         }
         let count = match self.sampling {
-            Sampling::Lhs { samples, .. } => Some(samples),
+            Sampling::Lhs { samples, .. } | Sampling::Random { samples, .. } => Some(samples),
             Sampling::Grid => self
                 .vary
                 .iter()
@@ -234,6 +272,21 @@ impl Study {
                         ),
                     ));
                 }
+            }
+        }
+        for t in &self.ties {
+            // a tied key must be a numeric key of the experiment format: patch a number and parse
+            let doc = patch::case_document(&self.base, std::slice::from_ref(&t.key), &[toml::Value::Float(1.0)])
+                .map_err(|reason| self.vary_error(&t.key, reason))?;
+            let text = toml::to_string(&doc).map_err(|e| self.vary_error(&t.key, e.to_string()))?;
+            if let Err(ModelError::Parse { message, .. }) = Experiment::from_toml_str(&text, &self.base_file) {
+                return Err(self.vary_error(
+                    &t.key,
+                    format!(
+                        "a tied key must be a numeric key of the experiment format: {}",
+                        parse_reason(&message)
+                    ),
+                ));
             }
         }
         Ok(())
@@ -276,7 +329,10 @@ impl Study {
     }
 
     fn experiment_with(&self, keys: &[String], values: &[toml::Value]) -> Result<Experiment, String> {
-        let doc = patch::case_document(&self.base, keys, values)?;
+        let mut doc = patch::case_document(&self.base, keys, values)?;
+        if keys.len() == self.vary.len() {
+            crate::tie::apply(&mut doc, &self.ties)?;
+        }
         let text = toml::to_string(&doc).map_err(|e| e.to_string())?;
         let exp = Experiment::from_toml_str(&text, &self.base_file).map_err(|e| e.to_string())?;
         flexstar_shaping::shape_loaded(exp).map_err(|e| e.to_string())
@@ -364,7 +420,7 @@ fn sampling(
                 return Err(StudyError::invalid(
                     file,
                     if samples.is_some() { "samples" } else { "seed" },
-                    "used with sampling = \"lhs\" only",
+                    "used with sampling = \"lhs\" or \"random\" only",
                 ));
             }
             Ok(Sampling::Grid)
@@ -380,10 +436,21 @@ fn sampling(
                 "sampling = \"lhs\" needs samples >= 1",
             )),
         },
+        "random" => match samples {
+            Some(n) if n >= 1 => Ok(Sampling::Random {
+                samples: n,
+                seed: seed.unwrap_or(1),
+            }),
+            _ => Err(StudyError::invalid(
+                file,
+                "samples",
+                "sampling = \"random\" needs samples >= 1",
+            )),
+        },
         other => Err(StudyError::invalid(
             file,
             "sampling",
-            format!("unknown sampling `{other}`: expected \"grid\" or \"lhs\""),
+            format!("unknown sampling `{other}`: expected \"grid\", \"lhs\" or \"random\""),
         )),
     }
 }
@@ -409,6 +476,40 @@ fn vary(file: &Path, v: VaryFile) -> Result<Vary, StudyError> {
             crate::derived::DERIVED.join(", ")
         )));
     }
+    let given = [
+        v.values.is_some(),
+        v.linspace.is_some(),
+        v.logspace.is_some(),
+        v.normal.is_some(),
+        v.uniform.is_some(),
+    ];
+    if given.iter().filter(|g| **g).count() != 1 {
+        return Err(err(
+            "give exactly one of values, linspace, logspace, normal or uniform".into()
+        ));
+    }
+    if let Some(p) = &v.normal {
+        let [mean, sd] = pair(p).map_err(|m| err(format!("normal = [mean, sd]: {m}")))?;
+        if !(sd > 0.0) {
+            return Err(err(format!("normal = [mean, sd] needs sd > 0, got sd = {sd}")));
+        }
+        return Ok(Vary {
+            key: v.key,
+            levels: Levels::Normal { mean, sd },
+        });
+    }
+    if let Some(p) = &v.uniform {
+        let [lo, hi] = pair(p).map_err(|m| err(format!("uniform = [lo, hi]: {m}")))?;
+        if !(lo < hi) {
+            return Err(err(format!(
+                "uniform = [lo, hi] needs lo < hi, got lo = {lo}, hi = {hi}"
+            )));
+        }
+        return Ok(Vary {
+            key: v.key,
+            levels: Levels::Uniform { lo, hi },
+        });
+    }
     let levels = match (v.values, v.linspace, v.logspace) {
         (Some(values), None, None) => {
             if values.is_empty() {
@@ -433,6 +534,39 @@ fn vary(file: &Path, v: VaryFile) -> Result<Vary, StudyError> {
         _ => return Err(err("give exactly one of values, linspace or logspace".into())),
     };
     Ok(Vary { key: v.key, levels })
+}
+
+/// Two finite numbers.
+fn pair(r: &[toml::Value]) -> Result<[f64; 2], String> {
+    let num = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+    match r {
+        [a, b] => match (num(a), num(b)) {
+            (Some(a), Some(b)) if a.is_finite() && b.is_finite() => Ok([a, b]),
+            _ => Err("two finite numbers expected".into()),
+        },
+        _ => Err(format!("two entries expected, got {}", r.len())),
+    }
+}
+
+/// The `[[tie]]` entries, parsed and ordered (`crate::tie`); the key syntax as for `[[vary]]`.
+fn ties(file: &Path, raw: Vec<TieFile>, vary: &[Vary], base: &toml::Table) -> Result<Vec<crate::tie::Tie>, StudyError> {
+    let err = |key: &str, reason: String| StudyError::VaryKey {
+        file: file.to_path_buf(),
+        key: key.to_string(),
+        reason,
+    };
+    let mut ties = Vec::with_capacity(raw.len());
+    for t in raw {
+        if !(t.key.contains('.') && t.key.split('.').all(|p| !p.is_empty())) || t.key.starts_with("scale.") {
+            return Err(err(
+                &t.key,
+                "a tied key is a dotted experiment key such as robot.Jp".into(),
+            ));
+        }
+        ties.push(crate::tie::Tie::new(&t.key, &t.formula).map_err(|m| err(&t.key, m))?);
+    }
+    let varied: Vec<String> = vary.iter().map(|v| v.key.clone()).collect();
+    crate::tie::ordered(ties, &varied, base).map_err(|(key, reason)| err(&key, reason))
 }
 
 fn range(r: &[toml::Value]) -> Result<(f64, f64, usize), String> {

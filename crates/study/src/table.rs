@@ -21,14 +21,16 @@ pub const METRIC_COLUMNS: [&str; 7] = [
 /// the AMM's own estimate of its truncation error [%], then the residual peak of
 /// |dG| after the motion [m] and the settling time [s, absolute; `inf` when not settled by
 /// `t_end`] (`docs/motions.md` 2.2-2.4), then the largest point EVP of the AMM
-/// against the FEM [%].
-pub const MORE_COLUMNS: [&str; 6] = [
+/// against the FEM [%], then the robot's first elastic frequency at the start pose [Hz] (the
+/// accurate AMM, sliders locked; the same on every row of a case).
+pub const MORE_COLUMNS: [&str; 7] = [
     "residual_tip_m",
     "modes",
     "error_estimate_percent",
     "residual_G_m",
     "settle_s",
     "evp_max_percent",
+    "f1_hz",
 ];
 
 /// Column names that are neither keys nor numbers to plot.
@@ -77,6 +79,8 @@ pub struct Row {
     pub settle_s: Option<f64>,
     /// Largest point EVP [%] of the AMM against the FEM over A, B, C, G (AMM rows).
     pub evp_max_percent: Option<f64>,
+    /// First elastic frequency at the start pose [Hz] (accurate AMM, sliders locked).
+    pub f1_hz: Option<f64>,
 }
 
 fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
@@ -100,6 +104,7 @@ impl Row {
             opt(self.residual_g_m),
             opt(self.settle_s),
             opt(self.evp_max_percent),
+            opt(self.f1_hz),
         ]);
         r
     }

@@ -204,7 +204,7 @@ fn rows_match_direct_solves_and_bad_values_become_rows() {
     let t = Table::read(&out.results).unwrap();
     assert_eq!(
         t.header.join(","),
-        "run_id,robot.Lp,scale.duration,solver,status,peak_tip_m,peak_wG_m,peak_Fa_N,evp_percent,wall_s,residual_tip_m,modes,error_estimate_percent,residual_G_m,settle_s,evp_max_percent"
+        "run_id,robot.Lp,scale.duration,solver,status,peak_tip_m,peak_wG_m,peak_Fa_N,evp_percent,wall_s,residual_tip_m,modes,error_estimate_percent,residual_G_m,settle_s,evp_max_percent,f1_hz"
     );
     assert_eq!(t.rows.len(), 8);
     // Lp = 0.7 > L: a row per solver saying why, the study goes on
@@ -320,4 +320,95 @@ fn the_hash_covers_every_file_a_case_reads() {
     let (_d, p) = setup(&plain);
     let fnv = flexstar_study::hash::hex64(format!("{plain}\0{BASE}").as_bytes());
     assert_eq!(Study::load(&p).unwrap().hash, fnv);
+}
+
+/// A tolerance study (`docs/studies.md`, "Tolerance studies"): random draws from a normal and a
+/// uniform distribution, reproducible from the seed, with the sample moments of the
+/// distributions (mean within 4 standard errors, the sd within 20 % at n = 400); a Latin
+/// hypercube puts one normal draw in each probability stratum (its normal CDF); a tied key
+/// follows its formula in every case's experiment.
+#[test]
+fn tolerance_draws_follow_their_distributions_and_ties_their_formulas() {
+    let top = "sampling = \"random\"\nsamples = 400\nseed = 3\n";
+    let vary = "[[vary]]\nkey = \"robot.Lp\"\nnormal = [0.03, 0.001]\n[[vary]]\nkey = \"robot.mpp_mpa\"\nuniform = [0.1, 0.3]\n\
+                [[tie]]\nkey = \"robot.Jp\"\nformula = \"2e-4 * (robot.Lp / 0.03)^3\"\n";
+    let (_dir, path) = setup(&study_with(top, vary));
+    let study = Study::load(&path).unwrap();
+    assert_eq!(study.sampling, Sampling::Random { samples: 400, seed: 3 });
+    let cases = study.cases();
+    assert_eq!(
+        cases,
+        Study::load(&path).unwrap().cases(),
+        "the same draws from the same seed"
+    );
+    let col = |j: usize| -> Vec<f64> { cases.iter().map(|c| c.values[j].as_float().unwrap()).collect() };
+    let moments = |v: &[f64]| {
+        let n = v.len() as f64;
+        let m = v.iter().sum::<f64>() / n;
+        (m, (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt())
+    };
+    let (m, sd) = moments(&col(0));
+    assert!(
+        (m - 0.03).abs() < 4.0 * 0.001 / 20.0 && (sd / 0.001 - 1.0).abs() < 0.2,
+        "normal: {m} {sd}"
+    );
+    let u = col(1);
+    let (m, sd) = moments(&u);
+    // uniform on [0.1, 0.3]: mean 0.2, sd 0.2 / sqrt(12)
+    assert!(u.iter().all(|x| (0.1..=0.3).contains(x)));
+    assert!(
+        (m - 0.2).abs() < 4.0 * 0.0577 / 20.0 && (sd / 0.0577 - 1.0).abs() < 0.2,
+        "uniform: {m} {sd}"
+    );
+    for c in cases.iter().take(5) {
+        let exp = study.experiment(&c.values).unwrap();
+        let want = 2e-4 * (exp.robot.lp / 0.03f64).powi(3);
+        assert!((exp.robot.jp / want - 1.0).abs() < 1e-10, "{} vs {want}", exp.robot.jp);
+    }
+    // a Latin hypercube of a normal key: one draw per probability stratum, by the normal CDF
+    // (statrs' erf-based CDF, an independent route from the inverse CDF that drew them)
+    let (_dir2, lhs) = setup(&study_with(
+        "sampling = \"lhs\"\nsamples = 50\n",
+        "[[vary]]\nkey = \"robot.L\"\nnormal = [0.5, 0.01]\n",
+    ));
+    let study = Study::load(&lhs).unwrap();
+    use statrs::distribution::{ContinuousCDF, Normal};
+    let n = Normal::new(0.5, 0.01).unwrap();
+    let mut strata: Vec<usize> = study
+        .cases()
+        .iter()
+        .map(|c| (n.cdf(c.values[0].as_float().unwrap()) * 50.0) as usize)
+        .collect();
+    strata.sort();
+    assert_eq!(strata, (0..50).collect::<Vec<_>>());
+}
+
+#[test]
+fn bad_distributions_and_ties_are_refused_naming_the_key() {
+    let grid = load_err(&study_text("[[vary]]\nkey = \"robot.Lp\"\nnormal = [0.03, 0.001]\n"));
+    assert!(grid.contains("robot.Lp") && grid.contains("sampling"), "{grid}");
+    let random = "sampling = \"random\"\nsamples = 4\n";
+    let sd = load_err(&study_with(
+        random,
+        "[[vary]]\nkey = \"robot.Lp\"\nnormal = [0.03, 0.0]\n",
+    ));
+    assert!(sd.contains("robot.Lp") && sd.contains("sd > 0"), "{sd}");
+    let lohi = load_err(&study_with(
+        random,
+        "[[vary]]\nkey = \"robot.Lp\"\nuniform = [0.03, 0.02]\n",
+    ));
+    assert!(lohi.contains("lo < hi"), "{lohi}");
+    let tie = "[[vary]]\nkey = \"robot.Lp\"\nuniform = [0.02, 0.03]\n[[tie]]\nkey = \"robot.Jp\"\nformula = \"robot.Lq * 2\"\n";
+    let unknown = load_err(&study_with(random, tie));
+    assert!(
+        unknown.contains("robot.Jp") && unknown.contains("robot.Lq"),
+        "{unknown}"
+    );
+    let cycle = "[[vary]]\nkey = \"robot.Lp\"\nuniform = [0.02, 0.03]\n[[tie]]\nkey = \"robot.Jp\"\nformula = \"robot.mpp_mpa\"\n\
+                 [[tie]]\nkey = \"robot.mpp_mpa\"\nformula = \"robot.Jp\"\n";
+    assert!(load_err(&study_with(random, cycle)).contains("cycle"));
+    let not_a_key =
+        "[[vary]]\nkey = \"robot.Lp\"\nuniform = [0.02, 0.03]\n[[tie]]\nkey = \"robot.Lq\"\nformula = \"robot.Lp\"\n";
+    let e = load_err(&study_with(random, not_a_key));
+    assert!(e.contains("robot.Lq"), "{e}");
 }

@@ -180,7 +180,7 @@ mod tests {
             modes: Some(n),
             ..AmmSettings::accurate()
         };
-        let modes = ModeSet::new(settings.family, n, &exp.robot).unwrap();
+        let modes = ModeSet::new(settings.family, n, exp.robot).unwrap();
         let (_, g2) = modes.axial_stiffening();
         let all: Vec<usize> = (0..n).collect();
         let fore = Foreshortening::new(&modes, &all, &g2, KEPT_ANALYTIC);

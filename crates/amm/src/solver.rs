@@ -114,7 +114,7 @@ pub(crate) fn validate(
             dt
         }
         None => match settings.mode_count() {
-            ModeCount::Tolerance(tol) => tolerance_step(tol) * robot_step_factor(&problem.robot),
+            ModeCount::Tolerance(tol) => tolerance_step(tol) * robot_step_factor(problem.robot),
             ModeCount::Fixed(_) => DEFAULT_DT,
         }
         .min(problem.time.dt_out),
@@ -146,14 +146,14 @@ pub(crate) fn validate(
     )?;
     if scan {
         check_trajectory(
-            &problem.robot,
-            &problem.trajectory,
+            problem.robot,
+            problem.trajectory,
             problem.time.t_end,
             preflight_step(problem.time.dt_out),
         )?;
     } else {
-        let s0 = problem.trajectory.s(&problem.robot, 0.0)?;
-        check_configuration(&problem.robot, s0).map_err(|violation| Infeasible { t: 0.0, violation })?;
+        let s0 = problem.trajectory.s(problem.robot, 0.0)?;
+        check_configuration(problem.robot, s0).map_err(|violation| Infeasible { t: 0.0, violation })?;
     }
     Ok(dt)
 }
@@ -269,8 +269,8 @@ impl Stats {
 /// Does `checked` cover the scan a run of `problem` would make?
 pub(crate) fn covers(checked: &CheckedMotion, problem: &EqualBeams) -> bool {
     checked.covers(
-        &problem.robot,
-        &problem.trajectory,
+        problem.robot,
+        problem.trajectory,
         problem.time.t_end,
         preflight_step(problem.time.dt_out),
     )
@@ -365,9 +365,9 @@ fn integrate_coarse<F: FnMut(&System, &[f64])>(
 /// The constrained system of N = `n_modes` modes of `settings.family` for the robot of `problem`,
 /// with its payload, damping and load (`docs/amm.md` section 11; nothing added at their defaults).
 pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, problem: &EqualBeams) -> Result<System, AmmError> {
-    let modes = ModeSet::new(settings.family, n_modes, &problem.robot)?;
-    let mut sys = System::new(modes, &problem.robot, settings.model);
-    sys.attach(&problem.payload, &problem.damping, &problem.load);
+    let modes = ModeSet::new(settings.family, n_modes, problem.robot)?;
+    let mut sys = System::new(modes, problem.robot, settings.model);
+    sys.attach(problem.payload, problem.damping, problem.load);
     Ok(sys)
 }
 
@@ -426,7 +426,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let kin =
-        |t: f64| RigidState::at(params, &problem.trajectory, t).map_err(|source| AmmError::Kinematics { t, source });
+        |t: f64| RigidState::at(params, problem.trajectory, t).map_err(|source| AmmError::Kinematics { t, source });
 
     // consistent initial accelerations: M qdd = f + C^T lambda, C qdd = 0 (q = q' = 0)
     let mut st = kin(0.0)?;

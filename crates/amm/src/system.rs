@@ -1053,7 +1053,7 @@ mod tests {
         let sys = sys_copy.unwrap();
         let h = exp.time.t_end / (qs.len() - 1) as f64;
         let (nm, nb, rho) = (sys.nm, sys.nb, sys.rho);
-        let pl = PayloadTerms::new(&exp.payload, 0).unwrap();
+        let pl = PayloadTerms::new(exp.payload, 0).unwrap();
         let mp = pl.mass_matrix();
         // T + V at step n (central velocity), P_d and the load's power on [n, n+1] (midpoint)
         let energy = |n: usize| {

@@ -129,15 +129,14 @@ fn solve_prescribed(
     // the same feasibility scan as the AMM and the kinematics, before any work: a pre-flight check
     // of the requested motion only (the FEM's equations never use the rigid kinematics)
     let step = preflight_step(problem.time.dt_out);
-    if !checked.is_some_and(|c| c.covers(params, &problem.trajectory, problem.time.t_end, step)) {
-        check_trajectory(params, &problem.trajectory, problem.time.t_end, step).map_err(FemError::Scan)?;
+    if !checked.is_some_and(|c| c.covers(params, problem.trajectory, problem.time.t_end, step)) {
+        check_trajectory(params, problem.trajectory, problem.time.t_end, step).map_err(FemError::Scan)?;
     }
-    let rigid = |t: f64| {
-        RigidState::at(params, &problem.trajectory, t).map_err(|source| FemError::PostProcessing { t, source })
-    };
+    let rigid =
+        |t: f64| RigidState::at(params, problem.trajectory, t).map_err(|source| FemError::PostProcessing { t, source });
     let r0 = rigid(0.0)?;
     let (t_out, shape_times) = times(problem, settings);
-    let motion = Motion::Prescribed(&problem.trajectory);
+    let motion = Motion::Prescribed(problem.trajectory);
     let attached = Attached::of(problem, r0.theta.v);
     let hist = integrate(
         params,
@@ -198,7 +197,7 @@ fn solve_direct(
     let started = std::time::Instant::now();
     let params = &problem.robot;
     let run = validate(problem, settings)?;
-    let r0 = RigidState::at(params, &problem.trajectory, 0.0).map_err(FemError::Start)?;
+    let r0 = RigidState::at(params, problem.trajectory, 0.0).map_err(FemError::Start)?;
     let (t_out, shape_times) = times(problem, settings);
     let motion = Motion::Driven {
         law,

@@ -47,7 +47,7 @@ impl Problem {
             time: exp.time,
             trajectory: exp.trajectory.clone(),
             drive: exp.drive.clone(),
-            payload: exp.payload.clone(),
+            payload: exp.payload,
             damping: exp.damping,
             load: exp.load.clone(),
         })

@@ -451,6 +451,29 @@ impl Response {
     }
 }
 
+/// A run's sidecar as the JSON document written (`path` only names errors).
+pub fn sidecar_value(path: &Path, sidecar: &RunSidecar) -> Result<serde_json::Value, ModelError> {
+    sidecar.to_value().map_err(|e| ModelError::Write {
+        file: path.to_path_buf(),
+        reason: e.to_string(),
+    })
+}
+
+/// The text of a sidecar file: the document as pretty JSON with a final newline (the one place
+/// of this format; `path` only names errors).
+pub fn sidecar_text(path: &Path, doc: &serde_json::Value) -> Result<String, ModelError> {
+    let text = serde_json::to_string_pretty(doc).map_err(|e| ModelError::Write {
+        file: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    Ok(text + "\n")
+}
+
+/// Write a sidecar document ([`sidecar_text`]), whole or not at all.
+pub fn write_sidecar_value(path: &Path, doc: &serde_json::Value) -> Result<(), ModelError> {
+    flexstar_io::output::write_string_atomically(path, &sidecar_text(path, doc)?).map_err(ModelError::from)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -619,27 +642,4 @@ mod tests {
         assert_eq!(c.extra[0].values, vec![0.0, -4.0, -8.0, -11.0]);
         assert_eq!(r.every_nth(1), r);
     }
-}
-
-/// A run's sidecar as the JSON document written (`path` only names errors).
-pub fn sidecar_value(path: &Path, sidecar: &RunSidecar) -> Result<serde_json::Value, ModelError> {
-    sidecar.to_value().map_err(|e| ModelError::Write {
-        file: path.to_path_buf(),
-        reason: e.to_string(),
-    })
-}
-
-/// The text of a sidecar file: the document as pretty JSON with a final newline (the one place
-/// of this format; `path` only names errors).
-pub fn sidecar_text(path: &Path, doc: &serde_json::Value) -> Result<String, ModelError> {
-    let text = serde_json::to_string_pretty(doc).map_err(|e| ModelError::Write {
-        file: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
-    Ok(text + "\n")
-}
-
-/// Write a sidecar document ([`sidecar_text`]), whole or not at all.
-pub fn write_sidecar_value(path: &Path, doc: &serde_json::Value) -> Result<(), ModelError> {
-    flexstar_io::output::write_string_atomically(path, &sidecar_text(path, doc)?).map_err(ModelError::from)
 }

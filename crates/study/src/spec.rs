@@ -490,7 +490,7 @@ fn vary(file: &Path, v: VaryFile) -> Result<Vary, StudyError> {
     }
     if let Some(p) = &v.normal {
         let [mean, sd] = pair(p).map_err(|m| err(format!("normal = [mean, sd]: {m}")))?;
-        if !(sd > 0.0) {
+        if sd <= 0.0 {
             return Err(err(format!("normal = [mean, sd] needs sd > 0, got sd = {sd}")));
         }
         return Ok(Vary {
@@ -500,7 +500,7 @@ fn vary(file: &Path, v: VaryFile) -> Result<Vary, StudyError> {
     }
     if let Some(p) = &v.uniform {
         let [lo, hi] = pair(p).map_err(|m| err(format!("uniform = [lo, hi]: {m}")))?;
-        if !(lo < hi) {
+        if lo >= hi {
             return Err(err(format!(
                 "uniform = [lo, hi] needs lo < hi, got lo = {lo}, hi = {hi}"
             )));

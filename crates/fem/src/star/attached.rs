@@ -90,7 +90,7 @@ impl Attached {
     /// orientation `theta0` [rad].
     pub fn of(exp: &EqualBeams, theta0: f64) -> Self {
         Attached {
-            payload: PayloadAtG::new(&exp.payload, theta0),
+            payload: PayloadAtG::new(exp.payload, theta0),
             beta: exp.damping.beta(),
             load: (!exp.load.is_none()).then(|| exp.load.clone()),
         }

@@ -93,6 +93,7 @@ impl Modal {
 /// sliders are free.
 pub fn modal(exp: &Experiment, pose: &RestPose, sliders: Sliders, k: usize) -> Result<Modal, ModalError> {
     crate::check_k(k)?;
+    crate::check_damping(exp)?;
     let amm = amm_pose_model(exp)?.modes_at(pose, sliders, k)?;
     let fem = fem_pose_modes(exp, pose, sliders, k)?;
     if amm.freq_hz.len() < amm.rigid + k {

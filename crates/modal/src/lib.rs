@@ -29,6 +29,19 @@ pub use error::ModalError;
 pub const MAX_K: usize = 50;
 
 /// Check K (`--modes`): 1 <= K <= [`MAX_K`].
+/// A damping whose `zeta` still waits for the first frequency (`Damping::pending`) would act as
+/// none: refused (resolve it first, `flexstar_shaping::shape`).
+pub fn check_damping(exp: &flexstar_model::Experiment) -> Result<(), ModalError> {
+    if exp.damping.pending() {
+        return Err(ModalError::Input(
+            "damping.zeta without f_hz holds at the first frequency at the start pose, not computed yet: \
+             resolve it first (flexstar_shaping::shape)"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
 pub fn check_k(k: usize) -> Result<(), ModalError> {
     if k == 0 || k > MAX_K {
         return Err(ModalError::Input(format!(

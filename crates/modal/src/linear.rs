@@ -331,6 +331,7 @@ pub fn linearize(exp: &Experiment, pose: &RestPose) -> Result<StateSpace, ModalE
 /// The linear model about `pose` with K elastic modes and the sliders held as `settings` says
 /// (module docs: states, inputs and outputs of each case).
 pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettings) -> Result<StateSpace, ModalError> {
+    crate::check_damping(exp)?;
     let modes = amm_modes(exp, pose, settings)?;
     let phi = &modes.shapes;
     let deflections: Vec<Vec<f64>> = deflection_rows(exp, pose, &modes.system)?

@@ -82,7 +82,9 @@ pub struct Damping {
     /// Damping ratio [-] at the frequency `f_hz` (exclusive with `beta`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub zeta: Option<f64>,
-    /// The frequency [Hz] at which `zeta` holds.
+    /// The frequency [Hz] at which `zeta` holds; without it, `zeta` holds at the robot's first
+    /// elastic frequency at the start pose, computed by the explicit step
+    /// `flexstar_shaping::shape` (pending until then, [`Damping::pending`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub f_hz: Option<f64>,
 }
@@ -94,6 +96,12 @@ impl Damping {
             beta: Some(beta),
             ..Damping::default()
         }
+    }
+
+    /// `zeta` is given without `f_hz`: it waits for the first frequency at the start pose
+    /// (`flexstar_shaping::shape`); a problem is not built before.
+    pub fn pending(&self) -> bool {
+        self.beta.is_none() && self.zeta.is_some() && self.f_hz.is_none()
     }
 
     /// beta [s]: as given, or `zeta / (pi f_hz)` (Eq. D5), or 0 (no damping).
@@ -133,9 +141,9 @@ impl Damping {
                 "damping.f_hz",
                 "f_hz goes with zeta (zeta at this frequency), not with beta",
             )),
-            (None, Some(_), None) => Err(ModelError::invalid(
-                "damping.f_hz",
-                "zeta needs the frequency it holds at: give f_hz [Hz] (beta = zeta / (pi f_hz))",
+            (None, Some(z), _) if z >= 1.0 => Err(ModelError::invalid(
+                "damping.zeta",
+                format!("a damping ratio below 1 (critical damping), got {z}"),
             )),
             (None, None, Some(_)) => Err(ModelError::invalid(
                 "damping.zeta",
@@ -339,7 +347,7 @@ s3 = [0.0, 0.0, 0.5]
             ("[payload]\noffset = [0.0, inf]", "payload.offset"),
             ("[damping]\nbeta = -1e-3", "damping.beta"),
             ("[damping]\nbeta = 1e-3\nzeta = 0.01", "damping.zeta"),
-            ("[damping]\nzeta = 0.01", "damping.f_hz"),
+            ("[damping]\nzeta = 1.0", "damping.zeta"),
             ("[damping]\nzeta = 0.01\nf_hz = 0.0", "damping.f_hz"),
             ("[damping]\nzeta = 0.01\nf_hz = inf", "damping.f_hz"),
             ("[damping]\nf_hz = 4.0", "damping.zeta"),

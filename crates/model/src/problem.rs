@@ -34,6 +34,13 @@ impl Problem {
     /// load. A pending `[shaper] f_hz = "auto"` is refused: the motion would run unshaped (apply
     /// it first, `flexstar_shaping::shape`). Errors name the key; the file is added by the loader.
     pub fn new(exp: &Experiment) -> Result<Self, ModelError> {
+        if exp.damping.pending() {
+            return Err(ModelError::invalid(
+                "damping.f_hz",
+                "zeta without f_hz holds at the first frequency at the start pose, not computed yet: resolve it \
+                 first (flexstar_shaping::shape)",
+            ));
+        }
         if exp.shaper_pending() {
             return Err(ModelError::invalid(
                 "shaper.f_hz",

@@ -5,8 +5,12 @@
 //! a `[shaper]` with given frequencies is pure arithmetic and is applied when the file is read
 //! (`flexstar_model::Experiment::apply_shaper`), while `f_hz = "auto"` needs the accurate AMM and
 //! its modes at the final pose, so a loaded experiment keeps it pending
-//! (`Experiment::shaper_pending`) until a front calls [`shape`]. The solvers' dispatch
-//! (`flexstar_solve::solve`) refuses an experiment whose shaper is still pending.
+//! (`Experiment::shaper_pending`) until a front calls [`shape`]. A problem is not built from an
+//! experiment whose shaper is still pending (`flexstar_model::Problem::new`).
+//!
+//! The same step first resolves the other value that needs the robot's modes: a `[damping] zeta`
+//! given without `f_hz` holds at the first elastic frequency at the start pose
+//! ([`resolve_damping`], `docs/usage.md`, damping), which the automatic shaper then designs with.
 
 mod auto;
 
@@ -17,6 +21,7 @@ use flexstar_model::{Experiment, ModelError};
 /// shaped motion. A no-op without `[shaper]` or when the motion is already shaped (given
 /// frequencies are applied when the file is read).
 pub fn shape(exp: &mut Experiment) -> Result<(), ModelError> {
+    resolve_damping(exp)?;
     if !exp.shaper_pending() {
         return exp.apply_shaper();
     }
@@ -24,6 +29,25 @@ pub fn shape(exp: &mut Experiment) -> Result<(), ModelError> {
     exp.apply_auto_shaper(choice)?;
     // the shaped motion rests later: `time.t_end` must still cover it (as for given frequencies)
     exp.validate()
+}
+
+/// `[damping] zeta` without `f_hz`: set `f_hz` to the robot's first elastic frequency at the start
+/// pose of its motion (the accurate AMM, sliders locked, the payload at G:
+/// `flexstar_modal::analysis::start_pose_frequencies`), so that the first mode has the damping
+/// ratio zeta (Eq. D5); the sidecar's resolved experiment records the frequency. A no-op
+/// otherwise. Errors under the key `damping.zeta`.
+pub fn resolve_damping(exp: &mut Experiment) -> Result<(), ModelError> {
+    if !exp.damping.pending() {
+        return Ok(());
+    }
+    let f1 = flexstar_modal::analysis::start_pose_frequencies(exp, 1)
+        .map_err(|e| ModelError::invalid("damping.zeta", format!("the first frequency at the start pose: {e}")))?
+        .first()
+        .copied()
+        .filter(|f| *f > 0.0)
+        .ok_or_else(|| ModelError::invalid("damping.zeta", "no elastic mode at the start pose"))?;
+    exp.damping.f_hz = Some(f1);
+    Ok(())
 }
 
 /// [`shape`] of an experiment read from a file: a refusal names the file (as the loader's do).

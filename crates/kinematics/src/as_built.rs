@@ -10,15 +10,7 @@
 use flexstar_model::geometry::Scalar;
 use flexstar_model::Robot;
 
-use crate::direct::RigidPose;
-
-fn sub<D: Scalar>(a: [D; 2], b: [D; 2]) -> [D; 2] {
-    [a[0] - b[0], a[1] - b[1]]
-}
-
-fn cross<D: Scalar>(a: [D; 2], b: [D; 2]) -> D {
-    a[0] * b[1] - a[1] * b[0]
-}
+use crate::direct::{cross, pose_on_lines, sub, RigidPose};
 
 /// Interior angle of the triangle `p` at vertex k [rad].
 fn angle_at(p: &[[f64; 2]; 3], k: usize) -> f64 {
@@ -55,19 +47,10 @@ pub fn direct_pose<D: Scalar>(robot: &Robot, s: [D; 3]) -> Option<RigidPose<D>> 
         return None;
     }
     let sigma = area2.signum();
-    // Eq. D2: G on the lines P_0 A_0 and P_1 A_1
+    // Eq. D2: G on the lines P_0 A_0 and P_1 A_1; Eq. D3: theta (phi_1 = 0) and xp
     let d0 = sub(apex(&p, 0, gaps, sigma), p[0]);
     let d1 = sub(apex(&p, 1, gaps, sigma), p[1]);
-    let tpar = cross(sub(p[1], p[0]), d1) / cross(d0, d1);
-    let g = [p[0][0] + d0[0] * tpar, p[0][1] + d0[1] * tpar];
-    // Eq. D3: e_x1 = (P_1 - G)/|P_1 - G| = [sin th, -cos th] (phi_1 = 0)
-    let g1 = sub(p[0], g);
-    let theta = g1[0].atan2(-g1[1]);
-    let xp = p.map(|q| {
-        let r = sub(q, g);
-        (r[0] * r[0] + r[1] * r[1]).sqrt()
-    });
-    Some(RigidPose { p, g, theta, xp })
+    Some(pose_on_lines(p, d0, d1))
 }
 
 #[cfg(test)]

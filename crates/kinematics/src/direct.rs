@@ -39,11 +39,11 @@ pub fn largest_angle(p: &[[f64; 2]; 3]) -> (f64, usize) {
     best
 }
 
-fn sub<D: Scalar>(a: [D; 2], b: [D; 2]) -> [D; 2] {
+pub(crate) fn sub<D: Scalar>(a: [D; 2], b: [D; 2]) -> [D; 2] {
     [a[0] - b[0], a[1] - b[1]]
 }
 
-fn cross<D: Scalar>(a: [D; 2], b: [D; 2]) -> D {
+pub(crate) fn cross<D: Scalar>(a: [D; 2], b: [D; 2]) -> D {
     a[0] * b[1] - a[1] * b[0]
 }
 
@@ -75,19 +75,22 @@ pub fn direct_kinematics<D: Scalar>(d: f64, s: [D; 3]) -> Option<RigidPose<D>> {
     // Simpson lines: I -> apex on JK, J -> apex on KI; they meet at the Fermat point.
     let a_jk = outward_apex(p[1], p[2], ccw);
     let a_ki = outward_apex(p[2], p[0], ccw);
-    let d1 = sub(a_jk, p[0]);
-    let d2 = sub(a_ki, p[1]);
-    let den = cross(d1, d2);
-    let tpar = cross(sub(p[1], p[0]), d2) / den;
-    let g = [p[0][0] + d1[0] * tpar, p[0][1] + d1[1] * tpar];
+    Some(pose_on_lines(p, sub(a_jk, p[0]), sub(a_ki, p[1])))
+}
+
+/// The pose whose centre G is where the line from revolute point I along `d0` meets the line from
+/// J along `d1` (two Simpson lines, or the apex lines of `crate::as_built`): G, theta from
+/// `e_x1 = (I - G)/|I - G| = [sin th, -cos th]` (Eq. 9) and `xp_i = |P_i - G|` (Eq. 10).
+pub(crate) fn pose_on_lines<D: Scalar>(p: [[D; 2]; 3], d0: [D; 2], d1: [D; 2]) -> RigidPose<D> {
+    let tpar = cross(sub(p[1], p[0]), d1) / cross(d0, d1);
+    let g = [p[0][0] + d0[0] * tpar, p[0][1] + d0[1] * tpar];
     let gi = sub(p[0], g);
-    // e_x1 = [sin th, -cos th] = (I - G)/|I - G|  =>  th = atan2(dx, -dy)  (Eq. 9)
     let theta = gi[0].atan2(-gi[1]);
     let xp = p.map(|q| {
         let r = sub(q, g);
         (r[0] * r[0] + r[1] * r[1]).sqrt()
     });
-    Some(RigidPose { p, g, theta, xp })
+    RigidPose { p, g, theta, xp }
 }
 
 #[cfg(test)]

@@ -70,35 +70,50 @@ pub fn e_w<D: Scalar>(i: usize, theta: D) -> [D; 2] {
 pub fn inverse_kinematics<D: Scalar>(params: &RobotParams, g: [D; 2], theta: D) -> Result<[D; 3], ModelError> {
     let mut s = [D::zero(); 3];
     for (i, si) in s.iter_mut().enumerate() {
-        let ex = e_x(i, theta);
-        let u = slider_direction(i);
-        let o = revolute_origin(i, params.d);
-        // r e_x - s u = o - g, solved by Cramer's rule.
-        let bx = -g[0] + o[0];
-        let by = -g[1] + o[1];
-        let det = ex[1] * u[0] - ex[0] * u[1];
-        if det.re().abs() < 1e-12 {
-            return Err(ModelError::InverseKinematics(format!(
-                "beam {} is parallel to slider {} at theta = {} rad",
-                i + 1,
-                i + 1,
-                theta.re()
-            )));
-        }
-        let r = (by * u[0] - bx * u[1]) / det;
-        if r.re() <= 0.0 {
-            return Err(ModelError::InverseKinematics(format!(
-                "beam {} points away from slider {} (G = ({}, {}), theta = {})",
-                i + 1,
-                i + 1,
-                g[0].re(),
-                g[1].re(),
-                theta.re()
-            )));
-        }
-        *si = (ex[0] * by - ex[1] * bx) / det;
+        *si = axis_coordinate(
+            i,
+            e_x(i, theta),
+            (revolute_origin(i, params.d), slider_direction(i)),
+            g,
+            theta,
+        )?;
     }
     Ok(s)
+}
+
+/// The coordinate s where beam i's rigid axis `g + r ex` (r > 0) meets slider line i, `o + s u`
+/// (`axis = (o, u)`): `r ex - s u = o - g`, solved by Cramer's rule. Fails when the beam is parallel
+/// to its slider or points away from it (`theta` [rad] only names the pose in the message).
+pub(crate) fn axis_coordinate<D: Scalar>(
+    i: usize,
+    ex: [D; 2],
+    (o, u): ([f64; 2], [f64; 2]),
+    g: [D; 2],
+    theta: D,
+) -> Result<D, ModelError> {
+    let bx = -g[0] + o[0];
+    let by = -g[1] + o[1];
+    let det = ex[1] * u[0] - ex[0] * u[1];
+    if det.re().abs() < 1e-12 {
+        return Err(ModelError::InverseKinematics(format!(
+            "beam {} is parallel to slider {} at theta = {} rad",
+            i + 1,
+            i + 1,
+            theta.re()
+        )));
+    }
+    let r = (by * u[0] - bx * u[1]) / det;
+    if r.re() <= 0.0 {
+        return Err(ModelError::InverseKinematics(format!(
+            "beam {} points away from slider {} (G = ({}, {}), theta = {})",
+            i + 1,
+            i + 1,
+            g[0].re(),
+            g[1].re(),
+            theta.re()
+        )));
+    }
+    Ok((ex[0] * by - ex[1] * bx) / det)
 }
 
 #[cfg(test)]

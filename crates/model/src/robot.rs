@@ -193,31 +193,8 @@ impl Robot {
     pub fn inverse_kinematics<D: Scalar>(&self, g: [D; 2], theta: D) -> Result<[D; 3], ModelError> {
         let mut s = [D::zero(); 3];
         for (i, si) in s.iter_mut().enumerate() {
-            let ex = self.e_x(i, theta);
-            let (u, o) = (self.axes[i].direction, self.axes[i].origin);
-            // r e_x - s u = o - g, by Cramer's rule
-            let (bx, by) = (-g[0] + o[0], -g[1] + o[1]);
-            let det = ex[1] * u[0] - ex[0] * u[1];
-            if det.re().abs() < 1e-12 {
-                return Err(ModelError::InverseKinematics(format!(
-                    "beam {} is parallel to slider {} at theta = {} rad",
-                    i + 1,
-                    i + 1,
-                    theta.re()
-                )));
-            }
-            let r = (by * u[0] - bx * u[1]) / det;
-            if r.re() <= 0.0 {
-                return Err(ModelError::InverseKinematics(format!(
-                    "beam {} points away from slider {} (G = ({}, {}), theta = {})",
-                    i + 1,
-                    i + 1,
-                    g[0].re(),
-                    g[1].re(),
-                    theta.re()
-                )));
-            }
-            *si = (ex[0] * by - ex[1] * bx) / det;
+            let axis = (self.axes[i].origin, self.axes[i].direction);
+            *si = crate::geometry::axis_coordinate(i, self.e_x(i, theta), axis, g, theta)?;
         }
         Ok(s)
     }

@@ -88,13 +88,7 @@ impl Histogram {
         {
             let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
             root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
-            let mut chart = ChartBuilder::on(&root)
-                .caption(&self.title, ("sans-serif", 15))
-                .margin(10)
-                .x_label_area_size(40)
-                .y_label_area_size(50)
-                .build_cartesian_2d(lo..hi, 0.0..top as f64 * 1.1)
-                .map_err(|x| e(x.to_string()))?;
+            let mut chart = cartesian(&root, &self.title, 50, lo..hi, 0.0..top as f64 * 1.1).map_err(&e)?;
             chart
                 .configure_mesh()
                 .x_desc(self.x_label.as_str())
@@ -118,18 +112,45 @@ impl Histogram {
                     .label(label.as_str())
                     .legend(move |(x, y)| Rectangle::new([(x + 2, y - 4), (x + 12, y + 4)], color.filled()));
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(180, 180, 180))
-                .label_font(("sans-serif", 12))
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(|x| e(x.to_string()))?;
+            legend(&mut chart).map_err(&e)?;
             root.present().map_err(|x| e(x.to_string()))?;
         }
         Ok(svg)
     }
+}
+
+/// A titled chart of the ranges `x` by `y` on `root`, with `y_area` pixels for the y labels.
+fn cartesian<'a, DB: DrawingBackend + 'a>(
+    root: &'a DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    y_area: u32,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+) -> Result<
+    ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>,
+    String,
+> {
+    ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 15))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(y_area)
+        .build_cartesian_2d(x, y)
+        .map_err(|x| x.to_string())
+}
+
+/// The legend of a chart's labelled series, upper right, on a white box.
+fn legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(180, 180, 180))
+        .label_font(("sans-serif", 12))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(|x| x.to_string())
 }
 
 const W: u32 = 560;
@@ -181,13 +202,7 @@ impl Scatter {
         {
             let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
             root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
-            let mut chart = ChartBuilder::on(&root)
-                .caption(&self.title, ("sans-serif", 15))
-                .margin(10)
-                .x_label_area_size(40)
-                .y_label_area_size(70)
-                .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
-                .map_err(|x| e(x.to_string()))?;
+            let mut chart = cartesian(&root, &self.title, 70, xr.0..xr.1, yr.0..yr.1).map_err(&e)?;
             chart
                 .configure_mesh()
                 .x_desc(self.x_label.as_str())
@@ -213,14 +228,7 @@ impl Scatter {
                     .label(set.label.as_str())
                     .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(180, 180, 180))
-                .label_font(("sans-serif", 12))
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(|x| e(x.to_string()))?;
+            legend(&mut chart).map_err(&e)?;
             root.present().map_err(|x| e(x.to_string()))?;
         }
         Ok(svg)

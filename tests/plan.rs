@@ -163,6 +163,17 @@ fn the_time_objective_beats_the_zvd_shaped_quintic_by_thirty_percent() {
         planned_rest <= 0.7 * zvd_rest,
         "planned {planned_rest} s vs ZVD {zvd_rest} s"
     );
+    // the record of the search: the AMM runs of every duration tried, and the chosen one's trace
+    let planner = &json(&dir.join("plan.json"))["planner"];
+    let total = planner["evaluations"].as_u64().unwrap();
+    let trace = planner["trace"].as_array().unwrap();
+    let last = trace.last().expect("the chosen duration's search")["evaluations"]
+        .as_u64()
+        .unwrap();
+    assert!(
+        total > 0 && last > 0 && last <= total,
+        "{total} evaluations, the chosen search {last}"
+    );
 }
 
 /// Bad input is refused before any work with the file and the key, and nothing is written.

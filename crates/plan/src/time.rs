@@ -128,8 +128,8 @@ fn zvd_baseline(
 
 /// The outcome of one step of the planned bisection.
 enum Trial {
-    /// The search ran: variables, evaluation, peak over the whole span, why it stopped.
-    Done(Vec<f64>, Eval, f64, String),
+    /// The search ran (its solution, the peak over the whole span).
+    Done(Searched),
     /// The start is rejected (infeasible, limits) or the search failed.
     Failed,
     /// The budget ran out during the search: the step says nothing.
@@ -140,20 +140,22 @@ enum Trial {
 /// the whole span.
 fn try_duration(cfg: &PlanConfig, s: &Setup, t_move: f64, x0: &[f64], r_max: f64) -> Trial {
     match search_at(cfg, s, t_move, x0, r_max) {
-        Some((_, _, peak, reason)) if peak > r_max && reason.contains("budget") => Trial::OutOfTime,
-        Some((x, e, peak, reason)) => Trial::Done(x, e, peak, reason),
+        Some(sr) if sr.peak > r_max && sr.sol.reason.contains("budget") => Trial::OutOfTime,
+        Some(sr) => Trial::Done(sr),
         None => Trial::Failed,
     }
 }
 
+/// One LM search at a duration: its solution (variables, evaluation, trace, evaluations, why it
+/// stopped) and the residual peak over the whole span [m].
+#[derive(Debug, Clone)]
+struct Searched {
+    sol: crate::lm::Solution,
+    peak: f64,
+}
+
 /// The search of [`try_duration`]; `None` when the start is rejected or a run fails.
-fn search_at(
-    cfg: &PlanConfig,
-    s: &Setup,
-    t_move: f64,
-    x0: &[f64],
-    r_max: f64,
-) -> Option<(Vec<f64>, Eval, f64, String)> {
+fn search_at(cfg: &PlanConfig, s: &Setup, t_move: f64, x0: &[f64], r_max: f64) -> Option<Searched> {
     let ev = s.evaluator.with_limits(cfg.limits);
     let e0 = evaluate(&ev, &s.family, x0, t_move).ok()?;
     let deadline = s.started + Duration::from_secs_f64(cfg.plan.budget());
@@ -168,11 +170,11 @@ fn search_at(
     let traj = s.family.trajectory(&sol.x, t_move);
     let run = s.evaluator.run(&traj, cfg.exp.time.t_end).ok()?;
     let peak = window_peak(&run, cfg.plan.t0 + t_move);
-    Some((sol.x, sol.eval, peak, sol.reason))
+    Some(Searched { sol, peak })
 }
 
 /// A success of the planned bisection: duration and the search's outcome.
-type Success = (f64, (Vec<f64>, Eval, f64, String));
+type Success = (f64, Searched);
 
 /// Bisection of the planned duration in `(lo, hi)`: the midpoints first (the baseline's
 /// duration `hi` is tried last, only if no shorter one succeeded); a step cut by the budget ends
@@ -182,8 +184,9 @@ fn bisect_planned(
     s: &Setup,
     (mut lo, mut hi): (f64, f64),
     r_max: f64,
-) -> (Vec<TimeStep>, Vec<Success>) {
+) -> (Vec<TimeStep>, Vec<Success>, usize) {
     let top = hi;
+    let mut evaluations = 0;
     let mut steps = Vec::new();
     let mut x = s.family.plain();
     let mut best: Vec<Success> = Vec::new();
@@ -196,22 +199,26 @@ fn bisect_planned(
         } else {
             0.5 * (lo + hi)
         };
-        match try_duration(cfg, s, t, &x, r_max) {
+        let trial = try_duration(cfg, s, t, &x, r_max);
+        if let Trial::Done(sr) = &trial {
+            evaluations += sr.sol.evaluations;
+        }
+        match trial {
             Trial::OutOfTime => break,
-            Trial::Done(xs, e, peak, reason) if peak <= r_max => {
+            Trial::Done(sr) if sr.peak <= r_max => {
                 steps.push(TimeStep {
                     t_move: t,
-                    peak_m: peak,
+                    peak_m: sr.peak,
                     ok: true,
                 });
                 hi = t;
-                x = xs.clone();
-                best.push((t, (xs, e, peak, reason)));
+                x = sr.sol.x.clone();
+                best.push((t, sr));
             }
-            Trial::Done(_, _, peak, _) => {
+            Trial::Done(sr) => {
                 steps.push(TimeStep {
                     t_move: t,
-                    peak_m: peak,
+                    peak_m: sr.peak,
                     ok: false,
                 });
                 lo = t;
@@ -226,7 +233,7 @@ fn bisect_planned(
             }
         }
     }
-    (steps, best)
+    (steps, best, evaluations)
 }
 
 /// The shortest success whose residual peak holds on the FEM too (the model the plan trusts,
@@ -242,7 +249,7 @@ fn fem_verified(
     let mut checks = Vec::new();
     for cand in &successes {
         let mut exp = cfg.exp.clone();
-        exp.trajectory = s.family.trajectory(&cand.1 .0, cand.0);
+        exp.trajectory = s.family.trajectory(&cand.1.sol.x, cand.0);
         let problem = crate::planner::problem_of(&exp)?;
         let r = flexstar_fem::solve(&problem, &exp.fem, flexstar_drive::SolveRequest::motion())
             .map(|s| s.response)
@@ -260,9 +267,9 @@ fn fem_verified(
     let mut longest = successes
         .pop()
         .ok_or_else(|| PlanError::Solver("no planned motion".into()))?;
-    longest.1 .3 = format!(
+    longest.1.sol.reason = format!(
         "{}; the FEM's residual exceeds residual_max at every duration tried",
-        longest.1 .3
+        longest.1.sol.reason
     );
     Ok((longest, checks))
 }
@@ -274,14 +281,17 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
     let t_lim = shortest_move(travel, &cfg.limits).0;
     let (zvd_base, zvd_dur, zvd_peak_m, zvd_steps) = zvd_baseline(cfg, s, r_max, t_lim)?;
     let zvd_found_s = s.started.elapsed().as_secs_f64();
-    let (steps, successes) = bisect_planned(cfg, s, (t_lim.max(0.25 * zvd_dur), zvd_dur), r_max);
+    let (steps, successes, evaluations) = bisect_planned(cfg, s, (t_lim.max(0.25 * zvd_dur), zvd_dur), r_max);
     if successes.is_empty() {
         return Err(PlanError::Solver(format!(
             "no planned motion as long as the ZVD-shaped quintic ({zvd_dur:.3} s) reached residual_max = {r_max} m"
         )));
     }
     let (chosen, fem_checks) = fem_verified(cfg, s, successes, r_max)?;
-    let (t_move, (x, eval, _, reason)) = chosen;
+    let (t_move, Searched { sol, .. }) = chosen;
+    let crate::lm::Solution {
+        x, eval, trace, reason, ..
+    } = sol;
     let plain = evaluate(&s.evaluator, &s.family, &s.family.plain(), t_move)
         .map_err(|e| PlanError::Solver(format!("the plain quintic: {e}")))?;
     Ok(Planned {
@@ -298,8 +308,8 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
         f1_hz: s.f1_hz,
         window_s: s.evaluator.window,
         r_floor_m: TIME_FLOOR_SHARE * r_max,
-        trace: Vec::new(),
-        evaluations: 0,
+        trace,
+        evaluations,
         reason,
         wall_s: s.started.elapsed().as_secs_f64(),
         zvd: zvd_experiment(&cfg.exp, s.family.quintic(zvd_base))?,

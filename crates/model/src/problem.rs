@@ -18,8 +18,6 @@ use crate::trajectory::Trajectory;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Problem {
     robot: Robot,
-    /// The robot in the paper's form when it is the paper's robot (see [`Robot::equal_beams`]).
-    params: Option<RobotParams>,
     time: TimeSpan,
     trajectory: Trajectory,
     drive: DriveSettings,
@@ -49,7 +47,6 @@ impl Problem {
         }
         let robot = check_physics(exp)?;
         Ok(Problem {
-            params: robot.equal_beams().ok().copied(),
             robot,
             time: exp.time,
             trajectory: exp.trajectory.clone(),
@@ -69,10 +66,7 @@ impl Problem {
     /// paper's form. This is the explicit check of [`Robot::equal_beams`]; its error names the
     /// datum that makes the robot other than the paper's.
     pub fn equal_beams(&self) -> Result<EqualBeams<'_>, ModelError> {
-        let robot = match &self.params {
-            Some(p) => p,
-            None => self.robot.equal_beams()?,
-        };
+        let robot = self.robot.equal_beams()?;
         Ok(EqualBeams {
             robot,
             time: self.time,
@@ -88,16 +82,11 @@ impl Problem {
     /// start, the servo's slider mass) are run again where they can be: on a robot in the paper's
     /// form; a robot of another form is refused by the solvers anyway ([`Problem::equal_beams`]).
     pub fn with_robot(&self, robot: Robot) -> Result<Self, ModelError> {
-        let params = robot.equal_beams().ok().copied();
-        if let Some(p) = &params {
+        if let Ok(p) = robot.equal_beams() {
             self.trajectory.validate(p)?;
             self.drive.validate(self.time.t_end, p.mpp_mpa)?;
         }
-        Ok(Problem {
-            robot,
-            params,
-            ..self.clone()
-        })
+        Ok(Problem { robot, ..self.clone() })
     }
 
     /// Simulated span and output step.

@@ -99,8 +99,8 @@ pub struct Robot {
     beams: [Beam; 3],
     axes: [ActuatorAxis; 3],
     /// The paper-form parameters when the data is the paper's robot (equal beams, 120-degree
-    /// welds, equilateral base), found by [`Robot::check_equal`].
-    equal: Option<RobotParams>,
+    /// welds, equilateral base), else the first datum that differs ([`paper_form`]).
+    equal: Result<RobotParams, String>,
 }
 
 impl Robot {
@@ -120,7 +120,7 @@ impl Robot {
             }
         }
         check_welds(&beams)?;
-        let equal = Self::check_equal(&beams, &axes);
+        let equal = paper_form(&beams, &axes);
         Ok(Robot { beams, axes, equal })
     }
 
@@ -145,8 +145,8 @@ impl Robot {
         )?;
         // the check found the paper's robot; keep the caller's own form of it (`EA` given or
         // defaulted), so that it compares equal with the parameters it came from
-        if robot.equal.is_some() {
-            robot.equal = Some(*params);
+        if robot.equal.is_ok() {
+            robot.equal = Ok(*params);
         }
         Ok(robot)
     }
@@ -203,57 +203,48 @@ impl Robot {
     /// 0, 120 and 240 degrees on an equilateral base centred at O. Otherwise the error says which
     /// datum differs: the solvers' equal-beam models refuse such a robot with it.
     pub fn equal_beams(&self) -> Result<&RobotParams, ModelError> {
-        self.equal.as_ref().ok_or_else(|| ModelError::Unsupported {
-            what: self.first_difference(),
-        })
+        self.equal
+            .as_ref()
+            .map_err(|what| ModelError::Unsupported { what: what.clone() })
     }
+}
 
-    /// Is the data the paper's robot? Its parameters when it is (with `EA` as given).
-    fn check_equal(beams: &[Beam; 3], axes: &[ActuatorAxis; 3]) -> Option<RobotParams> {
-        let b = beams[0];
-        let d = -axes[0].origin[1];
-        let same_beams = beams.iter().all(|x| {
-            Beam {
-                weld_angle: b.weld_angle,
-                ..*x
-            } == b
-        });
-        let welds = (0..3).all(|i| close(beams[i].weld_angle, beam_offset(i)));
-        let base = d > 0.0 && (0..3).all(|i| close_axis(&axes[i], &ActuatorAxis::paper(i, d)));
-        (same_beams && welds && base).then_some(RobotParams {
-            e: b.youngs_modulus,
-            i: b.second_moment,
-            rho: b.mass_per_length,
-            l: b.length,
-            d,
-            lp: b.sleeve_length,
-            mpp_mpa: b.sleeve_mass,
-            jp: b.sleeve_inertia,
-            ea: Some(b.axial_stiffness),
-        })
+/// Is the data the paper's robot? Its parameters when it is (with `EA` as given), else which
+/// datum differs: a beam other than beam 1, a weld angle, or the base.
+fn paper_form(beams: &[Beam; 3], axes: &[ActuatorAxis; 3]) -> Result<RobotParams, String> {
+    let b = beams[0];
+    let other = |x: &Beam| {
+        Beam {
+            weld_angle: b.weld_angle,
+            ..*x
+        } != b
+    };
+    if let Some(i) = (1..3).find(|&i| other(&beams[i])) {
+        return Err(format!("beam {} differs from beam 1", i + 1));
     }
-
-    /// Which datum makes this robot other than the paper's (for [`Robot::equal_beams`]).
-    fn first_difference(&self) -> String {
-        let b = self.beams[0];
-        if let Some(i) = (1..3).find(|&i| {
-            Beam {
-                weld_angle: b.weld_angle,
-                ..self.beams[i]
-            } != b
-        }) {
-            return format!("beam {} differs from beam 1", i + 1);
-        }
-        if let Some(i) = (0..3).find(|&i| !close(self.beams[i].weld_angle, beam_offset(i))) {
-            return format!(
-                "beam {} is welded at {} degrees, not {}",
-                i + 1,
-                self.beams[i].weld_angle.to_degrees(),
-                beam_offset(i).to_degrees()
-            );
-        }
-        "the base is not the equilateral triangle centred at O".to_string()
+    if let Some(i) = (0..3).find(|&i| !close(beams[i].weld_angle, beam_offset(i))) {
+        return Err(format!(
+            "beam {} is welded at {} degrees, not {}",
+            i + 1,
+            beams[i].weld_angle.to_degrees(),
+            beam_offset(i).to_degrees()
+        ));
     }
+    let d = -axes[0].origin[1];
+    if !(d > 0.0 && (0..3).all(|i| close_axis(&axes[i], &ActuatorAxis::paper(i, d)))) {
+        return Err("the base is not the equilateral triangle centred at O".to_string());
+    }
+    Ok(RobotParams {
+        e: b.youngs_modulus,
+        i: b.second_moment,
+        rho: b.mass_per_length,
+        l: b.length,
+        d,
+        lp: b.sleeve_length,
+        mpp_mpa: b.sleeve_mass,
+        jp: b.sleeve_inertia,
+        ea: Some(b.axial_stiffness),
+    })
 }
 
 /// Equal to rounding: angles and lengths built by different sums of the same numbers.

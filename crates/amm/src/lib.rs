@@ -31,6 +31,8 @@ mod geometric;
 pub mod modes;
 pub mod pose_modes;
 mod record;
+#[cfg(test)]
+mod rayleigh_decay;
 mod sleeve;
 pub mod solver;
 mod system;

@@ -95,11 +95,46 @@ impl PoseSystem {
         [force(0), force(1), psi]
     }
 
-    /// The damping matrix at rest [N s/m] (n x n, row-major) of Kelvin-Voigt damping of
-    /// retardation time `beta` [s]: `beta rho lambda_j` on the alpha coordinates (Eq. D2), i.e.
-    /// `beta K` (the beams' elastic stiffness is the only stiffness at rest).
-    pub fn damping_matrix(&self, beta: f64) -> Vec<f64> {
-        self.k.iter().map(|k| beta * k).collect()
+    /// The damping matrix at rest [N s/m] (n x n, row-major) of Rayleigh damping of
+    /// coefficients `alpha` [1/s] and `beta` [s] (Eqs. D2, D19 at a pose): `beta K` (`beta rho
+    /// lambda_j` on the alpha coordinates; the beams' elastic stiffness is the only stiffness at
+    /// rest) plus `alpha E^T M_e E`, `M_e` M's block of the elastic coordinates (alpha, u, thp of
+    /// each beam, the payload on beam 1's) and `E q'` their velocity relative to the rigid robot.
+    /// Sliders locked: `E = I`. Sliders free: the coordinates are measured from the pose, so a
+    /// rigid motion `ds` of the sliders moves them by `T ds`, and `E = [I, -T]`; T comes from the
+    /// `rigid` shapes (the zero-frequency modes, [`PoseModel::modes_at`]): `T = R_e R_s^-1` of
+    /// their elastic and slider parts. The rigid modes are then not damped.
+    pub fn damping_matrix(&self, alpha: f64, beta: f64, rigid: &[Vec<f64>]) -> Vec<f64> {
+        let (n, ne) = (self.n, 3 * (self.nm + 2));
+        let mut c: Vec<f64> = self.k.iter().map(|k| beta * k).collect();
+        if alpha == 0.0 {
+            return c;
+        }
+        // E (ne x n), row-major: the elastic velocity relative to the rigid robot
+        let mut e = vec![0.0; ne * n];
+        (0..ne).for_each(|a| e[a * n + a] = 1.0);
+        if self.sliders == Sliders::Free && rigid.len() == 3 {
+            let rs = nalgebra::Matrix3::from_fn(|r, k| rigid[k][ne + r]);
+            if let Some(inv) = rs.try_inverse() {
+                for a in 0..ne {
+                    for s in 0..3 {
+                        e[a * n + ne + s] = -(0..3).map(|k| rigid[k][a] * inv[(k, s)]).sum::<f64>();
+                    }
+                }
+            }
+        }
+        // alpha E^T M_e E
+        let me = |a: usize, b: usize| self.m[a * n + b];
+        let me_e: Vec<f64> = (0..ne)
+            .flat_map(|a| (0..n).map(move |j| (a, j)))
+            .map(|(a, j)| (0..ne).map(|b| me(a, b) * e[b * n + j]).sum())
+            .collect();
+        for i in 0..n {
+            for j in 0..n {
+                c[i * n + j] += alpha * (0..ne).map(|a| e[a * n + i] * me_e[a * n + j]).sum::<f64>();
+            }
+        }
+        c
     }
 
     /// Index of the first coordinate of beam i (its alpha block).

@@ -218,6 +218,8 @@ pub(crate) struct System {
     rho: f64,
     l: f64,
     jp: f64,
+    /// The thp diagonal of the step matrix, `Jp (1 + gamma' alpha)` (Eq. D19).
+    jp_step: f64,
     lambda_m: Vec<f64>,
     phi: Vec<f64>,
     psi: Vec<f64>,
@@ -259,6 +261,8 @@ pub(crate) struct System {
     payload: Option<PayloadTerms>,
     /// Kelvin-Voigt retardation time beta [s] (Eqs. D2-D3); 0: undamped.
     beta: f64,
+    /// Mass-proportional coefficient alpha [1/s] on the elastic coordinates (Eq. D19); 0: none.
+    alpha: f64,
     /// The load at G (Eq. L1); `None` without one.
     load: Option<LoadSettings>,
     /// Workspace of the payload's Woodbury correction, N + 2.
@@ -405,6 +409,7 @@ impl System {
             rho: params.rho,
             l,
             jp: params.jp,
+            jp_step: params.jp,
             lambda_m: modes.lambda().to_vec(),
             phi: modes.phi_integral().to_vec(),
             psi: modes.x_phi_integral().to_vec(),
@@ -426,6 +431,7 @@ impl System {
             lam: vec![0.0; m],
             payload: None,
             beta: 0.0,
+            alpha: 0.0,
             load: None,
             pay_tmp: vec![0.0; nb],
             modes,
@@ -433,12 +439,13 @@ impl System {
     }
 
     /// `docs/amm.md` section 11: the payload welded at G (Eqs. P1-P6, on beam 1's
-    /// coordinates), the Kelvin-Voigt damping `damping.beta()` [s] of the beams (Eqs. D2-D3) and
-    /// the load at G (Eq. L1, fixed frame). What is absent (no mass nor J, beta = 0, no load)
-    /// adds no code path, so the bare star's results stay bit for bit.
+    /// coordinates), the Rayleigh damping of the elastic coordinates, Kelvin-Voigt `beta` [s]
+    /// (Eqs. D2-D3) and mass-proportional `alpha` [1/s] (Eq. D19), and the load at G (Eq. L1,
+    /// fixed frame). What is absent (no mass nor J, alpha = beta = 0, no load) adds no code path,
+    /// so the bare star's results stay bit for bit.
     pub(crate) fn attach(&mut self, payload: &Payload, damping: &Damping, load: &LoadSettings) {
         self.payload = PayloadTerms::new(payload, self.beams[0].ids.len());
-        self.beta = damping.beta();
+        (self.alpha, self.beta) = damping.coefficients();
         self.load = (!load.is_none()).then(|| load.clone());
     }
 
@@ -491,14 +498,18 @@ impl System {
     fn factor_s(&mut self, bp: f64, gp: f64, thd: f64, thdd: f64) {
         let rho = self.rho;
         self.p = rho * (2.0 * gp * thd + bp * thdd);
-        let mut sigma = rho * self.l * (1.0 - bp * thd * thd);
+        // Eq. D19: the mass-proportional damping alpha M scales M in S by 1 + gamma' alpha
+        // (exactly 1 without it)
+        let mass = 1.0 + gp * self.alpha;
+        self.jp_step = self.jp * mass;
+        let mut sigma = rho * self.l * (mass - bp * thd * thd);
         let damped = gp * self.beta;
         for j in 0..self.nm {
             let d = if self.beta > 0.0 {
                 // Eq. D3: the Kelvin-Voigt damping beta K_e on the elastic stiffness only
-                rho * (1.0 + damped * self.lambda_m[j] + bp * (self.lambda_m[j] - thd * thd))
+                rho * (mass + damped * self.lambda_m[j] + bp * (self.lambda_m[j] - thd * thd))
             } else {
-                rho * (1.0 + bp * (self.lambda_m[j] - thd * thd))
+                rho * (mass + bp * (self.lambda_m[j] - thd * thd))
             };
             self.inv_d[j] = 1.0 / d;
             self.w[j] = self.phi[j] / d;
@@ -515,7 +526,7 @@ impl System {
             *xj = (*xj - self.p * pj * y) * dj;
         }
         x[nm] = y;
-        x[nm + 1] /= self.jp;
+        x[nm + 1] /= self.jp_step;
     }
 
     /// One linear solve of the index-3 generalized-alpha step (or of the consistent initial
@@ -603,6 +614,9 @@ impl System {
         if self.beta > 0.0 {
             self.damping_forcing(vhat);
         }
+        if self.alpha > 0.0 {
+            self.mass_damping_forcing(vhat);
+        }
         if self.payload.is_some() || self.load.is_some() {
             self.attachment_forcing(st, qhat, vhat, None);
         }
@@ -618,6 +632,22 @@ impl System {
             for ((r, v), l) in rows.zip(&self.lambda_m) {
                 *r -= c * l * v;
             }
+        }
+    }
+
+    /// Eq. D19: the mass-proportional force `- alpha M vhat` on the elastic coordinates at the
+    /// predictor: `- alpha rho alpha_j'` on the alpha rows, `- alpha rho L u'` on the u row,
+    /// `- alpha Jp thp'` on the thp row (the payload's `- alpha M_p P vhat` is added with its
+    /// other terms, `attachment_forcing`) [N, N, N m].
+    fn mass_damping_forcing(&mut self, vhat: &[f64]) {
+        let (nm, nb, c) = (self.nm, self.nb, self.alpha * self.rho);
+        for i in 0..3 {
+            let o = i * nb;
+            for (r, v) in self.resid[o..o + nm].iter_mut().zip(&vhat[o..o + nm]) {
+                *r -= c * v;
+            }
+            self.resid[o + nm] -= c * self.l * vhat[o + nm];
+            self.resid[o + nm + 1] -= self.alpha * self.jp * vhat[o + nm + 1];
         }
     }
 
@@ -659,6 +689,13 @@ impl System {
             let x = change.unwrap_or_else(|| Self::payload_motion_along(st, ex));
             let (zq, zv) = (self.payload_coordinates(qhat), self.payload_coordinates(vhat));
             rp = pl.forcing(x, zq, zv);
+            if change.is_none() && self.alpha > 0.0 {
+                // Eq. D19 on the payload: - alpha M_p z_v (not a rate of the rigid motion)
+                let m = pl.mass_matrix();
+                for (a, r) in rp.iter_mut().enumerate() {
+                    *r -= self.alpha * (0..3).map(|b| m[a][b] * zv[b]).sum::<f64>();
+                }
+            }
         }
         if let (Some(load), None) = (&self.load, change) {
             let [fx, fy, mz] = load.at(st.t);
@@ -766,7 +803,7 @@ impl System {
         let [g11, w1] = dots(&self.scaled0[1], [&self.dphi0, &self.phi]);
 
         let m = self.rows.len();
-        let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp);
+        let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp_step);
         self.a.iter_mut().for_each(|v| *v = 0.0);
         // disjoint borrows of the fields (no copy of the beams' workspaces)
         let (beams, a_mat, inv_d, phi0, dphi0, phi) = (
@@ -800,7 +837,7 @@ impl System {
             return Ok(());
         };
         let (h, cross, back) = beam.payload_products(self.p, self.inv_sigma);
-        if !pl.set_woodbury(x, bp, gp, &h) {
+        if !pl.set_woodbury(x, (bp, gp, 1.0 + gp * self.alpha), &h) {
             return Err(AmmError::SingularConstraints {
                 t: st.t,
                 source: RankError::Payload,
@@ -870,7 +907,7 @@ impl System {
     /// `qhat` given (and `bp > 0`), `C qdd = 0` without. Writes `qdd` and `self.lam`.
     pub(crate) fn solve_prepared(&mut self, bp: f64, qhat: Option<&[f64]>, qdd: &mut [f64]) {
         let (nm, nb) = (self.nm, self.nb);
-        let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp);
+        let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp_step);
         self.rhs.iter_mut().for_each(|v| *v = 0.0);
         // disjoint borrows of the fields (no copy of the beams' workspaces)
         let (beams, resid, dinv_r, rhs) = (&self.beams, &self.resid, &mut self.dinv_r, &mut self.rhs);
@@ -1016,11 +1053,17 @@ mod tests {
 
     #[test]
     fn energy_balance_at_a_locked_pose() {
+        // Kelvin-Voigt alone, then Rayleigh (the mass-proportional part dissipating as much)
+        energy_balance_with(Damping::with_beta(3e-3));
+        energy_balance_with(Damping::rayleigh(4.0, 1.5e-3));
+    }
+
+    fn energy_balance_with(damping: Damping) {
         // docs/amm.md 11.5, Eq. C6 where it is exact for the AMM: the star held at the centre pose
         // (sliders fixed: theta' = theta'' = 0, a_G = 0, time-invariant constraints that do no
         // work), paper model, a payload off G, damping and a load from zero. Kinetic energy
-        // (beams, sleeves, payload: Eq. P2) + strain energy + dissipated (Eq. D4) = load work,
-        // from the stored coordinates (central differences, midpoint rule: O(h^2)).
+        // (beams, sleeves, payload: Eq. P2) + strain energy + dissipated (Eqs. D4, D20) = load
+        // work, from the stored coordinates (central differences, midpoint rule: O(h^2)).
         let mut exp = flexstar_model::catalogue::paper_case(3);
         exp.trajectory = Trajectory::Polynomial {
             s1: vec![0.0],
@@ -1033,7 +1076,7 @@ mod tests {
             j: 3e-3,
             offset: [0.04, 0.02],
         };
-        exp.damping = Damping::with_beta(3e-3);
+        exp.damping = damping;
         // from zero with zero rate, on the time scale of the first period (0.25 s)
         exp.load = LoadSettings::polynomials(
             Some(vec![0.0, 0.0, 100.0, -200.0]),
@@ -1055,25 +1098,34 @@ mod tests {
         let (nm, nb, rho) = (sys.nm, sys.nb, sys.rho);
         let pl = PayloadTerms::new(exp.payload, 0).unwrap();
         let mp = pl.mass_matrix();
-        // T + V at step n (central velocity), P_d and the load's power on [n, n+1] (midpoint)
-        let energy = |n: usize| {
-            let v: Vec<f64> = (0..qs[n].len())
-                .map(|k| (qs[n + 1][k] - qs[n - 1][k]) / (2.0 * h))
-                .collect();
+        // the kinetic energy of velocities v: v^T M v / 2 (beams, sleeves, payload)
+        let kinetic = |v: &[f64]| {
             let mut e = 0.0;
             for i in 0..3 {
                 let o = i * nb;
-                for j in 0..nm {
-                    e += 0.5 * rho * (v[o + j].powi(2) + sys.lambda_m[j] * qs[n][o + j].powi(2));
-                }
+                e += 0.5 * rho * v[o..o + nm].iter().map(|x| x * x).sum::<f64>();
                 e += 0.5 * (rho * sys.l * v[o + nm].powi(2) + sys.jp * v[o + nm + 1].powi(2));
             }
-            let zv = sys.payload_coordinates(&v);
+            let zv = sys.payload_coordinates(v);
             e + 0.5
                 * (0..3)
                     .map(|a| (0..3).map(|b| zv[a] * mp[a][b] * zv[b]).sum::<f64>())
                     .sum::<f64>()
         };
+        // T + V at step n (central velocity), P_d and the load's power on [n, n+1] (midpoint)
+        let energy = |n: usize| {
+            let v: Vec<f64> = (0..qs[n].len())
+                .map(|k| (qs[n + 1][k] - qs[n - 1][k]) / (2.0 * h))
+                .collect();
+            let mut e = kinetic(&v);
+            for i in 0..3 {
+                for j in 0..nm {
+                    e += 0.5 * rho * sys.lambda_m[j] * qs[n][i * nb + j].powi(2);
+                }
+            }
+            e
+        };
+        let (alpha, beta) = exp.damping.coefficients();
         let (mut work, mut dissipated, mut worst, mut work_max) = (0.0, 0.0, 0.0f64, 0.0f64);
         for n in 0..qs.len() - 2 {
             let dq: Vec<f64> = (0..qs[n].len()).map(|k| qs[n + 1][k] - qs[n][k]).collect();
@@ -1083,9 +1135,12 @@ mod tests {
             work += -fy * dz[0] + fx * dz[1] + mz * dz[2];
             for i in 0..3 {
                 for j in 0..nm {
-                    dissipated += exp.damping.beta() * rho * sys.lambda_m[j] * dq[i * nb + j].powi(2) / h;
+                    dissipated += beta * rho * sys.lambda_m[j] * dq[i * nb + j].powi(2) / h;
                 }
             }
+            // Eq. D20: alpha v^T M v, with v = dq / h on the step
+            let v: Vec<f64> = dq.iter().map(|d| d / h).collect();
+            dissipated += alpha * 2.0 * kinetic(&v) * h;
             if n >= 1 {
                 worst = worst.max((energy(n + 1) + dissipated - work).abs());
                 work_max = work_max.max(work.abs());

@@ -218,7 +218,12 @@ pub(crate) fn attachments_line(exp: &Experiment) -> Option<String> {
         ));
     }
     if exp.damping != flexstar_model::Damping::default() {
-        parts.push(format!("Kelvin-Voigt damping (beta = {:.4e} s)", exp.damping.beta()));
+        let (alpha, beta) = exp.damping.coefficients();
+        parts.push(if alpha == 0.0 {
+            format!("Kelvin-Voigt damping (beta = {beta:.4e} s)")
+        } else {
+            format!("Rayleigh damping (alpha = {alpha:.4e} 1/s, beta = {beta:.4e} s)")
+        });
     }
     if !exp.load.is_none() {
         let l = &exp.load;

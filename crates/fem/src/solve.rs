@@ -109,6 +109,13 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 /// Returns the response and the work counters (steps, Newton iterations, factorisations).
 pub fn solve(problem: &Problem, settings: &FemSettings, request: SolveRequest) -> Result<Solved<Stats>, FemError> {
     let problem = &problem.equal_beams().map_err(FemError::Problem)?;
+    if problem.damping.alpha() > 0.0 {
+        return Err(FemError::Problem(flexstar_model::ModelError::Unsupported {
+            what: "damping.alpha: the FEM's mass-proportional damping of the elastic motion is not built yet \
+                   (docs/amm.md 11.2.1; the AMM models it)"
+                .into(),
+        }));
+    }
     let (response, stats) = match request.drive {
         Drive::Motion => solve_prescribed(problem, settings, request.proof, request.progress)?,
         Drive::Law(law) => solve_direct(problem, settings, law, request.progress)?,

@@ -111,9 +111,9 @@ fn explicit_zero_sections_give_the_bare_run_bit_for_bit() {
         offset: [0.03, -0.02],
     };
     exp.damping = Damping {
-        beta: None,
-        zeta: Some(0.0),
-        f_hz: Some(4.0),
+        zeta: Some(flexstar_model::ModeValues::One(0.0)),
+        f_hz: Some(flexstar_model::ModeValues::One(4.0)),
+        ..Damping::default()
     };
     exp.load = LoadSettings::polynomials(None, None, None);
     let problem = exp.problem().unwrap();

@@ -68,9 +68,8 @@ pub struct Modal {
     pub fem: flexstar_fem::pose_modes::PoseModes,
     /// K requested (elastic modes); the rigid ones come first when the sliders are free.
     pub k: usize,
-    /// Kelvin-Voigt retardation time beta [s] when the experiment has a `[damping]` section
-    /// (`None`: no damping columns).
-    pub beta: Option<f64>,
+    /// The experiment's `[damping]`, resolved, when it has one (`None`: no damping columns).
+    pub damping: Option<flexstar_model::Damping>,
 }
 
 impl Modal {
@@ -103,18 +102,20 @@ pub fn modal(exp: &Experiment, pose: &RestPose, sliders: Sliders, k: usize) -> R
             amm.freq_hz.len() - amm.rigid
         )));
     }
-    let beta = (exp.damping != flexstar_model::Damping::default()).then(|| exp.damping.beta());
-    Ok(Modal { amm, fem, k, beta })
+    let damping = (exp.damping != flexstar_model::Damping::default()).then_some(exp.damping);
+    Ok(Modal { amm, fem, k, damping })
 }
 
 impl Modal {
-    /// The damping ratios `(zeta_amm, zeta_fem)` of the rows of [`Modal::rows`]: `beta omega_k
-    /// / 2` of each model's own frequency (Eq. D11: at rest the damping matrix is `beta K` in both
-    /// models, so the undamped modes diagonalize it; 0 for the rigid modes); `None` without a
-    /// `[damping]` section.
+    /// The damping ratios `(zeta_amm, zeta_fem)` of the rows of [`Modal::rows`]:
+    /// `alpha / (2 omega_k) + beta omega_k / 2` of each model's own frequency (Eq. D11: at rest
+    /// with the sliders locked the damping matrix is `alpha M + beta K` in both models, so the
+    /// undamped modes diagonalize it; with free sliders the mass-proportional part acts on the
+    /// elastic coordinates only and the ratio is that of the formula, `docs/modes.md`; 0 for the
+    /// rigid modes); `None` without a `[damping]` section.
     pub fn damping_ratios(&self) -> Option<Vec<(f64, f64)>> {
-        let beta = self.beta?;
-        let zeta = |f: f64| beta * std::f64::consts::PI * f;
+        let damping = self.damping?;
+        let zeta = |f: f64| if f > 0.0 { damping.zeta_at(f) } else { 0.0 };
         Some(self.rows().iter().map(|&(_, a, f, _)| (zeta(a), zeta(f))).collect())
     }
 }

@@ -155,6 +155,10 @@ pub struct StateSpace {
     pub inputs: Vec<Signal>,
     /// Outputs in the order of C's rows (module docs).
     pub outputs: Vec<Signal>,
+    /// The damping ratio of every mode in the model, `(Phi^T C Phi)_kk / (2 omega_k)` of the
+    /// material damping (Eq. D13; Eq. D14 exactly with the sliders locked), 0 for the rigid modes;
+    /// empty without `[damping]`.
+    pub damping_ratios: Vec<f64>,
 }
 
 /// Derivatives of the rigid star (G [m], theta [rad]) with respect to s_j at the pose.
@@ -344,6 +348,13 @@ pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettin
         Holding::Servo { kp, kd } => servo_model(&modes, deflections, kp, kd),
     };
     add_damping_and_load(exp, &modes, &mut blocks, &mut inputs);
+    let damping_ratios = blocks.damping.as_ref().map_or_else(Vec::new, |c| {
+        let omega = modes.omega2.iter().map(|w| w.max(0.0).sqrt());
+        omega
+            .enumerate()
+            .map(|(k, w)| if w > 0.0 { c[k][k] / (2.0 * w) } else { 0.0 })
+            .collect()
+    });
     let [a, b, c, d] = blocks.matrices();
     let nr = phi.len();
     let mut states: Vec<Signal> = (1..=nr)
@@ -367,6 +378,7 @@ pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettin
         states,
         inputs,
         outputs,
+        damping_ratios,
     })
 }
 
@@ -378,7 +390,7 @@ fn add_damping_and_load(exp: &Experiment, modes: &PoseModes, blocks: &mut Blocks
     let sys = &modes.system;
     let phi = &modes.shapes;
     if exp.damping != flexstar_model::Damping::default() {
-        let (n, c) = (sys.n, sys.damping_matrix(exp.damping.beta()));
+        let (n, c) = (sys.n, sys.damping_matrix(exp.damping.alpha(), exp.damping.beta(), &phi[..modes.rigid]));
         let c_phi: Vec<Vec<f64>> = phi
             .iter()
             .map(|p| (0..n).map(|a| dot(&c[a * n..(a + 1) * n], p)).collect())
@@ -587,19 +599,21 @@ fn statespace_json(exp: &Experiment, ss: &StateSpace, fem: &flexstar_fem::pose_m
         "fem": {"coordinates": fem.n, "constraints": fem.rows, "elements": exp.fem.elements, "sliders": fem.sliders.name()},
         "payload": exp.payload,
         "damping": damping_json(exp),
+        "modal_damping_ratios": (!ss.damping_ratios.is_empty()).then_some(&ss.damping_ratios),
     })
 }
 
 /// The damping of the model in `statespace.json`: `null` without a `[damping]` section, else the
-/// section, beta [s] and how it enters A (Eq. D13).
+/// section, alpha [1/s], beta [s] and how they enter A (Eq. D13).
 fn damping_json(exp: &Experiment) -> serde_json::Value {
     if exp.damping == flexstar_model::Damping::default() {
         return serde_json::Value::Null;
     }
     serde_json::json!({
         "section": exp.damping,
+        "alpha_per_s": exp.damping.alpha(),
         "beta_s": exp.damping.beta(),
-        "in_A": "Kelvin-Voigt: -Phi^T (beta K) Phi = -beta Omega^2 in the velocity block (zeta_k = beta omega_k / 2)",
+        "in_A": "Rayleigh: -Phi^T (alpha M_e + beta K) Phi in the velocity block, M_e the mass of the elastic coordinates (sliders locked: -(alpha I + beta Omega^2), zeta_k = alpha / (2 omega_k) + beta omega_k / 2)",
     })
 }
 

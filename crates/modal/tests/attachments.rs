@@ -97,8 +97,8 @@ fn an_offset_payload_moves_both_models_alike() {
 fn damped_poles_leave_the_imaginary_axis_by_zeta_omega() {
     let mut exp = paper();
     exp.damping = Damping {
-        zeta: Some(0.02),
-        f_hz: Some(4.0),
+        zeta: Some(flexstar_model::ModeValues::One(0.02)),
+        f_hz: Some(flexstar_model::ModeValues::One(4.0)),
         ..Damping::default()
     };
     let beta = exp.damping.beta();
@@ -134,6 +134,47 @@ fn damped_poles_leave_the_imaginary_axis_by_zeta_omega() {
         .unwrap()
         .damping_ratios()
         .is_none());
+}
+
+/// Eqs. D13-D15: Rayleigh damping fitted to two ratios. With the sliders locked the eigenvalues
+/// of A (faer's general eigensolver) are `-zeta_k omega_k +- i omega_k sqrt(1 - zeta_k^2)` with
+/// `zeta_k = alpha / (2 omega_k) + beta omega_k / 2` of every mode, and the fitted law gives back
+/// the two ratios at their frequencies; with the sliders free the mass-proportional part acts on
+/// the elastic coordinates only, so the six rigid eigenvalues stay at 0.
+#[test]
+fn rayleigh_poles_follow_the_two_ratio_law() {
+    let mut exp = paper();
+    exp.damping = Damping {
+        zeta: Some(flexstar_model::ModeValues::Two([0.02, 0.015])),
+        f_hz: Some(flexstar_model::ModeValues::Two([4.0, 9.0])),
+        ..Damping::default()
+    };
+    let (alpha, beta) = exp.damping.coefficients();
+    assert!(alpha > 0.0 && beta > 0.0);
+    let pose = pose_from_task(&exp.robot, 0.03, -0.02, 0.1).unwrap();
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let eigen = |holding| {
+        let ss = linearize_with(&exp, &pose, &LinearSettings { modes: 8, holding }).unwrap();
+        let d = ss.a.to_dense();
+        let a = faer::Mat::from_fn(d.nrows(), d.ncols(), |r, c| d[[r, c]]);
+        (a.eigenvalues().unwrap(), ss)
+    };
+    let (ev, ss) = eigen(Holding::Locked);
+    for (f, z) in ss.modes.freq_hz.iter().zip(&ss.damping_ratios) {
+        let w = two_pi * f;
+        let zeta = alpha / (2.0 * w) + beta * w / 2.0;
+        assert!((z - zeta).abs() < 1e-9 * zeta, "statespace.json's ratio {z} vs the law {zeta}");
+        let pole = (-zeta * w, w * (1.0 - zeta * zeta).sqrt());
+        let found = ev
+            .iter()
+            .any(|z| (z.re - pole.0).abs() < 1e-7 * w && (z.im - pole.1).abs() < 1e-7 * w);
+        assert!(found, "pole {pole:?} of {f} Hz (zeta {zeta}) not among {ev:?}");
+    }
+    assert!((exp.damping.zeta_at(4.0) - 0.02).abs() < 1e-12 && (exp.damping.zeta_at(9.0) - 0.015).abs() < 1e-12);
+    let (ev, ss) = eigen(Holding::Free);
+    let wmax = ss.modes.freq_hz.iter().fold(0.0f64, |m, f| m.max(two_pi * f));
+    let zero_tol = (f64::EPSILON * wmax * wmax).sqrt() * 10.0;
+    assert_eq!(ev.iter().filter(|z| z.norm() < zero_tol).count(), 6, "{ev:?}");
 }
 
 /// Eq. L4: the load channel's static gain (sliders locked, `sum_k C_k B_k / omega_k^2`) against

@@ -1,6 +1,6 @@
 //! What flexstar adds to the paper's robot (`docs/amm.md` section 11, `docs/fem.md` section 9): a
-//! payload welded at the junction G (`[payload]`), Kelvin-Voigt material damping of the beams
-//! (`[damping]`) and an external load at G (`[load]`).
+//! payload welded at the junction G (`[payload]`), damping of the elastic motion (`[damping]`,
+//! [`crate::damping`]) and an external load at G (`[load]`).
 //!
 //! ```toml
 //! [payload]            # a rigid body welded at G (docs/amm.md 11.1, docs/fem.md 9.1)
@@ -8,8 +8,8 @@
 //! J = 1e-3             # kg m^2, about its own centre of mass
 //! offset = [0.01, 0.0] # m, its centre of mass from G in the star's frame (x along beam 1)
 //!
-//! [damping]            # Eq. D1: EI (kappa + beta kappa'), EA (eps + beta eps')
-//! beta = 8e-4          # s; or zeta = 0.01 with f_hz = 4.0 (beta = zeta / (pi f_hz), Eq. D5)
+//! [damping]            # Rayleigh: alpha M + beta K on the elastic motion (crate::damping)
+//! beta = 8e-4          # s; or zeta = 0.01 (at f_hz, default the first mode), or zeta = [z1, z2]
 //!
 //! [load]               # force and moment at G in the fixed frame (Eqs. L1, L2)
 //! file = "load.csv"    # header t,Fx,Fy,Mz (N, N, N m), linear in between
@@ -22,6 +22,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::damping::Damping;
 use crate::drive_section::ForceSamples;
 use crate::error::ModelError;
 
@@ -67,94 +68,6 @@ impl Payload {
             ));
         }
         Ok(())
-    }
-}
-
-/// `[damping]`: stiffness-proportional (Kelvin-Voigt) material damping of the beams, Eq. D1:
-/// bending moment `EI (kappa + beta kappa')`, axial force `EA (eps + beta eps')`, rates material.
-/// Mode k then has the damping ratio `beta omega_k / 2` (`docs/amm.md` 11.2, `docs/fem.md` 9.2).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Damping {
-    /// Retardation time beta [s] (exclusive with `zeta`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub beta: Option<f64>,
-    /// Damping ratio [-] at the frequency `f_hz` (exclusive with `beta`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub zeta: Option<f64>,
-    /// The frequency [Hz] at which `zeta` holds; without it, `zeta` holds at the robot's first
-    /// elastic frequency at the start pose, computed by the explicit step
-    /// `flexstar_shaping::shape` (pending until then, [`Damping::pending`]).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub f_hz: Option<f64>,
-}
-
-impl Damping {
-    /// A damping of retardation time `beta` [s].
-    pub fn with_beta(beta: f64) -> Self {
-        Damping {
-            beta: Some(beta),
-            ..Damping::default()
-        }
-    }
-
-    /// `zeta` is given without `f_hz`: it waits for the first frequency at the start pose
-    /// (`flexstar_shaping::shape`); a problem is not built before.
-    pub fn pending(&self) -> bool {
-        self.beta.is_none() && self.zeta.is_some() && self.f_hz.is_none()
-    }
-
-    /// beta [s]: as given, or `zeta / (pi f_hz)` (Eq. D5), or 0 (no damping).
-    pub fn beta(&self) -> f64 {
-        match (self.beta, self.zeta, self.f_hz) {
-            (Some(b), _, _) => b,
-            (None, Some(z), Some(f)) => z / (std::f64::consts::PI * f),
-            _ => 0.0,
-        }
-    }
-
-    /// The damping ratio of a mode of natural frequency `f` [Hz]: `beta pi f` (Eq. D5).
-    pub fn zeta_at(&self, f: f64) -> f64 {
-        self.beta() * std::f64::consts::PI * f
-    }
-
-    /// Check the values and their combination (keys named `damping.<key>`).
-    pub fn validate(&self) -> Result<(), ModelError> {
-        for (key, v) in [
-            ("damping.beta", self.beta),
-            ("damping.zeta", self.zeta),
-            ("damping.f_hz", self.f_hz),
-        ] {
-            if let Some(v) = v.filter(|v| !v.is_finite() || *v < 0.0) {
-                return Err(ModelError::invalid(
-                    key,
-                    format!("must be a finite number >= 0, got {v}"),
-                ));
-            }
-        }
-        match (self.beta, self.zeta, self.f_hz) {
-            (Some(_), Some(_), _) => Err(ModelError::invalid(
-                "damping.zeta",
-                "give either beta [s] or zeta with f_hz, not both",
-            )),
-            (Some(_), None, Some(_)) => Err(ModelError::invalid(
-                "damping.f_hz",
-                "f_hz goes with zeta (zeta at this frequency), not with beta",
-            )),
-            (None, Some(z), _) if z >= 1.0 => Err(ModelError::invalid(
-                "damping.zeta",
-                format!("a damping ratio below 1 (critical damping), got {z}"),
-            )),
-            (None, None, Some(_)) => Err(ModelError::invalid(
-                "damping.zeta",
-                "f_hz is the frequency of a zeta: give zeta too, or beta [s] alone",
-            )),
-            (None, Some(_), Some(f)) if f <= 0.0 => Err(ModelError::invalid(
-                "damping.f_hz",
-                format!("the frequency must be positive, got {f}"),
-            )),
-            _ => Ok(()),
-        }
     }
 }
 
@@ -315,12 +228,12 @@ s3 = [0.0, 0.0, 0.5]
     fn defaults_are_nothing_at_all() {
         let e = load("", Path::new("e.toml")).unwrap();
         assert!(e.payload.is_none() && e.load.is_none());
-        assert_eq!(e.damping.beta(), 0.0);
+        assert!(e.damping.is_none());
         assert_eq!(e.load.at(0.1), [0.0; 3]);
     }
 
     #[test]
-    fn sections_parse_and_zeta_gives_beta() {
+    fn sections_parse() {
         let e = load(
             "[payload]\nmass = 2.0\nJ = 0.01\noffset = [0.1, -0.2]\n[damping]\nzeta = 0.02\nf_hz = 4.0\n\
              [load]\nFx = [1.0, 2.0]\nMz = [0.0, 0.0, 3.0]",
@@ -333,9 +246,6 @@ s3 = [0.0, 0.0, 0.5]
         );
         // J + m |o|^2 = 0.01 + 2 (0.01 + 0.04)
         assert!((e.payload.inertia_about_g() - 0.11).abs() < 1e-15);
-        // Eq. D5: beta = zeta / (pi f); the ratio at f_hz is zeta again
-        assert!((e.damping.beta() - 0.02 / (std::f64::consts::PI * 4.0)).abs() < 1e-18);
-        assert!((e.damping.zeta_at(4.0) - 0.02).abs() < 1e-15);
         assert_eq!(e.load.at(0.5), [2.0, 0.0, 0.75]);
     }
 
@@ -345,13 +255,6 @@ s3 = [0.0, 0.0, 0.5]
             ("[payload]\nmass = -1.0", "payload.mass"),
             ("[payload]\nJ = nan", "payload.J"),
             ("[payload]\noffset = [0.0, inf]", "payload.offset"),
-            ("[damping]\nbeta = -1e-3", "damping.beta"),
-            ("[damping]\nbeta = 1e-3\nzeta = 0.01", "damping.zeta"),
-            ("[damping]\nzeta = 1.0", "damping.zeta"),
-            ("[damping]\nzeta = 0.01\nf_hz = 0.0", "damping.f_hz"),
-            ("[damping]\nzeta = 0.01\nf_hz = inf", "damping.f_hz"),
-            ("[damping]\nf_hz = 4.0", "damping.zeta"),
-            ("[damping]\nbeta = 1e-3\nf_hz = 4.0", "damping.f_hz"),
             ("[load]\nFx = []", "load.Fx"),
             ("[load]\nMz = [nan]", "load.Mz"),
         ] {
@@ -360,7 +263,6 @@ s3 = [0.0, 0.0, 0.5]
         }
         for (extra, key) in [
             ("[payload]\nmas = 1.0", "mas"),
-            ("[damping]\nalpha = 1.0", "alpha"),
             ("[load]\nFz = [1.0]", "Fz"),
         ] {
             let e = load(extra, Path::new("bad.toml")).unwrap_err();

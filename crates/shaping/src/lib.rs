@@ -31,23 +31,22 @@ pub fn shape(exp: &mut Experiment) -> Result<(), ModelError> {
     exp.validate()
 }
 
-/// `[damping] zeta` without `f_hz`: set `f_hz` to the robot's first elastic frequency at the start
-/// pose of its motion (the accurate AMM, sliders locked, the payload at G:
-/// `flexstar_modal::analysis::start_pose_frequencies`), so that the first mode has the damping
-/// ratio zeta (Eq. D5); the sidecar's resolved experiment records the frequency. A no-op
-/// otherwise. Errors under the key `damping.zeta`.
+/// `[damping]` at the robot's first elastic frequencies at the start pose of its motion (the
+/// accurate AMM, sliders locked, the payload at G: `flexstar_modal::analysis::start_pose_frequencies`):
+/// a `zeta` without `f_hz` holds at the first (two) of them, so that mode 1 (and 2) has the
+/// ratio zeta (Eqs. D5, D15), and a mass-proportional `alpha` is checked to leave mode 1 below
+/// critical damping (`flexstar_model::Damping::resolve`). The sidecar's resolved experiment
+/// records the frequencies. A no-op when nothing needs them. Errors under `damping.zeta` or
+/// `damping.alpha`.
 pub fn resolve_damping(exp: &mut Experiment) -> Result<(), ModelError> {
-    if !exp.damping.pending() {
+    let n = exp.damping.frequencies_needed();
+    if n == 0 {
         return Ok(());
     }
-    let f1 = flexstar_modal::analysis::start_pose_frequencies(exp, 1)
-        .map_err(|e| ModelError::invalid("damping.zeta", format!("the first frequency at the start pose: {e}")))?
-        .first()
-        .copied()
-        .filter(|f| *f > 0.0)
-        .ok_or_else(|| ModelError::invalid("damping.zeta", "no elastic mode at the start pose"))?;
-    exp.damping.f_hz = Some(f1);
-    Ok(())
+    let key = if exp.damping.zeta.is_some() { "damping.zeta" } else { "damping.alpha" };
+    let first = flexstar_modal::analysis::start_pose_frequencies(exp, n)
+        .map_err(|e| ModelError::invalid(key, format!("the first frequencies at the start pose: {e}")))?;
+    exp.damping.resolve(&first)
 }
 
 /// [`shape`] of an experiment read from a file: a refusal names the file (as the loader's do).

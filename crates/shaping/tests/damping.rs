@@ -20,7 +20,7 @@ fn zeta_alone_holds_at_the_first_frequency_and_the_run_decays_by_it() {
     assert!(e.contains("damping.f_hz"), "{e}");
     flexstar_shaping::shape(&mut exp).unwrap();
     let f_start = flexstar_modal::analysis::start_pose_frequencies(&exp, 1).unwrap()[0];
-    assert_eq!(exp.damping.f_hz, Some(f_start));
+    assert_eq!(exp.damping.f_hz, Some(flexstar_model::ModeValues::One(f_start)));
     assert!((exp.damping.zeta_at(f_start) - 0.015).abs() < 1e-15);
 
     let problem = exp.problem().unwrap();
@@ -58,4 +58,34 @@ fn a_ratio_of_one_or_more_is_refused() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("damping.zeta"), "{e}");
+}
+
+/// `zeta = [z1, z2]` without `f_hz` holds at the first two distinct frequencies at the start
+/// pose (the modal analysis computed apart here: the centre pose of the symmetric star has a
+/// double first frequency), through the Rayleigh fit of Eq. D15; `alpha` alone is
+/// checked against mode 1's critical damping at the start pose (`alpha < 2 omega_1`).
+#[test]
+fn two_ratios_hold_at_the_first_two_frequencies() {
+    let text = MOVE.replace("zeta = 0.015", "zeta = [0.015, 0.02]");
+    let mut exp = Experiment::from_toml_str(&text, std::path::Path::new("damped.toml")).unwrap();
+    assert!(exp.damping.pending());
+    flexstar_shaping::shape(&mut exp).unwrap();
+    let f = flexstar_modal::analysis::start_pose_frequencies(&exp, 6).unwrap();
+    assert!((f[1] / f[0] - 1.0).abs() < 1e-6, "a double first frequency: {f:?}");
+    let f2 = f[2..].iter().copied().find(|x| *x > 1.05 * f[0]).unwrap();
+    assert_eq!(exp.damping.f_hz, Some(flexstar_model::ModeValues::Two([f[0], f2])));
+    assert!((exp.damping.zeta_at(f[0]) - 0.015).abs() < 1e-12);
+    assert!((exp.damping.zeta_at(f2) - 0.02).abs() < 1e-12);
+    exp.problem().unwrap();
+
+    let w1 = 2.0 * std::f64::consts::PI * f[0];
+    for (alpha, ok) in [(1.9 * w1, true), (2.1 * w1, false)] {
+        let text = MOVE.replace("zeta = 0.015", &format!("alpha = {alpha}"));
+        let mut exp = Experiment::from_toml_str(&text, std::path::Path::new("damped.toml")).unwrap();
+        let r = flexstar_shaping::shape(&mut exp);
+        assert_eq!(r.is_ok(), ok, "alpha = {alpha}: {r:?}");
+        if let Err(e) = r {
+            assert!(e.to_string().contains("damping.alpha") && e.to_string().contains("mode 1"), "{e}");
+        }
+    }
 }

@@ -26,14 +26,17 @@ pub(crate) struct Section {
 }
 
 /// Factors of the imbalance and of the Newton matrix: `cf` on the dynamic part of the imbalance,
-/// `ck` on the stiffness in the matrix `M + ck K`, `cv` on the velocity derivative of the forces
-/// (the damping matrix `beta K_mat`, Eq. D9). In a step `cf = ck = beta'` [s^2] and `cv = gamma'`
-/// [s]; for the consistent initial accelerations `cf = 1`, `ck = cv = 0`.
+/// `ck` on the stiffness in the matrix `cm M + ck K`, `cv` on the velocity derivative of the
+/// forces (the damping matrix `beta K_mat`, Eq. D9), `cm` on the mass (`1 + gamma' alpha` with
+/// the mass-proportional damping, Eq. D18; 1 without, and `rho * 1` is `rho` exactly). In a step
+/// `cf = ck = beta'` [s^2] and `cv = gamma'` [s]; for the consistent initial accelerations
+/// `cf = 1`, `ck = cv = 0`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Factors {
     pub cf: f64,
     pub ck: f64,
     pub cv: f64,
+    pub cm: f64,
 }
 
 /// Global coordinates [m, rad], velocities and accelerations of the star's nodes (first
@@ -113,7 +116,8 @@ flexstar_numerics::dispatch_avx2! {
     /// Add `cf (M(q) qdd + f_conv(q, v) + f_int(q, v))` of every element to `res` (global DOFs,
     /// in element order) and, with `vals`, write each element's `M + ck K` (36 values, row-major,
     /// at [`block_index`]: the slot layout of `crate::star`). With damping (`sec.beta > 0`) the
-    /// internal force is Eq. D7's and the block Eq. D9's `M + (ck + cv beta) K_mat + ck G`.
+    /// internal force is Eq. D7's and the block Eq. D9's `M + (ck + cv beta) K_mat + ck G`; the
+    /// block's mass is `fac.cm M` (Eq. D18), the imbalance's inertia force uses `rho` itself.
     pub(crate) fn add_forces(
         elements: &[Element],
         nodes: NodeState,
@@ -162,6 +166,22 @@ flexstar_numerics::dispatch_avx2! {
         }
         for start in full..elements.len() {
             sum += power_of::<f64>(elements, start, q, v, sec);
+        }
+        sum
+    }
+}
+
+flexstar_numerics::dispatch_avx2! {
+    /// `sum_e x_e^T M_e y_e` over the elements at the global coordinates `q` (`x`, `y` global
+    /// vectors; for velocities [m/s, rad/s] and rates [1/s^2] a power [W], Eq. D16).
+    pub(crate) fn mass_product(elements: &[Element], q: &[f64], x: &[f64], y: &[f64], rho: f64) -> f64 {
+        let full = elements.len() / LANES * LANES;
+        let mut sum = 0.0;
+        for start in (0..full).step_by(LANES) {
+            sum += mass_product_of::<F64x4>(elements, start, [q, x, y], rho);
+        }
+        for start in full..elements.len() {
+            sum += mass_product_of::<f64>(elements, start, [q, x, y], rho);
         }
         sum
     }
@@ -288,7 +308,7 @@ fn add_forces_of<T: Real, const DAMPED: bool>(
     vals: Option<&mut [f64]>,
 ) -> Result<(), BadChord> {
     let Terms { nodes, sec, fac } = *terms;
-    let Factors { cf, ck, cv } = fac;
+    let Factors { cf, ck, cv, cm } = fac;
     let damped = [sec.ea, sec.ei, sec.beta];
     let chain = chain::<T>(elements, start);
     let st: ElementState<T> = states(elements, start, chain, nodes.q);
@@ -312,7 +332,7 @@ fn add_forces_of<T: Real, const DAMPED: bool>(
             } else {
                 st.internal(sec.ea, sec.ei)
             };
-            let m = std::hint::black_box(st.mass(sec.rho));
+            let m = std::hint::black_box(st.mass(sec.rho * cm));
             let mut mk = m;
             for a in 0..6 {
                 for b in 0..6 {
@@ -360,6 +380,25 @@ fn power_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], s
         sum += p.lane(k);
     }
     sum
+}
+
+/// [`mass_product`] for the `T::LANES` elements from `start` at `[q, x, y]` (lanes summed in
+/// order).
+#[inline(always)]
+fn mass_product_of<T: Real>(elements: &[Element], start: usize, [q, x, y]: [&[f64]; 3], rho: f64) -> f64 {
+    let chain = chain::<T>(elements, start);
+    let st: ElementState<T> = states(elements, start, chain, q);
+    let m = st.mass(rho);
+    let (xe, ye): ([T; 6], [T; 6]) = (gather(elements, start, chain, x), gather(elements, start, chain, y));
+    let mut p = T::splat(0.0);
+    for a in 0..6 {
+        let mut my = T::splat(0.0);
+        for b in 0..6 {
+            my += m[a][b] * ye[b];
+        }
+        p += xe[a] * my;
+    }
+    (0..T::LANES).map(|k| p.lane(k)).sum()
 }
 
 #[inline(always)]
@@ -445,7 +484,12 @@ mod tests {
             beta: 0.0,
         };
         let (cf, ck) = (6e-8, 6e-8);
-        let fac = Factors { cf, ck, cv: 2.6e-4 };
+        let fac = Factors {
+            cf,
+            ck,
+            cv: 2.6e-4,
+            cm: 1.0,
+        };
         // 11 elements: two full batches and a remainder of three
         let (elements, q, v, a) = chain(11);
         let nodes = NodeState { q: &q, v: &v, qdd: &a };
@@ -502,6 +546,7 @@ mod tests {
                 cf: 1.0,
                 ck: 1.0,
                 cv: 0.0,
+                cm: 1.0,
             },
             &mut res,
             None,
@@ -520,6 +565,7 @@ mod tests {
                 cf: 1.0,
                 ck: 1.0,
                 cv: 0.0,
+                cm: 1.0,
             },
             &mut res,
             None,
@@ -542,6 +588,7 @@ mod tests {
             cf: 6e-8,
             ck: 6e-8,
             cv: 2.6e-4,
+            cm: 1.0,
         };
         let (elements, q, v, a) = chain(11);
         let nodes = NodeState { q: &q, v: &v, qdd: &a };

@@ -96,6 +96,14 @@ pub enum FemError {
     /// configuration at an output time.
     #[error("post-processing at t = {t} s: no rigid configuration for the simulated sliders s = {s:?} m")]
     NoRigidConfiguration { t: f64, s: [f64; 3] },
+    /// Mass-proportional damping needs the star's rigid twist from the slider velocities (Eq.
+    /// D17), which a singular pose leaves undetermined: the three lines through the pins along the
+    /// sleeves' normals meet at one point (or are parallel). `det` is the twist matrix's
+    /// determinant relative to the product of its rows' norms.
+    #[error(
+        "singular pose at t = {t} s: the lines through the three pins normal to the sleeves meet at one point (relative determinant {det:.2e}), so the rigid velocity of the star is not determined by the sliders' and the mass-proportional damping (damping.alpha) cannot be applied"
+    )]
+    SingularPose { t: f64, det: f64 },
     /// A non-finite number appeared (element index given when known).
     #[error("non-finite value at t = {t} s in element {element}: {reason}")]
     NonFinite { t: f64, element: usize, reason: String },

@@ -11,8 +11,9 @@
 //! post-processing of [`solve`] (projection onto the rigid frames). [`solve`] with a law solves the
 //! direct problem (`docs/fem.md` section 8): the sliders, bodies of mass `mpp + mpa`, move under an actuator law
 //! (`flexstar_drive`), their coordinates unknowns of the same equations. Both carry an
-//! experiment's payload at G, Kelvin-Voigt damping of the beams and load at G
-//! (`docs/fem.md` section 9), skipped at their zero defaults. The formulation, the
+//! experiment's payload at G, Rayleigh damping (Kelvin-Voigt in the beams, mass-proportional on
+//! the motion relative to the rigid robot) and load at G (`docs/fem.md` section 9), skipped at
+//! their zero defaults. The formulation, the
 //! convergence study behind the defaults and the deviations are in `docs/fem.md`.
 
 #![allow(clippy::needless_range_loop)] // index loops over DOFs read like the equations

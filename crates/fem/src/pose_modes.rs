@@ -7,7 +7,9 @@
 //! is undeformed, so the tangent stiffness is the linear one. The pose is data ([`RestPose`]:
 //! G, theta, xp_i and the sliders s_i); no rigid kinematics enters the equations. With free
 //! sliders, slider i adds the coordinate `s_i` (mass `mpp_mpa`) and the pin rows of sleeve i
-//! read `r_i(xi) - P_i(s_i) + ... = 0` with `dP_i/ds_i = u_i` (Eqs. 1-3).
+//! read `r_i(xi) - P_i(s_i) + ... = 0` with `dP_i/ds_i = u_i` (Eqs. 1-3). The damping matrix at
+//! rest ([`SparsePoseSystem::damping_triplets`]) is Rayleigh's on the elastic motion (Eq. D18,
+//! `docs/fem.md` 9.2.1).
 
 use flexstar_model::geometry::{e_w, e_x, slider_direction};
 use flexstar_model::{Payload, RestPose, RobotParams, Sliders};
@@ -15,7 +17,7 @@ use flexstar_numerics::eigen::{constrained_modes, rigid_shift, ConstrainedModes}
 
 use crate::element::ElementState;
 use crate::modal_solver::{sparse_constrained_modes, Triplets};
-use crate::star::{InitialState, Star, ROWS, ROW_POINT};
+use crate::star::{InitialState, RigidTwist, Star, ROWS, ROW_POINT};
 use crate::FemError;
 
 /// The linearised FEM at a pose: `M q'' + K q = B f - Phi_q^T lambda`, `Phi_q q = 0`.
@@ -206,16 +208,63 @@ pub struct SparsePoseSystem {
     pub theta: f64,
     /// Element length [m].
     pub h: f64,
+    /// The rigid field per unit slider velocity `R` (Eq. D17) on the star's coordinates (rows of
+    /// M without the sliders; column i for `s_i' = 1` m/s: [m/s, rad/s] per m/s), with the pins at
+    /// the sleeves' centres; `Err` with the relative determinant of Eq. D17 at a singular pose.
+    pub rigid: Result<Vec<[f64; 3]>, f64>,
 }
 
 impl SparsePoseSystem {
     coordinate_helpers!();
 
-    /// The damping matrix at rest of Kelvin-Voigt damping of retardation time `beta` [s], as
-    /// triplets: the element's `df/dq' = beta K_mat` (Eq. D8), which at the unstressed rest pose
-    /// is `beta K` (no geometric part).
-    pub fn damping_triplets(&self, beta: f64) -> Triplets {
-        self.k.iter().map(|&(r, c, v)| (r, c, beta * v)).collect()
+    /// The star's coordinates (nodes, sleeve rotations, contact coordinates): all but the sliders.
+    fn star_coordinates(&self) -> usize {
+        if self.sliders == Sliders::Free {
+            self.n - 3
+        } else {
+            self.n
+        }
+    }
+
+    /// The damping matrix at rest of Rayleigh damping on the elastic motion (Eq. D18), as
+    /// triplets: Kelvin-Voigt's `beta K` (`beta` [s]; the element's `df/dq' = beta K_mat`, Eq. D8,
+    /// at the unstressed pose) and the mass-proportional `alpha M` on the star's coordinates
+    /// (`alpha` [1/s], Eq. D16 at `v_r = 0`: the sliders' mass is not damped); with free sliders
+    /// the slider columns get `-alpha M R` (the velocity relative to the rigid field `R s'`), so the
+    /// rigid modes are not damped. Free sliders with alpha at a singular pose:
+    /// [`FemError::SingularPose`].
+    pub fn damping_triplets(&self, alpha: f64, beta: f64) -> Result<Triplets, FemError> {
+        let mut c: Triplets = self.k.iter().map(|&(r, c, v)| (r, c, beta * v)).collect();
+        if alpha == 0.0 {
+            return Ok(c);
+        }
+        let nq = self.star_coordinates();
+        let star = |&&(r, col, _): &&(usize, usize, f64)| r < nq && col < nq;
+        c.extend(self.m.iter().filter(star).map(|&(r, col, v)| (r, col, alpha * v)));
+        if self.sliders == Sliders::Free {
+            c.extend(self.slider_damping_columns(alpha)?);
+        }
+        Ok(c)
+    }
+
+    /// Eq. D18's slider columns `-alpha M R` (star rows only).
+    fn slider_damping_columns(&self, alpha: f64) -> Result<Triplets, FemError> {
+        let rigid = self
+            .rigid
+            .as_ref()
+            .map_err(|&det| FemError::SingularPose { t: 0.0, det })?;
+        let nq = self.star_coordinates();
+        let mut mr = vec![[0.0; 3]; nq];
+        for &(r, col, v) in self.m.iter().filter(|&&(r, col, _)| r < nq && col < nq) {
+            for i in 0..3 {
+                mr[r][i] += v * rigid[col][i];
+            }
+        }
+        Ok((0..nq)
+            .flat_map(|r| (0..3).map(move |i| (r, i)))
+            .filter(|&(r, i)| mr[r][i] != 0.0)
+            .map(|(r, i)| (r, nq + i, -alpha * mr[r][i]))
+            .collect())
     }
 
     /// The dense system (entries summed in assembly order, so identical to assembling densely).
@@ -310,6 +359,7 @@ pub fn pose_triplets_with(
     if !payload.is_none() {
         m.extend(payload_triplets(payload, pose.theta));
     }
+    let rigid = rigid_field(params, &star, &q, pose);
     Ok(SparsePoseSystem {
         n,
         ne,
@@ -320,7 +370,26 @@ pub fn pose_triplets_with(
         sliders,
         theta: pose.theta,
         h: star.h,
+        rigid,
     })
+}
+
+/// `R` of Eq. D17 at the rest pose (star `star` at its coordinates `q`): the rigid velocity of
+/// every star coordinate per unit slider velocity, with the pins at the sleeves' centres
+/// `x_G + xp_i e_xi` (where the pins are at a rest pose); `Err(relative determinant)` at a
+/// singular pose.
+fn rigid_field(params: &RobotParams, star: &Star, q: &[f64], pose: &RestPose) -> Result<Vec<[f64; 3]>, f64> {
+    let pins = [0, 1, 2].map(|i| {
+        let ex = e_x(i, pose.theta);
+        [pose.g[0] + pose.xp[i] * ex[0], pose.g[1] + pose.xp[i] * ex[1]]
+    });
+    let axis = [0, 1, 2].map(|i| star.sleeve_angle(i, q));
+    let twist = RigidTwist::solve([q[0], q[1]], &pins, axis, params.l)?;
+    let mut r = vec![[0.0; 3]; star.n_dof];
+    for k in star.massive() {
+        r[k] = twist.per_slider.map(|w| star.rigid_velocity(q, w, k));
+    }
+    Ok(r)
 }
 
 /// The payload's mass matrix about G on node G's `(x, y, phi)` (Eq. P11 at `phi = 0`): `m` on
@@ -582,6 +651,59 @@ mod tests {
                 assert!((norm - 1.0).abs() < 1e-10 && perp_m < 1e-8, "{sliders:?} shape {j}");
             }
         }
+    }
+
+    /// `y = A x` for the triplets `a` of an `n`-row matrix.
+    fn times(a: &Triplets, x: &[f64], n: usize) -> Vec<f64> {
+        let mut y = vec![0.0; n];
+        for &(r, c, v) in a {
+            y[r] += v * x[c];
+        }
+        y
+    }
+
+    /// Eq. D18 against the modes of the eigensolver. Locked sliders: each M-normalised shape's
+    /// modal damping `x^T C x` is `alpha + beta omega^2` (Eq. D14's ratio times `2 omega`), to
+    /// round-off (1e-9; measured 4e-11). Free sliders: the three rigid modes (the null space of
+    /// K on the constraints, found by the dense eigensolver without Eq. D17) are left undamped by
+    /// `C`: `|C x|` below 1e-5 of `alpha |M_qq x_q|`, the force the naive `alpha M q'` would put
+    /// on them (measured 0.8-1.6e-7, the zero modes' accuracy: their omega^2 are 1e-7 of the
+    /// first elastic one, `free_sliders_give_three_rigid_modes`; a wrong `R` gives order 1).
+    #[test]
+    fn rayleigh_damping_matrix_damps_the_elastic_modes_only() {
+        let p = RobotParams::paper();
+        let pose = RestPose {
+            s: [0.0; 3],
+            g: [0.0; 2],
+            theta: 0.0,
+            xp: [p.d; 3],
+        };
+        let (alpha, beta) = (3.0, 2e-4);
+        let locked = pose_modes(&p, &pose, Sliders::Locked, 150, 4).unwrap();
+        let c = locked.system.damping_triplets(alpha, beta).unwrap();
+        for (x, w2) in locked.shapes.iter().zip(&locked.omega2) {
+            let xcx: f64 = times(&c, x, x.len()).iter().zip(x).map(|(a, b)| a * b).sum();
+            let want = alpha + beta * w2;
+            eprintln!("locked: x^T C x = {xcx:.12e}, alpha + beta omega^2 = {want:.12e}");
+            assert!((xcx - want).abs() < 1e-9 * want, "{xcx} vs {want}");
+        }
+        let free = pose_modes_dense(&p, &pose, Sliders::Free, 150, 1).unwrap();
+        let sys = &free.system;
+        let c = sys.damping_triplets(alpha, beta).unwrap();
+        let nq = sys.n - 3;
+        for x in &free.shapes[..free.rigid] {
+            let cx = times(&c, x, sys.n);
+            let mut xq = x.clone();
+            xq[nq..].iter_mut().for_each(|s| *s = 0.0);
+            let mx = times(&sys.m, &xq, sys.n);
+            let norm = |y: &[f64]| y[..nq].iter().map(|a| a * a).sum::<f64>().sqrt();
+            let (damped, naive) = (norm(&cx), alpha * norm(&mx));
+            eprintln!("free, rigid mode: |C x| = {damped:.3e}, naive alpha |M x| = {naive:.3e}");
+            assert!(naive > 0.0 && damped < 1e-5 * naive, "{damped} vs {naive}");
+            assert!(cx[nq..].iter().all(|v| *v == 0.0), "no damping on the slider rows");
+        }
+        // without alpha: Kelvin-Voigt's beta K alone, as before
+        assert_eq!(sys.damping_triplets(0.0, beta).unwrap().len(), sys.k.len());
     }
 
     /// Free sliders: three rigid modes (the mechanism), the elastic ones clearly above.

@@ -95,8 +95,9 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 /// - payload, damping and load, each only when its section is present (so a run at the defaults writes the
 ///   columns above and nothing else): `Ek_payload` (kinetic energy of the payload [J]) with a
 ///   `[payload]`, `W_load` (work of the load at G since t = 0 [J], trapezoidal rule on the steps)
-///   with a `[load]`, `E_d` (energy dissipated by the beams' Kelvin-Voigt damping since t = 0
-///   [J], Eq. D10) with a `[damping]`; the energy balance is then Eq. C6,
+///   with a `[load]`, `E_d` (energy dissipated since t = 0 [J] by the beams' Kelvin-Voigt
+///   damping, Eq. D10, and the mass-proportional damping of the elastic motion, Eq. D16) with a
+///   `[damping]`; the energy balance is then Eq. C6,
 ///   `W + W_load = Delta(Ek_star + Ek_sleeves + Ek_sliders + Ek_payload + U) + E_d`;
 /// - `shapes`: the deformed star at `settings.snapshots` and at t_end.
 ///
@@ -109,13 +110,6 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 /// Returns the response and the work counters (steps, Newton iterations, factorisations).
 pub fn solve(problem: &Problem, settings: &FemSettings, request: SolveRequest) -> Result<Solved<Stats>, FemError> {
     let problem = &problem.equal_beams().map_err(FemError::Problem)?;
-    if problem.damping.alpha() > 0.0 {
-        return Err(FemError::Problem(flexstar_model::ModelError::Unsupported {
-            what: "damping.alpha: the FEM's mass-proportional damping of the elastic motion is not built yet \
-                   (docs/amm.md 11.2.1; the AMM models it)"
-                .into(),
-        }));
-    }
     let (response, stats) = match request.drive {
         Drive::Motion => solve_prescribed(problem, settings, request.proof, request.progress)?,
         Drive::Law(law) => solve_direct(problem, settings, law, request.progress)?,

@@ -88,7 +88,7 @@ pub(crate) struct History {
 
 /// Work and dissipated energy since t = 0 [J], by the trapezoidal rule on the integration steps,
 /// with the powers [W] at the last step: the drivers' (`Fa . s'`), the load's at G (Eq. L2's
-/// `Fx x' + Fy y' + Mz phi'`) and the beams' dissipation (Eq. D10).
+/// `Fx x' + Fy y' + Mz phi'`) and the dissipation (Eqs. D10, D16).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Works {
     pub work: f64,
@@ -99,29 +99,30 @@ pub(crate) struct Works {
 
 impl Works {
     /// The powers at the state `st` (time `t`) with the drivers' forces `fa`.
-    fn powers(star: &Star, st: &State, fa: &[f64; 3], t: f64) -> [f64; 3] {
-        [
+    fn powers(star: &Star, st: &State, fa: &[f64; 3], t: f64) -> Result<[f64; 3], FemError> {
+        Ok([
             power(fa, &st.pins),
             star.load_power(&st.v, t),
-            star.dissipation_power(&st.q, &st.v),
-        ]
+            star.dissipation_power(&st.q, &st.v, &st.pins, t)?,
+        ])
     }
 
     /// Start at t = 0 (nothing done yet).
-    fn start(star: &Star, st: &State, fa: &[f64; 3]) -> Self {
-        Works {
-            powers: Self::powers(star, st, fa, 0.0),
+    fn start(star: &Star, st: &State, fa: &[f64; 3]) -> Result<Self, FemError> {
+        Ok(Works {
+            powers: Self::powers(star, st, fa, 0.0)?,
             ..Works::default()
-        }
+        })
     }
 
     /// One step of length `h` [s] ending at `t` in the state `st`.
-    fn advance(&mut self, star: &Star, st: &State, fa: &[f64; 3], t: f64, h: f64) {
-        let p = Self::powers(star, st, fa, t);
+    fn advance(&mut self, star: &Star, st: &State, fa: &[f64; 3], t: f64, h: f64) -> Result<(), FemError> {
+        let p = Self::powers(star, st, fa, t)?;
         self.work += 0.5 * h * (self.powers[0] + p[0]);
         self.w_load += 0.5 * h * (self.powers[1] + p[1]);
         self.e_d += 0.5 * h * (self.powers[2] + p[2]);
         self.powers = p;
+        Ok(())
     }
 }
 
@@ -179,6 +180,7 @@ fn initial_state(
             cf: 1.0,
             ck: 0.0,
             cv: 0.0,
+            cm: 1.0,
         },
         &mut res,
         0.0,
@@ -297,7 +299,7 @@ impl Stepper<'_, '_> {
         self.star.check_on_beams(&st.q, t)?;
         self.motion.check_feasible(params, &st.pins, t)?;
         let (fa, pf) = self.motion.forces(params, &st.pins, &st.lam, t)?;
-        self.works.advance(self.star, st, &fa, t, h);
+        self.works.advance(self.star, st, &fa, t, h)?;
         self.rec.record(params, self.star, st, fa, pf, t, self.works);
         Ok(())
     }
@@ -336,7 +338,7 @@ pub(crate) fn integrate(
     let mut rec = Recorder::new(t_out, snap_times);
     let mut stats = Stats::default();
     let (fa0, pf0) = motion.forces(params, &st.pins, &st.lam, 0.0)?;
-    let mut works = Works::start(&star, &st, &fa0);
+    let mut works = Works::start(&star, &st, &fa0)?;
     rec.record(params, &star, &st, fa0, pf0, 0.0, &works);
 
     let mut ws = Workspace::new(&star);
@@ -379,6 +381,6 @@ pub(crate) fn integrate(
         stats,
         payload: attached.payload.is_some(),
         load: attached.load.is_some(),
-        damping: attached.beta > 0.0,
+        damping: attached.beta > 0.0 || attached.alpha > 0.0,
     })
 }

@@ -31,7 +31,7 @@ pub(crate) struct Sample {
     pub ke_payload: f64,
     /// Work of the load at G since t = 0 [J] (0 without one; trapezoidal rule on the steps).
     pub w_load: f64,
-    /// Energy dissipated by the beams' damping since t = 0 [J] (Eq. D10; 0 undamped).
+    /// Energy dissipated by the damping since t = 0 [J] (Eqs. D10, D16; 0 undamped).
     pub e_d: f64,
     /// Slider positions s_i [m] and speeds s_i' [m/s] (prescribed, or simulated).
     pub s: [f64; 3],

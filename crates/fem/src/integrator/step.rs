@@ -209,7 +209,12 @@ fn newton_increment(
             sliders,
             load,
         },
-        Factors { cf: bp, ck: bp, cv: gp },
+        Factors {
+            cf: bp,
+            ck: bp,
+            cv: gp,
+            cm: 1.0,
+        },
         &mut ws.res,
         t1,
         stale,

@@ -1,6 +1,7 @@
 //! What an experiment attaches to the star (`docs/fem.md` section 9): a rigid payload welded to node G
 //! (Eqs. P10-P12), the beams' Kelvin-Voigt retardation time (Eqs. D6-D10, evaluated in the
-//! element pass) and a load at G (Eq. L2). Absent (the defaults), each adds nothing: its code path
+//! element pass), the mass-proportional damping of the elastic motion (Eqs. D16-D18, `rigid.rs`)
+//! and a load at G (Eq. L2). Absent (the defaults), each adds nothing: its code path
 //! is skipped, so the run is the bare star's bit for bit.
 
 use flexstar_model::geometry::{e_w, e_x};
@@ -81,6 +82,9 @@ pub(crate) struct Attached {
     pub payload: Option<PayloadAtG>,
     /// Kelvin-Voigt retardation time beta [s] of the beams (0: undamped).
     pub beta: f64,
+    /// Mass-proportional damping coefficient alpha [1/s] of the motion relative to the rigid
+    /// robot (Eq. D16; 0: none).
+    pub alpha: f64,
     /// The load at G, fixed frame.
     pub load: Option<LoadSettings>,
 }
@@ -92,6 +96,7 @@ impl Attached {
         Attached {
             payload: PayloadAtG::new(exp.payload, theta0),
             beta: exp.damping.beta(),
+            alpha: exp.damping.alpha(),
             load: (!exp.load.is_none()).then(|| exp.load.clone()),
         }
     }
@@ -113,11 +118,17 @@ impl Star {
             res[a] += cf * f[a];
         }
         if matrix {
-            let mp = p.mass_matrix(it.q[2]);
-            for a in 0..3 {
-                for b in 0..3 {
-                    self.vals[element_pass::block_index(0, 6 * a + b)] += mp[a][b];
-                }
+            self.add_payload_block(p, it.q[2], 1.0);
+        }
+    }
+
+    /// `scale M_p(phi)` (Eq. P11) into the G-G part of element 0's block (the border sums the
+    /// three beams' G-G parts; the sparse LU sums repeated slots).
+    pub(super) fn add_payload_block(&mut self, p: &PayloadAtG, phi: f64, scale: f64) {
+        let mp = p.mass_matrix(phi);
+        for a in 0..3 {
+            for b in 0..3 {
+                self.vals[element_pass::block_index(0, 6 * a + b)] += scale * mp[a][b];
             }
         }
     }
@@ -129,13 +140,19 @@ impl Star {
             .map_or(0.0, |p| p.kinetic_energy(&q[..3], &v[..3]))
     }
 
-    /// Dissipated power of the beams [W], Eq. D10 (0 undamped).
-    pub fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64 {
-        if self.attached.beta > 0.0 {
+    /// Dissipated power [W] at the coordinates `q`, velocities `v` and pins `pins` (time `t`
+    /// [s]): the beams' Kelvin-Voigt damping, Eq. D10, plus the mass-proportional damping's
+    /// `alpha v^T M (v - v_r)`, Eq. D16 (each 0 without its coefficient).
+    pub fn dissipation_power(&self, q: &[f64], v: &[f64], pins: &Pins, t: f64) -> Result<f64, FemError> {
+        let mut p = if self.attached.beta > 0.0 {
             element_pass::dissipation_power(&self.elements, q, v, self.section())
         } else {
             0.0
+        };
+        if self.attached.alpha > 0.0 {
+            p += self.mass_damping_power(q, v, pins, t)?;
         }
+        Ok(p)
     }
 
     /// Power of the load at G [W] at time `t` [s]: `Fx x' + Fy y' + Mz phi'` (0 without one).

@@ -39,9 +39,11 @@ use crate::FemError;
 
 mod attached;
 mod pattern;
+mod rigid;
 pub(crate) mod sleeve;
 
 pub(crate) use attached::Attached;
+pub(crate) use rigid::RigidTwist;
 use sleeve::{initial_sleeves, SLEEVE_COORDINATES};
 pub(crate) use sleeve::{pin_forces, ROWS, ROW_POINT};
 
@@ -150,6 +152,9 @@ pub(crate) struct Star {
     off_nu: usize,
     /// Payload, damping and load (`docs/fem.md` section 9; none by default).
     pub attached: Attached,
+    /// Work array of the mass-proportional damping: the shifted accelerations of Eq. D16
+    /// (`Star::shifted_accelerations`; empty without alpha).
+    shifted: Vec<f64>,
 }
 
 /// A sleeve must span at least two elements (its three contact points on distinct elements).
@@ -248,6 +253,7 @@ impl Star {
             off_sl: 0,
             off_nu: 0,
             attached: Attached::default(),
+            shifted: Vec::new(),
         };
         Ok((star, q, v))
     }
@@ -299,7 +305,10 @@ impl Star {
     /// out of the matrix: they are `O(h^2)` against the kept terms, see docs/fem.md.)
     /// Payload, damping and load (`docs/fem.md` section 9): the payload adds `cf f_p` (Eq. P11) to G's rows and
     /// `M_p` to the matrix, the load subtracts `cf (Fx, Fy, Mz)` from G's rows (Eq. L2), damping
-    /// enters the element forces (Eqs. D7, D9; `fac.cv` the velocity factor gamma').
+    /// enters the element forces (Eqs. D7, D9; `fac.cv` the velocity factor gamma'), and the
+    /// mass-proportional damping (alpha > 0, Eq. D16) the inertia forces through the shifted
+    /// accelerations `qdd + alpha (v - v_r)` on the nodes and sleeve rotations, with the matrix's
+    /// mass scaled by `1 + cv alpha` (Eq. D18); without alpha neither runs.
     /// Direct problem: `res[s_i] = cf ((mpp + mpa) s_i'' - Fa_i) - u_i . (nu_c + nu_l + nu_r)`,
     /// matrix diagonal `sliders.diag`, coupling `-u_i` with the sleeve's position rows.
     /// With `matrix == false` only the imbalance is evaluated (for a modified Newton iteration with
@@ -313,6 +322,14 @@ impl Star {
         t: f64,
         matrix: bool,
     ) -> Result<bool, FemError> {
+        let mut shifted = std::mem::take(&mut self.shifted);
+        let (it, fac) = if self.attached.alpha > 0.0 {
+            self.shifted_accelerations(&it, t, &mut shifted)?;
+            let cm = 1.0 + fac.cv * self.attached.alpha;
+            (Iterate { qdd: &shifted, ..it }, Factors { cm, ..fac })
+        } else {
+            (it, fac)
+        };
         let Iterate {
             q,
             v,
@@ -359,6 +376,10 @@ impl Star {
                 ))
             }
         }
+        if matrix && fac.cm != 1.0 {
+            self.add_mass_damping(q, fac.cm - 1.0);
+        }
+        self.shifted = shifted;
         self.check_imbalance(res, t)?;
         Ok(matrix)
     }
@@ -535,6 +556,7 @@ mod tests {
                 cf: bp,
                 ck: bp,
                 cv: 3e-4,
+                cm: 1.0,
             },
             &mut res,
             0.0,

@@ -178,7 +178,8 @@ fn coupled_step(
             row[k] = rec.sleeve_push(i, &st, &buf.qnew, dlam, sys.sleeves.axial());
         }
         row[i] += m + kp[i] * bp + kd[i] * gp;
-        row[3] = fa[i] - m * x_pred[i] - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
+        // Eq. 33 with the weight along the rail (Eq. G2)
+        row[3] = fa[i] + m * rec.gravity_along(i) - m * x_pred[i] - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
     }
     let dx = solve3(a).ok_or(AmmError::SingularConstraints {
         t,
@@ -262,7 +263,11 @@ fn integrate_direct(
         }
     }
     runs.push((n_modes, steps));
-    Ok(out.finish(settings, n_modes, dt_max, started))
+    let mut resp = out.finish(settings, n_modes, dt_max, started);
+    // the residual's reference: the static equilibrium where the reference motion rests
+    let scale = crate::solver::beam_time_scale(params);
+    resp.rest_offset = crate::static_start::rest_offset(&mut sys, problem, scale)?;
+    Ok(resp)
 }
 
 /// What every coupled step of one run borrows: the system, the step buffers, the actuator law
@@ -305,18 +310,24 @@ impl Predictors {
     }
 }
 
-/// The initial state: s, s' of the trajectory at t = 0, the star at rest elastically; consistent
-/// accelerations of both (bp = gp = 0: the step is linear, the solve exact).
+/// The initial state: s, s' of the trajectory at t = 0, the star at rest elastically (undeformed,
+/// or under gravity in the static equilibrium of the start pose with the sliders held, Eq. G4);
+/// consistent accelerations of both (bp = gp = 0: the step is linear, the solve exact).
 fn initial_state(
     problem: &EqualBeams,
     ctx: &mut StepContext,
     rec: &Recorder,
     n: usize,
 ) -> Result<DirectState, AmmError> {
-    let (q, v) = (vec![0.0; n], vec![0.0; n]);
+    let (mut q, v) = (vec![0.0; n], vec![0.0; n]);
     let mut qdd = vec![0.0; n];
     let jets = problem.trajectory.jets(ctx.params, 0.0)?;
     let (s, sd) = (jets.map(|j| j.v), jets.map(|j| j.d1));
+    if problem.gravity != [0.0; 2] {
+        let rest = rigid_at(ctx.params, s, [0.0; 3], [0.0; 3], 0.0)?;
+        let scale = crate::solver::beam_time_scale(ctx.params);
+        crate::static_start::static_equilibrium(ctx.sys, &rest, scale, &mut q)?;
+    }
     let sdd = coupled_step(
         ctx.sys,
         rec,

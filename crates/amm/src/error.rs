@@ -69,6 +69,10 @@ pub enum AmmError {
     /// The solution stopped being finite at time `t`.
     #[error("amm: t = {t:.6} s: the solution is no longer finite (step {dt:e} s)")]
     NonFinite { t: f64, dt: f64 },
+    /// The static equilibrium under gravity at the start pose did not converge (`change`: the
+    /// last relative change of the coordinates).
+    #[error("amm: t = {t:.6} s: the static equilibrium under gravity at the start pose did not converge (last relative change {change:.1e}): is the robot held at that pose?")]
+    StaticStart { t: f64, change: f64 },
     /// The run was stopped on request ([`flexstar_model::cancel`]) at output time `t` [s].
     #[error("amm: cancelled at t = {t} s")]
     Cancelled { t: f64 },

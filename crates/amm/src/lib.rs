@@ -31,6 +31,7 @@ mod geometric;
 pub mod modes;
 pub mod pose_modes;
 mod record;
+mod static_start;
 #[cfg(test)]
 mod rayleigh_decay;
 mod sleeve;
@@ -52,7 +53,7 @@ pub use solver::{
 /// the experiment has neither a payload nor a load.
 pub fn attachments_lost(family: flexstar_model::ModeFamily, problem: &flexstar_model::Problem) -> Option<String> {
     use flexstar_model::ModeFamily;
-    if problem.payload().is_none() && problem.load().is_none() {
+    if problem.payload().is_none() && problem.load().is_none() && problem.gravity() == [0.0; 2] {
         return None;
     }
     let lost = match family {
@@ -63,6 +64,6 @@ pub fn attachments_lost(family: flexstar_model::ModeFamily, problem: &flexstar_m
     };
     Some(format!(
         "the {family} family holds G by a hidden support and loses {lost} (docs/amm.md 11.1); \
-         the enriched (default) or free-free family carries the payload and the load completely"
+         the enriched (default) or free-free family carries the payload, the load and the weights completely"
     ))
 }

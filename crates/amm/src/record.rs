@@ -28,6 +28,8 @@ pub(crate) struct Recorder {
     nb: usize,
     full: bool,
     mpp_mpa: f64,
+    /// `g . u_i` [m/s^2]: gravity along each slider's rail (Eq. G2).
+    gravity_along: [f64; 3],
 }
 
 impl Recorder {
@@ -97,7 +99,16 @@ impl Recorder {
             nb,
             full: settings.model == AmmModel::Full,
             mpp_mpa: params.mpp_mpa,
+            gravity_along: [0, 1, 2].map(|i| {
+                let u = flexstar_model::geometry::slider_direction(i);
+                sys.gravity()[0] * u[0] + sys.gravity()[1] * u[1]
+            }),
         }
+    }
+
+    /// `g . u_i` [m/s^2] of slider i's rail (Eq. G2).
+    pub(crate) fn gravity_along(&self, i: usize) -> f64 {
+        self.gravity_along[i]
     }
 
     /// The multiplier of named column `k` (0 when the row is dropped).
@@ -155,7 +166,10 @@ impl Recorder {
             let w_g = [0, 1, 2].map(|i| beam_val(i, &self.phi0));
             let w_tip = [0, 1, 2].map(|i| beam_val(i, &self.phil));
             let fa = fa.unwrap_or_else(|| {
-                [0, 1, 2].map(|i| self.mpp_mpa * st.s[i].d2 + self.sleeve_push(i, st, q, lam, axial))
+                // Eq. 33 with the sleeve and slider's weight along the rail (Eq. G2)
+                [0, 1, 2].map(|i| {
+                    self.mpp_mpa * (st.s[i].d2 - self.gravity_along[i]) + self.sleeve_push(i, st, q, lam, axial)
+                })
             });
             self.resp.push(st.t, w_g, w_tip, fa);
             let dg = flexstar_metrics::residual::dg_vector(w_g, [0, 1, 2].map(|i| st.e_w(i)));

@@ -367,7 +367,7 @@ fn integrate_coarse<F: FnMut(&System, &[f64])>(
 pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, problem: &EqualBeams) -> Result<System, AmmError> {
     let modes = ModeSet::new(settings.family, n_modes, problem.robot)?;
     let mut sys = System::new(modes, problem.robot, settings.model);
-    sys.attach(problem.payload, problem.damping, problem.load);
+    sys.attach(problem.payload, problem.damping, problem.load, problem.gravity);
     Ok(sys)
 }
 
@@ -428,8 +428,12 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let kin =
         |t: f64| RigidState::at(params, problem.trajectory, t).map_err(|source| AmmError::Kinematics { t, source });
 
-    // consistent initial accelerations: M qdd = f + C^T lambda, C qdd = 0 (q = q' = 0)
+    // the start: undeformed, or under gravity the static equilibrium of the start pose (Eq. G4);
+    // then consistent initial accelerations: M qdd = f - K q + C^T lambda, C qdd = 0 (q' = 0)
     let mut st = kin(0.0)?;
+    if problem.gravity != [0.0; 2] {
+        crate::static_start::static_equilibrium(&mut sys, &st, beam_time_scale(params), &mut q)?;
+    }
     sys.solve(&st, 0.0, 0.0, &q, &v, &mut qdd).map_err(|e| match e {
         AmmError::SingularConstraints { t, source } => AmmError::TooFewModes {
             t,
@@ -482,6 +486,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     }
 
     let mut resp = rec.finish(format!("amm-{}", settings.family.name()));
+    resp.rest_offset = crate::static_start::rest_offset(&mut sys, problem, beam_time_scale(params))?;
     resp.info = run_info("amm", settings, n_modes, dt_max, started);
     Ok(resp)
 }
@@ -538,6 +543,7 @@ mod tests {
             payload: Default::default(),
             damping: Default::default(),
             load: Default::default(),
+            gravity: Default::default(),
             shaper: None,
             report: Default::default(),
             source: Default::default(),

@@ -263,6 +263,9 @@ pub(crate) struct System {
     beta: f64,
     /// Mass-proportional coefficient alpha [1/s] on the elastic coordinates (Eq. D19); 0: none.
     alpha: f64,
+    /// Gravity [m/s^2], base frame: the forcing reads the rigid acceleration of G as
+    /// `a_G - g` (`docs/as-built.md` 5, Eq. G1); `[0, 0]`: none.
+    gravity: [f64; 2],
     /// The load at G (Eq. L1); `None` without one.
     load: Option<LoadSettings>,
     /// Workspace of the payload's Woodbury correction, N + 2.
@@ -432,6 +435,7 @@ impl System {
             payload: None,
             beta: 0.0,
             alpha: 0.0,
+            gravity: [0.0; 2],
             load: None,
             pay_tmp: vec![0.0; nb],
             modes,
@@ -441,9 +445,11 @@ impl System {
     /// `docs/amm.md` section 11: the payload welded at G (Eqs. P1-P6, on beam 1's
     /// coordinates), the Rayleigh damping of the elastic coordinates, Kelvin-Voigt `beta` [s]
     /// (Eqs. D2-D3) and mass-proportional `alpha` [1/s] (Eq. D19), and the load at G (Eq. L1,
-    /// fixed frame). What is absent (no mass nor J, alpha = beta = 0, no load) adds no code path,
+    /// fixed frame), and gravity `[gx, gy]` [m/s^2] (Eq. G1). What is absent (no mass nor J,
+    /// alpha = beta = 0, no load, no gravity) adds no code path (gravity subtracts exact zeros),
     /// so the bare star's results stay bit for bit.
-    pub(crate) fn attach(&mut self, payload: &Payload, damping: &Damping, load: &LoadSettings) {
+    pub(crate) fn attach(&mut self, payload: &Payload, damping: &Damping, load: &LoadSettings, gravity: [f64; 2]) {
+        self.gravity = gravity;
         self.payload = PayloadTerms::new(payload, self.beams[0].ids.len());
         (self.alpha, self.beta) = damping.coefficients();
         self.load = (!load.is_none()).then(|| load.clone());
@@ -571,7 +577,7 @@ impl System {
         let (nm, nb, rho, l) = (self.nm, self.nb, self.rho, self.l);
         let thd = st.theta.d1;
         let thdd = st.theta.d2;
-        let ag = st.a_g();
+        let ag = self.apparent_a_g(st);
         if let Some(geo) = self.geometric.as_mut() {
             geo.multiply(qhat, nb);
         }
@@ -657,14 +663,27 @@ impl System {
         [q[nm], dot(&self.phi0, &q[..nm]), dot(&self.dphi0, &q[..nm])]
     }
 
-    /// The rigid quantities of the payload's terms ([`RigidTerms`]) on beam 1's frame at `st`.
-    fn payload_motion(st: &RigidState) -> RigidTerms {
-        Self::payload_motion_along(st, st.e_x(0))
+    /// Gravity `[gx, gy]` [m/s^2], base frame.
+    pub(crate) fn gravity(&self) -> [f64; 2] {
+        self.gravity
     }
 
-    /// [`System::payload_motion`] with beam 1's axis `ex = e_x1` given.
-    fn payload_motion_along(st: &RigidState, ex: [f64; 2]) -> RigidTerms {
-        let ag = st.a_g();
+    /// Eq. G1: the rigid acceleration of G less gravity, `a_G - g` [m/s^2], base frame: the
+    /// weight of every mass element of the star and the payload enters the equations as a
+    /// uniform acceleration of the base, opposite to g.
+    fn apparent_a_g(&self, st: &RigidState) -> [f64; 2] {
+        let a = st.a_g();
+        [a[0] - self.gravity[0], a[1] - self.gravity[1]]
+    }
+
+    /// The rigid quantities of the payload's terms ([`RigidTerms`]) on beam 1's frame at `st`.
+    fn payload_motion(&self, st: &RigidState) -> RigidTerms {
+        self.payload_motion_along(st, st.e_x(0))
+    }
+
+    /// [`System::payload_motion`] with beam 1's axis `ex = e_x1` given (gravity in, Eq. G1).
+    fn payload_motion_along(&self, st: &RigidState, ex: [f64; 2]) -> RigidTerms {
+        let ag = self.apparent_a_g(st);
         let ew = [-ex[1], ex[0]];
         let thd = st.theta.d1;
         [
@@ -686,7 +705,7 @@ impl System {
         let ew = [-ex[1], ex[0]];
         let mut rp = [0.0; 3];
         if let Some(pl) = &self.payload {
-            let x = change.unwrap_or_else(|| Self::payload_motion_along(st, ex));
+            let x = change.unwrap_or_else(|| self.payload_motion_along(st, ex));
             let (zq, zv) = (self.payload_coordinates(qhat), self.payload_coordinates(vhat));
             rp = pl.forcing(x, zq, zv);
             if change.is_none() && self.alpha > 0.0 {
@@ -821,7 +840,7 @@ impl System {
         self.sleeves.add_compliance(&mut self.a, m, &self.beams, bp);
         self.add_axial_flexibility(bp);
         if self.payload.is_some() {
-            self.payload_block(st, Self::payload_motion(st), bp, gp)?;
+            self.payload_block(st, self.payload_motion(st), bp, gp)?;
         }
         self.lu
             .factor(&self.a)

@@ -25,6 +25,7 @@ use flexstar_model::{
 /// undamped elastic transient is real but no part of the rigid limit).
 fn attached() -> Attachments {
     Attachments {
+        gravity: Default::default(),
         payload: Payload {
             mass: 0.8,
             j: 3e-3,

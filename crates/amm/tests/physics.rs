@@ -6,7 +6,7 @@ mod common;
 
 use common::{evp, max_abs, paper_case, settings};
 use flexstar_amm::{AmmError, DEFAULT_DT, EXTRA_COLUMNS, SHAPE_POINTS};
-use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
+use flexstar_kinematics::{rigid_inverse_dynamics_with, RigidState};
 use flexstar_model::response::RESPONSE_HEADER;
 use flexstar_model::{ModeFamily, Pose, Response, RobotParams, Trajectory};
 
@@ -129,13 +129,16 @@ fn slide_free_has_no_slope_moments_and_free_free_balances_them() {
 
 /// Largest |Fa_amm - Fa_rigid| over time and actuators, relative to the largest |Fa_rigid|.
 fn stiff_limit_error(fam: ModeFamily, to: Pose) -> f64 {
-    stiff_limit_error_with(&settings(fam, 10, Some(1e-4)), to)
+    stiff_limit_error_with(&settings(fam, 10, Some(1e-4)), to, [0.0; 2])
 }
 
-fn stiff_limit_error_with(amm: &flexstar_model::AmmSettings, to: Pose) -> f64 {
+/// [`stiff_limit_error`] of the AMM with `amm`'s settings under gravity `g` [m/s^2].
+fn stiff_limit_error_with(amm: &flexstar_model::AmmSettings, to: Pose, g: [f64; 2]) -> f64 {
     let mut p = RobotParams::paper();
     p.e *= 1e4;
     let mut exp = common::quintic(p, 0.5);
+    exp.gravity = flexstar_model::Gravity::new(g);
+    let attached = flexstar_model::Attachments::of(&exp);
     exp.trajectory = Trajectory::Quintic {
         from: Pose {
             gx: 0.0,
@@ -150,7 +153,7 @@ fn stiff_limit_error_with(amm: &flexstar_model::AmmSettings, to: Pose) -> f64 {
     let (mut err, mut scale) = (0.0f64, 0.0f64);
     for k in 0..r.len() {
         let st = RigidState::at(&p, &exp.trajectory, r.t[k]).unwrap();
-        let rigid = rigid_inverse_dynamics(&p, &st);
+        let rigid = rigid_inverse_dynamics_with(&p, &attached, &st);
         for i in 0..3 {
             err = err.max((r.fa[i][k] - rigid.fa[i]).abs());
             scale = scale.max(rigid.fa[i].abs());
@@ -221,13 +224,36 @@ fn stiff_accurate_model_reproduces_rigid_inverse_dynamics() {
             theta: 0.0,
         },
     ] {
-        let e = stiff_limit_error_with(&accurate, to);
+        let e = stiff_limit_error_with(&accurate, to, [0.0; 2]);
         eprintln!("enriched, full, to {to:?}: {:.3} %", e * 100.0);
         assert!(
             e < 5e-3,
             "to {to:?}: Fa off the rigid inverse dynamics by {:.3} %",
             e * 100.0
         );
+    }
+}
+
+/// `docs/as-built.md` 5: under gravity in any in-plane direction, started in the static
+/// equilibrium of the start pose, the stiff star's Fa reach the rigid-body inverse dynamics with
+/// the weights (Eqs. G1-G3; the rigid side is checked against the potential energy's gradient in
+/// the kinematics tests).
+#[test]
+fn stiff_star_under_gravity_reproduces_rigid_inverse_dynamics() {
+    let accurate = flexstar_model::AmmSettings {
+        modes: Some(12),
+        dt: Some(1e-4),
+        ..flexstar_model::AmmSettings::accurate()
+    };
+    let to = Pose {
+        gx: 0.03,
+        gy: -0.02,
+        theta: 0.3,
+    };
+    for g in [[0.0, -9.81], [6.0, 7.76], [-9.81, 0.0]] {
+        let e = stiff_limit_error_with(&accurate, to, g);
+        eprintln!("enriched, full, g = {g:?}: {:.3} %", e * 100.0);
+        assert!(e < 5e-3, "g = {g:?}: Fa off the rigid inverse dynamics by {:.3} %", e * 100.0);
     }
 }
 

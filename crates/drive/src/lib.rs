@@ -69,6 +69,7 @@ pub fn law_for(problem: &EqualBeams) -> Result<Option<Box<dyn ActuatorLaw>>, Dri
                 attached: flexstar_model::Attachments {
                     payload: *problem.payload,
                     load: problem.load.clone(),
+                    gravity: flexstar_model::Gravity::new(problem.gravity),
                 },
             }))
         }

@@ -112,6 +112,7 @@ fn forward_dynamics_with_payload_and_load_follows_the_motion() {
     let params = exp.robot;
     let trajectory = flexstar_model::catalogue::quintic_from_origin(flexstar_model::catalogue::GENERAL_TARGET, 0.4);
     let attached = Attachments {
+        gravity: Default::default(),
         payload: Payload {
             mass: 0.8,
             j: 3e-3,

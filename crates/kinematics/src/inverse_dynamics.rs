@@ -21,6 +21,9 @@
 //! (3 rho L + m) a_G + m (theta'' k x r - theta'^2 r)        = sum_i f_i e_wi + F
 //! (rho L^3 + 3 Jp + J + m |r|^2) theta'' + m (r x a_G)      = sum_i xp_i f_i + Mz
 //! ```
+//! Under gravity g (`docs/as-built.md` 5, Eqs. G1-G3) every weight is a uniform acceleration of
+//! the base opposite to g: `a_G` reads `a_G - g` in both, and `s_i''` reads `s_i'' - g . u_i` in
+//! Eq. 33 (the sleeve and the slider, whose centre of mass is on the pin, weigh on the rail).
 
 use flexstar_model::geometry::slider_direction;
 use flexstar_model::{Attachments, RobotParams};
@@ -52,7 +55,10 @@ pub fn rigid_inverse_dynamics_with(params: &RobotParams, attached: &Attachments,
     if attached.is_none() {
         return rigid_inverse_dynamics(params, state);
     }
+    // Eq. G1: the rigid acceleration of G less gravity
+    let g = attached.gravity.g;
     let a = state.a_g();
+    let a = [a[0] - g[0], a[1] - g[1]];
     let (th1, th2) = (state.theta.d1, state.theta.d2);
     let p = &attached.payload;
     let (ex, ew) = (state.e_x(0), state.e_w(0));
@@ -64,7 +70,12 @@ pub fn rigid_inverse_dynamics_with(params: &RobotParams, attached: &Attachments,
     let j = params.star_inertia() + 3.0 * params.jp + p.inertia_about_g();
     let newton = |c: usize, f: f64| m * a[c] + p.mass * (th2 * kr[c] - th1 * th1 * r[c]) - f;
     let euler = j * th2 + p.mass * (r[0] * a[1] - r[1] * a[0]) - mz;
-    forces_for(params, state, [newton(0, fx), newton(1, fy), euler])
+    let mut forces = forces_for(params, state, [newton(0, fx), newton(1, fy), euler]);
+    // Eq. G2: the sleeve and slider's weight along the rail
+    for (i, fa) in forces.fa.iter_mut().enumerate() {
+        *fa -= params.mpp_mpa * dot(g, slider_direction(i));
+    }
+    forces
 }
 
 /// The sleeves' normal forces that give the star the resultant `rhs = (Fx, Fy, Mz about G)` [N,

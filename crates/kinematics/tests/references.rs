@@ -263,6 +263,7 @@ fn rigid_inverse_dynamics_with_payload_and_load_balances_power() {
     use flexstar_model::{Attachments, LoadSettings, Payload};
     let p = paper();
     let attached = Attachments {
+        gravity: Default::default(),
         payload: Payload {
             mass: 0.7,
             j: 2e-3,
@@ -374,4 +375,96 @@ fn a_checked_motion_covers_only_what_was_checked() {
     let at = |t: f64| fast.s(&p, t).expect("a polynomial evaluates everywhere");
     assert!(check_configuration(&p, at(refused.t - 1e-6)).is_ok(), "{refused}");
     assert!(check_configuration(&p, at(refused.t + 1e-6)).is_err(), "{refused}");
+}
+
+/// `docs/as-built.md` 5 (Eqs. G1-G3) against two identities Newton-Euler does not use. At rest,
+/// the drivers hold the weights: `Fa_i = dV/ds_i`, V the potential energy of the star (its mass
+/// at G), the sleeves and sliders (on the pins) and the payload, differentiated by central
+/// differences of the direct kinematics. Moving, the drivers' power is `dT/dt + dV/dt`.
+#[test]
+fn rigid_inverse_dynamics_under_gravity_holds_the_weights() {
+    use flexstar_model::{Attachments, Gravity, Payload};
+    let p = paper();
+    let g = [2.5, -9.49];
+    let attached = Attachments {
+        gravity: Gravity::new(g),
+        payload: Payload {
+            mass: 0.7,
+            j: 2e-3,
+            offset: [0.03, -0.02],
+        },
+        load: Default::default(),
+    };
+    let m_p = attached.payload.mass;
+    // the payload's centre of mass at the pose of s
+    let centre = |gc: [f64; 2], theta: f64| {
+        let o = attached.payload.offset;
+        let (ex, ew) = ([theta.sin(), -theta.cos()], [theta.cos(), theta.sin()]);
+        [0, 1].map(|k| gc[k] + o[0] * ex[k] + o[1] * ew[k])
+    };
+    let potential = |s: [f64; 3]| {
+        let pose = flexstar_kinematics::direct_kinematics(p.d, s).unwrap();
+        let c = centre(pose.g, pose.theta);
+        let height = |x: [f64; 2]| -(g[0] * x[0] + g[1] * x[1]);
+        p.star_mass() * height(pose.g)
+            + p.mpp_mpa * (0..3).map(|i| height(revolute_point(i, p.d, s[i]))).sum::<f64>()
+            + m_p * height(c)
+    };
+    let s0 = [0.02, -0.03, 0.01];
+    let still = Trajectory::Polynomial {
+        s1: vec![s0[0]],
+        s2: vec![s0[1]],
+        s3: vec![s0[2]],
+    };
+    let st = RigidState::at(&p, &still, 0.0).unwrap();
+    let f = flexstar_kinematics::rigid_inverse_dynamics_with(&p, &attached, &st);
+    let h = 1e-6;
+    for i in 0..3 {
+        let (mut up, mut down) = (s0, s0);
+        up[i] += h;
+        down[i] -= h;
+        let grad = (potential(up) - potential(down)) / (2.0 * h);
+        assert!((f.fa[i] - grad).abs() < 1e-7 * (1.0 + grad.abs()), "slider {}: {} vs {grad}", i + 1, f.fa[i]);
+    }
+    // moving: power = dT/dt + dV/dt
+    let tr = Trajectory::Quintic {
+        from: Pose {
+            gx: 0.0,
+            gy: 0.0,
+            theta: 0.0,
+        },
+        to: Pose {
+            gx: 0.03,
+            gy: -0.02,
+            theta: 0.3,
+        },
+        t0: 0.0,
+        t1: 0.5,
+    };
+    for t in [0.1, 0.25, 0.4] {
+        let st = RigidState::at(&p, &tr, t).unwrap();
+        let f = flexstar_kinematics::rigid_inverse_dynamics_with(&p, &attached, &st);
+        let (w, wd) = (st.theta.d1, st.theta.d2);
+        let power: f64 = (0..3).map(|i| f.fa[i] * st.s[i].d1).sum();
+        let r = {
+            let c = centre([0.0; 2], st.theta.v);
+            [c[0], c[1]]
+        };
+        let kr = [-r[1], r[0]];
+        let vc = [st.g[0].d1 + w * kr[0], st.g[1].d1 + w * kr[1]];
+        let ac = [0, 1].map(|k| st.g[k].d2 + wd * kr[k] - w * w * r[k]);
+        let dtdt = p.star_mass() * (st.g[0].d1 * st.g[0].d2 + st.g[1].d1 * st.g[1].d2)
+            + (p.star_inertia() + 3.0 * p.jp) * w * wd
+            + p.mpp_mpa * (0..3).map(|i| st.s[i].d1 * st.s[i].d2).sum::<f64>()
+            + m_p * (vc[0] * ac[0] + vc[1] * ac[1])
+            + attached.payload.j * w * wd;
+        let dot_g = |v: [f64; 2]| g[0] * v[0] + g[1] * v[1];
+        let dvdt = -(p.star_mass() * dot_g([st.g[0].d1, st.g[1].d1])
+            + p.mpp_mpa * (0..3).map(|i| st.s[i].d1 * dot_g(slider_direction(i))).sum::<f64>()
+            + m_p * dot_g(vc));
+        assert!(
+            (power - dtdt - dvdt).abs() < 1e-10 * (1.0 + power.abs()),
+            "t={t}: {power} vs {dtdt} + {dvdt}"
+        );
+    }
 }

@@ -122,7 +122,7 @@ pub fn outside_envelope(
         }
     }
     if attachments {
-        why.push("a payload, damping or a load at G: not part of the envelope study".into());
+        why.push("a payload, damping, a load at G or gravity: not part of the envelope study".into());
     }
     if !small_deflection {
         why.push("the run leaves the small-deflection range".into());

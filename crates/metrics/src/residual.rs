@@ -74,7 +74,8 @@ impl Residual {
     }
 }
 
-/// The residual of `r` after `t_rest` [s]: peaks and RMS of |dG| and of the tips, and the
+/// The residual of `r` after `t_rest` [s]: peaks and RMS of |dG| and of the tips (about the
+/// static equilibrium of the rest pose, `Response::rest_offset`, under gravity), and the
 /// settling time in the band `settle_tol` [m]. Settled when the run ends with at least `hold_s`
 /// [s] below the band after its last excursion (one period of the first elastic mode at the final
 /// pose: an undamped oscillation above the band leaves it at least twice a period, so it never
@@ -85,17 +86,19 @@ pub fn residual_after(r: &Response, t_rest: f64, settle_tol: f64, hold_s: f64) -
         return None;
     }
     let t = &r.t[first..];
+    // about the static equilibrium where the motion rests (under gravity; else zero)
+    let offset = r.rest_offset.unwrap_or_default();
+    let w_g = |i: usize, k: usize| r.w_g[i][k] - offset.w_g[i];
+    let w_tip = |i: usize, k: usize| r.w_tip[i][k] - offset.w_tip[i];
     let dg: Vec<f64> = (first..r.t.len())
-        .map(|k| dg_magnitude([r.w_g[0][k], r.w_g[1][k], r.w_g[2][k]]))
+        .map(|k| dg_magnitude([w_g(0, k), w_g(1, k), w_g(2, k)]))
         .collect();
     let tip_mean: Vec<f64> = (first..r.t.len())
-        .map(|k| (r.w_tip.iter().map(|w| w[k] * w[k]).sum::<f64>() / 3.0).sqrt())
+        .map(|k| ((0..3).map(|i| w_tip(i, k) * w_tip(i, k)).sum::<f64>() / 3.0).sqrt())
         .collect();
-    let tip_peak_m = r
-        .w_tip
-        .iter()
-        .flat_map(|w| &w[first..])
-        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let tip_peak_m = (0..3)
+        .flat_map(|i| (first..r.t.len()).map(move |k| (i, k)))
+        .fold(0.0f64, |m, (i, k)| m.max(w_tip(i, k).abs()));
     let t_end = *t.last().unwrap_or(&t_rest);
     let last_out = t
         .iter()
@@ -486,5 +489,29 @@ mod tests {
         let keys = keys_of(Some(&res), 1e-4, true);
         assert!(keys["settle_s"].is_null() && keys["residual_G_peak_m"].is_null());
         assert_eq!(keys["residual_note"], "G is pinned in this family");
+    }
+
+    /// `docs/as-built.md` 5.5: under gravity the residual is measured about the static
+    /// equilibrium where the motion rests: a vibration about a sag has the vibration's peak, and
+    /// a sag alone settles at t_rest.
+    #[test]
+    fn under_gravity_the_residual_is_measured_about_the_rest_sag() {
+        let ts = grid(1.0, 1e-3);
+        let sag = [2e-4, -3e-3];
+        let w = 2.0 * std::f64::consts::PI * 4.0;
+        let e_w = frames(0.3);
+        let offset = flexstar_model::RestOffset {
+            t_rest: 0.4,
+            w_g: e_w.map(|e| sag[0] * e[0] + sag[1] * e[1]),
+            w_tip: [-2e-3, 0.0, 0.0],
+        };
+        let mut r = response(&ts, |t| [sag[0] + 5e-4 * (w * t).cos(), sag[1]], |_| -2e-3);
+        r.rest_offset = Some(offset);
+        let res = residual_after(&r, 0.4, 1e-4, 0.1).unwrap();
+        assert!((res.g_peak_m - 5e-4).abs() < 1e-9 && res.tip_peak_m < 1e-15, "{res:?}");
+        let mut still = response(&ts, |_| sag, |_| -2e-3);
+        still.rest_offset = Some(offset);
+        let res = residual_after(&still, 0.4, 1e-4, 0.1).unwrap();
+        assert!(res.g_peak_m < 1e-15 && res.settle_s == Some(0.4), "{res:?}");
     }
 }

@@ -179,28 +179,31 @@ impl LoadSettings {
     }
 }
 
-/// The payload and the load of an experiment together: what a rigid-body dynamics of the star
-/// needs beyond [`crate::RobotParams`] (the damping does no work on a rigid motion).
+/// The payload, the load and gravity of an experiment together: what a rigid-body dynamics of
+/// the star needs beyond [`crate::RobotParams`] (the damping does no work on a rigid motion).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Attachments {
     /// The payload welded at G.
     pub payload: Payload,
     /// The load at G.
     pub load: LoadSettings,
+    /// Gravity in the plane (`docs/as-built.md` 5).
+    pub gravity: crate::Gravity,
 }
 
 impl Attachments {
-    /// The payload and load of an experiment.
+    /// The payload, load and gravity of an experiment.
     pub fn of(exp: &crate::Experiment) -> Self {
         Attachments {
             payload: exp.payload,
             load: exp.load.clone(),
+            gravity: exp.gravity,
         }
     }
 
-    /// Neither payload nor load: the paper's bare star.
+    /// Neither payload nor load nor gravity: the paper's bare star.
     pub fn is_none(&self) -> bool {
-        self.payload.is_none() && self.load.is_none()
+        self.payload.is_none() && self.load.is_none() && self.gravity.is_none()
     }
 }
 

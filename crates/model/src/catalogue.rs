@@ -40,6 +40,7 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         payload: Default::default(),
         damping: Default::default(),
         load: Default::default(),
+        gravity: Default::default(),
         shaper: None,
         report: Default::default(),
         source: Default::default(),

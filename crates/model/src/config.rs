@@ -413,12 +413,16 @@ pub struct Experiment {
     /// A rigid body welded at G (`[payload]`, `docs/amm.md` section 11); none by default.
     #[serde(default)]
     pub payload: Payload,
-    /// Kelvin-Voigt damping of the beams (`[damping]`, `docs/amm.md` section 11); none by default.
+    /// Rayleigh damping of the elastic motion (`[damping]`, `docs/amm.md` 11.2); none by default.
     #[serde(default)]
     pub damping: Damping,
     /// Force and moment at G (`[load]`, `docs/amm.md` section 11); none by default.
     #[serde(default)]
     pub load: LoadSettings,
+    /// Gravity in the plane (`[gravity]`, `docs/as-built.md` 5); none by default (and then
+    /// absent from the resolved experiment, so that the experiment's hash is unchanged).
+    #[serde(default, skip_serializing_if = "crate::Gravity::is_none")]
+    pub gravity: crate::Gravity,
     /// Input shaping of the motion (`[shaper]`, `docs/motions.md` 3.7); none by
     /// default. Given frequencies are applied when the file is read ([`Experiment::apply_shaper`]);
     /// `f_hz = "auto"` waits for the explicit step `flexstar_shaping::shape`.

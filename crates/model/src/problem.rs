@@ -24,6 +24,7 @@ pub struct Problem {
     payload: Payload,
     damping: Damping,
     load: LoadSettings,
+    gravity: [f64; 2],
 }
 
 impl Problem {
@@ -54,6 +55,7 @@ impl Problem {
             payload: exp.payload,
             damping: exp.damping,
             load: exp.load.clone(),
+            gravity: exp.gravity.g,
         })
     }
 
@@ -75,6 +77,7 @@ impl Problem {
             payload: &self.payload,
             damping: &self.damping,
             load: &self.load,
+            gravity: self.gravity,
         })
     }
 
@@ -118,6 +121,11 @@ impl Problem {
     pub fn load(&self) -> &LoadSettings {
         &self.load
     }
+
+    /// Gravity `[gx, gy]` [m/s^2], base frame (`docs/as-built.md` 5); `[0, 0]`: none.
+    pub fn gravity(&self) -> [f64; 2] {
+        self.gravity
+    }
 }
 
 /// Check every physical value of `exp` (all but a pending shaper): the robot it describes.
@@ -130,6 +138,7 @@ pub(crate) fn check_physics(exp: &Experiment) -> Result<Robot, ModelError> {
     exp.payload.validate()?;
     exp.damping.validate()?;
     exp.load.validate(exp.time.t_end)?;
+    exp.gravity.validate()?;
     Ok(robot)
 }
 
@@ -146,6 +155,8 @@ pub struct EqualBeams<'a> {
     pub payload: &'a Payload,
     pub damping: &'a Damping,
     pub load: &'a LoadSettings,
+    /// Gravity `[gx, gy]` [m/s^2], base frame.
+    pub gravity: [f64; 2],
 }
 
 impl Experiment {

@@ -89,6 +89,21 @@ pub struct Response {
     pub shapes: Vec<StarShape>,
     /// Animation frames (`[amm] frames`, `[fem] frames`; empty without), `docs/motions.md` 5.
     pub frames: Vec<crate::animation::Frame>,
+    /// Under gravity: the static deflection at the pose where the motion comes to rest, about
+    /// which its residual vibration is measured (`docs/as-built.md` 5.5); `None` without gravity
+    /// or without a rest.
+    pub rest_offset: Option<RestOffset>,
+}
+
+/// The static equilibrium's elastic outputs at the final rest pose (`docs/as-built.md` 5.5).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct RestOffset {
+    /// The time the motion comes to rest [s] (`Trajectory::t_rest`).
+    pub t_rest: f64,
+    /// `w_iG` [m] of the static equilibrium there.
+    pub w_g: [f64; 3],
+    /// Tip `w_i(L)` [m] of the static equilibrium there.
+    pub w_tip: [f64; 3],
 }
 
 impl Response {
@@ -105,6 +120,7 @@ impl Response {
             shapes: Vec::new(),
             frames: Vec::new(),
             info: RunInfo::default(),
+            rest_offset: None,
         }
     }
 
@@ -161,6 +177,7 @@ impl Response {
                 .collect(),
             shapes: self.shapes.clone(),
             frames: self.frames.clone(),
+            rest_offset: self.rest_offset,
         }
     }
 
@@ -378,6 +395,7 @@ impl Response {
             column_units: column_units(&self.header()),
             experiment: self.resolved_experiment(experiment),
             residual: None,
+            rest_offset: self.rest_offset,
             frames_hash: None,
             validated_envelope: None,
             validated_envelope_reasons: None,

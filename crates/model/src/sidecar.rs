@@ -105,6 +105,10 @@ pub struct RunSidecar {
     pub experiment: Experiment,
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub residual: Option<ResidualKeys>,
+    /// Under gravity: the static deflection where the motion rests, about which the residual is
+    /// measured (`docs/as-built.md` 5.5).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rest_offset: Option<crate::RestOffset>,
     /// The hash of the run's frames files (`crate::animation::FRAMES_HASH_KEY`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frames_hash: Option<String>,

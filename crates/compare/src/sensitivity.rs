@@ -122,11 +122,12 @@ fn list(f: &[f64]) -> String {
 }
 
 /// The peak of `|dG| = sqrt(2/3 sum_i w_iG^2)` [m] (the elastic displacement of G in the fixed
-/// frame from its three rigid-frame components, docs/motions.md section 2) at `t >= t_rest`.
+/// frame from its three rigid-frame components, docs/motions.md section 2) at `t >= t_rest`,
+/// about the rest pose's static equilibrium under gravity (`Response::w_g_about_rest`).
 fn residual_peak(r: &Response, t_rest: f64) -> f64 {
     (0..r.t.len())
         .filter(|&k| r.t[k] >= t_rest - 1e-12)
-        .map(|k| flexstar_metrics::residual::dg_magnitude([r.w_g[0][k], r.w_g[1][k], r.w_g[2][k]]))
+        .map(|k| flexstar_metrics::residual::dg_magnitude([0, 1, 2].map(|i| r.w_g_about_rest(i, k))))
         .fold(0.0, f64::max)
 }
 

@@ -88,7 +88,7 @@ pub fn residual_after(r: &Response, t_rest: f64, settle_tol: f64, hold_s: f64) -
     let t = &r.t[first..];
     // about the static equilibrium where the motion rests (under gravity; else zero)
     let offset = r.rest_offset.unwrap_or_default();
-    let w_g = |i: usize, k: usize| r.w_g[i][k] - offset.w_g[i];
+    let w_g = |i: usize, k: usize| r.w_g_about_rest(i, k);
     let w_tip = |i: usize, k: usize| r.w_tip[i][k] - offset.w_tip[i];
     let dg: Vec<f64> = (first..r.t.len())
         .map(|k| dg_magnitude([w_g(0, k), w_g(1, k), w_g(2, k)]))

@@ -181,6 +181,13 @@ impl Response {
         }
     }
 
+    /// `w_iG` [m] at row k about the static equilibrium where the motion rests
+    /// ([`Response::rest_offset`], under gravity; else `w_iG` itself): what residual vibration
+    /// measures (`docs/as-built.md` 5.5).
+    pub fn w_g_about_rest(&self, i: usize, k: usize) -> f64 {
+        self.w_g[i][k] - self.rest_offset.map_or(0.0, |o| o.w_g[i])
+    }
+
     /// Number of output rows.
     pub fn len(&self) -> usize {
         self.t.len()

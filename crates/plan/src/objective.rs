@@ -173,17 +173,19 @@ fn after(resp: &Response, t_rest: f64) -> std::ops::Range<usize> {
     resp.t.partition_point(|&t| t < t_rest - 1e-12)..resp.t.len()
 }
 
-/// `sqrt(2/3) w_iG(t_k) / sqrt(n)` for the rows at or after `t_rest` (module docs).
+/// `sqrt(2/3) w_iG(t_k) / sqrt(n)` for the rows at or after `t_rest` (module docs), about the
+/// static equilibrium of the rest pose under gravity (`Response::w_g_about_rest`).
 pub fn residual_vector(resp: &Response, t_rest: f64) -> Vec<f64> {
     let rows = after(resp, t_rest);
     let scale = (2.0 / 3.0 / rows.len().max(1) as f64).sqrt();
-    rows.flat_map(|k| (0..3).map(move |i| scale * resp.w_g[i][k])).collect()
+    rows.flat_map(|k| (0..3).map(move |i| scale * resp.w_g_about_rest(i, k)))
+        .collect()
 }
 
-/// Peak |dG| [m] at or after `t_rest`.
+/// Peak |dG| [m] at or after `t_rest` (about the rest pose's static equilibrium under gravity).
 pub fn window_peak(resp: &Response, t_rest: f64) -> f64 {
     after(resp, t_rest)
-        .map(|k| dg_magnitude([resp.w_g[0][k], resp.w_g[1][k], resp.w_g[2][k]]))
+        .map(|k| dg_magnitude([0, 1, 2].map(|i| resp.w_g_about_rest(i, k))))
         .fold(0.0, f64::max)
 }
 

@@ -218,7 +218,7 @@ def modal(
     """Modes at a pose (``at`` = time of the trajectory [s], or ``pose`` = (Gx, Gy, theta)),
     AMM and FEM side by side: ``{"mode", "amm_hz", "fem_hz", "rigid", "pose"}``; with
     ``sliders="free"`` the three rigid modes (0 Hz) come first. With a ``[damping]`` section also
-    ``"zeta_amm"``, ``"zeta_fem"``: each model's damping ratio ``beta omega / 2`` of the mode."""
+    ``"zeta_amm"``, ``"zeta_fem"``: each model's damping ratio ``alpha / (2 omega) + beta omega / 2`` of the mode."""
     return _flexstar.modal(exp._inner, at, None if pose is None else tuple(pose), sliders, modes)
 
 

@@ -30,15 +30,60 @@ pub enum ShaperKind {
     /// Extra-insensitive: three impulses over one damped period, residual `v_tol` at the design
     /// frequency with zero slope.
     Ei,
+    /// Two-hump extra-insensitive: four impulses over 1.5 damped periods, residual `v_tol` at two
+    /// humps around the design frequency and zero at it (Singhose et al. 1997).
+    #[serde(rename = "2hump_ei")]
+    TwoHumpEi,
+    /// Three-hump extra-insensitive: five impulses over two damped periods, residual `v_tol` at
+    /// three humps, the middle one at the design frequency (Singhose et al. 1997).
+    #[serde(rename = "3hump_ei")]
+    ThreeHumpEi,
+}
+
+impl ShaperKind {
+    /// The kinds with a tolerable residual `v_tol` (the extra-insensitive family).
+    pub fn has_tolerance(self) -> bool {
+        matches!(self, ShaperKind::Ei | ShaperKind::TwoHumpEi | ShaperKind::ThreeHumpEi)
+    }
+
+    /// The name of `[shaper] kind`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShaperKind::Zv => "zv",
+            ShaperKind::Zvd => "zvd",
+            ShaperKind::Ei => "ei",
+            ShaperKind::TwoHumpEi => "2hump_ei",
+            ShaperKind::ThreeHumpEi => "3hump_ei",
+        }
+    }
+}
+
+/// Eq. H1 of `docs/motions.md` 3.1: the undamped amplitudes of the two-hump EI shaper of
+/// tolerance `v` (Singhose, Seering and Singer 1997): `X = (v^2 (sqrt(1 - v^2) + 1))^(1/3)`,
+/// `A1 = A4 = (3 X^2 + 2 X + 3 v^2) / (16 X)`, `A2 = A3 = 1/2 - A1`, half a period apart.
+fn two_hump(v: f64) -> [f64; 4] {
+    let x = (v * v * ((1.0 - v * v).sqrt() + 1.0)).cbrt();
+    let a1 = (3.0 * x * x + 2.0 * x + 3.0 * v * v) / (16.0 * x);
+    [a1, 0.5 - a1, 0.5 - a1, a1]
+}
+
+/// Eq. H2 of `docs/motions.md` 3.1: the undamped amplitudes of the three-hump EI shaper of
+/// tolerance `v`: `A1 = A5 = (1 + 3 v + 2 sqrt(2 v (v + 1))) / 16`, `A2 = A4 = (1 - v) / 4`,
+/// `A3 = 1 - 2 (A1 + A2)`, half a period apart.
+fn three_hump(v: f64) -> [f64; 5] {
+    let a1 = (1.0 + 3.0 * v + 2.0 * (2.0 * v * (v + 1.0)).sqrt()) / 16.0;
+    let a2 = (1.0 - v) / 4.0;
+    [a1, a2, 1.0 - 2.0 * (a1 + a2), a2, a1]
 }
 
 /// The EI shaper's tolerable residual when `v_tol` is not given (5 %, the papers' standard).
 pub const EI_V_TOL: f64 = 0.05;
 
 /// The impulses of one shaper of `kind` for a mode of natural frequency `f_hz` [Hz] and damping
-/// ratio `zeta` [-] (0 <= zeta < 1); `v_tol` is EI's tolerable residual (ignored otherwise).
-/// Formulas of `docs/motions.md` 3.1: ZV and ZVD from Singer and Seering (1990), EI from
-/// Singhose, Seering and Singer (1994), its amplitudes weighted by `K^j` when damped.
+/// ratio `zeta` [-] (0 <= zeta < 1); `v_tol` is the extra-insensitive kinds' tolerable residual
+/// (ignored otherwise). Formulas of `docs/motions.md` 3.1: ZV and ZVD from Singer and Seering
+/// (1990), EI from Singhose, Seering and Singer (1994), the two- and three-hump EI from Singhose,
+/// Seering and Singer (1997), the EI kinds' amplitudes weighted by `K^j` when damped.
 pub fn single(kind: ShaperKind, f_hz: f64, zeta: f64, v_tol: f64) -> Vec<Impulse> {
     let root = (1.0 - zeta * zeta).sqrt();
     let t_d = 1.0 / (f_hz * root);
@@ -51,6 +96,8 @@ pub fn single(kind: ShaperKind, f_hz: f64, zeta: f64, v_tol: f64) -> Vec<Impulse
             (1.0 - v_tol) / 2.0 * k,
             (1.0 + v_tol) / 4.0 * k * k,
         ],
+        ShaperKind::TwoHumpEi => damped(&two_hump(v_tol), k),
+        ShaperKind::ThreeHumpEi => damped(&three_hump(v_tol), k),
     };
     let sum: f64 = raw.iter().sum();
     raw.iter()
@@ -60,6 +107,12 @@ pub fn single(kind: ShaperKind, f_hz: f64, zeta: f64, v_tol: f64) -> Vec<Impulse
             a: a / sum,
         })
         .collect()
+}
+
+/// Undamped amplitudes `a_j` weighted by `K^j` (the damped form of the EI kinds, `docs/motions.md`
+/// 3.1).
+fn damped(a: &[f64], k: f64) -> Vec<f64> {
+    a.iter().zip(0..).map(|(a, j)| a * k.powi(j)).collect()
 }
 
 /// The convolution of two impulse trains (`docs/motions.md` 3.3): every pair `(A_i A_j, t_i +
@@ -120,7 +173,7 @@ pub fn duration(impulses: &[Impulse]) -> f64 {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShaperSection {
-    /// `"zv"`, `"zvd"` or `"ei"`.
+    /// `"zv"`, `"zvd"`, `"ei"`, `"2hump_ei"` or `"3hump_ei"`.
     pub kind: ShaperKind,
     /// `"auto"`, a frequency [Hz] or a list of them.
     pub f_hz: toml::Value,
@@ -128,7 +181,7 @@ pub struct ShaperSection {
     /// (`Damping::zeta_at(f)`), else 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub zeta: Option<toml::Value>,
-    /// EI only: the tolerable residual at the design frequency [-], default 0.05.
+    /// The EI kinds only: the tolerable residual at the humps [-], default 0.05.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub v_tol: Option<f64>,
     /// The frequencies used [Hz] (resolved).
@@ -252,20 +305,22 @@ impl ShaperSection {
         Ok(zs)
     }
 
-    /// EI's tolerance: `v_tol` in (0, 1), only with kind = "ei" (key `shaper.v_tol`).
+    /// The EI kinds' tolerance: `v_tol` in (0, 1) (0.5 at most for the multi-hump kinds, whose
+    /// amplitudes are positive only up to there), only with an EI kind (key `shaper.v_tol`).
     pub fn v_tol(&self) -> Result<f64, ModelError> {
-        match (self.kind, self.v_tol) {
-            (ShaperKind::Ei, None) => Ok(EI_V_TOL),
-            (ShaperKind::Ei, Some(v)) if v > 0.0 && v < 1.0 => Ok(v),
-            (ShaperKind::Ei, Some(v)) => Err(ModelError::invalid(
+        let most = if self.kind == ShaperKind::Ei { 1.0 } else { 0.5 };
+        match (self.kind.has_tolerance(), self.v_tol) {
+            (true, None) => Ok(EI_V_TOL),
+            (true, Some(v)) if v > 0.0 && v < most => Ok(v),
+            (true, Some(v)) => Err(ModelError::invalid(
                 "shaper.v_tol",
-                format!("need 0 < v_tol < 1, got {v}"),
+                format!("need 0 < v_tol < {most} for kind = \"{}\", got {v}", self.kind.name()),
             )),
-            (_, Some(_)) => Err(ModelError::invalid(
+            (false, Some(_)) => Err(ModelError::invalid(
                 "shaper.v_tol",
-                "v_tol belongs to kind = \"ei\" only",
+                "v_tol belongs to the extra-insensitive kinds only (\"ei\", \"2hump_ei\", \"3hump_ei\")",
             )),
-            (_, None) => Ok(0.0),
+            (false, None) => Ok(0.0),
         }
     }
 
@@ -422,7 +477,13 @@ mod tests {
         env / ((-zeta * w * (t - duration(imp))).exp() / wd)
     }
 
-    const KINDS: [ShaperKind; 3] = [ShaperKind::Zv, ShaperKind::Zvd, ShaperKind::Ei];
+    const KINDS: [ShaperKind; 5] = [
+        ShaperKind::Zv,
+        ShaperKind::Zvd,
+        ShaperKind::Ei,
+        ShaperKind::TwoHumpEi,
+        ShaperKind::ThreeHumpEi,
+    ];
 
     #[test]
     fn amplitudes_sum_to_one_and_start_at_zero() {
@@ -487,6 +548,60 @@ mod tests {
         let want = v * k * k / ((1.0 + v) / 4.0 * (1.0 + k * k) + (1.0 - v) / 2.0 * k);
         assert!((envelope_ratio(&sd, f, zeta) - want).abs() < 1e-12);
         assert!(want < v && want > 0.8 * v);
+    }
+
+    /// The defining property of the multi-hump EI shapers (Singhose, Seering and Singer 1997),
+    /// independent of their closed forms: over their band the undamped residual rises to exactly
+    /// `v_tol` at two (three) humps, one of them at the design frequency for the three-hump
+    /// shaper and zero there for the two-hump one, and stays below `v_tol` in between; each band
+    /// is wider than the one before (EI 0.40, two-hump 0.72, three-hump 0.96 of the design
+    /// frequency at 5 %).
+    #[test]
+    fn multi_hump_shapers_touch_their_tolerance_at_every_hump() {
+        let f = 4.0;
+        for (kind, humps, width) in [(ShaperKind::Ei, 1, 0.399), (ShaperKind::TwoHumpEi, 2, 0.724), (ShaperKind::ThreeHumpEi, 3, 0.963)] {
+            for v in [0.05, 0.1] {
+                let s = single(kind, f, 0.0, v);
+                assert_eq!(s.len(), humps + 2);
+                let curve = |r: f64| envelope_ratio(&s, f * r, 0.0);
+                // the band of residual <= v around the design frequency
+                let (mut lo, mut hi) = (1.0, 1.0);
+                while curve(lo - 1e-4) <= v + 1e-12 {
+                    lo -= 1e-4;
+                }
+                while curve(hi + 1e-4) <= v + 1e-12 {
+                    hi += 1e-4;
+                }
+                let grid: Vec<f64> = (0..=2000).map(|k| lo + (hi - lo) * k as f64 / 2000.0).collect();
+                let peaks: Vec<f64> = grid
+                    .windows(3)
+                    .filter(|w| curve(w[1]) >= curve(w[0]) && curve(w[1]) > curve(w[2]))
+                    .map(|w| w[1])
+                    .collect();
+                assert_eq!(peaks.len(), humps, "{kind:?} v = {v}: humps at {peaks:?}");
+                for p in &peaks {
+                    // the hump's top, refined by golden-section-free bisection on the slope
+                    let (mut a, mut b) = (p - 2e-3, p + 2e-3);
+                    for _ in 0..60 {
+                        let m = 0.5 * (a + b);
+                        if curve(m + 1e-9) > curve(m - 1e-9) {
+                            a = m;
+                        } else {
+                            b = m;
+                        }
+                    }
+                    let top = curve(0.5 * (a + b));
+                    assert!((top - v).abs() < 1e-9, "{kind:?} v = {v}: hump {top} at r = {a}");
+                }
+                if v == 0.05 {
+                    assert!((hi - lo - width).abs() < 2e-3, "{kind:?}: band {lo}..{hi}");
+                }
+                match kind {
+                    ShaperKind::TwoHumpEi => assert!(curve(1.0) < 1e-12),
+                    _ => assert!((curve(1.0) - v).abs() < 1e-12),
+                }
+            }
+        }
     }
 
     #[test]

@@ -29,6 +29,8 @@ fn merge_ratio(kind: ShaperKind) -> f64 {
         ShaperKind::Zv => 1.066,
         ShaperKind::Zvd => 1.335,
         ShaperKind::Ei => 1.499,
+        ShaperKind::TwoHumpEi => 2.136,
+        ShaperKind::ThreeHumpEi => 2.860,
     }
 }
 
@@ -310,7 +312,15 @@ mod tests {
                 ShaperKind::Zv => (PI * r / 2.0).cos().abs(),
                 ShaperKind::Zvd => (PI * r / 2.0).cos().powi(2),
                 ShaperKind::Ei => (0.475 + 0.525 * (PI * r).cos()).abs(),
+                _ => unreachable!(),
             };
+            assert!((v - 0.05).abs() < 2e-3, "{kind:?}: {v}");
+        }
+        // the multi-hump kinds: their sensitivity curves (undamped) at the band's lower edge
+        for kind in [ShaperKind::TwoHumpEi, ShaperKind::ThreeHumpEi] {
+            let r = 2.0 / (1.0 + merge_ratio(kind));
+            let s = flexstar_model::shaper::single(kind, 1.0, 0.0, 0.05);
+            let v = flexstar_model::shaper::residual(&s, r, 0.0);
             assert!((v - 0.05).abs() < 2e-3, "{kind:?}: {v}");
         }
     }

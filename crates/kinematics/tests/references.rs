@@ -254,6 +254,42 @@ fn rigid_inverse_dynamics_balances_power() {
     }
 }
 
+/// The task-space quintic from the origin to (0.03, -0.02, 0.3) in 0.5 s.
+fn general_quintic() -> Trajectory {
+    Trajectory::Quintic {
+        from: Pose {
+            gx: 0.0,
+            gy: 0.0,
+            theta: 0.0,
+        },
+        to: Pose {
+            gx: 0.03,
+            gy: -0.02,
+            theta: 0.3,
+        },
+        t0: 0.0,
+        t1: 0.5,
+    }
+}
+
+/// The rate of the kinetic energy of star, sleeves, sliders and a payload [W] (`1/2 m |v_c|^2 +
+/// 1/2 J theta'^2` for the payload, `v_c` the velocity of its centre of mass, returned too).
+fn kinetic_rate(p: &RobotParams, payload: &flexstar_model::Payload, st: &RigidState) -> (f64, [f64; 2]) {
+    let (w, wd) = (st.theta.d1, st.theta.d2);
+    let o = payload.offset;
+    let (ex, ew) = (st.e_x(0), st.e_w(0));
+    let r = [0, 1].map(|k| o[0] * ex[k] + o[1] * ew[k]);
+    let kr = [-r[1], r[0]];
+    let vc = [st.g[0].d1 + w * kr[0], st.g[1].d1 + w * kr[1]];
+    let ac = [0, 1].map(|k| st.g[k].d2 + wd * kr[k] - w * w * r[k]);
+    let rate = p.star_mass() * (st.g[0].d1 * st.g[0].d2 + st.g[1].d1 * st.g[1].d2)
+        + (p.star_inertia() + 3.0 * p.jp) * w * wd
+        + p.mpp_mpa * (0..3).map(|i| st.s[i].d1 * st.s[i].d2).sum::<f64>()
+        + payload.mass * (vc[0] * ac[0] + vc[1] * ac[1])
+        + payload.j * w * wd;
+    (rate, vc)
+}
+
 /// Eqs. P7-P8 against the power balance of the loaded robot: the drivers' power plus the load's
 /// (`F . v_G + Mz theta'`) is the rate of the kinetic energy of star, sleeves, sliders and the
 /// payload (`1/2 m |v_G + theta' k x r|^2 + 1/2 J theta'^2`, r the offset turned with the star),
@@ -271,38 +307,14 @@ fn rigid_inverse_dynamics_with_payload_and_load_balances_power() {
         },
         load: LoadSettings::polynomials(Some(vec![1.5, -2.0]), Some(vec![-0.5, 0.0, 4.0]), Some(vec![0.2, 0.1])),
     };
-    let tr = Trajectory::Quintic {
-        from: Pose {
-            gx: 0.0,
-            gy: 0.0,
-            theta: 0.0,
-        },
-        to: Pose {
-            gx: 0.03,
-            gy: -0.02,
-            theta: 0.3,
-        },
-        t0: 0.0,
-        t1: 0.5,
-    };
+    let tr = general_quintic();
     for t in [0.1, 0.25, 0.4] {
         let st = RigidState::at(&p, &tr, t).unwrap();
         let f = flexstar_kinematics::rigid_inverse_dynamics_with(&p, &attached, &st);
         let [fx, fy, mz] = attached.load.at(t);
-        let (w, wd) = (st.theta.d1, st.theta.d2);
+        let w = st.theta.d1;
         let power: f64 = (0..3).map(|i| f.fa[i] * st.s[i].d1).sum::<f64>() + fx * st.g[0].d1 + fy * st.g[1].d1 + mz * w;
-        let o = attached.payload.offset;
-        let (ex, ew) = (st.e_x(0), st.e_w(0));
-        let r = [0, 1].map(|k| o[0] * ex[k] + o[1] * ew[k]);
-        let kr = [-r[1], r[0]];
-        let vc = [st.g[0].d1 + w * kr[0], st.g[1].d1 + w * kr[1]];
-        let ac = [0, 1].map(|k| st.g[k].d2 + wd * kr[k] - w * w * r[k]);
-        let (m, j) = (attached.payload.mass, attached.payload.j);
-        let dtdt = p.star_mass() * (st.g[0].d1 * st.g[0].d2 + st.g[1].d1 * st.g[1].d2)
-            + (p.star_inertia() + 3.0 * p.jp) * w * wd
-            + p.mpp_mpa * (0..3).map(|i| st.s[i].d1 * st.s[i].d2).sum::<f64>()
-            + m * (vc[0] * ac[0] + vc[1] * ac[1])
-            + j * w * wd;
+        let (dtdt, _) = kinetic_rate(&p, &attached.payload, &st);
         assert!(
             (power - dtdt).abs() < 1e-10 * (1.0 + dtdt.abs()),
             "t={t}: {power} vs {dtdt}"
@@ -427,37 +439,12 @@ fn rigid_inverse_dynamics_under_gravity_holds_the_weights() {
         assert!((f.fa[i] - grad).abs() < 1e-7 * (1.0 + grad.abs()), "slider {}: {} vs {grad}", i + 1, f.fa[i]);
     }
     // moving: power = dT/dt + dV/dt
-    let tr = Trajectory::Quintic {
-        from: Pose {
-            gx: 0.0,
-            gy: 0.0,
-            theta: 0.0,
-        },
-        to: Pose {
-            gx: 0.03,
-            gy: -0.02,
-            theta: 0.3,
-        },
-        t0: 0.0,
-        t1: 0.5,
-    };
+    let tr = general_quintic();
     for t in [0.1, 0.25, 0.4] {
         let st = RigidState::at(&p, &tr, t).unwrap();
         let f = flexstar_kinematics::rigid_inverse_dynamics_with(&p, &attached, &st);
-        let (w, wd) = (st.theta.d1, st.theta.d2);
         let power: f64 = (0..3).map(|i| f.fa[i] * st.s[i].d1).sum();
-        let r = {
-            let c = centre([0.0; 2], st.theta.v);
-            [c[0], c[1]]
-        };
-        let kr = [-r[1], r[0]];
-        let vc = [st.g[0].d1 + w * kr[0], st.g[1].d1 + w * kr[1]];
-        let ac = [0, 1].map(|k| st.g[k].d2 + wd * kr[k] - w * w * r[k]);
-        let dtdt = p.star_mass() * (st.g[0].d1 * st.g[0].d2 + st.g[1].d1 * st.g[1].d2)
-            + (p.star_inertia() + 3.0 * p.jp) * w * wd
-            + p.mpp_mpa * (0..3).map(|i| st.s[i].d1 * st.s[i].d2).sum::<f64>()
-            + m_p * (vc[0] * ac[0] + vc[1] * ac[1])
-            + attached.payload.j * w * wd;
+        let (dtdt, vc) = kinetic_rate(&p, &attached.payload, &st);
         let dot_g = |v: [f64; 2]| g[0] * v[0] + g[1] * v[1];
         let dvdt = -(p.star_mass() * dot_g([st.g[0].d1, st.g[1].d1])
             + p.mpp_mpa * (0..3).map(|i| st.s[i].d1 * dot_g(slider_direction(i))).sum::<f64>()

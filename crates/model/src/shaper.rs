@@ -38,12 +38,19 @@ pub enum ShaperKind {
     /// three humps, the middle one at the design frequency (Singhose et al. 1997).
     #[serde(rename = "3hump_ei")]
     ThreeHumpEi,
+    /// Specified insensitivity: the shortest train on a grid of an eighth of a damped period
+    /// whose residual stays at most `v_tol` over a given band (`insensitivity`), by a cone program
+    /// (`docs/motions.md` 3.1, Eq. H3).
+    Si,
 }
 
 impl ShaperKind {
     /// The kinds with a tolerable residual `v_tol` (the extra-insensitive family).
     pub fn has_tolerance(self) -> bool {
-        matches!(self, ShaperKind::Ei | ShaperKind::TwoHumpEi | ShaperKind::ThreeHumpEi)
+        matches!(
+            self,
+            ShaperKind::Ei | ShaperKind::TwoHumpEi | ShaperKind::ThreeHumpEi | ShaperKind::Si
+        )
     }
 
     /// The name of `[shaper] kind`.
@@ -54,6 +61,7 @@ impl ShaperKind {
             ShaperKind::Ei => "ei",
             ShaperKind::TwoHumpEi => "2hump_ei",
             ShaperKind::ThreeHumpEi => "3hump_ei",
+            ShaperKind::Si => "si",
         }
     }
 }
@@ -85,6 +93,14 @@ pub const EI_V_TOL: f64 = 0.05;
 /// (1990), EI from Singhose, Seering and Singer (1994), the two- and three-hump EI from Singhose,
 /// Seering and Singer (1997), the EI kinds' amplitudes weighted by `K^j` when damped.
 pub fn single(kind: ShaperKind, f_hz: f64, zeta: f64, v_tol: f64) -> Vec<Impulse> {
+    if kind == ShaperKind::Si {
+        // the default band; a section's own band goes through `specified_insensitivity`
+        let band = (f_hz * (1.0 - SI_BAND), f_hz * (1.0 + SI_BAND));
+        if let Ok(s) = specified_insensitivity(f_hz, zeta, band, v_tol) {
+            return s;
+        }
+        return single(ShaperKind::Ei, f_hz, zeta, v_tol);
+    }
     let root = (1.0 - zeta * zeta).sqrt();
     let t_d = 1.0 / (f_hz * root);
     let k = (-zeta * std::f64::consts::PI / root).exp();
@@ -98,6 +114,7 @@ pub fn single(kind: ShaperKind, f_hz: f64, zeta: f64, v_tol: f64) -> Vec<Impulse
         ],
         ShaperKind::TwoHumpEi => damped(&two_hump(v_tol), k),
         ShaperKind::ThreeHumpEi => damped(&three_hump(v_tol), k),
+        ShaperKind::Si => unreachable!("designed above"),
     };
     let sum: f64 = raw.iter().sum();
     raw.iter()
@@ -107,6 +124,71 @@ pub fn single(kind: ShaperKind, f_hz: f64, zeta: f64, v_tol: f64) -> Vec<Impulse
             a: a / sum,
         })
         .collect()
+}
+
+/// The specified-insensitivity shaper's default band: +-20 % of its frequency (EI's 5 % band).
+pub const SI_BAND: f64 = 0.2;
+
+/// Grid of the specified-insensitivity design: impulse times every `T_d / SI_GRID`.
+const SI_GRID: usize = 8;
+
+/// The longest specified-insensitivity shaper tried: four damped periods.
+const SI_PERIODS: usize = 4;
+
+/// Eq. H3 of `docs/motions.md` 3.1: the shortest impulse train on the grid `t_j = j T_d / 8`
+/// (`T_d` the damped period at `f_hz` [Hz]) whose residual (section 3.2's formula, damping ratio
+/// `zeta`) is at most `v_tol` at every frequency of `band` = `(f_lo, f_hi)` [Hz]: for n = 2, 3, ...
+/// impulses, the amplitudes minimising the largest residual over 64 frequencies of the band
+/// (a second-order cone program, `flexstar_numerics::minimax`), accepted when that residual,
+/// checked on a four times finer sampling, is at most `v_tol`. Errors (key `shaper.insensitivity`)
+/// when four damped periods do not suffice.
+pub fn specified_insensitivity(f_hz: f64, zeta: f64, band: (f64, f64), v_tol: f64) -> Result<Vec<Impulse>, ModelError> {
+    let t_d = 1.0 / (f_hz * (1.0 - zeta * zeta).sqrt());
+    let dt = t_d / SI_GRID as f64;
+    let sample = |count: usize| -> Vec<f64> {
+        (0..count).map(|k| band.0 + (band.1 - band.0) * k as f64 / (count - 1) as f64).collect()
+    };
+    let (coarse, fine) = (sample(64), sample(256));
+    for n in 2..=SI_GRID * SI_PERIODS + 1 {
+        let t_n = (n - 1) as f64 * dt;
+        let forms: Vec<Vec<(f64, f64)>> = coarse
+            .iter()
+            .map(|&f| {
+                let w = 2.0 * std::f64::consts::PI * f;
+                let wd = w * (1.0 - zeta * zeta).sqrt();
+                (0..n)
+                    .map(|j| {
+                        let t = j as f64 * dt;
+                        let e = (zeta * w * (t - t_n)).exp();
+                        (e * (wd * t).cos(), e * (wd * t).sin())
+                    })
+                    .collect()
+            })
+            .collect();
+        let Some(best) = flexstar_numerics::minimax::minimax_weights(&forms) else {
+            continue;
+        };
+        if best.largest > v_tol {
+            continue;
+        }
+        let train: Vec<Impulse> = best
+            .weights
+            .iter()
+            .enumerate()
+            .map(|(j, &a)| Impulse { t: j as f64 * dt, a })
+            .collect();
+        if fine.iter().all(|&f| residual(&train, f, zeta) <= v_tol * (1.0 + 1e-6)) {
+            return Ok(train);
+        }
+    }
+    Err(ModelError::invalid(
+        "shaper.insensitivity",
+        format!(
+            "no shaper up to {SI_PERIODS} damped periods keeps the residual at or below v_tol = {v_tol} over \
+             {:.4}-{:.4} Hz around {f_hz} Hz: widen v_tol or narrow the band",
+            band.0, band.1
+        ),
+    ))
 }
 
 /// Undamped amplitudes `a_j` weighted by `K^j` (the damped form of the EI kinds, `docs/motions.md`
@@ -181,9 +263,14 @@ pub struct ShaperSection {
     /// (`Damping::zeta_at(f)`), else 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub zeta: Option<toml::Value>,
-    /// The EI kinds only: the tolerable residual at the humps [-], default 0.05.
+    /// The EI kinds and SI only: the tolerable residual [-], default 0.05.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub v_tol: Option<f64>,
+    /// SI only: the band of frequencies [Hz] over which the residual stays below `v_tol`:
+    /// `[f_lo, f_hi]` (one frequency inside it), or `"+-x %"` around each frequency; default
+    /// `"+-20 %"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub insensitivity: Option<toml::Value>,
     /// The frequencies used [Hz] (resolved).
     #[serde(default, skip_deserializing)]
     pub frequencies_hz: Vec<f64>,
@@ -242,6 +329,7 @@ impl ShaperSection {
             f_hz: toml::Value::Array(f_hz.iter().map(|&f| toml::Value::Float(f)).collect()),
             zeta: None,
             v_tol: None,
+            insensitivity: None,
             frequencies_hz: Vec::new(),
             zeta_used: Vec::new(),
             impulses: Vec::new(),
@@ -308,7 +396,7 @@ impl ShaperSection {
     /// The EI kinds' tolerance: `v_tol` in (0, 1) (0.5 at most for the multi-hump kinds, whose
     /// amplitudes are positive only up to there), only with an EI kind (key `shaper.v_tol`).
     pub fn v_tol(&self) -> Result<f64, ModelError> {
-        let most = if self.kind == ShaperKind::Ei { 1.0 } else { 0.5 };
+        let most = if matches!(self.kind, ShaperKind::Ei | ShaperKind::Si) { 1.0 } else { 0.5 };
         match (self.kind.has_tolerance(), self.v_tol) {
             (true, None) => Ok(EI_V_TOL),
             (true, Some(v)) if v > 0.0 && v < most => Ok(v),
@@ -318,9 +406,53 @@ impl ShaperSection {
             )),
             (false, Some(_)) => Err(ModelError::invalid(
                 "shaper.v_tol",
-                "v_tol belongs to the extra-insensitive kinds only (\"ei\", \"2hump_ei\", \"3hump_ei\")",
+                "v_tol belongs to the extra-insensitive kinds and si only (\"ei\", \"2hump_ei\", \"3hump_ei\", \"si\")",
             )),
             (false, None) => Ok(0.0),
+        }
+    }
+
+    /// SI's band around the frequency `f` [Hz] of `f_hz` (`n` of them) from `insensitivity`
+    /// (key `shaper.insensitivity`; only with kind = "si").
+    pub fn band(&self, f: f64, n: usize) -> Result<(f64, f64), ModelError> {
+        let bad = |why: String| ModelError::invalid("shaper.insensitivity", why);
+        let value = match (&self.insensitivity, self.kind) {
+            (None, _) => return Ok((f * (1.0 - SI_BAND), f * (1.0 + SI_BAND))),
+            (Some(_), k) if k != ShaperKind::Si => return Err(bad("belongs to kind = \"si\" only".into())),
+            (Some(v), _) => v,
+        };
+        match value {
+            toml::Value::String(s) => {
+                let x: f64 = s
+                    .trim()
+                    .trim_start_matches("+-")
+                    .trim_start_matches('\u{b1}')
+                    .trim_end_matches('%')
+                    .trim()
+                    .parse()
+                    .map_err(|_| bad(format!("\"{s}\": write \"+-x %\" (x in 0..100) or [f_lo, f_hi] in Hz")))?;
+                if !(x > 0.0 && x < 100.0) || !s.trim().starts_with(['+', '\u{b1}']) {
+                    return Err(bad(format!("\"{s}\": write \"+-x %\" with 0 < x < 100")));
+                }
+                Ok((f * (1.0 - x / 100.0), f * (1.0 + x / 100.0)))
+            }
+            toml::Value::Array(a) if a.len() == 2 => {
+                let lo = number(&a[0]).unwrap_or(f64::NAN);
+                let hi = number(&a[1]).unwrap_or(f64::NAN);
+                if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+                    return Err(bad(format!("[{lo}, {hi}]: need 0 < f_lo < f_hi, finite, in Hz")));
+                }
+                if n != 1 {
+                    return Err(bad(format!(
+                        "a band in Hz goes with one frequency; with {n}, write \"+-x %\" around each"
+                    )));
+                }
+                if !(lo <= f && f <= hi) {
+                    return Err(bad(format!("the band [{lo}, {hi}] Hz must contain the frequency {f} Hz")));
+                }
+                Ok((lo, hi))
+            }
+            v => Err(bad(format!("{v}: write \"+-x %\" or [f_lo, f_hi] in Hz"))),
         }
     }
 
@@ -330,7 +462,17 @@ impl ShaperSection {
         let zetas = self.zetas(f_hz, default)?;
         let v_tol = self.v_tol()?;
         let modes: Vec<(f64, f64)> = f_hz.iter().copied().zip(zetas.iter().copied()).collect();
-        self.impulses = multi(self.kind, &modes, v_tol);
+        self.impulses = if self.kind == ShaperKind::Si {
+            let mut train = vec![Impulse { t: 0.0, a: 1.0 }];
+            for &(f, z) in &modes {
+                let band = self.band(f, modes.len())?;
+                train = convolve(&train, &specified_insensitivity(f, z, band, v_tol)?);
+            }
+            train
+        } else {
+            self.band(0.0, 0)?;
+            multi(self.kind, &modes, v_tol)
+        };
         self.penalty_s = duration(&self.impulses);
         self.frequencies_hz = f_hz.to_vec();
         self.zeta_used = zetas;
@@ -602,6 +744,54 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Eq. H3 against what it promises and against the closed forms it must not lose to: the
+    /// residual (section 3.2's formula, checked against the closed forms below) at most v_tol on
+    /// 1001 frequencies of the band; no longer than the EI shaper for a band inside EI's own
+    /// (+-15 % at 5 %: EI covers +-20 %), no longer than ZV's half period for a band inside ZV's
+    /// (+-2 %: ZV covers +-3.2 %); damped too.
+    #[test]
+    fn specified_insensitivity_meets_its_band_no_later_than_the_closed_forms() {
+        let f = 4.0;
+        for (zeta, x, v, longest) in [(0.0, 0.15, 0.05, 1.0), (0.0, 0.02, 0.05, 0.5), (0.05, 0.3, 0.05, 2.0), (0.0, 0.5, 0.02, 4.0)] {
+            let band = (f * (1.0 - x), f * (1.0 + x));
+            let s = specified_insensitivity(f, zeta, band, v).unwrap();
+            let t_d = 1.0 / (f * (1.0 - zeta * zeta).sqrt());
+            assert!((s.iter().map(|p| p.a).sum::<f64>() - 1.0).abs() < 1e-12 && s.iter().all(|p| p.a >= 0.0));
+            let worst = (0..=1000)
+                .map(|k| residual(&s, band.0 + (band.1 - band.0) * k as f64 / 1000.0, zeta))
+                .fold(0.0, f64::max);
+            eprintln!("+-{x} at zeta {zeta}, v {v}: {} impulses over {:.3} T_d, worst residual {worst:.5}", s.len(), duration(&s) / t_d);
+            assert!(worst <= v * (1.0 + 1e-4), "+-{x}: {worst}");
+            assert!(duration(&s) <= longest * t_d + 1e-12, "+-{x}: {} periods", duration(&s) / t_d);
+        }
+        assert!(specified_insensitivity(f, 0.0, (0.4, 7.6), 0.01).unwrap_err().to_string().contains("shaper.insensitivity"));
+    }
+
+    #[test]
+    fn the_band_is_read_relative_or_in_hz_and_checked() {
+        let mut s = ShaperSection::new(ShaperKind::Si, &[4.0]);
+        assert_eq!(s.band(4.0, 1).unwrap(), (3.2, 4.8));
+        s.insensitivity = Some(toml::Value::String("+-10 %".into()));
+        let (lo, hi) = s.band(4.0, 2).unwrap();
+        assert!((lo - 3.6).abs() < 1e-12 && (hi - 4.4).abs() < 1e-12);
+        s.insensitivity = Some(toml::Value::Array(vec![toml::Value::Float(3.5), toml::Value::Float(4.6)]));
+        assert_eq!(s.band(4.0, 1).unwrap(), (3.5, 4.6));
+        for (value, n, why) in [
+            (toml::Value::Array(vec![toml::Value::Float(4.5), toml::Value::Float(5.0)]), 1, "contain"),
+            (toml::Value::Array(vec![toml::Value::Float(3.5), toml::Value::Float(4.5)]), 2, "one frequency"),
+            (toml::Value::String("10 %".into()), 1, "+-x %"),
+            (toml::Value::String("+-150 %".into()), 1, "0 < x < 100"),
+            (toml::Value::Float(0.2), 1, "+-x %"),
+        ] {
+            s.insensitivity = Some(value);
+            let e = s.band(4.0, n).unwrap_err().to_string();
+            assert!(e.contains("shaper.insensitivity") && e.contains(why), "{e}");
+        }
+        let mut z = ShaperSection::new(ShaperKind::Zvd, &[4.0]);
+        z.insensitivity = Some(toml::Value::String("+-10 %".into()));
+        assert!(z.resolve(&[4.0], |_| 0.0).unwrap_err().to_string().contains("kind = \"si\" only"));
     }
 
     #[test]

@@ -12,6 +12,7 @@ pub mod error;
 pub mod gen_alpha;
 pub mod lanes;
 pub mod measures;
+pub mod minimax;
 pub mod quadrature;
 pub mod vector;
 

@@ -31,6 +31,8 @@ fn merge_ratio(kind: ShaperKind) -> f64 {
         ShaperKind::Ei => 1.499,
         ShaperKind::TwoHumpEi => 2.136,
         ShaperKind::ThreeHumpEi => 2.860,
+        // its default band, +-20 % (a section's own band shapes each chosen frequency)
+        ShaperKind::Si => 1.5,
     }
 }
 

@@ -78,3 +78,34 @@ fn amm_agrees_with_fem_with_a_load() {
 fn amm_agrees_with_fem_with_payload_damping_and_load() {
     check(BRISK, "all", &format!("{PAYLOAD}{DAMPING}{LOAD}"));
 }
+
+/// Gravity (`docs/as-built.md` 5, `docs/fem.md` 9.5): the static sag of the paper's robot held at
+/// the centre pose under `g = [0, -9.81]`, each model started in its own static equilibrium (the
+/// AMM by its step's refinement, the FEM by Newton), and held there: G and the tips of the two
+/// solvers within 5e-3 (measured 4.7e-4 at G, 3.4e-4 at the tips, 1.778 mm at G).
+#[test]
+fn amm_and_fem_sag_alike_under_gravity() {
+    let text = format!(
+        "{}\n[gravity]\ng = [0.0, -9.81]\n",
+        "name = \"sag\"\n[time]\nt_end = 0.05\ndt_out = 0.001\n[trajectory]\nkind = \"polynomial\"\n\
+         s1 = [0.0]\ns2 = [0.0]\ns3 = [0.0]"
+    );
+    let exp = Experiment::from_toml_str(&text, Path::new("sag.toml")).unwrap();
+    let problem = exp.problem().unwrap();
+    let fem = flexstar_solve::response(&problem, Settings::Fem(&FemSettings::default()), None, None).unwrap();
+    let amm = flexstar_solve::response(&problem, Settings::Amm(&AmmSettings::accurate()), None, None).unwrap();
+    let dgy = |r: &flexstar_model::Response| r.column("dGy").expect("dGy")[0];
+    let rel = (dgy(&fem) - dgy(&amm)).abs() / dgy(&amm).abs();
+    let tip = |r: &flexstar_model::Response| [0, 1, 2].map(|i| r.w_tip[i][0]);
+    let largest = tip(&amm).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let tip_rel = (0..3).map(|i| (tip(&fem)[i] - tip(&amm)[i]).abs()).fold(0.0, f64::max) / largest;
+    eprintln!(
+        "dGy: FEM {:.6e} m, AMM {:.6e} m ({rel:.2e}); tips {:?} / {:?} m ({tip_rel:.2e})",
+        dgy(&fem),
+        dgy(&amm),
+        tip(&fem),
+        tip(&amm)
+    );
+    assert!(dgy(&amm) < -1e-3 && rel < 5e-3, "FEM {} m against the AMM's {} m", dgy(&fem), dgy(&amm));
+    assert!(tip_rel < 5e-3, "tips: FEM {:?} m against the AMM's {:?} m", tip(&fem), tip(&amm));
+}

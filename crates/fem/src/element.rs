@@ -494,6 +494,17 @@ impl ElementState {
         ]
     }
 
+    /// Mean position `int_0^1 r(zeta) dzeta` [m] of the element's interpolation (`rho l0` times
+    /// it is the first moment of its mass, for the weights' potential, `docs/fem.md` 9.5):
+    /// `x_a + d / 2 + l0 (th1 - th2) / 12 e2`, since `int H1 = 1/12`, `int H2 = -1/12`.
+    pub fn mean_position(&self, el_a: [f64; 2]) -> [f64; 2] {
+        let w = self.l0 * (self.th1 - self.th2) / 12.0;
+        [
+            el_a[0] + 0.5 * self.d[0] - w * self.s,
+            el_a[1] + 0.5 * self.d[1] + w * self.c,
+        ]
+    }
+
     /// Jacobian `J = d r(zeta) / d q_e` (2 x 6).
     #[inline]
     pub fn jacobian(&self, zeta: f64) -> [[f64; 6]; 2] {
@@ -681,6 +692,30 @@ mod tests {
                     k[i][j]
                 );
             }
+        }
+    }
+
+    /// The mean position against Simpson's rule on `position` (exact: the integrand is a cubic).
+    #[test]
+    fn mean_position_is_the_integral_of_the_interpolation() {
+        let e = el();
+        let mut q = q0();
+        q[2] += 0.03;
+        q[5] -= 0.02;
+        q[4] += 0.001;
+        let st = ElementState::new(&e, &q);
+        let n = 8;
+        let mut sum = [0.0; 2];
+        for k in 0..=n {
+            let z = k as f64 / n as f64;
+            let w = if k == 0 || k == n { 1.0 } else if k % 2 == 1 { 4.0 } else { 2.0 };
+            let r = st.position([q[0], q[1]], z);
+            sum[0] += w * r[0] / (3.0 * n as f64);
+            sum[1] += w * r[1] / (3.0 * n as f64);
+        }
+        let m = st.mean_position([q[0], q[1]]);
+        for k in 0..2 {
+            assert!((m[k] - sum[k]).abs() < 1e-15, "{k}: {} vs {}", m[k], sum[k]);
         }
     }
 

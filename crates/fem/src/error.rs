@@ -104,6 +104,13 @@ pub enum FemError {
         "singular pose at t = {t} s: the lines through the three pins normal to the sleeves meet at one point (relative determinant {det:.2e}), so the rigid velocity of the star is not determined by the sliders' and the mass-proportional damping (damping.alpha) cannot be applied"
     )]
     SingularPose { t: f64, det: f64 },
+    /// The static equilibrium under gravity (Eq. G8 of `docs/fem.md` 9.5: the start of a run, or
+    /// the rest pose of its residual's reference) did not converge at the pose of time `t` [s]
+    /// with the sliders held at `s` [m].
+    #[error(
+        "the static equilibrium under gravity at the pose of t = {t} s (sliders held at s = {s:?} m, pins fixed) failed: {reason}; is the robot held at that pose (a singular pose, a sleeve near the end of its beam)?"
+    )]
+    StaticEquilibrium { t: f64, s: [f64; 3], reason: NewtonFailure },
     /// A non-finite number appeared (element index given when known).
     #[error("non-finite value at t = {t} s in element {element}: {reason}")]
     NonFinite { t: f64, element: usize, reason: String },

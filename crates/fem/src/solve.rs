@@ -7,10 +7,10 @@ use flexstar_kinematics::{check_trajectory, direct_kinematics, preflight_step, C
 use flexstar_model::animation::{frame_times, ShapeTimes};
 use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::{
-    BeamShape, EqualBeams, FemSettings, FramePose, Problem, Response, RobotParams, RunInfo, StarShape,
+    BeamShape, EqualBeams, FemSettings, FramePose, Problem, Response, RestOffset, RobotParams, RunInfo, StarShape,
 };
 
-use crate::integrator::{integrate, History, Motion, RunSettings, Sample, Snapshot, Stats};
+use crate::integrator::{integrate, static_equilibrium, History, Motion, RunSettings, Sample, Snapshot, Stats};
 use crate::star::{Attached, InitialState};
 use crate::FemError;
 
@@ -71,8 +71,9 @@ const EXTRA: [&str; 17] = [
     "slopeG",
 ];
 
-/// The energies of the payload, the load and the damping, each written only with its section.
-const ATTACHED: [&str; 3] = ["Ek_payload", "W_load", "E_d"];
+/// The energies of the payload, the load, the damping and the weights, each written only with
+/// its section.
+const ATTACHED: [&str; 4] = ["Ek_payload", "W_load", "E_d", "V_g"];
 
 /// Extra columns a direct run writes first (see [`solve`] with [`Drive::Law`]).
 const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "Gy", "theta"];
@@ -97,8 +98,14 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 ///   `[payload]`, `W_load` (work of the load at G since t = 0 [J], trapezoidal rule on the steps)
 ///   with a `[load]`, `E_d` (energy dissipated since t = 0 [J] by the beams' Kelvin-Voigt
 ///   damping, Eq. D10, and the mass-proportional damping of the elastic motion, Eq. D16) with a
-///   `[damping]`; the energy balance is then Eq. C6,
-///   `W + W_load = Delta(Ek_star + Ek_sleeves + Ek_sliders + Ek_payload + U) + E_d`;
+///   `[damping]`, `V_g` (potential energy of the weights of beams, payload, sleeves and sliders
+///   [J], base frame origin, `docs/fem.md` 9.5) with a `[gravity]`; the energy balance is then
+///   Eq. C6, `W + W_load = Delta(Ek_star + Ek_sleeves + Ek_sliders + Ek_payload + U + V_g) + E_d`;
+/// - under gravity (`docs/fem.md` 9.5, Eqs. G6-G8): the weights act on the beams, the payload and
+///   the sliders (`Fa_i` gains `- (mpp + mpa) g . u_i`, Eq. G7), the run starts at rest in the
+///   deflected static equilibrium of its start pose (Eq. G8; every elastic output includes the
+///   sag), and `rest_offset` holds the static equilibrium's `w_iG`, `w_i(L)` at the pose where
+///   the motion comes to rest (`Trajectory::t_rest`, when within the run);
 /// - `shapes`: the deformed star at `settings.snapshots` and at t_end.
 ///
 /// `progress` receives the fraction of the time span done, in [0, 1].
@@ -110,17 +117,13 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 /// Returns the response and the work counters (steps, Newton iterations, factorisations).
 pub fn solve(problem: &Problem, settings: &FemSettings, request: SolveRequest) -> Result<Solved<Stats>, FemError> {
     let problem = &problem.equal_beams().map_err(FemError::Problem)?;
-    if problem.gravity != [0.0; 2] {
-        return Err(FemError::Problem(flexstar_model::ModelError::Unsupported {
-            what: "gravity.g: the FEM's weights and static start are not built yet (docs/as-built.md 5; the AMM \
-                   models them)"
-                .into(),
-        }));
-    }
-    let (response, stats) = match request.drive {
+    let (mut response, stats) = match request.drive {
         Drive::Motion => solve_prescribed(problem, settings, request.proof, request.progress)?,
         Drive::Law(law) => solve_direct(problem, settings, law, request.progress)?,
     };
+    if problem.gravity != [0.0; 2] {
+        response.rest_offset = rest_offset(problem, settings)?;
+    }
     Ok(Solved { response, stats })
 }
 
@@ -181,8 +184,8 @@ fn solve_prescribed(
 /// `Fa_i(t, s_i, s_i')` and by the beam through the sleeve's pin (Eq. 33 read the other way
 /// round, `docs/fem.md` section 8); its coordinate `s_i` is an unknown of the FEM, and the servo's
 /// `kp`, `kd` (`law.stiffness()`, `law.damping()`) enter the iteration matrix. Initial state:
-/// `s(0)`, `s'(0)` from `problem.trajectory` at t = 0, the star undeformed and moving rigidly (as
-/// [`solve`] starts), so that the `Fa` of an inverse run fed back reproduces that run. The
+/// `s(0)`, `s'(0)` from `problem.trajectory` at t = 0, the star undeformed and moving rigidly, or
+/// under gravity in the static equilibrium with the sliders held at `s(0)` (Eq. G8; as [`solve`] starts), so that the `Fa` of an inverse run fed back reproduces that run. The
 /// payload, damping and load of `problem` act as in [`solve`] (`docs/fem.md` section 9).
 ///
 /// The configuration is checked at every step (sleeves on their beams, then the limits of
@@ -337,16 +340,10 @@ fn post_process(
         let r = frame(s.t, s.s)?;
         let g = r.g;
         let dg = [s.g[0] - g[0], s.g[1] - g[1]];
-        let mut w_g = [0.0; 3];
-        let mut w_tip = [0.0; 3];
+        let (w_g, w_tip) = deflections(params, &r, s.g, &s.tip);
         for i in 0..3 {
-            let (ex, ew) = (e_x(i, r.theta), e_w(i, r.theta));
-            w_g[i] = dot(dg, ew);
-            let rel = [
-                s.tip[i][0] - g[0] - params.l * ex[0],
-                s.tip[i][1] - g[1] - params.l * ex[1],
-            ];
-            w_tip[i] = dot(rel, ew);
+            let ex = e_x(i, r.theta);
+            let ew = e_w(i, r.theta);
             extra[i].push(s.xi_c[i]);
             extra[3 + i].push(wrap(s.sleeve_angle[i] - ex[1].atan2(ex[0])));
             extra[6 + i].push(-dot(s.pin_force[i], ew));
@@ -386,6 +383,45 @@ fn post_process(
     Ok(resp)
 }
 
+/// `w_iG = (G_fem - G_rigid) . e_wi` and `w_i(L) = (tip_fem - (G_rigid + L e_xi)) . e_wi` [m]
+/// of the FEM's G at `g` and tips `tips` (fixed frame) on the rigid frame `r` (Eqs. 11-12).
+fn deflections(params: &RobotParams, r: &RigidFrame, g: [f64; 2], tips: &[[f64; 2]; 3]) -> ([f64; 3], [f64; 3]) {
+    let dg = [g[0] - r.g[0], g[1] - r.g[1]];
+    let w_g = [0, 1, 2].map(|i| dot(dg, e_w(i, r.theta)));
+    let w_tip = [0, 1, 2].map(|i| {
+        let ex = e_x(i, r.theta);
+        let rel = [
+            tips[i][0] - r.g[0] - params.l * ex[0],
+            tips[i][1] - r.g[1] - params.l * ex[1],
+        ];
+        dot(rel, e_w(i, r.theta))
+    });
+    (w_g, w_tip)
+}
+
+/// Under gravity, the static equilibrium's `w_iG` and `w_i(L)` at the pose where the problem's
+/// motion comes to rest (`docs/fem.md` 9.5, Eq. G8; `docs/as-built.md` 5.5: the residual
+/// vibration is measured about it), post-processed as the run's outputs on the rigid frame of
+/// that pose; `None` without a rest within the run. The load acts at its value at `t_rest`.
+fn rest_offset(problem: &EqualBeams, settings: &FemSettings) -> Result<Option<RestOffset>, FemError> {
+    let Some(t_rest) = problem.trajectory.t_rest().filter(|t| *t <= problem.time.t_end) else {
+        return Ok(None);
+    };
+    let params = problem.robot;
+    let r = RigidState::at(params, problem.trajectory, t_rest)
+        .map_err(|source| FemError::PostProcessing { t: t_rest, source })?;
+    let attached = Attached::of(problem, r.theta.v);
+    let s = r.s.map(|s| s.v);
+    let (star, q) = static_equilibrium(params, settings.elements / 3, &initial_state(&r), &attached, s, t_rest)?;
+    let pos = |j: usize| [q[3 * j], q[3 * j + 1]];
+    let frame = RigidFrame {
+        g: [r.g[0].v, r.g[1].v],
+        theta: r.theta.v,
+    };
+    let (w_g, w_tip) = deflections(params, &frame, pos(0), &[0, 1, 2].map(|i| pos(star.node(i, star.ne))));
+    Ok(Some(RestOffset { t_rest, w_g, w_tip }))
+}
+
 /// The deformed-star snapshots and the animation frames of `resp` from the recorded shapes
 /// (`times.all`, in order), each about the rigid frame `frame(t, s)` (post-processing only).
 fn add_shapes(
@@ -420,13 +456,14 @@ fn add_shapes(
 /// An optional column: whether the run has it, its name, its value in a sample.
 type OptionalColumn = (bool, &'static str, fn(&Sample) -> f64);
 
-/// The payload's, load's and damping's columns after the others, each only when the run had its
-/// section: `Ek_payload`, `W_load`, `E_d` [J] (see [`solve`]).
+/// The payload's, load's, damping's and gravity's columns after the others, each only when the
+/// run had its section: `Ek_payload`, `W_load`, `E_d`, `V_g` [J] (see [`solve`]).
 fn attachment_columns(hist: &History, names: &mut Vec<&str>, cols: &mut Vec<Vec<f64>>) {
-    let present: [OptionalColumn; 3] = [
+    let present: [OptionalColumn; 4] = [
         (hist.payload, ATTACHED[0], |s: &Sample| s.ke_payload),
         (hist.load, ATTACHED[1], |s: &Sample| s.w_load),
         (hist.damping, ATTACHED[2], |s: &Sample| s.e_d),
+        (hist.gravity, ATTACHED[3], |s: &Sample| s.v_g),
     ];
     for (on, name, value) in present {
         if on {

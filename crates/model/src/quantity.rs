@@ -97,6 +97,7 @@ pub const QUANTITIES: &[Quantity] = &[
     q("Ek_payload", "J", "kinetic energy of the payload welded at G"),
     q("W_load", "J", "work of the load at G since t = 0"),
     q("E_d", "J", "energy dissipated by the beams' damping since t = 0"),
+    q("V_g", "J", "potential energy of the weights (beams, payload, sleeves, sliders)"),
     // a direct run's columns and kinematics.csv
     q("s{i}", "m", "position of slider i along its axis (Eqs. 1-3)"),
     q("sd{i}", "m/s", "velocity of slider i"),

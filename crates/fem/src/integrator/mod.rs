@@ -25,12 +25,14 @@ use crate::{FemError, NewtonFailure};
 
 mod motion;
 mod recorder;
+mod static_start;
 mod step;
 
 pub(crate) use motion::Motion;
 use motion::{pins_at, power};
 use recorder::{event_times, Recorder};
 pub(crate) use recorder::{Sample, Snapshot};
+pub(crate) use static_start::static_equilibrium;
 use step::{step, Workspace};
 
 /// Numerical settings of one run.
@@ -80,10 +82,12 @@ pub(crate) struct History {
     pub snapshots: Vec<Snapshot>,
     pub node_x: Vec<f64>,
     pub stats: Stats,
-    /// Which of the additions of `docs/fem.md` section 9 the run had: payload, load, damping (their columns).
+    /// Which of the additions of `docs/fem.md` section 9 the run had: payload, load, damping,
+    /// gravity (their columns).
     pub payload: bool,
     pub load: bool,
     pub damping: bool,
+    pub gravity: bool,
 }
 
 /// Work and dissipated energy since t = 0 [J], by the trapezoidal rule on the integration steps,
@@ -140,7 +144,9 @@ struct State {
 
 /// Consistent accelerations and multipliers at t = 0:
 /// `[M Phi_q^T; Phi_q 0] [q_dd; lambda] = [-f_conv - f_int; -Phi_dd_conv]` (with the sliders'
-/// rows `m s'' - u . F = Fa` in the direct problem).
+/// rows `m s'' - u . F = Fa` in the direct problem). The start must pass through the pins: every
+/// row vanishes for the undeformed start; a deflected start (Eq. G8) satisfies the tangent rows
+/// with Eq. S9's interior slope, so only their position rows are checked.
 fn initial_state(
     params: &RobotParams,
     motion: &Motion,
@@ -157,7 +163,8 @@ fn initial_state(
     };
     let pins0 = pins_of(star, &q)?;
     let phi0 = star.constraints(&q, &pins0);
-    let worst = phi0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let checked = |k: &usize| !(star.attached.weighs() && k % ROWS == ROWS - 1);
+    let worst = (0..phi0.len()).filter(checked).fold(0.0f64, |m, k| m.max(phi0[k].abs()));
     if worst > 1e-9 * l {
         return Err(FemError::Input(format!(
             "the initial pose does not pass through the pins (largest constraint violation {worst:.3e})"
@@ -298,7 +305,7 @@ impl Stepper<'_, '_> {
         let (params, st) = (self.params, &*self.st);
         self.star.check_on_beams(&st.q, t)?;
         self.motion.check_feasible(params, &st.pins, t)?;
-        let (fa, pf) = self.motion.forces(params, &st.pins, &st.lam, t)?;
+        let (fa, pf) = self.motion.forces(params, self.star, &st.pins, &st.lam, t)?;
         self.works.advance(self.star, st, &fa, t, h)?;
         self.rec.record(params, self.star, st, fa, pf, t, self.works);
         Ok(())
@@ -327,8 +334,14 @@ pub(crate) fn integrate(
     if t_out.is_empty() || t_out[0] != 0.0 {
         return Err(FemError::Input("output times must start at t = 0".into()));
     }
-    let (mut star, q, v) = Star::new(params, run.ne, init, motion.slider_unknowns())?;
+    let (mut star, mut q, v) = Star::new(params, run.ne, init, motion.slider_unknowns())?;
     star.attached = attached.clone();
+    if attached.weighs() {
+        // Eq. G8: start in the deflected static equilibrium, the sliders held where they start
+        let s0 = motion.start_sliders(params)?;
+        let (_, sag) = static_equilibrium(params, run.ne, init, attached, s0, 0.0)?;
+        q[..sag.len()].copy_from_slice(&sag);
+    }
     let mut st = initial_state(params, motion, &mut star, q, v)?;
     motion.check_feasible(params, &st.pins, 0.0)?;
 
@@ -337,7 +350,7 @@ pub(crate) fn integrate(
     let ga = GenAlpha::new(run.rho_inf);
     let mut rec = Recorder::new(t_out, snap_times);
     let mut stats = Stats::default();
-    let (fa0, pf0) = motion.forces(params, &st.pins, &st.lam, 0.0)?;
+    let (fa0, pf0) = motion.forces(params, &star, &st.pins, &st.lam, 0.0)?;
     let mut works = Works::start(&star, &st, &fa0)?;
     rec.record(params, &star, &st, fa0, pf0, 0.0, &works);
 
@@ -382,5 +395,6 @@ pub(crate) fn integrate(
         payload: attached.payload.is_some(),
         load: attached.load.is_some(),
         damping: attached.beta > 0.0 || attached.alpha > 0.0,
+        gravity: attached.weighs(),
     })
 }

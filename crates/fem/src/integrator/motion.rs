@@ -11,13 +11,20 @@ pub(super) fn pins_at(params: &RobotParams, traj: &Trajectory, t: f64) -> Result
 }
 
 /// Driving force (Eq. 33): `Fa_i = (mpp + mpa) s_i'' - F_i . u_i`, F_i the force of the beam on
-/// sleeve i (the sleeve is translationally massless: F_i passes through the pin to the slider).
-pub(super) fn driving_forces(params: &RobotParams, pins: &Pins, lam: &[f64]) -> ([f64; 3], [[f64; 2]; 3]) {
+/// sleeve i (the sleeve is translationally massless: F_i passes through the pin to the slider);
+/// under gravity less the weight of sleeve and slider along the rail, `- (mpp + mpa) g . u_i`
+/// (Eqs. G2, G7).
+pub(super) fn driving_forces(params: &RobotParams, star: &Star, pins: &Pins, lam: &[f64]) -> ([f64; 3], [[f64; 2]; 3]) {
     let f = pin_forces(lam);
-    let fa = [0, 1, 2].map(|i| {
+    let mut fa = [0, 1, 2].map(|i| {
         let u = slider_direction(i);
         params.mpp_mpa * pins.s[i][2] - (f[i][0] * u[0] + f[i][1] * u[1])
     });
+    if star.attached.weighs() {
+        for (i, fa) in fa.iter_mut().enumerate() {
+            *fa -= params.mpp_mpa * star.gravity_along(i);
+        }
+    }
     (fa, f)
 }
 
@@ -94,17 +101,28 @@ impl Motion<'_> {
         }))
     }
 
-    /// `Fa` [N] and the pin forces at a converged state: Eq. 33 (inverse), the law (direct).
+    /// `Fa` [N] and the pin forces at a converged state of `star`: Eq. 33 with Eq. G7 (inverse),
+    /// the law (direct).
     pub(super) fn forces(
         &self,
         params: &RobotParams,
+        star: &Star,
         pins: &Pins,
         lam: &[f64],
         t: f64,
     ) -> Result<([f64; 3], [[f64; 2]; 3]), FemError> {
         match self {
-            Motion::Prescribed(_) => Ok(driving_forces(params, pins, lam)),
+            Motion::Prescribed(_) => Ok(driving_forces(params, star, pins, lam)),
             Motion::Driven { law, .. } => Ok((Self::law_forces(*law, pins, t)?, pin_forces(lam))),
+        }
+    }
+
+    /// Where the sliders are held for the static equilibrium of the start (Eq. G8): `s(0)` [m]
+    /// of the trajectory (inverse) or of the initial data (direct).
+    pub(super) fn start_sliders(&self, params: &RobotParams) -> Result<[f64; 3], FemError> {
+        match self {
+            Motion::Prescribed(traj) => Ok(pins_at(params, traj, 0.0)?.s.map(|s| s[0])),
+            Motion::Driven { s0, .. } => Ok(*s0),
         }
     }
 

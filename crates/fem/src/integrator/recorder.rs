@@ -33,6 +33,8 @@ pub(crate) struct Sample {
     pub w_load: f64,
     /// Energy dissipated by the damping since t = 0 [J] (Eqs. D10, D16; 0 undamped).
     pub e_d: f64,
+    /// Potential energy of the weights [J] (`Star::gravity_potential`; 0 without gravity).
+    pub v_g: f64,
     /// Slider positions s_i [m] and speeds s_i' [m/s] (prescribed, or simulated).
     pub s: [f64; 3],
     pub sd: [f64; 3],
@@ -119,6 +121,7 @@ impl<'a> Recorder<'a> {
                 ke_payload: star.payload_energy(q, v),
                 w_load: works.w_load,
                 e_d: works.e_d,
+                v_g: star.gravity_potential(q, pins),
                 s: pins.s.map(|s| s[0]),
                 sd: pins.s.map(|s| s[1]),
             });

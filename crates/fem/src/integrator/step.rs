@@ -34,9 +34,8 @@ impl Workspace {
     /// rotations (node rotations and the three sleeve rotations), 1 for lengths.
     pub(super) fn new(star: &Star) -> Self {
         let (n_dof, n_sys) = (star.n_dof, star.n_sys);
-        let rot = |j: usize| j < 3 * star.n_nodes && j % 3 == 2 || (j >= 3 * star.n_nodes && j < 3 * star.n_nodes + 3);
         Workspace {
-            weight: (0..n_dof).map(|j| if rot(j) { star.h } else { 1.0 }).collect(),
+            weight: increment_weights(star),
             a_part: vec![0.0; n_dof],
             qh: vec![0.0; n_dof],
             vh: vec![0.0; n_dof],
@@ -48,6 +47,13 @@ impl Workspace {
             res: vec![0.0; n_sys],
         }
     }
+}
+
+/// Weight of each coordinate's increment in Newton's convergence tests: the element length h [m]
+/// for rotations (node rotations and the three sleeve rotations), 1 for lengths.
+pub(super) fn increment_weights(star: &Star) -> Vec<f64> {
+    let rot = |j: usize| j < 3 * star.n_nodes && j % 3 == 2 || (j >= 3 * star.n_nodes && j < 3 * star.n_nodes + 3);
+    (0..star.n_dof).map(|j| if rot(j) { star.h } else { 1.0 }).collect()
 }
 
 /// Generalized-alpha predictor of every coordinate ([`GenAlpha::predict`]) and the first Newton

@@ -1,8 +1,8 @@
 //! What an experiment attaches to the star (`docs/fem.md` section 9): a rigid payload welded to node G
 //! (Eqs. P10-P12), the beams' Kelvin-Voigt retardation time (Eqs. D6-D10, evaluated in the
 //! element pass), the mass-proportional damping of the elastic motion (Eqs. D16-D18, `rigid.rs`)
-//! and a load at G (Eq. L2). Absent (the defaults), each adds nothing: its code path
-//! is skipped, so the run is the bare star's bit for bit.
+//! a load at G (Eq. L2) and gravity (Eqs. G6-G7, `gravity.rs`). Absent (the defaults), each adds
+//! nothing: its code path is skipped, so the run is the bare star's bit for bit.
 
 use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::{EqualBeams, LoadSettings, Payload};
@@ -34,6 +34,13 @@ impl PayloadAtG {
             j: p.j,
             c0: [ox * ex[0] + oy * ew[0], ox * ex[1] + oy * ew[1]],
         })
+    }
+
+    /// The centre of mass `X + R(phi) c0` [m], fixed frame, at G's coordinates `q_g = (x, y, phi)`
+    /// (Eq. P10).
+    pub fn centre(&self, q_g: &[f64]) -> [f64; 2] {
+        let c = self.offset(q_g[2]);
+        [q_g[0] + c[0], q_g[1] + c[1]]
     }
 
     /// `c = R(phi) c0` [m]: the centre of mass from G, fixed frame.
@@ -75,7 +82,8 @@ impl PayloadAtG {
     }
 }
 
-/// The additions to one run (`docs/fem.md` section 9): payload, damping, load (each absent by default).
+/// The additions to one run (`docs/fem.md` section 9): payload, damping, load, gravity (each
+/// absent by default).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Attached {
     /// The payload welded to G.
@@ -87,10 +95,12 @@ pub(crate) struct Attached {
     pub alpha: f64,
     /// The load at G, fixed frame.
     pub load: Option<LoadSettings>,
+    /// Gravity `[gx, gy]` [m/s^2], fixed (base) frame (Eqs. G6-G7; `[0, 0]`: none).
+    pub gravity: [f64; 2],
 }
 
 impl Attached {
-    /// The `[payload]`, `[damping]` and `[load]` of `exp` for a star starting at the
+    /// The `[payload]`, `[damping]`, `[load]` and `[gravity]` of `exp` for a star starting at the
     /// orientation `theta0` [rad].
     pub fn of(exp: &EqualBeams, theta0: f64) -> Self {
         Attached {
@@ -98,7 +108,14 @@ impl Attached {
             beta: exp.damping.beta(),
             alpha: exp.damping.alpha(),
             load: (!exp.load.is_none()).then(|| exp.load.clone()),
+            gravity: exp.gravity,
         }
+    }
+
+    /// Whether the run has gravity (every gravity code path is guarded on it, so a run without
+    /// is the bare star's bit for bit).
+    pub fn weighs(&self) -> bool {
+        self.gravity != [0.0; 2]
     }
 
     /// `(Fx, Fy, Mz)` [N, N, N m] of the load at time `t` [s]; `None` without a load.

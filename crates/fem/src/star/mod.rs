@@ -38,6 +38,7 @@ use crate::sparse::SparseLu;
 use crate::FemError;
 
 mod attached;
+mod gravity;
 mod pattern;
 mod rigid;
 pub(crate) mod sleeve;
@@ -308,7 +309,9 @@ impl Star {
     /// enters the element forces (Eqs. D7, D9; `fac.cv` the velocity factor gamma'), and the
     /// mass-proportional damping (alpha > 0, Eq. D16) the inertia forces through the shifted
     /// accelerations `qdd + alpha (v - v_r)` on the nodes and sleeve rotations, with the matrix's
-    /// mass scaled by `1 + cv alpha` (Eq. D18); without alpha neither runs.
+    /// mass scaled by `cm + cv alpha` (Eq. D18), and gravity (Eqs. G6-G7) through the
+    /// accelerations `qdd - t_g`; without alpha and gravity neither runs. `fac.cm = 0` leaves the
+    /// mass out of the matrix (the static equilibrium, Eq. G8).
     /// Direct problem: `res[s_i] = cf ((mpp + mpa) s_i'' - Fa_i) - u_i . (nu_c + nu_l + nu_r)`,
     /// matrix diagonal `sliders.diag`, coupling `-u_i` with the sleeve's position rows.
     /// With `matrix == false` only the imbalance is evaluated (for a modified Newton iteration with
@@ -323,9 +326,9 @@ impl Star {
         matrix: bool,
     ) -> Result<bool, FemError> {
         let mut shifted = std::mem::take(&mut self.shifted);
-        let (it, fac) = if self.attached.alpha > 0.0 {
+        let (it, fac) = if self.attached.alpha > 0.0 || self.attached.weighs() {
             self.shifted_accelerations(&it, t, &mut shifted)?;
-            let cm = 1.0 + fac.cv * self.attached.alpha;
+            let cm = fac.cm + fac.cv * self.attached.alpha;
             (Iterate { qdd: &shifted, ..it }, Factors { cm, ..fac })
         } else {
             (it, fac)

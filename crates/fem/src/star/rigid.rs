@@ -127,12 +127,18 @@ impl Star {
 
     /// Eq. D16 through the inertia routines: the accelerations `qdd + alpha (v - v_r)` on
     /// [`Star::massive`] (the sliders' and contact coordinates' unchanged) at the iterate `it`,
-    /// written into `out`; `v_r` from the iterate's pins and slider velocities (Eq. D17).
+    /// written into `out`; `v_r` from the iterate's pins and slider velocities (Eq. D17). Under
+    /// gravity, less the weights' field `t_g` (Eqs. G6-G7, `Star::subtract_weight_field`).
     pub(super) fn shifted_accelerations(&self, it: &Iterate, t: f64, out: &mut Vec<f64>) -> Result<(), FemError> {
-        let w = self.rigid_twist(it.q, &it.pins.p, t)?.at(it.pins.s.map(|s| s[1]));
         out.clear();
         out.extend_from_slice(it.qdd);
-        self.add_relative_rates(it.q, it.v, w, out);
+        if self.attached.alpha > 0.0 {
+            let w = self.rigid_twist(it.q, &it.pins.p, t)?.at(it.pins.s.map(|s| s[1]));
+            self.add_relative_rates(it.q, it.v, w, out);
+        }
+        if self.attached.weighs() {
+            self.subtract_weight_field(out);
+        }
         Ok(())
     }
 

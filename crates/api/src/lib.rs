@@ -7,6 +7,7 @@
 
 pub mod document;
 mod error;
+pub mod export;
 mod figures;
 pub mod kinematics;
 pub mod modal;

@@ -32,7 +32,7 @@ pub enum PoseSpec {
 }
 
 /// A modal error; with `source` the experiment file comes first in the message.
-fn from_modal(source: Option<&str>, t: f64, e: ModalError) -> ApiError {
+pub(crate) fn from_modal(source: Option<&str>, t: f64, e: ModalError) -> ApiError {
     let file = source.unwrap_or("");
     let message = match source {
         Some(s) => format!("{s}: {e}"),

@@ -45,6 +45,9 @@ enum Command {
     /// Plan a rest-to-rest motion that leaves little residual vibration ([plan], [limits]) and
     /// compare it with the plain and the ZVD-shaped quintic: DIR/<name>/plan.md, plan.toml, plan.csv
     Plan(commands::plan::Args),
+    /// A run's or a plan's motion for a motion controller: DIR/setpoints.csv (t, s, v, a, j, F at
+    /// k / rate) and setpoints.json
+    Export(commands::export::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -61,6 +64,7 @@ fn main() -> std::process::ExitCode {
         Command::Linearize(args) => commands::modal::run_linearize(args),
         Command::Animate(args) => commands::animate::run(args),
         Command::Plan(args) => commands::plan::run(args),
+        Command::Export(args) => commands::export::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

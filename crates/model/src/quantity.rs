@@ -36,7 +36,8 @@ const fn q(name: &'static str, unit: &'static str, meaning: &'static str) -> Qua
 }
 
 /// Every column of every CSV flexstar writes for a run or a motion: the solver results (the
-/// fixed columns, the AMM's and the FEM's), a direct run's file and `kinematics.csv`.
+/// fixed columns, the AMM's and the FEM's), a direct run's file, `kinematics.csv` and the
+/// controller's `setpoints.csv` (`flexstar export`).
 pub const QUANTITIES: &[Quantity] = &[
     q("t", "s", "time"),
     // the fixed columns of every solver result
@@ -114,6 +115,15 @@ pub const QUANTITIES: &[Quantity] = &[
     q("aGy", "m/s^2", "acceleration of rigid G, y, fixed frame"),
     q("thetadot", "rad/s", "angular velocity of the rigid star"),
     q("thetaddot", "rad/s^2", "angular acceleration of the rigid star"),
+    // setpoints.csv (flexstar export): the motion's exact derivatives and the feed-forward
+    q("v{i}", "m/s", "setpoint velocity of slider i, exact derivative of the motion"),
+    q("a{i}", "m/s^2", "setpoint acceleration of slider i, exact"),
+    q("j{i}", "m/s^3", "setpoint jerk of slider i, exact"),
+    q(
+        "F{i}",
+        "N",
+        "feed-forward force of actuator i along +u_i: the accurate AMM's Fa_i at the sample time",
+    ),
 ];
 
 /// The declared quantity that column `name` belongs to (`w2G`: `w{i}G`).

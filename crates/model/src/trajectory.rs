@@ -183,6 +183,38 @@ impl Jet {
     }
 }
 
+/// Value and first four time derivatives of one scalar: for a slider, position [m], velocity
+/// [m/s], acceleration [m/s^2], jerk [m/s^3] and snap [m/s^4].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Jet4 {
+    pub v: f64,
+    pub d1: f64,
+    pub d2: f64,
+    pub d3: f64,
+    pub d4: f64,
+}
+
+impl Jet4 {
+    /// The derivatives held by `f(x)` for the nested dual `x` of [`nested_dual`]: the outer
+    /// parts are `f`, `f'`, `f''` evaluated at the inner dual `t + e`, whose parts are in turn
+    /// the value and its first two derivatives.
+    fn from_nested(x: Dual2<Dual2<f64>>) -> Self {
+        Jet4 {
+            v: x.re.re,
+            d1: x.re.v1,
+            d2: x.re.v2,
+            d3: x.v1.v2,
+            d4: x.v2.v2,
+        }
+    }
+}
+
+/// The time t [s] as a second-order dual number over a second-order dual number, both parts
+/// seeded with dt/dt = 1: a function of it carries its derivatives up to the fourth, exactly.
+fn nested_dual(t: f64) -> Dual2<Dual2<f64>> {
+    Dual2::new(Dual2::from_re(t).derivative(), Dual2::from_re(1.0), Dual2::from_re(0.0))
+}
+
 impl Trajectory {
     /// The paper's polynomial trajectories: `s_i = k_i t^2`.
     pub fn quadratic(k: [f64; 3]) -> Self {
@@ -357,6 +389,15 @@ impl Trajectory {
         Ok(s.map(Jet::from_dual2))
     }
 
+    /// `s_i` [m] and its first four time derivatives (velocity [m/s], acceleration [m/s^2], jerk
+    /// [m/s^3], snap [m/s^4]) at time t [s], exact: [`Trajectory::s`] evaluated on nested
+    /// second-order dual numbers (`Dual2<Dual2<f64>>`, `docs/motions.md`, "Export for the
+    /// controller"). At a knot where a derivative jumps (a quintic's ends, a rest segment's
+    /// joints) it is the value of the piece the evaluation falls in.
+    pub fn jets4(&self, params: &RobotParams, t: f64) -> Result<[Jet4; 3], ModelError> {
+        Ok(self.s(params, nested_dual(t))?.map(Jet4::from_nested))
+    }
+
     /// Check coefficients and times; the key is relative to the `[trajectory]` table.
     pub fn validate(&self, params: &RobotParams) -> Result<(), ModelError> {
         match self {
@@ -427,6 +468,33 @@ mod tests {
         assert!((j[0].v - 0.09).abs() < 1e-15 && (j[0].d1 - 0.6).abs() < 1e-15 && (j[0].d2 - 2.0).abs() < 1e-15);
         assert!((j[1].d2 + 1.0).abs() < 1e-15);
         assert_eq!(j[2], Jet::default());
+    }
+
+    /// The four derivatives of a polynomial against its coefficients, differentiated by hand:
+    /// s = 1 + 2 t - 3 t^2 + 4 t^3 - 5 t^4 + 6 t^5.
+    #[test]
+    fn jets4_of_a_polynomial_are_its_derivatives() {
+        let c = vec![1.0, 2.0, -3.0, 4.0, -5.0, 6.0];
+        let tr = Trajectory::Polynomial {
+            s1: c.clone(),
+            s2: vec![0.0],
+            s3: c,
+        };
+        let t = 0.7f64;
+        let want = [
+            1.0 + 2.0 * t - 3.0 * t.powi(2) + 4.0 * t.powi(3) - 5.0 * t.powi(4) + 6.0 * t.powi(5),
+            2.0 - 6.0 * t + 12.0 * t.powi(2) - 20.0 * t.powi(3) + 30.0 * t.powi(4),
+            -6.0 + 24.0 * t - 60.0 * t.powi(2) + 120.0 * t.powi(3),
+            24.0 - 120.0 * t + 360.0 * t.powi(2),
+            -120.0 + 720.0 * t,
+        ];
+        let j = tr.jets4(&RobotParams::paper(), t).unwrap();
+        let got = [j[0].v, j[0].d1, j[0].d2, j[0].d3, j[0].d4];
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-12 * (1.0 + w.abs()), "{got:?} vs {want:?}");
+        }
+        assert_eq!(j[0], j[2]);
+        assert_eq!(j[1], Jet4::default());
     }
 
     #[test]

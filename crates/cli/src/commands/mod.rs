@@ -2,6 +2,7 @@
 
 pub mod animate;
 pub mod compare;
+pub mod export;
 pub mod kinematics;
 pub mod modal;
 pub mod modes;

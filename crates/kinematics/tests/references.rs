@@ -221,23 +221,7 @@ fn rigid_inverse_dynamics_balances_power() {
     // Power of the drivers = d/dt of the kinetic energy of sliders, sleeves and rigid star:
     // T = 1/2 m_s |v_G|^2 + 1/2 (rho L^3 + 3 Jp) theta'^2 + 1/2 (mpp+mpa) sum s_i'^2.
     let p = paper();
-    let trs = [
-        Trajectory::quadratic([1.0, 0.0, 0.5]),
-        Trajectory::Quintic {
-            from: Pose {
-                gx: 0.0,
-                gy: 0.0,
-                theta: 0.0,
-            },
-            to: Pose {
-                gx: 0.03,
-                gy: -0.02,
-                theta: 0.3,
-            },
-            t0: 0.0,
-            t1: 0.5,
-        },
-    ];
+    let trs = [Trajectory::quadratic([1.0, 0.0, 0.5]), general_quintic()];
     for tr in &trs {
         for t in [0.1, 0.25, 0.4] {
             let st = RigidState::at(&p, tr, t).unwrap();

@@ -208,7 +208,7 @@ impl Attachments {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use crate::Experiment;
     use std::path::Path;
 
@@ -223,7 +223,9 @@ s2 = [0.0]
 s3 = [0.0, 0.0, 0.5]
 "#;
 
-    fn load(extra: &str, config: &Path) -> Result<Experiment, String> {
+    /// A small experiment with the sections `extra`, read as if from `config` (the model's tests
+    /// of the optional sections share it).
+    pub(crate) fn load(extra: &str, config: &Path) -> Result<Experiment, String> {
         Experiment::from_toml_str(&format!("{BASE}{extra}\n"), config).map_err(|e| e.to_string())
     }
 

@@ -327,19 +327,8 @@ mod tests {
     use crate::Experiment;
     use std::path::Path;
 
-    const BASE: &str = r#"
-name = "p"
-[time]
-t_end = 0.2
-[trajectory]
-kind = "polynomial"
-s1 = [0.0, 0.0, 1.0]
-s2 = [0.0]
-s3 = [0.0, 0.0, 0.5]
-"#;
-
     fn load(extra: &str) -> Result<Experiment, String> {
-        Experiment::from_toml_str(&format!("{BASE}{extra}\n"), Path::new("bad.toml")).map_err(|e| e.to_string())
+        crate::attachments::tests::load(extra, Path::new("bad.toml"))
     }
 
     #[test]

@@ -81,11 +81,8 @@ mod tests {
     use crate::Experiment;
     use std::path::Path;
 
-    const BASE: &str = "name = \"p\"\n[time]\nt_end = 0.2\n[trajectory]\nkind = \"polynomial\"\n\
-                        s1 = [0.0]\ns2 = [0.0]\ns3 = [0.0]\n";
-
     fn load(extra: &str) -> Result<Experiment, String> {
-        Experiment::from_toml_str(&format!("{BASE}{extra}\n"), Path::new("g.toml")).map_err(|e| e.to_string())
+        crate::attachments::tests::load(extra, Path::new("g.toml"))
     }
 
     #[test]

@@ -106,6 +106,16 @@ fn amm_and_fem_sag_alike_under_gravity() {
         tip(&fem),
         tip(&amm)
     );
-    assert!(dgy(&amm) < -1e-3 && rel < 5e-3, "FEM {} m against the AMM's {} m", dgy(&fem), dgy(&amm));
-    assert!(tip_rel < 5e-3, "tips: FEM {:?} m against the AMM's {:?} m", tip(&fem), tip(&amm));
+    assert!(
+        dgy(&amm) < -1e-3 && rel < 5e-3,
+        "FEM {} m against the AMM's {} m",
+        dgy(&fem),
+        dgy(&amm)
+    );
+    assert!(
+        tip_rel < 5e-3,
+        "tips: FEM {:?} m against the AMM's {:?} m",
+        tip(&fem),
+        tip(&amm)
+    );
 }

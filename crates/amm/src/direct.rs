@@ -179,7 +179,9 @@ fn coupled_step(
         }
         row[i] += m + kp[i] * bp + kd[i] * gp;
         // Eq. 33 with the weight along the rail (Eq. G2)
-        row[3] = fa[i] + m * rec.gravity_along(i) - m * x_pred[i] - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
+        row[3] = fa[i] + m * rec.gravity_along(i)
+            - m * x_pred[i]
+            - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
     }
     let dx = solve3(a).ok_or(AmmError::SingularConstraints {
         t,

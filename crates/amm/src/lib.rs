@@ -30,12 +30,12 @@ mod foreshortening;
 mod geometric;
 pub mod modes;
 pub mod pose_modes;
-mod record;
-mod static_start;
 #[cfg(test)]
 mod rayleigh_decay;
+mod record;
 mod sleeve;
 pub mod solver;
+mod static_start;
 mod system;
 
 pub use direct::DIRECT_COLUMNS;

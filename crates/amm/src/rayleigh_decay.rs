@@ -62,9 +62,9 @@ fn decay_rate(x: &[f64], h: f64) -> f64 {
         .collect();
     let n = peaks.len() as f64;
     let (mt, my) = peaks.iter().fold((0.0, 0.0), |(a, b), (t, y)| (a + t / n, b + y / n));
-    let (sxy, sxx) = peaks
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (t, y)| (a + (t - mt) * (y - my), b + (t - mt) * (t - mt)));
+    let (sxy, sxx) = peaks.iter().fold((0.0, 0.0), |(a, b), (t, y)| {
+        (a + (t - mt) * (y - my), b + (t - mt) * (t - mt))
+    });
     -sxy / sxx
 }
 
@@ -84,7 +84,11 @@ fn the_first_two_modes_decay_at_the_rayleigh_rates() {
                 omega[k] / (2.0 * std::f64::consts::PI)
             );
             // the filter is exact for the linear system at rest; what is left is the peaks' sampling
-            assert!((measured / law - 1.0).abs() < 5e-3, "mode {}: {measured} vs {law}", k + 1);
+            assert!(
+                (measured / law - 1.0).abs() < 5e-3,
+                "mode {}: {measured} vs {law}",
+                k + 1
+            );
         }
     }
 }

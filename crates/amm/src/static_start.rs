@@ -65,7 +65,11 @@ pub(crate) fn static_equilibrium(
 /// Under gravity, the static equilibrium's `w_iG` and tips at the pose where the problem's
 /// motion comes to rest (`docs/as-built.md` 5.5: the residual vibration is measured about it);
 /// `None` without gravity or without a rest within the run. `sys` is left at that equilibrium.
-pub(crate) fn rest_offset(sys: &mut System, problem: &EqualBeams, time_scale: f64) -> Result<Option<RestOffset>, AmmError> {
+pub(crate) fn rest_offset(
+    sys: &mut System,
+    problem: &EqualBeams,
+    time_scale: f64,
+) -> Result<Option<RestOffset>, AmmError> {
     let Some(t_rest) = problem.trajectory.t_rest().filter(|t| *t <= problem.time.t_end) else {
         return Ok(None);
     };
@@ -119,14 +123,19 @@ mod tests {
             let (mut worst, mut largest) = (0.0f64, 0.0f64);
             for i in 0..3 {
                 let w = |x: f64, d: usize| {
-                    (0..nm).map(|j| sys.modes.eval(j, x)[d] * q[i * (nm + 2) + j]).sum::<f64>()
+                    (0..nm)
+                        .map(|j| sys.modes.eval(j, x)[d] * q[i * (nm + 2) + j])
+                        .sum::<f64>()
                 };
                 let xr = st.xp[i].v + p.lp / 2.0;
                 let sag = w(p.l, 0) - (w(xr, 0) + w(xr, 1) * (p.l - xr));
                 let e_w = st.e_w(i);
                 let load = p.rho * (exp.gravity.g[0] * e_w[0] + exp.gravity.g[1] * e_w[1]);
                 let textbook = load * (p.l - xr).powi(4) / (8.0 * p.ei());
-                eprintln!("{family:?} N = {nm}, beam {}: tip off the edge's tangent {sag:.6e} m, cantilever {textbook:.6e} m", i + 1);
+                eprintln!(
+                    "{family:?} N = {nm}, beam {}: tip off the edge's tangent {sag:.6e} m, cantilever {textbook:.6e} m",
+                    i + 1
+                );
                 worst = worst.max((sag - textbook).abs());
                 largest = largest.max(textbook.abs());
             }
@@ -134,7 +143,10 @@ mod tests {
         };
         for family in [ModeFamily::Enriched, ModeFamily::FreeFree] {
             let (coarse, fine) = (error(family, 40), error(family, 80));
-            assert!(fine < 1e-3 && fine < coarse, "{family:?}: {coarse:.2e} at N = 40, {fine:.2e} at N = 80");
+            assert!(
+                fine < 1e-3 && fine < coarse,
+                "{family:?}: {coarse:.2e} at N = 40, {fine:.2e} at N = 80"
+            );
         }
     }
 }

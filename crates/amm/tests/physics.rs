@@ -253,7 +253,11 @@ fn stiff_star_under_gravity_reproduces_rigid_inverse_dynamics() {
     for g in [[0.0, -9.81], [6.0, 7.76], [-9.81, 0.0]] {
         let e = stiff_limit_error_with(&accurate, to, g);
         eprintln!("enriched, full, g = {g:?}: {:.3} %", e * 100.0);
-        assert!(e < 5e-3, "g = {g:?}: Fa off the rigid inverse dynamics by {:.3} %", e * 100.0);
+        assert!(
+            e < 5e-3,
+            "g = {g:?}: Fa off the rigid inverse dynamics by {:.3} %",
+            e * 100.0
+        );
     }
 }
 

@@ -373,8 +373,7 @@ fn residual_keys(p: &Prepared, r: &Response) -> Result<flexstar_model::ResidualK
 /// Why an AMM run is outside the validated envelope of the accurate model (`docs/validation.md`
 /// section 8, [`flexstar_metrics::envelope`]); empty inside it.
 fn outside_envelope(exp: &Experiment, small_deflection: bool) -> Vec<String> {
-    let attachments =
-        !(exp.payload.is_none() && exp.damping.is_none() && exp.load.is_none() && exp.gravity.is_none());
+    let attachments = !(exp.payload.is_none() && exp.damping.is_none() && exp.load.is_none() && exp.gravity.is_none());
     flexstar_metrics::envelope::outside_envelope(
         &exp.robot,
         exp.amm.model,

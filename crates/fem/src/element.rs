@@ -708,7 +708,13 @@ mod tests {
         let mut sum = [0.0; 2];
         for k in 0..=n {
             let z = k as f64 / n as f64;
-            let w = if k == 0 || k == n { 1.0 } else if k % 2 == 1 { 4.0 } else { 2.0 };
+            let w = if k == 0 || k == n {
+                1.0
+            } else if k % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
             let r = st.position([q[0], q[1]], z);
             sum[0] += w * r[0] / (3.0 * n as f64);
             sum[1] += w * r[1] / (3.0 * n as f64);

@@ -9,8 +9,7 @@
 use flexstar_drive::SolveRequest;
 use flexstar_kinematics::{rigid_inverse_dynamics_with, RigidState};
 use flexstar_model::{
-    catalogue, Attachments, Damping, Experiment, FemSettings, Gravity, Payload, Response, RobotParams,
-    Trajectory,
+    catalogue, Attachments, Damping, Experiment, FemSettings, Gravity, Payload, Response, RobotParams, Trajectory,
 };
 use flexstar_numerics::measures::max_abs;
 
@@ -71,7 +70,10 @@ fn a_star_at_rest_keeps_its_static_sag() {
     );
     assert!(dgy[0] < -1e-3, "G must sag: dGy = {} m", dgy[0]);
     assert!(drift < 1e-9 * dgy[0].abs() + 1e-12, "dGy drifts by {drift} m");
-    assert!(tip_drift < 1e-9 + 1e-9 * max_abs(&tips), "a tip drifts by {tip_drift} m");
+    assert!(
+        tip_drift < 1e-9 + 1e-9 * max_abs(&tips),
+        "a tip drifts by {tip_drift} m"
+    );
     // the residual's reference at the rest pose is the same equilibrium
     let offset = r.rest_offset.expect("a rest within the run under gravity");
     for i in 0..3 {
@@ -107,7 +109,10 @@ fn overhangs(g: [f64; 2]) -> Vec<Overhang> {
     let mut out = vec![];
     for i in 0..3 {
         let (ex, ew) = (st.e_x(i), st.e_w(i));
-        let (normal, axial) = (p.rho * (g[0] * ew[0] + g[1] * ew[1]), p.rho * (g[0] * ex[0] + g[1] * ex[1]));
+        let (normal, axial) = (
+            p.rho * (g[0] * ew[0] + g[1] * ew[1]),
+            p.rho * (g[0] * ex[0] + g[1] * ex[1]),
+        );
         if normal.abs() < 1e-3 * p.rho * g[0].hypot(g[1]) {
             continue;
         }
@@ -138,7 +143,12 @@ fn overhangs(g: [f64; 2]) -> Vec<Overhang> {
 /// (the cantilever's exact shape in linear theory, which the Hermite elements reproduce at the
 /// nodes).
 fn quartic_at(x: &[f64], w: &[f64], x0: f64) -> (f64, f64) {
-    let pts: Vec<(f64, f64)> = x.iter().zip(w).filter(|(xk, _)| **xk > x0).map(|(a, b)| (a - x0, *b)).collect();
+    let pts: Vec<(f64, f64)> = x
+        .iter()
+        .zip(w)
+        .filter(|(xk, _)| **xk > x0)
+        .map(|(a, b)| (a - x0, *b))
+        .collect();
     assert!(pts.len() >= 8, "too few nodes on the overhang");
     let scale = pts.last().unwrap().0;
     let mut ata = [[0.0; 5]; 5];
@@ -215,7 +225,11 @@ fn stiff_limit_under_gravity_follows_the_rigid_inverse_dynamics() {
         }
         let peak = rigid.iter().map(|f| max_abs(f)).fold(0.0, f64::max);
         for i in 0..3 {
-            let err = r.fa[i].iter().zip(&rigid[i]).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            let err = r.fa[i]
+                .iter()
+                .zip(&rigid[i])
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
             let num: f64 = r.fa[i].iter().zip(&rigid[i]).map(|(a, b)| (a - b).abs()).sum();
             let den: f64 = rigid[i].iter().map(|b| b.abs()).sum();
             let evp = num / den * 100.0;
@@ -224,7 +238,11 @@ fn stiff_limit_under_gravity_follows_the_rigid_inverse_dynamics() {
                 i + 1,
                 err / peak * 100.0
             );
-            assert!(err < 5e-3 * peak, "g = {g:?}: Fa{} off by {err} N (peak {peak} N)", i + 1);
+            assert!(
+                err < 5e-3 * peak,
+                "g = {g:?}: Fa{} off by {err} N (peak {peak} N)",
+                i + 1
+            );
             assert!(evp < 0.5, "g = {g:?}: Fa{} EVP {evp} %", i + 1);
         }
     }
@@ -265,7 +283,10 @@ fn energy_balance_with_the_weights() {
     let direct = fem(&exp, &coarse(), SolveRequest::law(&table));
     let drift = (0..3)
         .map(|i| {
-            let (a, b) = (col(&inverse, &format!("xp{}", i + 1)), col(&direct, &format!("xp{}", i + 1)));
+            let (a, b) = (
+                col(&inverse, &format!("xp{}", i + 1)),
+                col(&direct, &format!("xp{}", i + 1)),
+            );
             a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
         })
         .fold(0.0, f64::max);
@@ -277,7 +298,10 @@ fn energy_balance_with_the_weights() {
         "Eq. C6 with V_g: defect {d_inv:.2e} (inverse), {d_dir:.2e} (direct) of the work; Delta V_g {change:.3e} J, W {:.3e} J",
         col(&inverse, "W")[inverse.len() - 1]
     );
-    assert!(change.abs() > 1e-2, "the weights must be a real part of the balance: {change} J");
+    assert!(
+        change.abs() > 1e-2,
+        "the weights must be a real part of the balance: {change} J"
+    );
     assert!(d_inv < 1e-4, "inverse: Eq. C6 off by {d_inv:.2e} of the work");
     assert!(d_dir < 1e-4, "direct: Eq. C6 off by {d_dir:.2e} of the work");
 }

@@ -420,7 +420,12 @@ fn rigid_inverse_dynamics_under_gravity_holds_the_weights() {
         up[i] += h;
         down[i] -= h;
         let grad = (potential(up) - potential(down)) / (2.0 * h);
-        assert!((f.fa[i] - grad).abs() < 1e-7 * (1.0 + grad.abs()), "slider {}: {} vs {grad}", i + 1, f.fa[i]);
+        assert!(
+            (f.fa[i] - grad).abs() < 1e-7 * (1.0 + grad.abs()),
+            "slider {}: {} vs {grad}",
+            i + 1,
+            f.fa[i]
+        );
     }
     // moving: power = dT/dt + dV/dt
     let tr = general_quintic();

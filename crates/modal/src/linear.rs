@@ -390,7 +390,10 @@ fn add_damping_and_load(exp: &Experiment, modes: &PoseModes, blocks: &mut Blocks
     let sys = &modes.system;
     let phi = &modes.shapes;
     if exp.damping != flexstar_model::Damping::default() {
-        let (n, c) = (sys.n, sys.damping_matrix(exp.damping.alpha(), exp.damping.beta(), &phi[..modes.rigid]));
+        let (n, c) = (
+            sys.n,
+            sys.damping_matrix(exp.damping.alpha(), exp.damping.beta(), &phi[..modes.rigid]),
+        );
         let c_phi: Vec<Vec<f64>> = phi
             .iter()
             .map(|p| (0..n).map(|a| dot(&c[a * n..(a + 1) * n], p)).collect())

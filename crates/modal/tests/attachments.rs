@@ -163,7 +163,10 @@ fn rayleigh_poles_follow_the_two_ratio_law() {
     for (f, z) in ss.modes.freq_hz.iter().zip(&ss.damping_ratios) {
         let w = two_pi * f;
         let zeta = alpha / (2.0 * w) + beta * w / 2.0;
-        assert!((z - zeta).abs() < 1e-9 * zeta, "statespace.json's ratio {z} vs the law {zeta}");
+        assert!(
+            (z - zeta).abs() < 1e-9 * zeta,
+            "statespace.json's ratio {z} vs the law {zeta}"
+        );
         let pole = (-zeta * w, w * (1.0 - zeta * zeta).sqrt());
         let found = ev
             .iter()

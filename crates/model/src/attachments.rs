@@ -266,10 +266,7 @@ s3 = [0.0, 0.0, 0.5]
             let e = load(extra, Path::new("bad.toml")).unwrap_err();
             assert!(e.contains("bad.toml") && e.contains(key), "{extra}: {e}");
         }
-        for (extra, key) in [
-            ("[payload]\nmas = 1.0", "mas"),
-            ("[load]\nFz = [1.0]", "Fz"),
-        ] {
+        for (extra, key) in [("[payload]\nmas = 1.0", "mas"), ("[load]\nFz = [1.0]", "Fz")] {
             let e = load(extra, Path::new("bad.toml")).unwrap_err();
             assert!(e.contains("bad.toml") && e.contains(key), "{extra}: {e}");
         }

@@ -73,7 +73,10 @@ impl<'de> Deserialize<'de> for ModeValues {
                 match v.as_slice() {
                     [a] => Ok(ModeValues::One(*a)),
                     [a, b] => Ok(ModeValues::Two([*a, *b])),
-                    _ => Err(de::Error::invalid_length(v.len(), &"one value or two (the first two modes)")),
+                    _ => Err(de::Error::invalid_length(
+                        v.len(),
+                        &"one value or two (the first two modes)",
+                    )),
                 }
             }
         }
@@ -201,7 +204,11 @@ impl Damping {
         if let Some(&f1) = first.first() {
             let z1 = self.zeta_at(f1);
             if z1 >= 1.0 {
-                let key = if self.zeta.is_some() { "damping.zeta" } else { "damping.alpha" };
+                let key = if self.zeta.is_some() {
+                    "damping.zeta"
+                } else {
+                    "damping.alpha"
+                };
                 return Err(ModelError::invalid(
                     key,
                     format!("makes mode 1 ({f1:.4} Hz at the start pose) critically damped or more: ratio {z1:.3}"),
@@ -221,10 +228,7 @@ impl Damping {
             ("damping.f_hz", list(self.f_hz)),
         ] {
             if let Some(v) = values.iter().find(|v| !v.is_finite() || **v < 0.0) {
-                return Err(ModelError::invalid(
-                    key,
-                    format!("must be finite and >= 0, got {v}"),
-                ));
+                return Err(ModelError::invalid(key, format!("must be finite and >= 0, got {v}")));
             }
         }
         if self.zeta.is_some() && (self.alpha.is_some() || self.beta.is_some()) {
@@ -245,7 +249,10 @@ impl Damping {
         if let Some((k, z)) = zeta.values().iter().enumerate().find(|(_, z)| **z >= 1.0) {
             return Err(ModelError::invalid(
                 "damping.zeta",
-                format!("the ratio of mode {} must be below 1 (critical damping), got {z}", k + 1),
+                format!(
+                    "the ratio of mode {} must be below 1 (critical damping), got {z}",
+                    k + 1
+                ),
             ));
         }
         let Some(f) = self.f_hz else { return Ok(()) };
@@ -286,7 +293,10 @@ fn rayleigh_fit(z: [f64; 2], f: [f64; 2]) -> (f64, f64) {
         return (0.0, 2.0 * z[0] / w1);
     }
     let den = w2 * w2 - w1 * w1;
-    (2.0 * w1 * w2 * (z[0] * w2 - z[1] * w1) / den, 2.0 * (z[1] * w2 - z[0] * w1) / den)
+    (
+        2.0 * w1 * w2 * (z[0] * w2 - z[1] * w1) / den,
+        2.0 * (z[1] * w2 - z[0] * w1) / den,
+    )
 }
 
 /// A fit with a negative coefficient makes some mode's ratio negative (below mode 1 for alpha,
@@ -306,7 +316,10 @@ fn check_fit(z: [f64; 2], f: [f64; 2]) -> Result<(), ModelError> {
     if alpha >= 0.0 && beta >= 0.0 {
         return Ok(());
     }
-    let (lo, hi) = (z[0] * f[0].min(f[1]) / f[0].max(f[1]), z[0] * f[0].max(f[1]) / f[0].min(f[1]));
+    let (lo, hi) = (
+        z[0] * f[0].min(f[1]) / f[0].max(f[1]),
+        z[0] * f[0].max(f[1]) / f[0].min(f[1]),
+    );
     let (coef, which) = if alpha < 0.0 {
         (format!("alpha = {alpha:.4e} 1/s"), "the modes below mode 1")
     } else {
@@ -381,7 +394,11 @@ mod tests {
             ("[damping]\nbeta = -1e-3", "damping.beta", ">= 0"),
             ("[damping]\nalpha = nan", "damping.alpha", "finite"),
             ("[damping]\nbeta = 1e-3\nzeta = 0.01", "damping.zeta", "not both"),
-            ("[damping]\nalpha = 1.0\nzeta = [0.01, 0.02]", "damping.zeta", "not both"),
+            (
+                "[damping]\nalpha = 1.0\nzeta = [0.01, 0.02]",
+                "damping.zeta",
+                "not both",
+            ),
             ("[damping]\nzeta = 1.0", "damping.zeta", "mode 1"),
             ("[damping]\nzeta = [0.01, 1.2]", "damping.zeta", "mode 2"),
             ("[damping]\nzeta = [0.01, 0.02, 0.03]", "zeta", "two"),
@@ -391,13 +408,28 @@ mod tests {
             ("[damping]\nf_hz = 4.0", "damping.f_hz", "zeta"),
             ("[damping]\nbeta = 1e-3\nf_hz = 4.0", "damping.f_hz", "zeta"),
             // z2 / z1 above f2 / f1: alpha < 0 (mode 1's side); below f1 / f2: beta < 0
-            ("[damping]\nzeta = [0.01, 0.05]\nf_hz = [4.0, 8.0]", "damping.zeta", "alpha"),
-            ("[damping]\nzeta = [0.01, 0.004]\nf_hz = [4.0, 8.0]", "damping.zeta", "beta"),
-            ("[damping]\nzeta = [0.01, 0.02]\nf_hz = [4.0, 4.0]", "damping.zeta", "one frequency"),
+            (
+                "[damping]\nzeta = [0.01, 0.05]\nf_hz = [4.0, 8.0]",
+                "damping.zeta",
+                "alpha",
+            ),
+            (
+                "[damping]\nzeta = [0.01, 0.004]\nf_hz = [4.0, 8.0]",
+                "damping.zeta",
+                "beta",
+            ),
+            (
+                "[damping]\nzeta = [0.01, 0.02]\nf_hz = [4.0, 4.0]",
+                "damping.zeta",
+                "one frequency",
+            ),
             ("[damping]\ngamma = 1.0", "gamma", "unknown"),
         ] {
             let e = load(extra).unwrap_err();
-            assert!(e.contains("bad.toml") && e.contains(key) && e.contains(why), "{extra}: {e}");
+            assert!(
+                e.contains("bad.toml") && e.contains(key) && e.contains(why),
+                "{extra}: {e}"
+            );
         }
     }
 }

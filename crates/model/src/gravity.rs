@@ -101,7 +101,10 @@ mod tests {
             ("[gravity]\ngz = 1.0", "gz", "unknown"),
         ] {
             let e = load(extra).unwrap_err();
-            assert!(e.contains("g.toml") && e.contains(key) && e.contains(why), "{extra}: {e}");
+            assert!(
+                e.contains("g.toml") && e.contains(key) && e.contains(why),
+                "{extra}: {e}"
+            );
         }
     }
 }

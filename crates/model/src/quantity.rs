@@ -98,7 +98,11 @@ pub const QUANTITIES: &[Quantity] = &[
     q("Ek_payload", "J", "kinetic energy of the payload welded at G"),
     q("W_load", "J", "work of the load at G since t = 0"),
     q("E_d", "J", "energy dissipated by the beams' damping since t = 0"),
-    q("V_g", "J", "potential energy of the weights (beams, payload, sleeves, sliders)"),
+    q(
+        "V_g",
+        "J",
+        "potential energy of the weights (beams, payload, sleeves, sliders)",
+    ),
     // a direct run's columns and kinematics.csv
     q("s{i}", "m", "position of slider i along its axis (Eqs. 1-3)"),
     q("sd{i}", "m/s", "velocity of slider i"),
@@ -116,7 +120,11 @@ pub const QUANTITIES: &[Quantity] = &[
     q("thetadot", "rad/s", "angular velocity of the rigid star"),
     q("thetaddot", "rad/s^2", "angular acceleration of the rigid star"),
     // setpoints.csv (flexstar export): the motion's exact derivatives and the feed-forward
-    q("v{i}", "m/s", "setpoint velocity of slider i, exact derivative of the motion"),
+    q(
+        "v{i}",
+        "m/s",
+        "setpoint velocity of slider i, exact derivative of the motion",
+    ),
     q("a{i}", "m/s^2", "setpoint acceleration of slider i, exact"),
     q("j{i}", "m/s^3", "setpoint jerk of slider i, exact"),
     q(

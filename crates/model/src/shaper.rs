@@ -146,7 +146,9 @@ pub fn specified_insensitivity(f_hz: f64, zeta: f64, band: (f64, f64), v_tol: f6
     let t_d = 1.0 / (f_hz * (1.0 - zeta * zeta).sqrt());
     let dt = t_d / SI_GRID as f64;
     let sample = |count: usize| -> Vec<f64> {
-        (0..count).map(|k| band.0 + (band.1 - band.0) * k as f64 / (count - 1) as f64).collect()
+        (0..count)
+            .map(|k| band.0 + (band.1 - band.0) * k as f64 / (count - 1) as f64)
+            .collect()
     };
     let (coarse, fine) = (sample(64), sample(256));
     for n in 2..=SI_GRID * SI_PERIODS + 1 {
@@ -396,7 +398,11 @@ impl ShaperSection {
     /// The EI kinds' tolerance: `v_tol` in (0, 1) (0.5 at most for the multi-hump kinds, whose
     /// amplitudes are positive only up to there), only with an EI kind (key `shaper.v_tol`).
     pub fn v_tol(&self) -> Result<f64, ModelError> {
-        let most = if matches!(self.kind, ShaperKind::Ei | ShaperKind::Si) { 1.0 } else { 0.5 };
+        let most = if matches!(self.kind, ShaperKind::Ei | ShaperKind::Si) {
+            1.0
+        } else {
+            0.5
+        };
         match (self.kind.has_tolerance(), self.v_tol) {
             (true, None) => Ok(EI_V_TOL),
             (true, Some(v)) if v > 0.0 && v < most => Ok(v),
@@ -448,7 +454,9 @@ impl ShaperSection {
                     )));
                 }
                 if !(lo <= f && f <= hi) {
-                    return Err(bad(format!("the band [{lo}, {hi}] Hz must contain the frequency {f} Hz")));
+                    return Err(bad(format!(
+                        "the band [{lo}, {hi}] Hz must contain the frequency {f} Hz"
+                    )));
                 }
                 Ok((lo, hi))
             }
@@ -701,7 +709,11 @@ mod tests {
     #[test]
     fn multi_hump_shapers_touch_their_tolerance_at_every_hump() {
         let f = 4.0;
-        for (kind, humps, width) in [(ShaperKind::Ei, 1, 0.399), (ShaperKind::TwoHumpEi, 2, 0.724), (ShaperKind::ThreeHumpEi, 3, 0.963)] {
+        for (kind, humps, width) in [
+            (ShaperKind::Ei, 1, 0.399),
+            (ShaperKind::TwoHumpEi, 2, 0.724),
+            (ShaperKind::ThreeHumpEi, 3, 0.963),
+        ] {
             for v in [0.05, 0.1] {
                 let s = single(kind, f, 0.0, v);
                 assert_eq!(s.len(), humps + 2);
@@ -754,7 +766,12 @@ mod tests {
     #[test]
     fn specified_insensitivity_meets_its_band_no_later_than_the_closed_forms() {
         let f = 4.0;
-        for (zeta, x, v, longest) in [(0.0, 0.15, 0.05, 1.0), (0.0, 0.02, 0.05, 0.5), (0.05, 0.3, 0.05, 2.0), (0.0, 0.5, 0.02, 4.0)] {
+        for (zeta, x, v, longest) in [
+            (0.0, 0.15, 0.05, 1.0),
+            (0.0, 0.02, 0.05, 0.5),
+            (0.05, 0.3, 0.05, 2.0),
+            (0.0, 0.5, 0.02, 4.0),
+        ] {
             let band = (f * (1.0 - x), f * (1.0 + x));
             let s = specified_insensitivity(f, zeta, band, v).unwrap();
             let t_d = 1.0 / (f * (1.0 - zeta * zeta).sqrt());
@@ -762,11 +779,22 @@ mod tests {
             let worst = (0..=1000)
                 .map(|k| residual(&s, band.0 + (band.1 - band.0) * k as f64 / 1000.0, zeta))
                 .fold(0.0, f64::max);
-            eprintln!("+-{x} at zeta {zeta}, v {v}: {} impulses over {:.3} T_d, worst residual {worst:.5}", s.len(), duration(&s) / t_d);
+            eprintln!(
+                "+-{x} at zeta {zeta}, v {v}: {} impulses over {:.3} T_d, worst residual {worst:.5}",
+                s.len(),
+                duration(&s) / t_d
+            );
             assert!(worst <= v * (1.0 + 1e-4), "+-{x}: {worst}");
-            assert!(duration(&s) <= longest * t_d + 1e-12, "+-{x}: {} periods", duration(&s) / t_d);
+            assert!(
+                duration(&s) <= longest * t_d + 1e-12,
+                "+-{x}: {} periods",
+                duration(&s) / t_d
+            );
         }
-        assert!(specified_insensitivity(f, 0.0, (0.4, 7.6), 0.01).unwrap_err().to_string().contains("shaper.insensitivity"));
+        assert!(specified_insensitivity(f, 0.0, (0.4, 7.6), 0.01)
+            .unwrap_err()
+            .to_string()
+            .contains("shaper.insensitivity"));
     }
 
     #[test]
@@ -776,11 +804,22 @@ mod tests {
         s.insensitivity = Some(toml::Value::String("+-10 %".into()));
         let (lo, hi) = s.band(4.0, 2).unwrap();
         assert!((lo - 3.6).abs() < 1e-12 && (hi - 4.4).abs() < 1e-12);
-        s.insensitivity = Some(toml::Value::Array(vec![toml::Value::Float(3.5), toml::Value::Float(4.6)]));
+        s.insensitivity = Some(toml::Value::Array(vec![
+            toml::Value::Float(3.5),
+            toml::Value::Float(4.6),
+        ]));
         assert_eq!(s.band(4.0, 1).unwrap(), (3.5, 4.6));
         for (value, n, why) in [
-            (toml::Value::Array(vec![toml::Value::Float(4.5), toml::Value::Float(5.0)]), 1, "contain"),
-            (toml::Value::Array(vec![toml::Value::Float(3.5), toml::Value::Float(4.5)]), 2, "one frequency"),
+            (
+                toml::Value::Array(vec![toml::Value::Float(4.5), toml::Value::Float(5.0)]),
+                1,
+                "contain",
+            ),
+            (
+                toml::Value::Array(vec![toml::Value::Float(3.5), toml::Value::Float(4.5)]),
+                2,
+                "one frequency",
+            ),
             (toml::Value::String("10 %".into()), 1, "+-x %"),
             (toml::Value::String("+-150 %".into()), 1, "0 < x < 100"),
             (toml::Value::Float(0.2), 1, "+-x %"),
@@ -791,7 +830,11 @@ mod tests {
         }
         let mut z = ShaperSection::new(ShaperKind::Zvd, &[4.0]);
         z.insensitivity = Some(toml::Value::String("+-10 %".into()));
-        assert!(z.resolve(&[4.0], |_| 0.0).unwrap_err().to_string().contains("kind = \"si\" only"));
+        assert!(z
+            .resolve(&[4.0], |_| 0.0)
+            .unwrap_err()
+            .to_string()
+            .contains("kind = \"si\" only"));
     }
 
     #[test]

@@ -58,7 +58,10 @@ pub fn minimax_weights(forms: &[Vec<(f64, f64)>]) -> Option<Minimax> {
         .ok()?;
     let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).ok()?;
     solver.solve();
-    if !matches!(solver.solution.status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
+    if !matches!(
+        solver.solution.status,
+        SolverStatus::Solved | SolverStatus::AlmostSolved
+    ) {
         return None;
     }
     // clean round-off: clip to the orthant and renormalise, then measure
@@ -68,7 +71,10 @@ pub fn minimax_weights(forms: &[Vec<(f64, f64)>]) -> Option<Minimax> {
     let largest = forms
         .iter()
         .map(|f| {
-            let (re, im) = f.iter().zip(&w).fold((0.0, 0.0), |(r, i), (c, x)| (r + c.0 * x, i + c.1 * x));
+            let (re, im) = f
+                .iter()
+                .zip(&w)
+                .fold((0.0, 0.0), |(r, i), (c, x)| (r + c.0 * x, i + c.1 * x));
             re.hypot(im)
         })
         .fold(0.0, f64::max);

@@ -43,7 +43,11 @@ pub fn resolve_damping(exp: &mut Experiment) -> Result<(), ModelError> {
     if n == 0 {
         return Ok(());
     }
-    let key = if exp.damping.zeta.is_some() { "damping.zeta" } else { "damping.alpha" };
+    let key = if exp.damping.zeta.is_some() {
+        "damping.zeta"
+    } else {
+        "damping.alpha"
+    };
     let first = flexstar_modal::analysis::start_pose_frequencies(exp, n)
         .map_err(|e| ModelError::invalid(key, format!("the first frequencies at the start pose: {e}")))?;
     exp.damping.resolve(&first)

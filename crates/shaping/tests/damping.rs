@@ -85,7 +85,10 @@ fn two_ratios_hold_at_the_first_two_frequencies() {
         let r = flexstar_shaping::shape(&mut exp);
         assert_eq!(r.is_ok(), ok, "alpha = {alpha}: {r:?}");
         if let Err(e) = r {
-            assert!(e.to_string().contains("damping.alpha") && e.to_string().contains("mode 1"), "{e}");
+            assert!(
+                e.to_string().contains("damping.alpha") && e.to_string().contains("mode 1"),
+                "{e}"
+            );
         }
     }
 }

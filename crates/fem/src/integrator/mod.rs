@@ -164,7 +164,9 @@ fn initial_state(
     let pins0 = pins_of(star, &q)?;
     let phi0 = star.constraints(&q, &pins0);
     let checked = |k: &usize| !(star.attached.weighs() && k % ROWS == ROWS - 1);
-    let worst = (0..phi0.len()).filter(checked).fold(0.0f64, |m, k| m.max(phi0[k].abs()));
+    let worst = (0..phi0.len())
+        .filter(checked)
+        .fold(0.0f64, |m, k| m.max(phi0[k].abs()));
     if worst > 1e-9 * l {
         return Err(FemError::Input(format!(
             "the initial pose does not pass through the pins (largest constraint violation {worst:.3e})"

@@ -2,8 +2,8 @@
 //! equilibrium of a pose, the sliders held and the pins fixed, by Newton's method with the FEM's
 //! own assembly (inertia off: zero velocities and accelerations, the mass out of the matrix).
 
-use super::*;
 use super::step::increment_weights;
+use super::*;
 
 /// Newton iterations allowed for the static equilibrium. The matrix leaves out the constraint
 /// Hessians `lambda . Phi_qq` (the sleeves' reactions turning with the beams) and the weights'

@@ -283,7 +283,7 @@ fn validate(problem: &EqualBeams, settings: &FemSettings) -> Result<RunSettings,
 }
 
 /// Initial data: the undeformed star in the rigid configuration at s(0), moving rigidly.
-fn initial_state(r0: &RigidState) -> InitialState {
+pub(crate) fn initial_state(r0: &RigidState) -> InitialState {
     InitialState {
         g: [r0.g[0].v, r0.g[1].v],
         g_dot: [r0.g[0].d1, r0.g[1].d1],

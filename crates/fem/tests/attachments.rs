@@ -25,16 +25,9 @@ use flexstar_model::{
 use flexstar_numerics::measures::max_abs;
 use rigid_forward::rigid_forward_dynamics_with;
 
-fn coarse() -> FemSettings {
-    FemSettings {
-        elements: 108,
-        ..Default::default()
-    }
-}
-
-fn col<'a>(r: &'a Response, name: &str) -> &'a [f64] {
-    r.column(name).unwrap_or_else(|| panic!("no column {name}"))
-}
+#[path = "support/run.rs"]
+mod run;
+use run::{coarse, col};
 
 /// A payload with an offset from G and its own inertia (about the star's mass, 0.49 kg).
 fn payload() -> Payload {

@@ -21,16 +21,9 @@ use flexstar_model::{catalogue, Experiment, FemSettings, Pose, Response, RobotPa
 use flexstar_numerics::measures::max_abs;
 use rigid_forward::rigid_forward_dynamics;
 
-fn coarse() -> FemSettings {
-    FemSettings {
-        elements: 108,
-        ..Default::default()
-    }
-}
-
-fn col<'a>(r: &'a Response, name: &str) -> &'a [f64] {
-    r.column(name).unwrap_or_else(|| panic!("no column {name}"))
-}
+#[path = "support/run.rs"]
+mod run;
+use run::{coarse, col};
 
 /// Rest-to-rest task-space quintic, general plane motion (s'' not constant, unlike the paper's
 /// quadratic cases, so that the integration of s is exercised).

@@ -15,16 +15,9 @@ use flexstar_numerics::measures::max_abs;
 
 const DOWN: [f64; 2] = [0.0, -9.81];
 
-fn coarse() -> FemSettings {
-    FemSettings {
-        elements: 108,
-        ..Default::default()
-    }
-}
-
-fn col<'a>(r: &'a Response, name: &str) -> &'a [f64] {
-    r.column(name).unwrap_or_else(|| panic!("no column {name}"))
-}
+#[path = "support/run.rs"]
+mod run;
+use run::{coarse, col};
 
 fn fem(exp: &Experiment, settings: &FemSettings, request: SolveRequest) -> Response {
     flexstar_fem::solve(&exp.problem().unwrap(), settings, request)

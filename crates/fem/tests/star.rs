@@ -10,23 +10,16 @@
 
 use flexstar_fem::FemError;
 use flexstar_kinematics::{rigid_inverse_dynamics, RigidState};
-use flexstar_model::{catalogue, Experiment, FemSettings, Pose, Response, RobotParams, Trajectory};
+use flexstar_model::{catalogue, Experiment, FemSettings, Pose, RobotParams, Trajectory};
 use flexstar_numerics::measures::max_abs;
 
 fn experiment(robot: RobotParams, trajectory: Trajectory, t_end: f64) -> Experiment {
     catalogue::experiment("test", robot, trajectory, t_end, 1e-3)
 }
 
-fn coarse() -> FemSettings {
-    FemSettings {
-        elements: 108,
-        ..Default::default()
-    }
-}
-
-fn col<'a>(r: &'a Response, name: &str) -> &'a [f64] {
-    r.column(name).unwrap_or_else(|| panic!("no column {name}"))
-}
+#[path = "support/run.rs"]
+mod run;
+use run::{coarse, col};
 
 /// Rest-to-rest task-space quintic (zero velocity and acceleration at both ends), general motion.
 fn quintic() -> Trajectory {

@@ -189,14 +189,7 @@ mod tests {
         let params = exp.robot;
         for t in [0.1, 0.25, 0.4] {
             let r = RigidState::at(&params, &exp.trajectory, t).unwrap();
-            let init = InitialState {
-                g: [r.g[0].v, r.g[1].v],
-                g_dot: [r.g[0].d1, r.g[1].d1],
-                theta: r.theta.v,
-                theta_dot: r.theta.d1,
-                xp: r.xp.map(|x| x.v),
-                xp_dot: r.xp.map(|x| x.d1),
-            };
+            let init = crate::solve::initial_state(&r);
             let (star, q, v) = Star::new(&params, 36, &init, None).unwrap();
             let pins = Pins::new(&params, r.s.map(|s| [s.v, s.d1, s.d2]));
             let w = star.rigid_twist(&q, &pins.p, t).unwrap().at(pins.s.map(|s| s[1]));

@@ -8,12 +8,12 @@
 //! gaps it is the Fermat construction of [`crate::direct`].
 
 use flexstar_model::geometry::Scalar;
-use flexstar_model::Robot;
+use flexstar_model::RobotGeometry;
 
-use crate::direct::{cross, pose_on_lines, sub, RigidPose};
+use crate::direct::{cross, direct_kinematics, pose_on_lines, sub, RigidPose};
 
 /// Interior angle of the triangle `p` at vertex k [rad].
-fn angle_at(p: &[[f64; 2]; 3], k: usize) -> f64 {
+pub(crate) fn angle_at(p: &[[f64; 2]; 3], k: usize) -> f64 {
     let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
     let (u, v) = (sub(b, a), sub(c, a));
     cross(u, v).abs().atan2(u[0] * v[0] + u[1] * v[1])
@@ -33,12 +33,22 @@ fn apex<D: Scalar>(p: &[[D; 2]; 3], k: usize, gaps: [f64; 3], sigma: f64) -> [D;
     [p[i][0] + e[0] * c - e[1] * s, p[i][1] + e[0] * s + e[1] * c]
 }
 
+/// The rigid pose of `robot` for actuator coordinates `s` [m]: the paper's Fermat construction
+/// (Eqs. 4-10, [`direct_kinematics`]) for the paper's robot, the apex construction of
+/// [`direct_pose`] (Eqs. K1, D1-D3) for any other.
+pub fn rigid_pose<K: RobotGeometry + ?Sized, D: Scalar>(robot: &K, s: [D; 3]) -> Option<RigidPose<D>> {
+    match robot.paper_form() {
+        Some(p) => direct_kinematics(p.d, s),
+        None => direct_pose(robot, s),
+    }
+}
+
 /// Eqs. K1, D1-D3: the rigid pose of `robot` for actuator coordinates `s` [m].
 ///
 /// Returns `None` when the revolute points are degenerate or an angle of their triangle at P_k
 /// reaches the gap g_ij that G must see P_i P_j under (no pose assembles the star there,
 /// `docs/as-built.md` 3).
-pub fn direct_pose<D: Scalar>(robot: &Robot, s: [D; 3]) -> Option<RigidPose<D>> {
+pub fn direct_pose<K: RobotGeometry + ?Sized, D: Scalar>(robot: &K, s: [D; 3]) -> Option<RigidPose<D>> {
     let p: [[D; 2]; 3] = std::array::from_fn(|i| robot.revolute_point(i, s[i]));
     let re = p.map(|q| [q[0].re(), q[1].re()]);
     let area2 = cross(sub(re[1], re[0]), sub(re[2], re[0]));
@@ -56,7 +66,8 @@ pub fn direct_pose<D: Scalar>(robot: &Robot, s: [D; 3]) -> Option<RigidPose<D>> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flexstar_model::{ActuatorAxis, RobotParams};
+    use flexstar_model::geometry::inverse_kinematics;
+    use flexstar_model::{ActuatorAxis, Robot, RobotParams};
     use num_dual::Dual64;
 
     /// A robot as built: uneven base, unequal weld angles (the beams' other data do not enter).
@@ -95,7 +106,7 @@ mod tests {
             // Jacobian by its exact columns: d/dG = -I, d/dtheta = -r_i e_wi, d/dr_i = -e_xi
             let mut jac = nalgebra::SMatrix::<f64, 6, 6>::zeros();
             for i in 0..3 {
-                let (e, th) = (robot.e_x(i, x[2]), x[2] + robot.weld_angles()[i]);
+                let (e, th) = (robot.e_x(i, x[2]), x[2] + robot.weld_angle(i));
                 let ew = [th.cos(), th.sin()];
                 jac[(2 * i, 0)] = -1.0;
                 jac[(2 * i + 1, 1)] = -1.0;
@@ -127,7 +138,7 @@ mod tests {
                 assert!((pose.xp[i] - r[i]).abs() < 1e-12, "{s:?} beam {}", i + 1);
             }
             // and the inverse kinematics of the pose returns s
-            let back = robot.inverse_kinematics(pose.g, pose.theta).unwrap();
+            let back = inverse_kinematics(&robot, pose.g, pose.theta).unwrap();
             for i in 0..3 {
                 assert!((back[i] - s[i]).abs() < 1e-12, "{s:?}: {back:?}");
             }

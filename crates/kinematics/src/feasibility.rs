@@ -1,14 +1,16 @@
 //! Where a trajectory leaves the feasible range (docs/conventions.md, Feasible range).
 //!
 //! A motion is physically possible while, for every beam and slider,
-//! `Lp/2 < xp_i` (the sleeve does not reach the junction G), `xp_i + Lp/2 < L` (it does not slide
-//! off the tip), `|s_i| < sqrt(3) d` (the slider stays on its side of the base) and every angle of
-//! IJK is below 120 degrees (the Fermat point exists).
+//! `Lp_i/2 < xp_i` (the sleeve does not reach the junction G), `xp_i + Lp_i/2 < L_i` (it does not
+//! slide off the tip), `s_i` within its side of the base (`|s_i| < sqrt(3) d` on the paper's) and
+//! every angle of IJK is below the gap G must see its opposite side under (120 degrees on the
+//! paper's robot: the Fermat point exists; `docs/as-built.md` 3). Every function here takes the
+//! paper's robot or one as built ([`RobotGeometry`]).
 
-use flexstar_model::geometry::revolute_point;
-use flexstar_model::{RobotParams, Trajectory};
+use flexstar_model::{FeasibilityKey, RobotGeometry, Trajectory};
 
-use crate::direct::{direct_kinematics, largest_angle};
+use crate::as_built::{angle_at, rigid_pose};
+use crate::direct::largest_angle;
 
 /// Which limit is violated.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,10 +19,18 @@ pub enum Violation {
     SleeveAtJunction { beam: usize, xp: f64 },
     /// Sleeve i slides off the tip: `xp_i + Lp/2 >= L`.
     SleeveOffTip { beam: usize, xp: f64 },
-    /// Slider i leaves its side of the base: `|s_i| >= sqrt(3) d`.
+    /// Slider i leaves its side of the base: `|s_i| >= sqrt(3) d` on the paper's robot, the
+    /// side's end `limit` [m] on one as built.
     SliderOffBase { slider: usize, s: f64 },
     /// An angle of IJK reaches 120 degrees: no Fermat point.
     NoFermatPoint { vertex: usize, angle_deg: f64 },
+    /// An angle of the revolute points' triangle reaches the gap between the other two beams
+    /// (a robot as built, `docs/as-built.md` 3): no pose assembles the star.
+    NoAssembly {
+        vertex: usize,
+        angle_deg: f64,
+        gap_deg: f64,
+    },
     /// The trajectory could not be evaluated (e.g. inverse kinematics of a task-space pose).
     Trajectory(String),
     /// A limit reached at a given via point or table row, or between two of them: `at` names
@@ -54,6 +64,16 @@ impl std::fmt::Display for Violation {
                 "triangle IJK has an angle of {angle_deg:.2} degrees at {} (no Fermat point beyond 120)",
                 ["I", "J", "K"][*vertex]
             ),
+            Violation::NoAssembly {
+                vertex,
+                angle_deg,
+                gap_deg,
+            } => write!(
+                f,
+                "the revolute points' triangle has an angle of {angle_deg:.2} degrees at {}, not below the gap of \
+                 {gap_deg:.2} degrees between the other two beams (no pose assembles the star)",
+                ["I", "J", "K"][*vertex]
+            ),
             Violation::Trajectory(msg) => write!(f, "{msg}"),
             Violation::Located { at, violation } => write!(f, "{at}: {violation}"),
         }
@@ -70,7 +90,7 @@ pub struct Infeasible {
 }
 
 /// Smallest feasibility margin at time t and the limit it belongs to; negative means violated.
-fn margin(params: &RobotParams, traj: &Trajectory, t: f64) -> (f64, Violation) {
+fn margin<K: RobotGeometry + ?Sized>(params: &K, traj: &Trajectory, t: f64) -> (f64, Violation) {
     match traj.s(params, t) {
         Ok(s) => configuration_margin(params, s),
         Err(e) => (-1.0, Violation::Trajectory(e.to_string())),
@@ -79,7 +99,7 @@ fn margin(params: &RobotParams, traj: &Trajectory, t: f64) -> (f64, Violation) {
 
 /// Smallest feasibility margin of the configuration `s` [m] (a length [m]; the angle limit is
 /// scaled by Lp) and the limit it belongs to; negative or zero means violated.
-fn configuration_margin(params: &RobotParams, s: [f64; 3]) -> (f64, Violation) {
+fn configuration_margin<K: RobotGeometry + ?Sized>(params: &K, s: [f64; 3]) -> (f64, Violation) {
     let mut worst = (f64::INFINITY, Violation::Trajectory(String::new()));
     let mut take = |m: f64, v: Violation| {
         if m < worst.0 {
@@ -87,31 +107,44 @@ fn configuration_margin(params: &RobotParams, s: [f64; 3]) -> (f64, Violation) {
         }
     };
     for (i, si) in s.iter().enumerate() {
-        take(
-            params.half_side() - si.abs(),
-            Violation::SliderOffBase { slider: i + 1, s: *si },
-        );
+        let [lo, hi] = params.slider_travel(i);
+        let m = if params.paper_form().is_some() {
+            hi - si.abs()
+        } else {
+            (si - lo).min(hi - si)
+        };
+        take(m, Violation::SliderOffBase { slider: i + 1, s: *si });
     }
-    let pts = [0, 1, 2].map(|i| revolute_point(i, params.d, s[i]));
-    let (ang, k) = largest_angle(&pts);
+    let pts: [[f64; 2]; 3] = std::array::from_fn(|i| params.revolute_point(i, s[i]));
     // angle margin scaled to a length so that the margins are comparable
-    take(
-        (2.0 * std::f64::consts::FRAC_PI_3 - ang) * params.lp,
-        Violation::NoFermatPoint {
-            vertex: k,
-            angle_deg: ang.to_degrees(),
-        },
-    );
-    if let Some(pose) = direct_kinematics(params.d, s) {
+    if let Some(p) = params.paper_form() {
+        let (ang, k) = largest_angle(&pts);
+        take(
+            (2.0 * std::f64::consts::FRAC_PI_3 - ang) * p.lp,
+            Violation::NoFermatPoint {
+                vertex: k,
+                angle_deg: ang.to_degrees(),
+            },
+        );
+    } else {
+        let gaps = params.gaps();
+        for (k, gap) in gaps.iter().enumerate() {
+            let ang = angle_at(&pts, k);
+            take(
+                (gap - ang) * params.sleeve_length(k),
+                Violation::NoAssembly {
+                    vertex: k,
+                    angle_deg: ang.to_degrees(),
+                    gap_deg: gap.to_degrees(),
+                },
+            );
+        }
+    }
+    if let Some(pose) = rigid_pose(params, s) {
         for (i, xp) in pose.xp.iter().enumerate() {
-            take(
-                xp - params.lp / 2.0,
-                Violation::SleeveAtJunction { beam: i + 1, xp: *xp },
-            );
-            take(
-                params.l - params.lp / 2.0 - xp,
-                Violation::SleeveOffTip { beam: i + 1, xp: *xp },
-            );
+            let (l, lp) = (params.beam_length(i), params.sleeve_length(i));
+            take(xp - lp / 2.0, Violation::SleeveAtJunction { beam: i + 1, xp: *xp });
+            take(l - lp / 2.0 - xp, Violation::SleeveOffTip { beam: i + 1, xp: *xp });
         }
     }
     worst
@@ -123,7 +156,12 @@ fn configuration_margin(params: &RobotParams, s: [f64; 3]) -> (f64, Violation) {
 /// The given poses of a `via` or `table` trajectory (its [`Trajectory::knots`]) are checked
 /// first, each by [`check_configuration`], so that an infeasible row or point is named as such;
 /// a limit reached between them names the two it lies between (`docs/motions.md` section 1.6).
-pub fn check_trajectory(params: &RobotParams, traj: &Trajectory, t_end: f64, scan_step: f64) -> Result<(), Infeasible> {
+pub fn check_trajectory<K: RobotGeometry + ?Sized>(
+    params: &K,
+    traj: &Trajectory,
+    t_end: f64,
+    scan_step: f64,
+) -> Result<(), Infeasible> {
     check_knots(params, traj)?;
     scan_trajectory(params, traj, t_end, scan_step).map_err(|e| match traj.between(e.t) {
         Some(at) => Infeasible {
@@ -138,7 +176,7 @@ pub fn check_trajectory(params: &RobotParams, traj: &Trajectory, t_end: f64, sca
 }
 
 /// Every via point or table row of `traj` inside the feasible range.
-fn check_knots(params: &RobotParams, traj: &Trajectory) -> Result<(), Infeasible> {
+fn check_knots<K: RobotGeometry + ?Sized>(params: &K, traj: &Trajectory) -> Result<(), Infeasible> {
     for knot in traj.knots() {
         let at = |violation| Infeasible {
             t: knot.t,
@@ -155,7 +193,12 @@ fn check_knots(params: &RobotParams, traj: &Trajectory) -> Result<(), Infeasible
     Ok(())
 }
 
-fn scan_trajectory(params: &RobotParams, traj: &Trajectory, t_end: f64, scan_step: f64) -> Result<(), Infeasible> {
+fn scan_trajectory<K: RobotGeometry + ?Sized>(
+    params: &K,
+    traj: &Trajectory,
+    t_end: f64,
+    scan_step: f64,
+) -> Result<(), Infeasible> {
     let n = ((t_end / scan_step.min(t_end / 200.0)).ceil() as usize).max(1);
     let (m0, v0) = margin(params, traj, 0.0);
     if m0 <= 0.0 {
@@ -194,7 +237,7 @@ pub fn preflight_step(dt_out: f64) -> f64 {
 /// is given; it can only be made by the check.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CheckedMotion {
-    params: RobotParams,
+    robot: FeasibilityKey,
     trajectory: Trajectory,
     t_end: f64,
     scan_step: f64,
@@ -203,21 +246,24 @@ pub struct CheckedMotion {
 impl CheckedMotion {
     /// Does this check cover a run of `traj` on `params` over `[0, t_end]` scanned at
     /// `scan_step` or coarser (same robot and trajectory, a span and a step no larger)?
-    pub fn covers(&self, params: &RobotParams, traj: &Trajectory, t_end: f64, scan_step: f64) -> bool {
-        self.params == *params && self.trajectory == *traj && t_end <= self.t_end && self.scan_step <= scan_step
+    pub fn covers<K: RobotGeometry + ?Sized>(&self, params: &K, traj: &Trajectory, t_end: f64, scan_step: f64) -> bool {
+        self.robot == params.feasibility_key()
+            && self.trajectory == *traj
+            && t_end <= self.t_end
+            && self.scan_step <= scan_step
     }
 }
 
 /// [`check_trajectory`], returning the proof of the check on success.
-pub fn check_motion(
-    params: &RobotParams,
+pub fn check_motion<K: RobotGeometry + ?Sized>(
+    params: &K,
     traj: &Trajectory,
     t_end: f64,
     scan_step: f64,
 ) -> Result<CheckedMotion, Infeasible> {
     check_trajectory(params, traj, t_end, scan_step)?;
     Ok(CheckedMotion {
-        params: *params,
+        robot: params.feasibility_key(),
         trajectory: traj.clone(),
         t_end,
         scan_step,
@@ -225,13 +271,13 @@ pub fn check_motion(
 }
 
 /// Is `s` (at rest) inside the feasible range? Used by property tests and samplers.
-pub fn is_feasible_configuration(params: &RobotParams, s: [f64; 3]) -> bool {
+pub fn is_feasible_configuration<K: RobotGeometry + ?Sized>(params: &K, s: [f64; 3]) -> bool {
     check_configuration(params, s).is_ok()
 }
 
 /// Check one configuration `s` [m] (e.g. a state of a direct-dynamics run, where the motion is
 /// not known in advance): `Err` names the limit reached.
-pub fn check_configuration(params: &RobotParams, s: [f64; 3]) -> Result<(), Violation> {
+pub fn check_configuration<K: RobotGeometry + ?Sized>(params: &K, s: [f64; 3]) -> Result<(), Violation> {
     match configuration_margin(params, s) {
         (m, _) if m > 0.0 => Ok(()),
         (_, violation) => Err(violation),

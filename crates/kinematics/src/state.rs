@@ -1,11 +1,11 @@
 //! The rigid state of the robot at one instant, with exact first and second time derivatives.
 
-use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::trajectory::Jet;
-use flexstar_model::{RobotParams, Trajectory};
+use flexstar_model::{RobotGeometry, Trajectory};
 use num_dual::Dual2;
 
-use crate::direct::{direct_kinematics, largest_angle};
+use crate::as_built::{angle_at, rigid_pose};
+use crate::direct::largest_angle;
 use crate::KinematicsError;
 
 /// Rigid kinematics at time t: every quantity with its first and second time derivative
@@ -24,31 +24,32 @@ pub struct RigidState {
     pub xp: [Jet; 3],
     /// Revolute points I, J, K [m], fixed frame (Eqs. 1-3).
     pub p: [[f64; 2]; 3],
+    /// The beams' weld angles phi_i [rad] (`docs/as-built.md` Eq. W1; the paper: 0, 120, 240
+    /// degrees), which [`RigidState::e_x`] and [`RigidState::e_w`] add to theta.
+    pub weld: [f64; 3],
 }
 
 impl RigidState {
-    /// Rigid state for the actuator coordinates of `trajectory` at time `t`.
-    pub fn at(params: &RobotParams, trajectory: &Trajectory, t: f64) -> Result<Self, KinematicsError> {
+    /// Rigid state for the actuator coordinates of `trajectory` at time `t`, on the paper's
+    /// robot or one as built ([`RobotGeometry`]).
+    pub fn at<K: RobotGeometry + ?Sized>(params: &K, trajectory: &Trajectory, t: f64) -> Result<Self, KinematicsError> {
         let s = trajectory
             .s(params, Dual2::from_re(t).derivative())
             .map_err(|source| KinematicsError::Trajectory { t, source })?;
         Self::from_actuators(params, s, t)
     }
 
-    /// Rigid state for actuator coordinates given as second-order dual numbers in time.
-    pub fn from_actuators(params: &RobotParams, s: [Dual2<f64>; 3], t: f64) -> Result<Self, KinematicsError> {
-        let pose = direct_kinematics(params.d, s).ok_or_else(|| {
-            let p = s.map(|si| si.re);
-            let pts = [0, 1, 2].map(|i| flexstar_model::geometry::revolute_point(i, params.d, p[i]));
-            let (ang, k) = largest_angle(&pts);
-            KinematicsError::NoSolution {
-                t,
-                reason: format!(
-                    "triangle IJK has an angle of {:.2} degrees at {} (a Fermat point needs every angle below 120)",
-                    ang.to_degrees(),
-                    ["I", "J", "K"][k]
-                ),
-            }
+    /// Rigid state for actuator coordinates given as second-order dual numbers in time (the
+    /// pose of [`rigid_pose`]: the Fermat point on the paper's robot, `docs/as-built.md` D1-D3
+    /// on one as built).
+    pub fn from_actuators<K: RobotGeometry + ?Sized>(
+        params: &K,
+        s: [Dual2<f64>; 3],
+        t: f64,
+    ) -> Result<Self, KinematicsError> {
+        let pose = rigid_pose(params, s).ok_or_else(|| KinematicsError::NoSolution {
+            t,
+            reason: no_pose_reason(params, s.map(|si| si.re)),
         })?;
         Ok(RigidState {
             t,
@@ -57,17 +58,20 @@ impl RigidState {
             theta: Jet::from_dual2(pose.theta),
             xp: pose.xp.map(Jet::from_dual2),
             p: pose.p.map(|q| [q[0].re, q[1].re]),
+            weld: std::array::from_fn(|i| params.weld_angle(i)),
         })
     }
 
     /// Unit vector e_xi along rigid beam i (0-based), Eq. 11.
     pub fn e_x(&self, i: usize) -> [f64; 2] {
-        e_x(i, self.theta.v)
+        let a = self.theta.v + self.weld[i];
+        [a.sin(), -a.cos()]
     }
 
     /// Unit vector e_wi normal to rigid beam i (0-based), Eq. 12.
     pub fn e_w(&self, i: usize) -> [f64; 2] {
-        e_w(i, self.theta.v)
+        let a = self.theta.v + self.weld[i];
+        [a.cos(), a.sin()]
     }
 
     /// Acceleration of G, a_G [m/s^2] (Eq. 8).
@@ -91,6 +95,34 @@ impl RigidState {
     pub fn point(&self, i: usize, x: f64) -> [f64; 2] {
         let e = self.e_x(i);
         [self.g[0].v + x * e[0], self.g[1].v + x * e[1]]
+    }
+}
+
+/// Why no rigid pose exists at the actuator coordinates `s` [m]: the angle of the revolute
+/// points' triangle that reaches the gap G must see its opposite side under (120 degrees on the
+/// paper's robot: no Fermat point), or a degenerate triangle.
+pub(crate) fn no_pose_reason<K: RobotGeometry + ?Sized>(robot: &K, s: [f64; 3]) -> String {
+    let pts: [[f64; 2]; 3] = std::array::from_fn(|i| robot.revolute_point(i, s[i]));
+    if robot.paper_form().is_some() {
+        let (ang, k) = largest_angle(&pts);
+        return format!(
+            "triangle IJK has an angle of {:.2} degrees at {} (a Fermat point needs every angle below 120)",
+            ang.to_degrees(),
+            ["I", "J", "K"][k]
+        );
+    }
+    let gaps = robot.gaps();
+    match (0..3).find(|&k| angle_at(&pts, k) >= gaps[k]) {
+        Some(k) => format!(
+            "the triangle of the revolute points has an angle of {:.2} degrees at {}, not below the {:.2} \
+             degrees between beams {} and {} that G must see the opposite side under (docs/as-built.md 3)",
+            angle_at(&pts, k).to_degrees(),
+            ["I", "J", "K"][k],
+            gaps[k].to_degrees(),
+            (k + 1) % 3 + 1,
+            (k + 2) % 3 + 1
+        ),
+        None => "the revolute points are (nearly) aligned".to_string(),
     }
 }
 

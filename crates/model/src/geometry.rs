@@ -7,7 +7,7 @@
 use num_dual::DualNum;
 
 use crate::error::ModelError;
-use crate::params::RobotParams;
+use crate::robot_geometry::RobotGeometry;
 
 /// A real number or a dual number over f64: the scalar type of every differentiable geometric
 /// function, so that `Dual2` arguments give exact first and second derivatives.
@@ -63,20 +63,20 @@ pub fn e_w<D: Scalar>(i: usize, theta: D) -> [D; 2] {
 }
 
 /// Closed-form inverse kinematics of the rigid robot: the actuator coordinates `s_i` that put
-/// the star's centre at `G = (gx, gy)` with orientation `theta` [rad].
+/// the star's centre at `G = (gx, gy)` with orientation `theta` [rad], for the paper's robot or
+/// one as built (`docs/as-built.md` 3, inverse kinematics).
 ///
 /// Revolute point i is where the line `G + r e_xi` (r > 0) meets slider line i. Fails when a beam
 /// is parallel to its slider or points away from it.
-pub fn inverse_kinematics<D: Scalar>(params: &RobotParams, g: [D; 2], theta: D) -> Result<[D; 3], ModelError> {
+pub fn inverse_kinematics<K: RobotGeometry + ?Sized, D: Scalar>(
+    robot: &K,
+    g: [D; 2],
+    theta: D,
+) -> Result<[D; 3], ModelError> {
     let mut s = [D::zero(); 3];
     for (i, si) in s.iter_mut().enumerate() {
-        *si = axis_coordinate(
-            i,
-            e_x(i, theta),
-            (revolute_origin(i, params.d), slider_direction(i)),
-            g,
-            theta,
-        )?;
+        let axis = robot.axis(i);
+        *si = axis_coordinate(i, robot.e_x(i, theta), (axis.origin, axis.direction), g, theta)?;
     }
     Ok(s)
 }
@@ -119,6 +119,7 @@ pub(crate) fn axis_coordinate<D: Scalar>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::RobotParams;
 
     #[test]
     fn start_pose_gives_zero_strokes() {

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::drive_section::ForceSamples;
 use crate::error::ModelError;
 use crate::geometry::{inverse_kinematics, Scalar};
-use crate::params::RobotParams;
+use crate::robot_geometry::RobotGeometry;
 use crate::spline::PiecewiseQuintic;
 
 /// A via point: time `t` [s] and the task-space pose of the rigid star at it (centre G [m] in
@@ -57,7 +57,7 @@ impl ViaMotion {
 
     /// Check the points (count, finite values, times, every pose reachable by the inverse
     /// kinematics); errors name `trajectory.points` and the 1-based point.
-    pub fn validate(&self, params: &RobotParams) -> Result<(), ModelError> {
+    pub fn validate<K: RobotGeometry + ?Sized>(&self, params: &K) -> Result<(), ModelError> {
         check_points(&self.points).map_err(|r| ModelError::invalid("trajectory.points", r))?;
         for (k, p) in self.points.iter().enumerate() {
             inverse_kinematics(params, [p.gx, p.gy], p.theta).map_err(|e| {
@@ -163,12 +163,12 @@ pub struct TableMotion {
 impl TableMotion {
     /// A table given in memory (`file` only names it in messages): rows checked as
     /// [`TableMotion::read_file`] checks a file's. Errors are the reason, with the 1-based row.
-    pub fn from_rows(
+    pub fn from_rows<K: RobotGeometry + ?Sized>(
         file: PathBuf,
         space: TableSpace,
         t: Vec<f64>,
         rows: Vec<[f64; 3]>,
-        params: &RobotParams,
+        params: &K,
     ) -> Result<Self, String> {
         ForceSamples::check(&t, &rows).map_err(|e| e.to_string())?;
         check_table_rows(space, &t, &rows, params)?;
@@ -192,7 +192,7 @@ impl TableMotion {
 
     /// Read and check the table file (relative to the experiment file `config`) for the robot
     /// `params`. Errors name the experiment file, `trajectory.file`, the table file and the row.
-    pub fn read_file(&mut self, config: &Path, params: &RobotParams) -> Result<(), ModelError> {
+    pub fn read_file<K: RobotGeometry + ?Sized>(&mut self, config: &Path, params: &K) -> Result<(), ModelError> {
         let path = self.file_path(config);
         let bad = |reason: String| ModelError::Invalid {
             file: config.to_path_buf(),
@@ -262,7 +262,12 @@ fn table_space(path: &Path, columns: Option<TableSpace>) -> Result<TableSpace, S
 /// The table checks beyond a forces file's: first time >= 0, no gap, every task-space row
 /// reachable by the inverse kinematics (the full feasible range of every row is checked with the
 /// motion, by `flexstar_kinematics::check_trajectory`).
-fn check_table_rows(space: TableSpace, t: &[f64], rows: &[[f64; 3]], params: &RobotParams) -> Result<(), String> {
+fn check_table_rows<K: RobotGeometry + ?Sized>(
+    space: TableSpace,
+    t: &[f64],
+    rows: &[[f64; 3]],
+    params: &K,
+) -> Result<(), String> {
     if t[0] < 0.0 {
         return Err(format!(
             "row 1: time {} s: times must be >= 0 (the run starts at rest at t = 0)",

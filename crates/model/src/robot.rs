@@ -9,7 +9,7 @@
 //! beams, the FEM's three SIMD lanes) rely on.
 
 use crate::error::ModelError;
-use crate::geometry::{beam_offset, revolute_origin, slider_direction, Scalar};
+use crate::geometry::{beam_offset, revolute_origin, slider_direction};
 use crate::params::RobotParams;
 
 /// One flexible beam of the star with its sleeve (the passive prismatic joint it slides through).
@@ -172,31 +172,6 @@ impl Robot {
     pub fn gaps(&self) -> [f64; 3] {
         let phi = self.weld_angles();
         [phi[2] - phi[1], std::f64::consts::TAU - phi[2], phi[1] - phi[0]]
-    }
-
-    /// Revolute point i at actuator coordinate `s` [m], fixed frame: `o_i + s u_i` (Eqs. 1-3 on
-    /// the paper's base).
-    pub fn revolute_point<D: Scalar>(&self, i: usize, s: D) -> [D; 2] {
-        let a = &self.axes[i];
-        [s * a.direction[0] + a.origin[0], s * a.direction[1] + a.origin[1]]
-    }
-
-    /// Unit vector `e_xi` along rigid beam i at orientation `theta` (Eq. W1).
-    pub fn e_x<D: Scalar>(&self, i: usize, theta: D) -> [D; 2] {
-        let a = theta + self.beams[i].weld_angle;
-        [a.sin(), -a.cos()]
-    }
-
-    /// The actuator coordinates that put G at `g` [m] with orientation `theta` [rad]
-    /// (`docs/as-built.md` 3, inverse kinematics): beam i's axis meets slider line i, on the
-    /// beam's positive side. Fails when a beam is parallel to its slider or points away from it.
-    pub fn inverse_kinematics<D: Scalar>(&self, g: [D; 2], theta: D) -> Result<[D; 3], ModelError> {
-        let mut s = [D::zero(); 3];
-        for (i, si) in s.iter_mut().enumerate() {
-            let axis = (self.axes[i].origin, self.axes[i].direction);
-            *si = crate::geometry::axis_coordinate(i, self.e_x(i, theta), axis, g, theta)?;
-        }
-        Ok(s)
     }
 
     /// The robot in the paper's form, when it is the paper's robot: three equal beams welded at

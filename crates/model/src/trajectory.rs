@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::ModelError;
 use crate::geometry::inverse_kinematics;
 use crate::motion::{TableMotion, TableSpace, ViaMotion, ViaPoint};
-use crate::params::RobotParams;
+use crate::robot_geometry::RobotGeometry;
 use crate::shaper::Impulse;
 
 /// A task-space pose of the rigid star: centre G [m] in the fixed frame and orientation theta [rad].
@@ -226,7 +226,7 @@ impl Trajectory {
     }
 
     /// Actuator coordinates `s_i(t)` [m], generic over dual numbers for exact derivatives.
-    pub fn s<D: Scalar>(&self, params: &RobotParams, t: D) -> Result<[D; 3], ModelError> {
+    pub fn s<K: RobotGeometry + ?Sized, D: Scalar>(&self, params: &K, t: D) -> Result<[D; 3], ModelError> {
         match self {
             Trajectory::Polynomial { s1, s2, s3 } => Ok([horner(s1, t), horner(s2, t), horner(s3, t)]),
             Trajectory::Table(tab) if tab.data()?.space == TableSpace::Slider => Ok(tab.data()?.eval(t)),
@@ -366,7 +366,11 @@ impl Trajectory {
     /// Read the file of a `table` (relative to the experiment file `config`) for the robot
     /// `params`; a no-op for the other kinds. Errors name `config`, `trajectory.file`, the table
     /// file and the row.
-    pub fn read_file(&mut self, config: &std::path::Path, params: &RobotParams) -> Result<(), ModelError> {
+    pub fn read_file<K: RobotGeometry + ?Sized>(
+        &mut self,
+        config: &std::path::Path,
+        params: &K,
+    ) -> Result<(), ModelError> {
         match self {
             Trajectory::Table(tab) => tab.read_file(config, params),
             Trajectory::Shaped(sh) => sh.base.read_file(config, params),
@@ -384,7 +388,7 @@ impl Trajectory {
     }
 
     /// `s_i`, `s_i'` and `s_i''` at time t [s].
-    pub fn jets(&self, params: &RobotParams, t: f64) -> Result<[Jet; 3], ModelError> {
+    pub fn jets<K: RobotGeometry + ?Sized>(&self, params: &K, t: f64) -> Result<[Jet; 3], ModelError> {
         let s = self.s(params, Dual2::from_re(t).derivative())?;
         Ok(s.map(Jet::from_dual2))
     }
@@ -394,12 +398,12 @@ impl Trajectory {
     /// second-order dual numbers (`Dual2<Dual2<f64>>`, `docs/motions.md`, "Export for the
     /// controller"). At a knot where a derivative jumps (a quintic's ends, a rest segment's
     /// joints) it is the value of the piece the evaluation falls in.
-    pub fn jets4(&self, params: &RobotParams, t: f64) -> Result<[Jet4; 3], ModelError> {
+    pub fn jets4<K: RobotGeometry + ?Sized>(&self, params: &K, t: f64) -> Result<[Jet4; 3], ModelError> {
         Ok(self.s(params, nested_dual(t))?.map(Jet4::from_nested))
     }
 
     /// Check coefficients and times; the key is relative to the `[trajectory]` table.
-    pub fn validate(&self, params: &RobotParams) -> Result<(), ModelError> {
+    pub fn validate<K: RobotGeometry + ?Sized>(&self, params: &K) -> Result<(), ModelError> {
         match self {
             Trajectory::Polynomial { s1, s2, s3 } => {
                 for (key, c) in [("trajectory.s1", s1), ("trajectory.s2", s2), ("trajectory.s3", s3)] {
@@ -460,6 +464,7 @@ fn horner<D: Scalar>(c: &[f64], t: D) -> D {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::RobotParams;
 
     #[test]
     fn quadratic_derivatives_are_exact() {

@@ -114,6 +114,20 @@ impl ApiError {
         }
     }
 
+    /// The robot of `exp` (from `file`) in the paper's form, for a command `by` that takes only
+    /// the paper's robot so far (`docs/as-built.md` 6); a config error naming the file, the
+    /// command and the datum that differs otherwise.
+    pub fn paper_robot<'a>(
+        exp: &'a flexstar_model::Experiment,
+        file: impl std::fmt::Display,
+        by: &str,
+    ) -> std::result::Result<&'a flexstar_model::RobotParams, ApiError> {
+        exp.paper_robot(by).map_err(|e| {
+            let reason = e.to_string();
+            Self::config_text(&file, Some("robot"), &reason, format!("{file}: {reason}"))
+        })
+    }
+
     /// A model error: reading and validation are config errors, writing an output error.
     pub fn from_model(e: ModelError) -> Self {
         let message = e.to_string();
@@ -126,7 +140,7 @@ impl ApiError {
                 Self::config_text(file.display(), Some(&key), &reason, message)
             }
             ModelError::InverseKinematics(r) => Self::config_text("", None, &r, message),
-            ModelError::Unsupported { what } => Self::config_text("", Some("robot"), &what, message),
+            ModelError::Unsupported { what, .. } => Self::config_text("", Some("robot"), &what, message),
             ModelError::Write { .. } => ApiError::Output(message),
         }
     }

@@ -23,6 +23,8 @@ fn from_kinematics(source: &str, e: KinematicsError) -> ApiError {
 /// G, theta, xp_i and their derivatives (SI units, base frame) at every output time of `exp`
 /// (from `source`), after the feasibility scan of the whole motion.
 pub fn table(exp: &Experiment, source: &str) -> Result<Vec<RigidState>> {
+    // the rigid inverse dynamics of the table reads the paper's form
+    crate::ApiError::paper_robot(exp, source, "flexstar kinematics")?;
     kinematics_table(exp).map_err(|e| from_kinematics(source, e))
 }
 

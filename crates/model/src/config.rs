@@ -397,9 +397,10 @@ pub struct Experiment {
     pub description: String,
     #[serde(default)]
     pub robot: RobotParams,
-    /// The actuator axes (`[base]`, `docs/as-built.md` 2); read into `robot.d` when the file is
-    /// read (the paper's equilateral base), not written back.
-    #[serde(default, skip_serializing)]
+    /// The actuator axes (`[base]`, `docs/as-built.md` 2): the paper's equilateral base is read
+    /// into `robot.d` (and the section dropped), any other into `robot.as_built`; written back
+    /// only then.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub base: Option<crate::robot_section::BaseSection>,
     pub time: TimeSpan,
     pub trajectory: Trajectory,
@@ -543,8 +544,20 @@ impl Experiment {
 }
 
 impl Experiment {
-    /// `[base]` into `robot.d`: the in-radius of the equilateral base it describes (an uneven
-    /// base is refused until the solvers model it); giving `robot.d` too is refused.
+    /// The robot in the paper's compact form, for a command `by` that does not model a robot
+    /// as built yet (`docs/as-built.md` 6): an error naming it and the datum that differs
+    /// otherwise.
+    pub fn paper_robot(&self, by: &str) -> Result<&RobotParams, ModelError> {
+        if self.robot.as_built.is_none() {
+            return Ok(&self.robot);
+        }
+        crate::Robot::from_params(&self.robot)?.paper_form_for(by)?;
+        Ok(&self.robot)
+    }
+
+    /// `[base]` into the robot: the paper's equilateral base sets `robot.d` (its in-radius; the
+    /// section is then not written back), any other base makes the robot one as built
+    /// ([`RobotParams::as_built`], `docs/as-built.md` 2); giving `robot.d` too is refused.
     fn read_base(&mut self, text: &str) -> Result<(), ModelError> {
         let Some(base) = &self.base else {
             return Ok(());
@@ -559,9 +572,25 @@ impl Experiment {
                 "give the base once: robot.d (the paper's equilateral triangle of that in-radius) or [base]",
             ));
         }
-        self.robot.d = base
-            .paper_in_radius()
-            .map_err(|(key, reason)| ModelError::invalid(key, reason))?;
+        let axes = base.axes().map_err(|(key, reason)| ModelError::invalid(key, reason))?;
+        let paper_d = crate::robot_section::BaseSection::paper_in_radius(&axes);
+        // the in-radius of the paper's base, or the distance from O to axis 1 (its in-radius
+        // for a base given by sides)
+        self.robot.d = paper_d.unwrap_or_else(|| {
+            (axes[0].origin[0] * axes[0].direction[1] - axes[0].origin[1] * axes[0].direction[0]).abs()
+        });
+        match (&mut self.robot.as_built, paper_d) {
+            (Some(a), _) => a.axes = axes,
+            (None, Some(_)) => {}
+            (None, None) => {
+                let mut a = crate::robot::AsBuilt::of_paper(&self.robot);
+                a.axes = axes;
+                self.robot.as_built = Some(a);
+            }
+        }
+        if paper_d.is_some() {
+            self.base = None;
+        }
         Ok(())
     }
 
@@ -669,8 +698,9 @@ pub fn check_step(key: &str, dt: f64, dt_out: f64) -> Result<(), ModelError> {
 mod tests {
     use super::*;
 
-    /// `[robot]` lists and `[base]` read from a file: equal lists are the paper's form, an
-    /// unequal one is refused naming the file and the key, `[base]` sets `d` and may not come with it.
+    /// `[robot]` lists and `[base]` read from a file: equal lists are the paper's form, unequal
+    /// ones and an uneven base a robot as built, written back in the same form (the resolved
+    /// experiment reads back to the same robot); `[base]` may not come with `robot.d`.
     #[test]
     fn robot_lists_and_the_base_from_a_file() {
         let body = "name = \"r\"\n[time]\nt_end = 0.1\n[trajectory]\nkind = \"polynomial\"\n\
@@ -679,17 +709,39 @@ mod tests {
         let plain = read("").unwrap();
         let listed = read("[robot]\nL = [0.5, 0.5, 0.5]\nweld_deg = [0, 120, 240]\n").unwrap();
         assert_eq!(listed.robot, plain.robot);
-        let e = read("[robot]\nL = [0.42, 0.42, 0.40]\n").unwrap_err().to_string();
-        assert!(e.contains("r.toml") && e.contains("robot.L"), "{e}");
         let side = 2.0 * 3f64.sqrt() * 0.2;
         let based = read(&format!("[base]\nsides = [{side}, {side}, {side}]\n")).unwrap();
-        assert!((based.robot.d - 0.2).abs() < 1e-15);
+        assert!((based.robot.d - 0.2).abs() < 1e-15 && based.robot.as_built.is_none() && based.base.is_none());
         let e = read(&format!("[robot]\nd = 0.2\n[base]\nsides = [{side}, {side}, {side}]\n"))
             .unwrap_err()
             .to_string();
         assert!(e.contains("robot.d") && e.contains("once"), "{e}");
-        let e = read("[base]\nsides = [0.62, 0.64, 0.61]\n").unwrap_err().to_string();
-        assert!(e.contains("r.toml") && e.contains("uneven base"), "{e}");
+        // a robot as built: its own data, and the same robot after writing and reading it back
+        let built =
+            read("[robot]\nL = [0.52, 0.5, 0.48]\nweld_deg = [0, 119, 241]\n[base]\nsides = [0.626, 0.618, 0.631]\n")
+                .unwrap();
+        let robot = crate::Robot::from_params(&built.robot).unwrap();
+        assert_eq!(robot.beams().map(|b| b.length), [0.52, 0.5, 0.48]);
+        assert_eq!(robot.beams()[2].weld_angle, 241f64.to_radians());
+        assert_eq!(
+            robot.axes(),
+            &crate::ActuatorAxis::from_sides([0.626, 0.618, 0.631]).unwrap()
+        );
+        assert!(built
+            .paper_robot("a command")
+            .unwrap_err()
+            .to_string()
+            .contains("a command"));
+        let text = toml::to_string(&built).unwrap();
+        let again = Experiment::from_toml_str(&text, Path::new("again.toml")).unwrap();
+        // the same robot, its defaulted EA now written
+        assert_eq!(crate::Robot::from_params(&again.robot).unwrap(), robot, "{text}");
+        let e = read("[robot]\nLp = [0.03, 0.03, 0.6]\n").unwrap_err().to_string();
+        assert!(e.contains("r.toml") && e.contains("robot.Lp[3]"), "{e}");
+        let e = read("[robot]\nweld_deg = [0, 200, 240]\n").unwrap_err().to_string();
+        assert!(e.contains("robot.weld_deg"), "{e}");
+        let e = read("[base]\nsides = [0.2, 0.2, 0.5]\n").unwrap_err().to_string();
+        assert!(e.contains("base.sides"), "{e}");
     }
 
     #[test]

@@ -23,8 +23,11 @@ pub enum ModelError {
     InverseKinematics(String),
     /// A robot the solvers' equal-beam models do not take (`docs/architecture.md`, "The robot
     /// description"): `what` names the datum that makes it other than the paper's.
-    #[error("{what}: the solvers model three equal beams welded 120 degrees apart on an equilateral base")]
-    Unsupported { what: String },
+    #[error(
+        "{what}: {by} takes only the paper's robot so far (three equal beams welded 120 degrees apart on an \
+         equilateral base; docs/as-built.md 6)"
+    )]
+    Unsupported { what: String, by: String },
     /// A result file could not be written (nothing is left behind).
     #[error("{file}: cannot write: {reason}")]
     Write { file: PathBuf, reason: String },

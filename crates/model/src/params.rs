@@ -1,6 +1,6 @@
 //! Robot parameters (paper, section 8; docs/paper-defects.md, Parameters).
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Serialize, Serializer};
 
 use crate::error::ModelError;
 
@@ -11,9 +11,13 @@ use crate::error::ModelError;
 ///
 /// TOML keys keep the paper's symbols (`E`, `I`, `rho`, `L`, `d`, `Lp`, `mpp_mpa`, `Jp`); every
 /// key is optional and defaults to the paper's value (section 8).
-/// Read through [`crate::robot_section`]: a key may be a list of three equal values, `EA` may
-/// come from `A` or `density`, and `weld_deg` may be given (the paper's).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// Read through [`crate::robot_section`]: a key may be a list of three values, `EA` may come
+/// from `A` or `density`, and `weld_deg` and `[base]` may be given. A robot other than the
+/// paper's (values that differ between beams, other weld angles, an uneven base) is carried
+/// whole in [`RobotParams::as_built`]; the fields then hold beam 1's values and the in-radius
+/// of the base, and every reader of beam data reads the per-beam [`crate::Robot`] instead
+/// ([`crate::Problem::robot`], [`crate::RobotGeometry`]).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(try_from = "crate::robot_section::RobotSection")]
 pub struct RobotParams {
     /// Young's modulus E [Pa].
@@ -41,6 +45,10 @@ pub struct RobotParams {
     /// Default `E * rho / 7800` (steel density), docs/paper-defects.md: 6e6 N.
     #[serde(rename = "EA")]
     pub ea: Option<f64>,
+    /// The robot as built when it is not the paper's (`docs/as-built.md`): every beam's data,
+    /// its weld angle and the actuator axes; `None` for the paper's form.
+    #[serde(skip)]
+    pub as_built: Option<crate::robot::AsBuilt>,
 }
 
 impl Default for RobotParams {
@@ -62,6 +70,7 @@ impl RobotParams {
             mpp_mpa: 0.2,
             jp: 2e-4,
             ea: None,
+            as_built: None,
         }
     }
 
@@ -90,8 +99,29 @@ impl RobotParams {
         self.rho * self.l.powi(3)
     }
 
-    /// Check every parameter; the error names the key and the reason.
+    /// Check every parameter; the error names the key and the reason. A robot as built is
+    /// checked beam by beam (`robot.L[3]`), with its weld angles and axes ([`crate::Robot::new`]).
     pub fn validate(&self) -> Result<(), ModelError> {
+        if let Some(a) = &self.as_built {
+            crate::Robot::new(a.beams, a.axes)?;
+            for b in &a.beams {
+                let one = RobotParams {
+                    e: b.youngs_modulus,
+                    i: b.second_moment,
+                    rho: b.mass_per_length,
+                    l: b.length,
+                    lp: b.sleeve_length,
+                    mpp_mpa: b.sleeve_mass,
+                    jp: b.sleeve_inertia,
+                    ea: Some(b.axial_stiffness),
+                    as_built: None,
+                    // the base is checked by Robot::new; d does not describe an uneven one
+                    d: RobotParams::paper().d,
+                };
+                one.check_derived()?;
+            }
+            return Ok(());
+        }
         let positive = [
             ("robot.E", self.e),
             ("robot.I", self.i),
@@ -265,5 +295,87 @@ mod tests {
         p.l = 1e100;
         p.d = 1e99;
         assert!(p.validate().is_ok());
+    }
+}
+
+/// One value for the three beams, or a list of three where they differ (how `[robot]` is written
+/// back, e.g. in a run's sidecar: the per-beam values used).
+#[derive(Serialize)]
+#[serde(untagged)]
+enum Written {
+    One(f64),
+    Three([f64; 3]),
+}
+
+impl Written {
+    fn of(v: [f64; 3]) -> Self {
+        if v[0] == v[1] && v[1] == v[2] {
+            Written::One(v[0])
+        } else {
+            Written::Three(v)
+        }
+    }
+}
+
+/// `[robot]` as it is written back: the keys of the file, per beam where the beams differ,
+/// `weld_deg` when the welds are not the paper's, and `d` unless the base is uneven (then the
+/// experiment writes `[base]`).
+#[derive(Serialize)]
+struct RobotWritten {
+    #[serde(rename = "E")]
+    e: Written,
+    #[serde(rename = "I")]
+    i: Written,
+    rho: Written,
+    #[serde(rename = "L")]
+    l: Written,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    d: Option<f64>,
+    #[serde(rename = "Lp")]
+    lp: Written,
+    mpp_mpa: Written,
+    #[serde(rename = "Jp")]
+    jp: Written,
+    #[serde(rename = "EA")]
+    ea: Option<Written>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    weld_deg: Option<[f64; 3]>,
+}
+
+impl Serialize for RobotParams {
+    fn serialize<S: Serializer>(&self, ser: S) -> Result<S::Ok, S::Error> {
+        let written = match &self.as_built {
+            None => RobotWritten {
+                e: Written::One(self.e),
+                i: Written::One(self.i),
+                rho: Written::One(self.rho),
+                l: Written::One(self.l),
+                d: Some(self.d),
+                lp: Written::One(self.lp),
+                mpp_mpa: Written::One(self.mpp_mpa),
+                jp: Written::One(self.jp),
+                ea: self.ea.map(Written::One),
+                weld_deg: None,
+            },
+            Some(a) => {
+                let per = |f: fn(&crate::Beam) -> f64| Written::of(a.beams.map(|b| f(&b)));
+                let paper_axes = (0..3).all(|i| a.axes[i] == crate::ActuatorAxis::paper(i, self.d));
+                let welds = a.beams.map(|b| b.weld_angle);
+                let paper_welds = (0..3).all(|i| welds[i] == crate::geometry::beam_offset(i));
+                RobotWritten {
+                    e: per(|b| b.youngs_modulus),
+                    i: per(|b| b.second_moment),
+                    rho: per(|b| b.mass_per_length),
+                    l: per(|b| b.length),
+                    d: paper_axes.then_some(self.d),
+                    lp: per(|b| b.sleeve_length),
+                    mpp_mpa: per(|b| b.sleeve_mass),
+                    jp: per(|b| b.sleeve_inertia),
+                    ea: Some(per(|b| b.axial_stiffness)),
+                    weld_deg: (!paper_welds).then(|| welds.map(f64::to_degrees)),
+                }
+            }
+        };
+        written.serialize(ser)
     }
 }

@@ -93,6 +93,36 @@ impl ActuatorAxis {
     }
 }
 
+/// The data of a robot other than the paper's, as the file gives it (`[robot]` lists,
+/// `weld_deg`, `[base]`): carried by [`RobotParams::as_built`] and checked by [`Robot::new`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AsBuilt {
+    pub beams: [Beam; 3],
+    pub axes: [ActuatorAxis; 3],
+}
+
+impl AsBuilt {
+    /// The paper's robot of `params` as data: its beams welded 120 degrees apart on the
+    /// equilateral base of in-radius `params.d`, to be changed key by key.
+    pub fn of_paper(params: &RobotParams) -> Self {
+        let beam = |i: usize| Beam {
+            youngs_modulus: params.e,
+            second_moment: params.i,
+            axial_stiffness: params.ea(),
+            mass_per_length: params.rho,
+            length: params.l,
+            sleeve_length: params.lp,
+            sleeve_mass: params.mpp_mpa,
+            sleeve_inertia: params.jp,
+            weld_angle: beam_offset(i),
+        };
+        AsBuilt {
+            beams: [beam(0), beam(1), beam(2)],
+            axes: std::array::from_fn(|i| ActuatorAxis::paper(i, params.d)),
+        }
+    }
+}
+
 /// The robot: its three beams and three actuator axes, validated.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Robot {
@@ -124,25 +154,16 @@ impl Robot {
         Ok(Robot { beams, axes, equal })
     }
 
-    /// The paper's form: three equal beams of `params`, welded 120 degrees apart, on the
-    /// equilateral base of in-radius `params.d` (every value checked by [`RobotParams::validate`]).
+    /// The robot `params` describe (every value checked by [`RobotParams::validate`]): its
+    /// [`RobotParams::as_built`] data when it has some, else the paper's form, three equal beams
+    /// of `params` welded 120 degrees apart on the equilateral base of in-radius `params.d`.
     pub fn from_params(params: &RobotParams) -> Result<Self, ModelError> {
         params.validate()?;
-        let beam = |i: usize| Beam {
-            youngs_modulus: params.e,
-            second_moment: params.i,
-            axial_stiffness: params.ea(),
-            mass_per_length: params.rho,
-            length: params.l,
-            sleeve_length: params.lp,
-            sleeve_mass: params.mpp_mpa,
-            sleeve_inertia: params.jp,
-            weld_angle: beam_offset(i),
-        };
-        let mut robot = Self::new(
-            [beam(0), beam(1), beam(2)],
-            std::array::from_fn(|i| ActuatorAxis::paper(i, params.d)),
-        )?;
+        if let Some(a) = params.as_built {
+            return Self::new(a.beams, a.axes);
+        }
+        let a = AsBuilt::of_paper(params);
+        let mut robot = Self::new(a.beams, a.axes)?;
         // the check found the paper's robot; keep the caller's own form of it (`EA` given or
         // defaulted), so that it compares equal with the parameters it came from
         if robot.equal.is_ok() {
@@ -178,9 +199,16 @@ impl Robot {
     /// 0, 120 and 240 degrees on an equilateral base centred at O. Otherwise the error says which
     /// datum differs: the solvers' equal-beam models refuse such a robot with it.
     pub fn equal_beams(&self) -> Result<&RobotParams, ModelError> {
-        self.equal
-            .as_ref()
-            .map_err(|what| ModelError::Unsupported { what: what.clone() })
+        self.paper_form_for("this solver")
+    }
+
+    /// [`Robot::equal_beams`] for a command or model `by` that takes only the paper's robot so
+    /// far: the error names it and the datum that differs.
+    pub fn paper_form_for(&self, by: &str) -> Result<&RobotParams, ModelError> {
+        self.equal.as_ref().map_err(|what| ModelError::Unsupported {
+            what: what.clone(),
+            by: by.to_string(),
+        })
     }
 }
 
@@ -210,6 +238,7 @@ fn paper_form(beams: &[Beam; 3], axes: &[ActuatorAxis; 3]) -> Result<RobotParams
         return Err("the base is not the equilateral triangle centred at O".to_string());
     }
     Ok(RobotParams {
+        as_built: None,
         e: b.youngs_modulus,
         i: b.second_moment,
         rho: b.mass_per_length,

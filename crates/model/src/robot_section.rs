@@ -4,9 +4,10 @@
 //! (`L = [0.42, 0.42, 0.40]`); the axial stiffness is `EA`, or follows from the section area `A`
 //! (`EA = E A`) or the material's `density` (`EA = E rho / density`); `weld_deg` gives the beams'
 //! weld angles and `[base]` the actuator axes (`sides`, or `points` with `directions`). The robot
-//! description holds all of it ([`crate::Robot`]); the solvers model the paper's form, so a value
-//! that differs between beams, weld angles other than 0, 120, 240 degrees or an uneven base are
-//! refused when the file is read, naming the key, until the solvers take them.
+//! description holds all of it ([`crate::Robot`]): a robot other than the paper's (a value that
+//! differs between beams, weld angles other than 0, 120, 240 degrees, an uneven base) is carried
+//! whole in [`RobotParams::as_built`]; a command or solver that does not model it yet refuses it
+//! by name (`docs/as-built.md` 6).
 
 use std::fmt;
 
@@ -14,19 +15,11 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 
 use crate::params::RobotParams;
-use crate::robot::ActuatorAxis;
+use crate::robot::{ActuatorAxis, AsBuilt};
 
 /// A `[robot]` value for the three beams: one number or a list of three.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PerBeam(pub [f64; 3]);
-
-impl PerBeam {
-    /// The common value of three equal ones; `None` when they differ.
-    fn common(&self) -> Option<f64> {
-        let [a, b, c] = self.0;
-        (a == b && b == c).then_some(a)
-    }
-}
 
 impl<'de> Deserialize<'de> for PerBeam {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -87,32 +80,27 @@ pub(crate) struct RobotSection {
     weld_deg: Option<[f64; 3]>,
 }
 
-/// One value of the three beams, refused when they differ (the solvers' paper form).
-fn one(key: &str, v: Option<PerBeam>, paper: f64) -> Result<f64, String> {
-    match v {
-        None => Ok(paper),
-        Some(p) => p.common().ok_or_else(|| {
-            format!(
-                "robot.{key} = {:?}: beams with different values are part of the robot description \
-                 (docs/as-built.md) but neither solver models them yet; give one value for the three beams",
-                p.0
-            )
-        }),
-    }
+/// The three beams' values of a key: the given ones, or the paper's for the three.
+fn list(v: Option<PerBeam>, paper: f64) -> [f64; 3] {
+    v.map_or([paper; 3], |p| p.0)
 }
+
+/// Weld angles within this of the paper's (degrees) are the paper's: `120.0` written in a file is
+/// the paper's `2 pi / 3`.
+const PAPER_WELD_TOL_DEG: f64 = 1e-9;
 
 impl TryFrom<RobotSection> for RobotParams {
     type Error = String;
 
     fn try_from(s: RobotSection) -> Result<Self, String> {
         let paper = RobotParams::paper();
-        let e = one("E", s.e, paper.e)?;
-        let rho = one("rho", s.rho, paper.rho)?;
-        let ea = match (s.ea, s.area, s.density) {
+        let e = list(s.e, paper.e);
+        let rho = list(s.rho, paper.rho);
+        let ea: Option<[f64; 3]> = match (s.ea, s.area, s.density) {
             (None, None, None) => None,
-            (Some(v), None, None) => Some(one("EA", Some(v), 0.0)?),
-            (None, Some(a), None) => Some(e * one("A", Some(a), 0.0)?),
-            (None, None, Some(dens)) => Some(e * rho / one("density", Some(dens), 0.0)?),
+            (Some(v), None, None) => Some(v.0),
+            (None, Some(a), None) => Some(std::array::from_fn(|k| e[k] * a.0[k])),
+            (None, None, Some(dens)) => Some(std::array::from_fn(|k| e[k] * rho[k] / dens.0[k])),
             _ => {
                 return Err(
                     "robot.EA: give the axial stiffness one way: EA [N], or the section area A [m^2] \
@@ -121,55 +109,99 @@ impl TryFrom<RobotSection> for RobotParams {
                 )
             }
         };
-        if let Some(w) = s.weld_deg {
-            let paper_welds = [0.0, 120.0, 240.0];
-            if w.iter().zip(paper_welds).any(|(a, b)| (a - b).abs() > 1e-9) {
-                return Err(format!(
-                    "robot.weld_deg = {w:?}: weld angles other than [0, 120, 240] are part of the robot \
-                     description (docs/as-built.md) but neither solver models them yet"
-                ));
+        let values = [
+            e,
+            list(s.i, paper.i),
+            rho,
+            list(s.l, paper.l),
+            list(s.lp, paper.lp),
+            list(s.mpp_mpa, paper.mpp_mpa),
+            list(s.jp, paper.jp),
+        ];
+        let [e, i, rho, l, lp, mpp_mpa, jp] = values;
+        let paper_welds = [0.0, 120.0, 240.0];
+        let welds = s.weld_deg.filter(|w| {
+            w.iter()
+                .zip(paper_welds)
+                .any(|(a, b)| (a - b).abs() > PAPER_WELD_TOL_DEG)
+        });
+        let compact = RobotParams {
+            e: e[0],
+            i: i[0],
+            rho: rho[0],
+            l: l[0],
+            d: s.d.unwrap_or(paper.d),
+            lp: lp[0],
+            mpp_mpa: mpp_mpa[0],
+            jp: jp[0],
+            ea: ea.map(|v| v[0]),
+            as_built: None,
+        };
+        let equal = |v: &[f64; 3]| v[0] == v[1] && v[1] == v[2];
+        if welds.is_none() && values.iter().all(equal) && ea.as_ref().is_none_or(equal) {
+            return Ok(compact);
+        }
+        // a robot as built: beam 1's values above, every beam's here
+        let mut a = AsBuilt::of_paper(&compact);
+        for (k, b) in a.beams.iter_mut().enumerate() {
+            b.youngs_modulus = e[k];
+            b.second_moment = i[k];
+            b.mass_per_length = rho[k];
+            b.length = l[k];
+            b.sleeve_length = lp[k];
+            b.sleeve_mass = mpp_mpa[k];
+            b.sleeve_inertia = jp[k];
+            b.axial_stiffness = ea.map_or(e[k] * rho[k] / 7800.0, |v| v[k]);
+            if let Some(w) = welds {
+                b.weld_angle = w[k].to_radians();
             }
         }
         Ok(RobotParams {
-            e,
-            i: one("I", s.i, paper.i)?,
-            rho,
-            l: one("L", s.l, paper.l)?,
-            d: s.d.unwrap_or(paper.d),
-            lp: one("Lp", s.lp, paper.lp)?,
-            mpp_mpa: one("mpp_mpa", s.mpp_mpa, paper.mpp_mpa)?,
-            jp: one("Jp", s.jp, paper.jp)?,
-            ea,
+            as_built: Some(a),
+            ..compact
         })
     }
 }
 
 /// `[base]`: the three actuator axes, by the triangle's `sides` [m] or by `points` [m] and
 /// `directions` (`docs/as-built.md` 2).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BaseSection {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub sides: Option<[f64; 3]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub points: Option<[[f64; 2]; 3]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub directions: Option<[[f64; 2]; 3]>,
 }
 
 impl BaseSection {
-    /// The in-radius `d` [m] of the paper's equilateral base that this section describes; an
-    /// error (key, reason) for a base the solvers do not model yet or an invalid one.
-    pub fn paper_in_radius(&self) -> Result<f64, (String, String)> {
+    /// The three actuator axes this section gives (`docs/as-built.md` 2: from the sides, Eq. B1,
+    /// or the points and directions, normalised); an error (key, reason) for an invalid base.
+    pub fn axes(&self) -> Result<[ActuatorAxis; 3], (String, String)> {
         let axes = match (self.sides, self.points, self.directions) {
             (Some(sides), None, None) => {
                 ActuatorAxis::from_sides(sides).map_err(|e| ("base.sides".into(), e.detail()))?
             }
-            (None, Some(points), Some(directions)) => std::array::from_fn(|i| {
-                let u = directions[i];
-                let n = u[0].hypot(u[1]);
-                ActuatorAxis {
-                    origin: points[i],
-                    direction: [u[0] / n, u[1] / n],
+            (None, Some(points), Some(directions)) => {
+                let mut axes = [ActuatorAxis::paper(0, 1.0); 3];
+                for (k, axis) in axes.iter_mut().enumerate() {
+                    let u = directions[k];
+                    let n = u[0].hypot(u[1]);
+                    if !(n.is_finite() && n > 0.0 && points[k].iter().all(|v| v.is_finite())) {
+                        return Err((
+                            format!("base.directions[{}]", k + 1),
+                            format!("every point and direction must be finite and the direction non-zero, got point {:?}, direction {u:?}", points[k]),
+                        ));
+                    }
+                    *axis = ActuatorAxis {
+                        origin: points[k],
+                        direction: [u[0] / n, u[1] / n],
+                    };
                 }
-            }),
+                axes
+            }
             _ => {
                 return Err((
                     "base".into(),
@@ -178,15 +210,12 @@ impl BaseSection {
                 ))
             }
         };
-        if axes
-            .iter()
-            .any(|a| !(a.origin.iter().chain(&a.direction).all(|v| v.is_finite())))
-        {
-            return Err((
-                "base".into(),
-                "every point and direction must be finite and non-zero".into(),
-            ));
-        }
+        Ok(axes)
+    }
+
+    /// The in-radius `d` [m] when the axes are the paper's equilateral base centred at O (to
+    /// rounding), else `None`: the base is uneven.
+    pub fn paper_in_radius(axes: &[ActuatorAxis; 3]) -> Option<f64> {
         let d = -axes[0].origin[1];
         let paper = d > 0.0
             && (0..3).all(|i| {
@@ -196,16 +225,7 @@ impl BaseSection {
                         && (axes[i].direction[k] - p.direction[k]).abs() <= 1e-12
                 })
             });
-        if !paper {
-            return Err((
-                "base".into(),
-                format!(
-                    "an uneven base is part of the robot description (docs/as-built.md 2) but neither solver \
-                     models it yet; its axes are {axes:?}"
-                ),
-            ));
-        }
-        Ok(d)
+        paper.then_some(d)
     }
 }
 
@@ -219,10 +239,16 @@ mod tests {
     }
 
     #[test]
-    fn equal_lists_are_one_value_and_unequal_ones_are_refused_naming_the_key() {
+    fn equal_lists_are_one_value_and_unequal_ones_a_robot_as_built() {
         assert_eq!(read("L = [0.5, 0.5, 0.5]\nJp = 2e-4").unwrap(), RobotParams::paper());
-        let e = read("L = [0.42, 0.42, 0.40]").unwrap_err();
-        assert!(e.contains("robot.L") && e.contains("docs/as-built.md"), "{e}");
+        let p = read("L = [0.42, 0.42, 0.40]\nE = 70e9\nrho = 0.108\nA = 4e-5").unwrap();
+        let a = p.as_built.expect("beams differ");
+        assert_eq!(a.beams.map(|b| b.length), [0.42, 0.42, 0.40]);
+        // the material's EA follows per beam: E A = 2.8e6 N for each
+        assert!(a.beams.iter().all(|b| (b.axial_stiffness - 2.8e6).abs() < 1e-6));
+        // beam 1's values in the compact form; the paper's base and welds
+        assert_eq!((p.l, p.e), (0.42, 70e9));
+        assert_eq!(a.axes, std::array::from_fn(|i| ActuatorAxis::paper(i, p.d)));
         let e = read("L = [0.42, 0.42]").unwrap_err();
         assert!(e.contains("three"), "{e}");
         let e = read("L = \"long\"").unwrap_err();
@@ -244,26 +270,33 @@ mod tests {
     }
 
     #[test]
-    fn the_paper_welds_and_base_are_accepted_and_others_refused() {
-        assert!(read("weld_deg = [0, 120, 240]").is_ok());
-        assert!(read("weld_deg = [0, 121, 240]").unwrap_err().contains("robot.weld_deg"));
+    fn the_paper_welds_and_base_are_the_paper_form_and_others_a_robot_as_built() {
+        assert_eq!(read("weld_deg = [0, 120, 240]").unwrap(), RobotParams::paper());
+        let w = read("weld_deg = [0, 121, 240]").unwrap().as_built.unwrap();
+        assert_eq!(w.beams[1].weld_angle, 121f64.to_radians());
         let equal = BaseSection {
             sides: Some([2.0 * 3f64.sqrt() * 0.2; 3]),
             points: None,
             directions: None,
         };
-        assert!((equal.paper_in_radius().unwrap() - 0.2).abs() < 1e-15);
+        let d = BaseSection::paper_in_radius(&equal.axes().unwrap()).unwrap();
+        assert!((d - 0.2).abs() < 1e-15);
         let uneven = BaseSection {
             sides: Some([0.62, 0.64, 0.61]),
             ..equal.clone()
         };
-        assert!(uneven.paper_in_radius().unwrap_err().1.contains("uneven base"));
+        assert_eq!(BaseSection::paper_in_radius(&uneven.axes().unwrap()), None);
         let paper = RobotParams::paper();
         let by_points = BaseSection {
             sides: None,
             points: Some(std::array::from_fn(|i| ActuatorAxis::paper(i, paper.d).origin)),
             directions: Some(std::array::from_fn(|i| ActuatorAxis::paper(i, paper.d).direction)),
         };
-        assert_eq!(by_points.paper_in_radius().unwrap(), paper.d);
+        assert_eq!(BaseSection::paper_in_radius(&by_points.axes().unwrap()), Some(paper.d));
+        let zero = BaseSection {
+            directions: Some([[1.0, 0.0], [0.0, 0.0], [0.0, 1.0]]),
+            ..by_points
+        };
+        assert_eq!(zero.axes().unwrap_err().0, "base.directions[2]");
     }
 }

@@ -363,11 +363,10 @@ pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunO
 fn residual_keys(p: &Prepared, r: &Response) -> Result<flexstar_model::ResidualKeys> {
     let res = flexstar_modal::settle::run_residual(&p.exp, r).map_err(|e| ApiError::solver(&p.source, e))?;
     let pinned = p.solver == Solver::Amm && p.exp.amm.family == ModeFamily::PinnedFree;
-    Ok(flexstar_metrics::residual::sidecar_keys(
-        res.as_ref(),
-        p.exp.report.settle_tol,
-        pinned,
-    ))
+    let mut keys = flexstar_metrics::residual::sidecar_keys(res.as_ref(), p.exp.report.settle_tol, pinned);
+    // per dwell (docs/motions.md 2.5): an addition, the keys above stay as they are
+    keys.dwells = flexstar_modal::settle::run_dwells(&p.exp, r, pinned).map_err(|e| ApiError::solver(&p.source, e))?;
+    Ok(keys)
 }
 
 /// Why an AMM run is outside the validated envelope of the accurate model (`docs/validation.md`
@@ -432,6 +431,16 @@ pub fn residual_line(sidecar: &flexstar_model::RunSidecar) -> Option<String> {
     ))
 }
 
+/// The sidecar's residual per dwell (`docs/motions.md` 2.5), one line each
+/// ([`flexstar_metrics::dwell::dwell_text`]), when the motion has more than one dwell (a single
+/// dwell is [`residual_line`]'s window); empty otherwise.
+pub fn dwell_lines(sidecar: &flexstar_model::RunSidecar) -> Vec<String> {
+    match sidecar.residual.as_ref().and_then(|k| k.dwells.as_ref()) {
+        Some(d) if d.len() > 1 => d.iter().map(flexstar_metrics::dwell::dwell_text).collect(),
+        _ => Vec::new(),
+    }
+}
+
 /// Columns a direct run's file puts right after the fixed ones (a file contract, `docs/outputs.md`).
 fn direct_columns(servo: bool) -> Vec<&'static str> {
     let mut v = vec!["Gx", "Gy", "theta"];
@@ -443,7 +452,8 @@ fn direct_columns(servo: bool) -> Vec<&'static str> {
 
 /// Write a run's files in `dir` (already `DIR/<name>/`): `<stem>.csv` (a direct run: the
 /// sliders first, then the fixed columns, the pose, a servo's errors), `<stem>-shapes.csv`,
-/// `<stem>.json` (the outcome's sidecar) and with `figures` the figures in `dir/figures/`.
+/// `<stem>-dwells.csv` when the motion has a dwell (`docs/motions.md` 2.5), `<stem>.json` (the
+/// outcome's sidecar) and with `figures` the figures in `dir/figures/`.
 /// The CSV files and the sidecar are one run set ([`RunSet`]): published together.
 pub fn write_run(out: &mut RunOutcome, dir: &Path, figures: bool) -> Result<()> {
     let (r, exp, stem) = (&out.response, &out.exp, &out.stem);
@@ -462,17 +472,24 @@ pub fn write_run(out: &mut RunOutcome, dir: &Path, figures: bool) -> Result<()> 
     r.stage_shapes_csv(&mut set, &format!("{stem}-shapes.csv"))?;
     let frames_hash = flexstar_model::animation::stage_run_frames(&r.frames, &mut set, stem)?;
     out.sidecar.frames_hash.clone_from(&frames_hash);
+    let dwells = out.sidecar.residual.as_ref().and_then(|k| k.dwells.clone());
+    if let Some(d) = &dwells {
+        set.text(&format!("{stem}-dwells.csv"), &flexstar_model::sidecar::dwells_csv(d))?;
+    }
     let json = dir.join(format!("{stem}.json"));
     let doc = flexstar_model::response::sidecar_value(&json, &out.sidecar)?;
     set.text(&format!("{stem}.json"), &sidecar_text(&json, &doc)?)?;
     set.commit()?;
     out.files.extend([csv.clone(), shapes, json]);
+    if dwells.is_some() {
+        out.files.push(dir.join(format!("{stem}-dwells.csv")));
+    }
     if frames_hash.is_some() {
         out.files
             .extend(flexstar_model::animation::frames_file_names(stem).map(|n| dir.join(n)));
     }
     if figures {
-        let figs = crate::figures::run_figures(exp, stem, r, direct, dir)?;
+        let figs = crate::figures::run_figures(exp, stem, r, direct, dir, dwells.as_deref())?;
         out.files.extend(figs);
     }
     out.csv = Some(csv);

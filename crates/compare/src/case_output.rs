@@ -14,6 +14,7 @@ use serde::Serialize;
 
 use flexstar_plot::{Figure, RenderedFigure, Style, EXTRA_COLORS, FAMILY_COLORS, FEM_STYLE};
 
+use crate::dwells::{case_dwells, dwells_markdown, RunDwells};
 use crate::figures::{figure_forces, figure_sliders, figure_star, figure_tips, figure_w_g, Run};
 use crate::residual::{case_residuals, mark_t_rest, residual_csv, residual_markdown, RunResidual};
 use crate::runs::CaseResults;
@@ -95,7 +96,15 @@ fn run_style(family: ModeFamily, used: &mut Vec<ModeFamily>) -> Style {
 /// forces over the rigid-body inverse dynamics. `hold` [s]: one period of the first mode at the
 /// final pose when the motion rests before `t_end` (the settling hold): the time figures then get
 /// zoom rows on the motion and on the residual window after it ([`crate::residual::time_zooms`]).
-pub fn case_figures(exp: &Experiment, case: &CaseResults, hold: Option<f64>) -> Result<Vec<Figure>, Error> {
+/// `dwells`: every run's dwells (`docs/motions.md` 2.5): with any, the figure `-dG` (|dG|, the
+/// band, the settling instants); with several, the time figures' zoom rows are one per move and
+/// its dwell instead ([`crate::dwells::dwell_zooms`]).
+pub fn case_figures(
+    exp: &Experiment,
+    case: &CaseResults,
+    hold: Option<f64>,
+    dwells: &[RunDwells],
+) -> Result<Vec<Figure>, Error> {
     let mut runs = vec![Run {
         label: "FEM".into(),
         response: &case.fem,
@@ -153,6 +162,32 @@ pub fn case_figures(exp: &Experiment, case: &CaseResults, hold: Option<f64>) -> 
             mark_t_rest(f, t_rest);
             f.zooms = zooms.clone();
         }
+    }
+    // per dwell (docs/motions.md 2.5): every run has the same dwells (one trajectory)
+    let per_run: Vec<&[flexstar_model::DwellKeys]> = runs_of(case)
+        .iter()
+        .map(|(stem, _)| {
+            dwells
+                .iter()
+                .find(|d| d.run == *stem)
+                .map_or(&[][..], |d| d.dwells.as_slice())
+        })
+        .collect();
+    if let Some(first) = per_run.iter().find(|d| !d.is_empty()) {
+        if first.len() > 1 {
+            let zooms = crate::dwells::dwell_zooms(first, exp.time.t_end);
+            for f in figs.iter_mut().filter(|f| !f.name.ends_with("-star")) {
+                f.zooms = zooms.clone();
+            }
+        }
+        figs.push(crate::dwells::figure_dg(
+            &format!("{}-dG", exp.name),
+            &format!("{}: |dG| per move and dwell", exp.name),
+            &runs,
+            &per_run,
+            exp.report.settle_tol,
+            exp.time.t_end,
+        ));
     }
     figs.extend(crate::sensitivity::figure_sensitivity(exp)?);
     Ok(figs)
@@ -246,7 +281,7 @@ pub fn compare_markdown(
     row: &TableRow,
     (checks, warnings): (&RunChecks, &[ValidityWarning]),
     figures: &[RenderedFigure],
-    residuals: Option<&[RunResidual]>,
+    (residuals, dwells): (Option<&[RunResidual]>, &[RunDwells]),
 ) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# {}: AMM against FEM\n", exp.name);
@@ -294,6 +329,10 @@ pub fn compare_markdown(
     }
     if let Some(res) = residuals {
         let _ = write!(s, "\n{}", residual_markdown(res));
+    }
+    let per_dwell = dwells_markdown(dwells);
+    if !per_dwell.is_empty() {
+        let _ = write!(s, "\n{per_dwell}");
     }
     let m = row.measures;
     let _ = writeln!(
@@ -414,6 +453,9 @@ pub struct WrittenCase {
     /// Every run's residual vibration after the motion (`None`: it does not rest before
     /// `t_end`), written as `residual.csv`.
     pub residuals: Option<Vec<RunResidual>>,
+    /// Every run's residual per dwell (`docs/motions.md` 2.5; empty without a dwell), written as
+    /// `<stem>-dwells.csv` and the sidecars' `dwells`.
+    pub dwells: Vec<RunDwells>,
 }
 
 /// Write every output of one case into `dir` (see the module docs).
@@ -426,9 +468,10 @@ pub fn write_case(
     figures: bool,
 ) -> Result<WrittenCase, Error> {
     let residuals = case_residuals(exp, case)?;
+    let dwells = case_dwells(exp, case)?;
     let hold = residuals.iter().flatten().next().map(|r| r.residual.hold_s);
     let drawn = if figures {
-        case_figures(exp, case, hold)?
+        case_figures(exp, case, hold, &dwells)?
     } else {
         Vec::new()
     };
@@ -441,17 +484,28 @@ pub fn write_case(
     let mut set = RunSet::begin(dir)?;
     for (stem, r) in runs_of(case) {
         let res = residuals.iter().flatten().find(|x| x.run == stem);
-        let keys = match res {
+        let mut keys = match res {
             Some(x) => crate::residual::sidecar_keys_of(x),
             None => flexstar_metrics::residual::sidecar_keys(None, exp.report.settle_tol, false),
         };
+        keys.dwells = dwells.iter().find(|d| d.run == stem).map(|d| d.dwells.clone());
+        if let Some(d) = &keys.dwells {
+            set.text(&format!("{stem}-dwells.csv"), &flexstar_model::sidecar::dwells_csv(d))?;
+        }
         let check = small_deflection_check(r, exp.robot.l);
         r.stage_run(&mut set, &stem, None, (exp, prov), (check, Some(keys)))?;
     }
     set.text("compare.csv", &csv)?;
     set.text(
         "compare.md",
-        &compare_markdown(exp, case, row, (&checks, &warnings), &figs, residuals.as_deref()),
+        &compare_markdown(
+            exp,
+            case,
+            row,
+            (&checks, &warnings),
+            &figs,
+            (residuals.as_deref(), &dwells),
+        ),
     )?;
     set.text(
         "compare.json",
@@ -467,6 +521,7 @@ pub fn write_case(
         checks,
         compare_csv: csv,
         residuals,
+        dwells,
     })
 }
 

@@ -14,6 +14,7 @@ pub mod builtin;
 pub mod case_output;
 pub mod compare;
 pub mod direct_figures;
+pub mod dwells;
 pub mod evp;
 pub mod figures;
 pub mod paper;

@@ -130,6 +130,8 @@ pub struct ReportCase<'a> {
     pub dir: &'a Path,
     /// Every run's residual vibration after the motion (`write_case`'s).
     pub residuals: Option<&'a [crate::residual::RunResidual]>,
+    /// Every run's residual per dwell (`write_case`'s; empty without a dwell).
+    pub dwells: &'a [crate::dwells::RunDwells],
 }
 
 /// What a report shows: a title, the provenance, for `verify` Table I and the checks, and the
@@ -199,6 +201,7 @@ pub fn case_report(
             checks: &written.checks,
             dir: Path::new(""),
             residuals: written.residuals.as_deref(),
+            dwells: &written.dwells,
         }],
     })
 }
@@ -403,16 +406,22 @@ fn evps_html(h: &mut String, c: &ReportCase) {
     );
 }
 
-/// The residual vibration after the motion (`residual.csv`'s table), when the motion rests.
+/// The residual vibration after the motion (`residual.csv`'s table), when the motion rests, and
+/// per dwell when there are several.
 fn residual_html(h: &mut String, c: &ReportCase) {
-    let Some(res) = c.residuals else {
-        return;
-    };
-    let md = crate::residual::residual_markdown(res);
-    let (heading, body) = md.split_once("\n\n").unwrap_or(("", &md));
-    let _ = writeln!(h, "<h3>{}</h3>", escape(heading.trim_start_matches("## ")));
-    h.push_str(&markdown_to_html(body));
-    let _ = writeln!(h, "<p>Also as {}.</p>", file_link(c.dir, "residual.csv"));
+    if let Some(res) = c.residuals {
+        let md = crate::residual::residual_markdown(res);
+        let (heading, body) = md.split_once("\n\n").unwrap_or(("", &md));
+        let _ = writeln!(h, "<h3>{}</h3>", escape(heading.trim_start_matches("## ")));
+        h.push_str(&markdown_to_html(body));
+        let _ = writeln!(h, "<p>Also as {}.</p>", file_link(c.dir, "residual.csv"));
+    }
+    // per dwell (docs/motions.md 2.5), when a run has several
+    let md = crate::dwells::dwells_markdown(c.dwells);
+    if let Some((heading, body)) = md.split_once("\n\n") {
+        let _ = writeln!(h, "<h3>{}</h3>", escape(heading.trim_start_matches("## ")));
+        h.push_str(&markdown_to_html(body));
+    }
 }
 
 /// The figures with their captions and links to their files.

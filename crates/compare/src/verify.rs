@@ -204,6 +204,7 @@ fn write_summary(opts: &VerifyOptions, v: &Verified, per_case: &[WrittenCase]) -
                     checks: &written.checks,
                     dir: Path::new(&s.exp.name),
                     residuals: written.residuals.as_deref(),
+                    dwells: &written.dwells,
                 })
                 .collect(),
         });

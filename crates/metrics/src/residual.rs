@@ -296,6 +296,7 @@ pub fn sidecar_keys(res: Option<&Residual>, settle_tol: f64, g_pinned: bool) -> 
         tracking_peak_m: tracking.map(|r| r.tracking_peak_m),
         tracking_end_m: tracking.map(|r| r.tracking_end_m),
         residual_note: None,
+        dwells: None,
     };
     if g_pinned && res.is_some() {
         keys.g_peak_m = None;

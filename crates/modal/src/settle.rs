@@ -38,3 +38,57 @@ pub fn run_residual(exp: &Experiment, r: &Response) -> Result<Option<Residual>, 
     };
     Ok(residual_after(r, t_rest, exp.report.settle_tol, hold))
 }
+
+/// The residual of `r`, a run of `exp`, per dwell (`docs/motions.md` 2.5), in the band
+/// `[report] settle_tol`: every move's dwell ([`flexstar_metrics::dwell::dwell_windows`]) judged
+/// with the hold of one period of the first elastic mode at the dwell's pose (sliders locked, the
+/// accurate AMM, payload included; for the last dwell the hold of [`settle_hold_s`]). Under
+/// gravity a dwell away from the final pose is listed unmeasured (its sag is not computed).
+/// `g_pinned`: the run's modes pin G. `None` when no move ends before `t_end`.
+pub fn run_dwells(
+    exp: &Experiment,
+    r: &Response,
+    g_pinned: bool,
+) -> Result<Option<Vec<flexstar_model::DwellKeys>>, ModalError> {
+    use flexstar_metrics::dwell::{dwell_residual, dwell_windows, moves, Baseline};
+    let moves: Vec<(f64, f64)> = moves(&exp.trajectory)
+        .into_iter()
+        .filter(|m| m.1 < exp.time.t_end)
+        .collect();
+    let Some(&t_last) = r.t.last() else {
+        return Ok(None);
+    };
+    let windows = dwell_windows(&moves, t_last);
+    if windows.is_empty() {
+        return Ok(None);
+    }
+    let model = crate::analysis::amm_pose_model(exp)?;
+    let s_rest = match exp.trajectory.t_rest() {
+        Some(t) => Some(exp.trajectory.s(&exp.robot, t)?),
+        None => None,
+    };
+    let mut out = Vec::with_capacity(windows.len());
+    for w in &windows {
+        let s = exp.trajectory.s(&exp.robot, w.move_end)?;
+        let pose = crate::pose::pose_from_sliders(&exp.robot, s)?;
+        let f = model.frequencies_at(&pose, flexstar_model::Sliders::Locked, 1)?;
+        let hold = match f.first() {
+            Some(&f1) if f1 > 0.0 => 1.0 / f1,
+            _ => {
+                return Err(ModalError::Input(format!(
+                    "no elastic mode at the pose of dwell {} (t = {} s) to time the settling by",
+                    w.dwell, w.move_end
+                )))
+            }
+        };
+        // the sag is known at the final pose only (as-built.md 5.5)
+        let at_rest_pose = s_rest.is_some_and(|sr| (0..3).all(|i| (s[i] - sr[i]).abs() <= 1e-12));
+        let baseline = if r.rest_offset.is_some() && !at_rest_pose {
+            Baseline::Unknown
+        } else {
+            Baseline::RestPose
+        };
+        out.push(dwell_residual(r, w, exp.report.settle_tol, hold, baseline, g_pinned));
+    }
+    Ok(Some(out))
+}

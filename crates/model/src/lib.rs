@@ -52,5 +52,5 @@ pub use rest_pose::{RestPose, Sliders};
 pub use robot::{ActuatorAxis, Beam, Robot};
 pub use robot_geometry::{FeasibilityKey, RobotGeometry};
 pub use shaper::{Impulse, ShaperKind, ShaperSection};
-pub use sidecar::{ResidualKeys, RunSidecar, ValidityExceeded};
+pub use sidecar::{DwellKeys, ResidualKeys, RunSidecar, ValidityExceeded};
 pub use trajectory::{Pose, ShapedMotion, Trajectory};

@@ -36,8 +36,8 @@ const fn q(name: &'static str, unit: &'static str, meaning: &'static str) -> Qua
 }
 
 /// Every column of every CSV flexstar writes for a run or a motion: the solver results (the
-/// fixed columns, the AMM's and the FEM's), a direct run's file, `kinematics.csv` and the
-/// controller's `setpoints.csv` (`flexstar export`).
+/// fixed columns, the AMM's and the FEM's), a direct run's file, `kinematics.csv`, the
+/// controller's `setpoints.csv` (`flexstar export`) and a run's `<stem>-dwells.csv`.
 pub const QUANTITIES: &[Quantity] = &[
     q("t", "s", "time"),
     // the fixed columns of every solver result
@@ -132,6 +132,36 @@ pub const QUANTITIES: &[Quantity] = &[
         "N",
         "feed-forward force of actuator i along +u_i: the accurate AMM's Fa_i at the sample time",
     ),
+    // <stem>-dwells.csv: the residual per dwell (docs/motions.md 2.5)
+    q("dwell", "-", "number of the dwell (and of the move before it), from 1"),
+    q("move_start", "s", "start of the move before the dwell"),
+    q("move_end", "s", "end of that move: the sliders come to rest"),
+    q("t_start", "s", "start of the dwell (= move_end)"),
+    q(
+        "t_end",
+        "s",
+        "end of the dwell: the next move's start, or the run's last output time",
+    ),
+    q("G_peak_m", "m", "largest |dG| in the dwell"),
+    q("G_rms_m", "m", "RMS of |dG| over the dwell (trapezoidal)"),
+    q("tip_peak_m", "m", "largest |w_i(L)| of the three tips in the dwell"),
+    q(
+        "tip_rms_m",
+        "m",
+        "RMS over the dwell of sqrt(1/3 sum_i w_i(L)^2)",
+    ),
+    q(
+        "settle_s",
+        "s",
+        "last time in the dwell with |dG| above settle_tol, when the dwell then ends with settle_hold_s in the band; empty when not",
+    ),
+    q("settled", "-", "settled within the dwell: true or false"),
+    q(
+        "settle_hold_s",
+        "s",
+        "one period of the first elastic mode at the dwell's pose, sliders locked",
+    ),
+    q("note", "-", "why a value is empty or the dwell cannot settle"),
 ];
 
 /// The declared quantity that column `name` belongs to (`w2G`: `w{i}G`).

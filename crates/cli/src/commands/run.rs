@@ -134,6 +134,9 @@ fn summary(o: &RunOutcome, figures: bool, seconds: f64) {
     if let Some(line) = flexstar_api::run::residual_line(&o.sidecar) {
         eprintln!("{}: {line}", exp.name);
     }
+    for line in flexstar_api::run::dwell_lines(&o.sidecar) {
+        eprintln!("{}: {line}", exp.name);
+    }
     if let Some(line) = flexstar_api::run::envelope_line(&o.sidecar) {
         eprintln!("note: {}: {line}", exp.name);
     }

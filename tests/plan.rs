@@ -26,6 +26,11 @@ fn json(path: &Path) -> serde_json::Value {
 
 /// `flexstar plan cfg --out out`, asserting success; the plan folder.
 fn plan(cfg: &Path, out: &Path) -> PathBuf {
+    plan_with_stderr(cfg, out).0
+}
+
+/// [`plan`], with what the command printed on stderr.
+fn plan_with_stderr(cfg: &Path, out: &Path) -> (PathBuf, String) {
     let o = flexstar(&["plan", cfg.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let name = std::fs::read_to_string(cfg).unwrap();
@@ -35,7 +40,42 @@ fn plan(cfg: &Path, out: &Path) -> PathBuf {
         .and_then(|l| l.strip_suffix('"'))
         .unwrap()
         .to_string();
-    out.join(name)
+    (out.join(name), stderr(&o))
+}
+
+/// A target move's plan file with `lines` added to its `[plan]` (the last section), written
+/// into `dir`.
+fn variant(dir: &Path, name: &str, lines: &str) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/motions");
+    let text = std::fs::read_to_string(root.join(format!("{name}.toml"))).unwrap();
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, format!("{text}\n{lines}\n")).unwrap();
+    path
+}
+
+/// Peak `|s_i''|` [m/s^2] over `t <= t_rest` of `flexstar kinematics` of `cfg`, and the peak
+/// `|s_i'''|` [m/s^3] as one-sided differences of those accelerations: at the `dt_out` = 1 ms
+/// grid these underestimate the quintic's jerk jump at its ends by about `3 h / T` (0.6-0.7 %
+/// on the three moves: the difference quotient over the first step averages `60 - 180 tau`).
+fn kinematic_peaks(cfg: &Path, out: &Path, name: &str, t_rest: f64) -> (f64, f64) {
+    let o = flexstar(&["kinematics", cfg.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (h, rows) = table(&out.join(name).join("kinematics.csv"));
+    let (t, acc) = (col(&h, "t"), ["sdd1", "sdd2", "sdd3"].map(|c| col(&h, c)));
+    let rows: Vec<&Vec<f64>> = rows.iter().filter(|r| r[t] <= t_rest + 1e-9).collect();
+    let a = rows.iter().flat_map(|r| acc.map(|c| r[c].abs())).fold(0.0, f64::max);
+    let j = rows
+        .windows(2)
+        .flat_map(|w| acc.map(|c| ((w[1][c] - w[0][c]) / (w[1][t] - w[0][t])).abs()))
+        .fold(0.0, f64::max);
+    (a, j)
+}
+
+/// Peak `|Fa_i|` [N] over a run CSV.
+fn force_peak(csv: &Path) -> f64 {
+    let (h, rows) = table(csv);
+    let fa = ["Fa1", "Fa2", "Fa3"].map(|c| col(&h, c));
+    rows.iter().flat_map(|r| fa.map(|c| r[c].abs())).fold(0.0, f64::max)
 }
 
 /// The FEM residual peaks of the three motions (plain, ZVD, planned) and their `t_rest`.
@@ -46,15 +86,18 @@ fn fem_peaks(dir: &Path) -> [(f64, f64); 3] {
     })
 }
 
-/// Item 6, second target, on the three target moves: the planned motion's FEM residual peak of
-/// G is at most 1/20 of the plain quintic's of the same `t_move`, and the AMM agrees with the FEM
-/// on it within 10 %.
+/// Item 6, second target, on the three target moves with the smoothness of docs/motions.md 4.10
+/// lifted (`peak_factor = "off"`, `monotone = false`: the plans of 4.9, as violent as they need
+/// to be): the planned motion's FEM residual peak of G is at most 1/20 of the plain quintic's of
+/// the same `t_move`, and the AMM agrees with the FEM on it within 10 %.
 #[test]
 fn planned_moves_leave_a_twentieth_of_the_plain_residual_on_the_fem() {
     let out = tempfile::tempdir().unwrap();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/motions");
     for name in ["plan-centre", "plan-edge", "plan-turn"] {
-        let dir = plan(&root.join(format!("{name}.toml")), out.path());
+        let dir = plan(
+            &variant(out.path(), name, "peak_factor = \"off\"\nmonotone = false"),
+            out.path(),
+        );
         let [(plain, t_plain), _, (planned, t_planned)] = fem_peaks(&dir);
         assert!((t_plain - t_planned).abs() < 1e-12, "{name}: same t_move");
         assert!(
@@ -66,6 +109,82 @@ fn planned_moves_leave_a_twentieth_of_the_plain_residual_on_the_fem() {
             (amm - planned).abs() <= 0.1 * planned,
             "{name}: AMM {amm:.3e} m vs FEM {planned:.3e} m"
         );
+    }
+}
+
+/// The default plan is smooth (docs/motions.md 4.10), judged outside the planner: its peak
+/// `|s''|` and `|s'''|` from `flexstar kinematics` of the written `plan.toml` (the table spline)
+/// at most 1.5 times those of `flexstar kinematics` of the plain quintic written here; its peak
+/// force on the FEM (an independent model; the planner bounds the AMM's) at most 1.5 times the
+/// plain quintic's FEM force, with 0.5 % for the models' difference; the progress along the
+/// segment, from `plan.csv`'s poses, never decreasing; a warning on stderr and in `plan.json`
+/// whenever a peak exceeds the quintic's; the FEM residual never above the plain quintic's (the
+/// search only accepts descent from it), and on the centre move at most 1/20 of it (measured
+/// 2.6 %, 4.10).
+#[test]
+fn default_plans_keep_the_quintic_peaks_and_move_forward() {
+    let out = tempfile::tempdir().unwrap();
+    let moves = [
+        ("plan-centre", [0.0, 0.0, 0.0], [0.03, -0.02, 0.2], 0.42, 1.5),
+        ("plan-edge", [0.0, 0.0, 0.0], [0.2, -0.11, 0.0], 0.66, 2.0),
+        ("plan-turn", [0.12, 0.07, -0.05], [0.12, 0.07, 0.2], 0.5, 1.6),
+    ];
+    for (name, from, to, t_move, t_end) in moves {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/motions");
+        let (dir, err) = plan_with_stderr(&root.join(format!("{name}.toml")), out.path());
+        let quintic = out.path().join(format!("{name}-quintic.toml"));
+        let pose = |p: [f64; 3]| format!("{{ Gx = {:?}, Gy = {:?}, theta = {:?} }}", p[0], p[1], p[2]);
+        std::fs::write(
+            &quintic,
+            format!(
+                "name = \"{name}-quintic\"\n[time]\nt_end = {t_end:?}\ndt_out = 0.001\n[trajectory]\nkind = \"quintic\"\n\
+                 from = {}\nto = {}\nt0 = 0.0\nt1 = {t_move:?}\n",
+                pose(from),
+                pose(to)
+            ),
+        )
+        .unwrap();
+        let kin = out.path().join("kin");
+        let (a_q, j_q) = kinematic_peaks(&quintic, &kin, &format!("{name}-quintic"), t_move);
+        let (a_p, j_p) = kinematic_peaks(&dir.join("plan.toml"), &kin, name, t_move);
+        assert!(a_p <= 1.5 * a_q * (1.0 + 1e-3), "{name}: |s''| {a_p} vs quintic {a_q}");
+        assert!(j_p <= 1.5 * j_q * 1.02, "{name}: |s'''| {j_p} vs quintic {j_q}");
+        let (f_q, f_p) = (
+            force_peak(&dir.join("plain/fem.csv")),
+            force_peak(&dir.join("planned/fem.csv")),
+        );
+        assert!(f_p <= 1.5 * f_q * 1.005, "{name}: FEM |Fa| {f_p} vs quintic {f_q}");
+        let (h, rows) = table(&dir.join("plan.csv"));
+        let q = ["Gx", "Gy", "theta"].map(|c| col(&h, c));
+        let d: Vec<f64> = (0..3).map(|k| to[k] - from[k]).collect();
+        let dd: f64 = d.iter().map(|x| x * x).sum();
+        let progress: Vec<f64> = rows
+            .iter()
+            .map(|r| (0..3).map(|k| (r[q[k]] - from[k]) * d[k]).sum::<f64>() / dd)
+            .collect();
+        assert!(
+            progress.windows(2).all(|w| w[1] >= w[0] - 1e-12),
+            "{name}: progress goes backwards"
+        );
+        let warnings = json(&dir.join("plan.json"))["warnings"].as_array().unwrap().len();
+        let above = [a_p > a_q * (1.0 + 1e-3), j_p > j_q * 1.02, f_p > f_q * 1.005];
+        if above.iter().any(|b| *b) {
+            assert!(
+                warnings > 0 && err.contains("warning: the planned motion's peak"),
+                "{name}: {err}"
+            );
+        }
+        let [(plain, _), _, (planned, _)] = fem_peaks(&dir);
+        assert!(
+            planned <= plain,
+            "{name}: planned {planned:.3e} m vs plain {plain:.3e} m"
+        );
+        if name == "plan-centre" {
+            assert!(
+                planned <= plain / 20.0,
+                "{name}: planned {planned:.3e} m vs plain {plain:.3e} m"
+            );
+        }
     }
 }
 
@@ -111,7 +230,8 @@ fn plan_toml_reruns_the_planned_motion() {
 
 /// A binding `a_max` holds on the planned motion (the peak of `|s_i''|` from `flexstar
 /// kinematics` of `plan.toml`, a second computation of the slider jets) while the residual still
-/// falls tenfold on the FEM.
+/// falls tenfold on the FEM. The user's `a_max` alone (`peak_factor = "off"`): with the default
+/// factor the jerk bound of 4.10 binds too and the residual falls 7-fold (measured 14.6 %).
 #[test]
 fn the_planned_motion_keeps_its_limits() {
     let out = tempfile::tempdir().unwrap();
@@ -120,7 +240,7 @@ fn the_planned_motion_keeps_its_limits() {
         std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/motions/plan-centre.toml"))
             .unwrap()
             .replace("name = \"plan-centre\"", "name = \"limited\"");
-    std::fs::write(&cfg, format!("{base}\n[limits]\na_max = 2.5\n")).unwrap();
+    std::fs::write(&cfg, format!("{base}\npeak_factor = \"off\"\n[limits]\na_max = 2.5\n")).unwrap();
     let dir = plan(&cfg, out.path());
     let o = flexstar(&[
         "kinematics",
@@ -142,7 +262,10 @@ fn the_planned_motion_keeps_its_limits() {
 
 /// Item 6, third target: with `objective = "time"` the planned move is at least 30 % shorter than
 /// the ZVD-shaped quintic at the same residual, and its FEM residual holds the bound; the ZVD
-/// baseline (base duration found by the planner) holds it on the FEM too.
+/// baseline (base duration found by the planner) holds it on the FEM too. `budget_s = 60`, as
+/// the target moves' files have it: with the default 8 s the bisection's length depends on how
+/// busy the machine is (docs/motions.md 4.5), and under the test harness's parallel plans the
+/// smooth searches of 4.10 ran out of it before a first success.
 #[test]
 fn the_time_objective_beats_the_zvd_shaped_quintic_by_thirty_percent() {
     let out = tempfile::tempdir().unwrap();
@@ -150,7 +273,7 @@ fn the_time_objective_beats_the_zvd_shaped_quintic_by_thirty_percent() {
     std::fs::write(
         &cfg,
         "name = \"fast\"\n[time]\nt_end = 1.5\ndt_out = 0.001\n[plan]\nfrom = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\n\
-         to = { Gx = 0.03, Gy = -0.02, theta = 0.2 }\nobjective = \"time\"\nresidual_max = 5e-5\n",
+         to = { Gx = 0.03, Gy = -0.02, theta = 0.2 }\nobjective = \"time\"\nresidual_max = 5e-5\nbudget_s = 60\n",
     )
     .unwrap();
     let dir = plan(&cfg, out.path());
@@ -174,6 +297,19 @@ fn the_time_objective_beats_the_zvd_shaped_quintic_by_thirty_percent() {
         total > 0 && last > 0 && last <= total,
         "{total} evaluations, the chosen search {last}"
     );
+    // the search over t_move: every duration tried made AMM runs, and they add up to the total
+    let ts = &planner["time_search"];
+    let steps = ts["steps"].as_array().unwrap();
+    assert!(!steps.is_empty() && steps.iter().all(|s| s["evaluations"].as_u64().unwrap() > 0));
+    let per_step: u64 = steps.iter().map(|s| s["evaluations"].as_u64().unwrap()).sum();
+    let (zvd, search) = (
+        ts["zvd_evaluations"].as_u64().unwrap(),
+        ts["search_evaluations"].as_u64().unwrap(),
+    );
+    assert!(
+        per_step == search && zvd + search == total && zvd > 0,
+        "steps {per_step}, search {search}, ZVD {zvd}, total {total}"
+    );
 }
 
 /// Bad input is refused before any work with the file and the key, and nothing is written.
@@ -190,6 +326,12 @@ fn bad_plans_are_refused_with_the_key_and_nothing_is_written() {
         (format!("{plan}t_move = 0.1\n[limits]\na_max = 2.0\nv_max = 0.5\n"), "shorter than the limits allow"),
         (format!("{plan}t_move = 0.42\n[limits]\na_max = 2.0\n"), "the plain quintic in t_move = 0.42 s reaches |s''|"),
         (format!("{plan}t_move = 0.42\n[limits]\nv_max = -1.0\n"), "limits.v_max"),
+        (format!("{plan}t_move = 0.42\n[limits]\nj_max = 0.0\n"), "limits.j_max"),
+        (format!("{plan}t_move = 0.42\n[limits]\nj_max = nan\n"), "limits.j_max"),
+        (format!("{plan}t_move = 0.42\n[limits]\nj_max = 40.0\n"), "the plain quintic in t_move = 0.42 s reaches |s'''|"),
+        (format!("{plan}t_move = 0.42\npeak_factor = 0.5\n"), "plan.peak_factor"),
+        (format!("{plan}t_move = 0.42\nsmoothness = -1.0\n"), "plan.smoothness"),
+        (format!("{plan}t_move = 0.42\ntip_weight = -1.0\n"), "plan.tip_weight"),
         (format!("{plan}t_move = 0.42\npoints = 40\n"), "plan.points"),
         (
             "[plan]\nfrom = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\nto = { Gx = 0.5, Gy = 0.0, theta = 0.0 }\nt_move = 0.4\n".into(),

@@ -27,9 +27,7 @@ fn subsample(r: &flexstar_model::Response, every: usize) -> flexstar_model::Resp
 
 /// Mean EVP of the N-run at step `k h` against the same N at `h` (the time error of the coarse step).
 fn time_error(exp: &Experiment, k: usize) -> f64 {
-    let n = next_modes(first_modes(
-        &exp.problem().expect("valid problem").equal_beams().expect("paper form"),
-    ));
+    let n = next_modes(first_modes(&exp.problem().expect("valid problem")));
     let run = |dt: f64, dt_out: f64| {
         let mut e = exp.clone();
         e.time.dt_out = dt_out;
@@ -54,7 +52,7 @@ fn time_error(exp: &Experiment, k: usize) -> f64 {
 fn pair_difference(exp: &Experiment, dt: f64) -> (f64, f64) {
     let mut e = exp.clone();
     e.time.dt_out = e.time.dt_out.max(dt);
-    let n = first_modes(&e.problem().expect("valid problem").equal_beams().expect("paper form"));
+    let n = first_modes(&e.problem().expect("valid problem"));
     let run = |m: usize| {
         let s = AmmSettings {
             modes: Some(m),

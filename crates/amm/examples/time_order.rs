@@ -29,8 +29,7 @@ fn main() {
             .expect("automatic choice");
         let (n, h) = (auto.info.modes.expect("N"), auto.info.dt);
         let problem = exp.problem().expect("valid problem");
-        let equal = problem.equal_beams().expect("the paper's robot form");
-        let coarse = estimate_grid(&equal, h).expect("a span long enough for the estimate's grid");
+        let coarse = estimate_grid(&problem, h).expect("a span long enough for the estimate's grid");
         let run = |step: f64, every: usize| {
             let mut e = exp.clone();
             e.time.dt_out = every as f64 * exp.time.dt_out;
@@ -45,7 +44,7 @@ fn main() {
                 .map(|s| s.response)
                 .expect("solve")
         };
-        let check = time_check_grid(&equal, h);
+        let check = time_check_grid(&problem, h);
         let [e_check, e2] = {
             let delivered = run(h, check);
             [

@@ -24,9 +24,10 @@
 //! geometric part the AMM leaves out ([`geometric_part`], Eq. G1, 12.9).
 
 use flexstar_metrics::evp::point_evps;
-use flexstar_model::{EqualBeams, Response};
+use flexstar_model::{Problem, Response};
 
 use crate::error::AmmError;
+use crate::star::Star;
 
 /// Largest N the automatic choice tries (stable to N = 200).
 pub const MAX_AUTO_MODES: usize = 200;
@@ -77,10 +78,18 @@ pub fn time_error_estimate(e_check: f64) -> f64 {
 pub const GEOMETRIC_COEFF: f64 = 0.5;
 
 /// Eq. G1 [%]: the estimate's part for the geometric nonlinearity the AMM leaves out, from the
-/// run `r` of `problem` (tips w_i(L) and junction values w_iG [m], the robot's L [m]).
-pub fn geometric_part(problem: &EqualBeams, r: &Response) -> f64 {
-    let largest = |h: &[Vec<f64>; 3]| h.iter().flatten().fold(0.0f64, |m, w| m.max(w.abs()));
-    let a = largest(&r.w_tip).max(largest(&r.w_g)) / problem.robot.l;
+/// run `r` of `problem` (tips w_i(L) and junction values w_iG [m], each beam's L_i [m]: the
+/// largest `A_i / L_i`, `docs/amm.md` 13, Eq. J8).
+pub fn geometric_part(problem: &Problem, r: &Response) -> f64 {
+    geometric_part_of(&Star::new(problem), r)
+}
+
+/// [`geometric_part`] of the AMM's view of a problem.
+pub(crate) fn geometric_part_of(problem: &Star, r: &Response) -> f64 {
+    let largest = |h: &Vec<f64>| h.iter().fold(0.0f64, |m, w| m.max(w.abs()));
+    let a = (0..3)
+        .map(|i| largest(&r.w_tip[i]).max(largest(&r.w_g[i])) / problem.beam(i).l)
+        .fold(0.0f64, f64::max);
     GEOMETRIC_COEFF * 100.0 * a * a
 }
 
@@ -92,7 +101,12 @@ pub const MIN_ESTIMATE_ROWS: usize = 20;
 /// `every` times `problem.time.dt_out`, the first multiple at least [`ESTIMATE_STEP_FACTOR`] h, so that
 /// its times are a subset of the delivered ones. `None` (pairs at the delivered step) when that grid
 /// would have fewer than [`MIN_ESTIMATE_ROWS`] rows.
-pub fn estimate_grid(problem: &EqualBeams, h: f64) -> Option<usize> {
+pub fn estimate_grid(problem: &Problem, h: f64) -> Option<usize> {
+    estimate_grid_of(&Star::new(problem), h)
+}
+
+/// [`estimate_grid`] of the AMM's view of a problem.
+pub(crate) fn estimate_grid_of(problem: &Star, h: f64) -> Option<usize> {
     let every = output_multiple(problem, ESTIMATE_STEP_FACTOR * h);
     let rows = (problem.time.t_end / (every as f64 * problem.time.dt_out) - 1e-9).ceil() + 1.0;
     (rows >= MIN_ESTIMATE_ROWS as f64).then_some(every)
@@ -103,13 +117,18 @@ pub fn estimate_grid(problem: &EqualBeams, h: f64) -> Option<usize> {
 /// Its EVP is measured where the delivered run's own EVP is: on the estimate's coarser grid a
 /// response with fast components (w_G) can read a difference 1.5 times larger or smaller
 /// (`docs/amm.md` 12.10).
-pub fn time_check_grid(problem: &EqualBeams, h: f64) -> usize {
+pub fn time_check_grid(problem: &Problem, h: f64) -> usize {
+    time_check_grid_of(&Star::new(problem), h)
+}
+
+/// [`time_check_grid`] of the AMM's view of a problem.
+pub(crate) fn time_check_grid_of(problem: &Star, h: f64) -> usize {
     output_multiple(problem, TIME_CHECK_STEP_FACTOR * h)
 }
 
 /// The smallest k >= 1 with `k problem.time.dt_out >= step` (to round-off): the output grid, a
 /// subset of the delivered one, that a run at `step` [s] can fill.
-fn output_multiple(problem: &EqualBeams, step: f64) -> usize {
+fn output_multiple(problem: &Star, step: f64) -> usize {
     ((step / problem.time.dt_out) - 1e-9).ceil().max(1.0) as usize
 }
 
@@ -118,10 +137,18 @@ fn output_multiple(problem: &EqualBeams, step: f64) -> usize {
 /// (`docs/amm.md` section 8), so a start below `+ 12` buys a run that no useful tolerance accepts.
 pub const START_MARGIN: usize = 12;
 
-/// First N of the automatic choice: the modes resolve the sleeve (`2 L / Lp`) plus
-/// [`START_MARGIN`], at least 8 and at most [`MAX_AUTO_MODES`].
-pub fn first_modes(problem: &EqualBeams) -> usize {
-    let resolve = (2.0 * problem.robot.l / problem.robot.lp).ceil();
+/// First N of the automatic choice: the modes resolve the sleeve (`2 L / Lp`, the largest over
+/// the beams, `docs/amm.md` 13, Eq. J8) plus [`START_MARGIN`], at least 8 and at most
+/// [`MAX_AUTO_MODES`]. One N serves the three beams.
+pub fn first_modes(problem: &Problem) -> usize {
+    first_modes_of(&Star::new(problem))
+}
+
+/// [`first_modes`] of the AMM's view of a problem.
+pub(crate) fn first_modes_of(problem: &Star) -> usize {
+    let resolve = (0..3)
+        .map(|i| (2.0 * problem.beam(i).l / problem.beam(i).lp).ceil())
+        .fold(0.0f64, f64::max);
     let n = if resolve.is_finite() {
         resolve as usize
     } else {
@@ -159,7 +186,7 @@ pub(crate) enum Pass {
 /// The estimate's pair at N_prev and N, found by raising N from [`first_modes`] at `pass` until
 /// the estimate of the N-run is below `tol`: `(N, estimate, the N-run, wall time of all runs)`.
 fn raise_until_below<F>(
-    problem: &EqualBeams,
+    problem: &Star,
     tol: f64,
     pass: Pass,
     run: &mut F,
@@ -167,7 +194,7 @@ fn raise_until_below<F>(
 where
     F: FnMut(usize, Pass) -> Result<Response, AmmError>,
 {
-    let mut n = first_modes(problem);
+    let mut n = first_modes_of(problem);
     let mut prev = run(n, pass)?;
     let mut wall = prev.info.wall_s;
     let mut reached = f64::NAN;
@@ -203,7 +230,7 @@ where
 /// `info.tol_percent` set, its wall time the sum over the runs. Fails with the estimate reached
 /// when the tolerance is not met at [`MAX_AUTO_MODES`].
 pub(crate) fn solve_to_tolerance<F>(
-    problem: &EqualBeams,
+    problem: &Star,
     tol: f64,
     every: Option<usize>,
     check_every: usize,
@@ -248,8 +275,8 @@ fn mean_evp(run: &Response, reference: &Response) -> f64 {
 
 /// The delivered run with the automatic choice's report: `estimate` (truncation and time) plus
 /// the geometric part of the delivered run ([`geometric_part`]).
-fn finish(problem: &EqualBeams, mut delivered: Response, estimate: f64, tol: f64, wall: f64) -> Response {
-    let geometric = geometric_part(problem, &delivered);
+fn finish(problem: &Star, mut delivered: Response, estimate: f64, tol: f64, wall: f64) -> Response {
+    let geometric = geometric_part_of(problem, &delivered);
     delivered.info.error_estimate_percent = Some(estimate + geometric);
     delivered.info.tol_percent = Some(tol);
     delivered.info.wall_s = wall;
@@ -266,9 +293,8 @@ mod tests {
         // paper robot: 2 L / Lp = 2 * 0.5 / 0.03 = 33.3 -> 34 modes resolve the sleeve
         let exp = paper_case(1);
         let problem = exp.problem().unwrap();
-        let exp = problem.equal_beams().unwrap();
-        assert_eq!(first_modes(&exp), 34 + START_MARGIN);
-        let mut n = first_modes(&exp);
+        assert_eq!(first_modes(&problem), 34 + START_MARGIN);
+        let mut n = first_modes(&problem);
         let mut steps = 0;
         while next_modes(n) != n {
             assert!(next_modes(n) > n);
@@ -282,7 +308,7 @@ mod tests {
     /// A model response on `exp`'s grid (every `every`-th row): tips `(1 + e) sin(2 pi t)` with a
     /// truncation error e = 0.3 % (53 / N)^7 (so that N = 53 is the first whose estimate, exactly
     /// 0.3 % for a pure power law, is below 0.5 %) plus `time_error`.
-    fn model(exp: &EqualBeams, every: usize, n: usize, time_error: f64) -> Response {
+    fn model(exp: &Star, every: usize, n: usize, time_error: f64) -> Response {
         let e = 0.003 * (53.0 / n as f64).powi(7) + time_error;
         let mut r = Response::with_capacity("model", 0);
         for t in exp.time.output_times() {
@@ -296,8 +322,8 @@ mod tests {
     fn coarse_pairs_then_one_delivered_run_or_the_fallback_when_the_coarse_step_is_too_rough() {
         let exp = paper_case(3);
         let problem = exp.problem().unwrap();
-        let exp = problem.equal_beams().unwrap();
-        let every = estimate_grid(&exp, 5e-4).expect("0.5 s at 1 ms outputs gives a coarse grid");
+        let exp = Star::new(&problem);
+        let every = estimate_grid(&problem, 5e-4).expect("0.5 s at 1 ms outputs gives a coarse grid");
         assert_eq!(every, 4, "8 x 0.5 ms = 4 ms on a 1 ms output grid");
         // time error c (k h)^p, 2^p - 1 = TIME_CHECK_RATIO, c set by the coarse run's E(8 h, h)
         let order = (TIME_CHECK_RATIO + 1.0).log2();
@@ -327,7 +353,7 @@ mod tests {
             assert_eq!(r.len(), exp.time.output_times().len());
             // Richardson is exact for the power law: 0.3 % (to the EVP's trapezoidal rule),
             // plus the time part, the delivered run's own time error c (Eq. T1), plus Eq. G1
-            let est = r.info.error_estimate_percent.unwrap() - geometric_part(&exp, &r);
+            let est = r.info.error_estimate_percent.unwrap() - geometric_part(&problem, &r);
             let time_part = 100.0 * c;
             assert!(
                 (est - 0.3 - time_part).abs() < 0.01 + 0.02 * time_part,
@@ -338,6 +364,6 @@ mod tests {
         let mut short = paper_case(3);
         short.time.t_end = 0.05;
         let problem = short.problem().unwrap();
-        assert_eq!(estimate_grid(&problem.equal_beams().unwrap(), 5e-4), None);
+        assert_eq!(estimate_grid(&problem, 5e-4), None);
     }
 }

@@ -20,15 +20,16 @@
 //! the per-step change of s'' times the step (`docs/amm.md` section 10).
 
 use flexstar_drive::ActuatorLaw;
-use flexstar_kinematics::{check_configuration, direct_kinematics, RigidState};
-use flexstar_model::{AmmSettings, EqualBeams, ModeCount, Response, RobotParams};
+use flexstar_kinematics::RigidState;
+use flexstar_model::{AmmSettings, ModeCount, Response};
 use flexstar_numerics::GenAlpha;
 use num_dual::{Dual2, HyperDual64};
 
 use crate::adaptive;
 use crate::error::{AmmError, RankError};
 use crate::record::Recorder;
-use crate::solver::{shape_times, stops, validate, Stats, Stop, RHO_INF};
+use crate::solver::{shape_times, star_time_scale, stops, validate, Stats, Stop, RHO_INF};
+use crate::star::Star;
 use crate::system::System;
 
 /// Columns a direct run writes first among its extra columns: the sliders `s_i` [m] and `s_i'`
@@ -49,7 +50,7 @@ pub const DIRECT_COLUMNS: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "G
 /// else its start only. The configuration reached is checked at every step: leaving the feasible
 /// range stops the run with the time (to one step) and the reason.
 pub(crate) fn solve_direct_scanned(
-    problem: &EqualBeams,
+    problem: &Star,
     settings: &AmmSettings,
     law: &dyn ActuatorLaw,
     scan: bool,
@@ -58,7 +59,7 @@ pub(crate) fn solve_direct_scanned(
     let response = match settings.mode_count() {
         ModeCount::Fixed(n) => integrate_direct(problem, settings, law, n, scan, &mut runs)?,
         ModeCount::Tolerance(tol) => {
-            validate(problem, settings, adaptive::first_modes(problem), scan)?;
+            validate(problem, settings, adaptive::first_modes_of(problem), scan)?;
             // the pairs at the delivered step: the coarse-step estimate (`adaptive`) is measured
             // on inverse runs only, and a servo's loop may not tolerate the coarse step
             // (the reference was scanned once just above: not again per N)
@@ -71,9 +72,15 @@ pub(crate) fn solve_direct_scanned(
 }
 
 /// The rigid state of sliders at `s` [m], `sd` [m/s], `sdd` [m/s^2] at time `t`.
-fn rigid_at(params: &RobotParams, s: [f64; 3], sd: [f64; 3], sdd: [f64; 3], t: f64) -> Result<RigidState, AmmError> {
+fn rigid_at(star: &Star, s: [f64; 3], sd: [f64; 3], sdd: [f64; 3], t: f64) -> Result<RigidState, AmmError> {
     let sv = [0, 1, 2].map(|i| Dual2::new(s[i], sd[i], sdd[i]));
-    RigidState::from_actuators(params, sv, t).map_err(|source| AmmError::Kinematics { t, source })
+    star.state_from(sv, t)
+}
+
+/// The configuration `s` [m] reached at `t` [s] is feasible, or the run stops there.
+fn check_reached(star: &Star, s: [f64; 3], t: f64) -> Result<(), AmmError> {
+    star.check_configuration(s)
+        .map_err(|violation| AmmError::DirectInfeasible { t, violation })
 }
 
 /// Derivatives of the rigid motion's a_G, theta' and theta'' with respect to s''_k, where
@@ -87,7 +94,7 @@ struct Sensitivity {
     d_thdd: [f64; 3],
 }
 
-fn sensitivity(params: &RobotParams, s: [f64; 3], sd: [f64; 3], gp: f64, t: f64) -> Result<Sensitivity, AmmError> {
+fn sensitivity(star: &Star, s: [f64; 3], sd: [f64; 3], gp: f64, t: f64) -> Result<Sensitivity, AmmError> {
     let mut out = Sensitivity {
         d_ag: [[0.0; 2]; 3],
         d_thd: [0.0; 3],
@@ -95,11 +102,13 @@ fn sensitivity(params: &RobotParams, s: [f64; 3], sd: [f64; 3], gp: f64, t: f64)
     };
     for k in 0..3 {
         let sv = [0, 1, 2].map(|i| HyperDual64::new(s[i], sd[i], if i == k { 1.0 } else { 0.0 }, 0.0));
-        let pose = direct_kinematics(params.d, sv).ok_or_else(|| AmmError::Kinematics {
+        // the paper's Fermat construction on the paper's robot, the apex construction (D1-D3 of
+        // docs/as-built.md) on a robot as built
+        let pose = flexstar_kinematics::as_built::rigid_pose(star.robot, sv).ok_or_else(|| AmmError::Kinematics {
             t,
             source: flexstar_kinematics::KinematicsError::NoSolution {
                 t,
-                reason: "no Fermat point at the sliders' configuration".into(),
+                reason: "no pose of the star at the sliders' configuration".into(),
             },
         })?;
         let (gx, gy, th) = (pose.g[0], pose.g[1], pose.theta);
@@ -141,7 +150,7 @@ fn coupled_step(
     rec: &Recorder,
     buf: &mut Coupled,
     law: &dyn ActuatorLaw,
-    params: &RobotParams,
+    star: &Star,
     t: f64,
     (bp, gp): (f64, f64),
     (shat, sdhat, x_pred): ([f64; 3], [f64; 3], [f64; 3]),
@@ -150,9 +159,9 @@ fn coupled_step(
 ) -> Result<[f64; 3], AmmError> {
     let s = [0, 1, 2].map(|i| shat[i] + bp * x_pred[i]);
     let sd = [0, 1, 2].map(|i| sdhat[i] + gp * x_pred[i]);
-    check_configuration(params, s).map_err(|violation| AmmError::DirectInfeasible { t, violation })?;
-    let st = rigid_at(params, s, sd, x_pred, t)?;
-    let sens = sensitivity(params, s, sd, gp, t)?;
+    check_reached(star, s, t)?;
+    let st = rigid_at(star, s, sd, x_pred, t)?;
+    let sens = sensitivity(star, s, sd, gp, t)?;
 
     // base solution at the predictor, then the sensitivities with the same factors
     sys.prepare(&st, bp, gp, qhat)?;
@@ -171,9 +180,10 @@ fn coupled_step(
     // Eq. 33 for the correction ds'': (m + kp bp + kd gp) ds'' + dPush/ds'' ds'' = residual
     let fa = law.force(t, s, sd).map_err(|source| AmmError::Drive { t, source })?;
     let (kp, kd) = (law.stiffness(), law.damping());
-    let m = params.mpp_mpa;
     let mut a = [[0.0; 4]; 3];
     for (i, row) in a.iter_mut().enumerate() {
+        // each slider's own sleeve and slider mass (docs/amm.md 13)
+        let m = star.beam(i).mpp_mpa;
         for (k, dlam) in buf.dlam.iter().enumerate() {
             row[k] = rec.sleeve_push(i, &st, &buf.qnew, dlam, sys.sleeves.axial());
         }
@@ -214,7 +224,7 @@ fn solve3(a: [[f64; 4]; 3]) -> Option<[f64; 3]> {
 /// [`solve_direct_scanned`] at N = `n_modes`: the system and recorder set up, the consistent start, then
 /// generalized-alpha substeps between consecutive stops (output times and snapshots).
 fn integrate_direct(
-    problem: &EqualBeams,
+    problem: &Star,
     settings: &AmmSettings,
     law: &dyn ActuatorLaw,
     n_modes: usize,
@@ -223,7 +233,6 @@ fn integrate_direct(
 ) -> Result<Response, AmmError> {
     let started = std::time::Instant::now();
     let dt_max = validate(problem, settings, n_modes, scan)?;
-    let params = &problem.robot;
     let mut steps = 0;
     let mut sys = crate::solver::build_system(settings, n_modes, problem)?;
     let n = sys.dim();
@@ -232,7 +241,7 @@ fn integrate_direct(
     let times = shape_times(problem, settings);
     let stops = stops(&out_times, &times.all, 1e-9 * problem.time.dt_out);
     let mut out = DirectOutput {
-        rec: Recorder::new(&sys, settings, params, out_times.len(), times),
+        rec: Recorder::new(&sys, settings, problem, out_times.len(), times),
         cols: (0..DIRECT_COLUMNS.len())
             .map(|_| Vec::with_capacity(out_times.len()))
             .collect(),
@@ -242,7 +251,7 @@ fn integrate_direct(
         sys: &mut sys,
         buf: &mut buf,
         law,
-        params,
+        star: problem,
     };
 
     let mut state = initial_state(problem, &mut ctx, &out.rec, n)?;
@@ -267,7 +276,7 @@ fn integrate_direct(
     runs.push((n_modes, steps));
     let mut resp = out.finish(settings, n_modes, dt_max, started);
     // the residual's reference: the static equilibrium where the reference motion rests
-    let scale = crate::solver::beam_time_scale(params);
+    let scale = star_time_scale(problem);
     resp.rest_offset = crate::static_start::rest_offset(&mut sys, problem, scale)?;
     Ok(resp)
 }
@@ -278,7 +287,7 @@ struct StepContext<'a> {
     sys: &'a mut System,
     buf: &'a mut Coupled,
     law: &'a dyn ActuatorLaw,
-    params: &'a RobotParams,
+    star: &'a Star<'a>,
 }
 
 /// The state of a direct run at a step: elastic coordinates q [-], their rates and the
@@ -315,19 +324,14 @@ impl Predictors {
 /// The initial state: s, s' of the trajectory at t = 0, the star at rest elastically (undeformed,
 /// or under gravity in the static equilibrium of the start pose with the sliders held, Eq. G4);
 /// consistent accelerations of both (bp = gp = 0: the step is linear, the solve exact).
-fn initial_state(
-    problem: &EqualBeams,
-    ctx: &mut StepContext,
-    rec: &Recorder,
-    n: usize,
-) -> Result<DirectState, AmmError> {
+fn initial_state(problem: &Star, ctx: &mut StepContext, rec: &Recorder, n: usize) -> Result<DirectState, AmmError> {
     let (mut q, v) = (vec![0.0; n], vec![0.0; n]);
     let mut qdd = vec![0.0; n];
-    let jets = problem.trajectory.jets(ctx.params, 0.0)?;
+    let jets = problem.jets(0.0)?;
     let (s, sd) = (jets.map(|j| j.v), jets.map(|j| j.d1));
     if problem.gravity != [0.0; 2] {
-        let rest = rigid_at(ctx.params, s, [0.0; 3], [0.0; 3], 0.0)?;
-        let scale = crate::solver::beam_time_scale(ctx.params);
+        let rest = rigid_at(ctx.star, s, [0.0; 3], [0.0; 3], 0.0)?;
+        let scale = star_time_scale(ctx.star);
         crate::static_start::static_equilibrium(ctx.sys, &rest, scale, &mut q)?;
     }
     let sdd = coupled_step(
@@ -335,7 +339,7 @@ fn initial_state(
         rec,
         ctx.buf,
         ctx.law,
-        ctx.params,
+        ctx.star,
         0.0,
         (0.0, 0.0),
         (s, sd, jets.map(|j| j.d2)),
@@ -383,7 +387,7 @@ fn substep(
         rec,
         ctx.buf,
         ctx.law,
-        ctx.params,
+        ctx.star,
         t,
         (bp, gp),
         (shat, sdhat, x.sdd),
@@ -420,8 +424,8 @@ impl DirectOutput {
     /// range stops the run with the time and the reason), the law's forces evaluated.
     fn record(&mut self, ctx: &StepContext, stop: &Stop, t: f64, x: &DirectState) -> Result<(), AmmError> {
         let (s, sd, sdd) = (x.s, x.sd, x.sdd);
-        check_configuration(ctx.params, s).map_err(|violation| AmmError::DirectInfeasible { t, violation })?;
-        let st = rigid_at(ctx.params, s, sd, sdd, t)?;
+        check_reached(ctx.star, s, t)?;
+        let st = rigid_at(ctx.star, s, sd, sdd, t)?;
         let fa = ctx
             .law
             .force(t, s, sd)
@@ -464,7 +468,9 @@ mod tests {
     fn sensitivity_matches_finite_differences() {
         // s' = sdhat + gp s'' (bp = 0, the terms the sensitivity drops): the derivatives of a_G,
         // theta', theta'' with respect to s''_k against central differences
-        let params = RobotParams::paper();
+        let problem = flexstar_model::catalogue::paper_case(1).problem().unwrap();
+        let star = Star::new(&problem);
+        let params = star;
         let (s, sdhat, x, gp) = ([0.03, -0.02, 0.05], [0.4, -0.3, 0.6], [2.0, -1.0, 3.0], 0.05);
         let state = |x: [f64; 3]| {
             let sd = [0, 1, 2].map(|i| sdhat[i] + gp * x[i]);

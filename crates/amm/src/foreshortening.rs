@@ -33,8 +33,8 @@ pub(crate) const KEPT_ANALYTIC: usize = 10;
 pub(crate) struct Foreshortening {
     /// Indices of the modes kept in the velocity part.
     kept: Vec<usize>,
-    /// `G2` on the kept modes, row-major [1/m].
-    g2_kept: Vec<f64>,
+    /// `G2` on the kept modes, row-major [1/m]: one for equal beams, else one per beam.
+    g2_kept: Vec<Vec<f64>>,
     /// Modal accelerations alpha'' of each beam at the last solve (3 N).
     alpha_dd: Vec<f64>,
     /// Scratch: the kept modal velocities.
@@ -42,10 +42,11 @@ pub(crate) struct Foreshortening {
 }
 
 impl Foreshortening {
-    /// For `modes` with the geometric stiffness matrix `g2` given on the modes `rows` (k x k,
-    /// row-major; `rows` must hold the kept ones), keeping the first `analytic` analytic modes
-    /// and every junction shape in the velocity part.
-    pub(crate) fn new(modes: &ModeSet, rows: &[usize], g2: &[f64], analytic: usize) -> Self {
+    /// For `modes` (beam 1's; the family and N of all three) with the geometric stiffness
+    /// matrices `g2` (one shared by equal beams, or one per beam, `docs/amm.md` 13) given on the
+    /// modes `rows` (k x k, row-major; `rows` must hold the kept ones), keeping the first
+    /// `analytic` analytic modes and every junction shape in the velocity part.
+    pub(crate) fn new(modes: &ModeSet, rows: &[usize], g2: &[Vec<f64>], analytic: usize) -> Self {
         let n = modes.len();
         let na = modes.analytic_len();
         let k = rows.len();
@@ -58,9 +59,13 @@ impl Foreshortening {
                     .expect("the kept modes are among the rows")
             })
             .collect();
-        let g2_kept = at
+        let g2_kept = g2
             .iter()
-            .flat_map(|&a| at.iter().map(move |&b| g2[a * k + b]))
+            .map(|g2| {
+                at.iter()
+                    .flat_map(|&a| at.iter().map(move |&b| g2[a * k + b]))
+                    .collect()
+            })
             .collect();
         Foreshortening {
             v: vec![0.0; kept.len()],
@@ -88,7 +93,8 @@ impl Foreshortening {
             *vk = va[j];
         }
         let k = self.kept.len();
-        for (row, vj) in self.g2_kept.chunks_exact(k).zip(&self.v) {
+        let g2_kept = &self.g2_kept[beam.min(self.g2_kept.len() - 1)];
+        for (row, vj) in g2_kept.chunks_exact(k).zip(&self.v) {
             let gv: f64 = row.iter().zip(&self.v).map(|(g, v)| g * v).sum();
             e2 += vj * gv;
         }
@@ -109,7 +115,7 @@ impl Foreshortening {
         let mut kept = 0.0;
         for (a, &j) in self.kept.iter().enumerate() {
             for (b, &m) in self.kept.iter().enumerate() {
-                kept += va[j] * self.g2_kept[a * k + b] * va[m];
+                kept += va[j] * self.g2_kept[0][a * k + b] * va[m];
             }
         }
         let mut full = 0.0;
@@ -138,7 +144,7 @@ mod tests {
             let modes = ModeSet::new(family, 20, &p).unwrap();
             let (_, g2) = modes.axial_stiffening();
             let all: Vec<usize> = (0..modes.len()).collect();
-            let mut fore = Foreshortening::new(&modes, &all, &g2, KEPT_ANALYTIC);
+            let mut fore = Foreshortening::new(&modes, &all, std::slice::from_ref(&g2), KEPT_ANALYTIC);
             // alpha of w = x: its projections (x lies in the span of the two rigid modes)
             let shape = modes.x_phi_integral().to_vec();
             let (psi, psid, psidd) = (0.03, 2.0, -50.0);
@@ -174,16 +180,16 @@ mod tests {
         )
         .unwrap();
         let problem = exp.problem().unwrap();
-        let exp = problem.equal_beams().unwrap();
+        let exp = crate::star::Star::new(&problem);
         let n = 53;
         let settings = AmmSettings {
             modes: Some(n),
             ..AmmSettings::accurate()
         };
-        let modes = ModeSet::new(settings.family, n, exp.robot).unwrap();
+        let modes = ModeSet::new(settings.family, n, exp.beam(0)).unwrap();
         let (_, g2) = modes.axial_stiffening();
         let all: Vec<usize> = (0..n).collect();
-        let fore = Foreshortening::new(&modes, &all, &g2, KEPT_ANALYTIC);
+        let fore = Foreshortening::new(&modes, &all, std::slice::from_ref(&g2), KEPT_ANALYTIC);
         let h = crate::DEFAULT_DT;
         let mut prev: Option<Vec<f64>> = None;
         let (mut err2, mut ref2) = (0.0, 0.0);

@@ -24,8 +24,9 @@ pub(crate) const KEPT_ANALYTIC: usize = 16;
 pub(crate) struct GeometricStiffness {
     /// Indices of the kept modes, increasing.
     kept: Vec<usize>,
-    /// `[G1; G2]` on the kept modes (2k x k): G1 [-], G2 [1/m].
-    g12: Mat<f64>,
+    /// `[G1; G2]` on the kept modes (2k x k): G1 [-], G2 [1/m]; one for equal beams, else one
+    /// per beam (`docs/amm.md` 13, Eq. J6).
+    g12: Vec<Mat<f64>>,
     /// The kept coordinates of the three beams as columns (k x 3).
     alpha: Mat<f64>,
     /// `[G1; G2] alpha` for the three beams (2k x 3).
@@ -33,13 +34,19 @@ pub(crate) struct GeometricStiffness {
 }
 
 impl GeometricStiffness {
-    /// For `modes`, keeping its first `analytic` analytic modes and every junction shape
+    /// For `modes` (one set shared by equal beams, or one per beam, of one family and N),
+    /// keeping the first `analytic` analytic modes and every junction shape
     /// ([`GeometricStiffness::kept_modes`]): G1 and G2 on those modes only.
-    pub(crate) fn new(modes: &ModeSet, analytic: usize) -> Self {
-        let kept = Self::kept_modes(modes, analytic);
-        let (g1, g2) = modes.axial_stiffening_on(&kept);
+    pub(crate) fn new(modes: &[ModeSet], analytic: usize) -> Self {
+        let kept = Self::kept_modes(&modes[0], analytic);
         let k = kept.len();
-        let g12 = Mat::from_fn(2 * k, k, |r, c| if r < k { g1[r * k + c] } else { g2[(r - k) * k + c] });
+        let g12 = modes
+            .iter()
+            .map(|m| {
+                let (g1, g2) = m.axial_stiffening_on(&kept);
+                Mat::from_fn(2 * k, k, |r, c| if r < k { g1[r * k + c] } else { g2[(r - k) * k + c] })
+            })
+            .collect();
         GeometricStiffness {
             kept,
             g12,
@@ -54,10 +61,11 @@ impl GeometricStiffness {
         (0..na.min(analytic)).chain(na..modes.len()).collect()
     }
 
-    /// G2 on the kept modes, row-major (k x k) [1/m].
-    pub(crate) fn g2(&self) -> Vec<f64> {
+    /// G2 of beam `beam`'s modes on the kept modes, row-major (k x k) [1/m].
+    pub(crate) fn g2(&self, beam: usize) -> Vec<f64> {
         let k = self.kept.len();
-        (0..k * k).map(|e| self.g12[(k + e / k, e % k)]).collect()
+        let g12 = &self.g12[beam.min(self.g12.len() - 1)];
+        (0..k * k).map(|e| g12[(k + e / k, e % k)]).collect()
     }
 
     /// The kept modes' indices.
@@ -74,14 +82,27 @@ impl GeometricStiffness {
                 col[r] = q[i * stride + j];
             }
         }
-        matmul(
-            self.products.as_mut(),
-            Accum::Replace,
-            self.g12.as_ref(),
-            self.alpha.as_ref(),
-            1.0,
-            Par::Seq,
-        );
+        if let [g12] = &self.g12[..] {
+            matmul(
+                self.products.as_mut(),
+                Accum::Replace,
+                g12.as_ref(),
+                self.alpha.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+        } else {
+            for (i, g12) in self.g12.iter().enumerate() {
+                matmul(
+                    self.products.as_mut().subcols_mut(i, 1),
+                    Accum::Replace,
+                    g12.as_ref(),
+                    self.alpha.as_ref().subcols(i, 1),
+                    1.0,
+                    Par::Seq,
+                );
+            }
+        }
     }
 
     /// `G1 alpha_i` on the kept rows, from the last [`GeometricStiffness::multiply`].
@@ -115,7 +136,7 @@ mod tests {
         )
         .unwrap();
         let problem = exp.problem().unwrap();
-        let exp = problem.equal_beams().unwrap();
+        let exp = crate::star::Star::new(&problem);
         let n = 53;
         let settings = AmmSettings {
             modes: Some(n),

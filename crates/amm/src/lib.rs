@@ -13,7 +13,9 @@
 //!   section 1, 12.3, 12.11);
 //! - [`pose_modes`]: the modes of the star held at rest at one pose, and its linearised system;
 //! - [`solver`]: index-3 generalized-alpha time integration and the outputs ([`solve`]);
-//! - [`direct`]: the direct problem, sliders driven by forces or a servo ([`solve`] with `Drive::Law`, `docs/amm.md` section 10).
+//! - [`direct`]: the direct problem, sliders driven by forces or a servo ([`solve`] with `Drive::Law`, `docs/amm.md` section 10);
+//! - `star` (private): the AMM's view of a problem, beam by beam: the robot as built (unequal
+//!   beams, other weld angles, an uneven base; `docs/amm.md` section 13, Eqs. J1-J8).
 //!
 //! Frames and signs follow `docs/conventions.md`; the derivation, the departures from the
 //! printed paper and the convergence study are in `docs/amm.md`. SI units throughout.
@@ -35,6 +37,7 @@ mod rayleigh_decay;
 mod record;
 mod sleeve;
 pub mod solver;
+mod star;
 mod static_start;
 mod system;
 

@@ -19,6 +19,10 @@
 //! sleeve rows of Eqs. 41-42 (`w_i(xp_i + e) - e thp_i - ds_i cos(theta) = 0`); its axial component
 //! slides the sleeve along the beam, which is free at rest.
 //!
+//! A robot as built ([`PoseModel::of_robot`], `docs/amm.md` 13) has each beam's own modes, rho_i,
+//! L_i, Jp_i and slider mass, the junction rows of Eqs. J4-J5, and `u_i . e_wi =
+//! cos(theta + phi_i - a_i)` (Eq. J7) in place of `cos(theta)`.
+//!
 //! A payload at G (`docs/amm.md` 11.4) adds its rigid-body mass matrix about G, `P^T M_p P` (Eqs. P1-P2, at
 //! rest only `M_p` remains), to beam 1's block: M is then no longer diagonal and the modes come
 //! from the general constrained solver. The damping matrix at rest is `beta K` (Eq. D2, the
@@ -27,13 +31,14 @@
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
-use flexstar_model::{AmmModel, ModeFamily, Payload, RestPose, RobotParams, Sliders};
+use flexstar_model::{AmmModel, ModeFamily, Payload, RestPose, Robot, RobotParams, Sliders};
 use flexstar_numerics::eigen::{constrained_modes, rigid_shift};
 
 use crate::error::AmmError;
 use crate::modes::ModeSet;
 use crate::sleeve::SleeveRow;
-use crate::system::{Row, System};
+use crate::star::{beam_params, Weld};
+use crate::system::{pick, Row, System};
 use flexstar_numerics::NumericsError;
 
 /// Default modes per beam of the modal analysis (enriched family): the first six frequencies of
@@ -61,8 +66,11 @@ pub struct PoseSystem {
     pub rows: usize,
     /// How the sliders are held.
     pub sliders: Sliders,
-    /// The mode set of the beams.
+    /// The mode set of the beams (beam 1's on a robot as built, [`PoseSystem::beam_modes`]).
     pub modes: ModeSet,
+    /// Each beam's mode set on a robot as built (`docs/amm.md` 13, Eq. J1); empty when the three
+    /// beams share [`PoseSystem::modes`].
+    pub beam_modes: Vec<ModeSet>,
     /// Orientation of the pose theta [rad] (the frame of the junction rows).
     pub theta: f64,
     /// The payload welded at G (in M; none: the paper's massless G).
@@ -77,7 +85,7 @@ impl PoseSystem {
         let [mut u, mut w, mut psi] = [vec![0.0; self.n], vec![0.0; self.n], vec![0.0; self.n]];
         u[self.nm] = 1.0;
         for (j, (wj, pj)) in w.iter_mut().zip(psi.iter_mut()).take(self.nm).enumerate() {
-            let v = self.modes.eval(j, 0.0);
+            let v = self.beam_modes(0).eval(j, 0.0);
             (*wj, *pj) = (v[0], v[1]);
         }
         [u, w, psi]
@@ -137,6 +145,15 @@ impl PoseSystem {
         c
     }
 
+    /// The mode set of beam i (0-based).
+    pub fn beam_modes(&self, i: usize) -> &ModeSet {
+        if self.beam_modes.is_empty() {
+            &self.modes
+        } else {
+            &self.beam_modes[i]
+        }
+    }
+
     /// Index of the first coordinate of beam i (its alpha block).
     pub fn beam_offset(&self, i: usize) -> usize {
         i * (self.nm + 2)
@@ -151,7 +168,8 @@ impl PoseSystem {
     /// the pose, for the coordinate vector q [m].
     pub fn deflection(&self, q: &[f64], i: usize, x: f64) -> f64 {
         let o = self.beam_offset(i);
-        (0..self.nm).map(|j| self.modes.eval(j, x)[0] * q[o + j]).sum()
+        let modes = self.beam_modes(i);
+        (0..self.nm).map(|j| modes.eval(j, x)[0] * q[o + j]).sum()
     }
 
     /// Row vector `r` with `r . q` = the deflection of beam i at x (see [`PoseSystem::deflection`]).
@@ -159,7 +177,7 @@ impl PoseSystem {
         let mut r = vec![0.0; self.n];
         let o = self.beam_offset(i);
         for j in 0..self.nm {
-            r[o + j] = self.modes.eval(j, x)[0];
+            r[o + j] = self.beam_modes(i).eval(j, x)[0];
         }
         r
     }
@@ -173,7 +191,10 @@ pub type PoseModes = flexstar_numerics::eigen::PoseModes<PoseSystem>;
 /// eigenproblems only).
 #[derive(Debug, Clone)]
 pub struct PoseModel {
-    params: RobotParams,
+    /// Each beam's data in the one-beam form.
+    beams: [RobotParams; 3],
+    /// The junction's coefficients and the rails (Eqs. J3-J7).
+    weld: Weld,
     payload: Payload,
     sys: System,
 }
@@ -182,15 +203,54 @@ impl PoseModel {
     /// N = `nm` modes of `family` per beam for the robot `params` (the same for the paper's and
     /// the full model: their differences vanish at rest, module docs).
     pub fn new(params: &RobotParams, family: ModeFamily, nm: usize) -> Result<Self, AmmError> {
-        let modes = ModeSet::new(family, nm, params)?;
+        Self::build([*params; 3], true, Weld::paper(), family, nm)
+    }
+
+    /// [`PoseModel::new`] for a robot as built (`docs/amm.md` 13): each beam its own modes and
+    /// data, the weld's junction rows and the rails' projections; the paper's robot gives
+    /// [`PoseModel::new`] of its compact form.
+    pub fn of_robot(robot: &Robot, family: ModeFamily, nm: usize) -> Result<Self, AmmError> {
+        if let Ok(p) = robot.equal_beams() {
+            return Self::new(p, family, nm);
+        }
+        let beams = beam_params(robot);
+        let shared = beams[1] == beams[0] && beams[2] == beams[0];
+        Self::build(beams, shared, Weld::of(robot), family, nm)
+    }
+
+    fn build(
+        beams: [RobotParams; 3],
+        shared: bool,
+        weld: Weld,
+        family: ModeFamily,
+        nm: usize,
+    ) -> Result<Self, AmmError> {
+        let sets = if shared { &beams[..1] } else { &beams[..] };
+        let modes = sets
+            .iter()
+            .map(|p| ModeSet::new(family, nm, p))
+            .collect::<Result<Vec<_>, _>>()?;
         // At rest the full model's extra terms vanish (module docs): its constraint rows equal the
         // paper model's, so the system is built without the axial-inertia matrices it never uses.
-        let sys = System::new(modes, params, AmmModel::Paper);
+        let sys = System::new(modes, &beams, &weld, AmmModel::Paper);
         Ok(PoseModel {
-            params: *params,
+            beams,
+            weld,
             payload: Payload::default(),
             sys,
         })
+    }
+
+    /// [`PoseModel::of_robot`] for the robot carrying `payload` at G (`docs/amm.md` 11.4).
+    pub fn of_robot_with_payload(
+        robot: &Robot,
+        payload: &Payload,
+        family: ModeFamily,
+        nm: usize,
+    ) -> Result<Self, AmmError> {
+        let mut model = Self::of_robot(robot, family, nm)?;
+        model.payload = *payload;
+        Ok(model)
     }
 
     /// [`PoseModel::new`] for the robot carrying `payload` at G (`docs/amm.md` 11.4).
@@ -205,16 +265,20 @@ impl PoseModel {
         Ok(model)
     }
 
-    /// The mode set of the beams.
+    /// The mode set of the beams (beam 1's on a robot as built).
     pub fn modes(&self) -> &ModeSet {
-        &self.sys.modes
+        &self.sys.beam(0).modes
     }
 
     /// Assemble `M`, `K`, `C` at `pose` (sliders held as `sliders`).
     pub fn system_at(&self, pose: &RestPose, sliders: Sliders) -> PoseSystem {
-        let params = &self.params;
         let mut sys = self.sys.clone();
-        let modes = sys.modes.clone();
+        let modes = sys.beam(0).modes.clone();
+        let beam_modes: Vec<ModeSet> = if sys.bm.len() == 1 {
+            Vec::new()
+        } else {
+            sys.bm.iter().map(|b| b.modes.clone()).collect()
+        };
         let nm = modes.len();
         let nb = nm + 2;
         sys.update_sleeve_rows(pose.xp, &vec![0.0; sys.dim()]);
@@ -224,9 +288,9 @@ impl PoseModel {
         let n = n_beams + if sliders == Sliders::Free { 3 } else { 0 };
         let mut m = vec![0.0; n * n];
         let mut k = vec![0.0; n * n];
-        let lambda = modes.lambda();
         for i in 0..3 {
-            let o = i * nb;
+            let (o, params) = (i * nb, &self.beams[i]);
+            let lambda = pick(&sys.bm, i).modes.lambda();
             for j in 0..nm {
                 m[(o + j) * n + o + j] = params.rho;
                 k[(o + j) * n + o + j] = params.rho * lambda[j];
@@ -239,13 +303,14 @@ impl PoseModel {
             c[r * n..r * n + n_beams].copy_from_slice(&c_beams[r * n_beams..(r + 1) * n_beams]);
         }
         if sliders == Sliders::Free {
-            let cos_th = pose.theta.cos();
+            // u_i . e_wi: cos(theta) on the paper's robot, Eq. J7 on one as built
+            let normal = [0, 1, 2].map(|i| self.weld.normal_along_rail(i, pose.theta, 0.0));
             for i in 0..3 {
-                m[(n_beams + i) * n + n_beams + i] = params.mpp_mpa;
+                m[(n_beams + i) * n + n_beams + i] = self.beams[i].mpp_mpa;
             }
             for (r, row) in sys.rows.iter().enumerate() {
                 if let Row::Sleeve(i, SleeveRow::Fp | SleeveRow::FR | SleeveRow::FL) = *row {
-                    c[r * n + n_beams + i] = -cos_th;
+                    c[r * n + n_beams + i] = -normal[i];
                 }
             }
         }
@@ -258,6 +323,7 @@ impl PoseModel {
             rows,
             sliders,
             modes,
+            beam_modes,
             theta: pose.theta,
             payload: self.payload,
         };
@@ -639,6 +705,61 @@ mod tests {
         assert!(first_elastic > 1.0, "{first_elastic}");
         for w in &out.omega2[..3] {
             assert!(w.abs() < 1e-7 * first_elastic, "{w} vs {first_elastic}");
+        }
+    }
+
+    /// A robot as built (`docs/amm.md` 13) with free sliders at an off-centre pose: exactly three
+    /// rigid modes (the mechanism), the next clearly elastic, and in each the sliders move as the
+    /// robot's own inverse kinematics (central differences) says for the star's displacement.
+    #[test]
+    fn free_sliders_of_a_robot_as_built_give_three_rigid_modes() {
+        let robot = crate::star::as_built_robot(1.0);
+        let traj = flexstar_model::Trajectory::Polynomial {
+            s1: vec![0.02],
+            s2: vec![-0.01],
+            s3: vec![0.005],
+        };
+        let st = flexstar_kinematics::RigidState::at(&robot, &traj, 0.0).unwrap();
+        let pose = RestPose {
+            s: st.s.map(|x| x.v),
+            g: st.g.map(|x| x.v),
+            theta: st.theta.v,
+            xp: st.xp.map(|x| x.v),
+        };
+        let model = PoseModel::of_robot(&robot, ModeFamily::Enriched, 30).unwrap();
+        let sys = model.system_at(&pose, Sliders::Free);
+        let out = constrained_modes(sys.n, &sys.m, &sys.k, &sys.c, sys.rows, 5, rigid_shift(true)).unwrap();
+        let first_elastic = out.omega2[3];
+        assert!(first_elastic > 1.0, "{first_elastic}");
+        for w in &out.omega2[..3] {
+            assert!(w.abs() < 1e-7 * first_elastic, "{w} vs {first_elastic}");
+        }
+        // each rigid mode moves the sliders as the rigid kinematics of the robot as built says
+        // (Eq. J7's projection): the star's displacement (dG from beam 1's u_1, w_1G; dtheta
+        // from w_1'(0)) through central differences of the inverse kinematics
+        let [u, w, psi] = sys.junction_rows();
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let (ex, ew) = (st.e_x(0), st.e_w(0));
+        for shape in &out.shapes[..3] {
+            let (u1, w1, dth) = (dot(&u, shape), dot(&w, shape), dot(&psi, shape));
+            let dg = [u1 * ex[0] + w1 * ew[0], u1 * ex[1] + w1 * ew[1]];
+            let h = 1e-6 / (dg[0].hypot(dg[1]) + dth.abs());
+            let ik = |k: f64| {
+                let g = [pose.g[0] + k * h * dg[0], pose.g[1] + k * h * dg[1]];
+                flexstar_model::geometry::inverse_kinematics(&robot, g, pose.theta + k * h * dth).unwrap()
+            };
+            let (sp, sm) = (ik(1.0), ik(-1.0));
+            let ds: Vec<f64> = (0..3).map(|i| shape[sys.slider_index(i).unwrap()]).collect();
+            let scale = ds.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for i in 0..3 {
+                let want = (sp[i] - sm[i]) / (2.0 * h);
+                assert!(
+                    (ds[i] - want).abs() < 1e-5 * scale,
+                    "slider {}: {} vs {want}",
+                    i + 1,
+                    ds[i]
+                );
+            }
         }
     }
 }

@@ -3,18 +3,21 @@
 
 use flexstar_kinematics::RigidState;
 use flexstar_model::animation::ShapeTimes;
-use flexstar_model::{AmmModel, AmmSettings, BeamShape, Frame, FramePose, Response, RobotParams, StarShape};
+use flexstar_model::{AmmModel, AmmSettings, BeamShape, Frame, FramePose, Response, StarShape};
 
 use crate::sleeve::{self, SleeveRow};
 use crate::solver::{Stop, EXTRA_COLUMNS, SHAPE_POINTS};
+use crate::star::{Star, Weld};
 use crate::system::{Row, System};
 
 /// Output buffers, sized once.
 pub(crate) struct Recorder {
     resp: Response,
     extra: Vec<Vec<f64>>,
-    xs: Vec<f64>,
-    shape_phi: Vec<Vec<f64>>,
+    /// The snapshot points of each beam, `x = 0, L_i / 100, ..., L_i` [m].
+    xs: [Vec<f64>; 3],
+    /// The modes at the snapshot points, per beam (one list for equal beams).
+    shape_phi: Vec<Vec<Vec<f64>>>,
     shapes: Vec<StarShape>,
     /// Rigid pose at each shape time (what an animation frame is drawn about).
     poses: Vec<FramePose>,
@@ -22,35 +25,39 @@ pub(crate) struct Recorder {
     times: ShapeTimes,
     /// Multiplier index of each named multiplier column (`None`: row dropped for the family).
     col_rows: [Option<usize>; 19],
-    phi0: Vec<f64>,
-    phil: Vec<f64>,
+    /// `phi(0)` and `phi(L)` of each beam's modes (one for equal beams).
+    phi0: Vec<Vec<f64>>,
+    phil: Vec<Vec<f64>>,
     nm: usize,
     nb: usize,
     full: bool,
-    mpp_mpa: f64,
+    /// Each sleeve's and slider's mass `(mpp + mpa)_i` [kg] (Eq. 33).
+    mpp_mpa: [f64; 3],
     /// `g . u_i` [m/s^2]: gravity along each slider's rail (Eq. G2).
     gravity_along: [f64; 3],
+    /// The rails and the weld (Eq. J7).
+    weld: Weld,
 }
 
 impl Recorder {
-    pub(crate) fn new(
-        sys: &System,
-        settings: &AmmSettings,
-        params: &RobotParams,
-        n_out: usize,
-        times: ShapeTimes,
-    ) -> Self {
+    pub(crate) fn new(sys: &System, settings: &AmmSettings, problem: &Star, n_out: usize, times: ShapeTimes) -> Self {
         let (nm, nb) = (sys.nm, sys.nb);
         let extra: Vec<Vec<f64>> = (0..EXTRA_COLUMNS.len()).map(|_| Vec::with_capacity(n_out)).collect();
-        let xs: Vec<f64> = (0..SHAPE_POINTS)
-            .map(|k| params.l * k as f64 / (SHAPE_POINTS - 1) as f64)
-            .collect();
-        let shape_phi: Vec<Vec<f64>> = xs
-            .iter()
-            .map(|&x| {
-                let mut v = vec![0.0; nm];
-                sys.modes.values_at(x, &mut v, None);
-                v
+        let xs: [Vec<f64>; 3] = std::array::from_fn(|i| {
+            let l = problem.beam(i).l;
+            (0..SHAPE_POINTS)
+                .map(|k| l * k as f64 / (SHAPE_POINTS - 1) as f64)
+                .collect()
+        });
+        let shape_phi: Vec<Vec<Vec<f64>>> = (sys.bm.iter().zip(&xs))
+            .map(|(b, xs)| {
+                xs.iter()
+                    .map(|&x| {
+                        let mut v = vec![0.0; nm];
+                        b.modes.values_at(x, &mut v, None);
+                        v
+                    })
+                    .collect()
             })
             .collect();
         let shapes: Vec<StarShape> = times
@@ -58,8 +65,8 @@ impl Recorder {
             .iter()
             .map(|&t| StarShape {
                 t,
-                beams: std::array::from_fn(|_| BeamShape {
-                    x: xs.clone(),
+                beams: std::array::from_fn(|i| BeamShape {
+                    x: xs[i].clone(),
                     w: vec![0.0; SHAPE_POINTS],
                     pos: vec![[0.0; 2]; SHAPE_POINTS],
                 }),
@@ -93,16 +100,14 @@ impl Recorder {
             times,
             shapes,
             col_rows,
-            phi0: sys.phi0.clone(),
-            phil: sys.phil.clone(),
+            phi0: sys.bm.iter().map(|b| b.phi0.clone()).collect(),
+            phil: sys.bm.iter().map(|b| b.phil.clone()).collect(),
             nm,
             nb,
             full: settings.model == AmmModel::Full,
-            mpp_mpa: params.mpp_mpa,
-            gravity_along: [0, 1, 2].map(|i| {
-                let u = flexstar_model::geometry::slider_direction(i);
-                sys.gravity()[0] * u[0] + sys.gravity()[1] * u[1]
-            }),
+            mpp_mpa: problem.beams.map(|b| b.mpp_mpa),
+            gravity_along: problem.weld.along_rails(sys.gravity()),
+            weld: problem.weld,
         }
     }
 
@@ -126,7 +131,7 @@ impl Recorder {
             self.lam_of(lam, 13 + i),
         ];
         let thp = q[i * self.nb + self.nm + 1];
-        sleeve::rows::push(self.full, i, st, thp, forces, axial[i])
+        sleeve::rows::push(self.full, i, st, thp, forces, axial[i], &self.weld)
     }
 
     /// Record the state at `stop`: a snapshot of the deformed star and/or an output row. `fa`:
@@ -154,25 +159,27 @@ impl Recorder {
                 let (ex, ew) = (st.e_x(i), st.e_w(i));
                 let u = q[i * nb + nm];
                 let b = &mut shape.beams[i];
-                for (k, phi) in self.shape_phi.iter().enumerate() {
+                let shape_phi = crate::system::pick(&self.shape_phi, i);
+                for (k, phi) in shape_phi.iter().enumerate() {
                     let w = beam_val(i, phi);
-                    let x = self.xs[k] + u;
+                    let x = self.xs[i][k] + u;
                     b.w[k] = w;
                     b.pos[k] = [st.g[0].v + x * ex[0] + w * ew[0], st.g[1].v + x * ex[1] + w * ew[1]];
                 }
             }
         }
         if stop.output.is_some() {
-            let w_g = [0, 1, 2].map(|i| beam_val(i, &self.phi0));
-            let w_tip = [0, 1, 2].map(|i| beam_val(i, &self.phil));
+            use crate::system::pick;
+            let w_g = [0, 1, 2].map(|i| beam_val(i, pick::<Vec<f64>>(&self.phi0, i)));
+            let w_tip = [0, 1, 2].map(|i| beam_val(i, pick::<Vec<f64>>(&self.phil, i)));
             let fa = fa.unwrap_or_else(|| {
                 // Eq. 33 with the sleeve and slider's weight along the rail (Eq. G2)
                 [0, 1, 2].map(|i| {
-                    self.mpp_mpa * (st.s[i].d2 - self.gravity_along[i]) + self.sleeve_push(i, st, q, lam, axial)
+                    self.mpp_mpa[i] * (st.s[i].d2 - self.gravity_along[i]) + self.sleeve_push(i, st, q, lam, axial)
                 })
             });
             self.resp.push(st.t, w_g, w_tip, fa);
-            let dg = flexstar_metrics::residual::dg_vector(w_g, [0, 1, 2].map(|i| st.e_w(i)));
+            let dg = self.weld.dg(w_g, [0, 1, 2].map(|i| st.e_w(i)));
             for k in 0..self.extra.len() {
                 let val = match k {
                     4 => -self.lam_of(lam, 3) - self.lam_of(lam, 5),

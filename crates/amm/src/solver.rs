@@ -10,20 +10,19 @@
 //! Initial accelerations are consistent: `M q''(0) = f(0) + C^T lambda(0)`, `C q''(0) = 0`.
 
 use flexstar_drive::{Drive, SolveRequest, Solved};
-use flexstar_kinematics::{
-    check_configuration, check_trajectory, preflight_step, CheckedMotion, Infeasible, RigidState,
-};
+use flexstar_kinematics::{preflight_step, CheckedMotion, RigidState};
 use flexstar_model::animation::{frame_times, ShapeTimes};
 use flexstar_model::config::check_step;
 #[cfg(test)]
 use flexstar_model::Experiment;
-use flexstar_model::{AmmSettings, DriveKind, EqualBeams, ModeCount, ModeFamily, Problem, Response, RunInfo};
+use flexstar_model::{AmmSettings, DriveKind, ModeCount, ModeFamily, Problem, Response, RunInfo};
 use flexstar_numerics::GenAlpha;
 
 use crate::adaptive::{self, Pass};
 use crate::error::AmmError;
 use crate::modes::{ModeSet, MAX_MODES};
 use crate::record::Recorder;
+use crate::star::Star;
 use crate::system::System;
 
 /// Default integration step [s], 1/6 ms (six steps per default output interval), from the
@@ -58,6 +57,19 @@ pub fn robot_step_factor(robot: &flexstar_model::RobotParams) -> f64 {
     (beam_time_scale(robot) / beam_time_scale(&flexstar_model::RobotParams::paper())).min(1.0)
 }
 
+/// The fastest beam's time scale [s] (`docs/amm.md` 13, Eq. J8): [`beam_time_scale`] of the beam
+/// whose is the smallest.
+pub(crate) fn star_time_scale(problem: &Star) -> f64 {
+    let [a, b, c] = problem.beams.map(|p| beam_time_scale(&p));
+    a.min(b).min(c)
+}
+
+/// [`robot_step_factor`] of the fastest beam (`docs/amm.md` 13, Eq. J8).
+pub(crate) fn star_step_factor(problem: &Star) -> f64 {
+    let [a, b, c] = problem.beams.map(|p| robot_step_factor(&p));
+    a.min(b).min(c)
+}
+
 /// Spectral radius at infinity of the generalized-alpha scheme: mild damping of the unresolved
 /// high modes and of the multiplier oscillations of index-3 schemes (`docs/amm.md`).
 pub const RHO_INF: f64 = 0.8;
@@ -73,7 +85,9 @@ pub fn parse_family(name: &str) -> Result<ModeFamily, AmmError> {
 
 /// Names of the extra output columns, in order (after the fixed `RESPONSE_HEADER`).
 /// `dGx, dGy` [m, fixed frame] are the elastic displacement of G, `2/3 sum_i w_iG e_wi`
-/// (`docs/motions.md` 2.1; [`flexstar_metrics::residual::dg_vector`]), as the FEM writes it.
+/// (`docs/motions.md` 2.1; [`flexstar_metrics::residual::dg_vector`]), as the FEM writes it; on
+/// a robot as built `(sum e_wi e_wi^T)^-1 sum w_iG e_wi` (`docs/amm.md` 13, Eq. J7). `Fw` is the
+/// multiplier of Eq. 40 (Eq. J5 on a robot as built, where beam i receives the shear `c_i Fw`).
 pub const EXTRA_COLUMNS: [&str; 27] = [
     "Fix1", "Fix2", "Fix3", "M1G", "M2G", "M3G", "Fw", "Fp1", "Fp2", "Fp3", "FLp1", "FLp2", "FLp3", "FRp1", "FRp2",
     "FRp3", "Mp1", "Mp2", "Mp3", "thp1", "thp2", "thp3", "u1", "u2", "u3", "dGx", "dGy",
@@ -83,12 +97,7 @@ pub const EXTRA_COLUMNS: [&str; 27] = [
 /// the step ceiling [s].
 /// `scan`: check the trajectory's feasibility over the whole span (an inverse run, or a servo's
 /// reference); otherwise only its start configuration (a forces-driven run).
-pub(crate) fn validate(
-    problem: &EqualBeams,
-    settings: &AmmSettings,
-    modes: usize,
-    scan: bool,
-) -> Result<f64, AmmError> {
+pub(crate) fn validate(problem: &Star, settings: &AmmSettings, modes: usize, scan: bool) -> Result<f64, AmmError> {
     settings.validate(problem.time.dt_out).map_err(|e| match e {
         flexstar_model::ModelError::Invalid { key, reason, .. } => AmmError::invalid(key, reason),
         other => other.into(),
@@ -99,12 +108,16 @@ pub(crate) fn validate(
             format!("need 1 <= modes <= {MAX_MODES}, got {modes}"),
         ));
     }
-    if problem.robot.jp <= 0.0 {
+    if let Some(i) = (0..3).find(|&i| problem.beam(i).jp <= 0.0) {
         return Err(AmmError::invalid(
-            "robot.Jp",
+            if problem.paper.is_some() {
+                "robot.Jp".to_string()
+            } else {
+                format!("robot.Jp[{}]", i + 1)
+            },
             format!(
                 "the AMM needs a sleeve with rotational inertia (Eq. 31): Jp > 0, got {}",
-                problem.robot.jp
+                problem.beam(i).jp
             ),
         ));
     }
@@ -114,7 +127,7 @@ pub(crate) fn validate(
             dt
         }
         None => match settings.mode_count() {
-            ModeCount::Tolerance(tol) => tolerance_step(tol) * robot_step_factor(problem.robot),
+            ModeCount::Tolerance(tol) => tolerance_step(tol) * star_step_factor(problem),
             ModeCount::Fixed(_) => DEFAULT_DT,
         }
         .min(problem.time.dt_out),
@@ -145,15 +158,10 @@ pub(crate) fn validate(
         },
     )?;
     if scan {
-        check_trajectory(
-            problem.robot,
-            problem.trajectory,
-            problem.time.t_end,
-            preflight_step(problem.time.dt_out),
-        )?;
+        problem.check_trajectory(preflight_step(problem.time.dt_out))?;
     } else {
-        let s0 = problem.trajectory.s(problem.robot, 0.0)?;
-        check_configuration(problem.robot, s0).map_err(|violation| Infeasible { t: 0.0, violation })?;
+        let s0 = problem.s_at(0.0)?;
+        problem.check_start(s0, 0.0)?;
     }
     Ok(dt)
 }
@@ -193,6 +201,11 @@ pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 /// Solve the paper's constrained assumed-modes model (Eqs. 30-44) for one experiment: the one
 /// entry point of the AMM, for both drives of `request` (`flexstar_drive::SolveRequest`).
 ///
+/// The robot may be the paper's or one as built (`docs/amm.md` 13, Eqs. J1-J8): unequal beams
+/// (each its own mode set of the family and N, and its own block of the step), other weld angles
+/// (the junction rows of Eqs. J4-J5) and an uneven base (the rails of Eq. J7); the paper's robot
+/// runs exactly as the equal-beam model did.
+///
 /// `settings` are the `[amm]` settings after command-line overrides (`problem.amm` is not read).
 /// `request.proof`: the trajectory is scanned for feasibility only when the preflight's proof does
 /// not cover this experiment's robot, trajectory and span. `request.progress` is called once, with
@@ -215,7 +228,7 @@ pub(crate) fn stops(out_times: &[f64], snaps: &[f64], tol: f64) -> Vec<Stop> {
 /// An actuator law ([`Drive::Law`], the direct problem) returns the response described in
 /// [`crate::direct`] (labelled `amm-<family>-direct`).
 pub fn solve(problem: &Problem, settings: &AmmSettings, request: SolveRequest) -> Result<Solved<Stats>, AmmError> {
-    let problem = &problem.equal_beams()?;
+    let problem = &Star::new(problem);
     let covered = request.proof.is_some_and(|c| covers(c, problem));
     let (response, stats) = match request.drive {
         Drive::Motion => solve_scanned(problem, settings, !covered)?,
@@ -267,17 +280,12 @@ impl Stats {
 }
 
 /// Does `checked` cover the scan a run of `problem` would make?
-pub(crate) fn covers(checked: &CheckedMotion, problem: &EqualBeams) -> bool {
-    checked.covers(
-        problem.robot,
-        problem.trajectory,
-        problem.time.t_end,
-        preflight_step(problem.time.dt_out),
-    )
+pub(crate) fn covers(checked: &CheckedMotion, problem: &Star) -> bool {
+    problem.covered_by(checked, preflight_step(problem.time.dt_out))
 }
 
 /// [`solve`] of the prescribed motion; `scan`: check the trajectory's feasibility over the whole span first.
-fn solve_scanned(problem: &EqualBeams, settings: &AmmSettings, scan: bool) -> Result<(Response, Stats), AmmError> {
+fn solve_scanned(problem: &Star, settings: &AmmSettings, scan: bool) -> Result<(Response, Stats), AmmError> {
     let mut runs = Vec::new();
     let resp = match settings.mode_count() {
         ModeCount::Fixed(n) => {
@@ -296,7 +304,7 @@ fn solve_scanned(problem: &EqualBeams, settings: &AmmSettings, scan: bool) -> Re
 /// system of the last N is built once and reused by its runs at both steps. `runs` receives
 /// `(N, steps)` of every integration run, in order.
 fn solve_to_tolerance(
-    problem: &EqualBeams,
+    problem: &Star,
     settings: &AmmSettings,
     tol: f64,
     scan: bool,
@@ -304,9 +312,9 @@ fn solve_to_tolerance(
 ) -> Result<Response, AmmError> {
     // every input error before any work, at the first N; the trajectory is scanned once here
     // (unless the caller has)
-    let h = validate(problem, settings, adaptive::first_modes(problem), scan)?;
-    let every = adaptive::estimate_grid(problem, h);
-    let check_every = adaptive::time_check_grid(problem, h);
+    let h = validate(problem, settings, adaptive::first_modes_of(problem), scan)?;
+    let every = adaptive::estimate_grid_of(problem, h);
+    let check_every = adaptive::time_check_grid_of(problem, h);
     let mut built: Option<(usize, System)> = None;
     adaptive::solve_to_tolerance(problem, tol, every, check_every, |n, pass| {
         let started = std::time::Instant::now();
@@ -341,7 +349,7 @@ fn solve_to_tolerance(
 /// the time check's), no snapshots or frames.
 #[allow(clippy::too_many_arguments)]
 fn integrate_coarse<F: FnMut(&System, &[f64])>(
-    problem: &EqualBeams,
+    problem: &Star,
     settings: &AmmSettings,
     sys: System,
     h: f64,
@@ -364,9 +372,13 @@ fn integrate_coarse<F: FnMut(&System, &[f64])>(
 
 /// The constrained system of N = `n_modes` modes of `settings.family` for the robot of `problem`,
 /// with its payload, damping and load (`docs/amm.md` section 11; nothing added at their defaults).
-pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, problem: &EqualBeams) -> Result<System, AmmError> {
-    let modes = ModeSet::new(settings.family, n_modes, problem.robot)?;
-    let mut sys = System::new(modes, problem.robot, settings.model);
+/// Each beam gets its own mode set of the family and N (`docs/amm.md` 13, Eq. J1); equal beams
+/// share one.
+pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, problem: &Star) -> Result<System, AmmError> {
+    let modes = (problem.mode_params().iter())
+        .map(|p| ModeSet::new(settings.family, n_modes, p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut sys = System::new(modes, &problem.beams, &problem.weld, settings.model);
     sys.attach(problem.payload, problem.damping, problem.load, problem.gravity);
     Ok(sys)
 }
@@ -375,7 +387,7 @@ pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, problem: &Equ
 /// coordinates q; `scan`: check the trajectory's feasibility over the whole span first (off when
 /// the caller has, as the automatic N does once for all its runs).
 pub(crate) fn integrate<F: FnMut(&System, &[f64])>(
-    problem: &EqualBeams,
+    problem: &Star,
     settings: &AmmSettings,
     n_modes: usize,
     scan: bool,
@@ -389,7 +401,7 @@ pub(crate) fn integrate<F: FnMut(&System, &[f64])>(
 
 /// The snapshot times of the shapes file: the requested ones and `t_end`, sorted, duplicates
 /// (within 1e-9 of the output step) merged.
-pub(crate) fn snapshot_times(problem: &EqualBeams, settings: &AmmSettings) -> Vec<f64> {
+pub(crate) fn snapshot_times(problem: &Star, settings: &AmmSettings) -> Vec<f64> {
     let mut snaps: Vec<f64> = settings.snapshots.clone();
     snaps.push(problem.time.t_end);
     snaps.sort_by(|a, b| a.total_cmp(b));
@@ -399,7 +411,7 @@ pub(crate) fn snapshot_times(problem: &EqualBeams, settings: &AmmSettings) -> Ve
 
 /// The times at which the deformed star is recorded: the snapshots ([`snapshot_times`]) and the
 /// animation frames of `settings.frames` (`docs/motions.md` section 5), merged.
-pub(crate) fn shape_times(problem: &EqualBeams, settings: &AmmSettings) -> ShapeTimes {
+pub(crate) fn shape_times(problem: &Star, settings: &AmmSettings) -> ShapeTimes {
     let frames = frame_times(problem.time.t_end, settings.frames);
     ShapeTimes::merge(&snapshot_times(problem, settings), &frames, 1e-9 * problem.time.dt_out)
 }
@@ -407,32 +419,30 @@ pub(crate) fn shape_times(problem: &EqualBeams, settings: &AmmSettings) -> Shape
 /// [`integrate`] with the system `sys` built (fresh, not yet stepped) and the inputs validated:
 /// steps of at most `dt_max` [s]; the reported wall time counts from `started`.
 pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
-    problem: &EqualBeams,
+    problem: &Star,
     settings: &AmmSettings,
     mut sys: System,
     dt_max: f64,
     started: std::time::Instant,
     mut observe: F,
 ) -> Result<Response, AmmError> {
-    let params = &problem.robot;
-    let n_modes = sys.modes.len();
+    let n_modes = sys.nm;
     let (nm, n) = (sys.nm, sys.dim());
 
     let out_times = problem.time.output_times();
     let times = shape_times(problem, settings);
     let stops = stops(&out_times, &times.all, 1e-9 * problem.time.dt_out);
-    let mut rec = Recorder::new(&sys, settings, params, out_times.len(), times);
+    let mut rec = Recorder::new(&sys, settings, problem, out_times.len(), times);
     let ga = GenAlpha::new(RHO_INF);
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let kin =
-        |t: f64| RigidState::at(params, problem.trajectory, t).map_err(|source| AmmError::Kinematics { t, source });
+    let kin = |t: f64| problem.state(t);
 
     // the start: undeformed, or under gravity the static equilibrium of the start pose (Eq. G4);
     // then consistent initial accelerations: M qdd = f - K q + C^T lambda, C qdd = 0 (q' = 0)
     let mut st = kin(0.0)?;
     if problem.gravity != [0.0; 2] {
-        crate::static_start::static_equilibrium(&mut sys, &st, beam_time_scale(params), &mut q)?;
+        crate::static_start::static_equilibrium(&mut sys, &st, star_time_scale(problem), &mut q)?;
     }
     sys.solve(&st, 0.0, 0.0, &q, &v, &mut qdd).map_err(|e| match e {
         AmmError::SingularConstraints { t, source } => AmmError::TooFewModes {
@@ -486,7 +496,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     }
 
     let mut resp = rec.finish(format!("amm-{}", settings.family.name()));
-    resp.rest_offset = crate::static_start::rest_offset(&mut sys, problem, beam_time_scale(params))?;
+    resp.rest_offset = crate::static_start::rest_offset(&mut sys, problem, star_time_scale(problem))?;
     resp.info = run_info("amm", settings, n_modes, dt_max, started);
     Ok(resp)
 }
@@ -558,7 +568,7 @@ mod tests {
             let settings = AmmSettings::paper(fam, 20);
             let (mut worst, mut qmax, mut steps) = (0.0f64, 0.0f64, 0);
             let problem = case([1.0, 0.0, 0.5], 0.2).problem().unwrap();
-            integrate(&problem.equal_beams().unwrap(), &settings, 20, true, |sys, q| {
+            integrate(&Star::new(&problem), &settings, 20, true, |sys, q| {
                 worst = worst.max(sys.constraint_violation(q));
                 qmax = qmax.max(q.iter().fold(0.0f64, |m, v| m.max(v.abs())));
                 steps += 1;
@@ -579,14 +589,14 @@ mod tests {
         // shift f w' that the rows at xp - u neglected (docs/amm.md 12.11)
         let exp = case([1.0, 0.0, 0.5], 0.3);
         let problem = exp.problem().unwrap();
-        let exp = problem.equal_beams().unwrap();
+        let exp = Star::new(&problem);
         let settings = AmmSettings {
             modes: Some(30),
             ..AmmSettings::accurate()
         };
         let mut worst = [0.0f64; 3];
         integrate(&exp, &settings, 30, true, |sys, q| {
-            let gaps = sys.sleeve_gaps(q, exp.robot.lp);
+            let gaps = sys.sleeve_gaps(q, exp.beams.map(|b| b.lp));
             for (w, g) in worst.iter_mut().zip(gaps) {
                 *w = w.max(g);
             }
@@ -600,13 +610,64 @@ mod tests {
     }
 
     #[test]
+    fn the_per_beam_layout_reproduces_the_shared_one_bit_for_bit() {
+        // docs/amm.md 13: three equal beams run through the general layout (a mode set, an
+        // arrowhead, sleeve tables and G matrices per beam) give the shared layout's run exactly,
+        // in both models, with a payload, damping, a load and gravity
+        let mut exp = case([1.0, 0.0, 0.5], 0.1);
+        exp.payload = flexstar_model::Payload {
+            mass: 0.3,
+            j: 1e-3,
+            offset: [0.02, -0.01],
+        };
+        exp.damping = flexstar_model::Damping::rayleigh(2.0, 1e-4);
+        exp.load = flexstar_model::LoadSettings::polynomials(Some(vec![0.0, 5.0]), None, Some(vec![0.0, 0.0, 3.0]));
+        exp.gravity.g = [1.0, -9.81];
+        let problem = exp.problem().unwrap();
+        let star = Star::new(&problem);
+        assert!(star.shared && star.paper.is_some());
+        for settings in [
+            AmmSettings {
+                modes: Some(30),
+                snapshots: vec![0.05],
+                ..AmmSettings::accurate()
+            },
+            AmmSettings::paper(ModeFamily::FreeFree, 20),
+        ] {
+            let n = settings.modes.unwrap();
+            let shared = integrate(&star, &settings, n, true, |_, _| {}).unwrap();
+            let general = integrate(&star.per_beam(), &settings, n, true, |_, _| {}).unwrap();
+            let bits = |r: &Response| {
+                let mut v: Vec<u64> = r.t.iter().map(|x| x.to_bits()).collect();
+                for h in [&r.w_g, &r.w_tip, &r.fa] {
+                    v.extend(h.iter().flatten().map(|x| x.to_bits()));
+                }
+                v.extend(r.extra.iter().flat_map(|c| c.values.iter().map(|x| x.to_bits())));
+                v.extend(
+                    r.shapes
+                        .iter()
+                        .flat_map(|s| s.beams.iter().flat_map(|b| b.w.iter().map(|x| x.to_bits()))),
+                );
+                v
+            };
+            assert!(shared.w_tip[0].iter().any(|w| w.abs() > 1e-5), "no motion");
+            assert_eq!(bits(&shared), bits(&general), "{:?}", settings.model);
+        }
+    }
+
+    #[test]
     fn rows_dropped_per_family() {
         // docs/amm.md section 1: pinned-free loses sum w_iG, slide-free the slope equalities
         let p = RobotParams::paper();
         let count = |fam| {
-            System::new(ModeSet::new(fam, 25, &p).unwrap(), &p, AmmModel::Paper)
-                .rows
-                .len()
+            System::new(
+                vec![ModeSet::new(fam, 25, &p).unwrap()],
+                &[p; 3],
+                &crate::star::Weld::paper(),
+                AmmModel::Paper,
+            )
+            .rows
+            .len()
         };
         assert_eq!(count(ModeFamily::FreeFree), 18);
         assert_eq!(count(ModeFamily::PinnedFree), 17);

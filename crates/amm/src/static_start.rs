@@ -15,10 +15,11 @@
 //! `bp lambda_N`), hence the moderate `bp`.
 
 use flexstar_kinematics::RigidState;
-use flexstar_model::{EqualBeams, RestOffset};
+use flexstar_model::RestOffset;
 
 use crate::error::AmmError;
 use crate::modes::dot;
+use crate::star::Star;
 use crate::system::System;
 
 /// Most refinement passes: about 0.1 per pass on the paper's robot (module doc).
@@ -65,27 +66,23 @@ pub(crate) fn static_equilibrium(
 /// Under gravity, the static equilibrium's `w_iG` and tips at the pose where the problem's
 /// motion comes to rest (`docs/as-built.md` 5.5: the residual vibration is measured about it);
 /// `None` without gravity or without a rest within the run. `sys` is left at that equilibrium.
-pub(crate) fn rest_offset(
-    sys: &mut System,
-    problem: &EqualBeams,
-    time_scale: f64,
-) -> Result<Option<RestOffset>, AmmError> {
+pub(crate) fn rest_offset(sys: &mut System, problem: &Star, time_scale: f64) -> Result<Option<RestOffset>, AmmError> {
     let Some(t_rest) = problem.trajectory.t_rest().filter(|t| *t <= problem.time.t_end) else {
         return Ok(None);
     };
     if problem.gravity == [0.0; 2] {
         return Ok(None);
     }
-    let st = RigidState::at(problem.robot, problem.trajectory, t_rest)
-        .map_err(|source| AmmError::Kinematics { t: t_rest, source })?;
+    let st = problem.state(t_rest)?;
     let mut q = vec![0.0; sys.dim()];
     static_equilibrium(sys, &st, time_scale, &mut q)?;
     let (nm, nb) = (sys.nm, sys.nb);
-    let along = |v: &[f64]| [0, 1, 2].map(|i| dot(v, &q[i * nb..i * nb + nm]));
+    let along =
+        |v: fn(&crate::system::BeamModel) -> &[f64]| [0, 1, 2].map(|i| dot(v(sys.beam(i)), &q[i * nb..i * nb + nm]));
     Ok(Some(RestOffset {
         t_rest,
-        w_g: along(&sys.phi0),
-        w_tip: along(&sys.phil),
+        w_g: along(|b| &b.phi0),
+        w_tip: along(|b| &b.phil),
     }))
 }
 
@@ -107,9 +104,9 @@ mod tests {
                     s1 = [0.02]\ns2 = [-0.03]\ns3 = [0.01]\n[gravity]\ng = [0.0, -9.81]\n";
         let exp = Experiment::from_toml_str(text, std::path::Path::new("sag.toml")).unwrap();
         let problem = exp.problem().unwrap();
-        let eq = problem.equal_beams().unwrap();
-        let p = eq.robot;
-        let st = flexstar_kinematics::RigidState::at(p, eq.trajectory, 0.0).unwrap();
+        let eq = Star::new(&problem);
+        let p = eq.beam(0);
+        let st = eq.state(0.0).unwrap();
         // the largest departure from the textbook over the three beams, relative to the largest sag
         let error = |family: ModeFamily, nm: usize| {
             let settings = AmmSettings {
@@ -124,7 +121,7 @@ mod tests {
             for i in 0..3 {
                 let w = |x: f64, d: usize| {
                     (0..nm)
-                        .map(|j| sys.modes.eval(j, x)[d] * q[i * (nm + 2) + j])
+                        .map(|j| sys.beam(i).modes.eval(j, x)[d] * q[i * (nm + 2) + j])
                         .sum::<f64>()
                 };
                 let xr = st.xp[i].v + p.lp / 2.0;

@@ -23,6 +23,8 @@
 use flexstar_kinematics::RigidState;
 use flexstar_model::{AmmModel, Damping, LoadSettings, Payload, RobotParams};
 
+use crate::star::Weld;
+
 use crate::attach::{Mat3, PayloadTerms, RigidTerms};
 use crate::constraint_lu::{ConstraintLu, MAX_JUNCTION_ROWS};
 use crate::error::{AmmError, RankError};
@@ -32,15 +34,14 @@ use crate::modes::{dot, ModeSet};
 use crate::sleeve::{SleeveRow, Sleeves, B_MID, B_MSLOPE, SLEEVE_ROWS};
 use flexstar_numerics::vector::dots;
 
-const SQRT3: f64 = 1.732_050_807_568_877_2;
-
 /// One constraint row and its multiplier (`docs/amm.md` section 1; Eqs. 24-29, 38-43). Beams are
 /// 0-based here. The multiplier is the generalized force on the beam for the row as written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Row {
-    /// Eq. 38: `u_i - (w_{i+2,G} - w_{i+1,G}) / sqrt3 = 0`; multiplier `F_ix` (axial force at G).
+    /// Eq. 38: `u_i - (w_{i+2,G} - w_{i+1,G}) / sqrt3 = 0` (Eq. J4 for other welds, `docs/amm.md`
+    /// 13); multiplier `F_ix` (axial force at G).
     Fix(usize),
-    /// Eq. 40: `w_1G + w_2G + w_3G = 0`; multiplier `Fw`.
+    /// Eq. 40: `w_1G + w_2G + w_3G = 0` (Eq. J5: `sum c_i w_iG = 0` for other welds); multiplier `Fw`.
     Fw,
     /// Eq. 39: `w_1'(0) - w_2'(0) = 0`; multiplier `M1G`.
     M1G,
@@ -209,23 +210,138 @@ impl BeamRows {
     }
 }
 
+/// One beam's modes and data, and its arrowhead of the step matrix (`docs/amm.md` 13, Eqs. J1-J2):
+/// shared by the three beams when they are equal.
+#[derive(Debug, Clone)]
+pub(crate) struct BeamModel {
+    /// The beam's mode set (Eq. J1).
+    pub(crate) modes: ModeSet,
+    /// Mass per length rho_i [kg/m].
+    pub(crate) rho: f64,
+    /// Length L_i [m].
+    pub(crate) l: f64,
+    /// Sleeve inertia Jp_i [kg m^2].
+    pub(crate) jp: f64,
+    /// Eigenvalues lambda_m [1/s^2].
+    pub(crate) lambda_m: Vec<f64>,
+    /// `Phi_m = int phi_m` [m^0.5].
+    pub(crate) phi: Vec<f64>,
+    /// `Psi_m = int x phi_m` [m^1.5].
+    pub(crate) psi: Vec<f64>,
+    /// `phi_m(0)` [m^-0.5].
+    pub(crate) phi0: Vec<f64>,
+    /// `phi_m'(0)` [m^-1.5].
+    pub(crate) dphi0: Vec<f64>,
+    /// `phi_m(L)` [m^-0.5].
+    pub(crate) phil: Vec<f64>,
+    /// Full model: the axial flexibility `L / (3 EA)` [m/N] (Eq. A2); 0 in the paper's model.
+    axial_flex: f64,
+    // arrowhead data of the step (Eq. J2), per step
+    /// The thp diagonal of the step matrix, `Jp (1 + gamma' alpha)` (Eq. D19).
+    jp_step: f64,
+    inv_d: Vec<f64>,
+    w: Vec<f64>,
+    p: f64,
+    inv_sigma: f64,
+    scaled0: [Vec<f64>; 2],
+    /// The junction vectors' Gram entries `[g00, g01, g11]` and `[w0, w1]` of the step.
+    jgram: [f64; 3],
+    jw: [f64; 2],
+}
+
+impl BeamModel {
+    fn new(modes: ModeSet, params: &RobotParams, model: AmmModel) -> Self {
+        let nm = modes.len();
+        let l = params.l;
+        let (phi0, dphi0, phil) = end_values(&modes, l);
+        BeamModel {
+            rho: params.rho,
+            l,
+            jp: params.jp,
+            lambda_m: modes.lambda().to_vec(),
+            phi: modes.phi_integral().to_vec(),
+            psi: modes.x_phi_integral().to_vec(),
+            phi0,
+            dphi0,
+            phil,
+            axial_flex: match model {
+                AmmModel::Full => l / (3.0 * params.ea()),
+                AmmModel::Paper => 0.0,
+            },
+            jp_step: params.jp,
+            inv_d: vec![0.0; nm],
+            w: vec![0.0; nm],
+            p: 0.0,
+            inv_sigma: 0.0,
+            scaled0: [vec![0.0; nm], vec![0.0; nm]],
+            jgram: [0.0; 3],
+            jw: [0.0; 2],
+            modes,
+        }
+    }
+
+    /// Arrowhead data of `S = M + gamma' D + beta' K` (Eq. J2) for the angular rate th' and
+    /// acceleration th'', mass-proportional `alpha` [1/s] and Kelvin-Voigt `beta` [s], and the
+    /// junction vectors' Gram entries.
+    fn factor(&mut self, bp: f64, gp: f64, thd: f64, thdd: f64, alpha: f64, beta: f64) {
+        let rho = self.rho;
+        self.p = rho * (2.0 * gp * thd + bp * thdd);
+        // Eq. D19: the mass-proportional damping alpha M scales M in S by 1 + gamma' alpha
+        // (exactly 1 without it)
+        let mass = 1.0 + gp * alpha;
+        self.jp_step = self.jp * mass;
+        let mut sigma = rho * self.l * (mass - bp * thd * thd);
+        let damped = gp * beta;
+        for j in 0..self.lambda_m.len() {
+            let d = if beta > 0.0 {
+                // Eq. D3: the Kelvin-Voigt damping beta K_e on the elastic stiffness only
+                rho * (mass + damped * self.lambda_m[j] + bp * (self.lambda_m[j] - thd * thd))
+            } else {
+                rho * (mass + bp * (self.lambda_m[j] - thd * thd))
+            };
+            self.inv_d[j] = 1.0 / d;
+            self.w[j] = self.phi[j] / d;
+            sigma += self.p * self.p * self.phi[j] * self.w[j];
+        }
+        self.inv_sigma = 1.0 / sigma;
+        // Gram data of the junction vectors
+        for (sv, v) in self.scaled0.iter_mut().zip([&self.phi0, &self.dphi0]) {
+            for ((s, x), d) in sv.iter_mut().zip(v.iter()).zip(&self.inv_d) {
+                *s = x * d;
+            }
+        }
+        let [g00, g01, w0] = dots(&self.scaled0[0], [&self.phi0, &self.dphi0, &self.phi]);
+        let [g11, w1] = dots(&self.scaled0[1], [&self.dphi0, &self.phi]);
+        self.jgram = [g00, g01, g11];
+        self.jw = [w0, w1];
+    }
+
+    /// `x = S_i^-1 x` for this beam's arrowhead (N + 2 entries).
+    #[inline]
+    fn arrow_solve(&self, x: &mut [f64]) {
+        let nm = self.lambda_m.len();
+        let y = (x[nm] + self.p * dot(&self.w, &x[..nm])) * self.inv_sigma;
+        for ((xj, pj), dj) in x[..nm].iter_mut().zip(&self.phi).zip(&self.inv_d) {
+            *xj = (*xj - self.p * pj * y) * dj;
+        }
+        x[nm] = y;
+        x[nm + 1] /= self.jp_step;
+    }
+}
+
+/// The element of `v` for beam `i`: `v` holds one (shared by the three beams) or three.
+#[inline]
+pub(crate) fn pick<T>(v: &[T], i: usize) -> &T {
+    &v[i.min(v.len() - 1)]
+}
+
 /// Workspace of the constrained system: everything sized once, nothing allocated per step.
 #[derive(Debug, Clone)]
 pub(crate) struct System {
-    pub(crate) modes: ModeSet,
+    /// The beams' modes, data and arrowheads: one (equal beams) or three (`docs/amm.md` 13).
+    pub(crate) bm: Vec<BeamModel>,
     pub(crate) nm: usize,
     pub(crate) nb: usize,
-    rho: f64,
-    l: f64,
-    jp: f64,
-    /// The thp diagonal of the step matrix, `Jp (1 + gamma' alpha)` (Eq. D19).
-    jp_step: f64,
-    lambda_m: Vec<f64>,
-    phi: Vec<f64>,
-    psi: Vec<f64>,
-    pub(crate) phi0: Vec<f64>,
-    dphi0: Vec<f64>,
-    pub(crate) phil: Vec<f64>,
     pub(crate) rows: Vec<Row>,
     beams: [BeamRows; 3],
     /// Full model: the geometric stiffness of the axial inertia force (Eq. 23) on the modes
@@ -239,16 +355,7 @@ pub(crate) struct System {
     udd: [f64; 3],
     /// Full model: the foreshortening inertia of the bent beams in the u rows (`foreshortening`).
     fore: Option<Foreshortening>,
-    /// Full model: the axial flexibility `L / (3 EA)` [m/N] between a beam's root at G and its
-    /// mean axial displacement u_i (Eq. A2, `docs/amm.md` 12.12); 0 in the paper's model.
-    axial_flex: f64,
-    // arrowhead data of S (the same for the three beams)
-    inv_d: Vec<f64>,
-    w: Vec<f64>,
-    p: f64,
-    inv_sigma: f64,
     // per-step buffers
-    scaled0: [Vec<f64>; 2],
     dinv_r: Vec<f64>,
     resid: Vec<f64>,
     a: Vec<f64>,
@@ -311,17 +418,22 @@ fn constraint_rows(has_w0: bool, has_slope0: bool) -> Vec<Row> {
 
 /// Block of constraint row `row` on beam b: (basis vector, its factor, u coefficient, thp
 /// coefficient), `None` where the block is zero; `hp` is half the sleeve length [m].
-fn row_entry(row: Row, b: usize, has_w0: bool, hp: f64) -> Option<RowForm> {
+/// The junction's coefficients are those of `weld` (Eqs. 38, 40; J4, J5).
+fn row_entry(row: Row, b: usize, has_w0: bool, hp: f64, weld: &Weld) -> Option<RowForm> {
     match row {
         Row::Fix(i) if b == i => Some((NONE, 0.0, 1.0, 0.0)),
         Row::Fix(i) if has_w0 => Some((
             B_PHI0,
-            if b == (i + 1) % 3 { 1.0 / SQRT3 } else { -1.0 / SQRT3 },
+            if b == (i + 1) % 3 {
+                weld.fix[i][0]
+            } else {
+                weld.fix[i][1]
+            },
             0.0,
             0.0,
         )),
         Row::Fix(_) => None,
-        Row::Fw => Some((B_PHI0, 1.0, 0.0, 0.0)),
+        Row::Fw => Some((B_PHI0, weld.fw[b], 0.0, 0.0)),
         Row::M1G | Row::M3G => {
             let first = if row == Row::M1G { 0 } else { 2 };
             match b {
@@ -335,8 +447,8 @@ fn row_entry(row: Row, b: usize, has_w0: bool, hp: f64) -> Option<RowForm> {
 }
 
 /// The rows of each beam: which constraint rows touch it and how ([`row_entry`]), with the
-/// workspaces for `nm` modes.
-fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize) -> [BeamRows; 3] {
+/// workspaces for `nm` modes; `hp`: each beam's half sleeve length [m].
+fn beam_rows(rows: &[Row], has_w0: bool, hp: [f64; 3], nm: usize, weld: &Weld) -> [BeamRows; 3] {
     let mut beams: [BeamRows; 3] = std::array::from_fn(|_| BeamRows {
         ids: Vec::new(),
         basis: Vec::new(),
@@ -352,7 +464,7 @@ fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize) -> [BeamRows; 3] {
     });
     for (k, row) in rows.iter().enumerate() {
         for (b, beam) in beams.iter_mut().enumerate() {
-            let entry = row_entry(*row, b, has_w0, hp);
+            let entry = row_entry(*row, b, has_w0, hp[b], weld);
             if let Some((basis, sc, cu, ct)) = entry {
                 beam.ids.push(k);
                 beam.basis.push(basis);
@@ -368,64 +480,57 @@ fn beam_rows(rows: &[Row], has_w0: bool, hp: f64, nm: usize) -> [BeamRows; 3] {
 }
 
 impl System {
-    /// Build the system for `modes`, keeping the constraint rows that do not vanish identically
-    /// for the family (pinned-free: no `Fw`; slide-free: no slope equalities; clamped-free: neither).
-    pub(crate) fn new(modes: ModeSet, params: &RobotParams, model: AmmModel) -> Self {
-        let nm = modes.len();
+    /// Build the system for `modes` (one mode set shared by three equal beams, or one per beam,
+    /// of the same family and N) on the beams `params` (0-based) welded as `weld`
+    /// (`docs/amm.md` 13), keeping the constraint rows that do not vanish identically for the
+    /// family (pinned-free: no `Fw`; slide-free: no slope equalities; clamped-free: neither).
+    pub(crate) fn new(modes: Vec<ModeSet>, params: &[RobotParams; 3], weld: &Weld, model: AmmModel) -> Self {
+        debug_assert!(modes.len() == 1 || modes.len() == 3);
+        let nm = modes[0].len();
         let nb = nm + 2;
-        let l = params.l;
-        let sl = 1.0 / l.sqrt();
-        let bl = modes.beta_l();
-        let (phi0, dphi0, phil) = end_values(&modes, l);
-        // a non-zero value is O(1/sqrt L), a non-zero slope O(max(1, beta L) / L^1.5)
-        let val_scale = vec![sl; nm];
-        let slope_scale: Vec<f64> = bl.iter().map(|b| b.max(1.0) * sl / l).collect();
-        let has_w0 = !negligible(&phi0, &val_scale);
-        let has_slope0 = !negligible(&dphi0, &slope_scale);
+        // the rows kept: a family property, read on beam 1's modes
+        let (has_w0, has_slope0) = {
+            let (m0, l) = (&modes[0], params[0].l);
+            let sl = 1.0 / l.sqrt();
+            let bl = m0.beta_l();
+            let (phi0, dphi0, _) = end_values(m0, l);
+            // a non-zero value is O(1/sqrt L), a non-zero slope O(max(1, beta L) / L^1.5)
+            let val_scale = vec![sl; nm];
+            let slope_scale: Vec<f64> = bl.iter().map(|b| b.max(1.0) * sl / l).collect();
+            (!negligible(&phi0, &val_scale), !negligible(&dphi0, &slope_scale))
+        };
 
         let rows = constraint_rows(has_w0, has_slope0);
-        let hp = 0.5 * params.lp;
-        let beams = beam_rows(&rows, has_w0, hp, nm);
+        let hp = params.map(|p| 0.5 * p.lp);
+        let beams = beam_rows(&rows, has_w0, hp, nm, weld);
         debug_assert!(beams.iter().all(|b| b.ids.len() <= MAX_BEAM_ROWS));
         let m = rows.len();
         let n = 3 * nb;
         let (geometric, fore) = match model {
             AmmModel::Full => {
                 let geo = GeometricStiffness::new(&modes, geometric::KEPT_ANALYTIC);
-                let fore = Foreshortening::new(&modes, geo.kept(), &geo.g2(), KEPT_ANALYTIC);
+                let g2: Vec<Vec<f64>> = (0..modes.len()).map(|i| geo.g2(i)).collect();
+                let fore = Foreshortening::new(&modes[0], geo.kept(), &g2, KEPT_ANALYTIC);
                 (Some(geo), Some(fore))
             }
             AmmModel::Paper => (None, None),
         };
-        let axial_flex = match model {
-            AmmModel::Full => l / (3.0 * params.ea()),
-            AmmModel::Paper => 0.0,
-        };
+        let sleeves = Sleeves::new(&modes, params, model);
+        let bm = modes
+            .into_iter()
+            .zip(params.iter())
+            .map(|(modes, p)| BeamModel::new(modes, p, model))
+            .collect();
         System {
             fore,
-            sleeves: Sleeves::new(&modes, params, model),
-            axial_flex,
+            sleeves,
             geometric,
             udd: [0.0; 3],
             nm,
             nb,
-            rho: params.rho,
-            l,
-            jp: params.jp,
-            jp_step: params.jp,
-            lambda_m: modes.lambda().to_vec(),
-            phi: modes.phi_integral().to_vec(),
-            psi: modes.x_phi_integral().to_vec(),
-            phi0,
-            dphi0,
-            phil,
+            bm,
             rows,
             beams,
-            inv_d: vec![0.0; nm],
-            w: vec![0.0; nm],
-            p: 0.0,
-            inv_sigma: 0.0,
-            scaled0: [vec![0.0; nm], vec![0.0; nm]],
             dinv_r: vec![0.0; nm],
             resid: vec![0.0; n],
             a: vec![0.0; m * m],
@@ -438,8 +543,13 @@ impl System {
             gravity: [0.0; 2],
             load: None,
             pay_tmp: vec![0.0; nb],
-            modes,
         }
+    }
+
+    /// Beam i's modes, data and arrowhead (0-based; shared when the beams are equal).
+    #[inline]
+    pub(crate) fn beam(&self, i: usize) -> &BeamModel {
+        pick(&self.bm, i)
     }
 
     /// `docs/amm.md` section 11: the payload welded at G (Eqs. P1-P6, on beam 1's
@@ -459,7 +569,8 @@ impl System {
     /// shapes) instead of [`geometric::KEPT_ANALYTIC`], for the test of that truncation.
     #[cfg(test)]
     pub(crate) fn with_geometric_kept(mut self, analytic: usize) -> Self {
-        self.geometric = Some(GeometricStiffness::new(&self.modes, analytic));
+        let modes: Vec<ModeSet> = self.bm.iter().map(|b| b.modes.clone()).collect();
+        self.geometric = Some(GeometricStiffness::new(&modes, analytic));
         self
     }
 
@@ -468,11 +579,11 @@ impl System {
         3 * self.nb
     }
 
-    /// Basis vector `a` of beam `beam`.
-    fn basis<'s>(&'s self, beam: &'s BeamRows, a: usize) -> &'s [f64] {
+    /// Basis vector `a` of beam `i` (rows `beam`).
+    fn basis<'s>(&'s self, i: usize, beam: &'s BeamRows, a: usize) -> &'s [f64] {
         match a {
-            B_PHI0 => &self.phi0,
-            B_DPHI0 => &self.dphi0,
+            B_PHI0 => &self.beam(i).phi0,
+            B_DPHI0 => &self.beam(i).dphi0,
             _ => &beam.sleeve[a - B_MID],
         }
     }
@@ -480,7 +591,8 @@ impl System {
     /// Eqs. 41-43: refresh the sleeve rows for the sleeve positions xp_i(t) [m], about the
     /// predictor `qhat` in the full model ([`Sleeves::update`]).
     pub(crate) fn update_sleeve_rows(&mut self, xp: [f64; 3], qhat: &[f64]) {
-        self.sleeves.update(&mut self.beams, &self.rows, &self.modes, xp, qhat);
+        let modes: [&ModeSet; 3] = std::array::from_fn(|i| &pick(&self.bm, i).modes);
+        self.sleeves.update(&mut self.beams, &self.rows, modes, xp, qhat);
     }
 
     /// Eq. A3 (`docs/amm.md` 12.12): the beams' axial flexibility on the Fix rows, whose
@@ -489,50 +601,24 @@ impl System {
     /// row's diagonal of the Schur complement. No-op in the paper's model and for the consistent
     /// initial accelerations (`bp = 0`).
     fn add_axial_flexibility(&mut self, bp: f64) {
-        if self.axial_flex == 0.0 || bp <= 0.0 {
+        if self.bm[0].axial_flex == 0.0 || bp <= 0.0 {
             return;
         }
         let m = self.rows.len();
         for (k, row) in self.rows.iter().enumerate() {
-            if let Row::Fix(_) = row {
-                self.a[k * m + k] += self.axial_flex / bp;
+            if let Row::Fix(i) = row {
+                self.a[k * m + k] += pick(&self.bm, *i).axial_flex / bp;
             }
         }
     }
 
-    /// Arrowhead data of `S = M + gamma' D + beta' K` for the angular rate th' and acceleration th''.
+    /// Arrowhead data of each beam's block of `S = M + gamma' D + beta' K` (Eq. J2) for the
+    /// angular rate th' and acceleration th'': one for equal beams.
     fn factor_s(&mut self, bp: f64, gp: f64, thd: f64, thdd: f64) {
-        let rho = self.rho;
-        self.p = rho * (2.0 * gp * thd + bp * thdd);
-        // Eq. D19: the mass-proportional damping alpha M scales M in S by 1 + gamma' alpha
-        // (exactly 1 without it)
-        let mass = 1.0 + gp * self.alpha;
-        self.jp_step = self.jp * mass;
-        let mut sigma = rho * self.l * (mass - bp * thd * thd);
-        let damped = gp * self.beta;
-        for j in 0..self.nm {
-            let d = if self.beta > 0.0 {
-                // Eq. D3: the Kelvin-Voigt damping beta K_e on the elastic stiffness only
-                rho * (mass + damped * self.lambda_m[j] + bp * (self.lambda_m[j] - thd * thd))
-            } else {
-                rho * (mass + bp * (self.lambda_m[j] - thd * thd))
-            };
-            self.inv_d[j] = 1.0 / d;
-            self.w[j] = self.phi[j] / d;
-            sigma += self.p * self.p * self.phi[j] * self.w[j];
+        let (alpha, beta) = (self.alpha, self.beta);
+        for b in self.bm.iter_mut() {
+            b.factor(bp, gp, thd, thdd, alpha, beta);
         }
-        self.inv_sigma = 1.0 / sigma;
-    }
-
-    #[inline]
-    fn arrow_solve(&self, x: &mut [f64]) {
-        let nm = self.nm;
-        let y = (x[nm] + self.p * dot(&self.w, &x[..nm])) * self.inv_sigma;
-        for ((xj, pj), dj) in x[..nm].iter_mut().zip(&self.phi).zip(&self.inv_d) {
-            *xj = (*xj - self.p * pj * y) * dj;
-        }
-        x[nm] = y;
-        x[nm + 1] /= self.jp_step;
     }
 
     /// One linear solve of the index-3 generalized-alpha step (or of the consistent initial
@@ -574,7 +660,7 @@ impl System {
     /// The forcing `r = f - D vhat - K qhat` of the step at the rigid state `st`, into the
     /// workspace (per beam: Eq. 37 alpha rows, Eqs. 30/44 u row, Eq. 31 thp row).
     pub(crate) fn forcing(&mut self, st: &RigidState, qhat: &[f64], vhat: &[f64]) {
-        let (nm, nb, rho, l) = (self.nm, self.nb, self.rho, self.l);
+        let (nm, nb) = (self.nm, self.nb);
         let thd = st.theta.d1;
         let thdd = st.theta.d2;
         let ag = self.apparent_a_g(st);
@@ -582,6 +668,8 @@ impl System {
             geo.multiply(qhat, nb);
         }
         for i in 0..3 {
+            let bm = pick(&self.bm, i);
+            let (rho, l) = (bm.rho, bm.l);
             // Eqs. 11-12: e_x = [sin a, -cos a], e_w = [cos a, sin a], one sin/cos pair
             let ex = st.e_x(i);
             let ew = [-ex[1], ex[0]];
@@ -594,16 +682,16 @@ impl System {
             // no reduction in the loop (it vectorises); Phi . alpha and Phi . alpha' apart
             let c_phi = -rho * aw - 2.0 * rho * thd * vu - rho * thdd * qu;
             let (c_psi, c_q, thd2) = (-rho * thdd, -rho, thd * thd);
-            let rows = r[..nm].iter_mut().zip(&self.phi[..nm]).zip(&self.psi[..nm]);
-            for (((rj, &pj), &sj), (&lj, &qj)) in rows.zip(self.lambda_m[..nm].iter().zip(qa)) {
+            let rows = r[..nm].iter_mut().zip(&bm.phi[..nm]).zip(&bm.psi[..nm]);
+            for (((rj, &pj), &sj), (&lj, &qj)) in rows.zip(bm.lambda_m[..nm].iter().zip(qa)) {
                 *rj = c_phi * pj + c_psi * sj + c_q * (lj - thd2) * qj;
             }
-            let [phi_q, phi_v] = [dot(&self.phi, qa), dot(&self.phi, va)];
+            let [phi_q, phi_v] = [dot(&bm.phi, qa), dot(&bm.phi, va)];
             r[nm] = -rho * (l * ax - thd * thd * l * l / 2.0)
                 + 2.0 * rho * thd * phi_v
                 + rho * thdd * phi_q
                 + rho * l * thd * thd * qu;
-            r[nm + 1] = -self.jp * thdd;
+            r[nm + 1] = -bm.jp * thdd;
             if let Some(geo) = &self.geometric {
                 // Eq. 23: - rho (th'^2 G1 - a_x G2) alpha, at the predictor (docs/amm.md section 8)
                 let (c1, c2) = (rho * thd * thd, -rho * (ax + self.udd[i]));
@@ -631,11 +719,13 @@ impl System {
     /// Eq. D2: the Kelvin-Voigt force `- beta rho lambda_j alpha_j'` at the predictor `vhat` on
     /// every beam's alpha rows (the `D vhat` part of the step's forcing) [N].
     fn damping_forcing(&mut self, vhat: &[f64]) {
-        let (nm, nb, c) = (self.nm, self.nb, self.beta * self.rho);
+        let (nm, nb) = (self.nm, self.nb);
         for i in 0..3 {
+            let bm = pick(&self.bm, i);
+            let c = self.beta * bm.rho;
             let o = i * nb;
             let rows = self.resid[o..o + nm].iter_mut().zip(&vhat[o..o + nm]);
-            for ((r, v), l) in rows.zip(&self.lambda_m) {
+            for ((r, v), l) in rows.zip(&bm.lambda_m) {
                 *r -= c * l * v;
             }
         }
@@ -646,21 +736,23 @@ impl System {
     /// `- alpha Jp thp'` on the thp row (the payload's `- alpha M_p P vhat` is added with its
     /// other terms, `attachment_forcing`) [N, N, N m].
     fn mass_damping_forcing(&mut self, vhat: &[f64]) {
-        let (nm, nb, c) = (self.nm, self.nb, self.alpha * self.rho);
+        let (nm, nb) = (self.nm, self.nb);
         for i in 0..3 {
+            let bm = pick(&self.bm, i);
+            let c = self.alpha * bm.rho;
             let o = i * nb;
             for (r, v) in self.resid[o..o + nm].iter_mut().zip(&vhat[o..o + nm]) {
                 *r -= c * v;
             }
-            self.resid[o + nm] -= c * self.l * vhat[o + nm];
-            self.resid[o + nm + 1] -= self.alpha * self.jp * vhat[o + nm + 1];
+            self.resid[o + nm] -= c * bm.l * vhat[o + nm];
+            self.resid[o + nm + 1] -= self.alpha * bm.jp * vhat[o + nm + 1];
         }
     }
 
     /// `P q_1` (Eq. P1): `(u_1, phi(0) . alpha_1, phi'(0) . alpha_1)` of beam 1's block of `q`.
     fn payload_coordinates(&self, q: &[f64]) -> [f64; 3] {
-        let nm = self.nm;
-        [q[nm], dot(&self.phi0, &q[..nm]), dot(&self.dphi0, &q[..nm])]
+        let (nm, b) = (self.nm, &self.bm[0]);
+        [q[nm], dot(&b.phi0, &q[..nm]), dot(&b.dphi0, &q[..nm])]
     }
 
     /// Gravity `[gx, gy]` [m/s^2], base frame.
@@ -724,7 +816,8 @@ impl System {
         }
         let r = &mut self.resid[..nm + 1];
         r[nm] += rp[0];
-        for ((rj, p0), d0) in r[..nm].iter_mut().zip(&self.phi0).zip(&self.dphi0) {
+        let b = &self.bm[0];
+        for ((rj, p0), d0) in r[..nm].iter_mut().zip(&b.phi0).zip(&b.dphi0) {
             *rj += rp[1] * p0 + rp[2] * d0;
         }
     }
@@ -743,9 +836,11 @@ impl System {
         qhat: &[f64],
         vhat: &[f64],
     ) {
-        let (nm, nb, rho, l) = (self.nm, self.nb, self.rho, self.l);
+        let (nm, nb) = (self.nm, self.nb);
         let thd = st.theta.d1;
         for i in 0..3 {
+            let bm = pick(&self.bm, i);
+            let (rho, l) = (bm.rho, bm.l);
             // Eqs. 11-12: e_x = [sin a, -cos a], e_w = [cos a, sin a], one sin/cos pair
             let ex = st.e_x(i);
             let ew = [-ex[1], ex[0]];
@@ -758,8 +853,8 @@ impl System {
             let mut phi_q = 0.0;
             let mut phi_v = 0.0;
             for j in 0..nm {
-                let pj = self.phi[j];
-                r[j] = -rho * (daw * pj + d_thdd * self.psi[j]) - 2.0 * rho * d_thd * pj * vu
+                let pj = bm.phi[j];
+                r[j] = -rho * (daw * pj + d_thdd * bm.psi[j]) - 2.0 * rho * d_thd * pj * vu
                     + 2.0 * rho * thd * d_thd * qa[j]
                     - rho * d_thdd * pj * qu;
                 phi_q += pj * qa[j];
@@ -769,7 +864,7 @@ impl System {
                 + 2.0 * rho * d_thd * phi_v
                 + rho * d_thdd * phi_q
                 + 2.0 * rho * l * thd * d_thd * qu;
-            r[nm + 1] = -self.jp * d_thdd;
+            r[nm + 1] = -bm.jp * d_thdd;
             if let Some(geo) = &self.geometric {
                 // G1 alpha, G2 alpha of the last forcing (the same qhat)
                 let (c1, c2) = (2.0 * rho * thd * d_thd, -rho * dax);
@@ -810,31 +905,17 @@ impl System {
         let thd = st.theta.d1;
         let thdd = st.theta.d2;
         self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
+        // each beam's arrowhead and the Gram data of its junction vectors (once for equal beams)
         self.factor_s(bp, gp, thd, thdd);
 
-        // Gram data of the junction vectors (shared by the beams)
-        for (sv, v) in self.scaled0.iter_mut().zip([&self.phi0, &self.dphi0]) {
-            for ((s, x), d) in sv.iter_mut().zip(v.iter()).zip(&self.inv_d) {
-                *s = x * d;
-            }
-        }
-        let [g00, g01, w0] = dots(&self.scaled0[0], [&self.phi0, &self.dphi0, &self.phi]);
-        let [g11, w1] = dots(&self.scaled0[1], [&self.dphi0, &self.phi]);
-
         let m = self.rows.len();
-        let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp_step);
         self.a.iter_mut().for_each(|v| *v = 0.0);
         // disjoint borrows of the fields (no copy of the beams' workspaces)
-        let (beams, a_mat, inv_d, phi0, dphi0, phi) = (
-            &mut self.beams,
-            &mut self.a,
-            &self.inv_d,
-            &self.phi0,
-            &self.dphi0,
-            &self.phi,
-        );
-        for beam in beams.iter_mut() {
-            beam.fill_gram([g00, g01, g11], [w0, w1], inv_d, [phi0, dphi0, phi]);
+        let (beams, a_mat, bm) = (&mut self.beams, &mut self.a, &self.bm);
+        for (i, beam) in beams.iter_mut().enumerate() {
+            let b = pick(bm, i);
+            let (p, inv_sigma, inv_jp) = (b.p, b.inv_sigma, 1.0 / b.jp_step);
+            beam.fill_gram(b.jgram, b.jw, &b.inv_d, [&b.phi0, &b.dphi0, &b.phi]);
             beam.add_block(a_mat, m, p, inv_sigma, inv_jp);
         }
         self.sleeves.add_compliance(&mut self.a, m, &self.beams, bp);
@@ -855,7 +936,7 @@ impl System {
         let Some(pl) = self.payload.as_mut() else {
             return Ok(());
         };
-        let (h, cross, back) = beam.payload_products(self.p, self.inv_sigma);
+        let (h, cross, back) = beam.payload_products(self.bm[0].p, self.bm[0].inv_sigma);
         if !pl.set_woodbury(x, (bp, gp, 1.0 + gp * self.alpha), &h) {
             return Err(AmmError::SingularConstraints {
                 t: st.t,
@@ -909,12 +990,13 @@ impl System {
         let nm = self.nm;
         let c = pl.apply_w(self.payload_coordinates(x));
         let mut tmp = std::mem::take(&mut self.pay_tmp);
-        for ((t, p0), d0) in tmp[..nm].iter_mut().zip(&self.phi0).zip(&self.dphi0) {
+        let b = &self.bm[0];
+        for ((t, p0), d0) in tmp[..nm].iter_mut().zip(&b.phi0).zip(&b.dphi0) {
             *t = c[1] * p0 + c[2] * d0;
         }
         tmp[nm] = c[0];
         tmp[nm + 1] = 0.0;
-        self.arrow_solve(&mut tmp);
+        b.arrow_solve(&mut tmp);
         for (xi, t) in x.iter_mut().zip(&tmp) {
             *xi -= t;
         }
@@ -926,12 +1008,13 @@ impl System {
     /// `qhat` given (and `bp > 0`), `C qdd = 0` without. Writes `qdd` and `self.lam`.
     pub(crate) fn solve_prepared(&mut self, bp: f64, qhat: Option<&[f64]>, qdd: &mut [f64]) {
         let (nm, nb) = (self.nm, self.nb);
-        let (p, inv_sigma, inv_jp) = (self.p, self.inv_sigma, 1.0 / self.jp_step);
         self.rhs.iter_mut().for_each(|v| *v = 0.0);
         // disjoint borrows of the fields (no copy of the beams' workspaces)
         let (beams, resid, dinv_r, rhs) = (&self.beams, &self.resid, &mut self.dinv_r, &mut self.rhs);
-        let (w, inv_d, phi0, dphi0) = (&self.w, &self.inv_d, &self.phi0, &self.dphi0);
         for (i, beam) in beams.iter().enumerate() {
+            let b = pick(&self.bm, i);
+            let (p, inv_sigma, inv_jp) = (b.p, b.inv_sigma, 1.0 / b.jp_step);
+            let (w, inv_d, phi0, dphi0) = (&b.w, &b.inv_d, &b.phi0, &b.dphi0);
             let o = i * nb;
             // c_k . S^-1 r = ca_k D^-1 r_a + (cu_k - p g_k) y_r + ct_k r_thp / Jp, and c_k . qhat
             let r = &resid[o..o + nb];
@@ -1006,22 +1089,23 @@ impl System {
             }
             for (a, &c) in coef.iter().enumerate() {
                 if c != 0.0 {
-                    for (q, v) in qdd[o..o + nm].iter_mut().zip(self.basis(beam, a)) {
+                    for (q, v) in qdd[o..o + nm].iter_mut().zip(self.basis(i, beam, a)) {
                         *q += c * v;
                     }
                 }
             }
         }
         for i in 0..3 {
-            self.arrow_solve(&mut qdd[i * nb..(i + 1) * nb]);
+            self.beam(i).arrow_solve(&mut qdd[i * nb..(i + 1) * nb]);
         }
         self.payload_correct(&mut qdd[..nb]);
     }
 
     /// The sleeve rows evaluated exactly at the state q, for tests ([`Sleeves::gaps`]) [m].
     #[cfg(test)]
-    pub(crate) fn sleeve_gaps(&self, q: &[f64], lp: f64) -> [f64; 3] {
-        self.sleeves.gaps(&self.modes, &self.beams, &self.lam, q, lp)
+    pub(crate) fn sleeve_gaps(&self, q: &[f64], lp: [f64; 3]) -> [f64; 3] {
+        let modes: [&ModeSet; 3] = std::array::from_fn(|i| &self.beam(i).modes);
+        self.sleeves.gaps(modes, &self.beams, &self.lam, q, lp)
     }
 
     /// The constraint Jacobian C (rows x 3 (N + 2), row-major) at the last sleeve update: the
@@ -1036,7 +1120,7 @@ impl System {
                 row[o + nm] += beam.cu[k];
                 row[o + nm + 1] += beam.ct[k];
                 if beam.basis[k] != NONE {
-                    for (r, v) in row[o..o + nm].iter_mut().zip(self.basis(beam, beam.basis[k])) {
+                    for (r, v) in row[o..o + nm].iter_mut().zip(self.basis(i, beam, beam.basis[k])) {
                         *r += beam.sc[k] * v;
                     }
                 }
@@ -1055,7 +1139,7 @@ impl System {
             for (k, &g) in beam.ids.iter().enumerate() {
                 let mut v = beam.gu[k] * q[o + nm] + beam.ct[k] * q[o + nm + 1] + beam.gv[k];
                 if beam.basis[k] != NONE {
-                    v += beam.sc[k] * dot(self.basis(beam, beam.basis[k]), &q[o..o + nm]);
+                    v += beam.sc[k] * dot(self.basis(i, beam, beam.basis[k]), &q[o..o + nm]);
                 }
                 r[g] += v;
             }
@@ -1065,7 +1149,7 @@ impl System {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::solver::integrate;
     use flexstar_model::{AmmSettings, ModeFamily, Trajectory};
@@ -1103,7 +1187,14 @@ mod tests {
             Some(vec![0.0, 0.0, 8.0, -12.0]),
         );
         let problem = exp.problem().unwrap();
-        let exp = problem.equal_beams().unwrap();
+        energy_balance_on(&problem);
+    }
+
+    /// The energy balance of `problem` run with the sliders held (its trajectory constant).
+    pub(crate) fn energy_balance_on(problem: &flexstar_model::Problem) {
+        let exp = crate::star::Star::new(problem);
+        let st0 = exp.state(0.0).unwrap();
+        let (ex, ew) = (st0.e_x(0), st0.e_w(0));
         let settings = AmmSettings::paper(ModeFamily::FreeFree, 20);
         let mut qs: Vec<Vec<f64>> = vec![vec![0.0; 3 * 22]];
         let mut sys_copy = None;
@@ -1114,16 +1205,16 @@ mod tests {
         .unwrap();
         let sys = sys_copy.unwrap();
         let h = exp.time.t_end / (qs.len() - 1) as f64;
-        let (nm, nb, rho) = (sys.nm, sys.nb, sys.rho);
+        let (nm, nb) = (sys.nm, sys.nb);
         let pl = PayloadTerms::new(exp.payload, 0).unwrap();
         let mp = pl.mass_matrix();
         // the kinetic energy of velocities v: v^T M v / 2 (beams, sleeves, payload)
         let kinetic = |v: &[f64]| {
             let mut e = 0.0;
             for i in 0..3 {
-                let o = i * nb;
-                e += 0.5 * rho * v[o..o + nm].iter().map(|x| x * x).sum::<f64>();
-                e += 0.5 * (rho * sys.l * v[o + nm].powi(2) + sys.jp * v[o + nm + 1].powi(2));
+                let (o, b) = (i * nb, sys.beam(i));
+                e += 0.5 * b.rho * v[o..o + nm].iter().map(|x| x * x).sum::<f64>();
+                e += 0.5 * (b.rho * b.l * v[o + nm].powi(2) + b.jp * v[o + nm + 1].powi(2));
             }
             let zv = sys.payload_coordinates(v);
             e + 0.5
@@ -1138,8 +1229,9 @@ mod tests {
                 .collect();
             let mut e = kinetic(&v);
             for i in 0..3 {
+                let b = sys.beam(i);
                 for j in 0..nm {
-                    e += 0.5 * rho * sys.lambda_m[j] * qs[n][i * nb + j].powi(2);
+                    e += 0.5 * b.rho * b.lambda_m[j] * qs[n][i * nb + j].powi(2);
                 }
             }
             e
@@ -1149,12 +1241,13 @@ mod tests {
         for n in 0..qs.len() - 2 {
             let dq: Vec<f64> = (0..qs[n].len()).map(|k| qs[n + 1][k] - qs[n][k]).collect();
             let dz = sys.payload_coordinates(&dq);
-            // theta = 0: e_x1 = (0, -1), e_w1 = (1, 0), so (F . e_x1, F . e_w1, Mz) = (-Fy, Fx, Mz)
+            // (F . e_x1, F . e_w1, Mz) on beam 1's coordinates (Eq. L1) at the held pose
             let [fx, fy, mz] = exp.load.at((n as f64 + 0.5) * h);
-            work += -fy * dz[0] + fx * dz[1] + mz * dz[2];
+            work += (fx * ex[0] + fy * ex[1]) * dz[0] + (fx * ew[0] + fy * ew[1]) * dz[1] + mz * dz[2];
             for i in 0..3 {
+                let b = sys.beam(i);
                 for j in 0..nm {
-                    dissipated += beta * rho * sys.lambda_m[j] * dq[i * nb + j].powi(2) / h;
+                    dissipated += beta * b.rho * b.lambda_m[j] * dq[i * nb + j].powi(2) / h;
                 }
             }
             // Eq. D20: alpha v^T M v, with v = dq / h on the step

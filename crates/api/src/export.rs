@@ -575,6 +575,7 @@ fn limit_checks(limits: Option<&Limits>, p: &Peaks) -> Vec<LimitCheck> {
     [
         ("v_max", "m/s", l.v_max, max(p.v_m_per_s)),
         ("a_max", "m/s^2", l.a_max, max(p.a_m_per_s2)),
+        ("j_max", "m/s^3", l.j_max, max(p.j_m_per_s3)),
         ("Fa_max", "N", l.fa_max, max(p.f_n)),
     ]
     .into_iter()

@@ -8,7 +8,7 @@ use serde_json::{json, Value};
 
 use flexstar_metrics::residual::dg_magnitude;
 use flexstar_model::{Experiment, Response};
-use flexstar_plan::limits::{kinematic_peaks, Peak};
+use flexstar_plan::limits::{kinematic_peaks, KinematicPeaks, Peak};
 use flexstar_plan::objective::force_peak;
 use flexstar_plan::PlanConfig;
 use flexstar_plot::{Figure, Panel, Series, Style, FAMILY_COLORS, FEM_STYLE, MARK_STYLE};
@@ -32,9 +32,11 @@ pub struct MotionRow {
     pub settle_s: [Option<f64>; 2],
     /// Peak |Fa_i| [N]; AMM, FEM.
     pub fa_peak_n: [f64; 2],
-    /// Peak slider speed [m/s] and acceleration [m/s^2].
+    /// Peak slider speed [m/s], acceleration [m/s^2] and jerk [m/s^3] (rigid kinematics, exact
+    /// jets; `docs/motions.md` 4.10).
     pub v_peak: f64,
     pub a_peak: f64,
+    pub j_peak: f64,
     /// (AMM - FEM) / FEM of the residual peak of G [%].
     pub g_peak_diff_percent: Option<f64>,
     /// The shaper's frequencies [Hz] and penalty [s] (the ZVD row).
@@ -51,8 +53,13 @@ pub fn motion_row(m: &MotionRuns) -> MotionRow {
     };
     let t_rest = m.exp.trajectory.t_rest().unwrap_or(f64::NAN);
     let t0 = m.exp.trajectory.t_start();
-    let (v, a) = kinematic_peaks(&m.exp.robot, &m.exp.trajectory, (t0, t_rest), m.exp.time.dt_out, &[])
-        .unwrap_or((zero_peak(), zero_peak()));
+    let zero = KinematicPeaks {
+        v: zero_peak(),
+        a: zero_peak(),
+        j: zero_peak(),
+    };
+    let KinematicPeaks { v, a, j } =
+        kinematic_peaks(&m.exp.robot, &m.exp.trajectory, (t0, t_rest), m.exp.time.dt_out, &[]).unwrap_or(zero);
     let g = both(|r| r.g_peak_m);
     let shaper = m.exp.shaper.as_ref();
     MotionRow {
@@ -67,6 +74,7 @@ pub fn motion_row(m: &MotionRuns) -> MotionRow {
         fa_peak_n: [force_peak(&m.amm.response).value, force_peak(&m.fem.response).value],
         v_peak: v.value,
         a_peak: a.value,
+        j_peak: j.value,
         g_peak_diff_percent: match g {
             [Some(a), Some(f)] if f > 0.0 => Some(100.0 * (a - f) / f),
             _ => None,
@@ -95,10 +103,11 @@ pub fn plan_json(cfg: &PlanConfig, o: &PlanOutcome) -> Value {
         "plan": cfg.plan,
         "limits": cfg.limits,
         "planner": p,
+        "warnings": p.warnings,
         "via_points": points,
         "via_equivalent": "kind = \"via\", rest = false through via_points: the spline plan.csv samples",
-        "plain_r_norm_m": p.plain.norm(),
-        "planned_r_norm_m": p.eval.norm(),
+        "plain_r_norm_m": p.plain.norm_g(),
+        "planned_r_norm_m": p.eval.norm_g(),
         "comparison": o.motions.iter().map(motion_row).collect::<Vec<_>>(),
         "wall_s": o.wall_s,
     })
@@ -133,6 +142,7 @@ pub fn plan_markdown(cfg: &PlanConfig, o: &PlanOutcome) -> String {
         p.family.m,
     );
     s += &search_text(p);
+    s += &peaks_text(p);
     s += &comparison_table(&rows);
     s += &reading_text(&rows);
     s += &format!(
@@ -151,9 +161,9 @@ fn search_text(p: &flexstar_plan::Planned) -> String {
         p.modes,
         p.window_s,
         p.f1_hz,
-        p.plain.norm(),
-        p.eval.norm(),
-        100.0 * p.eval.norm() / p.plain.norm(),
+        p.plain.norm_g(),
+        p.eval.norm_g(),
+        100.0 * p.eval.norm_g() / p.plain.norm_g(),
         p.evaluations,
         p.wall_s,
         p.reason
@@ -164,6 +174,52 @@ fn search_text(p: &flexstar_plan::Planned) -> String {
              (AMM peak {:.3e} m); the planned move lasts {:.4} s, {:.1} % shorter.\n\n",
             ts.residual_max_m, ts.zvd_base_s, ts.zvd_duration_s, ts.zvd_peak_m, p.t_move, ts.shorter_percent
         );
+        s += &format!(
+            "The search over t_move ({} AMM runs for the ZVD baseline, {} for the planned durations):\n\n\
+             | t_move [s] | AMM residual peak [m] | holds | AMM runs | LM RMS of abs(dG) [m] | stop | wall [s] |\n|---|---|---|---|---|---|---|\n",
+            ts.zvd_evaluations, ts.search_evaluations
+        );
+        for st in &ts.steps {
+            s += &format!(
+                "| {:.4} | {:.3e} | {} | {} | {} | {} | {:.2} |\n",
+                st.t_move,
+                st.peak_m,
+                if st.ok { "yes" } else { "no" },
+                st.evaluations,
+                st.r_norm_m.map_or("-".into(), |r| format!("{r:.3e}")),
+                st.reason,
+                st.wall_s
+            );
+        }
+        s += "\n";
+    }
+    s
+}
+
+/// The limits the search enforced, the peaks against the plain quintic's, and the warnings
+/// (`docs/motions.md` 4.10).
+fn peaks_text(p: &flexstar_plan::Planned) -> String {
+    let b = &p.bounds;
+    let lim = |v: Option<f64>| v.map_or("none".to_string(), |v| format!("{v:.4}"));
+    let (q, n) = (&p.peaks.plain, &p.peaks.planned);
+    let mut s = format!(
+        "Limits the search enforced (peak factor {}): v_max {} m/s, a_max {} m/s^2, j_max {} m/s^3, Fa_max {} N. \
+         Peaks, plain quintic -> planned (AMM search samples): |s''| {:.4} -> {:.4} m/s^2, |s'''| {:.2} -> {:.2} m/s^3, \
+         |Fa| {:.4} -> {:.4} N.\n\n",
+        p.peak_factor.map_or("off".to_string(), |f| f.to_string()),
+        lim(b.v_max),
+        lim(b.a_max),
+        lim(b.j_max),
+        lim(b.fa_max),
+        q.a.value,
+        n.a.value,
+        q.j.value,
+        n.j.value,
+        q.fa.value,
+        n.fa.value
+    );
+    for w in &p.warnings {
+        s += &format!("**Warning:** {w}.\n\n");
     }
     s
 }
@@ -171,7 +227,7 @@ fn search_text(p: &flexstar_plan::Planned) -> String {
 /// The comparison table (AMM / FEM in each cell).
 fn comparison_table(rows: &[MotionRow]) -> String {
     let mut s = String::from(
-        "## Comparison (each cell AMM / FEM)\n\n| motion | move [s] | t_rest [s] | residual G peak [mm] | G RMS [mm] | tips peak [mm] | tips RMS [mm] | settle [s] | peak abs(Fa) [N] | peak abs(s') [m/s] | peak abs(s'') [m/s^2] | AMM-FEM G peak [%] | shaper [Hz], penalty [s] |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "## Comparison (each cell AMM / FEM)\n\n| motion | move [s] | t_rest [s] | residual G peak [mm] | G RMS [mm] | tips peak [mm] | tips RMS [mm] | settle [s] | peak abs(Fa) [N] | peak abs(s') [m/s] | peak abs(s'') [m/s^2] | peak abs(s''') [m/s^3] | AMM-FEM G peak [%] | shaper [Hz], penalty [s] |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let pair = |v: [Option<f64>; 2]| format!("{} / {}", mm(v[0]), mm(v[1]));
@@ -187,7 +243,7 @@ fn comparison_table(rows: &[MotionRow]) -> String {
             None => "-".into(),
         };
         s += &format!(
-            "| {} | {:.4} | {:.4} | {} | {} | {} | {} | {} / {} | {:.3} / {:.3} | {:.4} | {:.3} | {} | {} |\n",
+            "| {} | {:.4} | {:.4} | {} | {} | {} | {} | {} / {} | {:.3} / {:.3} | {:.4} | {:.3} | {:.1} | {} | {} |\n",
             r.motion,
             r.move_s,
             r.t_rest,
@@ -201,6 +257,7 @@ fn comparison_table(rows: &[MotionRow]) -> String {
             r.fa_peak_n[1],
             r.v_peak,
             r.a_peak,
+            r.j_peak,
             r.g_peak_diff_percent.map_or("n/a".into(), |d| format!("{d:+.1}")),
             shaper
         );

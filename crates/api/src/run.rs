@@ -337,12 +337,19 @@ pub fn solve(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<Re
 /// written.
 pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunOutcome> {
     let response = solve(p, progress)?;
-    let check = flexstar_metrics::small_deflection_check(&response, p.exp.robot.l);
+    // judged on the shortest beam of a robot as built (docs/as-built.md 6)
+    let l = flexstar_model::Robot::from_params(&p.exp.robot)
+        .map(|r| r.beams().iter().map(|b| b.length).fold(f64::INFINITY, f64::min))
+        .unwrap_or(p.exp.robot.l);
+    let check = flexstar_metrics::small_deflection_check(&response, l);
     let warning = check.as_ref().map(|v| format!("{}: {} {v}", p.source, p.stem));
     let mut sidecar = response.sidecar(&p.exp, &crate::provenance(), check);
-    sidecar.residual = Some(residual_keys(p, &response)?);
+    sidecar.residual = residual_keys(p, &response)?;
     if p.solver == Solver::Amm {
-        let why = outside_envelope(&p.exp, warning.is_none());
+        let mut why = outside_envelope(&p.exp, warning.is_none());
+        if p.exp.robot.as_built.is_some() {
+            why.push("the robot is one as built; the envelope was validated on three equal beams".to_string());
+        }
         sidecar.validated_envelope = Some(why.is_empty());
         sidecar.validated_envelope_reasons = Some(why);
     }
@@ -360,13 +367,18 @@ pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunO
 /// The residual vibration after the motion's end (`docs/motions.md` section 2) as the sidecar's
 /// keys ([`flexstar_model::ResidualKeys`]). An AMM run of the pinned-free family has G pinned by
 /// its modes (`phi(0) = 0`): its residual of G is null, with a note.
-fn residual_keys(p: &Prepared, r: &Response) -> Result<flexstar_model::ResidualKeys> {
+fn residual_keys(p: &Prepared, r: &Response) -> Result<Option<flexstar_model::ResidualKeys>> {
+    if p.exp.robot.as_built.is_some() {
+        // their hold is the first period at the final pose, which flexstar_modal computes on
+        // the paper's form only so far (docs/as-built.md 6)
+        return Ok(None);
+    }
     let res = flexstar_modal::settle::run_residual(&p.exp, r).map_err(|e| ApiError::solver(&p.source, e))?;
     let pinned = p.solver == Solver::Amm && p.exp.amm.family == ModeFamily::PinnedFree;
     let mut keys = flexstar_metrics::residual::sidecar_keys(res.as_ref(), p.exp.report.settle_tol, pinned);
     // per dwell (docs/motions.md 2.5): an addition, the keys above stay as they are
     keys.dwells = flexstar_modal::settle::run_dwells(&p.exp, r, pinned).map_err(|e| ApiError::solver(&p.source, e))?;
-    Ok(keys)
+    Ok(Some(keys))
 }
 
 /// Why an AMM run is outside the validated envelope of the accurate model (`docs/validation.md`

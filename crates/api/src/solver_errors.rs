@@ -34,7 +34,9 @@ pub fn from_fem(file: &str, e: FemError) -> ApiError {
             file: file.to_string(),
             t: *t,
         },
-        FemError::MeshTooCoarse { .. } => ApiError::config_text(file, Some("fem.elements"), &e.to_string(), message),
+        FemError::MeshTooCoarse { .. } | FemError::Elements { .. } => {
+            ApiError::config_text(file, Some("fem.elements"), &e.to_string(), message)
+        }
         FemError::Infeasible { t, .. }
         | FemError::SleeveOffBeam { t, .. }
         | FemError::SliderOffBase { t, .. }

@@ -38,9 +38,11 @@ use flexstar_model::{DriveKind, EqualBeams, Feedforward};
 /// The actuator law of a problem's drive (`docs/drives.md`): `None` for `kind = "motion"` (the
 /// trajectory is imposed), else the forces (table or polynomials) or the servo tracking
 /// the problem's trajectory with its gains resolved (`bandwidth_hz` with the slider mass
-/// `mpp_mpa`). The drive was validated with the problem; errors name the `drive.` key.
-pub fn law_for(problem: &EqualBeams) -> Result<Option<Box<dyn ActuatorLaw>>, DriveError> {
-    let d = problem.drive;
+/// `mpp_mpa`). The drive was validated with the problem; errors name the `drive.` key. Motions and
+/// forces take any robot; a servo (its rigid feed-forward and gains) the paper's form only so far
+/// (`docs/as-built.md` 6).
+pub fn law_for(problem: &flexstar_model::Problem) -> Result<Option<Box<dyn ActuatorLaw>>, DriveError> {
+    let d = problem.drive();
     let invalid = |e: flexstar_model::ModelError| match e {
         flexstar_model::ModelError::Invalid { key, reason, .. } => DriveError::Config(format!("key `{key}`: {reason}")),
         other => DriveError::Config(other.to_string()),
@@ -59,17 +61,21 @@ pub fn law_for(problem: &EqualBeams) -> Result<Option<Box<dyn ActuatorLaw>>, Dri
             }
         },
         DriveKind::Servo => {
-            let g = d.servo_gains(problem.robot.mpp_mpa).map_err(invalid)?;
+            let params = problem
+                .robot()
+                .paper_form_for("a servo drive")
+                .map_err(|e| DriveError::Config(e.to_string()))?;
+            let g = d.servo_gains(params.mpp_mpa).map_err(invalid)?;
             Some(Box::new(Servo {
                 kp: [g.kp; 3],
                 kd: [g.kd; 3],
                 rigid_feedforward: d.feedforward.unwrap_or_default() == Feedforward::Rigid,
-                reference: problem.trajectory.clone(),
-                params: *problem.robot,
+                reference: problem.trajectory().clone(),
+                params: *params,
                 attached: flexstar_model::Attachments {
-                    payload: *problem.payload,
-                    load: problem.load.clone(),
-                    gravity: flexstar_model::Gravity::new(problem.gravity),
+                    payload: *problem.payload(),
+                    load: problem.load().clone(),
+                    gravity: flexstar_model::Gravity::new(problem.gravity()),
                 },
             }))
         }
@@ -146,7 +152,7 @@ mod tests {
     /// The law of an experiment's drive, through its problem (where the drive is validated).
     fn law_of(exp: &flexstar_model::Experiment) -> Result<Option<Box<dyn ActuatorLaw>>, String> {
         let problem = exp.problem().map_err(|e| e.to_string())?;
-        law_for(&problem.equal_beams().map_err(|e| e.to_string())?).map_err(|e| e.to_string())
+        law_for(&problem).map_err(|e| e.to_string())
     }
 
     #[test]

@@ -135,14 +135,14 @@ impl<T: Real> ElementState<T> {
 
     /// Local forces `[N, M1, M2]` (axial force [N], end moments [N m]).
     #[inline(always)]
-    pub fn local_forces(&self, ea: f64, ei: f64) -> [T; 3] {
+    pub fn local_forces(&self, ea: T, ei: T) -> [T; 3] {
         self.local_forces_at([self.u, self.th1, self.th2], ea, ei)
     }
 
     /// Local forces `K_l p` [N, N m, N m] of the local deformations `p = [u, th1, th2]` [m, rad,
     /// rad], `K_l = diag(EA/l0, EI/l0 [4 2; 2 4])`.
     #[inline(always)]
-    fn local_forces_at(&self, p: [T; 3], ea: f64, ei: f64) -> [T; 3] {
+    fn local_forces_at(&self, p: [T; 3], ea: T, ei: T) -> [T; 3] {
         let k = self.inv_l0 * ei;
         [
             p[0] * ea * self.inv_l0,
@@ -171,7 +171,7 @@ impl<T: Real> ElementState<T> {
     /// the retardation time `beta` [s] and the rates of [`ElementState::local_rates`]; returns
     /// them with the rates `p'`.
     #[inline(always)]
-    pub fn damped_local_forces(&self, ea: f64, ei: f64, beta: f64, qd: &[T; 6]) -> ([T; 3], [T; 3]) {
+    pub fn damped_local_forces(&self, ea: T, ei: T, beta: T, qd: &[T; 6]) -> ([T; 3], [T; 3]) {
         let pd = self.local_rates(qd);
         let p = [self.u + pd[0] * beta, self.th1 + pd[1] * beta, self.th2 + pd[2] * beta];
         (self.local_forces_at(p, ea, ei), pd)
@@ -180,7 +180,7 @@ impl<T: Real> ElementState<T> {
     /// Dissipated power of the element, Eq. D10: `P_d = beta p'^T K_l p'` [W] (>= 0) at the
     /// element velocities `qd`.
     #[inline(always)]
-    pub fn dissipation_power(&self, ea: f64, ei: f64, beta: f64, qd: &[T; 6]) -> T {
+    pub fn dissipation_power(&self, ea: T, ei: T, beta: T, qd: &[T; 6]) -> T {
         let pd = self.local_rates(qd);
         let kp = self.local_forces_at(pd, ea, ei);
         (pd[0] * kp[0] + pd[1] * kp[1] + pd[2] * kp[2]) * beta
@@ -188,9 +188,9 @@ impl<T: Real> ElementState<T> {
 
     /// Strain energy [J]: `EA u^2 / (2 l0) + EI/l0 (2 th1^2 + 2 th1 th2 + 2 th2^2)`.
     #[inline(always)]
-    pub fn strain_energy(&self, ea: f64, ei: f64) -> T {
-        self.u * (0.5 * ea) * self.u / self.l0
-            + T::splat(ei) / self.l0 * 2.0 * (self.th1 * self.th1 + self.th1 * self.th2 + self.th2 * self.th2)
+    pub fn strain_energy(&self, ea: T, ei: T) -> T {
+        self.u * (ea * 0.5) * self.u / self.l0
+            + ei / self.l0 * 2.0 * (self.th1 * self.th1 + self.th1 * self.th2 + self.th2 * self.th2)
     }
 
     /// Internal force vector f = B^T [N, M1, M2] and tangent stiffness
@@ -203,11 +203,11 @@ impl<T: Real> ElementState<T> {
     /// the rotation-translation coupling is `-(k4 + k2) / l_n z`, and the rotation block is
     /// `[k4, k2; k2, k4]` (`k4 = 4 EI / l0`, `k2 = 2 EI / l0`).
     #[inline(always)]
-    pub fn internal(&self, ea: f64, ei: f64) -> ([T; 6], Mat6<T>) {
+    pub fn internal(&self, ea: T, ei: T) -> ([T; 6], Mat6<T>) {
         let [n, m1, m2] = self.local_forces(ea, ei);
         let f = self.internal_force(ea, ei);
         let il0 = self.inv_l0;
-        let (ka, k4, k2) = (il0 * ea, il0 * (4.0 * ei), il0 * (2.0 * ei));
+        let (ka, k4, k2) = (il0 * ea, il0 * (ei * 4.0), il0 * (ei * 2.0));
         (f, self.tangent(ka, k4, k2, n, m1 + m2))
     }
 
@@ -218,19 +218,19 @@ impl<T: Real> ElementState<T> {
     /// the geometric part of [`ElementState::internal`] with the damped local forces scaled by
     /// `c_geo` (`beta'`). The non-symmetric `beta B^T K_l dp'/dq` is left out (modified Newton).
     #[inline(always)]
-    pub fn damped_internal(&self, sec: [f64; 3], qd: &[T; 6], c_mat: T, c_geo: T) -> ([T; 6], Mat6<T>) {
+    pub fn damped_internal(&self, sec: [T; 3], qd: &[T; 6], c_mat: T, c_geo: T) -> ([T; 6], Mat6<T>) {
         let [ea, ei, beta] = sec;
         let ([n, m1, m2], _) = self.damped_local_forces(ea, ei, beta, qd);
         let f = self.force_of([n, m1, m2]);
         let il0 = self.inv_l0;
-        let (ka, k4, k2) = (il0 * ea * c_mat, il0 * (4.0 * ei) * c_mat, il0 * (2.0 * ei) * c_mat);
+        let (ka, k4, k2) = (il0 * ea * c_mat, il0 * (ei * 4.0) * c_mat, il0 * (ei * 2.0) * c_mat);
         (f, self.tangent(ka, k4, k2, n * c_geo, (m1 + m2) * c_geo))
     }
 
     /// The damped internal force of [`ElementState::damped_internal`] alone (`sec = [EA, EI,
     /// beta]` [N, N m^2, s]).
     #[inline(always)]
-    pub fn damped_internal_force(&self, sec: [f64; 3], qd: &[T; 6]) -> [T; 6] {
+    pub fn damped_internal_force(&self, sec: [T; 3], qd: &[T; 6]) -> [T; 6] {
         let [ea, ei, beta] = sec;
         self.force_of(self.damped_local_forces(ea, ei, beta, qd).0)
     }
@@ -281,7 +281,7 @@ impl<T: Real> ElementState<T> {
     /// Internal force vector `f = B^T [N, M1, M2]` alone (the first half of
     /// [`ElementState::internal`], for imbalance-only evaluations).
     #[inline(always)]
-    pub fn internal_force(&self, ea: f64, ei: f64) -> [T; 6] {
+    pub fn internal_force(&self, ea: T, ei: T) -> [T; 6] {
         self.force_of(self.local_forces(ea, ei))
     }
 
@@ -313,7 +313,7 @@ impl<T: Real> ElementState<T> {
     /// forming `M`, in closed form: with `J = sum_k phi_k A_k` and `r_conv = sum_k phi_k c_k`
     /// ([`ElementState::basis`]), `f = rho l0 sum_k A_k^T sum_l G_kl (A_l qdd + c_l)` ([`GRAM`]).
     #[inline(always)]
-    pub fn inertia_force(&self, rho: f64, qd: &[T; 6], qdd: &[T; 6]) -> [T; 6] {
+    pub fn inertia_force(&self, rho: T, qd: &[T; 6], qdd: &[T; 6]) -> [T; 6] {
         let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
         let jb = self.jbeta();
         let l0 = self.l0;
@@ -334,7 +334,7 @@ impl<T: Real> ElementState<T> {
 
     /// `rho l0 sum_k A_k^T v_k` (the transpose of the basis applied to four 2-vectors).
     #[inline(always)]
-    fn basis_transpose_times(&self, rho: f64, v: &[[T; 2]; 4]) -> [T; 6] {
+    fn basis_transpose_times(&self, rho: T, v: &[[T; 2]; 4]) -> [T; 6] {
         let (e1, e2) = ([self.c, self.s], [-self.s, self.c]);
         let jb = self.jbeta();
         let l0 = self.l0;
@@ -374,7 +374,7 @@ impl<T: Real> ElementState<T> {
     /// kg m^2] in closed form ([`ElementState::basis`], [`GRAM`]; exact, as the 4-point Gauss
     /// quadrature it replaces).
     #[inline(always)]
-    pub fn mass(&self, rho: f64) -> Mat6<T> {
+    pub fn mass(&self, rho: T) -> Mat6<T> {
         // A_0 = P_a, A_1 = P_b (node positions), A_2 = q e_phia^T + p_2 jb^T,
         // A_3 = q e_phib^T + p_3 jb^T with q = l0 e2, p_k = -l0 (e2 + th e1); expanded:
         const G: [[f64; 4]; 4] = GRAM;
@@ -446,7 +446,7 @@ impl<T: Real> ElementState<T> {
     /// Kinetic energy [J] of the element moving with velocities `qd`: `T = 1/2 qd . M(q) qd`
     /// (closed form: [`ElementState::inertia_force`] without its convective part).
     #[inline(always)]
-    pub fn kinetic_energy(&self, rho: f64, qd: &[T; 6]) -> T {
+    pub fn kinetic_energy(&self, rho: T, qd: &[T; 6]) -> T {
         let mqd = self.inertia_force(rho, &[T::splat(0.0); 6], qd);
         let mut sum = qd[0] * mqd[0];
         for j in 1..6 {
@@ -593,7 +593,7 @@ impl ElementState {
 /// rotations nor their angle (so no `atan2`: once per step for the energy balance). Equal to
 /// [`ElementState::dissipation_power`] up to round-off.
 #[inline(always)]
-pub fn chord_dissipation_power<T: Real>(l0: T, q: &[T; 6], qd: &[T; 6], sec: [f64; 3]) -> T {
+pub fn chord_dissipation_power<T: Real>(l0: T, q: &[T; 6], qd: &[T; 6], sec: [T; 3]) -> T {
     let [ea, ei, beta] = sec;
     let d = [q[3] - q[0], q[4] - q[1]];
     let dd = [qd[3] - qd[0], qd[4] - qd[1]];

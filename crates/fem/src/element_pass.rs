@@ -14,15 +14,91 @@ use flexstar_numerics::lanes::{F64x4, Real};
 
 use crate::element::{chord_dissipation_power, Element, ElementState};
 
-/// Section constants of the beams: axial stiffness EA [N], bending stiffness EI [N m^2], mass
+/// Section constants of one beam: axial stiffness EA [N], bending stiffness EI [N m^2], mass
 /// per length rho [kg/m], and the Kelvin-Voigt retardation time beta [s] (Eq. D1; 0: undamped,
-/// the damped code paths are then skipped).
-#[derive(Debug, Clone, Copy)]
+/// the damped code paths are then skipped; one value for the whole star).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Section {
     pub ea: f64,
     pub ei: f64,
     pub rho: f64,
     pub beta: f64,
+}
+
+/// The sections of the star's elements (`docs/fem.md` section 10, per-beam data): beam i's
+/// [`Section`] for its `per_beam` consecutive elements `i per_beam .. (i + 1) per_beam` (the
+/// element order of `crate::star`). A batch of four elements takes its lanes' section
+/// constants from their beams: one beam's values in every lane (the common case, and the only
+/// one when the three beams are equal), else lane by lane for a batch that straddles two beams.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Sections {
+    beams: [Section; 3],
+    per_beam: usize,
+    /// The three sections are equal: every batch takes beam 1's (the equal-beam path).
+    uniform: bool,
+}
+
+/// The section constants of `T::LANES` elements, one per lane: EA [N], EI [N m^2], rho [kg/m],
+/// beta [s].
+#[derive(Clone, Copy)]
+struct Lanes<T> {
+    ea: T,
+    ei: T,
+    rho: T,
+    beta: T,
+}
+
+impl Sections {
+    /// Beam i's section for the `per_beam` elements of beam i (elements numbered beam by beam).
+    pub fn per_beam(beams: [Section; 3], per_beam: usize) -> Self {
+        Sections {
+            beams,
+            per_beam: per_beam.max(1),
+            uniform: beams[1] == beams[0] && beams[2] == beams[0],
+        }
+    }
+
+    /// One section for every element.
+    #[cfg(test)]
+    pub fn uniform(sec: Section) -> Self {
+        Self::per_beam([sec; 3], usize::MAX)
+    }
+
+    /// The Kelvin-Voigt retardation time beta [s] (one for the star).
+    pub fn beta(&self) -> f64 {
+        self.beams[0].beta
+    }
+
+    /// The section of element `e`.
+    #[inline(always)]
+    pub fn of(&self, e: usize) -> &Section {
+        if self.uniform {
+            &self.beams[0]
+        } else {
+            &self.beams[(e / self.per_beam).min(2)]
+        }
+    }
+
+    /// The lanes' section constants of the `T::LANES` elements from `start`: splat when they
+    /// lie on one beam (bit for bit the constants of one element), else lane by lane.
+    #[inline(always)]
+    fn lanes<T: Real>(&self, start: usize) -> Lanes<T> {
+        let first = self.of(start);
+        if self.uniform || start / self.per_beam == (start + T::LANES - 1) / self.per_beam {
+            return Lanes {
+                ea: T::splat(first.ea),
+                ei: T::splat(first.ei),
+                rho: T::splat(first.rho),
+                beta: T::splat(first.beta),
+            };
+        }
+        Lanes {
+            ea: T::from_lanes(|k| self.of(start + k).ea),
+            ei: T::from_lanes(|k| self.of(start + k).ei),
+            rho: T::from_lanes(|k| self.of(start + k).rho),
+            beta: T::from_lanes(|k| self.of(start + k).beta),
+        }
+    }
 }
 
 /// Factors of the imbalance and of the Newton matrix: `cf` on the dynamic part of the imbalance,
@@ -121,13 +197,13 @@ flexstar_numerics::dispatch_avx2! {
     pub(crate) fn add_forces(
         elements: &[Element],
         nodes: NodeState,
-        sec: Section,
+        sec: &Sections,
         fac: Factors,
         res: &mut [f64],
         vals: Option<&mut [f64]>,
     ) -> Result<(), BadChord> {
         let terms = Terms { nodes, sec, fac };
-        if sec.beta > 0.0 {
+        if sec.beta() > 0.0 {
             add_all::<true>(elements, &terms, res, vals)
         } else {
             add_all::<false>(elements, &terms, res, vals)
@@ -158,7 +234,7 @@ fn add_all<const DAMPED: bool>(
 flexstar_numerics::dispatch_avx2! {
     /// Dissipated power of all elements [W], Eq. D10: `sum beta p'^T K_l p'`
     /// ([`ElementState::dissipation_power`], sums in element order).
-    pub(crate) fn dissipation_power(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> f64 {
+    pub(crate) fn dissipation_power(elements: &[Element], q: &[f64], v: &[f64], sec: &Sections) -> f64 {
         let full = elements.len() / LANES * LANES;
         let mut sum = 0.0;
         for start in (0..full).step_by(LANES) {
@@ -174,14 +250,14 @@ flexstar_numerics::dispatch_avx2! {
 flexstar_numerics::dispatch_avx2! {
     /// `sum_e x_e^T M_e y_e` over the elements at the global coordinates `q` (`x`, `y` global
     /// vectors; for velocities [m/s, rad/s] and rates [1/s^2] a power [W], Eq. D16).
-    pub(crate) fn mass_product(elements: &[Element], q: &[f64], x: &[f64], y: &[f64], rho: f64) -> f64 {
+    pub(crate) fn mass_product(elements: &[Element], q: &[f64], x: &[f64], y: &[f64], sec: &Sections) -> f64 {
         let full = elements.len() / LANES * LANES;
         let mut sum = 0.0;
         for start in (0..full).step_by(LANES) {
-            sum += mass_product_of::<F64x4>(elements, start, [q, x, y], rho);
+            sum += mass_product_of::<F64x4>(elements, start, [q, x, y], sec);
         }
         for start in full..elements.len() {
-            sum += mass_product_of::<f64>(elements, start, [q, x, y], rho);
+            sum += mass_product_of::<f64>(elements, start, [q, x, y], sec);
         }
         sum
     }
@@ -190,7 +266,7 @@ flexstar_numerics::dispatch_avx2! {
 flexstar_numerics::dispatch_avx2! {
     /// Kinetic and strain energy of all elements [J] (sums in element order):
     /// [`ElementState::kinetic_energy`], [`ElementState::strain_energy`].
-    pub(crate) fn energies(elements: &[Element], q: &[f64], v: &[f64], sec: Section) -> (f64, f64) {
+    pub(crate) fn energies(elements: &[Element], q: &[f64], v: &[f64], sec: &Sections) -> (f64, f64) {
         let full = elements.len() / LANES * LANES;
         let mut sums = (0.0, 0.0);
         for start in (0..full).step_by(LANES) {
@@ -289,7 +365,7 @@ fn states<T: Real>(elements: &[Element], start: usize, chain: Option<usize>, q: 
 #[derive(Clone, Copy)]
 struct Terms<'a> {
     nodes: NodeState<'a>,
-    sec: Section,
+    sec: &'a Sections,
     fac: Factors,
 }
 
@@ -309,6 +385,7 @@ fn add_forces_of<T: Real, const DAMPED: bool>(
 ) -> Result<(), BadChord> {
     let Terms { nodes, sec, fac } = *terms;
     let Factors { cf, ck, cv, cm } = fac;
+    let sec: Lanes<T> = sec.lanes(start);
     let damped = [sec.ea, sec.ei, sec.beta];
     let chain = chain::<T>(elements, start);
     let st: ElementState<T> = states(elements, start, chain, nodes.q);
@@ -327,7 +404,7 @@ fn add_forces_of<T: Real, const DAMPED: bool>(
         Some(vals) => {
             // Eq. D9 when damped: the factors are in the tangent already
             let (fi, kt) = if DAMPED {
-                let (c_mat, c_geo) = (T::splat(ck + cv * sec.beta), T::splat(ck));
+                let (c_mat, c_geo) = (T::splat(ck) + sec.beta * cv, T::splat(ck));
                 st.damped_internal(damped, &ve, c_mat, c_geo)
             } else {
                 st.internal(sec.ea, sec.ei)
@@ -370,7 +447,8 @@ fn add_forces_of<T: Real, const DAMPED: bool>(
 
 /// Dissipated power of the `T::LANES` elements from `start` [W] (lanes summed in order).
 #[inline(always)]
-fn power_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], sec: Section) -> f64 {
+fn power_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], sec: &Sections) -> f64 {
+    let sec: Lanes<T> = sec.lanes(start);
     let chain = chain::<T>(elements, start);
     let (pos, vel) = (gather(elements, start, chain, q), gather(elements, start, chain, v));
     let l0 = T::from_lanes(|k| elements[start + k].l0);
@@ -385,7 +463,8 @@ fn power_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], s
 /// [`mass_product`] for the `T::LANES` elements from `start` at `[q, x, y]` (lanes summed in
 /// order).
 #[inline(always)]
-fn mass_product_of<T: Real>(elements: &[Element], start: usize, [q, x, y]: [&[f64]; 3], rho: f64) -> f64 {
+fn mass_product_of<T: Real>(elements: &[Element], start: usize, [q, x, y]: [&[f64]; 3], sec: &Sections) -> f64 {
+    let rho = sec.lanes::<T>(start).rho;
     let chain = chain::<T>(elements, start);
     let st: ElementState<T> = states(elements, start, chain, q);
     let m = st.mass(rho);
@@ -402,7 +481,15 @@ fn mass_product_of<T: Real>(elements: &[Element], start: usize, [q, x, y]: [&[f6
 }
 
 #[inline(always)]
-fn energies_of<T: Real>(elements: &[Element], start: usize, q: &[f64], v: &[f64], sec: Section, sums: &mut (f64, f64)) {
+fn energies_of<T: Real>(
+    elements: &[Element],
+    start: usize,
+    q: &[f64],
+    v: &[f64],
+    sec: &Sections,
+    sums: &mut (f64, f64),
+) {
+    let sec: Lanes<T> = sec.lanes(start);
     let chain = chain::<T>(elements, start);
     let st: ElementState<T> = states(elements, start, chain, q);
     let ke = st.kinetic_energy(sec.rho, &gather(elements, start, chain, v));
@@ -496,7 +583,7 @@ mod tests {
         let (mut r1, mut m1) = (vec![0.0; q.len()], vec![0.0; blocks_len(elements.len())]);
         let (mut r2, mut m2) = (r1.clone(), m1.clone());
         one_by_one(&elements, nodes, sec, cf, ck, &mut r1, &mut m1);
-        add_forces(&elements, nodes, sec, fac, &mut r2, Some(&mut m2)).unwrap();
+        add_forces(&elements, nodes, &Sections::uniform(sec), fac, &mut r2, Some(&mut m2)).unwrap();
         assert_eq!(
             r1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
             r2.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
@@ -507,7 +594,7 @@ mod tests {
         );
         // the imbalance-only pass adds the same forces
         let mut r3 = vec![0.0; q.len()];
-        add_forces(&elements, nodes, sec, fac, &mut r3, None).unwrap();
+        add_forces(&elements, nodes, &Sections::uniform(sec), fac, &mut r3, None).unwrap();
         assert_eq!(r1, r3);
         // energies against the element-by-element sums
         let (mut t, mut u) = (0.0, 0.0);
@@ -520,8 +607,92 @@ mod tests {
             t += st.kinetic_energy(sec.rho, &pick(&v));
             u += st.strain_energy(sec.ea, sec.ei);
         }
-        assert_eq!(energies(&elements, &q, &v, sec), (t, u));
+        assert_eq!(energies(&elements, &q, &v, &Sections::uniform(sec)), (t, u));
         assert!(t > 0.0 && u > 0.0);
+    }
+
+    /// Per-beam sections (`docs/fem.md` section 10): three beams of three elements each (the
+    /// chain's last two on beam 3), so that both batches of four straddle two beams and take their
+    /// lanes' constants one by one; the batches give each element's own results bit for bit,
+    /// damped and undamped, and the energies and powers sum each element's with its own section.
+    #[test]
+    fn batches_across_beams_take_each_element_its_own_section() {
+        let beams = [
+            Section {
+                ea: 6e6,
+                ei: 0.5,
+                rho: 0.234,
+                beta: 8e-4,
+            },
+            Section {
+                ea: 7e6,
+                ei: 0.63,
+                rho: 0.21,
+                beta: 8e-4,
+            },
+            Section {
+                ea: 5e6,
+                ei: 0.41,
+                rho: 0.26,
+                beta: 8e-4,
+            },
+        ];
+        let (elements, q, v, a) = chain(11);
+        let nodes = NodeState { q: &q, v: &v, qdd: &a };
+        let fac = Factors {
+            cf: 6e-8,
+            ck: 6e-8,
+            cv: 2.6e-4,
+            cm: 1.0,
+        };
+        for damped in [false, true] {
+            let beta = if damped { 8e-4 } else { 0.0 };
+            let beams = beams.map(|s| Section { beta, ..s });
+            let sections = Sections::per_beam(beams, 3);
+            let own = |e: usize| beams[(e / 3).min(2)];
+            let (mut r1, mut m1) = (vec![0.0; q.len()], vec![0.0; blocks_len(elements.len())]);
+            let (mut t, mut u, mut p) = (0.0, 0.0, 0.0);
+            for (e, el) in elements.iter().enumerate() {
+                let sec = own(e);
+                let pick = |x: &[f64]| -> [f64; 6] {
+                    let (a, b) = (3 * el.nodes[0], 3 * el.nodes[1]);
+                    [x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2]]
+                };
+                let st = ElementState::new(el, &pick(&q));
+                let fm = st.inertia_force(sec.rho, &pick(&v), &pick(&a));
+                let (fi, k) = if damped {
+                    let c_mat = fac.ck + fac.cv * sec.beta;
+                    st.damped_internal([sec.ea, sec.ei, sec.beta], &pick(&v), c_mat, fac.ck)
+                } else {
+                    let (f, k) = st.internal(sec.ea, sec.ei);
+                    (f, k.map(|row| row.map(|x| x * fac.ck)))
+                };
+                let m = st.mass(sec.rho);
+                let d = [0, 1, 2, 3, 4, 5].map(|a| 3 * el.nodes[a / 3] + a % 3);
+                for a in 0..6 {
+                    for b in 0..6 {
+                        m1[block_index(e, 6 * a + b)] = m[a][b] + k[a][b];
+                    }
+                    r1[d[a]] += fac.cf * (fm[a] + fi[a]);
+                }
+                t += st.kinetic_energy(sec.rho, &pick(&v));
+                u += st.strain_energy(sec.ea, sec.ei);
+                p += st.dissipation_power(sec.ea, sec.ei, sec.beta, &pick(&v));
+            }
+            let (mut r2, mut m2) = (vec![0.0; q.len()], vec![0.0; blocks_len(elements.len())]);
+            add_forces(&elements, nodes, &sections, fac, &mut r2, Some(&mut m2)).unwrap();
+            assert_eq!(r1, r2, "imbalance, damped: {damped}");
+            assert_eq!(m1, m2, "blocks, damped: {damped}");
+            assert_eq!(energies(&elements, &q, &v, &sections), (t, u));
+            if damped {
+                let pb = dissipation_power(&elements, &q, &v, &sections);
+                assert!(p > 0.0 && (p - pb).abs() <= 1e-12 * p, "{p} vs {pb}");
+            }
+            // and the sections do matter: one section for all gives another imbalance
+            let mut r3 = vec![0.0; q.len()];
+            add_forces(&elements, nodes, &Sections::uniform(beams[0]), fac, &mut r3, None).unwrap();
+            assert!(r1.iter().zip(&r3).any(|(x, y)| x != y));
+        }
     }
 
     #[test]
@@ -541,7 +712,7 @@ mod tests {
         let err = add_forces(
             &elements,
             nodes,
-            sec,
+            &Sections::uniform(sec),
             Factors {
                 cf: 1.0,
                 ck: 1.0,
@@ -560,7 +731,7 @@ mod tests {
         let err = add_forces(
             &elements,
             nodes,
-            sec,
+            &Sections::uniform(sec),
             Factors {
                 cf: 1.0,
                 ck: 1.0,
@@ -612,15 +783,23 @@ mod tests {
             }
         }
         let (mut r2, mut m2) = (vec![0.0; q.len()], vec![0.0; blocks_len(elements.len())]);
-        add_forces(&elements, nodes, sec, fac, &mut r2, Some(&mut m2)).unwrap();
+        add_forces(&elements, nodes, &Sections::uniform(sec), fac, &mut r2, Some(&mut m2)).unwrap();
         assert_eq!(r1, r2);
         assert_eq!(m1, m2);
         let mut r3 = vec![0.0; q.len()];
-        add_forces(&elements, nodes, sec, fac, &mut r3, None).unwrap();
+        add_forces(&elements, nodes, &Sections::uniform(sec), fac, &mut r3, None).unwrap();
         assert_eq!(r1, r3);
         // damping changes the imbalance (the chain deforms at a rate) and the power sums
         let mut r4 = vec![0.0; q.len()];
-        add_forces(&elements, nodes, Section { beta: 0.0, ..sec }, fac, &mut r4, None).unwrap();
+        add_forces(
+            &elements,
+            nodes,
+            &Sections::uniform(Section { beta: 0.0, ..sec }),
+            fac,
+            &mut r4,
+            None,
+        )
+        .unwrap();
         assert!(r1.iter().zip(&r4).any(|(x, y)| x != y));
         let p: f64 = elements
             .iter()
@@ -632,7 +811,7 @@ mod tests {
                 ElementState::new(el, &pick(&q)).dissipation_power(sec.ea, sec.ei, sec.beta, &pick(&v))
             })
             .sum();
-        let pb = dissipation_power(&elements, &q, &v, sec);
+        let pb = dissipation_power(&elements, &q, &v, &Sections::uniform(sec));
         assert!(p > 0.0 && (p - pb).abs() <= 1e-12 * p, "{p} vs {pb}");
     }
 }

@@ -15,8 +15,8 @@ pub enum FemError {
     /// The experiment or the settings are unusable (message names the key and the bound).
     #[error("invalid FEM input: {0}")]
     Input(String),
-    /// The problem's robot is not the FEM's equal-beam robot, or a setting fails a model check
-    /// (animation frames); the model's error, with its key.
+    /// A setting fails a model check (animation frames) or the robot a model check of the
+    /// pose modes' robot; the model's error, with its key.
     #[error("invalid FEM input: {0}")]
     Problem(#[source] ModelError),
     /// The feasibility scan before any step refused the motion: its time and violation.
@@ -25,12 +25,19 @@ pub enum FemError {
     /// The rigid state at the start could not be evaluated.
     #[error("invalid FEM input: {0}")]
     Start(#[source] KinematicsError),
-    /// The mesh is too coarse to hold a sleeve: fewer than 2 elements across Lp.
+    /// `fem.elements` cannot be split over the three beams: the mesh has the same number of
+    /// elements on every beam (`docs/fem.md` section 10: the beams are lanes of one element
+    /// loop and one banded solver), so the total must be a positive multiple of 3.
+    #[error("fem.elements = {elements}: {reason}; give a positive multiple of 3 (the same number of elements on each of the three beams)")]
+    Elements { elements: usize, reason: &'static str },
+    /// The mesh is too coarse to hold a sleeve: fewer than 2 elements of beam `beam` (1-based)
+    /// across its sleeve's Lp.
     #[error(
-        "mesh too coarse: {per_beam} elements per beam give an element length {h:.4e} m, but a sleeve of length Lp = {lp} m needs at least 2 elements across it (at least {needed} elements per beam, {} in all)",
+        "mesh too coarse: {per_beam} elements per beam give beam {beam} an element length {h:.4e} m, but its sleeve of length Lp = {lp} m needs at least 2 elements across it (at least {needed} elements per beam, {} in all)",
         3 * needed
     )]
     MeshTooCoarse {
+        beam: usize,
         per_beam: usize,
         h: f64,
         lp: f64,
@@ -57,7 +64,8 @@ pub enum FemError {
     /// The run was stopped on request ([`flexstar_model::cancel`]) at output time `t` [s].
     #[error("cancelled at t = {t} s")]
     Cancelled { t: f64 },
-    /// A sleeve contact point left the beam: its material coordinate is outside (0, L).
+    /// A sleeve contact point left the beam: its material coordinate is outside (0, L_i), `l`
+    /// the beam's length [m].
     #[error(
         "sleeve {sleeve} slid off beam {sleeve} at t = {t} s: the {point} contact point is at material coordinate {xi:.5} m, outside (0, L = {l} m)"
     )]
@@ -68,11 +76,19 @@ pub enum FemError {
         xi: f64,
         l: f64,
     },
-    /// A slider left its side of the base triangle (|s_i| >= sqrt(3) d).
+    /// A slider left its side of the base triangle: `s` [m] outside the open interval `travel`
+    /// between the side's two corners (`(-sqrt(3) d, sqrt(3) d)` on the paper's base).
     #[error(
-        "slider {slider} left its base side at t = {t} s: s = {s:.5} m, |s| must stay below sqrt(3) d = {limit:.5} m"
+        "slider {slider} left its base side at t = {t} s: s = {s:.5} m, it must stay between the side's corners, {:.5} < s < {:.5} m",
+        travel[0],
+        travel[1]
     )]
-    SliderOffBase { t: f64, slider: usize, s: f64, limit: f64 },
+    SliderOffBase {
+        t: f64,
+        slider: usize,
+        s: f64,
+        travel: [f64; 2],
+    },
     /// The simulated configuration of a direct run left the feasible range (the reason names
     /// the limit: slider off its base side, sleeve at G or off the tip, no Fermat point).
     #[error("direct run left the feasible range at t = {t} s: {violation}")]

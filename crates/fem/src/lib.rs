@@ -13,7 +13,9 @@
 //! (`flexstar_drive`), their coordinates unknowns of the same equations. Both carry an
 //! experiment's payload at G, Rayleigh damping (Kelvin-Voigt in the beams, mass-proportional on
 //! the motion relative to the rigid robot) and load at G (`docs/fem.md` section 9), skipped at
-//! their zero defaults. The formulation, the
+//! their zero defaults. The robot is the problem's as built: each beam with its own section,
+//! length, sleeve and weld angle, each slider on its own axis (`docs/fem.md` section 10; the
+//! paper's robot is one value of it, solved bit for bit as before). The formulation, the
 //! convergence study behind the defaults and the deviations are in `docs/fem.md`.
 
 #![allow(clippy::needless_range_loop)] // index loops over DOFs read like the equations
@@ -31,5 +33,7 @@ mod star;
 
 pub use error::{FemError, LinearError, NewtonFailure, PivotError};
 pub use integrator::{Fallback, Stats};
-pub use solve::{default_dt, first_beam_frequency, solve, DEFAULT_DT, DEFAULT_RHO_INF, MIN_DEFAULT_DT};
+pub use solve::{
+    beam_frequency, default_dt, default_dt_of, first_beam_frequency, solve, DEFAULT_DT, DEFAULT_RHO_INF, MIN_DEFAULT_DT,
+};
 pub use star::InitialState;

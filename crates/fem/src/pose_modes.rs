@@ -10,15 +10,42 @@
 //! read `r_i(xi) - P_i(s_i) + ... = 0` with `dP_i/ds_i = u_i` (Eqs. 1-3). The damping matrix at
 //! rest ([`SparsePoseSystem::damping_triplets`]) is Rayleigh's on the elastic motion (Eq. D18,
 //! `docs/fem.md` 9.2.1).
+//!
+//! The robot is the paper's compact form ([`RobotParams`]) or one as built ([`Robot`]: each beam
+//! with its own section, length, sleeve and weld angle, each slider on its own axis; `docs/fem.md`
+//! section 10), read through [`PoseRobot`].
 
-use flexstar_model::geometry::{e_w, e_x, slider_direction};
-use flexstar_model::{Payload, RestPose, RobotParams, Sliders};
+use std::borrow::Cow;
+
+use flexstar_model::geometry::e_x;
+use flexstar_model::{Payload, RestPose, Robot, RobotGeometry, RobotParams, Sliders};
 use flexstar_numerics::eigen::{constrained_modes, rigid_shift, ConstrainedModes};
 
 use crate::element::ElementState;
 use crate::modal_solver::{sparse_constrained_modes, Triplets};
 use crate::star::{InitialState, RigidTwist, Star, ROWS, ROW_POINT};
 use crate::FemError;
+
+/// A robot the modes at a pose are taken of: the paper's compact form or a robot as built (see
+/// the module doc).
+pub trait PoseRobot {
+    /// The robot as per-beam data; [`FemError::Problem`] when the compact form is invalid.
+    fn pose_robot(&self) -> Result<Cow<'_, Robot>, FemError>;
+}
+
+impl PoseRobot for RobotParams {
+    fn pose_robot(&self) -> Result<Cow<'_, Robot>, FemError> {
+        Robot::from_params(self).map(Cow::Owned).map_err(FemError::Problem)
+    }
+}
+
+impl PoseRobot for Robot {
+    /// The robot as built, or the paper's form of it when it is the paper's robot (as
+    /// [`crate::solve`] meshes it, `docs/fem.md` section 10).
+    fn pose_robot(&self) -> Result<Cow<'_, Robot>, FemError> {
+        crate::solve::meshed(self)
+    }
+}
 
 /// The linearised FEM at a pose: `M q'' + K q = B f - Phi_q^T lambda`, `Phi_q q = 0`.
 ///
@@ -43,8 +70,19 @@ pub struct PoseSystem {
     pub sliders: Sliders,
     /// Orientation of the pose [rad] (for projections on e_wi).
     pub theta: f64,
-    /// Element length [m].
+    /// Element length of beam 1 [m] (of every beam when the beams are equal).
     pub h: f64,
+    /// Element length of each beam, `L_i / ne` [m].
+    pub element_lengths: [f64; 3],
+    /// Weld angle phi_i of each beam [rad] (`docs/as-built.md` Eq. W1; the paper's 0, 120, 240
+    /// degrees), for `e_wi = [cos(theta + phi_i), sin(theta + phi_i)]`.
+    pub weld: [f64; 3],
+}
+
+/// `e_wi` of the pose's orientation `theta` and beam i's weld angle `weld` [rad] (Eq. W1).
+fn normal_of(theta: f64, weld: f64) -> [f64; 2] {
+    let a = theta + weld;
+    [a.cos(), a.sin()]
 }
 
 /// Coordinate helpers shared by [`PoseSystem`] and [`SparsePoseSystem`] (fields n, ne, sliders,
@@ -64,16 +102,16 @@ macro_rules! coordinate_helpers {
         /// Row vector `r` with `r . q` = the displacement of node k of beam i along `e_wi` of the pose.
         pub fn deflection_row(&self, i: usize, k: usize) -> Vec<f64> {
             let mut r = vec![0.0; self.n];
-            let ew = e_w(i, self.theta);
+            let ew = normal_of(self.theta, self.weld[i]);
             let j = self.node(i, k);
             r[3 * j] = ew[0];
             r[3 * j + 1] = ew[1];
             r
         }
 
-        /// Displacements along `e_wi` of the nodes of beam i (k = 0..=ne, at x = k h) for q.
+        /// Displacements along `e_wi` of the nodes of beam i (k = 0..=ne, at x = k h_i) for q.
         pub fn deflections(&self, q: &[f64], i: usize) -> Vec<f64> {
-            let ew = e_w(i, self.theta);
+            let ew = normal_of(self.theta, self.weld[i]);
             (0..=self.ne)
                 .map(|k| {
                     let j = self.node(i, k);
@@ -89,8 +127,13 @@ impl PoseSystem {
 
     /// What each coordinate is, in the order of the rows and columns of M, K and Phi_q (see
     /// [`Coordinate`]); `xp` [m] are the sleeves' rest positions on their beams and `lp` [m] the
-    /// sleeve length (the contact coordinates' rest values).
+    /// sleeve length of equal beams (the contact coordinates' rest values).
     pub fn coordinates(&self, xp: [f64; 3], lp: f64) -> Vec<Coordinate> {
+        self.coordinates_of(xp, [lp; 3])
+    }
+
+    /// [`PoseSystem::coordinates`] with each sleeve's own length `lp` [m].
+    pub fn coordinates_of(&self, xp: [f64; 3], lp: [f64; 3]) -> Vec<Coordinate> {
         let n_nodes = 1 + 3 * self.ne;
         let mut out = Vec::with_capacity(self.n);
         let mut push = |node, beam, dof, x| {
@@ -106,7 +149,10 @@ impl PoseSystem {
             // node 0 is G (shared by the three beams); beam i's node k is 1 + i ne + k - 1
             let (beam, x) = match j {
                 0 => (None, 0.0),
-                _ => (Some((j - 1) / self.ne), ((j - 1) % self.ne + 1) as f64 * self.h),
+                _ => {
+                    let i = (j - 1) / self.ne;
+                    (Some(i), ((j - 1) % self.ne + 1) as f64 * self.element_lengths[i])
+                }
             };
             for dof in [Dof::Ux, Dof::Uy, Dof::Theta] {
                 push(Some(j), beam, dof, Some(x));
@@ -116,6 +162,7 @@ impl PoseSystem {
             push(None, Some(i), Dof::Psi, Some(*x));
         }
         for (i, x) in xp.iter().enumerate() {
+            let lp = lp[i];
             for (dof, off) in [(Dof::XiC, 0.0), (Dof::XiL, -0.5 * lp), (Dof::XiR, 0.5 * lp)] {
                 push(None, Some(i), dof, Some(x + off));
             }
@@ -206,8 +253,12 @@ pub struct SparsePoseSystem {
     pub sliders: Sliders,
     /// Orientation of the pose [rad].
     pub theta: f64,
-    /// Element length [m].
+    /// Element length of beam 1 [m] (of every beam when the beams are equal).
     pub h: f64,
+    /// Element length of each beam, `L_i / ne` [m].
+    pub element_lengths: [f64; 3],
+    /// Weld angle phi_i of each beam [rad] (`docs/as-built.md` Eq. W1).
+    pub weld: [f64; 3],
     /// The rigid field per unit slider velocity `R` (Eq. D17) on the star's coordinates (rows of
     /// M without the sliders; column i for `s_i' = 1` m/s: [m/s, rad/s] per m/s), with the pins at
     /// the sleeves' centres; `Err` with the relative determinant of Eq. D17 at a singular pose.
@@ -287,54 +338,57 @@ impl SparsePoseSystem {
             sliders: self.sliders,
             theta: self.theta,
             h: self.h,
+            element_lengths: self.element_lengths,
+            weld: self.weld,
         }
     }
 }
 
 /// Assemble M, K and Phi_q at `pose` with `elements` elements in the whole star (dense).
 pub fn pose_system(
-    params: &RobotParams,
+    robot: &(impl PoseRobot + ?Sized),
     pose: &RestPose,
     sliders: Sliders,
     elements: usize,
 ) -> Result<PoseSystem, FemError> {
-    Ok(pose_triplets(params, pose, sliders, elements)?.to_dense())
+    Ok(pose_triplets(robot, pose, sliders, elements)?.to_dense())
 }
 
 /// [`pose_system`] of the robot carrying `payload` at G (`docs/fem.md` section 9).
 pub fn pose_system_with(
-    params: &RobotParams,
+    robot: &(impl PoseRobot + ?Sized),
     payload: &Payload,
     pose: &RestPose,
     sliders: Sliders,
     elements: usize,
 ) -> Result<PoseSystem, FemError> {
-    Ok(pose_triplets_with(params, payload, pose, sliders, elements)?.to_dense())
+    Ok(pose_triplets_with(robot, payload, pose, sliders, elements)?.to_dense())
 }
 
 /// Assemble M, K and Phi_q at `pose` with `elements` elements in the whole star, as triplets.
 pub fn pose_triplets(
-    params: &RobotParams,
+    robot: &(impl PoseRobot + ?Sized),
     pose: &RestPose,
     sliders: Sliders,
     elements: usize,
 ) -> Result<SparsePoseSystem, FemError> {
-    pose_triplets_with(params, &Payload::default(), pose, sliders, elements)
+    pose_triplets_with(robot, &Payload::default(), pose, sliders, elements)
 }
 
 /// [`pose_triplets`] of the robot carrying `payload` at G: its mass matrix about G, `M_p` of
 /// Eq. P11 at rest (`phi = 0`, the offset turned by the pose's theta), on node G.
 pub fn pose_triplets_with(
-    params: &RobotParams,
+    robot: &(impl PoseRobot + ?Sized),
     payload: &Payload,
     pose: &RestPose,
     sliders: Sliders,
     elements: usize,
 ) -> Result<SparsePoseSystem, FemError> {
     if elements < 3 || !elements.is_multiple_of(3) {
-        return Err(FemError::Input(format!(
-            "fem.elements must be a positive multiple of 3, got {elements}"
-        )));
+        return Err(FemError::Elements {
+            elements,
+            reason: "not a positive multiple of 3",
+        });
     }
     let ne = elements / 3;
     let init = InitialState {
@@ -345,7 +399,8 @@ pub fn pose_triplets_with(
         xp: pose.xp,
         xp_dot: [0.0; 3],
     };
-    let (star, q, _) = Star::new(params, ne, &init, None)?;
+    let robot = robot.pose_robot()?;
+    let (star, q, _) = Star::new(&robot, ne, &init, None)?;
     let nd = star.n_dof;
     let n = nd + if sliders == Sliders::Free { 3 } else { 0 };
     let states: Vec<ElementState> = star
@@ -353,13 +408,13 @@ pub fn pose_triplets_with(
         .iter()
         .map(|el| ElementState::new(el, &element_q(el.nodes, &q)))
         .collect();
-    let (mut m, k) = element_triplets(params, &star, &states);
+    let (mut m, k) = element_triplets(&star, &states);
     let rows = 3 * ROWS;
-    let c = constraint_triplets(params, &star, &states, &q, pose, sliders, &mut m);
+    let c = constraint_triplets(&star, &states, &q, sliders, &mut m);
     if !payload.is_none() {
         m.extend(payload_triplets(payload, pose.theta));
     }
-    let rigid = rigid_field(params, &star, &q, pose);
+    let rigid = rigid_field(&star, &q, pose);
     Ok(SparsePoseSystem {
         n,
         ne,
@@ -369,7 +424,9 @@ pub fn pose_triplets_with(
         rows,
         sliders,
         theta: pose.theta,
-        h: star.h,
+        h: star.h[0],
+        element_lengths: star.h,
+        weld: robot.weld_angles(),
         rigid,
     })
 }
@@ -378,13 +435,14 @@ pub fn pose_triplets_with(
 /// every star coordinate per unit slider velocity, with the pins at the sleeves' centres
 /// `x_G + xp_i e_xi` (where the pins are at a rest pose); `Err(relative determinant)` at a
 /// singular pose.
-fn rigid_field(params: &RobotParams, star: &Star, q: &[f64], pose: &RestPose) -> Result<Vec<[f64; 3]>, f64> {
+fn rigid_field(star: &Star, q: &[f64], pose: &RestPose) -> Result<Vec<[f64; 3]>, f64> {
     let pins = [0, 1, 2].map(|i| {
-        let ex = e_x(i, pose.theta);
+        let ex = star.robot.e_x(i, pose.theta);
         [pose.g[0] + pose.xp[i] * ex[0], pose.g[1] + pose.xp[i] * ex[1]]
     });
     let axis = [0, 1, 2].map(|i| star.sleeve_angle(i, q));
-    let twist = RigidTwist::solve([q[0], q[1]], &pins, axis, params.l)?;
+    let u = [0, 1, 2].map(|i| star.slider_direction(i));
+    let twist = RigidTwist::solve([q[0], q[1]], &pins, &u, axis, star.length_scale())?;
     let mut r = vec![[0.0; 3]; star.n_dof];
     for k in star.massive() {
         r[k] = twist.per_slider.map(|w| star.rigid_velocity(q, w, k));
@@ -396,7 +454,9 @@ fn rigid_field(params: &RobotParams, star: &Star, q: &[f64], pose: &RestPose) ->
 /// x and y, `-m c_y`, `m c_x` coupling them to phi, `J + m |c|^2` on phi, with `c` the offset in
 /// the fixed frame at the orientation `theta` [rad].
 fn payload_triplets(payload: &Payload, theta: f64) -> Triplets {
-    let (ex, ew) = (e_x(0, theta), e_w(0, theta));
+    // beam 1's frame: its weld angle is 0 on every robot (docs/as-built.md Eq. W1)
+    let ex = e_x(0, theta);
+    let ew = [-ex[1], ex[0]];
     let [ox, oy] = payload.offset;
     let c = [ox * ex[0] + oy * ew[0], ox * ex[1] + oy * ew[1]];
     let m = payload.mass;
@@ -411,13 +471,16 @@ fn payload_triplets(payload: &Payload, theta: f64) -> Triplets {
     ]
 }
 
-/// The elements' mass and tangent stiffness at the pose (unstressed: the rest pose), as triplets.
-fn element_triplets(params: &RobotParams, star: &Star, states: &[ElementState]) -> (Triplets, Triplets) {
+/// The elements' mass and tangent stiffness at the pose (unstressed: the rest pose), as triplets
+/// (each element with its beam's EA_i, EI_i, rho_i).
+fn element_triplets(star: &Star, states: &[ElementState]) -> (Triplets, Triplets) {
     let mut m = Triplets::with_capacity(36 * star.elements.len() + 6);
     let mut k = Triplets::with_capacity(36 * star.elements.len());
-    let (ea, ei, rho) = (params.ea(), params.ei(), params.rho);
+    let sections = star.section();
     let zero = [0.0; 6];
-    for (el, st) in star.elements.iter().zip(states) {
+    for (e, (el, st)) in star.elements.iter().zip(states).enumerate() {
+        let sec = sections.of(e);
+        let (ea, ei, rho) = (sec.ea, sec.ei, sec.rho);
         let d = dofs(el.nodes);
         let (_, ke) = st.internal(ea, ei);
         let (_, me) = st.inertia(rho, &zero);
@@ -434,26 +497,24 @@ fn element_triplets(params: &RobotParams, star: &Star, states: &[ElementState]) 
 /// The sleeves' rows Phi_q at the pose (with the slider columns when the sliders are free), and
 /// the sleeves' rotational inertia Jp and the sliders' mass mpp + mpa added to `m`.
 fn constraint_triplets(
-    params: &RobotParams,
     star: &Star,
     states: &[ElementState],
     q: &[f64],
-    pose: &RestPose,
     sliders: Sliders,
     m: &mut Triplets,
 ) -> Triplets {
     let nd = star.n_dof;
     let mut c = Triplets::with_capacity(3 * ROWS * 9);
-    let pins = pose.s.map(|_| [0.0; 2]);
+    let pins = [[0.0; 2]; 3];
     for i in 0..3 {
         let ps = star.psi(i);
-        m.push((ps, ps, params.jp));
+        m.push((ps, ps, star.beam(i).sleeve_inertia));
         if let Some(si) = (sliders == Sliders::Free).then_some(nd + i) {
-            m.push((si, si, params.mpp_mpa));
+            m.push((si, si, star.beam(i).sleeve_mass));
         }
         for r in 0..ROWS {
             let xi_idx = star.xi(i, ROW_POINT[r]);
-            let (e, z) = star.locate(q[xi_idx]);
+            let (e, z) = star.locate(i, q[xi_idx]);
             let ge = i * star.ne + e;
             let na = star.node(i, e);
             // the pin only shifts the row's value, not its gradient
@@ -465,7 +526,7 @@ fn constraint_triplets(
             c.push((row, xi_idx, gxi));
             c.push((row, ps, gpsi));
             if sliders == Sliders::Free && r < 6 {
-                c.push((row, nd + i, -slider_direction(i)[r % 2]));
+                c.push((row, nd + i, -star.slider_direction(i)[r % 2]));
             }
         }
     }
@@ -475,25 +536,25 @@ fn constraint_triplets(
 /// The first `count` modes (after the rigid ones when the sliders are free) of the star at `pose`:
 /// shift-invert subspace iteration on the sparse bordered system ([`crate::modal_solver`]).
 pub fn pose_modes(
-    params: &RobotParams,
+    robot: &(impl PoseRobot + ?Sized),
     pose: &RestPose,
     sliders: Sliders,
     elements: usize,
     count: usize,
 ) -> Result<PoseModes, FemError> {
-    pose_modes_with(params, &Payload::default(), pose, sliders, elements, count)
+    pose_modes_with(robot, &Payload::default(), pose, sliders, elements, count)
 }
 
 /// [`pose_modes`] of the robot carrying `payload` at G (`docs/fem.md` section 9).
 pub fn pose_modes_with(
-    params: &RobotParams,
+    robot: &(impl PoseRobot + ?Sized),
     payload: &Payload,
     pose: &RestPose,
     sliders: Sliders,
     elements: usize,
     count: usize,
 ) -> Result<PoseModes, FemError> {
-    let sparse = pose_triplets_with(params, payload, pose, sliders, elements)?;
+    let sparse = pose_triplets_with(robot, payload, pose, sliders, elements)?;
     let rigid = if sliders == Sliders::Free { 3 } else { 0 };
     let out = sparse_constrained_modes(
         sparse.n,
@@ -511,13 +572,13 @@ pub fn pose_modes_with(
 /// The same modes by the dense null-space path ([`constrained_modes`]): the reference of the
 /// sparse path (test `sparse_and_dense_paths_agree`), O(n^3).
 pub fn pose_modes_dense(
-    params: &RobotParams,
+    robot: &(impl PoseRobot + ?Sized),
     pose: &RestPose,
     sliders: Sliders,
     elements: usize,
     count: usize,
 ) -> Result<PoseModes, FemError> {
-    let sparse = pose_triplets(params, pose, sliders, elements)?;
+    let sparse = pose_triplets(robot, pose, sliders, elements)?;
     let system = sparse.to_dense();
     let rigid = if sliders == Sliders::Free { 3 } else { 0 };
     let out = constrained_modes(

@@ -2,12 +2,15 @@
 //! given, forces found) or the direct one (forces or a servo given, motion found), and post-process its absolute results into the shared [`Response`] (projections of
 //! `docs/conventions.md`).
 
+use std::borrow::Cow;
+
 use flexstar_drive::{ActuatorLaw, Drive, SolveRequest, Solved};
-use flexstar_kinematics::{check_trajectory, direct_kinematics, preflight_step, CheckedMotion, RigidState};
+use flexstar_kinematics::as_built::rigid_pose;
+use flexstar_kinematics::{check_trajectory, preflight_step, CheckedMotion, KinematicsError, RigidState};
 use flexstar_model::animation::{frame_times, ShapeTimes};
-use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::{
-    BeamShape, EqualBeams, FemSettings, FramePose, Problem, Response, RestOffset, RobotParams, RunInfo, StarShape,
+    Beam, BeamShape, FemSettings, FramePose, Problem, Response, RestOffset, Robot, RobotGeometry, RobotParams, RunInfo,
+    StarShape, Trajectory,
 };
 
 use crate::integrator::{integrate, static_equilibrium, History, Motion, RunSettings, Sample, Snapshot, Stats};
@@ -27,6 +30,26 @@ const CLAMPED_FREE_1: f64 = 1.875_104_068_711_961 * 1.875_104_068_711_961;
 /// section 4.1).
 pub fn first_beam_frequency(params: &RobotParams) -> f64 {
     CLAMPED_FREE_1 * (params.ei() / (params.rho * params.l.powi(4))).sqrt()
+}
+
+/// First clamped-free bending frequency of one beam [rad/s],
+/// `omega_1 = (beta_1 L_i)^2 sqrt(EI_i / (rho_i L_i^4))` (Eq. S10 of `docs/fem.md` section 4.1 with
+/// beam i's own data, section 10).
+pub fn beam_frequency(beam: &Beam) -> f64 {
+    CLAMPED_FREE_1 * (beam.bending_stiffness() / (beam.mass_per_length * beam.length.powi(4))).sqrt()
+}
+
+/// The FEM's default integration step [s] for a robot as built (Eq. S10, `docs/fem.md` sections
+/// 4.1 and 10): [`default_dt`]'s rule at the stiffest beam's first clamped-free frequency
+/// ([`beam_frequency`], the highest of the three), so that every beam's first modes are
+/// resolved as on the paper's robot; on equal beams exactly [`default_dt`] of their parameters.
+pub fn default_dt_of(robot: &Robot) -> f64 {
+    if let Ok(p) = robot.equal_beams() {
+        return default_dt(p);
+    }
+    let omega = robot.beams().map(|b| beam_frequency(&b));
+    let ratio = first_beam_frequency(&RobotParams::paper()) / omega[0].max(omega[1]).max(omega[2]);
+    (DEFAULT_DT * ratio.powf(1.5).min(1.0)).max(MIN_DEFAULT_DT)
 }
 
 /// The FEM's default integration step [s] for `params` (Eq. S10, `docs/fem.md` section 4.1):
@@ -80,10 +103,17 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 
 /// Run the finite-element reference on `problem` with `settings` (which override `problem.fem`).
 ///
+/// The robot is the problem's as built (`docs/fem.md` section 10): each beam with its own
+/// section, length, sleeve and weld angle, each slider on its own axis `o_i + s u_i`; the
+/// paper's robot (three equal beams welded 120 degrees apart on an equilateral base) is one
+/// value of it, solved bit for bit as before per-beam data. Beam i's frame below is
+/// `e_xi = [sin(theta + phi_i), -cos(theta + phi_i)]`, `e_wi = [cos(theta + phi_i), sin(theta +
+/// phi_i)]` with its weld angle phi_i (`docs/as-built.md` Eq. W1; Eqs. 11-12 on the paper's robot).
+///
 /// Returns the response labelled `fem` at `problem.time.output_times()`:
-/// - `w_iG = (G_fem - G_rigid) . e_wi` and the tip value `w_i(L) = (tip_fem - (G_rigid + L e_xi)) . e_wi`
+/// - `w_iG = (G_fem - G_rigid) . e_wi` and the tip value `w_i(L_i) = (tip_fem - (G_rigid + L_i e_xi)) . e_wi`
 ///   [m], projected on the rigid frames of Eqs. 11-12 (post-processing only);
-/// - `Fa_i` [N], Eq. 33, from the pin reactions: `Fa_i = (mpp + mpa) s_i'' + F_i . u_i` with `F_i`
+/// - `Fa_i` [N], Eq. 33, from the pin reactions: `Fa_i = (mpp + mpa)_i s_i'' + F_i . u_i` with `F_i`
 ///   the force the sleeve exerts on the beam (sum over centre and edges) and `u_i` the slider
 ///   direction;
 /// - extra columns: `xp1..3` (material coordinate of each sleeve centre on its beam [m]),
@@ -102,11 +132,12 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 ///   [J], base frame origin, `docs/fem.md` 9.5) with a `[gravity]`; the energy balance is then
 ///   Eq. C6, `W + W_load = Delta(Ek_star + Ek_sleeves + Ek_sliders + Ek_payload + U + V_g) + E_d`;
 /// - under gravity (`docs/fem.md` 9.5, Eqs. G6-G8): the weights act on the beams, the payload and
-///   the sliders (`Fa_i` gains `- (mpp + mpa) g . u_i`, Eq. G7), the run starts at rest in the
+///   the sliders (`Fa_i` gains `- (mpp + mpa)_i g . u_i`, Eq. G7), the run starts at rest in the
 ///   deflected static equilibrium of its start pose (Eq. G8; every elastic output includes the
-///   sag), and `rest_offset` holds the static equilibrium's `w_iG`, `w_i(L)` at the pose where
+///   sag), and `rest_offset` holds the static equilibrium's `w_iG`, `w_i(L_i)` at the pose where
 ///   the motion comes to rest (`Trajectory::t_rest`, when within the run);
-/// - `shapes`: the deformed star at `settings.snapshots` and at t_end.
+/// - `shapes`: the deformed star at `settings.snapshots` and at t_end (beam i's material
+///   positions `k L_i / ne`).
 ///
 /// `progress` receives the fraction of the time span done, in [0, 1].
 ///
@@ -115,13 +146,14 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 /// unless `request.proof` covers the run) or an actuator law ([`Drive::Law`], see
 /// the direct dynamics below). `request.progress` receives the fraction of the time span done, in [0, 1].
 /// Returns the response and the work counters (steps, Newton iterations, factorisations).
+/// `settings.elements` must be a positive multiple of 3 ([`FemError::Elements`]): each beam gets
+/// a third of them.
 pub fn solve(problem: &Problem, settings: &FemSettings, request: SolveRequest) -> Result<Solved<Stats>, FemError> {
-    let problem = &problem.equal_beams().map_err(FemError::Problem)?;
     let (mut response, stats) = match request.drive {
         Drive::Motion => solve_prescribed(problem, settings, request.proof, request.progress)?,
         Drive::Law(law) => solve_direct(problem, settings, law, request.progress)?,
     };
-    if problem.gravity != [0.0; 2] {
+    if problem.gravity() != [0.0; 2] {
         response.rest_offset = rest_offset(problem, settings)?;
     }
     Ok(Solved { response, stats })
@@ -129,28 +161,27 @@ pub fn solve(problem: &Problem, settings: &FemSettings, request: SolveRequest) -
 
 /// [`solve`] of the prescribed motion, the feasibility scan skipped when `checked` covers the run.
 fn solve_prescribed(
-    problem: &EqualBeams,
+    problem: &Problem,
     settings: &FemSettings,
     checked: Option<&CheckedMotion>,
     progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> Result<(Response, Stats), FemError> {
     let started = std::time::Instant::now();
-    let params = &problem.robot;
+    let robot = &*meshed(problem.robot())?;
+    let trajectory = problem.trajectory();
     let run = validate(problem, settings)?;
     // the same feasibility scan as the AMM and the kinematics, before any work: a pre-flight check
     // of the requested motion only (the FEM's equations never use the rigid kinematics)
-    let step = preflight_step(problem.time.dt_out);
-    if !checked.is_some_and(|c| c.covers(params, problem.trajectory, problem.time.t_end, step)) {
-        check_trajectory(params, problem.trajectory, problem.time.t_end, step).map_err(FemError::Scan)?;
-    }
-    let rigid =
-        |t: f64| RigidState::at(params, problem.trajectory, t).map_err(|source| FemError::PostProcessing { t, source });
+    let (dt_out, t_end) = (problem.time().dt_out, problem.time().t_end);
+    let step = preflight_step(dt_out);
+    scan(robot, trajectory, t_end, step, checked)?;
+    let rigid = |t: f64| rigid_state(robot, trajectory, t).map_err(|source| FemError::PostProcessing { t, source });
     let r0 = rigid(0.0)?;
     let (t_out, shape_times) = times(problem, settings);
-    let motion = Motion::Prescribed(problem.trajectory);
+    let motion = Motion::Prescribed(trajectory);
     let attached = Attached::of(problem, r0.theta.v);
     let hist = integrate(
-        params,
+        robot,
         &motion,
         &t_out,
         &shape_times.all,
@@ -168,8 +199,8 @@ fn solve_prescribed(
             theta: r.theta.v,
         })
     };
-    let mut resp = post_process(params, &hist, "fem", &frame, r0.theta.v, false)?;
-    add_shapes(&mut resp, &hist, &shape_times, &frame)?;
+    let mut resp = post_process(robot, &hist, "fem", &frame, r0.theta.v, false)?;
+    add_shapes(robot, &mut resp, &hist, &shape_times, &frame)?;
     if let Some(cb) = progress {
         cb(1.0);
     }
@@ -180,7 +211,7 @@ fn solve_prescribed(
 /// Direct dynamics ([`solve`] with [`Drive::Law`]): the sliders move under the actuator law `law` instead of
 /// following `problem.trajectory`.
 ///
-/// Each slider is a body of mass `mpp + mpa` on its rail, pushed along `+u_i` by
+/// Each slider is a body of mass `(mpp + mpa)_i` on its rail, pushed along `+u_i` by
 /// `Fa_i(t, s_i, s_i')` and by the beam through the sleeve's pin (Eq. 33 read the other way
 /// round, `docs/fem.md` section 8); its coordinate `s_i` is an unknown of the FEM, and the servo's
 /// `kp`, `kd` (`law.stiffness()`, `law.damping()`) enter the iteration matrix. Initial state:
@@ -194,21 +225,22 @@ fn solve_prescribed(
 /// output.
 ///
 /// Returns the response and the work counters; the response labelled `fem-direct` (`info.solver = "fem-direct"`) at
-/// `problem.time.output_times()`: `w_iG`, `w_i(L)` projected on the rigid frames of the *simulated*
-/// sliders' direct kinematics (post-processing only), `Fa_i` [N] the law's forces at the output
+/// `problem.time.output_times()`: `w_iG`, `w_i(L_i)` projected on the rigid frames of the *simulated*
+/// sliders' direct kinematics (post-processing only; `docs/as-built.md` Eqs. D1-D3 on a robot as
+/// built), `Fa_i` [N] the law's forces at the output
 /// time, then the extra columns `s1..3` [m], `sd1..3` [m/s] (simulated sliders), `Gx, Gy` [m],
 /// `theta` [rad] (their rigid pose, Eqs. 4-9), then those of [`solve`] (with `dGx, dGy` and
 /// `slopeG` relative to that pose, `W` the work of the law's forces).
 fn solve_direct(
-    problem: &EqualBeams,
+    problem: &Problem,
     settings: &FemSettings,
     law: &dyn ActuatorLaw,
     progress: Option<&(dyn Fn(f64) + Sync)>,
 ) -> Result<(Response, Stats), FemError> {
     let started = std::time::Instant::now();
-    let params = &problem.robot;
+    let robot = &*meshed(problem.robot())?;
     let run = validate(problem, settings)?;
-    let r0 = RigidState::at(params, problem.trajectory, 0.0).map_err(FemError::Start)?;
+    let r0 = rigid_state(robot, problem.trajectory(), 0.0).map_err(FemError::Start)?;
     let (t_out, shape_times) = times(problem, settings);
     let motion = Motion::Driven {
         law,
@@ -217,7 +249,7 @@ fn solve_direct(
     };
     let attached = Attached::of(problem, r0.theta.v);
     let hist = integrate(
-        params,
+        robot,
         &motion,
         &t_out,
         &shape_times.all,
@@ -229,14 +261,14 @@ fn solve_direct(
 
     // post-processing with the rigid kinematics of the simulated sliders
     let frame = |t: f64, s: [f64; 3]| {
-        let pose = direct_kinematics(params.d, s).ok_or(FemError::NoRigidConfiguration { t, s })?;
+        let pose = rigid_pose(robot, s).ok_or(FemError::NoRigidConfiguration { t, s })?;
         Ok(RigidFrame {
             g: pose.g,
             theta: pose.theta,
         })
     };
-    let mut resp = post_process(params, &hist, "fem-direct", &frame, r0.theta.v, true)?;
-    add_shapes(&mut resp, &hist, &shape_times, &frame)?;
+    let mut resp = post_process(robot, &hist, "fem-direct", &frame, r0.theta.v, true)?;
+    add_shapes(robot, &mut resp, &hist, &shape_times, &frame)?;
     if let Some(cb) = progress {
         cb(1.0);
     }
@@ -244,17 +276,56 @@ fn solve_direct(
     Ok((resp, hist.stats))
 }
 
+/// The robot the FEM solves: the problem's as built, or, when it is the paper's robot (equal
+/// beams welded 120 degrees apart on an equilateral base centred at O, each datum equal to
+/// rounding: `Robot::equal_beams`), exactly the paper's form of it (`Robot::from_params`), so
+/// that a paper robot given beam by beam, its weld angles and axes computed by other sums of the
+/// same numbers, is solved bit for bit as the paper's (`docs/fem.md` section 10).
+pub(crate) fn meshed(robot: &Robot) -> Result<Cow<'_, Robot>, FemError> {
+    match robot.equal_beams() {
+        Ok(p) => Robot::from_params(p).map(Cow::Owned).map_err(FemError::Problem),
+        Err(_) => Ok(Cow::Borrowed(robot)),
+    }
+}
+
+/// The rigid state of `robot` at time `t` of `trajectory` (`flexstar_kinematics`: initial data
+/// and post-processing only, never in the equations; the Fermat construction on the paper's
+/// robot, `docs/as-built.md` Eqs. D1-D3 on one as built).
+fn rigid_state(robot: &Robot, trajectory: &Trajectory, t: f64) -> Result<RigidState, KinematicsError> {
+    RigidState::at(robot, trajectory, t)
+}
+
+/// The feasibility scan of the prescribed motion before any step (skipped when `checked`
+/// covers the run), with each beam's own L_i, Lp_i and each slider's travel on its side:
+/// [`FemError::Scan`] with the time and the limit.
+fn scan(
+    robot: &Robot,
+    trajectory: &Trajectory,
+    t_end: f64,
+    step: f64,
+    checked: Option<&CheckedMotion>,
+) -> Result<(), FemError> {
+    if !checked.is_some_and(|c| c.covers(robot, trajectory, t_end, step)) {
+        check_trajectory(robot, trajectory, t_end, step).map_err(FemError::Scan)?;
+    }
+    Ok(())
+}
+
 /// Check the settings against the problem (validated when it was built); the run's numerical
 /// settings.
-fn validate(problem: &EqualBeams, settings: &FemSettings) -> Result<RunSettings, FemError> {
-    let params = problem.robot;
-    if settings.elements < 3 || !settings.elements.is_multiple_of(3) {
-        return Err(FemError::Input(format!(
-            "fem.elements must be a positive multiple of 3 (three equal beams), got {}",
-            settings.elements
-        )));
+fn validate(problem: &Problem, settings: &FemSettings) -> Result<RunSettings, FemError> {
+    let elements = settings.elements;
+    if elements < 3 || !elements.is_multiple_of(3) {
+        let reason = if elements < 3 {
+            "fewer than one element per beam"
+        } else {
+            "not a multiple of 3"
+        };
+        return Err(FemError::Elements { elements, reason });
     }
-    let dt = settings.dt.unwrap_or(default_dt(params).min(problem.time.dt_out));
+    let dt = settings
+        .dt
+        .unwrap_or(default_dt_of(problem.robot()).min(problem.time().dt_out));
     if !(dt.is_finite() && dt > 0.0) {
         return Err(FemError::Input(format!("fem.dt must be positive, got {dt}")));
     }
@@ -264,7 +335,7 @@ fn validate(problem: &EqualBeams, settings: &FemSettings) -> Result<RunSettings,
             "fem.rho_inf must lie in [0, 1], got {rho_inf}"
         )));
     }
-    let t_end = problem.time.t_end;
+    let t_end = problem.time().t_end;
     if let Some(bad) = settings
         .snapshots
         .iter()
@@ -276,7 +347,7 @@ fn validate(problem: &EqualBeams, settings: &FemSettings) -> Result<RunSettings,
     }
     flexstar_model::animation::check_frames("fem.frames", settings.frames, t_end).map_err(FemError::Problem)?;
     Ok(RunSettings {
-        ne: settings.elements / 3,
+        ne: elements / 3,
         dt,
         rho_inf,
     })
@@ -296,13 +367,14 @@ pub(crate) fn initial_state(r0: &RigidState) -> InitialState {
 
 /// Output times and the shape times: the snapshots (t_end always among them) and the animation
 /// frames of `settings.frames` (`docs/motions.md` section 5).
-fn times(problem: &EqualBeams, settings: &FemSettings) -> (Vec<f64>, ShapeTimes) {
+fn times(problem: &Problem, settings: &FemSettings) -> (Vec<f64>, ShapeTimes) {
+    let t_end = problem.time().t_end;
     let mut snaps = settings.snapshots.clone();
-    snaps.push(problem.time.t_end);
+    snaps.push(t_end);
     snaps.sort_by(|a, b| a.total_cmp(b));
     snaps.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
-    let frames = frame_times(problem.time.t_end, settings.frames);
-    (problem.time.output_times(), ShapeTimes::merge(&snaps, &frames, 1e-12))
+    let frames = frame_times(t_end, settings.frames);
+    (problem.time().output_times(), ShapeTimes::merge(&snaps, &frames, 1e-12))
 }
 
 fn run_info(solver: &str, settings: &FemSettings, run: &RunSettings, started: std::time::Instant) -> RunInfo {
@@ -316,16 +388,23 @@ fn run_info(solver: &str, settings: &FemSettings, run: &RunSettings, started: st
 }
 
 /// The rigid frame the absolute results are projected on: centre G [m] and orientation theta
-/// [rad] (beam i along `e_xi(theta)`, Eqs. 11-12).
+/// [rad] (beam i along `e_xi(theta)` of its weld angle, `docs/as-built.md` Eq. W1).
 struct RigidFrame {
     g: [f64; 2],
     theta: f64,
 }
 
+/// `e_xi` and `e_wi` of `robot`'s beam i at the orientation `theta` [rad] (`docs/as-built.md`
+/// Eq. W1; Eqs. 11-12 on the paper's robot): `e_wi` is `e_xi` turned a quarter counter-clockwise.
+fn beam_frame(robot: &Robot, i: usize, theta: f64) -> ([f64; 2], [f64; 2]) {
+    let ex = robot.e_x(i, theta);
+    (ex, [-ex[1], ex[0]])
+}
+
 /// Project the absolute history on the rigid frames given by `frame(t, s)` (`theta0` the frame's
 /// orientation at t = 0); `direct` adds the sliders' columns first.
 fn post_process(
-    params: &RobotParams,
+    robot: &Robot,
     hist: &History,
     label: &str,
     frame: &dyn Fn(f64, [f64; 3]) -> Result<RigidFrame, FemError>,
@@ -340,10 +419,9 @@ fn post_process(
         let r = frame(s.t, s.s)?;
         let g = r.g;
         let dg = [s.g[0] - g[0], s.g[1] - g[1]];
-        let (w_g, w_tip) = deflections(params, &r, s.g, &s.tip);
+        let (w_g, w_tip) = deflections(robot, &r, s.g, &s.tip);
         for i in 0..3 {
-            let ex = e_x(i, r.theta);
-            let ew = e_w(i, r.theta);
+            let (ex, ew) = beam_frame(robot, i, r.theta);
             extra[i].push(s.xi_c[i]);
             extra[3 + i].push(wrap(s.sleeve_angle[i] - ex[1].atan2(ex[0])));
             extra[6 + i].push(-dot(s.pin_force[i], ew));
@@ -383,48 +461,47 @@ fn post_process(
     Ok(resp)
 }
 
-/// `w_iG = (G_fem - G_rigid) . e_wi` and `w_i(L) = (tip_fem - (G_rigid + L e_xi)) . e_wi` [m]
-/// of the FEM's G at `g` and tips `tips` (fixed frame) on the rigid frame `r` (Eqs. 11-12).
-fn deflections(params: &RobotParams, r: &RigidFrame, g: [f64; 2], tips: &[[f64; 2]; 3]) -> ([f64; 3], [f64; 3]) {
+/// `w_iG = (G_fem - G_rigid) . e_wi` and `w_i(L_i) = (tip_fem - (G_rigid + L_i e_xi)) . e_wi` [m]
+/// of the FEM's G at `g` and tips `tips` (fixed frame) on the rigid frame `r` (Eqs. 11-12, W1).
+fn deflections(robot: &Robot, r: &RigidFrame, g: [f64; 2], tips: &[[f64; 2]; 3]) -> ([f64; 3], [f64; 3]) {
     let dg = [g[0] - r.g[0], g[1] - r.g[1]];
-    let w_g = [0, 1, 2].map(|i| dot(dg, e_w(i, r.theta)));
+    let w_g = [0, 1, 2].map(|i| dot(dg, beam_frame(robot, i, r.theta).1));
     let w_tip = [0, 1, 2].map(|i| {
-        let ex = e_x(i, r.theta);
-        let rel = [
-            tips[i][0] - r.g[0] - params.l * ex[0],
-            tips[i][1] - r.g[1] - params.l * ex[1],
-        ];
-        dot(rel, e_w(i, r.theta))
+        let (ex, ew) = beam_frame(robot, i, r.theta);
+        let l = robot.beams()[i].length;
+        let rel = [tips[i][0] - r.g[0] - l * ex[0], tips[i][1] - r.g[1] - l * ex[1]];
+        dot(rel, ew)
     });
     (w_g, w_tip)
 }
 
-/// Under gravity, the static equilibrium's `w_iG` and `w_i(L)` at the pose where the problem's
+/// Under gravity, the static equilibrium's `w_iG` and `w_i(L_i)` at the pose where the problem's
 /// motion comes to rest (`docs/fem.md` 9.5, Eq. G8; `docs/as-built.md` 5.5: the residual
 /// vibration is measured about it), post-processed as the run's outputs on the rigid frame of
 /// that pose; `None` without a rest within the run. The load acts at its value at `t_rest`.
-fn rest_offset(problem: &EqualBeams, settings: &FemSettings) -> Result<Option<RestOffset>, FemError> {
-    let Some(t_rest) = problem.trajectory.t_rest().filter(|t| *t <= problem.time.t_end) else {
+fn rest_offset(problem: &Problem, settings: &FemSettings) -> Result<Option<RestOffset>, FemError> {
+    let Some(t_rest) = problem.trajectory().t_rest().filter(|t| *t <= problem.time().t_end) else {
         return Ok(None);
     };
-    let params = problem.robot;
-    let r = RigidState::at(params, problem.trajectory, t_rest)
+    let robot = &*meshed(problem.robot())?;
+    let r = rigid_state(robot, problem.trajectory(), t_rest)
         .map_err(|source| FemError::PostProcessing { t: t_rest, source })?;
     let attached = Attached::of(problem, r.theta.v);
     let s = r.s.map(|s| s.v);
-    let (star, q) = static_equilibrium(params, settings.elements / 3, &initial_state(&r), &attached, s, t_rest)?;
+    let (star, q) = static_equilibrium(robot, settings.elements / 3, &initial_state(&r), &attached, s, t_rest)?;
     let pos = |j: usize| [q[3 * j], q[3 * j + 1]];
     let frame = RigidFrame {
         g: [r.g[0].v, r.g[1].v],
         theta: r.theta.v,
     };
-    let (w_g, w_tip) = deflections(params, &frame, pos(0), &[0, 1, 2].map(|i| pos(star.node(i, star.ne))));
+    let (w_g, w_tip) = deflections(robot, &frame, pos(0), &[0, 1, 2].map(|i| pos(star.node(i, star.ne))));
     Ok(Some(RestOffset { t_rest, w_g, w_tip }))
 }
 
 /// The deformed-star snapshots and the animation frames of `resp` from the recorded shapes
 /// (`times.all`, in order), each about the rigid frame `frame(t, s)` (post-processing only).
 fn add_shapes(
+    robot: &Robot,
     resp: &mut Response,
     hist: &History,
     times: &ShapeTimes,
@@ -441,7 +518,7 @@ fn add_shapes(
             theta: r.theta,
             s: snap.s,
         };
-        Ok((star_shape(hist, snap, &r), pose))
+        Ok((star_shape(robot, hist, snap, &r), pose))
     };
     for &k in &times.snap_idx {
         resp.shapes.push(shape(k)?.0);
@@ -475,19 +552,18 @@ fn attachment_columns(hist: &History, names: &mut Vec<&str>, cols: &mut Vec<Vec<
 
 /// The deformed star of snapshot `snap`: per beam the node positions and their deflections `w`
 /// [m] from the rigid beam of the frame at the snapshot's slider positions.
-fn star_shape(hist: &History, snap: &Snapshot, r: &RigidFrame) -> StarShape {
+fn star_shape(robot: &Robot, hist: &History, snap: &Snapshot, r: &RigidFrame) -> StarShape {
     let g = r.g;
     let beams = [0, 1, 2].map(|i| {
-        let (ex, ew) = (e_x(i, r.theta), e_w(i, r.theta));
+        let (ex, ew) = beam_frame(robot, i, r.theta);
         let pos = snap.beams[i].clone();
-        let w = hist
-            .node_x
+        let w = hist.node_x[i]
             .iter()
             .zip(&pos)
             .map(|(x, p)| dot([p[0] - g[0] - x * ex[0], p[1] - g[1] - x * ex[1]], ew))
             .collect();
         BeamShape {
-            x: hist.node_x.clone(),
+            x: hist.node_x[i].clone(),
             w,
             pos,
         }

@@ -223,7 +223,10 @@ fn bad_input_stops_with_time_and_reason() {
     )
     .map(|s| s.response)
     .unwrap_err();
-    assert!(matches!(err, FemError::Input(_)), "{err}");
+    assert!(
+        matches!(err, FemError::Elements { elements: 100, .. }) && err.to_string().contains("multiple of 3"),
+        "{err}"
+    );
     let problem = exp.problem().unwrap();
     let err = flexstar_fem::solve(
         &problem,

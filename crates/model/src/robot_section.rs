@@ -137,7 +137,8 @@ impl TryFrom<RobotSection> for RobotParams {
             ea: ea.map(|v| v[0]),
             as_built: None,
         };
-        let equal = |v: &[f64; 3]| v[0] == v[1] && v[1] == v[2];
+        // by bits: three NaN are one (invalid) value, refused by the compact form's checks
+        let equal = |v: &[f64; 3]| v[0].to_bits() == v[1].to_bits() && v[1].to_bits() == v[2].to_bits();
         if welds.is_none() && values.iter().all(equal) && ea.as_ref().is_none_or(equal) {
             return Ok(compact);
         }

@@ -84,6 +84,26 @@ impl Family {
         }
     }
 
+    /// The progress along the move of a pose (dimensionless; `docs/motions.md` 4.10): its
+    /// projection on the chord from `from` to `to` in the scaled task coordinates,
+    /// `p = <D (q - q_from), D (q_to - q_from)> / |D (q_to - q_from)|^2` with `D` the inverse
+    /// scales of [`Family::interior`]. 0 at `from`, 1 at `to`; on the segment (timing) it is the
+    /// progress `lambda` itself. Linear in the pose, so `p'(t)` is this map of the pose rate
+    /// applied without the offset ([`Family::progress_rate`]).
+    pub fn progress(&self, pose: [f64; 3]) -> f64 {
+        let a = coords(self.from);
+        self.progress_rate([0, 1, 2].map(|k| pose[k] - a[k]))
+    }
+
+    /// `p'(t)` [1/s] for the pose rate `q'(t)` (task coordinates per second): the linear part of
+    /// [`Family::progress`].
+    pub fn progress_rate(&self, rate: [f64; 3]) -> f64 {
+        let (a, b, s) = (coords(self.from), coords(self.to), self.scales());
+        let d = [0, 1, 2].map(|k| (b[k] - a[k]) / (s[k] * s[k]));
+        let norm: f64 = (0..3).map(|k| d[k] * (b[k] - a[k])).sum();
+        (0..3).map(|k| d[k] * rate[k]).sum::<f64>() / norm
+    }
+
     /// The via points of the motion of duration `t_move` [s] for the variables `x`.
     pub fn points(&self, x: &[f64], t_move: f64) -> Vec<ViaPoint> {
         let point = |t: f64, p: [f64; 3]| ViaPoint {
@@ -158,6 +178,36 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The progress of 4.10: 0 at `from`, 1 at `to`, the timing variables themselves at the
+    /// knots of a timing motion, and blind to a path offset orthogonal to the chord in the scaled
+    /// coordinates; its rate is the derivative of the progress (central differences).
+    #[test]
+    fn progress_is_the_timing_variable_on_the_segment() {
+        let f = family(Shape::Timing);
+        assert!(f.progress([0.0, 0.0, 0.0]).abs() < 1e-15);
+        assert!((f.progress([0.03, -0.02, 0.2]) - 1.0).abs() < 1e-14);
+        let x = [0.05, 0.1, 0.4, 0.5, 0.9, 0.97];
+        for (p, xj) in f.interior(&x).into_iter().zip(x) {
+            assert!((f.progress(p) - xj).abs() < 1e-14);
+        }
+        // the scaled chord is (1, -1, 1) (extents 0.03, -0.02, 0.2 are the scales): the offset
+        // (0.03, 0.02, 0), scaled (1, 1, 0), is orthogonal to it
+        let off = [0.03, 0.02, 0.0];
+        let on = [0.012, -0.008, 0.08];
+        let p = f.progress([on[0] + 0.1 * off[0], on[1] + 0.1 * off[1], on[2] + 0.1 * off[2]]);
+        assert!((p - 0.4).abs() < 1e-12, "{p}");
+        let traj = f.trajectory(&x, 0.4);
+        let (t, h) = (0.23, 1e-6);
+        let q = |t: f64| traj.pose(t).unwrap().unwrap();
+        let fd = (f.progress(q(t + h)) - f.progress(q(t - h))) / (2.0 * h);
+        let rate = traj
+            .pose(Dual2::from_re(t).derivative())
+            .unwrap()
+            .unwrap()
+            .map(|c| c.v1);
+        assert!((f.progress_rate(rate) - fd).abs() < 1e-6 * fd.abs().max(1.0), "{fd}");
     }
 
     /// Timing variables keep the path on the segment (the curve is linear in its knot values).

@@ -48,6 +48,8 @@ pub struct TraceRow {
     pub evaluations: usize,
     /// `|r|`: RMS of |dG| over the window [m].
     pub r_norm_m: f64,
+    /// The square root of the objective, tips' and smoothness terms included (4.10) [m].
+    pub objective_m: f64,
     /// Peak |dG| over the window [m].
     pub window_peak_m: f64,
     /// The damping of the accepted step (relative).
@@ -87,6 +89,10 @@ where
         s.evaluations += s.x.len();
         match s.step(f, accept, &jac, &mut mu, stop) {
             Some(()) => {}
+            None if Instant::now() >= stop.deadline => {
+                s.reason = "the wall-clock budget is spent".into();
+                break;
+            }
             None => {
                 s.reason =
                     "no step lowers |r| within the limits: a minimum of the family (damping at its largest)".into();
@@ -135,7 +141,8 @@ impl Search {
         self.trace.push(TraceRow {
             iteration: self.trace.len(),
             evaluations: self.evaluations,
-            r_norm_m: self.eval.norm(),
+            r_norm_m: self.eval.norm_g(),
+            objective_m: self.eval.norm(),
             window_peak_m: self.eval.window_peak_m,
             damping,
             wall_s: self.start.elapsed().as_secs_f64(),
@@ -143,7 +150,7 @@ impl Search {
     }
 
     fn finished(&self, stop: Stop) -> Option<String> {
-        if self.eval.norm() <= stop.r_floor * 1.05 {
+        if self.eval.norm_g() <= stop.r_floor * 1.05 {
             Some(format!("|r| at or below the model floor {:.3e} m", stop.r_floor))
         } else if Instant::now() >= stop.deadline {
             Some("the wall-clock budget is spent".into())
@@ -163,7 +170,7 @@ impl Search {
     {
         let (jtj, jtr) = normal_equations(&jac.r, &self.eval.r);
         let scale = (0..jtj.nrows()).map(|i| jtj[(i, i)]).fold(0.0, f64::max).max(1e-300);
-        let limits = crate::qp::linearised_limits(&self.eval.usage, &jac.usage);
+        let limits = crate::qp::linearised_limits(&self.eval.usage, &jac.usage, &self.eval.progress, &jac.progress);
         while *mu <= MU_MAX && Instant::now() < stop.deadline {
             let dx = match &limits {
                 None => damped_step(&jtj, &jtr, *mu * scale)?,
@@ -189,7 +196,7 @@ impl Search {
     /// A step that lands well below the model floor is shortened to land on it (4.5: below
     /// the floor the model cannot vouch for the residual, and a shorter step keeps the motion
     /// closer to the plain quintic): `alpha` from the affine model `r(alpha) = r0 + alpha (r1 -
-    /// r0)` of the residual along the step, `|r(alpha)| = r_floor`. The full step stays when the
+    /// r0)` of G's rows along the step, `|r_G(alpha)| = r_floor`. The full step stays when the
     /// shortened one is rejected.
     fn onto_floor<F, A>(
         &mut self,
@@ -203,10 +210,11 @@ impl Search {
         F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
         A: Fn(&Eval) -> bool,
     {
-        if full.1.norm() >= FLOOR_LANDING * r_floor {
+        if full.1.norm_g() >= FLOOR_LANDING * r_floor {
             return full;
         }
-        let (r0, r1) = (&self.eval.r, &full.1.r);
+        let n_g = self.eval.n_g;
+        let (r0, r1) = (&self.eval.r[..n_g], &full.1.r[..n_g]);
         let d: Vec<f64> = r1.iter().zip(r0).map(|(a, b)| a - b).collect();
         let a = d.iter().map(|v| v * v).sum::<f64>();
         let b = 2.0 * r0.iter().zip(&d).map(|(p, q)| p * q).sum::<f64>();
@@ -238,10 +246,12 @@ impl Search {
     }
 }
 
-/// The Jacobians of the residual vector and of the limits' usage at one point.
+/// The Jacobians of the residual vector, of the limits' usage and of the progress rows at one
+/// point.
 pub struct Jacobian {
     pub r: Mat<f64>,
     pub usage: Mat<f64>,
+    pub progress: Mat<f64>,
 }
 
 /// The Jacobians of `r` and of the usage at `x` by forward differences (a backward difference
@@ -250,7 +260,7 @@ fn jacobian<F>(f: &F, x: &[f64], e0: &Eval) -> Result<Jacobian, Rejected>
 where
     F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
 {
-    let rows0: Vec<f64> = e0.r.iter().chain(&e0.usage).copied().collect();
+    let rows0: Vec<f64> = e0.r.iter().chain(&e0.usage).chain(&e0.progress).copied().collect();
     let r0 = &rows0;
     let columns: Vec<Result<Vec<f64>, Rejected>> = (0..x.len())
         .into_par_iter()
@@ -265,15 +275,16 @@ where
                 Ok(e) => (e, 1.0),
                 Err(_) => (at(-1.0)?, -1.0),
             };
-            let rows = e.r.iter().chain(&e.usage);
+            let rows = e.r.iter().chain(&e.usage).chain(&e.progress);
             Ok(rows.zip(r0).map(|(a, b)| sign * (a - b) / h).collect())
         })
         .collect();
     let columns = columns.into_iter().collect::<Result<Vec<_>, _>>()?;
-    let nr = e0.r.len();
+    let (nr, nu) = (e0.r.len(), e0.usage.len());
     Ok(Jacobian {
         r: Mat::from_fn(nr, x.len(), |i, j| columns[j][i]),
-        usage: Mat::from_fn(e0.usage.len(), x.len(), |i, j| columns[j][nr + i]),
+        usage: Mat::from_fn(nu, x.len(), |i, j| columns[j][nr + i]),
+        progress: Mat::from_fn(e0.progress.len(), x.len(), |i, j| columns[j][nr + nu + i]),
     })
 }
 
@@ -306,12 +317,16 @@ mod tests {
             t: 0.0,
         };
         Eval {
+            n_g: r.len(),
             r,
             window_peak_m: 0.0,
             fa: p,
             v: p,
             a: p,
+            j: p,
             usage: Vec::new(),
+            progress: Vec::new(),
+            jerk: Vec::new(),
         }
     }
 
@@ -332,6 +347,38 @@ mod tests {
             "{:?}: {}",
             s.x,
             s.reason
+        );
+    }
+
+    /// A progress row (`docs/motions.md` 4.10) is a linear constraint the step honours exactly:
+    /// the minimum of `(x - 2)^2 + (y - 1)^2` with the rows `x - 1.5 <= 0` and `x + y - 2 <= 0`
+    /// is the textbook KKT point (1.5, 0.5), reached without ever crossing a row (from a start
+    /// where both rows are active, above `qp::PROGRESS_ACTIVE`).
+    #[test]
+    fn progress_rows_bound_the_search_like_linear_constraints() {
+        let f = |x: &[f64]| {
+            let mut e = eval_of(vec![x[0] - 2.0, x[1] - 1.0]);
+            e.progress = vec![x[0] - 1.5, x[0] + x[1] - 2.0];
+            Ok(e)
+        };
+        let x0 = vec![1.3, 0.4];
+        let e0 = f(&x0).unwrap();
+        let stop = Stop {
+            r_floor: 0.0,
+            deadline: Instant::now() + std::time::Duration::from_secs(10),
+        };
+        let accept = |e: &Eval| e.within(&crate::section::Limits::default());
+        let s = minimise(&f, &accept, x0, e0, stop).unwrap();
+        assert!(
+            (s.x[0] - 1.5).abs() < 1e-4 && (s.x[1] - 0.5).abs() < 1e-4,
+            "{:?}: {}",
+            s.x,
+            s.reason
+        );
+        assert!(
+            s.eval.progress.iter().all(|p| *p <= crate::objective::PROGRESS_TOL),
+            "{:?}",
+            s.eval.progress
         );
     }
 

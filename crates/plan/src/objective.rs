@@ -4,43 +4,83 @@
 //! `r = sqrt(2/3) w_iG(t_k) / sqrt(n)` for the `n` output times `t_k` in `[t_rest, t_rest + W]`
 //! and i = 1..3, so that `|r|^2` is the mean square of |dG| over the window (Eq. R1 of 2.1).
 //! `r` is linear in the AMM's state, hence smooth in the variables.
+//!
+//! With the terms of `docs/motions.md` 4.10, `r` also holds the tips' rows (Eq. S2, weight
+//! `w_t`) and the smoothness rows (Eq. S1, weight `w_s`), after the rows of G; the evaluation
+//! records the usage of every limit (jerk included) and, for monotone progress, the progress
+//! rows that must stay at or below zero.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 
 use flexstar_metrics::residual::dg_magnitude;
 use flexstar_model::{AmmSettings, Experiment, Response, Trajectory};
 
-use crate::limits::{slider_samples, Peak};
+use crate::family::Family;
+use crate::limits::{slider_samples, KinematicPeaks, Peak};
 use crate::section::Limits;
+
+/// A progress row may exceed zero by this much and still count as monotone (a backward rate of
+/// 1e-6 of the mean rate `1/T`: the QP's own tolerance; `docs/motions.md` 4.10).
+pub const PROGRESS_TOL: f64 = 1e-6;
 
 /// What one evaluation gives.
 #[derive(Debug, Clone)]
 pub struct Eval {
-    /// The residual vector (m).
+    /// The residual vector (m): the `n_g` rows of G, then the tips' and the smoothness rows.
     pub r: Vec<f64>,
+    /// How many rows of `r` are G's.
+    pub n_g: usize,
     /// Peak |dG| [m] over the window.
     pub window_peak_m: f64,
     /// Peak |Fa_i| [N] over the run (the AMM's, Eq. 33).
     pub fa: Peak,
-    /// Peaks of |s_i'| [m/s] and |s_i''| [m/s^2] over the move.
+    /// Peaks of |s_i'| [m/s], |s_i''| [m/s^2] and |s_i'''| [m/s^3] over the move.
     pub v: Peak,
     pub a: Peak,
-    /// The usage `u = g / g_max` of every sample of every given limit (4.4): `|s_i'| / v_max`
-    /// and `|s_i''| / a_max` at the kinematic samples, `|Fa_i| / Fa_max` at every output time;
-    /// the same samples in every evaluation, so that the search can linearise them.
+    pub j: Peak,
+    /// The usage `u = g / g_max` of every sample of every given limit (4.4, 4.10): `|s_i'| /
+    /// v_max`, `|s_i''| / a_max` and `|s_i'''| / j_max` at the kinematic samples, `|Fa_i| /
+    /// Fa_max` at every output time; the same samples in every evaluation, so that the search can
+    /// linearise them.
     pub usage: Vec<f64>,
+    /// The progress rows (4.10), each at most zero for a monotone motion: `-T p'(t_k)` at the
+    /// interior samples and `p(t_j) - p(t_j+1)` for consecutive knots (ends included). Empty when
+    /// progress is free.
+    pub progress: Vec<f64>,
+    /// `s_i'''(t_k)` [m/s^3] at the kinematic samples (three per sample): the smoothness term's
+    /// reference when this is the plain quintic.
+    pub jerk: Vec<f64>,
 }
 
 impl Eval {
-    /// `|r|`: the RMS of |dG| over the window [m].
+    /// `|r|`: the square root of the objective (4.10; with no tips' or smoothness rows, the RMS
+    /// of |dG| over the window) [m].
     pub fn norm(&self) -> f64 {
         self.r.iter().map(|x| x * x).sum::<f64>().sqrt()
     }
 
-    /// The limits this evaluation breaks, by name (`v_max`, `a_max`, `Fa_max`).
+    /// The RMS of |dG| over the window [m] (the rows of G alone).
+    pub fn norm_g(&self) -> f64 {
+        self.r[..self.n_g].iter().map(|x| x * x).sum::<f64>().sqrt()
+    }
+
+    /// The kinematic peaks.
+    pub fn kinematic(&self) -> KinematicPeaks {
+        KinematicPeaks {
+            v: self.v,
+            a: self.a,
+            j: self.j,
+        }
+    }
+
+    /// The limits this evaluation breaks, by name (`v_max`, `a_max`, `j_max`, `Fa_max`).
     pub fn broken(&self, limits: &Limits) -> Vec<&'static str> {
         let mut out = Vec::new();
         for (name, peak, max) in [
             ("v_max", self.v, limits.v_max),
             ("a_max", self.a, limits.a_max),
+            ("j_max", self.j, limits.j_max),
             ("Fa_max", self.fa, limits.fa_max),
         ] {
             if max.is_some_and(|m| peak.value > m) {
@@ -49,6 +89,43 @@ impl Eval {
         }
         out
     }
+
+    /// Within `limits`, and monotone when the evaluation has progress rows (4.4, 4.10)?
+    pub fn within(&self, limits: &Limits) -> bool {
+        self.broken(limits).is_empty() && self.progress.iter().all(|&p| p <= PROGRESS_TOL)
+    }
+}
+
+/// The smoothness term's reference (`docs/motions.md` 4.10, Eq. S1): the plain quintic's slider
+/// jerk at the kinematic samples and the scale `sqrt(w_s) r_floor / |j_q|` of the rows
+/// `scale (s_i'''(t_k) - j_q,ik)`.
+#[derive(Debug, Clone)]
+pub struct SmoothRef {
+    pub jerk: Vec<f64>,
+    pub scale: f64,
+}
+
+impl SmoothRef {
+    /// The reference of weight `w_s` from the plain quintic's evaluation and the search's floor
+    /// `r_floor` [m]; `None` when the weight is zero.
+    pub fn new(plain: &Eval, weight: f64, r_floor: f64) -> Option<Self> {
+        let norm = plain.jerk.iter().map(|x| x * x).sum::<f64>().sqrt();
+        (weight > 0.0 && norm > 0.0).then(|| SmoothRef {
+            jerk: plain.jerk.clone(),
+            scale: weight.sqrt() * r_floor / norm,
+        })
+    }
+}
+
+/// The terms beyond G's residual (`docs/motions.md` 4.10).
+#[derive(Debug, Clone, Default)]
+pub struct Terms {
+    /// Weight `w_t` of the tips' rows (Eq. S2).
+    pub tip_weight: f64,
+    /// The smoothness rows' reference (Eq. S1).
+    pub smooth: Option<SmoothRef>,
+    /// The family whose progress must be monotone (`None`: free).
+    pub monotone: Option<Family>,
 }
 
 /// Why a candidate has no evaluation.
@@ -79,6 +156,10 @@ pub struct Evaluator {
     pub window: f64,
     /// The limits whose usage the evaluations record.
     limits: Limits,
+    /// The objective's terms beyond G (4.10).
+    terms: Terms,
+    /// AMM runs made by this evaluator and its copies (shared).
+    runs: Arc<AtomicUsize>,
 }
 
 impl Evaluator {
@@ -99,12 +180,24 @@ impl Evaluator {
             settings,
             window,
             limits: Limits::default(),
+            terms: Terms::default(),
+            runs: Arc::new(AtomicUsize::new(0)),
         }
     }
 
     /// The same evaluator recording the usage of `limits`.
     pub fn with_limits(&self, limits: Limits) -> Self {
         Evaluator { limits, ..self.clone() }
+    }
+
+    /// The same evaluator with the terms of 4.10.
+    pub fn with_terms(&self, terms: Terms) -> Self {
+        Evaluator { terms, ..self.clone() }
+    }
+
+    /// AMM runs made so far by this evaluator and every copy of it.
+    pub fn runs(&self) -> usize {
+        self.runs.load(Ordering::Relaxed)
     }
 
     /// The AMM run of `traj` up to `t_end` [s] (feasibility checked first over that span).
@@ -116,6 +209,7 @@ impl Evaluator {
         let checked = flexstar_kinematics::check_motion(&exp.robot, traj, t_end, step)
             .map_err(|e| Rejected::Infeasible(format!("t = {:.4} s: {}", e.t, e.violation)))?;
         let problem = exp.problem().map_err(|e| Rejected::Infeasible(e.detail()))?;
+        self.runs.fetch_add(1, Ordering::Relaxed);
         let r = flexstar_amm::solve(
             &problem,
             &self.settings,
@@ -136,25 +230,45 @@ impl Evaluator {
         let t0 = traj.t_start();
         let jets = slider_samples(&self.exp.robot, traj, (t0, t_rest), self.exp.time.dt_out, knots)
             .map_err(|e| Rejected::Infeasible(e.to_string()))?;
-        let (v, a) = crate::limits::peaks_of(&jets);
+        let KinematicPeaks { v, a, j } = crate::limits::peaks_of(&jets);
+        let jerk: Vec<f64> = jets.iter().flat_map(|(_, j)| j.map(|j| j.d3)).collect();
+        let mut r = residual_vector(&resp, t_rest);
+        let n_g = r.len();
+        if self.terms.tip_weight > 0.0 {
+            r.extend(tip_vector(&resp, t_rest, self.terms.tip_weight));
+        }
+        if let Some(s) = &self.terms.smooth {
+            r.extend(jerk.iter().zip(&s.jerk).map(|(j, q)| s.scale * (j - q)));
+        }
+        let progress = match &self.terms.monotone {
+            Some(family) => progress_rows(family, traj, (t0, t_rest), &jets, knots)?,
+            None => Vec::new(),
+        };
         Ok(Eval {
-            r: residual_vector(&resp, t_rest),
+            r,
+            n_g,
             window_peak_m: window_peak(&resp, t_rest),
             fa: force_peak(&resp),
             v,
             a,
+            j,
             usage: self.usage(&jets, &resp),
+            progress,
+            jerk,
         })
     }
 
     /// The samples of [`Eval::usage`].
-    fn usage(&self, jets: &[(f64, [flexstar_model::trajectory::Jet; 3])], resp: &Response) -> Vec<f64> {
+    fn usage(&self, jets: &[(f64, [flexstar_model::trajectory::Jet4; 3])], resp: &Response) -> Vec<f64> {
         let mut usage = Vec::new();
         if let Some(v) = self.limits.v_max {
             usage.extend(jets.iter().flat_map(|(_, j)| j.iter().map(move |j| j.d1.abs() / v)));
         }
         if let Some(a) = self.limits.a_max {
             usage.extend(jets.iter().flat_map(|(_, j)| j.iter().map(move |j| j.d2.abs() / a)));
+        }
+        if let Some(jm) = self.limits.j_max {
+            usage.extend(jets.iter().flat_map(|(_, j)| j.iter().map(move |j| j.d3.abs() / jm)));
         }
         if let Some(f) = self.limits.fa_max {
             usage.extend(resp.fa.iter().flatten().map(|x| x.abs() / f));
@@ -180,6 +294,48 @@ pub fn residual_vector(resp: &Response, t_rest: f64) -> Vec<f64> {
     let scale = (2.0 / 3.0 / rows.len().max(1) as f64).sqrt();
     rows.flat_map(|k| (0..3).map(move |i| scale * resp.w_g_about_rest(i, k)))
         .collect()
+}
+
+/// The tips' rows (`docs/motions.md` 4.10, Eq. S2): `sqrt(w_t / 3) w_i(L, t_k) / sqrt(n)` for the
+/// `n` rows at or after `t_rest` and i = 1..3, about the rest pose's static equilibrium, so that
+/// their squared norm is `w_t` times the mean square over the window of the tips' RMS
+/// `sqrt(1/3 sum_i w_i(L)^2)` (the measure of 2.2).
+pub fn tip_vector(resp: &Response, t_rest: f64, weight: f64) -> Vec<f64> {
+    let rows = after(resp, t_rest);
+    let scale = (weight / 3.0 / rows.len().max(1) as f64).sqrt();
+    let offset = resp.rest_offset.map_or([0.0; 3], |o| o.w_tip);
+    rows.flat_map(|k| (0..3).map(move |i| scale * (resp.w_tip[i][k] - offset[i])))
+        .collect()
+}
+
+/// The progress rows of [`Eval::progress`] (`docs/motions.md` 4.10): `-T p'(t)` at the samples
+/// strictly inside the move (the rate vanishes at both ends whatever the variables), then
+/// `p(t_j) - p(t_j+1)` over the knots with `p = 0` at the start and 1 at the end.
+fn progress_rows(
+    family: &Family,
+    traj: &Trajectory,
+    (t0, t1): (f64, f64),
+    jets: &[(f64, [flexstar_model::trajectory::Jet4; 3])],
+    knots: &[f64],
+) -> Result<Vec<f64>, Rejected> {
+    use num_dual::Dual64;
+    let span = t1 - t0;
+    let bad = |e: flexstar_model::ModelError| Rejected::Infeasible(e.to_string());
+    let inside = |t: f64| t > t0 + 1e-6 * span && t < t1 - 1e-6 * span;
+    let mut rows = Vec::new();
+    for (t, _) in jets.iter().filter(|(t, _)| inside(*t)) {
+        let q = traj.pose(Dual64::from_re(*t).derivative()).map_err(bad)?;
+        let rate = q.map_or([0.0; 3], |q| q.map(|c| c.eps));
+        rows.push(-span * family.progress_rate(rate));
+    }
+    let mut p = vec![0.0];
+    for &t in knots.iter().filter(|t| inside(**t)) {
+        let q = traj.pose(t).map_err(bad)?.unwrap_or([0.0; 3]);
+        p.push(family.progress(q));
+    }
+    p.push(1.0);
+    rows.extend(p.windows(2).map(|w| w[0] - w[1]));
+    Ok(rows)
 }
 
 /// Peak |dG| [m] at or after `t_rest` (about the rest pose's static equilibrium under gravity).

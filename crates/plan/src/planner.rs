@@ -10,10 +10,10 @@ use flexstar_model::geometry::inverse_kinematics;
 use flexstar_model::{DriveKind, Experiment, ModelError, ShaperKind, ShaperSection, Trajectory};
 
 use crate::family::Family;
-use crate::limits::{check_quintic_kinematics, check_t_move, kinematic_peaks, quintic_breaks, travels};
+use crate::limits::{check_quintic_kinematics, check_t_move, kinematic_peaks, quintic_breaks, travels, Peak};
 use crate::lm::{minimise, Stop, TraceRow};
-use crate::objective::{Eval, Evaluator};
-use crate::section::{Objective, PlanConfig};
+use crate::objective::{Eval, Evaluator, SmoothRef, Terms};
+use crate::section::{Limits, Objective, PlanConfig};
 use crate::PlanError;
 
 /// The search stops when the RMS of |dG| over the window is this share of the plain quintic's
@@ -27,8 +27,18 @@ pub const WINDOW_PERIODS: f64 = 2.0;
 #[derive(Debug, Clone, Serialize)]
 pub struct Planned {
     pub objective: Objective,
-    /// The limits the motion keeps.
+    /// The limits the motion keeps, as given (`[limits]`).
     pub limits: crate::section::Limits,
+    /// The limits the search enforced (`docs/motions.md` 4.10): each given limit, lowered to
+    /// `peak_factor` times the plain quintic's peak for `a_max`, `j_max` and `Fa_max`.
+    pub bounds: crate::section::Limits,
+    /// The peak factor in force (`None`: lifted).
+    pub peak_factor: Option<f64>,
+    /// The peaks of the plain quintic and of the planned motion (AMM force, rigid kinematics).
+    pub peaks: PeakComparison,
+    /// A note for each peak of the plan above the plain quintic's (4.10): the CLI prints them,
+    /// plan.json and plan.md carry them.
+    pub warnings: Vec<String>,
     /// Duration of the planned move [s] and its end [s].
     pub t_move: f64,
     pub t_rest: f64,
@@ -50,7 +60,12 @@ pub struct Planned {
     pub window_s: f64,
     /// The model floor of the search [m].
     pub r_floor_m: f64,
+    /// The search's trace (for `objective = "time"`, the chosen duration's search; the bisection
+    /// is in `time_search.steps`).
     pub trace: Vec<TraceRow>,
+    /// Every AMM run the planner's evaluator made (candidates, Jacobian columns, the plain
+    /// quintic, for `objective = "time"` the ZVD baseline's runs and the checks over the span);
+    /// not the one run that chose N.
     pub evaluations: usize,
     /// Why the search stopped.
     pub reason: String,
@@ -62,6 +77,85 @@ pub struct Planned {
     /// same nominal duration, or at the same residual for `objective = "time"`).
     #[serde(skip)]
     pub zvd: Experiment,
+}
+
+/// The peaks of one motion: `|s_i'|` [m/s], `|s_i''|` [m/s^2], `|s_i'''|` [m/s^3] and the AMM's
+/// `|Fa_i|` [N].
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct PeakSet {
+    pub v: Peak,
+    pub a: Peak,
+    pub j: Peak,
+    pub fa: Peak,
+}
+
+impl PeakSet {
+    /// The peaks of an evaluation.
+    pub fn of(e: &Eval) -> Self {
+        PeakSet {
+            v: e.v,
+            a: e.a,
+            j: e.j,
+            fa: e.fa,
+        }
+    }
+}
+
+/// The plain quintic's peaks and the plan's.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct PeakComparison {
+    pub plain: PeakSet,
+    pub planned: PeakSet,
+}
+
+/// The limits a search enforces (`docs/motions.md` 4.10): `v_max` as given; `a_max`, `j_max`
+/// and `Fa_max` each the smaller of the given limit and `factor` times the plain quintic's peak
+/// (`plain`, the same duration); with the factor lifted (`None`), the given limits.
+pub fn effective_bounds(limits: &Limits, factor: Option<f64>, plain: &Eval) -> Limits {
+    let cap = |given: Option<f64>, quintic: f64| match factor {
+        None => given,
+        Some(f) => Some(given.map_or(f * quintic, |g| g.min(f * quintic))),
+    };
+    Limits {
+        v_max: limits.v_max,
+        a_max: cap(limits.a_max, plain.a.value),
+        j_max: cap(limits.j_max, plain.j.value),
+        fa_max: cap(limits.fa_max, plain.fa.value),
+    }
+}
+
+/// A warning for each of the plan's peaks `|s''|`, `|s'''|`, `|Fa|` above the plain quintic's of
+/// the same duration (`docs/motions.md` 4.10).
+pub fn peak_warnings(plain: &PeakSet, planned: &PeakSet) -> Vec<String> {
+    [
+        ("|s''|", "m/s^2", plain.a, planned.a),
+        ("|s'''|", "m/s^3", plain.j, planned.j),
+        ("|Fa| (AMM)", "N", plain.fa, planned.fa),
+    ]
+    .into_iter()
+    .filter(|(_, _, q, p)| p.value > q.value * (1.0 + 1e-9))
+    .map(|(what, unit, q, p)| {
+        format!(
+            "the planned motion's peak {what} = {:.4} {unit} (slider {}, t = {:.3} s) is {:.2} x the plain quintic's {:.4} {unit} at the same t_move",
+            p.value,
+            p.slider,
+            p.t,
+            p.value / q.value,
+            q.value
+        )
+    })
+    .collect()
+}
+
+/// The evaluator of a search at one duration (`docs/motions.md` 4.10): the limits `bounds`,
+/// the tips' weight, the smoothness reference from the plain quintic `plain` with the search's
+/// floor `r_floor` [m], monotone progress unless lifted.
+pub fn search_evaluator(cfg: &PlanConfig, s: &Setup, bounds: Limits, plain: &Eval, r_floor: f64) -> Evaluator {
+    s.evaluator.with_limits(bounds).with_terms(Terms {
+        tip_weight: cfg.plan.tip_weight(),
+        smooth: SmoothRef::new(plain, cfg.plan.smoothness(), r_floor),
+        monotone: cfg.plan.monotone().then(|| s.family.clone()),
+    })
 }
 
 /// What every search shares: the family, the frozen AMM, the window.
@@ -122,7 +216,8 @@ fn check_plan_input(cfg: &PlanConfig) -> Result<(), PlanError> {
         check_t_move(t_move, travel, &cfg.limits).map_err(bad)?;
         let quintic = family.quintic(t_move);
         let span = (cfg.plan.t0, cfg.plan.t0 + t_move);
-        let peaks = kinematic_peaks(&cfg.exp.robot, &quintic, span, cfg.exp.time.dt_out, &[]).map_err(bad)?;
+        let knots = knot_times(&family, t_move);
+        let peaks = kinematic_peaks(&cfg.exp.robot, &quintic, span, cfg.exp.time.dt_out, &knots).map_err(bad)?;
         check_quintic_kinematics(t_move, peaks, &cfg.limits).map_err(bad)?;
     }
     Ok(())
@@ -217,17 +312,32 @@ fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Experiment) -> R
             .into());
     }
     let stop = Stop {
-        r_floor: FLOOR_SHARE * plain.norm(),
+        r_floor: FLOOR_SHARE * plain.norm_g(),
         deadline,
     };
-    let ev = s.evaluator.with_limits(cfg.limits);
+    let bounds = effective_bounds(&cfg.limits, cfg.plan.peak_factor(), &plain);
+    let ev = search_evaluator(cfg, s, bounds, &plain, stop.r_floor);
     let f = |x: &[f64]| evaluate(&ev, &s.family, x, t_move);
-    let accept = |e: &Eval| e.broken(&cfg.limits).is_empty();
+    let accept = |e: &Eval| e.within(&bounds);
     let e0 = f(&x0).map_err(|e| PlanError::Solver(format!("the plain quintic: {e}")))?;
+    if !accept(&e0) {
+        return Err(PlanError::Solver(format!(
+            "the plain quintic, the search's start, is outside the limits it enforces ({})",
+            e0.broken(&bounds).join(", ")
+        )));
+    }
     let sol = minimise(&f, &accept, x0, e0, stop).map_err(|e| PlanError::Solver(e.to_string()))?;
+    let peaks = PeakComparison {
+        plain: PeakSet::of(&plain),
+        planned: PeakSet::of(&sol.eval),
+    };
     Ok(Planned {
         objective: Objective::Residual,
         limits: cfg.limits,
+        bounds,
+        peak_factor: cfg.plan.peak_factor(),
+        warnings: peak_warnings(&peaks.plain, &peaks.planned),
+        peaks,
         t_move,
         t_rest: cfg.plan.t0 + t_move,
         trajectory: s.family.trajectory(&sol.x, t_move),
@@ -240,7 +350,7 @@ fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Experiment) -> R
         window_s: s.evaluator.window,
         r_floor_m: stop.r_floor,
         trace: sol.trace,
-        evaluations: sol.evaluations,
+        evaluations: s.evaluator.runs(),
         reason: sol.reason,
         wall_s: s.started.elapsed().as_secs_f64(),
         time_search: None,

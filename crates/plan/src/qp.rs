@@ -15,20 +15,40 @@ pub const ACTIVE: f64 = 0.5;
 /// usage of the trial stays below 1.
 pub const MARGIN: f64 = 2e-3;
 
-/// The constraint rows `G_k dx <= 1 - MARGIN - u_k` of the active samples.
+/// Progress rows (`docs/motions.md` 4.10, each `<= 0` for a monotone motion) above this value
+/// join the step's constraints: a rate below half the mean rate, or knots closer than half the
+/// progress.
+pub const PROGRESS_ACTIVE: f64 = -0.5;
+/// The linearised progress row is `<= -PROGRESS_MARGIN` where it already is, else `<=` its value:
+/// the step aims a little inside (the rows are linear in the variables; the margin absorbs the
+/// QP's tolerance).
+pub const PROGRESS_MARGIN: f64 = 1e-7;
+
+/// The constraint rows `G_k dx <= h_k` of the active samples: `h_k = 1 - MARGIN - u_k` for a
+/// limit's usage, `h_k = min(-p_k, max(-p_k - PROGRESS_MARGIN, 0))` for a progress row `p_k`.
 #[derive(Debug, Clone)]
 pub struct LinearLimits {
     pub g: Vec<Vec<f64>>,
     pub h: Vec<f64>,
 }
 
-/// The active samples' rows; `None` when no sample is active (the step is unconstrained).
-pub fn linearised_limits(usage: &[f64], grad: &Mat<f64>) -> Option<LinearLimits> {
+/// The active samples' rows (usage above [`ACTIVE`], progress above [`PROGRESS_ACTIVE`]); `None`
+/// when no sample is active (the step is unconstrained).
+pub fn linearised_limits(
+    usage: &[f64],
+    grad: &Mat<f64>,
+    progress: &[f64],
+    progress_grad: &Mat<f64>,
+) -> Option<LinearLimits> {
     let mut g = Vec::new();
     let mut h = Vec::new();
     for (k, &u) in usage.iter().enumerate().filter(|(_, u)| **u > ACTIVE) {
         g.push((0..grad.ncols()).map(|j| grad[(k, j)]).collect());
         h.push(1.0 - MARGIN - u);
+    }
+    for (k, &p) in progress.iter().enumerate().filter(|(_, p)| **p > PROGRESS_ACTIVE) {
+        g.push((0..progress_grad.ncols()).map(|j| progress_grad[(k, j)]).collect());
+        h.push((-p).min((-p - PROGRESS_MARGIN).max(0.0)));
     }
     (!g.is_empty()).then_some(LinearLimits { g, h })
 }

@@ -61,6 +61,37 @@ pub struct PlanSection {
     /// Wall-clock budget of the optimiser [s] (default 8).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub budget_s: Option<f64>,
+    /// Smoothness weight `w_s` >= 0 (default [`DEFAULT_SMOOTHNESS`]): the slider jerk's departure
+    /// from the plain quintic's joins the objective (`docs/motions.md` 4.10, Eq. S1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub smoothness: Option<f64>,
+    /// The planned motion's peak `|s_i''|`, `|s_i'''|` and `|Fa_i|` stay within this factor
+    /// (>= 1) of the plain quintic's at the same duration (default [`DEFAULT_PEAK_FACTOR`]);
+    /// `"off"` lifts it (`docs/motions.md` 4.10).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_factor: Option<PeakFactor>,
+    /// Progress along the path never goes backwards (default true; `docs/motions.md` 4.10).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub monotone: Option<bool>,
+    /// Weight `w_t` >= 0 of the tips' residual in the objective (default 0: G only;
+    /// `docs/motions.md` 4.10, Eq. S2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tip_weight: Option<f64>,
+}
+
+/// The default of `[plan] peak_factor` (`docs/motions.md` 4.10).
+pub const DEFAULT_PEAK_FACTOR: f64 = 1.5;
+/// The default of `[plan] smoothness` (`docs/motions.md` 4.10).
+pub const DEFAULT_SMOOTHNESS: f64 = 0.0;
+
+/// `[plan] peak_factor`: a number >= 1, or the word `"off"`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum PeakFactor {
+    /// The factor on the plain quintic's peaks (dimensionless).
+    Factor(f64),
+    /// `"off"` (any other word is refused by [`PlanSection::validate`]).
+    Word(String),
 }
 
 fn default_objective() -> Objective {
@@ -81,6 +112,9 @@ pub struct Limits {
     /// Largest slider acceleration `|s_i''|` [m/s^2].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub a_max: Option<f64>,
+    /// Largest slider jerk `|s_i'''|` [m/s^3] (`docs/motions.md` 4.10).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub j_max: Option<f64>,
     /// Largest driving force `|Fa_i|` [N] (Eq. 33, the accurate AMM's).
     #[serde(rename = "Fa_max", default, skip_serializing_if = "Option::is_none")]
     pub fa_max: Option<f64>,
@@ -99,6 +133,30 @@ impl PlanSection {
     /// The optimiser's wall-clock budget [s].
     pub fn budget(&self) -> f64 {
         self.budget_s.unwrap_or(8.0)
+    }
+
+    /// The factor on the plain quintic's peaks; `None` when lifted (`"off"`).
+    pub fn peak_factor(&self) -> Option<f64> {
+        match &self.peak_factor {
+            None => Some(DEFAULT_PEAK_FACTOR),
+            Some(PeakFactor::Factor(f)) => Some(*f),
+            Some(PeakFactor::Word(_)) => None,
+        }
+    }
+
+    /// The smoothness weight `w_s` (dimensionless).
+    pub fn smoothness(&self) -> f64 {
+        self.smoothness.unwrap_or(DEFAULT_SMOOTHNESS)
+    }
+
+    /// The tips' weight `w_t` (dimensionless).
+    pub fn tip_weight(&self) -> f64 {
+        self.tip_weight.unwrap_or(0.0)
+    }
+
+    /// Must the progress along the path be monotone?
+    pub fn monotone(&self) -> bool {
+        self.monotone.unwrap_or(true)
     }
 
     /// The checks that need no robot (`docs/motions.md` 4.8): finite poses, `t0 >= 0`, exactly
@@ -123,8 +181,39 @@ impl PlanSection {
                 format!("must be positive, got {b}"),
             ));
         }
+        self.validate_smooth()?;
         if self.from == self.to {
             return Err(ModelError::invalid("plan.to", "the move has no extent: to equals from"));
+        }
+        Ok(())
+    }
+
+    /// `peak_factor` a finite number >= 1 or `"off"`; `smoothness`, `tip_weight` finite and >= 0.
+    fn validate_smooth(&self) -> Result<(), ModelError> {
+        match &self.peak_factor {
+            Some(PeakFactor::Factor(f)) if !(f.is_finite() && *f >= 1.0) => {
+                return Err(ModelError::invalid(
+                    "plan.peak_factor",
+                    format!(
+                        "must be a finite number >= 1 (the plain quintic, the planner's start, has factor 1) or \"off\", got {f}"
+                    ),
+                ))
+            }
+            Some(PeakFactor::Word(w)) if w != "off" => {
+                return Err(ModelError::invalid(
+                    "plan.peak_factor",
+                    format!("must be a number >= 1 or \"off\", got \"{w}\""),
+                ))
+            }
+            _ => {}
+        }
+        for (key, v) in [
+            ("plan.smoothness", self.smoothness),
+            ("plan.tip_weight", self.tip_weight),
+        ] {
+            if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+                return Err(ModelError::invalid(key, format!("must be finite and >= 0, got {v}")));
+            }
         }
         Ok(())
     }
@@ -166,6 +255,7 @@ impl Limits {
         for (key, v) in [
             ("limits.v_max", self.v_max),
             ("limits.a_max", self.a_max),
+            ("limits.j_max", self.j_max),
             ("limits.Fa_max", self.fa_max),
         ] {
             if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
@@ -180,7 +270,7 @@ impl Limits {
 
     /// Is any limit given?
     pub fn any(&self) -> bool {
-        self.v_max.is_some() || self.a_max.is_some() || self.fa_max.is_some()
+        self.v_max.is_some() || self.a_max.is_some() || self.j_max.is_some() || self.fa_max.is_some()
     }
 }
 
@@ -293,4 +383,62 @@ pub fn quintic_table(plan: &PlanSection, t_move: f64) -> toml::Value {
         ("t0".to_string(), toml::Value::Float(plan.t0)),
         ("t1".to_string(), toml::Value::Float(plan.t0 + t_move)),
     ]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEAD: &str =
+        "name = \"t\"\n[time]\nt_end = 1.5\ndt_out = 0.001\n[plan]\nfrom = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\n\
+                        to = { Gx = 0.03, Gy = -0.02, theta = 0.2 }\nt_move = 0.42\n";
+
+    fn read(extra: &str) -> Result<PlanConfig, PlanError> {
+        plan_config_from_str(&format!("{HEAD}{extra}"), Path::new("smooth.toml"))
+    }
+
+    fn refused(extra: &str, key: &str) {
+        match read(extra) {
+            Err(PlanError::Input(e)) => {
+                let msg = e.to_string();
+                assert!(msg.contains("smooth.toml") && msg.contains(key), "{extra}: {msg}");
+            }
+            other => panic!("{extra}: not refused with {key}: {other:?}"),
+        }
+    }
+
+    /// The keys of `docs/motions.md` 4.10 as read: defaults, a number, `"off"`, an integer factor.
+    #[test]
+    fn smooth_keys_read_with_their_defaults() {
+        let c = read("").unwrap();
+        assert_eq!(c.plan.peak_factor(), Some(DEFAULT_PEAK_FACTOR));
+        assert!(c.plan.monotone() && c.plan.smoothness() == 0.0 && c.plan.tip_weight() == 0.0);
+        assert_eq!(c.limits.j_max, None);
+        let c = read(
+            "peak_factor = \"off\"\nmonotone = false\nsmoothness = 0.5\ntip_weight = 2.0\n[limits]\nj_max = 80.0\n",
+        )
+        .unwrap();
+        assert_eq!(c.plan.peak_factor(), None);
+        assert!(!c.plan.monotone() && c.plan.smoothness() == 0.5 && c.plan.tip_weight() == 2.0);
+        assert_eq!(c.limits.j_max, Some(80.0));
+        assert_eq!(read("peak_factor = 2\n").unwrap().plan.peak_factor(), Some(2.0));
+    }
+
+    /// Bad values of the new keys are refused with the file and the key (4.8, 4.10).
+    #[test]
+    fn bad_smooth_keys_are_refused_with_the_key() {
+        refused("[limits]\nj_max = 0.0\n", "limits.j_max");
+        refused("[limits]\nj_max = -3.0\n", "limits.j_max");
+        refused("[limits]\nj_max = nan\n", "limits.j_max");
+        refused("[limits]\nj_max = inf\n", "limits.j_max");
+        refused("peak_factor = 0.5\n", "plan.peak_factor");
+        refused("peak_factor = nan\n", "plan.peak_factor");
+        refused("peak_factor = \"of\"\n", "plan.peak_factor");
+        refused("smoothness = -1.0\n", "plan.smoothness");
+        refused("tip_weight = inf\n", "plan.tip_weight");
+        match read("[limits]\njerk_max = 3.0\n") {
+            Err(PlanError::Input(e)) => assert!(e.to_string().contains("jerk_max"), "{e}"),
+            other => panic!("unknown key accepted: {other:?}"),
+        }
+    }
 }

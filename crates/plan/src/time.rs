@@ -13,7 +13,10 @@ use serde::Serialize;
 use crate::limits::{shortest_move, travels};
 use crate::lm::{minimise, Stop};
 use crate::objective::{window_peak, Eval};
-use crate::planner::{evaluate, zvd_experiment, Planned, Setup};
+use crate::planner::{
+    effective_bounds, evaluate, peak_warnings, search_evaluator, zvd_experiment, PeakComparison, PeakSet, Planned,
+    Setup,
+};
 use crate::section::{Objective, PlanConfig};
 use crate::PlanError;
 
@@ -34,6 +37,16 @@ pub struct TimeStep {
     pub peak_m: f64,
     /// At most `residual_max` and within the limits?
     pub ok: bool,
+    /// AMM runs this step made (the plain quintic's, the search's, the check over the span).
+    pub evaluations: usize,
+    /// Wall time since the start of the plan when the step ended [s].
+    pub wall_s: f64,
+    /// The planned bisection: the search's `|r|` (RMS of |dG| over the window) [m] and why it
+    /// stopped (empty for the baseline's steps).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub r_norm_m: Option<f64>,
+    #[serde(skip_serializing_if = "String::is_empty")]
+    pub reason: String,
 }
 
 /// The record of the time objective (plan.json).
@@ -52,6 +65,9 @@ pub struct TimeSearch {
     pub steps: Vec<TimeStep>,
     /// The FEM's residual peak of the successes, shortest first, until one holds.
     pub fem_checks: Vec<TimeStep>,
+    /// AMM runs of the baseline's search and of the planned bisection.
+    pub zvd_evaluations: usize,
+    pub search_evaluations: usize,
     /// How much shorter the planned move is than the baseline [%].
     pub shorter_percent: f64,
 }
@@ -80,18 +96,24 @@ fn zvd_baseline(
     let mut lo = t_lim;
     let mut t = t_lim.max(1.0 / s.f1_hz);
     let mut found = None;
+    let step = |t: f64, peak: f64, runs: usize| TimeStep {
+        t_move: t,
+        peak_m: peak,
+        ok: peak <= r_max,
+        evaluations: s.evaluator.runs() - runs,
+        wall_s: s.started.elapsed().as_secs_f64(),
+        r_norm_m: None,
+        reason: String::new(),
+    };
     for _ in 0..GROWTHS {
+        let runs = s.evaluator.runs();
         // a candidate the solver cannot run (too violent a move) counts as too short
         let (peak, dur) = match zvd_peak(cfg, s, t) {
             Ok(v) => v,
             Err(PlanError::Input(_)) => break,
             Err(_) => (f64::INFINITY, f64::NAN),
         };
-        steps.push(TimeStep {
-            t_move: t,
-            peak_m: peak,
-            ok: peak <= r_max,
-        });
+        steps.push(step(t, peak, runs));
         if peak <= r_max {
             found = Some((t, dur, peak));
             break;
@@ -109,13 +131,10 @@ fn zvd_baseline(
     let mut hi = best.0;
     for _ in 0..BISECTIONS {
         let mid = 0.5 * (lo + hi);
+        let runs = s.evaluator.runs();
         let (peak, dur) = zvd_peak(cfg, s, mid).unwrap_or((f64::INFINITY, f64::NAN));
         let ok = peak <= r_max;
-        steps.push(TimeStep {
-            t_move: mid,
-            peak_m: peak,
-            ok,
-        });
+        steps.push(step(mid, peak, runs));
         if ok {
             hi = mid;
             best = (mid, dur, peak);
@@ -129,7 +148,7 @@ fn zvd_baseline(
 /// The outcome of one step of the planned bisection.
 enum Trial {
     /// The search ran (its solution, the peak over the whole span).
-    Done(Searched),
+    Done(Box<Searched>),
     /// The start is rejected (infeasible, limits) or the search failed.
     Failed,
     /// The budget ran out during the search: the step says nothing.
@@ -141,36 +160,59 @@ enum Trial {
 fn try_duration(cfg: &PlanConfig, s: &Setup, t_move: f64, x0: &[f64], r_max: f64) -> Trial {
     match search_at(cfg, s, t_move, x0, r_max) {
         Some(sr) if sr.peak > r_max && sr.sol.reason.contains("budget") => Trial::OutOfTime,
-        Some(sr) => Trial::Done(sr),
+        Some(sr) => Trial::Done(Box::new(sr)),
         None => Trial::Failed,
     }
 }
 
 /// One LM search at a duration: its solution (variables, evaluation, trace, evaluations, why it
-/// stopped) and the residual peak over the whole span [m].
+/// stopped), the residual peak over the whole span [m], the plain quintic of that duration and
+/// the limits the search enforced (4.10).
 #[derive(Debug, Clone)]
 struct Searched {
     sol: crate::lm::Solution,
     peak: f64,
+    plain: Eval,
+    bounds: crate::section::Limits,
 }
 
-/// The search of [`try_duration`]; `None` when the start is rejected or a run fails.
+/// The search of [`try_duration`]; `None` when the start is rejected or a run fails. The limits
+/// are those of the plain quintic of this duration (4.10), as is the smoothness reference.
 fn search_at(cfg: &PlanConfig, s: &Setup, t_move: f64, x0: &[f64], r_max: f64) -> Option<Searched> {
-    let ev = s.evaluator.with_limits(cfg.limits);
-    let e0 = evaluate(&ev, &s.family, x0, t_move).ok()?;
+    let plain = evaluate(&s.evaluator, &s.family, &s.family.plain(), t_move).ok()?;
+    if cfg.limits.fa_max.is_some_and(|m| plain.fa.value > m) {
+        return None;
+    }
+    let r_floor = TIME_FLOOR_SHARE * r_max;
+    let bounds = effective_bounds(&cfg.limits, cfg.plan.peak_factor(), &plain);
+    let ev = search_evaluator(cfg, s, bounds, &plain, r_floor);
     let deadline = s.started + Duration::from_secs_f64(cfg.plan.budget());
-    let stop = Stop {
-        r_floor: TIME_FLOOR_SHARE * r_max,
-        deadline,
-    };
+    let stop = Stop { r_floor, deadline };
     let f = |x: &[f64]| evaluate(&ev, &s.family, x, t_move);
-    let accept = |e: &Eval| e.broken(&cfg.limits).is_empty();
-    let e0 = if accept(&e0) { e0 } else { return None };
-    let sol = minimise(&f, &accept, x0.to_vec(), e0, stop).ok()?;
+    let accept = |e: &Eval| e.within(&bounds);
+    // a warm start that fails at this duration (a run fails, or it is outside this duration's
+    // limits) falls back on the plain quintic
+    let (x0, e0) = match f(x0).ok().filter(|e| accept(e)) {
+        Some(e) => (x0.to_vec(), e),
+        None => {
+            let x = s.family.plain();
+            let e = f(&x).ok()?;
+            (x, e)
+        }
+    };
+    if !accept(&e0) {
+        return None;
+    }
+    let sol = minimise(&f, &accept, x0, e0, stop).ok()?;
     let traj = s.family.trajectory(&sol.x, t_move);
     let run = s.evaluator.run(&traj, cfg.exp.time.t_end).ok()?;
     let peak = window_peak(&run, cfg.plan.t0 + t_move);
-    Some(Searched { sol, peak })
+    Some(Searched {
+        sol,
+        peak,
+        plain,
+        bounds,
+    })
 }
 
 /// A success of the planned bisection: duration and the search's outcome.
@@ -184,9 +226,8 @@ fn bisect_planned(
     s: &Setup,
     (mut lo, mut hi): (f64, f64),
     r_max: f64,
-) -> (Vec<TimeStep>, Vec<Success>, usize) {
+) -> (Vec<TimeStep>, Vec<Success>) {
     let top = hi;
-    let mut evaluations = 0;
     let mut steps = Vec::new();
     let mut x = s.family.plain();
     let mut best: Vec<Success> = Vec::new();
@@ -199,41 +240,44 @@ fn bisect_planned(
         } else {
             0.5 * (lo + hi)
         };
+        let runs = s.evaluator.runs();
         let trial = try_duration(cfg, s, t, &x, r_max);
-        if let Trial::Done(sr) = &trial {
-            evaluations += sr.sol.evaluations;
-        }
+        let step = |peak: f64, ok: bool, sr: Option<&Searched>, reason: &str| TimeStep {
+            t_move: t,
+            peak_m: peak,
+            ok,
+            evaluations: s.evaluator.runs() - runs,
+            wall_s: s.started.elapsed().as_secs_f64(),
+            r_norm_m: sr.map(|sr| sr.sol.eval.norm_g()),
+            reason: sr.map_or(reason.to_string(), |sr| sr.sol.reason.clone()),
+        };
         match trial {
-            Trial::OutOfTime => break,
+            Trial::OutOfTime => {
+                steps.push(step(f64::NAN, false, None, "the wall-clock budget is spent"));
+                break;
+            }
             Trial::Done(sr) if sr.peak <= r_max => {
-                steps.push(TimeStep {
-                    t_move: t,
-                    peak_m: sr.peak,
-                    ok: true,
-                });
+                steps.push(step(sr.peak, true, Some(sr.as_ref()), ""));
                 hi = t;
                 x = sr.sol.x.clone();
-                best.push((t, sr));
+                best.push((t, *sr));
             }
             Trial::Done(sr) => {
-                steps.push(TimeStep {
-                    t_move: t,
-                    peak_m: sr.peak,
-                    ok: false,
-                });
+                steps.push(step(sr.peak, false, Some(sr.as_ref()), ""));
                 lo = t;
             }
             Trial::Failed => {
-                steps.push(TimeStep {
-                    t_move: t,
-                    peak_m: f64::INFINITY,
-                    ok: false,
-                });
+                steps.push(step(
+                    f64::INFINITY,
+                    false,
+                    None,
+                    "no feasible start within the limits, or a run failed",
+                ));
                 lo = t;
             }
         }
     }
-    (steps, best, evaluations)
+    (steps, best)
 }
 
 /// The shortest success whose residual peak holds on the FEM too (the model the plan trusts,
@@ -259,6 +303,10 @@ fn fem_verified(
             t_move: cand.0,
             peak_m: peak,
             ok: peak <= r_max,
+            evaluations: 0,
+            wall_s: s.started.elapsed().as_secs_f64(),
+            r_norm_m: None,
+            reason: "the FEM's residual peak over [t_rest, t_end]".into(),
         });
         if peak <= r_max {
             return Ok((cand.clone(), checks));
@@ -281,22 +329,30 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
     let t_lim = shortest_move(travel, &cfg.limits).0;
     let (zvd_base, zvd_dur, zvd_peak_m, zvd_steps) = zvd_baseline(cfg, s, r_max, t_lim)?;
     let zvd_found_s = s.started.elapsed().as_secs_f64();
-    let (steps, successes, evaluations) = bisect_planned(cfg, s, (t_lim.max(0.25 * zvd_dur), zvd_dur), r_max);
+    let zvd_evaluations = s.evaluator.runs();
+    let (steps, successes) = bisect_planned(cfg, s, (t_lim.max(0.25 * zvd_dur), zvd_dur), r_max);
+    let search_evaluations = s.evaluator.runs() - zvd_evaluations;
     if successes.is_empty() {
         return Err(PlanError::Solver(format!(
             "no planned motion as long as the ZVD-shaped quintic ({zvd_dur:.3} s) reached residual_max = {r_max} m"
         )));
     }
     let (chosen, fem_checks) = fem_verified(cfg, s, successes, r_max)?;
-    let (t_move, Searched { sol, .. }) = chosen;
+    let (t_move, Searched { sol, plain, bounds, .. }) = chosen;
     let crate::lm::Solution {
         x, eval, trace, reason, ..
     } = sol;
-    let plain = evaluate(&s.evaluator, &s.family, &s.family.plain(), t_move)
-        .map_err(|e| PlanError::Solver(format!("the plain quintic: {e}")))?;
+    let peaks = PeakComparison {
+        plain: PeakSet::of(&plain),
+        planned: PeakSet::of(&eval),
+    };
     Ok(Planned {
         objective: Objective::Time,
         limits: cfg.limits,
+        bounds,
+        peak_factor: cfg.plan.peak_factor(),
+        warnings: peak_warnings(&peaks.plain, &peaks.planned),
+        peaks,
         t_move,
         t_rest: cfg.plan.t0 + t_move,
         trajectory: s.family.trajectory(&x, t_move),
@@ -309,7 +365,7 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
         window_s: s.evaluator.window,
         r_floor_m: TIME_FLOOR_SHARE * r_max,
         trace,
-        evaluations,
+        evaluations: s.evaluator.runs(),
         reason,
         wall_s: s.started.elapsed().as_secs_f64(),
         zvd: zvd_experiment(&cfg.exp, s.family.quintic(zvd_base))?,
@@ -322,6 +378,8 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
             zvd_found_s,
             steps,
             fem_checks,
+            zvd_evaluations,
+            search_evaluations,
             shorter_percent: 100.0 * (1.0 - t_move / zvd_dur),
         }),
     })

@@ -136,8 +136,10 @@ pub fn freqmap<'py>(
 
 /// Plan a rest-to-rest motion (as `flexstar plan`, docs/motions.md section 4): writes
 /// `out/<name>/` (plan.toml, plan.csv, plan.json, plan.md, the runs, the figures); returns
-/// `{"dir", "plan_toml", "plan_csv", "t_move", "evaluations", "reason", "residual_G_peak_m"}`,
-/// the last a dict of `plain`, `zvd`, `planned` to `(AMM, FEM)` residual peaks of |dG| [m].
+/// `{"dir", "plan_toml", "plan_csv", "t_move", "evaluations", "reason", "warnings",
+/// "residual_G_peak_m"}`: `warnings` the planner's notes of peaks above the plain quintic's
+/// (docs/motions.md 4.10), the last a dict of `plain`, `zvd`, `planned` to `(AMM, FEM)` residual
+/// peaks of |dG| [m].
 #[pyfunction]
 #[pyo3(signature = (config, out))]
 pub fn plan<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bound<'py, PyDict>> {
@@ -156,6 +158,7 @@ pub fn plan<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bou
     d.set_item("t_move", o.planned.t_move)?;
     d.set_item("evaluations", o.planned.evaluations)?;
     d.set_item("reason", o.planned.reason.clone())?;
+    d.set_item("warnings", o.planned.warnings.clone())?;
     let peaks = PyDict::new(py);
     for m in &o.motions {
         let peak = |r: &flexstar_api::RunOutcome| r.residual_g_peak_m();

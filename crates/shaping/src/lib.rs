@@ -25,6 +25,8 @@ pub fn shape(exp: &mut Experiment) -> Result<(), ModelError> {
     if !exp.shaper_pending() {
         return exp.apply_shaper();
     }
+    exp.paper_robot("an \"auto\" shaper")
+        .map_err(|e| ModelError::invalid("shaper.f_hz", e.to_string()))?;
     let choice = auto::resolve_auto(exp).map_err(|e| ModelError::invalid("shaper.f_hz", format!("\"auto\": {e}")))?;
     exp.apply_auto_shaper(choice)?;
     // the shaped motion rests later: `time.t_end` must still cover it (as for given frequencies)
@@ -43,6 +45,9 @@ pub fn resolve_damping(exp: &mut Experiment) -> Result<(), ModelError> {
     if n == 0 {
         return Ok(());
     }
+    // the start pose's frequencies come from flexstar_modal, on the paper's form only so far
+    exp.paper_robot("a damping ratio without f_hz")
+        .map_err(|e| ModelError::invalid("damping.zeta", e.to_string()))?;
     let key = if exp.damping.zeta.is_some() {
         "damping.zeta"
     } else {

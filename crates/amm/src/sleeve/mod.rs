@@ -47,7 +47,7 @@ use flexstar_model::{AmmModel, ModeFamily, RobotParams};
 use crate::foreshortening::KEPT_ANALYTIC;
 use crate::geometric::GeometricStiffness;
 use crate::modes::{dot, ModeSet, SleeveBending, Triplet};
-use crate::system::{BeamRows, Row};
+use crate::system::{pick, BeamRows, Row};
 use compliance::SleeveCompliance;
 use rows::ShiftTerms;
 pub(crate) use rows::{SleeveRow, B_MID, B_MSLOPE, SLEEVE_ROWS};
@@ -60,16 +60,16 @@ pub(crate) struct Sleeves {
     /// Full model: the rows at the material point in the sleeve.
     full: bool,
     /// Factors of the modes' values at the sleeve's centre and edges and slope at its centre
-    /// (half-width Lp/2).
-    tri: Triplet,
+    /// (half-width Lp/2): one for equal beams, else one per beam (`docs/amm.md` 13, Eq. J6).
+    tri: Vec<Triplet>,
     /// Full model, per beam: the beam's slopes at the sleeve's edges and curvature at its centre.
     bent: [SleeveBending; 3],
     /// Full model: the material point in the sleeve drawn out by the foreshortening
-    /// ([`shift`], Eqs. S1-S3).
-    shift: Option<SleeveShift>,
+    /// ([`shift`], Eqs. S1-S3): one table for equal beams, else one per beam.
+    shift: Option<Vec<SleeveShift>>,
     /// Full model, enriched family: the truncation flexibility of the sleeves (Eqs. R3-R4,
-    /// `docs/amm.md` 12); `None` otherwise.
-    compliance: Option<SleeveCompliance>,
+    /// `docs/amm.md` 12), one for equal beams, else one per beam; `None` otherwise.
+    compliance: Option<Vec<SleeveCompliance>>,
     /// Per beam: the truncation flexibility `R_ab` of the sleeve rows (Eq. R3, `docs/amm.md` 12), a,
     /// b over `B_MID..=B_MSLOPE`, at the last update (with [`Sleeves::compliance`]).
     res: [[[f64; 4]; 4]; 3],
@@ -81,17 +81,27 @@ pub(crate) struct Sleeves {
 }
 
 impl Sleeves {
-    /// The sleeves of beams of `params` on `modes`, in `model`.
-    pub(crate) fn new(modes: &ModeSet, params: &RobotParams, model: AmmModel) -> Self {
-        let hp = 0.5 * params.lp;
+    /// The sleeves of the beams `params` (0-based) on `modes` (one mode set shared by equal
+    /// beams, or one per beam), in `model`.
+    pub(crate) fn new(modes: &[ModeSet], params: &[RobotParams; 3], model: AmmModel) -> Self {
         let full = model == AmmModel::Full;
-        let n_bent = if full { modes.analytic_len() } else { 0 };
-        let shift = full.then(|| SleeveShift::new(modes, &GeometricStiffness::kept_modes(modes, KEPT_ANALYTIC)));
-        let compliance = (full && modes.family() == ModeFamily::Enriched)
-            .then(|| SleeveCompliance::new(params.l, hp, params.ei(), params.rho, modes.lambda()));
+        let n_bent = if full { modes[0].analytic_len() } else { 0 };
+        let per_beam = modes.iter().zip(params.iter());
+        let shift = full.then(|| {
+            modes
+                .iter()
+                .map(|m| SleeveShift::new(m, &GeometricStiffness::kept_modes(m, KEPT_ANALYTIC)))
+                .collect()
+        });
+        let compliance = (full && modes[0].family() == ModeFamily::Enriched).then(|| {
+            per_beam
+                .clone()
+                .map(|(m, p)| SleeveCompliance::new(p.l, 0.5 * p.lp, p.ei(), p.rho, m.lambda()))
+                .collect()
+        });
         Sleeves {
             full,
-            tri: modes.triplet(hp),
+            tri: per_beam.map(|(m, p)| m.triplet(0.5 * p.lp)).collect(),
             bent: std::array::from_fn(|_| SleeveBending::new(n_bent)),
             shift,
             compliance,
@@ -108,8 +118,8 @@ impl Sleeves {
         &self.axial
     }
 
-    /// Eqs. 41-43: refresh the sleeve rows of `beams` (the rows `rows`, on `modes`) for the
-    /// sleeve positions xp_i(t) [m].
+    /// Eqs. 41-43: refresh the sleeve rows of `beams` (the rows `rows`, beam i on `modes[i]`)
+    /// for the sleeve positions xp_i(t) [m].
     ///
     /// Paper model: the rows at the rigid material points xp_i, xp_i +- Lp/2, constant in u_i.
     /// Full model (`docs/amm.md` section 8): at the material point that sits in the sleeve,
@@ -123,30 +133,26 @@ impl Sleeves {
         &mut self,
         beams: &mut [BeamRows; 3],
         rows: &[Row],
-        modes: &ModeSet,
+        modes: [&ModeSet; 3],
         xp: [f64; 3],
         qhat: &[f64],
     ) {
-        let nm = modes.len();
+        let nm = modes[0].len();
         let nb = nm + 2;
         let full = self.full;
         self.xp = xp;
         for (i, (beam, &x)) in beams.iter_mut().zip(&xp).enumerate() {
             let alpha = &qhat[i * nb..i * nb + nm];
             let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
-            let shift = self.shift.as_mut().map_or(0.0, |s| s.evaluate(i, x - u_hat, alpha));
+            let shift = self.shift.as_mut().map_or(0.0, |s| {
+                let n = s.len();
+                s[i.min(n - 1)].evaluate(i, x - u_hat, alpha)
+            });
             let xc = x - u_hat + shift;
             let [mid, right, left, mslope] = &mut beam.sleeve;
             let bent = &mut self.bent[i];
-            modes.triplet_at(
-                &self.tri,
-                xc,
-                left,
-                mid,
-                right,
-                mslope,
-                full.then_some((alpha, &mut *bent)),
-            );
+            let tri = pick(&self.tri, i);
+            modes[i].triplet_at(tri, xc, left, mid, right, mslope, full.then_some((alpha, &mut *bent)));
             if full {
                 let slope_mid = dot(mslope, alpha);
                 let slopes = [slope_mid, bent.slope_right, bent.slope_left];
@@ -159,15 +165,17 @@ impl Sleeves {
             }
             mslope.iter_mut().for_each(|v| *v = -*v);
             if let Some(c) = self.compliance.as_mut() {
-                self.res[i] = c.block(xc, [mid, right, left, mslope]);
+                let n = c.len();
+                self.res[i] = c[i.min(n - 1)].block(xc, [mid, right, left, mslope]);
             }
             if let Some(s) = self.shift.as_ref() {
+                let s = pick(s, i);
                 let terms = ShiftTerms {
                     kept: s.kept(),
                     g: s.gradient(i),
                     two_f: 2.0 * shift,
                     thp: qhat[i * nb + nm + 1],
-                    hp: self.tri.half_length(),
+                    hp: tri.half_length(),
                     slopes: self.axial[i].map(|c| -c),
                     curvature: bent.curvature,
                 };
@@ -184,8 +192,15 @@ impl Sleeves {
     /// (the rigid material points, as the paper takes them) [m]. `beams`, `lam`: the rows and the
     /// multipliers of the last solve (for the truncation flexibility's deflection).
     #[cfg(test)]
-    pub(crate) fn gaps(&self, modes: &ModeSet, beams: &[BeamRows; 3], lam: &[f64], q: &[f64], lp: f64) -> [f64; 3] {
-        let nm = modes.len();
+    pub(crate) fn gaps(
+        &self,
+        modes: [&ModeSet; 3],
+        beams: &[BeamRows; 3],
+        lam: &[f64],
+        q: &[f64],
+        lp: [f64; 3],
+    ) -> [f64; 3] {
+        let nm = modes[0].len();
         let nb = nm + 2;
         let mut v = vec![0.0; nm];
         let mut gaps = [0.0f64; 3];
@@ -193,6 +208,7 @@ impl Sleeves {
             let o = i * nb;
             let (alpha, u, thp) = (&q[o..o + nm], q[o + nm], q[o + nm + 1]);
             let mut xc = self.xp[i] - u;
+            let (modes, lp) = (modes[i], lp[i]);
             for _ in 0..3 {
                 xc = self.xp[i] - u + modes.half_squared_slope_integral(alpha, xc);
             }

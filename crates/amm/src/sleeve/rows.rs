@@ -8,8 +8,8 @@
 //! `system`). Their multipliers are the generalized forces of the sleeve on the beam for the rows
 //! as written: normal forces along `+e_wi` [N] at the centre and the edges, and a couple [N m].
 
+use crate::star::Weld;
 use flexstar_kinematics::RigidState;
-use flexstar_model::geometry::slider_direction;
 
 use crate::system::{BeamRows, Row, RowForm};
 
@@ -123,14 +123,25 @@ pub(super) fn u_gradient(row: SleeveRow, [slope_mid, slope_right, slope_left]: [
 /// (`full == false`): `(Fp + FL + FR) cos(theta + thp_i)` with the sleeve rotation `thp` [rad];
 /// full model: along the forces its rows carry, each row's force on the beam being
 /// `lambda (e_w + c_u e_x)` with `c_u` its u gradient (`axial` = `[c_Fp, c_FR, c_FL]`, -w').
-pub(crate) fn push(full: bool, i: usize, st: &RigidState, thp: f64, [fp, fl, fr]: [f64; 3], axial: [f64; 3]) -> f64 {
+///
+/// The rail's direction and the paper model's projection are those of `weld` (Eq. J7,
+/// `docs/amm.md` 13: `cos(theta + phi_i + thp_i - a_i)`, `cos(theta + thp_i)` on the paper's robot).
+pub(crate) fn push(
+    full: bool,
+    i: usize,
+    st: &RigidState,
+    thp: f64,
+    [fp, fl, fr]: [f64; 3],
+    axial: [f64; 3],
+    weld: &Weld,
+) -> f64 {
     if full {
-        let d = slider_direction(i);
+        let d = weld.rails[i];
         let (ew, ex) = (st.e_w(i), st.e_x(i));
         let (wd, xd) = (ew[0] * d[0] + ew[1] * d[1], ex[0] * d[0] + ex[1] * d[1]);
         let [cp, cr, cl] = axial;
         (fp + fl + fr) * wd + (fp * cp + fr * cr + fl * cl) * xd
     } else {
-        (fp + fl + fr) * (st.theta.v + thp).cos()
+        (fp + fl + fr) * weld.normal_along_rail(i, st.theta.v, thp)
     }
 }

@@ -22,12 +22,35 @@ pub fn run(args: Args) -> anyhow::Result<()> {
              {} evaluations in {:.2} s ({})",
             p.t_move,
             p.window_s,
-            p.eval.norm(),
-            p.plain.norm(),
+            p.eval.norm_g(),
+            p.plain.norm_g(),
             p.evaluations,
             p.wall_s,
             p.reason
         );
+        if let Some(ts) = &p.time_search {
+            let tried: Vec<String> = ts
+                .steps
+                .iter()
+                .map(|s| {
+                    format!(
+                        "{:.4} s {} ({} runs)",
+                        s.t_move,
+                        if s.ok { "holds" } else { "fails" },
+                        s.evaluations
+                    )
+                })
+                .collect();
+            eprintln!(
+                "plan: time search: ZVD baseline {:.4} s ({} runs); durations tried {}",
+                ts.zvd_duration_s,
+                ts.zvd_evaluations,
+                tried.join(", ")
+            );
+        }
+        for w in &p.warnings {
+            eprintln!("warning: {w}");
+        }
     })?;
     for n in &outcome.notes {
         eprintln!("{n}");

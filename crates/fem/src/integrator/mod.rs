@@ -14,9 +14,7 @@
 //! come out at the output times with second-order accuracy.
 
 use flexstar_drive::ActuatorLaw;
-use flexstar_kinematics::feasibility::check_configuration;
-use flexstar_model::geometry::slider_direction;
-use flexstar_model::{RobotParams, Trajectory};
+use flexstar_model::{Robot, Trajectory};
 use flexstar_numerics::GenAlpha;
 
 use crate::error::PivotError;
@@ -80,7 +78,8 @@ pub struct Fallback {
 pub(crate) struct History {
     pub samples: Vec<Sample>,
     pub snapshots: Vec<Snapshot>,
-    pub node_x: Vec<f64>,
+    /// Material positions of each beam's nodes from G [m] (`k h_i`).
+    pub node_x: [Vec<f64>; 3],
     pub stats: Stats,
     /// Which of the additions of `docs/fem.md` section 9 the run had: payload, load, damping,
     /// gravity (their columns).
@@ -147,18 +146,12 @@ struct State {
 /// rows `m s'' - u . F = Fa` in the direct problem). The start must pass through the pins: every
 /// row vanishes for the undeformed start; a deflected start (Eq. G8) satisfies the tangent rows
 /// with Eq. S9's interior slope, so only their position rows are checked.
-fn initial_state(
-    params: &RobotParams,
-    motion: &Motion,
-    star: &mut Star,
-    q: Vec<f64>,
-    v: Vec<f64>,
-) -> Result<State, FemError> {
+fn initial_state(motion: &Motion, star: &mut Star, q: Vec<f64>, v: Vec<f64>) -> Result<State, FemError> {
     let (n_dof, n_sys) = (star.n_dof, star.n_sys);
-    let l = params.l;
+    let l = star.length_scale();
     let zeros = vec![0.0; n_dof];
     let pins_of = |star: &Star, q: &[f64]| match motion {
-        Motion::Prescribed(traj) => pins_at(params, traj, 0.0),
+        Motion::Prescribed(traj) => pins_at(star, traj, 0.0),
         Motion::Driven { .. } => Ok(star.pins_of(q, &v, &zeros)),
     };
     let pins0 = pins_of(star, &q)?;
@@ -174,7 +167,7 @@ fn initial_state(
     }
     let mut res = vec![0.0; n_sys];
     let lam0 = vec![0.0; 3 * ROWS];
-    let sl0 = motion.slider_rows(params, &pins0, 0.0, 0.0, 0.0)?;
+    let sl0 = motion.slider_rows(star, &pins0, 0.0, 0.0, 0.0)?;
     star.assemble(
         Iterate {
             q: &q,
@@ -245,7 +238,7 @@ fn convective_accelerations(
         }
     }
     for i in 0..3 {
-        let u = slider_direction(i);
+        let u = star.slider_direction(i);
         for r in 0..6 {
             // Phi contains -P(t): its second derivative contributes -s'' u (prescribed s only;
             // the direct problem's s'' is an unknown, zero in pins0)
@@ -262,7 +255,6 @@ const MAX_HALVINGS: u32 = 5;
 
 /// One step of the integration loop with everything it updates.
 struct Stepper<'a, 'r> {
-    params: &'a RobotParams,
     motion: &'a Motion<'a>,
     star: &'a mut Star,
     ga: &'a GenAlpha,
@@ -281,17 +273,7 @@ impl Stepper<'_, '_> {
         if depth < MAX_HALVINGS {
             backup.clone_from(self.st);
         }
-        match step(
-            self.params,
-            self.motion,
-            self.star,
-            self.ga,
-            self.st,
-            self.ws,
-            self.stats,
-            t1,
-            h,
-        ) {
+        match step(self.motion, self.star, self.ga, self.st, self.ws, self.stats, t1, h) {
             Ok(()) => self.finish(t1, h),
             Err(FemError::Newton { .. } | FemError::NonFinite { .. }) if depth < MAX_HALVINGS => {
                 self.st.clone_from(backup);
@@ -304,21 +286,21 @@ impl Stepper<'_, '_> {
 
     /// The checks, works and records after a converged step ending at `t` [s] of length `h`.
     fn finish(&mut self, t: f64, h: f64) -> Result<(), FemError> {
-        let (params, st) = (self.params, &*self.st);
+        let st = &*self.st;
         self.star.check_on_beams(&st.q, t)?;
-        self.motion.check_feasible(params, &st.pins, t)?;
-        let (fa, pf) = self.motion.forces(params, self.star, &st.pins, &st.lam, t)?;
+        self.motion.check_feasible(self.star, &st.pins, t)?;
+        let (fa, pf) = self.motion.forces(self.star, &st.pins, &st.lam, t)?;
         self.works.advance(self.star, st, &fa, t, h)?;
-        self.rec.record(params, self.star, st, fa, pf, t, self.works);
+        self.rec.record(self.star, st, fa, pf, t, self.works);
         Ok(())
     }
 }
 
-/// Integrate from the initial state to the last output time, the star carrying `attached`'s
-/// payload, damping and load (`docs/fem.md` section 9).
+/// Integrate the star of `robot` from the initial state to the last output time, the star
+/// carrying `attached`'s payload, damping and load (`docs/fem.md` section 9).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn integrate(
-    params: &RobotParams,
+    robot: &Robot,
     motion: &Motion,
     t_out: &[f64],
     snap_times: &[f64],
@@ -336,25 +318,25 @@ pub(crate) fn integrate(
     if t_out.is_empty() || t_out[0] != 0.0 {
         return Err(FemError::Input("output times must start at t = 0".into()));
     }
-    let (mut star, mut q, v) = Star::new(params, run.ne, init, motion.slider_unknowns())?;
+    let (mut star, mut q, v) = Star::new(robot, run.ne, init, motion.slider_unknowns())?;
     star.attached = attached.clone();
     if attached.weighs() {
         // Eq. G8: start in the deflected static equilibrium, the sliders held where they start
-        let s0 = motion.start_sliders(params)?;
-        let (_, sag) = static_equilibrium(params, run.ne, init, attached, s0, 0.0)?;
+        let s0 = motion.start_sliders(&star)?;
+        let (_, sag) = static_equilibrium(robot, run.ne, init, attached, s0, 0.0)?;
         q[..sag.len()].copy_from_slice(&sag);
     }
-    let mut st = initial_state(params, motion, &mut star, q, v)?;
-    motion.check_feasible(params, &st.pins, 0.0)?;
+    let mut st = initial_state(motion, &mut star, q, v)?;
+    motion.check_feasible(&star, &st.pins, 0.0)?;
 
     let t_end = *t_out.last().unwrap_or(&0.0);
     let events = event_times(t_out, snap_times);
     let ga = GenAlpha::new(run.rho_inf);
     let mut rec = Recorder::new(t_out, snap_times);
     let mut stats = Stats::default();
-    let (fa0, pf0) = motion.forces(params, &star, &st.pins, &st.lam, 0.0)?;
+    let (fa0, pf0) = motion.forces(&star, &st.pins, &st.lam, 0.0)?;
     let mut works = Works::start(&star, &st, &fa0)?;
-    rec.record(params, &star, &st, fa0, pf0, 0.0, &works);
+    rec.record(&star, &st, fa0, pf0, 0.0, &works);
 
     let mut ws = Workspace::new(&star);
     let mut t = 0.0;
@@ -366,7 +348,6 @@ pub(crate) fn integrate(
         for sub in 1..=n_sub {
             let t1 = if sub == n_sub { tb } else { ta + h * sub as f64 };
             let mut run_step = Stepper {
-                params,
                 motion,
                 star: &mut star,
                 ga: &ga,

@@ -3,26 +3,28 @@
 
 use super::*;
 
-pub(super) fn pins_at(params: &RobotParams, traj: &Trajectory, t: f64) -> Result<Pins, FemError> {
-    let j = traj
-        .jets(params, t)
+/// The pins of the prescribed motion at time `t` [s]: `s_i(t)` and its derivatives from the
+/// trajectory, the revolute points on `star`'s actuator axes.
+pub(super) fn pins_at(star: &Star, traj: &Trajectory, t: f64) -> Result<Pins, FemError> {
+    let j = star
+        .jets(traj, t)
         .map_err(|source| FemError::Trajectory { t, source })?;
-    Ok(Pins::new(params, j.map(|x| [x.v, x.d1, x.d2])))
+    Ok(Pins::new(&star.robot, j.map(|x| [x.v, x.d1, x.d2])))
 }
 
-/// Driving force (Eq. 33): `Fa_i = (mpp + mpa) s_i'' - F_i . u_i`, F_i the force of the beam on
+/// Driving force (Eq. 33): `Fa_i = (mpp + mpa)_i s_i'' - F_i . u_i`, F_i the force of the beam on
 /// sleeve i (the sleeve is translationally massless: F_i passes through the pin to the slider);
-/// under gravity less the weight of sleeve and slider along the rail, `- (mpp + mpa) g . u_i`
+/// under gravity less the weight of sleeve and slider along the rail, `- (mpp + mpa)_i g . u_i`
 /// (Eqs. G2, G7).
-pub(super) fn driving_forces(params: &RobotParams, star: &Star, pins: &Pins, lam: &[f64]) -> ([f64; 3], [[f64; 2]; 3]) {
+pub(super) fn driving_forces(star: &Star, pins: &Pins, lam: &[f64]) -> ([f64; 3], [[f64; 2]; 3]) {
     let f = pin_forces(lam);
     let mut fa = [0, 1, 2].map(|i| {
-        let u = slider_direction(i);
-        params.mpp_mpa * pins.s[i][2] - (f[i][0] * u[0] + f[i][1] * u[1])
+        let u = star.slider_direction(i);
+        star.beam(i).sleeve_mass * pins.s[i][2] - (f[i][0] * u[0] + f[i][1] * u[1])
     });
     if star.attached.weighs() {
         for (i, fa) in fa.iter_mut().enumerate() {
-            *fa -= params.mpp_mpa * star.gravity_along(i);
+            *fa -= star.beam(i).sleeve_mass * star.gravity_along(i);
         }
     }
     (fa, f)
@@ -55,20 +57,22 @@ impl Motion<'_> {
     }
 
     /// Prescribed pins at time `t` (inverse problem), `None` in the direct problem, where the
-    /// pins follow the Newton iterate. Checks that the prescribed sliders stay on their sides.
-    pub(super) fn prescribed_pins(&self, params: &RobotParams, t: f64) -> Result<Option<Pins>, FemError> {
+    /// pins follow the Newton iterate. Checks that the prescribed sliders stay on their sides
+    /// (strictly between the side's corners, [`Star::slider_travel`]).
+    pub(super) fn prescribed_pins(&self, star: &Star, t: f64) -> Result<Option<Pins>, FemError> {
         let Motion::Prescribed(traj) = self else {
             return Ok(None);
         };
-        let pins = pins_at(params, traj, t)?;
-        let limit = params.half_side();
+        let pins = pins_at(star, traj, t)?;
         for i in 0..3 {
-            if pins.s[i][0].abs() >= limit {
+            let travel = star.slider_travel[i];
+            let s = pins.s[i][0];
+            if !(s > travel[0] && s < travel[1]) {
                 return Err(FemError::SliderOffBase {
                     t,
                     slider: i + 1,
-                    s: pins.s[i][0],
-                    limit,
+                    s,
+                    travel,
                 });
             }
         }
@@ -85,7 +89,7 @@ impl Motion<'_> {
     /// zero for the initial accelerations); `None` in the inverse problem.
     pub(super) fn slider_rows(
         &self,
-        params: &RobotParams,
+        star: &Star,
         pins: &Pins,
         t: f64,
         bp: f64,
@@ -97,7 +101,7 @@ impl Motion<'_> {
         let (kp, kd) = (law.stiffness(), law.damping());
         Ok(Some(SliderRows {
             fa: Self::law_forces(*law, pins, t)?,
-            diag: [0, 1, 2].map(|i| params.mpp_mpa + bp * kp[i] + gp * kd[i]),
+            diag: [0, 1, 2].map(|i| star.beam(i).sleeve_mass + bp * kp[i] + gp * kd[i]),
         }))
     }
 
@@ -105,33 +109,33 @@ impl Motion<'_> {
     /// the law (direct).
     pub(super) fn forces(
         &self,
-        params: &RobotParams,
         star: &Star,
         pins: &Pins,
         lam: &[f64],
         t: f64,
     ) -> Result<([f64; 3], [[f64; 2]; 3]), FemError> {
         match self {
-            Motion::Prescribed(_) => Ok(driving_forces(params, star, pins, lam)),
+            Motion::Prescribed(_) => Ok(driving_forces(star, pins, lam)),
             Motion::Driven { law, .. } => Ok((Self::law_forces(*law, pins, t)?, pin_forces(lam))),
         }
     }
 
     /// Where the sliders are held for the static equilibrium of the start (Eq. G8): `s(0)` [m]
     /// of the trajectory (inverse) or of the initial data (direct).
-    pub(super) fn start_sliders(&self, params: &RobotParams) -> Result<[f64; 3], FemError> {
+    pub(super) fn start_sliders(&self, star: &Star) -> Result<[f64; 3], FemError> {
         match self {
-            Motion::Prescribed(traj) => Ok(pins_at(params, traj, 0.0)?.s.map(|s| s[0])),
+            Motion::Prescribed(traj) => Ok(pins_at(star, traj, 0.0)?.s.map(|s| s[0])),
             Motion::Driven { s0, .. } => Ok(*s0),
         }
     }
 
     /// Direct problem: the simulated configuration must stay feasible (the limits of
     /// `flexstar_kinematics::feasibility`, applied to the simulated s: a check, not an equation).
-    pub(super) fn check_feasible(&self, params: &RobotParams, pins: &Pins, t: f64) -> Result<(), FemError> {
+    pub(super) fn check_feasible(&self, star: &Star, pins: &Pins, t: f64) -> Result<(), FemError> {
         if let Motion::Prescribed(_) = self {
             return Ok(());
         }
-        check_configuration(params, pins.s.map(|s| s[0])).map_err(|violation| FemError::Infeasible { t, violation })
+        star.check_configuration(pins.s.map(|s| s[0]))
+            .map_err(|violation| FemError::Infeasible { t, violation })
     }
 }

@@ -92,7 +92,6 @@ impl<'a> Recorder<'a> {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn record(
         &mut self,
-        params: &RobotParams,
         star: &Star,
         st: &State,
         fa: [f64; 3],
@@ -115,7 +114,7 @@ impl<'a> Recorder<'a> {
                 pin_force,
                 ke_star,
                 ke_sleeves: star.sleeve_energy(v),
-                ke_sliders: 0.5 * params.mpp_mpa * (0..3).map(|i| pins.s[i][1].powi(2)).sum::<f64>(),
+                ke_sliders: star.slider_energy(pins),
                 strain,
                 work: works.work,
                 ke_payload: star.payload_energy(q, v),

@@ -24,12 +24,12 @@ const STATIC: Factors = Factors {
 };
 
 /// The static equilibrium under `attached`'s weights and its load at time `t` [s] of the star
-/// meshed with `ne` elements per beam around the rigid pose `init` (its rates ignored), the
+/// of `robot` meshed with `ne` elements per beam around the rigid pose `init` (its rates ignored), the
 /// sliders held at `s` [m] (Eq. G8). Returns that star (inverse layout: no slider unknowns) and
 /// its coordinates (nodes, sleeve rotations, contact coordinates); a Newton iteration that does
 /// not converge is [`FemError::StaticEquilibrium`] with the time and the slider positions.
 pub(crate) fn static_equilibrium(
-    params: &RobotParams,
+    robot: &Robot,
     ne: usize,
     init: &InitialState,
     attached: &Attached,
@@ -42,9 +42,10 @@ pub(crate) fn static_equilibrium(
         xp_dot: [0.0; 3],
         ..*init
     };
-    let (mut star, mut q, zeros) = Star::new(params, ne, &at_rest, None)?;
+    let (mut star, mut q, zeros) = Star::new(robot, ne, &at_rest, None)?;
     star.attached = attached.clone();
-    let pins = Pins::new(params, s.map(|si| [si, 0.0, 0.0]));
+    let pins = Pins::new(robot, s.map(|si| [si, 0.0, 0.0]));
+    let l = star.length_scale();
     let load = star.attached.load_at(t);
     let weight = increment_weights(&star);
     let mut lam = vec![0.0; 3 * ROWS];
@@ -73,7 +74,7 @@ pub(crate) fn static_equilibrium(
         // round-off accepted once the positions are converged)
         let stalled = dl >= 0.5 * last.1 && dl <= 1e-4 * (1.0 + l_max);
         last = (dq, dl);
-        if dq <= 1e-11 * params.l && (dl <= 1e-6 * (1.0 + l_max) || stalled) {
+        if dq <= 1e-11 * l && (dl <= 1e-6 * (1.0 + l_max) || stalled) {
             star.check_on_beams(&q, t)?;
             return Ok((star, q));
         }

@@ -49,11 +49,24 @@ impl Workspace {
     }
 }
 
-/// Weight of each coordinate's increment in Newton's convergence tests: the element length h [m]
-/// for rotations (node rotations and the three sleeve rotations), 1 for lengths.
+/// Weight of each coordinate's increment in Newton's convergence tests: the element length
+/// `h_i` [m] of its beam for rotations (node rotations of beam i, sleeve i's rotation; G's, the
+/// longest element's), 1 for lengths.
 pub(super) fn increment_weights(star: &Star) -> Vec<f64> {
-    let rot = |j: usize| j < 3 * star.n_nodes && j % 3 == 2 || (j >= 3 * star.n_nodes && j < 3 * star.n_nodes + 3);
-    (0..star.n_dof).map(|j| if rot(j) { star.h } else { 1.0 }).collect()
+    let n = 3 * star.n_nodes;
+    let h_g = star.h[0].max(star.h[1]).max(star.h[2]);
+    let weight = |j: usize| {
+        if j == 2 {
+            h_g
+        } else if j < n && j % 3 == 2 {
+            star.h[(j / 3 - 1) / star.ne]
+        } else if (n..n + 3).contains(&j) {
+            star.h[j - n]
+        } else {
+            1.0
+        }
+    };
+    (0..star.n_dof).map(weight).collect()
 }
 
 /// Generalized-alpha predictor of every coordinate ([`GenAlpha::predict`]) and the first Newton
@@ -105,7 +118,6 @@ flexstar_numerics::dispatch_avx2! {
     /// return. Compiled for AVX2 and for the baseline, chosen at run time (the vector loops of the
     /// predictor and the Newton updates; the solver's parts dispatch on their own).
     pub(super) fn step(
-        params: &RobotParams,
         motion: &Motion,
         star: &mut Star,
         ga: &GenAlpha,
@@ -115,9 +127,9 @@ flexstar_numerics::dispatch_avx2! {
         t1: f64,
         h: f64,
     ) -> Result<(), FemError> {
-        let (n_dof, l) = (star.n_dof, params.l);
+        let (n_dof, l) = (star.n_dof, star.length_scale());
         let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
-        let fixed = motion.prescribed_pins(params, t1)?;
+        let fixed = motion.prescribed_pins(star, t1)?;
         let load = star.attached.load_at(t1);
         // predictor: constant acceleration, previous multipliers
         predict(ga, h, bp, gp, st, ws);
@@ -136,7 +148,7 @@ flexstar_numerics::dispatch_avx2! {
                 Some(p) => (p, None),
                 None => {
                     let p = star.pins_of(&ws.q1, &ws.v1, &ws.qdd1);
-                    (p, motion.slider_rows(params, &p, t1, bp, gp)?)
+                    (p, motion.slider_rows(star, &p, t1, bp, gp)?)
                 }
             };
             let fresh = newton_increment(star, ws, (&pins, sliders.as_ref(), load), (bp, gp), t1, stale, stats)?;

@@ -5,7 +5,7 @@
 //! nothing: its code path is skipped, so the run is the bare star's bit for bit.
 
 use flexstar_model::geometry::{e_w, e_x};
-use flexstar_model::{EqualBeams, LoadSettings, Payload};
+use flexstar_model::{LoadSettings, Payload, Problem};
 
 use super::*;
 
@@ -27,6 +27,7 @@ impl PayloadAtG {
         if p.is_none() {
             return None;
         }
+        // beam 1's frame: its weld angle is 0 on every robot (docs/as-built.md Eq. W1)
         let (ex, ew) = (e_x(0, theta0), e_w(0, theta0));
         let [ox, oy] = p.offset;
         Some(PayloadAtG {
@@ -100,15 +101,16 @@ pub(crate) struct Attached {
 }
 
 impl Attached {
-    /// The `[payload]`, `[damping]`, `[load]` and `[gravity]` of `exp` for a star starting at the
-    /// orientation `theta0` [rad].
-    pub fn of(exp: &EqualBeams, theta0: f64) -> Self {
+    /// The `[payload]`, `[damping]`, `[load]` and `[gravity]` of `problem` for a star starting at
+    /// the orientation `theta0` [rad].
+    pub fn of(problem: &Problem, theta0: f64) -> Self {
+        let load = problem.load();
         Attached {
-            payload: PayloadAtG::new(exp.payload, theta0),
-            beta: exp.damping.beta(),
-            alpha: exp.damping.alpha(),
-            load: (!exp.load.is_none()).then(|| exp.load.clone()),
-            gravity: exp.gravity,
+            payload: PayloadAtG::new(problem.payload(), theta0),
+            beta: problem.damping().beta(),
+            alpha: problem.damping().alpha(),
+            load: (!load.is_none()).then(|| load.clone()),
+            gravity: problem.gravity(),
         }
     }
 
@@ -162,7 +164,7 @@ impl Star {
     /// `alpha v^T M (v - v_r)`, Eq. D16 (each 0 without its coefficient).
     pub fn dissipation_power(&self, q: &[f64], v: &[f64], pins: &Pins, t: f64) -> Result<f64, FemError> {
         let mut p = if self.attached.beta > 0.0 {
-            element_pass::dissipation_power(&self.elements, q, v, self.section())
+            element_pass::dissipation_power(&self.elements, q, v, &self.section())
         } else {
             0.0
         };

@@ -8,7 +8,7 @@ use super::*;
 impl Star {
     /// `g . u_i` [m/s^2]: gravity along slider i's rail (Eq. G7).
     pub fn gravity_along(&self, i: usize) -> f64 {
-        let (g, u) = (self.attached.gravity, slider_direction(i));
+        let (g, u) = (self.attached.gravity, self.slider_direction(i));
         g[0] * u[0] + g[1] * u[1]
     }
 
@@ -33,7 +33,7 @@ impl Star {
     }
 
     /// Potential energy of the weights [J] at the coordinates `q` with the pins `pins`,
-    /// `V_g = -g . (sum_e rho int r dx + m r_c + (mpp + mpa) sum_i P_i)` (base frame origin): the
+    /// `V_g = -g . (sum_e rho_i int r dx + m r_c + sum_i (mpp + mpa)_i P_i)` (base frame origin): the
     /// beams' element interpolation ([`ElementState::mean_position`]), the payload's centre of
     /// mass (Eq. P10), the sleeves and sliders at their pins (their centre of mass, Eq. G7).
     /// Its gradient in q is `-M(q) t_g`, the weights of Eq. G6. 0 without gravity.
@@ -46,16 +46,19 @@ impl Star {
             moment[0] += m * r[0];
             moment[1] += m * r[1];
         };
-        for el in &self.elements {
+        for (e, el) in self.elements.iter().enumerate() {
             let st = ElementState::new(el, &self.element_q(el, q));
             let a = 3 * el.nodes[0];
-            add(self.params.rho * el.l0, st.mean_position([q[a], q[a + 1]]));
+            add(
+                self.beam(e / self.ne).mass_per_length * el.l0,
+                st.mean_position([q[a], q[a + 1]]),
+            );
         }
         if let Some(p) = self.attached.payload {
             add(p.m, p.centre(&q[..3]));
         }
-        for pin in &pins.p {
-            add(self.params.mpp_mpa, *pin);
+        for (i, pin) in pins.p.iter().enumerate() {
+            add(self.beam(i).sleeve_mass, *pin);
         }
         let g = self.attached.gravity;
         -(g[0] * moment[0] + g[1] * moment[1])

@@ -1,9 +1,14 @@
 //! The assembled star: three co-rotational beams welded at one shared node G, and three rigid
-//! sleeves pinned at the revolute points `P_i(t)` (Eqs. 1-3) through which the beams slide.
+//! sleeves pinned at the revolute points `P_i(t) = o_i + s_i(t) u_i` of the robot's actuator axes
+//! (Eqs. 1-3 on the paper's base) through which the beams slide.
+//!
+//! Every beam has its own data (`flexstar_model::Beam`: EA, EI, rho, L, the sleeve's Lp, mass and
+//! inertia, the weld angle; `docs/fem.md` section 10): beam i is meshed with `ne` elements of
+//! length `h_i = L_i / ne` along `e_xi(theta0)`, at the angle `theta0 + phi_i` of its weld.
 //!
 //! Unknowns (all in the fixed XY frame, SI units):
 //! - node j: `[x, y, phi]` (position [m], cross-section rotation increment [rad]); node 0 is G,
-//!   beam i (0-based) has nodes `1 + i ne + (k - 1)` at material coordinates `k h`, k = 1..ne;
+//!   beam i (0-based) has nodes `1 + i ne + (k - 1)` at material coordinates `k h_i`, k = 1..ne;
 //! - sleeve i: its rotation `psi_i` and the material coordinates `xi_ic, xi_il, xi_ir` of its
 //!   centre and edges on beam i ([`sleeve`], which says what a sleeve is: its coordinates, its 7
 //!   constraint rows and their Jacobian blocks, the forces it transmits, where friction would enter).
@@ -26,18 +31,18 @@
 //! (the beam pushes the sleeve, hence the pin and the slider, with `F_i`): Eq. 33 read the other
 //! way round.
 
-use flexstar_model::geometry::{e_x, revolute_point, slider_direction};
-use flexstar_model::RobotParams;
+use flexstar_model::{Beam, Robot, RobotGeometry};
 
 use crate::bordered::{Bordered, Layout, NU_COLUMNS, NU_SLOTS, SLIDER_SLOTS};
 use crate::element::{Element, ElementState};
 pub(crate) use crate::element_pass::Factors;
-use crate::element_pass::{self, NodeState, Section};
+use crate::element_pass::{self, NodeState, Section, Sections};
 use crate::integrator::Fallback;
 use crate::sparse::SparseLu;
 use crate::FemError;
 
 mod attached;
+mod axes;
 mod gravity;
 mod pattern;
 mod rigid;
@@ -69,15 +74,17 @@ pub struct InitialState {
 /// Pin kinematics at one instant: revolute points, and the actuator jets.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Pins {
+    /// Revolute points `P_i = o_i + s_i u_i` [m], fixed frame (Eqs. 1-3 on the paper's base).
     pub p: [[f64; 2]; 3],
     /// `[s, s', s'']` of each actuator.
     pub s: [[f64; 3]; 3],
 }
 
 impl Pins {
-    pub fn new(params: &RobotParams, s: [[f64; 3]; 3]) -> Self {
+    /// The pins of `robot`'s actuator axes at the actuator jets `s` ([m, m/s, m/s^2]).
+    pub fn new(robot: &Robot, s: [[f64; 3]; 3]) -> Self {
         Pins {
-            p: [0, 1, 2].map(|i| revolute_point(i, params.d, s[i][0])),
+            p: [0, 1, 2].map(|i| robot.revolute_point(i, s[i][0])),
             s,
         }
     }
@@ -110,11 +117,15 @@ pub(crate) struct Iterate<'a> {
 
 /// The assembled model with its sparse iteration matrix.
 pub(crate) struct Star {
-    pub params: RobotParams,
-    /// Elements per beam.
+    /// The robot: per-beam data and the actuator axes.
+    pub robot: Robot,
+    /// Elements per beam (the same on every beam).
     pub ne: usize,
-    /// Element length [m].
-    pub h: f64,
+    /// Element length of each beam, `h_i = L_i / ne` [m].
+    pub h: [f64; 3],
+    /// Open interval `(lo, hi)` of each slider's coordinate on its side of the base [m]
+    /// (`RobotGeometry::slider_travel`: `|s_i| < sqrt(3) d` on the paper's base).
+    pub slider_travel: [[f64; 2]; 3],
     pub elements: Vec<Element>,
     /// Initial angle of beam i [rad].
     pub gamma0: [f64; 3],
@@ -158,29 +169,48 @@ pub(crate) struct Star {
     shifted: Vec<f64>,
 }
 
-/// A sleeve must span at least two elements (its three contact points on distinct elements).
-fn check_mesh(params: &RobotParams, ne: usize, h: f64) -> Result<(), FemError> {
-    if params.lp < 2.0 * h * (1.0 - 1e-12) {
-        let needed = (2.0 * params.l / params.lp).ceil() as usize;
-        return Err(FemError::MeshTooCoarse {
-            per_beam: ne,
-            h,
-            lp: params.lp,
-            needed,
-        });
+/// Every sleeve must span at least two elements of its beam (its three contact points on
+/// distinct elements): `Lp_i >= 2 h_i`. The error names the first beam that fails and the
+/// count per beam that holds every sleeve, `max_i ceil(2 L_i / Lp_i)`.
+fn check_mesh(robot: &Robot, ne: usize, h: &[f64; 3]) -> Result<(), FemError> {
+    let beams = robot.beams();
+    let needed = beams
+        .iter()
+        .map(|b| (2.0 * b.length / b.sleeve_length).ceil() as usize)
+        .max()
+        .unwrap_or(1);
+    for (i, b) in beams.iter().enumerate() {
+        if b.sleeve_length < 2.0 * h[i] * (1.0 - 1e-12) {
+            return Err(FemError::MeshTooCoarse {
+                beam: i + 1,
+                per_beam: ne,
+                h: h[i],
+                lp: b.sleeve_length,
+                needed,
+            });
+        }
     }
     Ok(())
 }
 
-/// The elements of the three beams (`ne` each, length `h` [m], straight along `e_x(i, theta)`)
-/// and the nodes' initial positions and velocities of the rigid star (written into `q`, `v`);
-/// returns the elements and the beams' initial angles gamma0_i [rad].
-fn initial_beams(ne: usize, h: f64, init: &InitialState, q: &mut [f64], v: &mut [f64]) -> (Vec<Element>, [f64; 3]) {
+/// The elements of the three beams (`ne` each, beam i's of length `h[i]` [m], straight along
+/// `e_xi(theta)` of `robot`'s weld angles, Eq. W1 of `docs/as-built.md`) and the nodes' initial
+/// positions and velocities of the rigid star (written into `q`, `v`); returns the elements and
+/// the beams' initial angles gamma0_i [rad].
+fn initial_beams(
+    robot: &Robot,
+    ne: usize,
+    h: &[f64; 3],
+    init: &InitialState,
+    q: &mut [f64],
+    v: &mut [f64],
+) -> (Vec<Element>, [f64; 3]) {
     let mut gamma0 = [0.0; 3];
     let mut elements = Vec::with_capacity(3 * ne);
     let perp = |r: [f64; 2]| [-(r[1]), r[0]];
     for i in 0..3 {
-        let ex = e_x(i, init.theta);
+        let ex = robot.e_x(i, init.theta);
+        let h = h[i];
         gamma0[i] = ex[1].atan2(ex[0]);
         for k in 0..ne {
             elements.push(Element {
@@ -205,23 +235,30 @@ fn initial_beams(ne: usize, h: f64, init: &InitialState, q: &mut [f64], v: &mut 
 }
 
 impl Star {
-    /// Mesh the star with `ne` elements per beam around the initial pose. With `sliders`
-    /// (`[s_i, s_i']` [m, m/s] at t = 0) the slider coordinates are unknowns too (direct problem).
+    /// Mesh the star of `robot` with `ne` elements per beam (beam i's of length `L_i / ne`)
+    /// around the initial pose. With `sliders` (`[s_i, s_i']` [m, m/s] at t = 0) the slider
+    /// coordinates are unknowns too (direct problem).
     pub fn new(
-        params: &RobotParams,
+        robot: &Robot,
         ne: usize,
         init: &InitialState,
         sliders: Option<[[f64; 2]; 3]>,
     ) -> Result<(Self, Vec<f64>, Vec<f64>), FemError> {
-        let h = params.l / ne as f64;
-        check_mesh(params, ne, h)?;
+        if ne == 0 {
+            return Err(FemError::Elements {
+                elements: 0,
+                reason: "no element on a beam",
+            });
+        }
+        let h = robot.beams().map(|b| b.length / ne as f64);
+        check_mesh(robot, ne, &h)?;
         let n_nodes = 1 + 3 * ne;
         let n_dof = 3 * n_nodes + SLEEVE_COORDINATES + if sliders.is_some() { 3 } else { 0 };
         let n_sys = n_dof + 3 * ROWS;
         let mut q = vec![0.0; n_dof];
         let mut v = vec![0.0; n_dof];
-        let (elements, gamma0) = initial_beams(ne, h, init, &mut q, &mut v);
-        initial_sleeves(params, 3 * n_nodes, init, &mut q, &mut v);
+        let (elements, gamma0) = initial_beams(robot, ne, &h, init, &mut q, &mut v);
+        initial_sleeves(robot, 3 * n_nodes, init, &mut q, &mut v);
         if let Some(sl) = sliders {
             for i in 0..3 {
                 q[3 * n_nodes + SLEEVE_COORDINATES + i] = sl[i][0];
@@ -229,9 +266,10 @@ impl Star {
             }
         }
         let star = Star {
-            params: *params,
+            robot: robot.clone(),
             ne,
             h,
+            slider_travel: std::array::from_fn(|i| robot.slider_travel(i)),
             elements,
             gamma0,
             n_nodes,
@@ -267,7 +305,24 @@ impl Star {
     /// Direct problem: pin kinematics from the slider unknowns (`[s, s', s'']` of each slider).
     pub fn pins_of(&self, q: &[f64], v: &[f64], qdd: &[f64]) -> Pins {
         let k = |i: usize| self.slider(i);
-        Pins::new(&self.params, [0, 1, 2].map(|i| [q[k(i)], v[k(i)], qdd[k(i)]]))
+        Pins::new(&self.robot, [0, 1, 2].map(|i| [q[k(i)], v[k(i)], qdd[k(i)]]))
+    }
+
+    /// Beam i's data (section, length, sleeve, weld angle).
+    pub fn beam(&self, i: usize) -> &Beam {
+        &self.robot.beams()[i]
+    }
+
+    /// Unit direction `u_i` of slider i's axis (fixed frame; Eqs. 1-3 on the paper's base).
+    pub fn slider_direction(&self, i: usize) -> [f64; 2] {
+        self.robot.axes()[i].direction
+    }
+
+    /// The star's length scale [m]: the longest beam's length (the Newton tolerances' unit,
+    /// `1e-11 L`; L itself on equal beams).
+    pub fn length_scale(&self) -> f64 {
+        let l = self.robot.beams().map(|b| b.length);
+        l[0].max(l[1]).max(l[2])
     }
 
     /// Global node index of node k (0 = G, ne = tip) of beam i.
@@ -280,10 +335,11 @@ impl Star {
         [q[a], q[a + 1], q[a + 2], q[b], q[b + 1], q[b + 2]]
     }
 
-    /// Element of beam i that holds material coordinate xi, and the local coordinate zeta (which
-    /// leaves [0, 1] only when xi leaves (0, L), i.e. when the sleeve is off the beam).
-    pub fn locate(&self, xi: f64) -> (usize, f64) {
-        let x = xi / self.h;
+    /// Element of beam i that holds material coordinate xi [m] (its index on the beam), and the
+    /// local coordinate zeta (which leaves [0, 1] only when xi leaves (0, L_i), i.e. when the
+    /// sleeve is off the beam).
+    pub fn locate(&self, i: usize, xi: f64) -> (usize, f64) {
+        let x = xi / self.h[i];
         let e = if x.is_finite() {
             (x.floor().max(0.0) as usize).min(self.ne - 1)
         } else {
@@ -348,7 +404,7 @@ impl Star {
         let nodes = NodeState { q, v, qdd };
         let section = self.section();
         let vals = matrix.then_some(&mut self.vals[..]);
-        element_pass::add_forces(&self.elements, nodes, section, fac, res, vals).map_err(|bad| {
+        element_pass::add_forces(&self.elements, nodes, &section, fac, res, vals).map_err(|bad| {
             FemError::NonFinite {
                 t,
                 element: bad.element,
@@ -410,8 +466,8 @@ impl Star {
     fn assemble_sliders(&mut self, sl: &SliderRows, qdd: &[f64], lam: &[f64], cf: f64, res: &mut [f64], matrix: bool) {
         for i in 0..3 {
             let si = self.slider(i);
-            let u = slider_direction(i);
-            res[si] += cf * (self.params.mpp_mpa * qdd[si] - sl.fa[i]);
+            let u = self.slider_direction(i);
+            res[si] += cf * (self.beam(i).sleeve_mass * qdd[si] - sl.fa[i]);
             let base = self.off_sl + SLIDER_SLOTS * i;
             if matrix {
                 self.vals[base] = sl.diag[i];
@@ -472,22 +528,24 @@ impl Star {
     /// element interpolation's, exact: [`ElementState::kinetic_energy`],
     /// [`ElementState::strain_energy`]), in one pass over the elements.
     pub fn beam_energies(&self, q: &[f64], v: &[f64]) -> (f64, f64) {
-        element_pass::energies(&self.elements, q, v, self.section())
+        element_pass::energies(&self.elements, q, v, &self.section())
     }
 
-    /// Section constants of the beams.
-    fn section(&self) -> Section {
-        Section {
-            ea: self.params.ea(),
-            ei: self.params.ei(),
-            rho: self.params.rho,
+    /// Section constants of the beams (beam i's EA_i, EI_i, rho_i for its `ne` elements; the
+    /// Kelvin-Voigt beta of the star), `docs/fem.md` section 10.
+    pub(crate) fn section(&self) -> Sections {
+        let sec = |b: &Beam| Section {
+            ea: b.axial_stiffness,
+            ei: b.bending_stiffness(),
+            rho: b.mass_per_length,
             beta: self.attached.beta,
-        }
+        };
+        Sections::per_beam(self.robot.beams().each_ref().map(sec), self.ne)
     }
 
-    /// Material positions (from G) of the nodes of one beam [m].
-    pub fn node_x(&self) -> Vec<f64> {
-        (0..=self.ne).map(|k| k as f64 * self.h).collect()
+    /// Material positions (from G) of the nodes of each beam [m]: `k h_i`, k = 0..=ne.
+    pub fn node_x(&self) -> [Vec<f64>; 3] {
+        self.h.map(|h| (0..=self.ne).map(|k| k as f64 * h).collect())
     }
 }
 
@@ -520,7 +578,7 @@ mod tests {
 
     /// [`solve_and_check`] with `ne` elements per beam.
     fn solve_and_check_mesh(amp: f64, direct: bool, ne: usize) -> bool {
-        let params = RobotParams::paper();
+        let params = Robot::from_params(&flexstar_model::RobotParams::paper()).unwrap();
         let init = InitialState {
             g: [0.01, -0.02],
             g_dot: [0.1, 0.05],

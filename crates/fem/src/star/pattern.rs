@@ -12,7 +12,7 @@ impl Star {
         let mut rebuild = self.bordered.is_none();
         for i in 0..3 {
             for p in 0..3 {
-                let (e, _) = self.locate(q[self.xi(i, p)]);
+                let (e, _) = self.locate(i, q[self.xi(i, p)]);
                 let lo = self.win[i][p];
                 if lo == usize::MAX || e < lo || e >= lo + self.ww {
                     rebuild = true;

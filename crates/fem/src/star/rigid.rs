@@ -23,10 +23,11 @@ pub(crate) struct RigidTwist {
 
 impl RigidTwist {
     /// Eq. D17, first line: `n_i . (V + Omega k x (P_i - x_G)) = s_i' n_i . u_i` for G at `g`
-    /// [m], the pins `p` [m] and the sleeve axes at the angles `axis` [rad] (fixed frame), with
-    /// `l` [m] the scale of the lever arms; `Err` with the relative determinant at a singular
-    /// pose (the three lines through the pins along the sleeves' normals concurrent or parallel).
-    pub fn solve(g: [f64; 2], p: &[[f64; 2]; 3], axis: [f64; 3], l: f64) -> Result<Self, f64> {
+    /// [m], the pins `p` [m], the sliders' unit directions `u` and the sleeve axes at the angles
+    /// `axis` [rad] (fixed frame), with `l` [m] the scale of the lever arms; `Err` with the
+    /// relative determinant at a singular pose (the three lines through the pins along the
+    /// sleeves' normals concurrent or parallel).
+    pub fn solve(g: [f64; 2], p: &[[f64; 2]; 3], u: &[[f64; 2]; 3], axis: [f64; 3], l: f64) -> Result<Self, f64> {
         let rows: [[f64; 3]; 3] = std::array::from_fn(|i| {
             let n = [-axis[i].sin(), axis[i].cos()];
             let r = [p[i][0] - g[0], p[i][1] - g[1]];
@@ -44,7 +45,7 @@ impl RigidTwist {
         }
         // column i of A^-1 D: adj column i times n_i . u_i / det; the third unknown is Omega l
         let per_slider = std::array::from_fn(|i| {
-            let u = slider_direction(i);
+            let u = u[i];
             let d = (rows[i][0] * u[0] + rows[i][1] * u[1]) / det;
             [adj[0][i] * d, adj[1][i] * d, adj[2][i] * d / l]
         });
@@ -88,7 +89,9 @@ impl Star {
     /// [`FemError::SingularPose`] at time `t` [s].
     pub fn rigid_twist(&self, q: &[f64], p: &[[f64; 2]; 3], t: f64) -> Result<RigidTwist, FemError> {
         let axis = [0, 1, 2].map(|i| self.sleeve_angle(i, q));
-        RigidTwist::solve([q[0], q[1]], p, axis, self.params.l).map_err(|det| FemError::SingularPose { t, det })
+        let u = [0, 1, 2].map(|i| self.slider_direction(i));
+        RigidTwist::solve([q[0], q[1]], p, &u, axis, self.length_scale())
+            .map_err(|det| FemError::SingularPose { t, det })
     }
 
     /// Eq. D17, second line: the rigid velocity of coordinate `k` (in [`Star::massive`]) at the
@@ -147,7 +150,7 @@ impl Star {
     /// payload's G block, `c = gamma' alpha`, at the coordinates `q`.
     pub(super) fn add_mass_damping(&mut self, q: &[f64], c: f64) {
         for i in 0..3 {
-            self.vals[self.off_psi + 4 * i] += c * self.params.jp;
+            self.vals[self.off_psi + 4 * i] += c * self.beam(i).sleeve_inertia;
         }
         if let Some(p) = self.attached.payload {
             self.add_payload_block(&p, q[2], c);
@@ -161,8 +164,10 @@ impl Star {
         let w = self.rigid_twist(q, &pins.p, t)?.at(pins.s.map(|s| s[1]));
         let mut rel = vec![0.0; q.len()];
         self.add_relative_rates(q, v, w, &mut rel);
-        let beams = element_pass::mass_product(&self.elements, q, v, &rel, self.params.rho);
-        let sleeves: f64 = (0..3).map(|i| self.params.jp * v[self.psi(i)] * rel[self.psi(i)]).sum();
+        let beams = element_pass::mass_product(&self.elements, q, v, &rel, &self.section());
+        let sleeves: f64 = (0..3)
+            .map(|i| self.beam(i).sleeve_inertia * v[self.psi(i)] * rel[self.psi(i)])
+            .sum();
         let payload = self.attached.payload.map_or(0.0, |p| {
             let mp = p.mass_matrix(q[2]);
             (0..3)
@@ -187,11 +192,12 @@ mod tests {
     fn rigid_field_is_the_velocity_of_the_rigid_robot() {
         let exp = flexstar_model::catalogue::paper_case(3);
         let params = exp.robot;
+        let robot = Robot::from_params(&params).unwrap();
         for t in [0.1, 0.25, 0.4] {
             let r = RigidState::at(&params, &exp.trajectory, t).unwrap();
             let init = crate::solve::initial_state(&r);
-            let (star, q, v) = Star::new(&params, 36, &init, None).unwrap();
-            let pins = Pins::new(&params, r.s.map(|s| [s.v, s.d1, s.d2]));
+            let (star, q, v) = Star::new(&robot, 36, &init, None).unwrap();
+            let pins = Pins::new(&robot, r.s.map(|s| [s.v, s.d1, s.d2]));
             let w = star.rigid_twist(&q, &pins.p, t).unwrap().at(pins.s.map(|s| s[1]));
             let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             assert!(scale > 0.1, "the robot must move at t = {t}: {scale}");
@@ -215,7 +221,8 @@ mod tests {
             let a: f64 = axis[i];
             [g[0] + 0.2 * a.cos(), g[1] + 0.2 * a.sin()]
         });
-        let tw = RigidTwist::solve(g, &p, axis, 0.5).unwrap();
+        let u = [0, 1, 2].map(flexstar_model::geometry::slider_direction);
+        let tw = RigidTwist::solve(g, &p, &u, axis, 0.5).unwrap();
         assert_eq!(tw.at([0.0; 3]), [0.0; 3]);
         // the twist satisfies its three equations for any slider velocities
         let sd = [0.3, -0.7, 1.1];
@@ -224,11 +231,11 @@ mod tests {
             let n = [-axis[i].sin(), axis[i].cos()];
             let r = [p[i][0] - g[0], p[i][1] - g[1]];
             let vp = [w[0] - w[2] * r[1], w[1] + w[2] * r[0]];
-            let u = slider_direction(i);
+            let u = u[i];
             let lhs = n[0] * vp[0] + n[1] * vp[1];
             assert!((lhs - sd[i] * (n[0] * u[0] + n[1] * u[1])).abs() < 1e-14, "row {i}");
         }
-        let det = RigidTwist::solve(g, &[g; 3], axis, 0.5).unwrap_err();
+        let det = RigidTwist::solve(g, &[g; 3], &u, axis, 0.5).unwrap_err();
         assert!(det < 1e-12, "{det}");
         let msg = FemError::SingularPose { t: 0.2, det }.to_string();
         assert!(msg.contains("t = 0.2 s") && msg.contains("damping.alpha"), "{msg}");

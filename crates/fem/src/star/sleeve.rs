@@ -1,5 +1,6 @@
 //! The sleeve: the passive prismatic joint through which beam i slides, a rigid body of
-//! rotational inertia `Jp` [kg m^2] pinned at the revolute point `P_i(t)` of slider i (Eqs. 1-3).
+//! rotational inertia `Jp_i` [kg m^2] and length `Lp_i` [m] (beam i's data) pinned at the
+//! revolute point `P_i(t) = o_i + s_i(t) u_i` of slider i (Eqs. 1-3 on the paper's base).
 //!
 //! **Unknowns of sleeve i** (fixed XY frame, SI units; indices [`Star::psi`], [`Star::xi`], the
 //! [`SLEEVE_COORDINATES`] after the nodes' `3 n_nodes`):
@@ -65,12 +66,13 @@ pub(crate) const ROW_POINT: [usize; ROWS] = [0, 0, 1, 1, 2, 2, 0];
 pub(crate) const SLEEVE_COORDINATES: usize = 12;
 
 /// The sleeves' initial coordinates (from `psi0`: three rotations, then the three contact points
-/// of each sleeve at xp_i and xp_i -+ Lp/2), turning with the star at `init.theta_dot` and
+/// of each sleeve at xp_i and xp_i -+ Lp_i/2), turning with the star at `init.theta_dot` and
 /// sliding at `init.xp_dot`.
-pub(super) fn initial_sleeves(params: &RobotParams, psi0: usize, init: &InitialState, q: &mut [f64], v: &mut [f64]) {
+pub(super) fn initial_sleeves(robot: &Robot, psi0: usize, init: &InitialState, q: &mut [f64], v: &mut [f64]) {
     for i in 0..3 {
+        let lp = robot.beams()[i].sleeve_length;
         v[psi0 + i] = init.theta_dot;
-        for (p, off) in [0.0, -0.5 * params.lp, 0.5 * params.lp].iter().enumerate() {
+        for (p, off) in [0.0, -0.5 * lp, 0.5 * lp].iter().enumerate() {
             q[psi0 + 3 + 3 * i + p] = init.xp[i] + off;
             v[psi0 + 3 + 3 * i + p] = init.xp_dot[i];
         }
@@ -108,15 +110,21 @@ impl Star {
         self.gamma0[i] + q[self.psi(i)]
     }
 
-    /// Kinetic energy of the sleeves' rotations [J] at velocities `v`.
+    /// Kinetic energy of the sleeves' rotations [J] at velocities `v`: `1/2 sum Jp_i psi_i'^2`
+    /// (on equal beams `1/2 Jp sum psi_i'^2`, as it was written before per-beam data).
     pub fn sleeve_energy(&self, v: &[f64]) -> f64 {
-        0.5 * self.params.jp * (0..3).map(|i| v[self.psi(i)].powi(2)).sum::<f64>()
+        let jp = self.robot.beams().map(|b| b.sleeve_inertia);
+        if jp[1] == jp[0] && jp[2] == jp[0] {
+            return 0.5 * jp[0] * (0..3).map(|i| v[self.psi(i)].powi(2)).sum::<f64>();
+        }
+        0.5 * (0..3).map(|i| jp[i] * v[self.psi(i)].powi(2)).sum::<f64>()
     }
 
-    /// The sleeves must stay on their beams: every contact point inside (0, L) at time `t` [s].
+    /// The sleeves must stay on their beams: every contact point of sleeve i inside (0, L_i) at
+    /// time `t` [s].
     pub fn check_on_beams(&self, q: &[f64], t: f64) -> Result<(), FemError> {
-        let l = self.params.l;
         for i in 0..3 {
+            let l = self.beam(i).length;
             for (p, name) in [(0, "centre"), (1, "left edge"), (2, "right edge")] {
                 let xi = q[self.xi(i, p)];
                 if !(xi > 0.0 && xi < l) {
@@ -148,9 +156,10 @@ impl Star {
     ) {
         let Iterate { q, qdd, lam, pins, .. } = *it;
         let ps = self.psi(i);
-        res[ps] += cf * self.params.jp * qdd[ps];
+        let jp = self.beam(i).sleeve_inertia;
+        res[ps] += cf * jp * qdd[ps];
         if matrix {
-            self.vals[self.off_psi + 4 * i] = self.params.jp;
+            self.vals[self.off_psi + 4 * i] = jp;
             for p in 0..3 {
                 self.vals[self.off_psi + 4 * i + 1 + p] = 0.0;
             }
@@ -159,7 +168,7 @@ impl Star {
         // state (recomputed: cheaper than storing every element's state, which at 3000
         // elements leaves the cache)
         let points: [(usize, f64, ElementState); 3] = [0, 1, 2].map(|p| {
-            let (e, z) = self.locate(q[self.xi(i, p)]);
+            let (e, z) = self.locate(i, q[self.xi(i, p)]);
             let el = &self.elements[i * self.ne + e];
             (e, z, ElementState::new(el, &self.element_q(el, q)))
         });
@@ -207,7 +216,7 @@ impl Star {
     /// Eq. S9 (`docs/fem.md` section 2.1): the slope that the interior field of the centre's
     /// element adds at the contact point under the point moment `C = -lambda_7` and the normal
     /// point force `P = -lambda_c . e2` that the sleeve applies there, `F_ut P + F_tt C`, with the
-    /// flexibilities of the element clamped at both nodes (length h, contact at `a = z h`,
+    /// flexibilities of the element clamped at both nodes (length `h_i`, beam i's `EI_i`, contact at `a = z h`,
     /// `b = h - a`): `F_tt = a b (a^2 - a b + b^2) / (EI h^3)`, `F_ut = a^2 b^2 (b - a) / (2 EI h^3)`.
     /// `scale = 1 / cf` turns the scaled multipliers into forces. With `matrix`, writes the
     /// row's derivatives with respect to the multipliers into the slot group `off_nu`. Returns
@@ -221,7 +230,7 @@ impl Star {
         scale: f64,
         matrix: bool,
     ) -> f64 {
-        let (f_ut, f_tt) = interior_flexibilities(z, self.h, self.params.ei());
+        let (f_ut, f_tt) = interior_flexibilities(z, self.h[i], self.beam(i).bending_stiffness());
         let e2 = [-st.s, st.c];
         let k = ROWS * i;
         // the row's derivatives with respect to (nu_7, nu_cx, nu_cy)
@@ -250,7 +259,7 @@ impl Star {
         z: f64,
     ) -> (f64, [f64; 6], f64, f64) {
         if r < 6 {
-            let (k, lp2) = (r % 2, 0.5 * self.params.lp);
+            let (k, lp2) = (r % 2, 0.5 * self.beam(i).sleeve_length);
             let ang = self.gamma0[i] + psi;
             let (a, aperp) = ([ang.cos(), ang.sin()], [-ang.sin(), ang.cos()]);
             let pos = st.position(node_a, z);
@@ -261,23 +270,23 @@ impl Star {
                 1 => (lp2 * a[k], lp2 * aperp[k]),
                 _ => (-lp2 * a[k], -lp2 * aperp[k]),
             };
-            (pos[k] - pin[k] + off, jac[k], rz[k] / self.h, gpsi)
+            (pos[k] - pin[k] + off, jac[k], rz[k] / self.h[i], gpsi)
         } else {
             let (al, g, az) = st.angle(z);
-            (al - psi, g, az / self.h, -1.0)
+            (al - psi, g, az / self.h[i], -1.0)
         }
     }
 
     /// Constraint values `Phi(q, t)` (21), for the consistent initial accelerations.
     pub fn constraints(&self, q: &[f64], pins: &Pins) -> Vec<f64> {
-        let lp2 = 0.5 * self.params.lp;
         let mut out = vec![0.0; 3 * ROWS];
         for i in 0..3 {
+            let lp2 = 0.5 * self.beam(i).sleeve_length;
             let ang = self.gamma0[i] + q[self.psi(i)];
             let a = [ang.cos(), ang.sin()];
             for r in 0..ROWS {
                 let p = ROW_POINT[r];
-                let (e, z) = self.locate(q[self.xi(i, p)]);
+                let (e, z) = self.locate(i, q[self.xi(i, p)]);
                 let el = &self.elements[i * self.ne + e];
                 let st = ElementState::new(el, &self.element_q(el, q));
                 let na = self.node(i, e);
@@ -432,6 +441,7 @@ mod tests {
     fn row_terms_match_central_differences_of_the_constraints() {
         let exp = flexstar_model::catalogue::paper_case(3);
         let params = exp.robot;
+        let robot = Robot::from_params(&params).unwrap();
         let ne = 40;
         let h = 1e-6;
         let mut checked = 0;
@@ -445,8 +455,8 @@ mod tests {
                 xp: r.xp.map(|x| x.v),
                 xp_dot: [0.0; 3],
             };
-            let pins = Pins::new(&params, r.s.map(|s| [s.v, s.d1, s.d2]));
-            let (star, mut q, _) = Star::new(&params, ne, &init, None).unwrap();
+            let pins = Pins::new(&robot, r.s.map(|s| [s.v, s.d1, s.d2]));
+            let (star, mut q, _) = Star::new(&robot, ne, &init, None).unwrap();
             for (j, x) in q.iter_mut().enumerate().take(3 * star.n_nodes) {
                 let amp = if j % 3 == 2 { 0.02 } else { 2e-3 };
                 *x += amp * (0.7 * j as f64 + n as f64).sin();
@@ -455,9 +465,9 @@ mod tests {
                 q[star.psi(i)] += 0.01 * (i as f64 + 1.0);
                 // contact points well inside their elements (the Jacobian jumps at nodes)
                 for p in 0..3 {
-                    let (_, z) = star.locate(q[star.xi(i, p)]);
+                    let (_, z) = star.locate(i, q[star.xi(i, p)]);
                     if !(0.05..=0.95).contains(&z) {
-                        q[star.xi(i, p)] += 0.3 * star.h;
+                        q[star.xi(i, p)] += 0.3 * star.h[i];
                     }
                 }
             }
@@ -468,7 +478,7 @@ mod tests {
                 let ps = star.psi(i);
                 for r in 0..ROWS {
                     let p = ROW_POINT[r];
-                    let (e, z) = star.locate(q[star.xi(i, p)]);
+                    let (e, z) = star.locate(i, q[star.xi(i, p)]);
                     let el = &star.elements[i * star.ne + e];
                     let st = ElementState::new(el, &star.element_q(el, &q));
                     let na = star.node(i, e);

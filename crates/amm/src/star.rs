@@ -104,18 +104,7 @@ impl Weld {
 /// Each beam of `robot` in the one-beam form of the mode sets and sleeves (`d` = 0: the base is
 /// the robot's axes).
 pub(crate) fn beam_params(robot: &Robot) -> [RobotParams; 3] {
-    robot.beams().map(|b| RobotParams {
-        e: b.youngs_modulus,
-        i: b.second_moment,
-        rho: b.mass_per_length,
-        l: b.length,
-        d: 0.0,
-        lp: b.sleeve_length,
-        mpp_mpa: b.sleeve_mass,
-        jp: b.sleeve_inertia,
-        ea: Some(b.axial_stiffness),
-        as_built: None,
-    })
+    robot.beams().map(|b| b.params(0.0))
 }
 
 /// The problem as the AMM solves it (module docs).

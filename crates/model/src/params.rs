@@ -105,19 +105,8 @@ impl RobotParams {
         if let Some(a) = &self.as_built {
             crate::Robot::new(a.beams, a.axes)?;
             for b in &a.beams {
-                let one = RobotParams {
-                    e: b.youngs_modulus,
-                    i: b.second_moment,
-                    rho: b.mass_per_length,
-                    l: b.length,
-                    lp: b.sleeve_length,
-                    mpp_mpa: b.sleeve_mass,
-                    jp: b.sleeve_inertia,
-                    ea: Some(b.axial_stiffness),
-                    as_built: None,
-                    // the base is checked by Robot::new; d does not describe an uneven one
-                    d: RobotParams::paper().d,
-                };
+                // the base is checked by Robot::new; d does not describe an uneven one
+                let one = b.params(RobotParams::paper().d);
                 one.check_derived()?;
             }
             return Ok(());

@@ -37,6 +37,23 @@ pub struct Beam {
 }
 
 impl Beam {
+    /// This beam in the paper's compact form, as if the three were equal, on the base of
+    /// in-radius `d` [m]: what a one-beam computation (a mode set, a sleeve, a check) reads.
+    pub fn params(&self, d: f64) -> RobotParams {
+        RobotParams {
+            e: self.youngs_modulus,
+            i: self.second_moment,
+            rho: self.mass_per_length,
+            l: self.length,
+            d,
+            lp: self.sleeve_length,
+            mpp_mpa: self.sleeve_mass,
+            jp: self.sleeve_inertia,
+            ea: Some(self.axial_stiffness),
+            as_built: None,
+        }
+    }
+
     /// Bending stiffness EI [N m^2].
     pub fn bending_stiffness(&self) -> f64 {
         self.youngs_modulus * self.second_moment
@@ -237,18 +254,7 @@ fn paper_form(beams: &[Beam; 3], axes: &[ActuatorAxis; 3]) -> Result<RobotParams
     if !(d > 0.0 && (0..3).all(|i| close_axis(&axes[i], &ActuatorAxis::paper(i, d)))) {
         return Err("the base is not the equilateral triangle centred at O".to_string());
     }
-    Ok(RobotParams {
-        as_built: None,
-        e: b.youngs_modulus,
-        i: b.second_moment,
-        rho: b.mass_per_length,
-        l: b.length,
-        d,
-        lp: b.sleeve_length,
-        mpp_mpa: b.sleeve_mass,
-        jp: b.sleeve_inertia,
-        ea: Some(b.axial_stiffness),
-    })
+    Ok(b.params(d))
 }
 
 /// Equal to rounding: angles and lengths built by different sums of the same numbers.

@@ -208,8 +208,7 @@ impl Robot {
     /// its index: `gaps()[k]` is the angle under which G sees the two revolute points other
     /// than k's.
     pub fn gaps(&self) -> [f64; 3] {
-        let phi = self.weld_angles();
-        [phi[2] - phi[1], std::f64::consts::TAU - phi[2], phi[1] - phi[0]]
+        crate::robot_geometry::gaps_of(self.weld_angles())
     }
 
     /// The robot in the paper's form, when it is the paper's robot: three equal beams welded at

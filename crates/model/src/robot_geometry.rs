@@ -95,27 +95,49 @@ impl<T: RobotGeometry + ?Sized> RobotGeometry for &T {
     }
 }
 
+/// The compact form answers with its robot as built when it carries one
+/// ([`RobotParams::as_built`], the file's per-beam lists, welds and base): a generic function
+/// given `&exp.robot` then reads the robot the file describes, never the paper's geometry by
+/// mistake. Without it, the paper's own numbers.
 impl RobotGeometry for RobotParams {
     fn weld_angle(&self, i: usize) -> f64 {
-        beam_offset(i)
+        match &self.as_built {
+            Some(a) => a.beams[i].weld_angle,
+            None => beam_offset(i),
+        }
     }
     fn gaps(&self) -> [f64; 3] {
-        [2.0 * std::f64::consts::FRAC_PI_3; 3]
+        match &self.as_built {
+            Some(a) => gaps_of(a.beams.map(|b| b.weld_angle)),
+            None => [2.0 * std::f64::consts::FRAC_PI_3; 3],
+        }
     }
     fn axis(&self, i: usize) -> ActuatorAxis {
-        ActuatorAxis::paper(i, self.d)
+        match &self.as_built {
+            Some(a) => a.axes[i],
+            None => ActuatorAxis::paper(i, self.d),
+        }
     }
-    fn slider_travel(&self, _i: usize) -> [f64; 2] {
-        [-self.half_side(), self.half_side()]
+    fn slider_travel(&self, i: usize) -> [f64; 2] {
+        match &self.as_built {
+            Some(a) => side_of(&a.axes, i),
+            None => [-self.half_side(), self.half_side()],
+        }
     }
-    fn beam_length(&self, _i: usize) -> f64 {
-        self.l
+    fn beam_length(&self, i: usize) -> f64 {
+        match &self.as_built {
+            Some(a) => a.beams[i].length,
+            None => self.l,
+        }
     }
-    fn sleeve_length(&self, _i: usize) -> f64 {
-        self.lp
+    fn sleeve_length(&self, i: usize) -> f64 {
+        match &self.as_built {
+            Some(a) => a.beams[i].sleeve_length,
+            None => self.lp,
+        }
     }
     fn paper_form(&self) -> Option<&RobotParams> {
-        Some(self)
+        self.as_built.is_none().then_some(self)
     }
 }
 
@@ -144,6 +166,11 @@ impl RobotGeometry for Robot {
     fn paper_form(&self) -> Option<&RobotParams> {
         self.equal_beams().ok()
     }
+}
+
+/// The gaps `[g_23, g_31, g_12]` [rad] of beams welded at `phi` (Eq. W2).
+pub(crate) fn gaps_of(phi: [f64; 3]) -> [f64; 3] {
+    [phi[2] - phi[1], std::f64::consts::TAU - phi[2], phi[1] - phi[0]]
 }
 
 /// The side of the base that axis i runs along: `[lo, hi]` in its coordinate s between the points
@@ -208,5 +235,22 @@ mod tests {
                 "{i}: {s:?}"
             );
         }
+    }
+
+    #[test]
+    fn parameters_carrying_a_robot_as_built_answer_with_it() {
+        // the file's robot as built: beam 3 shorter and welded 2 degrees off, an uneven base
+        let p = RobotParams::paper();
+        let mut a = crate::robot::AsBuilt::of_paper(&p);
+        a.beams[2].length = 0.47;
+        a.beams[2].weld_angle += 2f64.to_radians();
+        a.axes = ActuatorAxis::from_sides([0.63, 0.6, 0.64]).unwrap();
+        let params = RobotParams { as_built: Some(a), ..p };
+        let robot = Robot::from_params(&params).unwrap();
+        assert!(params.paper_form().is_none() && robot.paper_form().is_none());
+        assert_eq!(params.feasibility_key(), robot.feasibility_key());
+        assert_eq!(params.gaps(), robot.gaps());
+        // and the paper's own parameters keep the paper's numbers
+        assert_eq!(p.feasibility_key(), Robot::from_params(&p).unwrap().feasibility_key());
     }
 }

@@ -57,7 +57,7 @@ pub type RunChecks = Vec<(String, Option<ValidityExceeded>)>;
 pub fn run_checks(exp: &Experiment, case: &CaseResults) -> RunChecks {
     runs_of(case)
         .into_iter()
-        .map(|(run, r)| (run, small_deflection_check(r, exp.robot.l)))
+        .map(|(run, r)| (run, small_deflection_check(r, &exp.robot)))
         .collect()
 }
 
@@ -492,7 +492,7 @@ pub fn write_case(
         if let Some(d) = &keys.dwells {
             set.text(&format!("{stem}-dwells.csv"), &flexstar_model::sidecar::dwells_csv(d))?;
         }
-        let check = small_deflection_check(r, exp.robot.l);
+        let check = small_deflection_check(r, &exp.robot);
         r.stage_run(&mut set, &stem, None, (exp, prov), (check, Some(keys)))?;
     }
     set.text("compare.csv", &csv)?;

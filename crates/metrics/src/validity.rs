@@ -23,7 +23,7 @@
 //! (co-rotational, large rotations), stays valid and is the tool to use there.
 
 use flexstar_model::sidecar::ValidityExceeded;
-use flexstar_model::Response;
+use flexstar_model::{Response, RobotGeometry};
 
 /// Tip deflection bound, as a fraction of the beam length L.
 pub const TIP_BOUND: f64 = 0.05;
@@ -34,13 +34,15 @@ pub const G_BOUND: f64 = 0.05;
 
 /// Check a response against the small-deflection bounds ([`TIP_BOUND`] on the tips, [`G_BOUND`]
 /// on `w_1G..w_3G`, [`SLOPE_BOUND`] on `thp1..3` where present); `None` while it stays in range.
-/// `l`: beam length [m].
-pub fn small_deflection_check(r: &Response, l: f64) -> Option<ValidityExceeded> {
+/// `robot`: each beam's length L_i [m] ([`RobotGeometry::beam_length`]; on a robot as built each
+/// beam is judged against its own).
+pub fn small_deflection_check(r: &Response, robot: &impl RobotGeometry) -> Option<ValidityExceeded> {
+    let l = |i: usize| robot.beam_length(i);
     let mut series: Vec<(String, Vec<f64>, f64)> = (0..3)
         .map(|i| {
             (
                 format!("|w{}tip| / L", i + 1),
-                r.w_tip[i].iter().map(|w| w.abs() / l).collect(),
+                r.w_tip[i].iter().map(|w| w.abs() / l(i)).collect(),
                 TIP_BOUND,
             )
         })
@@ -48,7 +50,7 @@ pub fn small_deflection_check(r: &Response, l: f64) -> Option<ValidityExceeded> 
     for i in 0..3 {
         series.push((
             format!("|w{}G| / L", i + 1),
-            r.w_g[i].iter().map(|w| w.abs() / l).collect(),
+            r.w_g[i].iter().map(|w| w.abs() / l(i)).collect(),
             G_BOUND,
         ));
     }
@@ -92,7 +94,7 @@ mod tests {
     /// past it, 24 mm is not.
     #[test]
     fn the_junction_displacement_is_bounded() {
-        let l = 0.5;
+        let l = &flexstar_model::RobotParams::paper(); // L = 0.5 m
         let at = |w3g: f64| {
             let mut r = Response::with_capacity("x", 2);
             r.push(0.0, [0.0; 3], [0.0; 3], [0.0; 3]);
@@ -107,7 +109,7 @@ mod tests {
 
     #[test]
     fn first_time_past_the_bound_is_reported() {
-        let l = 0.5;
+        let l = &flexstar_model::RobotParams::paper(); // L = 0.5 m
         assert_eq!(small_deflection_check(&response(&[0.0, 0.01, -0.024]), l), None);
         let v = small_deflection_check(&response(&[0.0, 0.01, -0.026, 0.04]), l).unwrap();
         assert_eq!(v.quantity, "|w2tip| / L");
@@ -120,5 +122,20 @@ mod tests {
         );
         let v = small_deflection_check(&r, l).unwrap();
         assert_eq!((v.quantity.as_str(), v.t), ("|thp1|", 0.1));
+    }
+
+    /// On a robot as built each beam's tip is judged against its own length: 24 mm is past
+    /// 0.05 L on a 0.45 m beam 2, not on the 0.5 m beams.
+    #[test]
+    fn each_beam_is_judged_against_its_own_length() {
+        let p = flexstar_model::RobotParams::paper();
+        let mut a = flexstar_model::robot::AsBuilt::of_paper(&p);
+        a.beams[1].length = 0.45;
+        let built = flexstar_model::RobotParams { as_built: Some(a), ..p };
+        let r = response(&[0.0, 0.024]);
+        assert_eq!(small_deflection_check(&r, &p), None);
+        let v = small_deflection_check(&r, &built).unwrap();
+        assert_eq!(v.quantity, "|w2tip| / L");
+        assert!((v.value - 0.024 / 0.45).abs() < 1e-12);
     }
 }

@@ -217,7 +217,7 @@ impl Evaluator {
         )
         .map(|s| s.response)
         .map_err(|e| Rejected::Solver(e.to_string()))?;
-        if let Some(v) = flexstar_metrics::small_deflection_check(&r, exp.robot.l) {
+        if let Some(v) = flexstar_metrics::small_deflection_check(&r, &exp.robot) {
             return Err(Rejected::Solver(format!("outside the small-deflection range: {v}")));
         }
         Ok(r)

@@ -49,7 +49,7 @@ fn nine_envelope_cases_meet_the_evp_bounds_and_their_estimates_are_within_a_fact
             let amm = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::motion())
                 .map(|s| s.response)
                 .expect("the AMM run");
-            let range = small_deflection_check(&amm, exp.robot.l);
+            let range = small_deflection_check(&amm, &exp.robot);
             assert!(
                 range.is_none(),
                 "{}: in the small-deflection range: {range:?}",

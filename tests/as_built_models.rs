@@ -11,35 +11,18 @@
 //! 0.064 % (0.154 % at G, estimate 0.079 %); all at once under gravity on brisk, N = 55, mean
 //! 0.082 % (0.112 %, estimate 0.069 %).
 
-use flexstar_solve::Settings;
-use std::path::Path;
-
-use flexstar_metrics::evp::point_evps;
-use flexstar_model::{AmmSettings, Experiment, FemSettings};
+#[path = "support/models.rs"]
+mod models;
 
 const SMOOTH: &str = include_str!("../configs/motions/smooth.toml");
 const BRISK: &str = include_str!("../configs/motions/brisk.toml");
 
-/// EVPs (Eq. 45) of the accurate AMM against the FEM on the motion `base` with the robot
-/// `robot` (its `[robot]`, `[base]` and `[gravity]` sections).
+/// The accurate AMM against the FEM on the motion `base` with the robot `robot` (its `[robot]`,
+/// `[base]` and `[gravity]` sections).
 fn check(base: &str, name: &str, robot: &str) {
-    let exp = Experiment::from_toml_str(&format!("{base}\n{robot}"), Path::new("as-built.toml")).unwrap();
+    let exp = models::experiment(base, robot, "as-built.toml");
     assert!(exp.robot.as_built.is_some(), "{name}: a robot as built");
-    let problem = exp.problem().unwrap();
-    let fem = flexstar_solve::response(&problem, Settings::Fem(&FemSettings::default()), None, None).unwrap();
-    let amm = flexstar_solve::response(&problem, Settings::Amm(&AmmSettings::accurate()), None, None).unwrap();
-    let e = point_evps(&amm, &fem).unwrap();
-    let mean = e.mean.expect("the tips move");
-    eprintln!(
-        "{name}: N = {:?}, estimate {:?} %, EVP A/B/C/G = {:?}, mean {mean:.3} %",
-        amm.info.modes, amm.info.error_estimate_percent, e.points
-    );
-    assert!(mean <= 1.0, "{name}: mean EVP {mean} %");
-    for (p, v) in ["A", "B", "C", "G"].iter().zip(e.points) {
-        if let Some(v) = v {
-            assert!(v <= 2.0, "{name}: point {p}: EVP {v} %");
-        }
-    }
+    models::amm_against_fem(&exp, name).assert_within(name, 1.0, 2.0);
 }
 
 #[test]

@@ -6,6 +6,7 @@ use num_dual::Dual2;
 
 use crate::as_built::{angle_at, rigid_pose};
 use crate::direct::largest_angle;
+use crate::feasibility::Violation;
 use crate::KinematicsError;
 
 /// Rigid kinematics at time t: every quantity with its first and second time derivative
@@ -98,30 +99,28 @@ impl RigidState {
     }
 }
 
-/// Why no rigid pose exists at the actuator coordinates `s` [m]: the angle of the revolute
-/// points' triangle that reaches the gap G must see its opposite side under (120 degrees on the
-/// paper's robot: no Fermat point), or a degenerate triangle.
+/// Why no rigid pose exists at the actuator coordinates `s` [m], in the feasibility scan's words
+/// ([`Violation`]): the angle of the revolute points' triangle that reaches the gap G must see its
+/// opposite side under (120 degrees on the paper's robot: no Fermat point), or a degenerate
+/// triangle.
 pub(crate) fn no_pose_reason<K: RobotGeometry + ?Sized>(robot: &K, s: [f64; 3]) -> String {
     let pts: [[f64; 2]; 3] = std::array::from_fn(|i| robot.revolute_point(i, s[i]));
     if robot.paper_form().is_some() {
         let (ang, k) = largest_angle(&pts);
-        return format!(
-            "triangle IJK has an angle of {:.2} degrees at {} (a Fermat point needs every angle below 120)",
-            ang.to_degrees(),
-            ["I", "J", "K"][k]
-        );
+        return Violation::NoFermatPoint {
+            vertex: k,
+            angle_deg: ang.to_degrees(),
+        }
+        .to_string();
     }
     let gaps = robot.gaps();
     match (0..3).find(|&k| angle_at(&pts, k) >= gaps[k]) {
-        Some(k) => format!(
-            "the triangle of the revolute points has an angle of {:.2} degrees at {}, not below the {:.2} \
-             degrees between beams {} and {} that G must see the opposite side under (docs/as-built.md 3)",
-            angle_at(&pts, k).to_degrees(),
-            ["I", "J", "K"][k],
-            gaps[k].to_degrees(),
-            (k + 1) % 3 + 1,
-            (k + 2) % 3 + 1
-        ),
+        Some(k) => Violation::NoAssembly {
+            vertex: k,
+            angle_deg: angle_at(&pts, k).to_degrees(),
+            gap_deg: gaps[k].to_degrees(),
+        }
+        .to_string(),
         None => "the revolute points are (nearly) aligned".to_string(),
     }
 }

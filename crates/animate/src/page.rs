@@ -1,7 +1,7 @@
 //! The page: the runs' frames as JSON in a `<script type="application/json">`, an inline SVG in
 //! the fixed frame (mm) and a small script (`page.js`) that draws a frame and plays them.
 
-use flexstar_model::geometry::revolute_point;
+use flexstar_model::RobotGeometry;
 use serde_json::{json, Value};
 
 use crate::read::RunFrames;
@@ -126,14 +126,15 @@ fn run_json(r: &RunFrames, k: usize) -> Value {
     json!({ "name": r.name, "colour": colour(&r.name, k), "rigid": rigid, "elastic": elastic, "G": g, "theta": theta })
 }
 
-/// The base triangle [um]: its three corners, where the sides (the sliders' rails, at distance d
-/// from O) meet, `s_i = +-sqrt(3) d`; empty without d.
+/// The base triangle [um]: its three corners, where the sliders' axes meet (the end of each
+/// slider's side, `docs/as-built.md` 2; `s_i = sqrt(3) d` on the paper's base); empty when the
+/// sidecar does not give the robot.
 fn base_json(r: &RunFrames) -> Value {
-    let Some(d) = r.d else {
+    let Some(robot) = &r.robot else {
         return json!([]);
     };
     let corners: Vec<[i64; 2]> = (0..3)
-        .map(|i| revolute_point(i, d, 3f64.sqrt() * d).map(micro))
+        .map(|i| robot.revolute_point(i, robot.slider_travel(i)[1]).map(micro))
         .collect();
     json!(corners)
 }
@@ -147,10 +148,11 @@ fn payload_json(runs: &[RunFrames]) -> Value {
     }
 }
 
-/// The rails (segments over the sliders' travel, 10 % of d beyond) and the slider points per
-/// frame [um] of the first run, when its sidecar gives d.
+/// The rails (segments over the sliders' travel in this motion, a tenth of the base's size
+/// beyond: `0.1 d` on the paper's base, d the in-radius) and the slider points per frame [um] of
+/// the first run, when its sidecar gives the robot.
 fn rails_json(r: &RunFrames) -> (Value, Value) {
-    let Some(d) = r.d else {
+    let Some(robot) = &r.robot else {
         return (json!([]), json!([]));
     };
     let rails: Vec<[i64; 4]> = (0..3)
@@ -159,12 +161,22 @@ fn rails_json(r: &RunFrames) -> (Value, Value) {
                 .pose
                 .iter()
                 .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p[3 + i]), b.max(p[3 + i])));
-            let (a, b) = (revolute_point(i, d, lo - 0.1 * d), revolute_point(i, d, hi + 0.1 * d));
+            // a side of the paper's base is 2 sqrt(3) d long
+            let [a0, a1] = robot.slider_travel(i);
+            let margin = 0.1 * (a1 - a0) / (2.0 * 3f64.sqrt());
+            let (a, b) = (
+                robot.revolute_point(i, lo - margin),
+                robot.revolute_point(i, hi + margin),
+            );
             [micro(a[0]), micro(a[1]), micro(b[0]), micro(b[1])]
         })
         .collect();
     let sliders: Vec<Vec<i64>> = (r.pose.iter())
-        .map(|p| (0..3).flat_map(|i| revolute_point(i, d, p[3 + i]).map(micro)).collect())
+        .map(|p| {
+            (0..3)
+                .flat_map(|i| robot.revolute_point(i, p[3 + i]).map(micro))
+                .collect()
+        })
         .collect();
     (json!(rails), json!(sliders))
 }
@@ -218,7 +230,7 @@ mod tests {
             pose: times.iter().map(|_| [0.0; 6]).collect(),
             t_rest: None,
             l: Some(0.5),
-            d: None,
+            robot: None,
             payload: None,
             experiment: None,
         }
@@ -248,7 +260,13 @@ mod tests {
     #[test]
     fn the_page_draws_the_base_triangle_and_the_payload() {
         let mut r = run("amm-enriched", &[0.0, 0.1], 1e-3);
-        r.d = Some(0.18);
+        r.robot = Some(
+            flexstar_model::Robot::from_params(&flexstar_model::RobotParams {
+                d: 0.18,
+                ..flexstar_model::RobotParams::paper()
+            })
+            .unwrap(),
+        );
         r.payload = Some((0.5, [0.01, 0.0]));
         let html = build_page(&[r], None).unwrap();
         let start = html.find("id=\"frames-data\">").unwrap() + "id=\"frames-data\">".len();
@@ -279,5 +297,37 @@ mod tests {
         assert_eq!(v["runs"][0]["name"], "amm-</script>");
         // elastic part in nanometres: the tip of beam 1, 1 mm in y
         assert_eq!(v["runs"][0]["elastic"][0][0][5], 1_000_000);
+    }
+
+    /// An uneven base is drawn as built: the corners where the axes meet are its vertices, so the
+    /// corners' distances are the file's sides (in some order).
+    #[test]
+    fn an_uneven_base_is_drawn_with_its_own_sides() {
+        let sides = [0.63, 0.6, 0.64];
+        let p = flexstar_model::RobotParams::paper();
+        let mut a = flexstar_model::robot::AsBuilt::of_paper(&p);
+        a.axes = flexstar_model::ActuatorAxis::from_sides(sides).unwrap();
+        let robot = flexstar_model::Robot::from_params(&flexstar_model::RobotParams { as_built: Some(a), ..p });
+        let mut r = run("amm-enriched", &[0.0, 0.1], 1e-3);
+        r.robot = Some(robot.unwrap());
+        let corners = base_json(&r);
+        let c: Vec<[f64; 2]> = corners
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| [c[0].as_f64().unwrap() * 1e-6, c[1].as_f64().unwrap() * 1e-6])
+            .collect();
+        let mut got: Vec<f64> = (0..3)
+            .map(|k| {
+                let (u, v) = (c[k], c[(k + 1) % 3]);
+                (u[0] - v[0]).hypot(u[1] - v[1])
+            })
+            .collect();
+        let mut want = sides.to_vec();
+        got.sort_by(f64::total_cmp);
+        want.sort_by(f64::total_cmp);
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).abs() < 3e-6, "{got:?} against {want:?}");
+        }
     }
 }

@@ -25,10 +25,12 @@ pub struct RunFrames {
     pub pose: Vec<[f64; 6]>,
     /// End of the motion `t_rest` [s] when the sidecar knows it.
     pub t_rest: Option<f64>,
-    /// Beam length L [m] and base size d [m] (the base triangle's in-radius) from the sidecar's
-    /// experiment, when present.
+    /// Beam length L [m] (beam 1's) from the sidecar's experiment, when present.
     pub l: Option<f64>,
-    pub d: Option<f64>,
+    /// The robot the sidecar's experiment describes (its base: the actuator axes and the
+    /// sliders' travel along them), when it says: the paper's triangle from `d`, or the axes of
+    /// a robot as built (`docs/as-built.md` 2).
+    pub robot: Option<flexstar_model::Robot>,
     /// The payload welded at G (`[payload]`): mass [kg] and offset of its centre of mass from G
     /// in the star's rigid frame [m]; `None` without one.
     pub payload: Option<(f64, [f64; 2])>,
@@ -98,7 +100,7 @@ fn read_run(dir: &Path, stem: &str) -> Result<RunFrames, AnimateError> {
         pose,
         t_rest: facts.t_rest,
         l: facts.l,
-        d: facts.d,
+        robot: facts.robot,
         payload: facts.payload,
         experiment: flexstar_model::identity::recorded(&doc),
     })
@@ -216,12 +218,12 @@ fn read_pose(file: &Path) -> Result<Vec<[f64; 6]>, AnimateError> {
 struct Facts {
     t_rest: Option<f64>,
     l: Option<f64>,
-    d: Option<f64>,
+    robot: Option<flexstar_model::Robot>,
     payload: Option<(f64, [f64; 2])>,
 }
 
-/// `t_rest` [s] (a top-level `t_rest` key, else the experiment's trajectory), L and d [m] and
-/// the payload from a sidecar document; `None` for what it does not say.
+/// `t_rest` [s] (a top-level `t_rest` key, else the experiment's trajectory), L [m], the robot
+/// and the payload from a sidecar document; `None` for what it does not say.
 fn sidecar_facts(doc: &serde_json::Value) -> Facts {
     let exp = doc
         .get("experiment")
@@ -246,10 +248,21 @@ fn sidecar_facts(doc: &serde_json::Value) -> Facts {
     let payload = num("payload", "mass")
         .filter(|m| *m > 0.0 || num("payload", "J").is_some_and(|j| j > 0.0))
         .map(|m| (m, offset));
+    // the experiment's robot (a robot as built with its base), else the paper's of the file's d
+    let robot = match &exp {
+        Some(exp) => flexstar_model::Robot::from_params(&exp.robot).ok(),
+        None => num("robot", "d").and_then(|d| {
+            flexstar_model::Robot::from_params(&flexstar_model::RobotParams {
+                d,
+                ..flexstar_model::RobotParams::paper()
+            })
+            .ok()
+        }),
+    };
     Facts {
         t_rest,
-        l: num("robot", "L"),
-        d: num("robot", "d"),
+        l: num("robot", "L").or_else(|| exp.as_ref().map(|e| e.robot.l)),
+        robot,
         payload,
     }
 }

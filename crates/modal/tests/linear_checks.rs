@@ -22,7 +22,7 @@ fn to_faer(m: &sprs::CsMat<f64>) -> faer::Mat<f64> {
 
 /// An off-centre turned pose (all three sliders and xp distinct, no symmetry to hide an error).
 fn linear_model(exp: &Experiment) -> StateSpace {
-    let pose = pose_from_task(&exp.robot, 0.03, -0.02, 0.1).unwrap();
+    let pose = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), 0.03, -0.02, 0.1).unwrap();
     linearize(exp, &pose).unwrap()
 }
 

@@ -1,5 +1,6 @@
 //! `modal`, `freqmap` and `linearize` (`docs/modes.md`): modes at a pose, frequency maps over the
-//! workspace and the linear state-space model about a pose (over `flexstar_modal`).
+//! workspace and the linear state-space model about a pose (over `flexstar_modal`), of the
+//! paper's robot or one as built (`docs/modes.md`, a robot as built).
 
 use std::path::{Path, PathBuf};
 
@@ -65,15 +66,15 @@ pub fn check_k(k: usize) -> Result<()> {
     flexstar_modal::check_k(k).map_err(|e| from_modal(None, f64::NAN, e))
 }
 
-/// The rest pose, checked against the workspace (the error names the limit).
+/// The rest pose of the experiment's robot, checked against its workspace (the error names the
+/// limit).
 pub fn resolve_pose(exp: &Experiment, source: &str, spec: &PoseSpec) -> Result<RestPose> {
-    ApiError::paper_robot(exp, source, "modes at a pose (modal, linearize)")?;
     match spec {
         PoseSpec::At(t) => pose_at_time(exp, *t).map_err(|e| from_modal(Some(source), *t, e)),
         PoseSpec::Task {
             pose: [gx, gy, th],
             text,
-        } => pose_from_task(&exp.robot, *gx, *gy, *th).map_err(|e| {
+        } => task_pose(exp, [*gx, *gy, *th]).map_err(|e| {
             let inner = format!("--pose {text}: {e}");
             match e {
                 ModalError::Infeasible(reason) => ApiError::Infeasible {
@@ -85,6 +86,11 @@ pub fn resolve_pose(exp: &Experiment, source: &str, spec: &PoseSpec) -> Result<R
             }
         }),
     }
+}
+
+/// The pose `[Gx, Gy, theta]` [m, m, rad] of the experiment's robot (inverse kinematics).
+fn task_pose(exp: &Experiment, [gx, gy, th]: [f64; 3]) -> std::result::Result<RestPose, ModalError> {
+    pose_from_task(&flexstar_modal::robot(exp)?, gx, gy, th)
 }
 
 /// The outcome of `modal`: the pose, both analyses and the files written (if any).
@@ -166,11 +172,20 @@ pub fn modal(
         write_modal_csv(Dest::Set(&mut set, "modal.csv"), &m).map_err(|e| from_modal(None, f64::NAN, e))?;
         sidecar.stage(&mut set)?;
         set.commit()?;
-        let figure = mode_shapes_figure("modal-shapes", &m, &pose, exp.robot.l);
+        let figure = mode_shapes_figure("modal-shapes", &m, &pose, longest_beam(exp));
         write_svg_png(&figure, &dir)?;
         files.extend(["modal.csv", "modal.json", "modal-shapes.svg", "modal-shapes.png"].map(|f| dir.join(f)));
     }
     Ok(ModalOutcome { pose, modal: m, files })
+}
+
+/// The longest beam of the experiment's robot [m] (`robot.L` on the paper's robot): the scale of
+/// the mode shapes' figure.
+fn longest_beam(exp: &Experiment) -> f64 {
+    match &exp.robot.as_built {
+        None => exp.robot.l,
+        Some(a) => a.beams.iter().map(|b| b.length).fold(0.0, f64::max),
+    }
 }
 
 /// The pose and the sliders as `modal` reports them, five decimals and no `-0.00000`:
@@ -261,7 +276,6 @@ pub fn freqmap<P>(
 where
     P: Fn(usize, usize) + Sync,
 {
-    ApiError::paper_robot(exp, source, "flexstar freqmap")?;
     check_grid(&s.gx, &s.gy).map_err(|e| from_modal(None, f64::NAN, e))?;
     check_k(s.k)?;
     if !s.theta.is_finite() {

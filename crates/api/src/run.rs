@@ -362,19 +362,19 @@ pub fn run(p: &Prepared, progress: Option<&(dyn Fn(f64) + Sync)>) -> Result<RunO
 }
 
 /// The residual vibration after the motion's end (`docs/motions.md` section 2) as the sidecar's
-/// keys ([`flexstar_model::ResidualKeys`]). An AMM run of the pinned-free family has G pinned by
-/// its modes (`phi(0) = 0`): its residual of G is null, with a note.
+/// keys ([`flexstar_model::ResidualKeys`]), of the paper's robot or one as built (the hold is the
+/// first period at the robot's own final pose). An AMM run of the pinned-free family has G
+/// pinned by its modes (`phi(0) = 0`): its residual of G is null, with a note.
 fn residual_keys(p: &Prepared, r: &Response) -> Result<Option<flexstar_model::ResidualKeys>> {
-    if p.exp.robot.as_built.is_some() {
-        // their hold is the first period at the final pose, which flexstar_modal computes on
-        // the paper's form only so far (docs/as-built.md 6)
-        return Ok(None);
-    }
-    let res = flexstar_modal::settle::run_residual(&p.exp, r).map_err(|e| ApiError::solver(&p.source, e))?;
+    use flexstar_modal::settle::{dwells_with_hold, residual_with_hold, settle_hold_s};
+    let solver_error = |e| ApiError::solver(&p.source, e);
+    // the final pose's modes once, for the residual and the last dwell
+    let hold = settle_hold_s(&p.exp).map_err(solver_error)?;
+    let res = residual_with_hold(&p.exp, r, hold);
     let pinned = p.solver == Solver::Amm && p.exp.amm.family == ModeFamily::PinnedFree;
     let mut keys = flexstar_metrics::residual::sidecar_keys(res.as_ref(), p.exp.report.settle_tol, pinned);
     // per dwell (docs/motions.md 2.5): an addition, the keys above stay as they are
-    keys.dwells = flexstar_modal::settle::run_dwells(&p.exp, r, pinned).map_err(|e| ApiError::solver(&p.source, e))?;
+    keys.dwells = dwells_with_hold(&p.exp, r, pinned, hold).map_err(solver_error)?;
     Ok(Some(keys))
 }
 

@@ -19,7 +19,7 @@ fn paper_robot() -> Experiment {
 
 fn one_pose(c: &mut Criterion) {
     let exp = paper_robot();
-    let pose = pose_from_task(&exp.robot, 0.03, -0.02, 0.1).expect("feasible pose");
+    let pose = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), 0.03, -0.02, 0.1).expect("feasible pose");
     let model = PoseModel::new(&exp.robot, ModeFamily::Enriched, DEFAULT_MODAL_MODES).expect("mode set");
     let mut group = c.benchmark_group("amm_modes_one_pose");
     group.sample_size(20);

@@ -29,18 +29,21 @@ pub fn amm_basis(exp: &Experiment) -> (ModeFamily, usize) {
 }
 
 /// The AMM's model at a pose for an experiment: the basis of [`amm_basis`] and the experiment's
-/// payload at G (`docs/amm.md` 11.4).
+/// payload at G (`docs/amm.md` 11.4), of its robot as data (`PoseModel::of_robot`: each beam its
+/// own mode set and data on a robot as built, `docs/amm.md` 13; the paper's compact form on the
+/// paper's robot).
 pub fn amm_pose_model(exp: &Experiment) -> Result<flexstar_amm::pose_modes::PoseModel, ModalError> {
     let (family, nm) = amm_basis(exp);
-    Ok(flexstar_amm::pose_modes::PoseModel::with_payload(
-        &exp.robot,
+    Ok(flexstar_amm::pose_modes::PoseModel::of_robot_with_payload(
+        &crate::robot(exp)?,
         &exp.payload,
         family,
         nm,
     )?)
 }
 
-/// The FEM's modes at a pose for an experiment (`[fem] elements`, the payload at G).
+/// The FEM's modes at a pose for an experiment (`[fem] elements`, the payload at G), of its
+/// robot as data (`docs/fem.md` 10 on a robot as built).
 pub fn fem_pose_modes(
     exp: &Experiment,
     pose: &RestPose,
@@ -48,7 +51,7 @@ pub fn fem_pose_modes(
     k: usize,
 ) -> Result<flexstar_fem::pose_modes::PoseModes, ModalError> {
     Ok(flexstar_fem::pose_modes::pose_modes_with(
-        &exp.robot,
+        &crate::robot(exp)?,
         &exp.payload,
         pose,
         sliders,
@@ -157,8 +160,7 @@ pub fn final_pose_frequencies(exp: &Experiment, count: usize) -> Result<Option<V
     let Some(t_rest) = exp.trajectory.t_rest() else {
         return Ok(None);
     };
-    let s = exp.trajectory.s(&exp.robot, t_rest)?;
-    let pose = crate::pose::pose_from_sliders(&exp.robot, s)?;
+    let pose = crate::pose::pose_of_motion(exp, &crate::robot(exp)?, t_rest)?;
     let f = amm_pose_model(exp)?.frequencies_at(&pose, Sliders::Locked, count)?;
     Ok(Some(f))
 }

@@ -5,7 +5,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use flexstar_amm::pose_modes::PoseModel;
 use flexstar_io::output::fmt_number;
 use flexstar_io::run_set::RunSet;
-use flexstar_model::{Experiment, Sliders};
+use flexstar_model::{Experiment, Robot, Sliders};
 use rayon::prelude::*;
 
 use crate::pose::pose_from_task;
@@ -84,7 +84,8 @@ pub struct Grid {
 
 /// The first `k` elastic frequencies over the grid, in parallel (with free sliders the three
 /// rigid modes at 0 Hz are left out: f1 is the first elastic one); `progress(done, total)` is
-/// called from the worker threads. Infeasible poses are kept with the reason.
+/// called from the worker threads. Infeasible poses are kept with the reason. The experiment's
+/// robot may be one as built: its poses and modes are its own ([`crate::robot`]).
 pub fn freqmap<P>(
     exp: &Experiment,
     grid: &Grid,
@@ -99,6 +100,7 @@ where
     crate::check_k(k)?;
     check_grid(gx, gy)?;
     let total = gx.n * gy.n;
+    let robot = crate::robot(exp)?;
     // the AMM's pose-independent part (mode set, constraint machinery) once per map
     let amm = match solver {
         Solver::Amm => Some(crate::analysis::amm_pose_model(exp)?),
@@ -109,7 +111,7 @@ where
         .into_par_iter()
         .map(|idx| {
             let (x, y) = (gx.at(idx % gx.n), gy.at(idx / gx.n));
-            let result = point(exp, amm.as_ref(), (x, y, theta), grid.sliders, k);
+            let result = point(exp, &robot, amm.as_ref(), (x, y, theta), grid.sliders, k);
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             MapPoint {
                 gx: x,
@@ -123,15 +125,17 @@ where
 }
 
 /// The first `k` elastic frequencies at the pose `(gx, gy, theta)`: by the AMM when `amm` is
-/// given, else the FEM; the rigid modes of free sliders (0 Hz) left out.
+/// given, else the FEM; the rigid modes of free sliders (0 Hz) left out. `robot` is the
+/// experiment's.
 fn point(
     exp: &Experiment,
+    robot: &Robot,
     amm: Option<&PoseModel>,
     (gx, gy, theta): (f64, f64, f64),
     sliders: Sliders,
     k: usize,
 ) -> Result<Vec<f64>, String> {
-    let pose = pose_from_task(&exp.robot, gx, gy, theta).map_err(|e| e.to_string())?;
+    let pose = pose_from_task(robot, gx, gy, theta).map_err(|e| e.to_string())?;
     let f = match amm {
         // eigenvalues only (no shapes): a third of the cost of `modes_at`, equal to 1e-7
         Some(model) => model.frequencies_at(&pose, sliders, k).map_err(|e| e.to_string())?,

@@ -14,6 +14,10 @@
 //! The physics (mass, stiffness and constraints at a pose) lives in the solvers:
 //! `flexstar_amm::pose_modes` and `flexstar_fem::pose_modes`. SI units; frames as in
 //! `docs/conventions.md`.
+//!
+//! Every analysis reads the experiment's robot as data ([`robot`]: the paper's robot or one as
+//! built, `docs/as-built.md`; `docs/modes.md`, a robot as built): the rigid pose through the
+//! generic kinematics, each beam's own data in both solvers and in the linear model's outputs.
 
 pub mod analysis;
 pub mod error;
@@ -28,7 +32,12 @@ pub use error::ModalError;
 /// Largest number of modes K a command accepts.
 pub const MAX_K: usize = 50;
 
-/// Check K (`--modes`): 1 <= K <= [`MAX_K`].
+/// The experiment's robot as data (`Robot::from_params`): the paper's robot (whose solvers and
+/// kinematics then take their compact form, bit for bit) or one as built.
+pub fn robot(exp: &flexstar_model::Experiment) -> Result<flexstar_model::Robot, ModalError> {
+    Ok(flexstar_model::Robot::from_params(&exp.robot)?)
+}
+
 /// A damping whose `zeta` still waits for the first frequency (`Damping::pending`) would act as
 /// none: refused (resolve it first, `flexstar_shaping::shape`).
 pub fn check_damping(exp: &flexstar_model::Experiment) -> Result<(), ModalError> {
@@ -42,6 +51,7 @@ pub fn check_damping(exp: &flexstar_model::Experiment) -> Result<(), ModalError>
     Ok(())
 }
 
+/// Check K (`--modes`): 1 <= K <= [`MAX_K`].
 pub fn check_k(k: usize) -> Result<(), ModalError> {
     if k == 0 || k > MAX_K {
         return Err(ModalError::Input(format!(

@@ -32,13 +32,17 @@
 //! with a `[load]` section the inputs end with the load at G, `Fx`, `Fy` [N] and `Mz` [N m],
 //! `B_load = [0; Phi^T P_L]` (Eq. L4, `P_L` the junction rows of Eq. L1 at the pose), D gaining
 //! zero columns.
+//!
+//! A robot as built (`docs/modes.md`, a robot as built): the modes are its own (each beam's mode
+//! set and data, each slider's mass and rail), the rigid Jacobian is its generic kinematics, and
+//! the outputs take each beam's own length `L_i` and normal `e_wi` of its weld angle (Eq. M1).
 
 use std::path::Path;
 
-use flexstar_amm::pose_modes::{PoseModes, PoseSystem};
+use flexstar_amm::pose_modes::{PoseModel, PoseModes, PoseSystem};
 use flexstar_io::output::write_atomically;
 use flexstar_kinematics::RigidState;
-use flexstar_model::{DriveKind, Experiment, RestPose, Sliders};
+use flexstar_model::{DriveKind, Experiment, RestPose, Robot, RobotGeometry, Sliders};
 use num_dual::Dual2;
 use sprs::{CsMat, TriMat};
 
@@ -70,6 +74,9 @@ impl Holding {
     }
 
     /// The servo of an experiment, closed around free sliders; errors name the `[drive]` key.
+    /// The same gains on every slider: `kp`, `kd` as given, or from `bandwidth_hz` with the
+    /// slider mass, which must then be the same on the three sliders (a robot as built whose
+    /// sliders' masses differ is refused, naming `drive.bandwidth_hz`: give `kp` and `kd`).
     pub fn servo_of(exp: &Experiment) -> Result<Holding, ModalError> {
         if exp.drive.kind != DriveKind::Servo {
             return Err(ModalError::Input(format!(
@@ -77,7 +84,20 @@ impl Holding {
                 drive_kind_name(exp.drive.kind)
             )));
         }
-        let g = exp.drive.servo_gains(exp.robot.mpp_mpa)?;
+        let masses = crate::robot(exp)?.beams().map(|b| b.sleeve_mass);
+        let g = exp.drive.servo_gains(masses[0])?;
+        for m in &masses[1..] {
+            if exp.drive.servo_gains(*m)? != g {
+                return Err(flexstar_model::ModelError::invalid(
+                    "drive.bandwidth_hz",
+                    format!(
+                        "the gains from bandwidth_hz scale with the slider mass, and the sliders' masses differ \
+                         (robot.mpp_mpa = {masses:?} kg): the linear model's servo has one kp and kd, give them"
+                    ),
+                )
+                .into());
+            }
+        }
         Ok(Holding::Servo { kp: g.kp, kd: g.kd })
     }
 
@@ -161,12 +181,13 @@ pub struct StateSpace {
     pub damping_ratios: Vec<f64>,
 }
 
-/// Derivatives of the rigid star (G [m], theta [rad]) with respect to s_j at the pose.
-fn rigid_jacobian(exp: &Experiment, pose: &RestPose) -> Result<[[f64; 3]; 3], ModalError> {
+/// Derivatives of the rigid star (G [m], theta [rad]) with respect to s_j at the pose, of the
+/// robot's own rigid kinematics (`docs/as-built.md` 3 on a robot as built).
+fn rigid_jacobian(robot: &Robot, pose: &RestPose) -> Result<[[f64; 3]; 3], ModalError> {
     let mut jac = [[0.0; 3]; 3];
     for (j, _) in pose.s.iter().enumerate() {
         let s = [0, 1, 2].map(|i| Dual2::new(pose.s[i], if i == j { 1.0 } else { 0.0 }, 0.0));
-        let st = RigidState::from_actuators(&exp.robot, s, 0.0).map_err(|e| ModalError::Infeasible(e.to_string()))?;
+        let st = RigidState::from_actuators(robot, s, 0.0).map_err(|e| ModalError::Infeasible(e.to_string()))?;
         jac[0][j] = st.g[0].d1;
         jac[1][j] = st.g[1].d1;
         jac[2][j] = st.theta.d1;
@@ -187,22 +208,23 @@ fn dense_to_cs(rows: usize, cols: usize, f: impl Fn(usize, usize) -> f64) -> CsM
     t.to_csr()
 }
 
-/// Rows `h` (on the AMM coordinates, `h . q`) of the tip deflections `w_i(L)` then of `w_iG`,
-/// relative to the rigid star: with free sliders the rigid part the slider displacements carry
-/// (the rigid kinematics' Jacobian, projected on `e_wi`, lever L at the tip) is removed; with
-/// locked sliders the rigid star does not move.
-fn deflection_rows(exp: &Experiment, pose: &RestPose, sys: &PoseSystem) -> Result<Vec<Vec<f64>>, ModalError> {
+/// Rows `h` (on the AMM coordinates, `h . q`) of the tip deflections `w_i(L_i)` then of `w_iG`,
+/// relative to the rigid star (Eq. M1 of `docs/modes.md`): with free sliders the rigid part the
+/// slider displacements carry (the rigid kinematics' Jacobian, projected on beam i's own `e_wi`,
+/// lever `L_i` at the tip) is removed; with locked sliders the rigid star does not move.
+fn deflection_rows(robot: &Robot, pose: &RestPose, sys: &PoseSystem) -> Result<Vec<Vec<f64>>, ModalError> {
     let jac = match sys.sliders {
-        Sliders::Free => Some(rigid_jacobian(exp, pose)?),
+        Sliders::Free => Some(rigid_jacobian(robot, pose)?),
         Sliders::Locked => None,
     };
-    let l = exp.robot.l;
     let mut h = Vec::with_capacity(6);
-    for (x, lever) in [(l, l), (0.0, 0.0)] {
+    for at_tip in [true, false] {
         for i in 0..3 {
+            let x = if at_tip { robot.beams()[i].length } else { 0.0 };
+            let lever = x;
             let mut row = sys.deflection_row(i, x);
             if let Some(jac) = &jac {
-                let ew = flexstar_model::geometry::e_w(i, pose.theta);
+                let ew = robot.e_w(i, pose.theta);
                 for (j, ((jx, jy), jt)) in jac[0].iter().zip(&jac[1]).zip(&jac[2]).enumerate() {
                     if let Some(s_j) = sys.slider_index(j) {
                         row[s_j] -= jx * ew[0] + jy * ew[1] + lever * jt;
@@ -246,8 +268,8 @@ fn inverse3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
 /// Locked sliders' base excitation: the columns `M R_j` (on the locked coordinates), where
 /// `R_j = dq/ds_j` is the rigid motion of the star when slider j moves, from the three rigid
 /// modes of the sliders-free system (their beam part times the inverse of their slider part).
-fn base_excitation(exp: &Experiment, pose: &RestPose, locked: &PoseSystem) -> Result<Vec<[f64; 3]>, ModalError> {
-    let free = crate::analysis::amm_pose_model(exp)?.modes_at(pose, Sliders::Free, 1)?;
+fn base_excitation(model: &PoseModel, pose: &RestPose, locked: &PoseSystem) -> Result<Vec<[f64; 3]>, ModalError> {
+    let free = model.modes_at(pose, Sliders::Free, 1)?;
     let rigid = &free.shapes[..free.rigid];
     let mut s = [[0.0; 3]; 3];
     for (i, row) in s.iter_mut().enumerate() {
@@ -269,9 +291,14 @@ fn base_excitation(exp: &Experiment, pose: &RestPose, locked: &PoseSystem) -> Re
 }
 
 /// The AMM's modes at the pose for `settings` (K checked, enough modes in the basis).
-fn amm_modes(exp: &Experiment, pose: &RestPose, settings: &LinearSettings) -> Result<PoseModes, ModalError> {
+fn amm_modes(
+    exp: &Experiment,
+    model: &PoseModel,
+    pose: &RestPose,
+    settings: &LinearSettings,
+) -> Result<PoseModes, ModalError> {
     crate::check_k(settings.modes)?;
-    let modes = crate::analysis::amm_pose_model(exp)?.modes_at(pose, settings.holding.sliders(), settings.modes)?;
+    let modes = model.modes_at(pose, settings.holding.sliders(), settings.modes)?;
     if modes.shapes.len() < modes.rigid + settings.modes {
         return Err(ModalError::Input(format!(
             "--modes {}: the AMM with N = {} modes per beam has only {} modes",
@@ -333,17 +360,20 @@ pub fn linearize(exp: &Experiment, pose: &RestPose) -> Result<StateSpace, ModalE
 }
 
 /// The linear model about `pose` with K elastic modes and the sliders held as `settings` says
-/// (module docs: states, inputs and outputs of each case).
+/// (module docs: states, inputs and outputs of each case), of the experiment's robot (the paper's
+/// or one as built, [`crate::robot`]).
 pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettings) -> Result<StateSpace, ModalError> {
     crate::check_damping(exp)?;
-    let modes = amm_modes(exp, pose, settings)?;
+    let robot = crate::robot(exp)?;
+    let model = crate::analysis::amm_pose_model(exp)?;
+    let modes = amm_modes(exp, &model, pose, settings)?;
     let phi = &modes.shapes;
-    let deflections: Vec<Vec<f64>> = deflection_rows(exp, pose, &modes.system)?
+    let deflections: Vec<Vec<f64>> = deflection_rows(&robot, pose, &modes.system)?
         .iter()
         .map(|r| phi.iter().map(|p| dot(r, p)).collect())
         .collect();
     let (mut blocks, mut inputs, outputs) = match settings.holding {
-        Holding::Locked => locked_model(exp, pose, &modes, deflections)?,
+        Holding::Locked => locked_model(&model, pose, &modes, deflections)?,
         Holding::Free => free_model(&modes, deflections),
         Holding::Servo { kp, kd } => servo_model(&modes, deflections, kp, kd),
     };
@@ -426,13 +456,13 @@ fn zeros(rows: usize, cols: usize) -> Vec<Vec<f64>> {
 
 /// Locked sliders: inputs the slider accelerations, `B = -Phi^T M R` (module docs).
 fn locked_model(
-    exp: &Experiment,
+    model: &PoseModel,
     pose: &RestPose,
     modes: &PoseModes,
     deflections: Vec<Vec<f64>>,
 ) -> Result<Model, ModalError> {
     let sys = &modes.system;
-    let mr = base_excitation(exp, pose, sys)?;
+    let mr = base_excitation(model, pose, sys)?;
     let bm = modes
         .shapes
         .iter()
@@ -623,17 +653,19 @@ fn damping_json(exp: &Experiment) -> serde_json::Value {
 /// Write `dir/linear/`: A, B, C, D, statespace.json, the FEM's M, K, Phi_q at the pose (sliders
 /// held as the model's) and `fem-coordinates.csv` (what their rows are). Everything is computed
 /// before the first file is written, and the files are published as one set
-/// ([`flexstar_io::run_set::RunSet`]).
+/// ([`flexstar_io::run_set::RunSet`]). The FEM's are of the experiment's robot (each sleeve's
+/// own length in `fem-coordinates.csv` on a robot as built).
 pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(), ModalError> {
     let sliders = ss.settings.holding.sliders();
-    let fem =
-        flexstar_fem::pose_modes::pose_system_with(&exp.robot, &exp.payload, &ss.pose, sliders, exp.fem.elements)?;
+    let robot = crate::robot(exp)?;
+    let fem = flexstar_fem::pose_modes::pose_system_with(&robot, &exp.payload, &ss.pose, sliders, exp.fem.elements)?;
     let (fm, fk, fc) = (
         dense(fem.n, fem.n, &fem.m),
         dense(fem.n, fem.n, &fem.k),
         dense(fem.rows, fem.n, &fem.c),
     );
-    let coordinates = fem_coordinates_csv(&fem.coordinates(ss.pose.xp, exp.robot.lp));
+    let lp = robot.beams().map(|b| b.sleeve_length);
+    let coordinates = fem_coordinates_csv(&fem.coordinates_of(ss.pose.xp, lp));
     let json = statespace_json(exp, ss, &fem);
     // the seven matrices, the coordinates and the JSON are published together (a run set, `docs/outputs.md`)
     let mut set = flexstar_io::run_set::RunSet::begin(&dir.join("linear"))?;

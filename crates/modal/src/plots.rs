@@ -2,7 +2,6 @@
 //! `flexstar-plot`): the first mode shapes at a pose (AMM over FEM over the rigid
 //! star) and the heat map of a frequency map with the workspace boundary and the experiment's path.
 
-use flexstar_model::geometry::{e_w, e_x};
 use flexstar_model::RestPose;
 use flexstar_plot::{
     axis_ticks, colormap, draw_legend, Drawing, Figure, GridFigure, Panel, Series, Style, FEM_STYLE, RIGID_STYLE,
@@ -27,13 +26,14 @@ pub const SHAPE_AMPLITUDE: f64 = 0.12;
 pub const SHAPES_SHOWN: usize = 6;
 
 /// Deflections of one mode along the three beams at `x[k]` [m]: AMM (evaluated at the FEM's
-/// nodes) and FEM, both along `e_wi` of the pose, per unit modal coordinate (mass-normalised).
+/// nodes, `k h_i` on beam i) and FEM, both along `e_wi` of the pose, per unit modal coordinate
+/// (mass-normalised).
 fn sampled(modal: &Modal, j: usize) -> ([Vec<f64>; 3], [Vec<f64>; 3]) {
     let (a, f) = (&modal.amm.system, &modal.fem.system);
     let fem = [0, 1, 2].map(|i| f.deflections(&modal.fem.shapes[j], i));
     let amm = [0, 1, 2].map(|i| {
         (0..=f.ne)
-            .map(|k| a.deflection(&modal.amm.shapes[j], i, k as f64 * f.h))
+            .map(|k| a.deflection(&modal.amm.shapes[j], i, k as f64 * f.element_lengths[i]))
             .collect()
     });
     (amm, fem)
@@ -83,11 +83,42 @@ fn matched_fem(modal: &Modal, j: usize, samples: &[(Vec<f64>, Vec<f64>)]) -> Vec
     }
 }
 
-/// The star drawn at `pose` with deflections `w[i][k]` at `x_k = k h` magnified by `scale`.
-fn star_series(pose: &RestPose, h: f64, w: &[Vec<f64>], scale: f64, label: &str, style: Style) -> Vec<Series> {
+/// Where the beams of a drawn star lie: each beam's element length `h_i` [m] and weld angle
+/// `phi_i` [rad] (the FEM's pose system: the paper's 0, 120, 240 degrees and equal h on the
+/// paper's robot).
+struct BeamLines {
+    h: [f64; 3],
+    weld: [f64; 3],
+}
+
+impl BeamLines {
+    fn of(fem: &flexstar_fem::pose_modes::SparsePoseSystem) -> Self {
+        BeamLines {
+            h: fem.element_lengths,
+            weld: fem.weld,
+        }
+    }
+
+    /// `e_xi` and `e_wi` of beam i at orientation `theta` (Eqs. 11-12, W1).
+    fn frame(&self, i: usize, theta: f64) -> ([f64; 2], [f64; 2]) {
+        let a = theta + self.weld[i];
+        ([a.sin(), -a.cos()], [a.cos(), a.sin()])
+    }
+}
+
+/// The star drawn at `pose` with deflections `w[i][k]` at `x_k = k h_i` magnified by `scale`.
+fn star_series(
+    pose: &RestPose,
+    beams: &BeamLines,
+    w: &[Vec<f64>],
+    scale: f64,
+    label: &str,
+    style: Style,
+) -> Vec<Series> {
     (0..3)
         .map(|i| {
-            let (ex, ew) = (e_x(i, pose.theta), e_w(i, pose.theta));
+            let (ex, ew) = beams.frame(i, pose.theta);
+            let h = beams.h[i];
             let (x, y) = w[i]
                 .iter()
                 .enumerate()
@@ -112,6 +143,8 @@ fn star_series(pose: &RestPose, h: f64, w: &[Vec<f64>], scale: f64, label: &str,
 /// The first [`SHAPES_SHOWN`] elastic mode shapes at `pose`: the AMM's (orange) and the FEM's
 /// (black) star over the rigid one (grey dashed), drawn with the same magnification (the AMM
 /// shape's largest deflection = [`SHAPE_AMPLITUDE`] L), so that both normalisations show.
+/// Each beam is drawn along its own weld angle with its own length (the FEM's mesh of a robot
+/// as built); `l` [m] sets the magnification (the longest beam).
 pub fn mode_shapes_figure(name: &str, modal: &Modal, pose: &RestPose, l: f64) -> GridFigure {
     let first = modal.amm.rigid;
     let last = (first + SHAPES_SHOWN)
@@ -123,7 +156,7 @@ pub fn mode_shapes_figure(name: &str, modal: &Modal, pose: &RestPose, l: f64) ->
             (flat(&a), flat(&f))
         })
         .collect();
-    let h = modal.fem.system.h;
+    let beams = BeamLines::of(&modal.fem.system);
     let per_beam = |v: &[f64]| -> Vec<Vec<f64>> { v.chunks(v.len() / 3).map(|c| c.to_vec()).collect() };
     let rigid: Vec<Vec<f64>> = vec![vec![0.0; modal.fem.system.ne + 1]; 3];
     let panels = (first..last)
@@ -132,9 +165,9 @@ pub fn mode_shapes_figure(name: &str, modal: &Modal, pose: &RestPose, l: f64) ->
             let fem = matched_fem(modal, j, &samples);
             let peak = amm.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
             let scale = if peak > 0.0 { SHAPE_AMPLITUDE * l / peak } else { 1.0 };
-            let mut series = star_series(pose, h, &rigid, 0.0, "rigid star", RIGID_STYLE);
-            series.extend(star_series(pose, h, &per_beam(&fem), scale, "FEM", FEM_STYLE));
-            series.extend(star_series(pose, h, &per_beam(amm), scale, "AMM", AMM_STYLE));
+            let mut series = star_series(pose, &beams, &rigid, 0.0, "rigid star", RIGID_STYLE);
+            series.extend(star_series(pose, &beams, &per_beam(&fem), scale, "FEM", FEM_STYLE));
+            series.extend(star_series(pose, &beams, &per_beam(amm), scale, "AMM", AMM_STYLE));
             Panel {
                 title: format!(
                     "mode {}: AMM {:.3} Hz, FEM {:.3} Hz",
@@ -199,7 +232,7 @@ pub fn trajectory_path(exp: &flexstar_model::Experiment, map_theta: f64) -> Opti
     if exp.drive.kind == flexstar_model::DriveKind::Forces {
         return None;
     }
-    let states = flexstar_kinematics::table::kinematics_table(exp).ok()?;
+    let states = rigid_path(exp)?;
     let what = if exp.drive.kind == flexstar_model::DriveKind::Servo {
         "reference G(t)"
     } else {
@@ -233,6 +266,19 @@ pub fn trajectory_path(exp: &flexstar_model::Experiment, map_theta: f64) -> Opti
             dashed: false,
         },
     })
+}
+
+/// The rigid states of the experiment's robot (the paper's or one as built, [`crate::robot`]) at
+/// its output times; `None` when its motion leaves the feasible range.
+fn rigid_path(exp: &flexstar_model::Experiment) -> Option<Vec<flexstar_kinematics::RigidState>> {
+    use flexstar_kinematics::{feasibility::check_trajectory, RigidState};
+    let robot = crate::robot(exp).ok()?;
+    check_trajectory(&robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out).ok()?;
+    let times = exp.time.output_times();
+    times
+        .into_iter()
+        .map(|t| RigidState::at(&robot, &exp.trajectory, t).ok())
+        .collect()
 }
 
 /// The heat map of the first `shown` frequencies of a map (one panel each, own colour scale),

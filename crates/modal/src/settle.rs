@@ -33,10 +33,15 @@ pub fn settle_hold_s(exp: &Experiment) -> Result<Option<f64>, ModalError> {
 /// The residual of `r`, a run of `exp`, after the motion's end, in the band `[report]
 /// settle_tol`; `None` when the motion does not rest before `t_end`.
 pub fn run_residual(exp: &Experiment, r: &Response) -> Result<Option<Residual>, ModalError> {
-    let (Some(t_rest), Some(hold)) = (motion_end(exp), settle_hold_s(exp)?) else {
-        return Ok(None);
+    Ok(residual_with_hold(exp, r, settle_hold_s(exp)?))
+}
+
+/// [`run_residual`] with the settling hold `hold` [s] of [`settle_hold_s`] already computed.
+pub fn residual_with_hold(exp: &Experiment, r: &Response, hold: Option<f64>) -> Option<Residual> {
+    let (Some(t_rest), Some(hold)) = (motion_end(exp), hold) else {
+        return None;
     };
-    Ok(residual_after(r, t_rest, exp.report.settle_tol, hold))
+    residual_after(r, t_rest, exp.report.settle_tol, hold)
 }
 
 /// The residual of `r`, a run of `exp`, per dwell (`docs/motions.md` 2.5), in the band
@@ -50,6 +55,19 @@ pub fn run_dwells(
     r: &Response,
     g_pinned: bool,
 ) -> Result<Option<Vec<flexstar_model::DwellKeys>>, ModalError> {
+    dwells_with_hold(exp, r, g_pinned, settle_hold_s(exp)?)
+}
+
+/// [`run_dwells`] with the final pose's hold `final_hold` [s] of [`settle_hold_s`] already
+/// computed: a dwell held by the sliders of the final rest (to the bit) takes it instead of
+/// solving the final pose's modes again. The experiment's robot may be one as built (its own
+/// poses and modes, [`crate::robot`]).
+pub fn dwells_with_hold(
+    exp: &Experiment,
+    r: &Response,
+    g_pinned: bool,
+    final_hold: Option<f64>,
+) -> Result<Option<Vec<flexstar_model::DwellKeys>>, ModalError> {
     use flexstar_metrics::dwell::{dwell_residual, dwell_windows, moves, Baseline};
     let moves: Vec<(f64, f64)> = moves(&exp.trajectory)
         .into_iter()
@@ -62,24 +80,18 @@ pub fn run_dwells(
     if windows.is_empty() {
         return Ok(None);
     }
+    let robot = crate::robot(exp)?;
     let model = crate::analysis::amm_pose_model(exp)?;
     let s_rest = match exp.trajectory.t_rest() {
-        Some(t) => Some(exp.trajectory.s(&exp.robot, t)?),
+        Some(t) => Some(exp.trajectory.s(&robot, t)?),
         None => None,
     };
     let mut out = Vec::with_capacity(windows.len());
     for w in &windows {
-        let s = exp.trajectory.s(&exp.robot, w.move_end)?;
-        let pose = crate::pose::pose_from_sliders(&exp.robot, s)?;
-        let f = model.frequencies_at(&pose, flexstar_model::Sliders::Locked, 1)?;
-        let hold = match f.first() {
-            Some(&f1) if f1 > 0.0 => 1.0 / f1,
-            _ => {
-                return Err(ModalError::Input(format!(
-                    "no elastic mode at the pose of dwell {} (t = {} s) to time the settling by",
-                    w.dwell, w.move_end
-                )))
-            }
+        let s = exp.trajectory.s(&robot, w.move_end)?;
+        let hold = match final_hold.filter(|_| s_rest == Some(s)) {
+            Some(hold) => hold,
+            None => dwell_hold(&model, &robot, s, w)?,
         };
         // the sag is known at the final pose only (as-built.md 5.5)
         let at_rest_pose = s_rest.is_some_and(|sr| (0..3).all(|i| (s[i] - sr[i]).abs() <= 1e-12));
@@ -91,4 +103,23 @@ pub fn run_dwells(
         out.push(dwell_residual(r, w, exp.report.settle_tol, hold, baseline, g_pinned));
     }
     Ok(Some(out))
+}
+
+/// One period [s] of the first elastic mode at the pose the sliders `s` [m] hold during dwell
+/// `w` (sliders locked, the AMM's `model`).
+fn dwell_hold(
+    model: &flexstar_amm::pose_modes::PoseModel,
+    robot: &flexstar_model::Robot,
+    s: [f64; 3],
+    w: &flexstar_metrics::dwell::DwellWindow,
+) -> Result<f64, ModalError> {
+    let pose = crate::pose::pose_from_sliders(robot, s)?;
+    let f = model.frequencies_at(&pose, flexstar_model::Sliders::Locked, 1)?;
+    match f.first() {
+        Some(&f1) if f1 > 0.0 => Ok(1.0 / f1),
+        _ => Err(ModalError::Input(format!(
+            "no elastic mode at the pose of dwell {} (t = {} s) to time the settling by",
+            w.dwell, w.move_end
+        ))),
+    }
 }

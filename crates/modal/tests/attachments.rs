@@ -38,7 +38,7 @@ fn supported_payload_frequencies(exp: &Experiment, m: f64, j: f64) -> (f64, f64)
 /// FEM +7e-6 and +8e-6.
 #[test]
 fn heavy_payload_frequencies_match_the_elastic_supports() {
-    let pose = pose_from_task(&paper().robot, 0.0, 0.0, 0.0).unwrap();
+    let pose = pose_from_task(&flexstar_modal::robot(&paper()).unwrap(), 0.0, 0.0, 0.0).unwrap();
     for (m, j) in [(100.0, 0.0), (0.0, 1.0)] {
         let mut exp = paper();
         exp.payload = Payload {
@@ -79,7 +79,7 @@ fn an_offset_payload_moves_both_models_alike() {
         j: 2e-3,
         offset: [0.04, -0.03],
     };
-    let pose = pose_from_task(&exp.robot, 0.03, -0.02, 0.1).unwrap();
+    let pose = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), 0.03, -0.02, 0.1).unwrap();
     let both = modal(&exp, &pose, Sliders::Locked, 4).unwrap();
     let bare = modal(&paper(), &pose, Sliders::Locked, 4).unwrap();
     for ((_, a, f, rel), (_, a0, _, _)) in both.rows().into_iter().zip(bare.rows()) {
@@ -102,7 +102,7 @@ fn damped_poles_leave_the_imaginary_axis_by_zeta_omega() {
         ..Damping::default()
     };
     let beta = exp.damping.beta();
-    let pose = pose_from_task(&exp.robot, 0.03, -0.02, 0.1).unwrap();
+    let pose = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), 0.03, -0.02, 0.1).unwrap();
     let settings = LinearSettings {
         modes: 8,
         holding: Holding::Free,
@@ -151,7 +151,7 @@ fn rayleigh_poles_follow_the_two_ratio_law() {
     };
     let (alpha, beta) = exp.damping.coefficients();
     assert!(alpha > 0.0 && beta > 0.0);
-    let pose = pose_from_task(&exp.robot, 0.03, -0.02, 0.1).unwrap();
+    let pose = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), 0.03, -0.02, 0.1).unwrap();
     let two_pi = 2.0 * std::f64::consts::PI;
     let eigen = |holding| {
         let ss = linearize_with(&exp, &pose, &LinearSettings { modes: 8, holding }).unwrap();
@@ -190,7 +190,7 @@ fn load_channel_static_gain_matches_the_fem_static_deflection() {
     use faer::linalg::solvers::Solve;
     let mut exp = paper();
     exp.load = LoadSettings::polynomials(Some(vec![0.0]), None, None);
-    let pose = pose_from_task(&exp.robot, 0.03, -0.02, 0.1).unwrap();
+    let pose = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), 0.03, -0.02, 0.1).unwrap();
     let settings = LinearSettings {
         modes: 40,
         holding: Holding::Locked,

@@ -148,7 +148,8 @@ fn stiff_sleeve_limit_is_the_clamped_pinned_free_beam() {
 #[test]
 fn no_drift_or_spurious_mode_up_to_n_200() {
     let p = RobotParams::paper();
-    let pose = flexstar_modal::pose::pose_from_task(&p, -0.175, 0.0, 0.0).unwrap();
+    let pose = flexstar_modal::pose::pose_from_task(&flexstar_model::Robot::from_params(&p).unwrap(), -0.175, 0.0, 0.0)
+        .unwrap();
     for sliders in [Sliders::Locked, Sliders::Free] {
         let run = |n| flexstar_amm::pose_modes::pose_modes(&p, &pose, sliders, ModeFamily::Enriched, n, 6).unwrap();
         let (a, b, c) = (run(60), run(120), run(200));

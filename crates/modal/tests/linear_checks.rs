@@ -6,6 +6,9 @@
 #[allow(dead_code)]
 mod rigid_forward;
 
+#[path = "support/inertia_relief.rs"]
+mod inertia_relief;
+
 use flexstar_modal::linear::{linearize, StateSpace, ELASTIC_MODES};
 use flexstar_modal::pose::pose_from_task;
 use flexstar_model::{Experiment, Sliders};
@@ -22,7 +25,7 @@ fn to_faer(m: &sprs::CsMat<f64>) -> faer::Mat<f64> {
 
 /// An off-centre turned pose (all three sliders and xp distinct, no symmetry to hide an error).
 fn linear_model(exp: &Experiment) -> StateSpace {
-    let pose = pose_from_task(&exp.robot, 0.03, -0.02, 0.1).unwrap();
+    let pose = pose_from_task(&flexstar_modal::robot(exp).unwrap(), 0.03, -0.02, 0.1).unwrap();
     linearize(exp, &pose).unwrap()
 }
 
@@ -207,92 +210,15 @@ fn pulse_response_matches_the_nonlinear_direct_run() {
     }
 }
 
-/// C's tip and G rows against the FEM's static deflection. With free sliders a constant force
-/// accelerates the robot, so the static problem is the inertia-relief one: the elastic
-/// deflection u under `f - M Phi_r Phi_r^T f` (the load less the inertia of the rigid
-/// acceleration it causes), `Phi_q u = 0`, u M-orthogonal to the rigid modes. Its value in the
-/// outputs is the DC gain of the elastic part of the transfer, `sum_{j elastic} C_j B_j /
-/// omega_j^2` from the linear model's C, B and A. Reference: the FEM (150 elements) solved
-/// directly as one dense saddle-point system (faer LU), with its own rigid modes and the outputs
-/// measured as in the model (node displacement along e_wi less the rigid star held by the
-/// sliders' displacement, rigid Jacobian by dual numbers).
+/// C's tip and G rows against the FEM's static deflection: the elastic DC gain of the linear
+/// model, `sum_{j elastic} C_j B_j / omega_j^2`, against the FEM's inertia-relief deflection
+/// (tests/support/inertia_relief.rs: 150 elements, one dense saddle-point system, the outputs
+/// measured as in the model).
 #[test]
 fn elastic_static_gain_matches_the_fem_inertia_relief_deflection() {
-    use faer::linalg::solvers::Solve;
     let exp = paper();
     let ss = linear_model(&exp);
-    let (a, b, c) = (ss.a.to_dense(), ss.b.to_dense(), ss.c.to_dense());
-    let nr = ss.a.rows() / 2;
-    // linear model: elastic DC gain (rows 3..9: tips, G)
-    let gain = |r: usize, k: usize| -> f64 { (3..nr).map(|j| c[[r, j]] * b[[nr + j, k]] / -a[[nr + j, j]]).sum() };
-    // FEM
-    let fem = flexstar_fem::pose_modes::pose_modes(&exp.robot, &ss.pose, Sliders::Free, 150, 1).unwrap();
-    let sys = fem.system.to_dense();
-    let (n, rows) = (sys.n, sys.rows);
-    let mphi: Vec<Vec<f64>> = fem.shapes[..3]
-        .iter()
-        .map(|x| (0..n).map(|i| (0..n).map(|j| sys.m[i * n + j] * x[j]).sum()).collect())
-        .collect();
-    let size = n + rows + 3;
-    let mut kkt = faer::Mat::<f64>::zeros(size, size);
-    for i in 0..n {
-        for j in 0..n {
-            kkt[(i, j)] = sys.k[i * n + j];
-        }
-    }
-    for r in 0..rows {
-        for j in 0..n {
-            kkt[(n + r, j)] = sys.c[r * n + j];
-            kkt[(j, n + r)] = sys.c[r * n + j];
-        }
-    }
-    for (q, mp) in mphi.iter().enumerate() {
-        for j in 0..n {
-            kkt[(n + rows + q, j)] = mp[j];
-            kkt[(j, n + rows + q)] = mp[j];
-        }
-    }
-    let lu = kkt.partial_piv_lu();
-    // rigid Jacobian dG/ds, dtheta/ds at the pose (dual numbers), for the outputs
-    let jac: Vec<[f64; 3]> = (0..3)
-        .map(|k| {
-            let s = [0, 1, 2].map(|i| num_dual::Dual2::new(ss.pose.s[i], if i == k { 1.0 } else { 0.0 }, 0.0));
-            let st = flexstar_kinematics::RigidState::from_actuators(&exp.robot, s, 0.0).unwrap();
-            [st.g[0].d1, st.g[1].d1, st.theta.d1]
-        })
-        .collect();
-    let l = exp.robot.l;
-    let mut worst = 0.0f64;
-    let mut scale = 0.0f64;
-    for k in 0..3 {
-        let sk = sys.slider_index(k).unwrap();
-        let mut f = vec![0.0; n];
-        f[sk] = 1.0;
-        let mut rhs = faer::Mat::<f64>::zeros(size, 1);
-        for i in 0..n {
-            let relief: f64 = (0..3).map(|q| mphi[q][i] * fem.shapes[q][sk]).sum();
-            rhs[(i, 0)] = f[i] - relief;
-        }
-        lu.solve_in_place(rhs.as_mut());
-        let u: Vec<f64> = (0..n).map(|i| rhs[(i, 0)]).collect();
-        let ds: Vec<f64> = (0..3).map(|j| u[sys.slider_index(j).unwrap()]).collect();
-        for i in 0..3 {
-            let ew = flexstar_model::geometry::e_w(i, ss.pose.theta);
-            let rigid = |lever: f64| -> f64 {
-                (0..3)
-                    .map(|j| ds[j] * (jac[j][0] * ew[0] + jac[j][1] * ew[1] + lever * jac[j][2]))
-                    .sum()
-            };
-            let tip = sys.deflections(&u, i)[sys.ne] - rigid(l);
-            let g = sys.deflections(&u, i)[0] - rigid(0.0);
-            for (row, fem_v) in [(3 + i, tip), (6 + i, g)] {
-                let lin = gain(row, k);
-                eprintln!("Fa{} -> output {row}: linear {lin:.6e} m/N, FEM {fem_v:.6e} m/N", k + 1);
-                worst = worst.max((lin - fem_v).abs());
-                scale = scale.max(fem_v.abs());
-            }
-        }
-    }
+    let (worst, scale) = inertia_relief::elastic_static_gain_error(&flexstar_modal::robot(&exp).unwrap(), &ss);
     assert!(scale > 0.0);
     // measured: 0.11 % of the largest gain (2.7e-3 m/N); entry by entry 0.4 % at most
     assert!(

@@ -21,7 +21,7 @@ fn paper() -> Experiment {
 }
 
 fn pose(exp: &Experiment) -> RestPose {
-    pose_from_task(&exp.robot, 0.03, -0.02, 0.1).unwrap()
+    pose_from_task(&flexstar_modal::robot(exp).unwrap(), 0.03, -0.02, 0.1).unwrap()
 }
 
 fn to_faer(m: &sprs::CsMat<f64>) -> faer::Mat<f64> {

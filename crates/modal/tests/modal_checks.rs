@@ -47,7 +47,7 @@ fn margins(exp: &Experiment, pose: &flexstar_model::RestPose) -> Vec<(f64, Strin
 #[test]
 fn amm_and_fem_agree_within_one_percent() {
     let exp = paper();
-    let edge = pose_from_task(&exp.robot, -0.175, 0.0, 0.0).unwrap();
+    let edge = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), -0.175, 0.0, 0.0).unwrap();
     let m = margins(&exp, &edge);
     // nearest limits: the Fermat angle (108.7 deg, 11.3 deg from 120) and sleeve 3 (13.4 mm)
     assert_eq!(m[0].1, "Fermat angle of IJK", "{m:?}");
@@ -56,7 +56,7 @@ fn amm_and_fem_agree_within_one_percent() {
     assert!(m[1].0 > 0.0 && m[1].0 < 0.015, "{m:?}");
     assert!(m[1].0 / (exp.robot.l - exp.robot.lp) < 0.03, "{m:?}");
     for (gx, gy, th) in [(0.0, 0.0, 0.0), (0.03, -0.02, 0.1), (-0.175, 0.0, 0.0)] {
-        let pose = pose_from_task(&exp.robot, gx, gy, th).unwrap();
+        let pose = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), gx, gy, th).unwrap();
         let m = flexstar_modal::analysis::modal(&exp, &pose, Sliders::Locked, 6).unwrap();
         for (mode, a, f, rel) in m.rows() {
             assert!(
@@ -83,9 +83,13 @@ fn matrix_market_round_trip_is_identical() {
 #[test]
 fn bad_input_is_refused_with_the_reason() {
     let exp = paper();
-    let e = pose_from_task(&exp.robot, 0.0, 0.0, 1.2).unwrap_err().to_string();
+    let e = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), 0.0, 0.0, 1.2)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("outside the workspace"), "{e}");
-    let e = pose_from_task(&exp.robot, 0.3, 0.0, 0.0).unwrap_err().to_string();
+    let e = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), 0.3, 0.0, 0.0)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("limit") || e.contains("Fermat") || e.contains("points away"),
         "{e}"

@@ -11,6 +11,9 @@
 //! The same step first resolves the other value that needs the robot's modes: a `[damping] zeta`
 //! given without `f_hz` holds at the first elastic frequency at the start pose
 //! ([`resolve_damping`], `docs/usage.md`, damping), which the automatic shaper then designs with.
+//!
+//! Both read the experiment's robot, the paper's or one as built: its own modes at its own start
+//! and final poses (`flexstar_modal`, `docs/modes.md`, a robot as built).
 
 mod auto;
 
@@ -25,8 +28,6 @@ pub fn shape(exp: &mut Experiment) -> Result<(), ModelError> {
     if !exp.shaper_pending() {
         return exp.apply_shaper();
     }
-    exp.paper_robot("an \"auto\" shaper")
-        .map_err(|e| ModelError::invalid("shaper.f_hz", e.to_string()))?;
     let choice = auto::resolve_auto(exp).map_err(|e| ModelError::invalid("shaper.f_hz", format!("\"auto\": {e}")))?;
     exp.apply_auto_shaper(choice)?;
     // the shaped motion rests later: `time.t_end` must still cover it (as for given frequencies)
@@ -45,9 +46,6 @@ pub fn resolve_damping(exp: &mut Experiment) -> Result<(), ModelError> {
     if n == 0 {
         return Ok(());
     }
-    // the start pose's frequencies come from flexstar_modal, on the paper's form only so far
-    exp.paper_robot("a damping ratio without f_hz")
-        .map_err(|e| ModelError::invalid("damping.zeta", e.to_string()))?;
     let key = if exp.damping.zeta.is_some() {
         "damping.zeta"
     } else {

@@ -8,12 +8,12 @@
 mod common;
 
 use flexstar_drive::{ForceTable, SolveRequest};
-use flexstar_model::{DriveKind, Feedforward, Pose, Trajectory};
 use flexstar_kinematics::RigidState;
 use flexstar_model::catalogue::{quintic_from_origin, GENERAL_TARGET};
 use flexstar_model::{
     ActuatorAxis, AmmSettings, Beam, Experiment, Gravity, ModeFamily, Problem, Response, Robot, RobotParams,
 };
+use flexstar_model::{DriveKind, Feedforward, Pose, Trajectory};
 
 /// Three different beams (every datum differs), welds 0, 117, 243.5 degrees, the base from the
 /// sides 0.626, 0.618, 0.631 m; each beam's E times `stiff`.
@@ -327,7 +327,10 @@ fn a_servo_tracks_its_reference_on_a_robot_as_built() {
          {lag:.3e} m; the paper's robot {paper_peak:.3e} m, at the end {paper_end:.3e} m"
     );
     assert!(peak < 0.25 * lag, "{peak} m against {lag} m");
-    assert!(peak < 2.0 * paper_peak && end < 2.0 * paper_end.max(1e-6), "{peak}, {end} m");
+    assert!(
+        peak < 2.0 * paper_peak && end < 2.0 * paper_end.max(1e-6),
+        "{peak}, {end} m"
+    );
     assert!(end < 0.1 * peak, "settles: {end} of {peak} m");
 }
 

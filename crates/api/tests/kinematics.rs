@@ -75,5 +75,8 @@ fn kinematics_of_a_robot_as_built_writes_its_table() {
     eprintln!("the paper's formulas miss the forces as built by {gap:.3} N of {scale:.3} N");
     assert!(gap > 0.05 * scale, "{gap} of {scale}");
     let rigid = RigidState::at(&robot, &exp.trajectory, 0.1).unwrap();
-    assert_eq!(rigid.theta.v, states[20].theta.v, "the table's states are the robot as built's");
+    assert_eq!(
+        rigid.theta.v, states[20].theta.v,
+        "the table's states are the robot as built's"
+    );
 }

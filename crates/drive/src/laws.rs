@@ -133,7 +133,7 @@ impl Servo {
 /// carries ([`RobotParams::as_built`], `docs/as-built.md` 3 and 7).
 enum RigidRobot<'a> {
     Paper(&'a RobotParams),
-    AsBuilt(Robot),
+    AsBuilt(Box<Robot>),
 }
 
 impl<'a> RigidRobot<'a> {
@@ -141,7 +141,7 @@ impl<'a> RigidRobot<'a> {
         match params.as_built {
             None => Ok(RigidRobot::Paper(params)),
             Some(_) => Robot::from_params(params)
-                .map(RigidRobot::AsBuilt)
+                .map(|r| RigidRobot::AsBuilt(Box::new(r)))
                 .map_err(|e| DriveError::Config(e.to_string())),
         }
     }
@@ -150,7 +150,7 @@ impl<'a> RigidRobot<'a> {
     fn jets(&self, trajectory: &Trajectory, t: f64) -> Result<[Jet; 3], DriveError> {
         match self {
             RigidRobot::Paper(p) => trajectory.jets(*p, t),
-            RigidRobot::AsBuilt(r) => trajectory.jets(r, t),
+            RigidRobot::AsBuilt(r) => trajectory.jets(r.as_ref(), t),
         }
         .map_err(|e| reference_error(t, e))
     }
@@ -164,7 +164,7 @@ impl<'a> RigidRobot<'a> {
                 rigid_inverse_dynamics_with(p, attached, &state).fa
             }
             RigidRobot::AsBuilt(r) => {
-                let state = RigidState::at(r, trajectory, t).map_err(|e| reference_error(t, e))?;
+                let state = RigidState::at(r.as_ref(), trajectory, t).map_err(|e| reference_error(t, e))?;
                 rigid_inverse_dynamics_of(r, attached, &state).fa
             }
         })

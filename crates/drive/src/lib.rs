@@ -62,9 +62,7 @@ pub fn law_for(problem: &flexstar_model::Problem) -> Result<Option<Box<dyn Actua
         },
         DriveKind::Servo => {
             let robot = problem.robot();
-            let g = d
-                .slider_gains(robot.beams().map(|b| b.sleeve_mass))
-                .map_err(invalid)?;
+            let g = d.slider_gains(robot.beams().map(|b| b.sleeve_mass)).map_err(invalid)?;
             Some(Box::new(Servo {
                 kp: g.map(|g| g.kp),
                 kd: g.map(|g| g.kd),
@@ -113,9 +111,9 @@ pub fn add_tracking_errors(resp: &mut flexstar_model::Response, problem: &Proble
         *col = Vec::with_capacity(s.len());
         for (&t, &si) in resp.t.iter().zip(s) {
             let r = reference(t).map_err(|e| DriveError::Reference {
-                    t,
-                    reason: e.to_string(),
-                })?;
+                t,
+                reason: e.to_string(),
+            })?;
             col.push(r[i] - si);
         }
     }

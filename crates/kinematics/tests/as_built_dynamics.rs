@@ -276,7 +276,10 @@ fn the_paper_robot_through_the_general_formulas_is_the_paper_form() {
     let mut beams = *paper.beams();
     beams[1].length *= 1.0 + 1e-12;
     let nudged = Robot::new(beams, *paper.axes()).unwrap();
-    assert!(nudged.paper_form().is_none(), "the nudged robot takes the general formulas");
+    assert!(
+        nudged.paper_form().is_none(),
+        "the nudged robot takes the general formulas"
+    );
     let traj = Trajectory::Quintic {
         from: Pose {
             gx: 0.0,

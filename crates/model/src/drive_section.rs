@@ -519,7 +519,10 @@ s3 = [0.0, 0.0, 0.5]
         let g = e.drive.slider_gains([0.2, 0.25, 0.3]).unwrap();
         let wn = 20.0 * std::f64::consts::PI;
         for (gi, m) in g.iter().zip([0.2, 0.25, 0.3]) {
-            assert!((gi.kp - m * wn * wn).abs() < 1e-9 && (gi.kd - m * wn).abs() < 1e-12, "{gi:?}");
+            assert!(
+                (gi.kp - m * wn * wn).abs() < 1e-9 && (gi.kd - m * wn).abs() < 1e-12,
+                "{gi:?}"
+            );
         }
         let e = with("[0.2, 0.0, 0.3]").unwrap_err();
         assert!(

@@ -9,7 +9,9 @@ use flexstar_kinematics::CheckedMotion;
 use flexstar_io::run_set::RunSet;
 use flexstar_model::config::check_step;
 use flexstar_model::response::sidecar_text;
-use flexstar_model::{AmmModel, DriveKind, DriveSettings, Experiment, ForceSamples, ModeFamily, Response};
+use flexstar_model::{
+    AmmModel, DriveKind, DriveSettings, Experiment, ForceSamples, ModeFamily, Response, RobotGeometry,
+};
 
 use crate::solver_errors::{from_amm, from_fem};
 use crate::{ApiError, Result};
@@ -243,21 +245,31 @@ fn forces_drive(f: &Forces) -> Result<(DriveSettings, String)> {
 }
 
 /// The feasibility scan of both solvers, here too so that nothing is created for a motion that
-/// is refused (a forces-driven run: its start only; its motion is checked as it goes).
+/// is refused (a forces-driven run: its start only; its motion is checked as it goes), on the
+/// robot the experiment describes (the paper's form, or its robot as built).
 fn preflight(exp: &Experiment, source: &str) -> Result<Option<CheckedMotion>> {
+    let robot = flexstar_model::Robot::from_params(&exp.robot).map_err(ApiError::from_model)?;
+    match robot.paper_form() {
+        Some(p) => preflight_on(p, exp, source),
+        None => preflight_on(&robot, exp, source),
+    }
+}
+
+/// [`preflight`] on the geometry `robot`.
+fn preflight_on<K: RobotGeometry + ?Sized>(robot: &K, exp: &Experiment, source: &str) -> Result<Option<CheckedMotion>> {
     let servo = exp.drive.kind == DriveKind::Servo;
     if exp.drive.is_direct() && !servo {
         let s0 = exp
             .trajectory
-            .s(&exp.robot, 0.0)
+            .s(robot, 0.0)
             .map_err(|e| ApiError::infeasible(source, 0.0, e))?;
-        flexstar_kinematics::check_configuration(&exp.robot, s0).map_err(|violation| {
+        flexstar_kinematics::check_configuration(robot, s0).map_err(|violation| {
             ApiError::infeasible(source, 0.0, flexstar_kinematics::Infeasible { t: 0.0, violation })
         })?;
         Ok(None)
     } else {
         let step = flexstar_kinematics::preflight_step(exp.time.dt_out);
-        flexstar_kinematics::check_motion(&exp.robot, &exp.trajectory, exp.time.t_end, step)
+        flexstar_kinematics::check_motion(robot, &exp.trajectory, exp.time.t_end, step)
             .map(Some)
             .map_err(|e| ApiError::infeasible(source, e.t, e))
     }

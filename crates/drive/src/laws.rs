@@ -1,8 +1,9 @@
 //! The three kinds of actuator law: a force table (e.g. a solver's own `Fa` output fed back),
 //! force polynomials, and a PD servo on each slider with optional rigid-body feedforward.
 
-use flexstar_kinematics::{rigid_inverse_dynamics_with, RigidState};
-use flexstar_model::{Attachments, ForceSamples, RobotParams, Trajectory};
+use flexstar_kinematics::{rigid_inverse_dynamics_of, rigid_inverse_dynamics_with, RigidState};
+use flexstar_model::trajectory::Jet;
+use flexstar_model::{Attachments, ForceSamples, Robot, RobotParams, Trajectory};
 
 use crate::{ActuatorLaw, DriveError};
 
@@ -81,7 +82,9 @@ impl ActuatorLaw for ForcePolynomials {
 /// `Fa_i = ff_i(t) + kp_i (s_ref,i(t) - s_i) + kd_i (s_ref,i'(t) - s_i')` [N].
 ///
 /// The feedforward `ff` is the rigid-body inverse dynamics of the reference (Eq. 33 with a rigid
-/// star, [`rigid_inverse_dynamics_with`], carrying the payload and load) or zero.
+/// star, [`rigid_inverse_dynamics_with`], carrying the payload and load; on a robot as built
+/// `docs/as-built.md` 7, [`rigid_inverse_dynamics_of`]) or zero. The gains are per slider (from
+/// a bandwidth, each on its own slider's mass: `docs/as-built.md` 7.6).
 #[derive(Debug, Clone)]
 pub struct Servo {
     /// Proportional gains [N/m].
@@ -92,7 +95,8 @@ pub struct Servo {
     pub rigid_feedforward: bool,
     /// The reference motion `s_ref(t)`.
     pub reference: Trajectory,
-    /// The robot (masses for the feedforward).
+    /// The robot (geometry of the reference, masses for the feedforward): the paper's compact
+    /// form, or a robot as built carried whole in its `as_built` ([`Robot::to_params`]).
     pub params: RobotParams,
     /// The payload and load the feedforward includes (`docs/amm.md` 11.1; none: the bare star).
     pub attached: Attachments,
@@ -109,27 +113,69 @@ impl Servo {
     /// Reference `s_ref`, `s_ref'` and the feedforward at time `t`; errors if the reference
     /// itself is not a valid pose at `t`.
     pub fn reference_at(&self, t: f64) -> Result<ReferencePoint, DriveError> {
-        let jets = self
-            .reference
-            .jets(&self.params, t)
-            .map_err(|e| DriveError::Reference {
-                t,
-                reason: e.to_string(),
-            })?;
-        let ff = if self.rigid_feedforward {
-            let state = RigidState::at(&self.params, &self.reference, t).map_err(|e| DriveError::Reference {
-                t,
-                reason: e.to_string(),
-            })?;
-            rigid_inverse_dynamics_with(&self.params, &self.attached, &state).fa
+        let robot = RigidRobot::of(&self.params)?;
+        let jets = robot.jets(&self.reference, t)?;
+        let feedforward = if self.rigid_feedforward {
+            robot.forces(&self.attached, &self.reference, t)?
         } else {
             [0.0; 3]
         };
         Ok(ReferencePoint {
             s: jets.map(|j| j.v),
             v: jets.map(|j| j.d1),
-            feedforward: ff,
+            feedforward,
         })
+    }
+}
+
+/// The robot a [`RobotParams`] describes, as the reference and the feedforward read it: the
+/// paper's compact form itself (today's formulas, bit for bit), or the robot as built it
+/// carries ([`RobotParams::as_built`], `docs/as-built.md` 3 and 7).
+enum RigidRobot<'a> {
+    Paper(&'a RobotParams),
+    AsBuilt(Box<Robot>),
+}
+
+impl<'a> RigidRobot<'a> {
+    fn of(params: &'a RobotParams) -> Result<Self, DriveError> {
+        match params.as_built {
+            None => Ok(RigidRobot::Paper(params)),
+            Some(_) => Robot::from_params(params)
+                .map(|r| RigidRobot::AsBuilt(Box::new(r)))
+                .map_err(|e| DriveError::Config(e.to_string())),
+        }
+    }
+
+    /// `s(t)` of `trajectory` with its first and second derivatives.
+    fn jets(&self, trajectory: &Trajectory, t: f64) -> Result<[Jet; 3], DriveError> {
+        match self {
+            RigidRobot::Paper(p) => trajectory.jets(*p, t),
+            RigidRobot::AsBuilt(r) => trajectory.jets(r.as_ref(), t),
+        }
+        .map_err(|e| reference_error(t, e))
+    }
+
+    /// The rigid-body inverse dynamics of `trajectory` at time `t` carrying `attached` [N]
+    /// (Eq. 33 with a rigid star, Eqs. P7-P8; `docs/as-built.md` Eqs. N1-N6 as built).
+    fn forces(&self, attached: &Attachments, trajectory: &Trajectory, t: f64) -> Result<[f64; 3], DriveError> {
+        Ok(match self {
+            RigidRobot::Paper(p) => {
+                let state = RigidState::at(*p, trajectory, t).map_err(|e| reference_error(t, e))?;
+                rigid_inverse_dynamics_with(p, attached, &state).fa
+            }
+            RigidRobot::AsBuilt(r) => {
+                let state = RigidState::at(r.as_ref(), trajectory, t).map_err(|e| reference_error(t, e))?;
+                rigid_inverse_dynamics_of(r, attached, &state).fa
+            }
+        })
+    }
+}
+
+/// The reference cannot be evaluated at time `t` [s].
+fn reference_error(t: f64, e: impl std::fmt::Display) -> DriveError {
+    DriveError::Reference {
+        t,
+        reason: e.to_string(),
     }
 }
 
@@ -157,28 +203,13 @@ impl ActuatorLaw for Servo {
     }
 }
 
-/// The rigid-body inverse dynamics of a trajectory [N] at time `t` (Eq. 33 with a rigid star,
-/// Eqs. P7-P8 with `attached`).
-fn rigid_forces(
-    params: &RobotParams,
-    attached: &Attachments,
-    trajectory: &Trajectory,
-    t: f64,
-) -> Result<[f64; 3], DriveError> {
-    let state = RigidState::at(params, trajectory, t).map_err(|e| DriveError::Reference {
-        t,
-        reason: e.to_string(),
-    })?;
-    Ok(rigid_inverse_dynamics_with(params, attached, &state).fa)
-}
-
 /// The forces that move the *rigid* robot along `trajectory` (Eq. 33 with a rigid star), as a
 /// drive: the open-loop input of the stiff-limit check.
 #[derive(Debug, Clone)]
 pub struct RigidInverseForces {
     /// The motion the forces are computed for.
     pub trajectory: Trajectory,
-    /// The robot.
+    /// The robot: the paper's compact form, or a robot as built carried in its `as_built`.
     pub params: RobotParams,
     /// The payload and load it carries (none: the bare star).
     pub attached: Attachments,
@@ -186,7 +217,7 @@ pub struct RigidInverseForces {
 
 impl ActuatorLaw for RigidInverseForces {
     fn force(&self, t: f64, _s: [f64; 3], _v: [f64; 3]) -> Result<[f64; 3], DriveError> {
-        rigid_forces(&self.params, &self.attached, &self.trajectory, t)
+        RigidRobot::of(&self.params)?.forces(&self.attached, &self.trajectory, t)
     }
     fn stiffness(&self) -> [f64; 3] {
         [0.0; 3]

@@ -33,14 +33,14 @@ mod request;
 pub use laws::{ForcePolynomials, ForceTable, ReferencePoint, RigidInverseForces, Servo};
 pub use request::{Drive, Progress, SolveRequest, Solved};
 
-use flexstar_model::{DriveKind, EqualBeams, Feedforward};
+use flexstar_model::{DriveKind, Feedforward, Problem, RobotGeometry};
 
 /// The actuator law of a problem's drive (`docs/drives.md`): `None` for `kind = "motion"` (the
 /// trajectory is imposed), else the forces (table or polynomials) or the servo tracking
-/// the problem's trajectory with its gains resolved (`bandwidth_hz` with the slider mass
-/// `mpp_mpa`). The drive was validated with the problem; errors name the `drive.` key. Motions and
-/// forces take any robot; a servo (its rigid feed-forward and gains) the paper's form only so far
-/// (`docs/as-built.md` 6).
+/// the problem's trajectory with its gains resolved (`bandwidth_hz` with each slider's mass
+/// `mpp_mpa_i`). The drive was validated with the problem; errors name the `drive.` key. Every
+/// drive takes any robot: a servo on a robot as built has its own slider masses in its gains and
+/// the robot's rigid inverse dynamics as feed-forward (`docs/as-built.md` 7).
 pub fn law_for(problem: &flexstar_model::Problem) -> Result<Option<Box<dyn ActuatorLaw>>, DriveError> {
     let d = problem.drive();
     let invalid = |e: flexstar_model::ModelError| match e {
@@ -61,17 +61,14 @@ pub fn law_for(problem: &flexstar_model::Problem) -> Result<Option<Box<dyn Actua
             }
         },
         DriveKind::Servo => {
-            let params = problem
-                .robot()
-                .paper_form_for("a servo drive")
-                .map_err(|e| DriveError::Config(e.to_string()))?;
-            let g = d.servo_gains(params.mpp_mpa).map_err(invalid)?;
+            let robot = problem.robot();
+            let g = d.slider_gains(robot.beams().map(|b| b.sleeve_mass)).map_err(invalid)?;
             Some(Box::new(Servo {
-                kp: [g.kp; 3],
-                kd: [g.kd; 3],
+                kp: g.map(|g| g.kp),
+                kd: g.map(|g| g.kd),
                 rigid_feedforward: d.feedforward.unwrap_or_default() == Feedforward::Rigid,
                 reference: problem.trajectory().clone(),
-                params: *params,
+                params: robot.to_params(),
                 attached: flexstar_model::Attachments {
                     payload: *problem.payload(),
                     load: problem.load().clone(),
@@ -98,8 +95,13 @@ pub enum DriveError {
 
 /// Add the servo's tracking errors `e_i = s_ref,i(t) - s_i(t)` [m] to a direct run's response
 /// as columns `e1, e2, e3` (after its other columns), from its `s1, s2, s3` columns and the
-/// reference, the problem's trajectory.
-pub fn add_tracking_errors(resp: &mut flexstar_model::Response, problem: &EqualBeams) -> Result<(), DriveError> {
+/// reference, the problem's trajectory on its robot (the paper's form or one as built).
+pub fn add_tracking_errors(resp: &mut flexstar_model::Response, problem: &Problem) -> Result<(), DriveError> {
+    let robot = problem.robot();
+    let reference = |t: f64| match robot.paper_form() {
+        Some(p) => problem.trajectory().s(p, t),
+        None => problem.trajectory().s(robot, t),
+    };
     let mut cols = [Vec::new(), Vec::new(), Vec::new()];
     for (i, col) in cols.iter_mut().enumerate() {
         let name = ["s1", "s2", "s3"][i];
@@ -108,13 +110,10 @@ pub fn add_tracking_errors(resp: &mut flexstar_model::Response, problem: &EqualB
             .ok_or_else(|| DriveError::Config(format!("the direct run has no column {name}")))?;
         *col = Vec::with_capacity(s.len());
         for (&t, &si) in resp.t.iter().zip(s) {
-            let r = problem
-                .trajectory
-                .s(problem.robot, t)
-                .map_err(|e| DriveError::Reference {
-                    t,
-                    reason: e.to_string(),
-                })?;
+            let r = reference(t).map_err(|e| DriveError::Reference {
+                t,
+                reason: e.to_string(),
+            })?;
             col.push(r[i] - si);
         }
     }
@@ -177,6 +176,35 @@ mod tests {
         exp.drive.kd = Some(1.0);
         let e = law_of(&exp).err().unwrap();
         assert!(e.contains("drive.bandwidth_hz"), "{e}");
+    }
+
+    /// A servo on a robot as built: each slider's gains on its own mass, and at zero tracking
+    /// error the robot as built's rigid inverse dynamics (`docs/as-built.md` 7) on its own
+    /// geometry.
+    #[test]
+    fn a_servo_on_a_robot_as_built_has_its_own_gains_and_feedforward() {
+        let text = "name = \"b\"\n[time]\nt_end = 0.3\n[trajectory]\nkind = \"quintic\"\n\
+                    from = { Gx = 0.0, Gy = 0.0, theta = 0.0 }\nto = { Gx = 0.02, Gy = -0.01, theta = 0.1 }\n\
+                    t0 = 0.0\nt1 = 0.25\n[robot]\nL = [0.52, 0.48, 0.5]\nmpp_mpa = [0.2, 0.26, 0.17]\n\
+                    weld_deg = [0, 118, 242.5]\n[base]\nsides = [0.63, 0.6, 0.64]\n[gravity]\ng = [0.0, -9.81]\n\
+                    [drive]\nkind = \"servo\"\nbandwidth_hz = 20.0\ndamping_ratio = 0.7\n";
+        let exp = flexstar_model::Experiment::from_toml_str(text, std::path::Path::new("b.toml")).unwrap();
+        let problem = exp.problem().unwrap();
+        let law = law_for(&problem).unwrap().unwrap();
+        for (i, m) in [0.2, 0.26, 0.17].into_iter().enumerate() {
+            let (kp, kd) = Servo::gains_from_bandwidth(m, 20.0, 0.7);
+            assert_eq!((law.stiffness()[i], law.damping()[i]), (kp, kd), "slider {}", i + 1);
+        }
+        let robot = problem.robot();
+        let t = 0.12;
+        let jets = problem.trajectory().jets(robot, t).unwrap();
+        let f = law.force(t, jets.map(|j| j.v), jets.map(|j| j.d1)).unwrap();
+        let state = flexstar_kinematics::RigidState::at(robot, problem.trajectory(), t).unwrap();
+        let attached = flexstar_model::Attachments::of(&exp);
+        let ff = flexstar_kinematics::rigid_inverse_dynamics_of(robot, &attached, &state).fa;
+        for i in 0..3 {
+            assert!((f[i] - ff[i]).abs() < 1e-12 * ff[i].abs().max(1.0), "{f:?} vs {ff:?}");
+        }
     }
 
     #[test]

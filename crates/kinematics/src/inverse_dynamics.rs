@@ -41,7 +41,8 @@ pub struct RigidForces {
 }
 
 /// Driving forces of the rigid robot (Eq. 33 with a rigid star and `theta_pi = 0`), the paper's
-/// bare star (no payload, no load).
+/// bare star (no payload, no load). `params` is read in the paper's compact form (its `as_built`
+/// is not read): a robot as built takes [`crate::rigid_inverse_dynamics_of`].
 pub fn rigid_inverse_dynamics(params: &RobotParams, state: &RigidState) -> RigidForces {
     let a = state.a_g();
     let m = params.star_mass();
@@ -51,6 +52,8 @@ pub fn rigid_inverse_dynamics(params: &RobotParams, state: &RigidState) -> Rigid
 
 /// Driving forces of the rigid robot carrying `attached`'s payload and load at time `state.t`
 /// (Eqs. P7-P8 and Eq. 33); the bare star's [`rigid_inverse_dynamics`] when there is neither.
+/// The paper's compact form, as [`rigid_inverse_dynamics`]; a robot as built takes
+/// [`crate::rigid_inverse_dynamics_of`] (`docs/as-built.md` 7).
 pub fn rigid_inverse_dynamics_with(params: &RobotParams, attached: &Attachments, state: &RigidState) -> RigidForces {
     if attached.is_none() {
         return rigid_inverse_dynamics(params, state);
@@ -82,18 +85,27 @@ pub fn rigid_inverse_dynamics_with(params: &RobotParams, attached: &Attachments,
 /// N, N m], and the driving forces of Eq. 33 with them.
 fn forces_for(params: &RobotParams, state: &RigidState, rhs: [f64; 3]) -> RigidForces {
     let ew = [0, 1, 2].map(|i| state.e_w(i));
+    let normal = sleeve_forces(state, rhs);
+    let fa = [0, 1, 2].map(|i| params.mpp_mpa * state.s[i].d2 + normal[i] * dot(ew[i], slider_direction(i)));
+    RigidForces { fa, normal }
+}
+
+/// The sleeves' normal forces `f_i` [N] along `e_wi` that give the star the resultant `rhs =
+/// (Fx, Fy, Mz about G)` [N, N, N m]: `sum f_i e_wi = (Fx, Fy)`, `sum xp_i f_i = Mz` (the system
+/// of Eqs. P7-P8, `docs/as-built.md` Eq. N5 for any weld angles).
+pub(crate) fn sleeve_forces(state: &RigidState, rhs: [f64; 3]) -> [f64; 3] {
+    let ew = [0, 1, 2].map(|i| state.e_w(i));
     let rows = [
         [ew[0][0], ew[1][0], ew[2][0], rhs[0]],
         [ew[0][1], ew[1][1], ew[2][1], rhs[1]],
         [state.xp[0].v, state.xp[1].v, state.xp[2].v, rhs[2]],
     ];
-    let normal = solve3(rows);
-    let fa = [0, 1, 2].map(|i| params.mpp_mpa * state.s[i].d2 + normal[i] * dot(ew[i], slider_direction(i)));
-    RigidForces { fa, normal }
+    solve3(rows)
 }
 
 /// Cramer's rule for a 3x3 system given as augmented rows, on nalgebra's determinant (the
-/// matrix is well conditioned whenever the Fermat point exists: the e_wi are 120 degrees apart).
+/// matrix is well conditioned whenever the pose exists: its determinant is
+/// `xp_1 sin(g_23) + xp_2 sin(g_31) + xp_3 sin(g_12) > 0`, `docs/as-built.md` 7.4).
 fn solve3(r: [[f64; 4]; 3]) -> [f64; 3] {
     let a = Matrix3::from_fn(|i, j| r[i][j]);
     let b = Vector3::from_fn(|i, _| r[i][3]);

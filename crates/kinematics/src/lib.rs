@@ -10,6 +10,8 @@
 //! - [`RigidState::a_x`], [`RigidState::a_w`]: rigid accelerations of any beam point (Eqs. 11-12);
 //! - [`feasibility`]: the first time a trajectory leaves the feasible range, with the reason;
 //! - [`inverse_dynamics`]: driving forces of the rigid robot (Eq. 33 with a rigid star);
+//! - [`star_masses`]: the same for a robot as built (`docs/as-built.md` 7, Eqs. N1-N6: the
+//!   star's centre of mass off G), [`rigid_inverse_dynamics_of`] choosing between the two;
 //! - [`table`]: the `kinematics.csv` table.
 //!
 //! The closed-form inverse kinematics lives in `flexstar_model::geometry` (trajectories need it)
@@ -19,6 +21,7 @@ pub mod as_built;
 pub mod direct;
 pub mod feasibility;
 pub mod inverse_dynamics;
+pub mod star_masses;
 pub mod state;
 pub mod table;
 
@@ -28,6 +31,7 @@ pub use feasibility::{
 };
 pub use flexstar_model::geometry::inverse_kinematics;
 pub use inverse_dynamics::{rigid_inverse_dynamics, rigid_inverse_dynamics_with, RigidForces};
+pub use star_masses::{rigid_inverse_dynamics_of, StarMasses};
 pub use state::RigidState;
 
 /// Errors of the rigid kinematics.
@@ -52,6 +56,9 @@ pub enum KinematicsError {
          overflow it; give physical values"
     )]
     NotFinite { t: f64, column: &'static str, value: f64 },
+    /// The experiment's robot is not a valid robot (its data as read from the file).
+    #[error("robot: {0}")]
+    Robot(flexstar_model::ModelError),
     /// Writing a result file failed.
     #[error(transparent)]
     Write(flexstar_model::ModelError),

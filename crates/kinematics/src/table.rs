@@ -3,17 +3,17 @@
 use std::path::Path;
 
 use flexstar_io::output::{fmt_number, write_atomically};
-use flexstar_model::{Attachments, Experiment, RobotParams};
+use flexstar_model::{Attachments, Experiment, Robot, RobotGeometry};
 
 use crate::feasibility::check_trajectory;
-use crate::inverse_dynamics::rigid_inverse_dynamics_with;
+use crate::star_masses::rigid_inverse_dynamics_of;
 use crate::state::RigidState;
 use crate::KinematicsError;
 
 /// Column header of `kinematics.csv` (a file contract, `docs/outputs.md`): the pose and its
 /// derivatives, then the slider velocities `sd_i` [m/s] and accelerations `sdd_i` [m/s^2] and the
-/// rigid driving forces `Fa_i` [N] of [`rigid_inverse_dynamics_with`] (the payload and load
-/// included). Units: `flexstar_model::quantity::QUANTITIES`.
+/// rigid driving forces `Fa_i` [N] of [`rigid_inverse_dynamics_of`] (the payload, load and
+/// gravity included; a robot as built by `docs/as-built.md` 7). Units: `flexstar_model::quantity::QUANTITIES`.
 pub const KINEMATICS_HEADER: [&str; 23] = [
     "t",
     "s1",
@@ -40,19 +40,30 @@ pub const KINEMATICS_HEADER: [&str; 23] = [
     "Fa3",
 ];
 
-/// Rigid states at the experiment's output times, after checking feasibility over the span.
+/// Rigid states at the experiment's output times, after checking feasibility over the span, on
+/// the robot the experiment describes: the paper's compact form, or its robot as built
+/// (`docs/as-built.md` 3).
 pub fn kinematics_table(exp: &Experiment) -> Result<Vec<RigidState>, KinematicsError> {
-    check_trajectory(&exp.robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out)?;
+    let robot = Robot::from_params(&exp.robot).map_err(KinematicsError::Robot)?;
+    match robot.paper_form() {
+        Some(p) => states_on(p, exp),
+        None => states_on(&robot, exp),
+    }
+}
+
+/// [`kinematics_table`] on the geometry `robot`.
+fn states_on<K: RobotGeometry + ?Sized>(robot: &K, exp: &Experiment) -> Result<Vec<RigidState>, KinematicsError> {
+    check_trajectory(robot, &exp.trajectory, exp.time.t_end, exp.time.dt_out)?;
     exp.time
         .output_times()
         .into_iter()
-        .map(|t| RigidState::at(&exp.robot, &exp.trajectory, t))
+        .map(|t| RigidState::at(robot, &exp.trajectory, t))
         .collect()
 }
 
-/// One CSV row in the order of [`KINEMATICS_HEADER`] for the robot `params` carrying `attached`.
-pub fn row(params: &RobotParams, attached: &Attachments, st: &RigidState) -> [f64; 23] {
-    let fa = rigid_inverse_dynamics_with(params, attached, st).fa;
+/// One CSV row in the order of [`KINEMATICS_HEADER`] for `robot` carrying `attached`.
+pub fn row(robot: &Robot, attached: &Attachments, st: &RigidState) -> [f64; 23] {
+    let fa = rigid_inverse_dynamics_of(robot, attached, st).fa;
     [
         st.t,
         st.s[0].v,
@@ -84,14 +95,14 @@ pub fn row(params: &RobotParams, attached: &Attachments, st: &RigidState) -> [f6
 /// values overflow a derived quantity, e.g. a slider mass that makes `Fa` infinite): the error
 /// names the time and the column.
 pub fn kinematics_rows(
-    params: &RobotParams,
+    robot: &Robot,
     attached: &Attachments,
     states: &[RigidState],
 ) -> Result<Vec<[f64; 23]>, KinematicsError> {
     states
         .iter()
         .map(|st| {
-            let r = row(params, attached, st);
+            let r = row(robot, attached, st);
             match r.iter().position(|v| !v.is_finite()) {
                 None => Ok(r),
                 Some(k) => Err(KinematicsError::NotFinite {
@@ -104,15 +115,15 @@ pub fn kinematics_rows(
         .collect()
 }
 
-/// Write the table of the robot `params` carrying `attached` as CSV, whole or not at all; nothing
-/// is written when a value is not finite ([`kinematics_rows`]).
+/// Write the table of `robot` carrying `attached` as CSV, whole or not at all; nothing is written
+/// when a value is not finite ([`kinematics_rows`]).
 pub fn write_kinematics_csv(
     path: &Path,
-    params: &RobotParams,
+    robot: &Robot,
     attached: &Attachments,
     states: &[RigidState],
 ) -> Result<(), KinematicsError> {
-    let rows = kinematics_rows(params, attached, states)?;
+    let rows = kinematics_rows(robot, attached, states)?;
     write_atomically(path, |w| {
         let mut out = csv::Writer::from_writer(w);
         out.write_record(KINEMATICS_HEADER)?;
@@ -140,7 +151,8 @@ mod tests {
         }
         let exp = paper_case(3);
         let st = RigidState::at(&exp.robot, &exp.trajectory, 0.25).unwrap();
-        let r = row(&exp.robot, &Attachments::default(), &st);
+        let robot = Robot::from_params(&exp.robot).unwrap();
+        let r = row(&robot, &Attachments::default(), &st);
         let col = |name: &str| r[KINEMATICS_HEADER.iter().position(|c| *c == name).unwrap()];
         let f = crate::rigid_inverse_dynamics(&exp.robot, &st);
         for i in 0..3 {

@@ -299,8 +299,9 @@ impl DriveSettings {
     }
 
     /// Check the keys against the kind and the values (keys named `drive.<key>`); `t_end` [s]
-    /// is the span a forces file must cover.
-    pub fn validate(&self, t_end: f64, slider_mass: f64) -> Result<(), ModelError> {
+    /// is the span a forces file must cover, `slider_masses` [kg] each slider's `mpp_mpa` (a
+    /// servo's gains from a bandwidth, [`DriveSettings::slider_gains`]).
+    pub fn validate(&self, t_end: f64, slider_masses: [f64; 3]) -> Result<(), ModelError> {
         let allowed: &[&str] = match self.kind {
             DriveKind::Motion => &[],
             DriveKind::Forces => &FORCE_KEYS,
@@ -315,7 +316,7 @@ impl DriveSettings {
         match self.kind {
             DriveKind::Motion => Ok(()),
             DriveKind::Forces => self.validate_forces(t_end),
-            DriveKind::Servo => self.servo_gains(slider_mass).map(|_| ()),
+            DriveKind::Servo => self.slider_gains(slider_masses).map(|_| ()),
         }
     }
 
@@ -359,6 +360,25 @@ impl DriveSettings {
                 "a forces drive needs file = \"...\" or all three of Fa1, Fa2, Fa3",
             )),
         }
+    }
+
+    /// The servo gains of each slider (`docs/as-built.md` 7.6): [`DriveSettings::servo_gains`]
+    /// on each slider's own mass `slider_masses[i]` = `mpp_mpa_i` [kg] (`kp`, `kd` given hold
+    /// for all three). Errors name the key, and the slider when the masses differ.
+    pub fn slider_gains(&self, slider_masses: [f64; 3]) -> Result<[ServoGains; 3], ModelError> {
+        let equal = slider_masses.iter().all(|m| m.to_bits() == slider_masses[0].to_bits());
+        let mut gains = [ServoGains { kp: 0.0, kd: 0.0 }; 3];
+        for (i, (g, m)) in gains.iter_mut().zip(slider_masses).enumerate() {
+            *g = self.servo_gains(m).map_err(|e| match e {
+                ModelError::Invalid { file, key, reason } if !equal => ModelError::Invalid {
+                    file,
+                    key,
+                    reason: format!("slider {}: {reason}", i + 1),
+                },
+                other => other,
+            })?;
+        }
+        Ok(gains)
     }
 
     /// Servo gains: `kp` and `kd`, or `bandwidth_hz` and `damping_ratio` with the slider mass
@@ -482,6 +502,33 @@ s3 = [0.0, 0.0, 0.5]
             BASE.replace("[time]", "[robot]\nmpp_mpa = 0.0\n[time]")
         );
         assert!(Experiment::from_toml_str(&text, Path::new("m0.toml")).is_ok());
+    }
+
+    /// Sliders of different masses (`[robot] mpp_mpa` as a list): the gains from a bandwidth on
+    /// each slider's own mass, the same law; a massless one is refused naming the slider.
+    #[test]
+    fn each_slider_takes_the_gains_of_its_own_mass() {
+        let with = |masses: &str| {
+            let text = format!(
+                "{}[drive]\nkind = \"servo\"\nbandwidth_hz = 10.0\ndamping_ratio = 0.5\n",
+                BASE.replace("[time]", &format!("[robot]\nmpp_mpa = {masses}\n[time]"))
+            );
+            Experiment::from_toml_str(&text, Path::new("m.toml")).map_err(|e| e.to_string())
+        };
+        let e = with("[0.2, 0.25, 0.3]").unwrap();
+        let g = e.drive.slider_gains([0.2, 0.25, 0.3]).unwrap();
+        let wn = 20.0 * std::f64::consts::PI;
+        for (gi, m) in g.iter().zip([0.2, 0.25, 0.3]) {
+            assert!(
+                (gi.kp - m * wn * wn).abs() < 1e-9 && (gi.kd - m * wn).abs() < 1e-12,
+                "{gi:?}"
+            );
+        }
+        let e = with("[0.2, 0.0, 0.3]").unwrap_err();
+        assert!(
+            e.contains("m.toml") && e.contains("drive.bandwidth_hz") && e.contains("slider 2"),
+            "{e}"
+        );
     }
 
     #[test]

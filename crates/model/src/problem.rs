@@ -81,14 +81,13 @@ impl Problem {
         })
     }
 
-    /// The same run on another robot. The checks that depend on the robot (the trajectory's
-    /// start, the servo's slider mass) are run again where they can be: on a robot in the paper's
-    /// form; a robot of another form is refused by the solvers anyway ([`Problem::equal_beams`]).
+    /// The same run on another robot. The checks that depend on the robot are run again: the
+    /// servo's slider masses on any robot, the trajectory's start on a robot in the paper's form.
     pub fn with_robot(&self, robot: Robot) -> Result<Self, ModelError> {
         if let Ok(p) = robot.equal_beams() {
             self.trajectory.validate(p)?;
-            self.drive.validate(self.time.t_end, p.mpp_mpa)?;
         }
+        self.drive.validate(self.time.t_end, slider_masses(&robot))?;
         Ok(Problem { robot, ..self.clone() })
     }
 
@@ -134,12 +133,17 @@ pub(crate) fn check_physics(exp: &Experiment) -> Result<Robot, ModelError> {
     exp.time.validate()?;
     exp.trajectory.validate(&exp.robot)?;
     exp.check_motion_fits()?;
-    exp.drive.validate(exp.time.t_end, exp.robot.mpp_mpa)?;
+    exp.drive.validate(exp.time.t_end, slider_masses(&robot))?;
     exp.payload.validate()?;
     exp.damping.validate()?;
     exp.load.validate(exp.time.t_end)?;
     exp.gravity.validate()?;
     Ok(robot)
+}
+
+/// Each slider's mass with its sleeve, `mpp_mpa_i` [kg] (a servo's gains from a bandwidth).
+fn slider_masses(robot: &Robot) -> [f64; 3] {
+    robot.beams().map(|b| b.sleeve_mass)
 }
 
 /// A [`Problem`] whose robot is the paper's: three equal beams welded 120 degrees apart on an

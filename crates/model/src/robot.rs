@@ -189,6 +189,25 @@ impl Robot {
         Ok(robot)
     }
 
+    /// The compact form that carries this robot, for a holder of [`RobotParams`]: the paper's
+    /// form when it is the paper's robot ([`Robot::equal_beams`]), else beam 1's values with the
+    /// whole robot in [`RobotParams::as_built`] and `d` the distance of O from axis 1 (the
+    /// in-radius of a base from sides) [m]. [`Robot::from_params`] of it is this robot again.
+    pub fn to_params(&self) -> RobotParams {
+        if let Ok(p) = &self.equal {
+            return *p;
+        }
+        let a = self.axes[0];
+        let d = (a.origin[0] * a.direction[1] - a.origin[1] * a.direction[0]).abs();
+        RobotParams {
+            as_built: Some(AsBuilt {
+                beams: self.beams,
+                axes: self.axes,
+            }),
+            ..self.beams[0].params(d)
+        }
+    }
+
     /// The three beams, beam 1 first.
     pub fn beams(&self) -> &[Beam; 3] {
         &self.beams
@@ -341,6 +360,25 @@ mod tests {
         let again = Robot::new(*r.beams(), *r.axes()).unwrap();
         assert_eq!(again.equal_beams().unwrap().ea(), p.ea());
         assert_eq!(again.equal_beams().unwrap().d, p.d);
+    }
+
+    /// The compact form that carries a robot reads back as that robot: the paper's form for the
+    /// paper's robot, the data as built for another, with `d` the in-radius of a base from sides.
+    #[test]
+    fn the_compact_form_of_a_robot_reads_back_as_it() {
+        let p = RobotParams::paper();
+        assert_eq!(Robot::from_params(&p).unwrap().to_params(), p);
+        let mut beams = *Robot::from_params(&p).unwrap().beams();
+        beams[1].sleeve_mass = 0.25;
+        beams[2].weld_angle = 243f64.to_radians();
+        let sides = [0.626, 0.618, 0.631];
+        let robot = Robot::new(beams, ActuatorAxis::from_sides(sides).unwrap()).unwrap();
+        let compact = robot.to_params();
+        assert!(compact.as_built.is_some());
+        assert_eq!(Robot::from_params(&compact).unwrap(), robot);
+        let s = 0.5 * sides.iter().sum::<f64>();
+        let in_radius = (s * (s - sides[0]) * (s - sides[1]) * (s - sides[2])).sqrt() / s;
+        assert!((compact.d - in_radius).abs() < 1e-15, "{} vs {in_radius}", compact.d);
     }
 
     #[test]

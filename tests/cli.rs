@@ -572,6 +572,55 @@ fn output_files_have_normal_permissions_and_exact_numbers() {
     }
 }
 
+/// `compare` on a robot as built under a servo (`docs/as-built.md` 6-7): the AMM within the
+/// robots-as-built targets of the FEM (mean EVP at most 1 %), and each slider's gains from the
+/// bandwidth on its own mass, `kp_i = m_i (2 pi f)^2`, `kd_i = 2 zeta m_i 2 pi f` (formulas
+/// written here), in compare.md.
+#[test]
+fn compare_takes_a_robot_as_built_and_its_servo_per_slider() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let text = std::fs::read_to_string(root.join("configs/servo/case3-servo.toml"))
+        .unwrap()
+        .replace(
+            "mpp_mpa = 0.2   # kg",
+            "mpp_mpa = [0.2, 0.26, 0.17]\nweld_deg = [0, 121.5, 238]",
+        )
+        .replace("d = 0.18        # m\n", "")
+        .replace("t_end = 0.5 ", "t_end = 0.3 ")
+        + "[base]\nsides = [0.63, 0.6, 0.64]\n";
+    let cfg = dir.path().join("built.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let out = dir.path().join("out");
+    let o = flexstar(&[
+        "compare",
+        cfg.to_str().unwrap(),
+        "--no-figures",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let case = out.join("case3-servo");
+    let csv = std::fs::read_to_string(case.join("compare.csv")).unwrap();
+    let mean: f64 = csv.lines().nth(1).unwrap().split(',').nth(5).unwrap().parse().unwrap();
+    assert!(mean <= 1.0, "mean EVP {mean} %");
+    let md = std::fs::read_to_string(case.join("compare.md")).unwrap();
+    let w = 2.0 * std::f64::consts::PI * 20.0;
+    for (i, m) in [0.2, 0.26, 0.17].iter().enumerate() {
+        let at = md.find(&format!("slider {}: kp = ", i + 1)).expect("per-slider gains") + 15;
+        let number = |from: usize| md[from..].split(' ').next().unwrap().parse::<f64>().unwrap();
+        let kp = number(at);
+        let kd = number(at + md[at..].find("kd = ").unwrap() + 5);
+        // the report prints five significant digits
+        assert!((kp / (m * w * w) - 1.0).abs() < 1e-4, "slider {}: kp {kp}", i + 1);
+        assert!(
+            (kd / (2.0 * 0.7 * m * w) - 1.0).abs() < 1e-4,
+            "slider {}: kd {kd}",
+            i + 1
+        );
+    }
+}
+
 #[test]
 fn compare_refuses_bad_input_before_any_work() {
     let dir = tempfile::tempdir().unwrap();

@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use flexstar_io::run_set::RunSet;
-use flexstar_kinematics::{rigid_inverse_dynamics_with, RigidState};
+use flexstar_kinematics::{rigid_inverse_dynamics_of, RigidState};
 use flexstar_metrics::small_deflection_check;
 use flexstar_model::{DriveKind, Experiment, Feedforward, ModeFamily, Provenance, Response, ValidityExceeded};
 use serde::Serialize;
@@ -126,9 +126,10 @@ pub fn case_figures(
     };
     let t = &case.fem.t;
     let attached = flexstar_model::Attachments::of(exp);
+    let robot = flexstar_model::Robot::from_params(&exp.robot)?;
     let rigid: Vec<[f64; 3]> = t
         .iter()
-        .map(|&ti| kin(ti).map(|s| rigid_inverse_dynamics_with(&exp.robot, &attached, &s).fa))
+        .map(|&ti| kin(ti).map(|s| rigid_inverse_dynamics_of(&robot, &attached, &s).fa))
         .collect::<Result<_, _>>()?;
     let mut figs = vec![figure_w_g(&exp.name, &runs), figure_tips(&exp.name, &runs)];
     let last = kin(exp.time.t_end)?;

@@ -159,8 +159,6 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
             file: file.clone(),
             reason,
         };
-        // the rigid references and figures of a comparison read the paper's form
-        exp.paper_robot("flexstar compare").map_err(|e| input(e.to_string()))?;
         for run in spec.amm.iter().chain(&spec.extra) {
             run.settings
                 .validate(exp.time.dt_out)

@@ -26,9 +26,13 @@ pub struct ServoSummary {
     /// Closed-loop bandwidth [Hz] and damping ratio, when the gains were given that way.
     pub bandwidth_hz: Option<f64>,
     pub damping_ratio: Option<f64>,
-    /// The gains used [N/m], [N s/m].
+    /// The gains used [N/m], [N s/m] (slider 1's).
     pub kp: f64,
     pub kd: f64,
+    /// Each slider's gains `[kp, kd]` when they differ (a robot as built whose sliders' masses
+    /// differ, the gains from a bandwidth: `docs/as-built.md` 7); absent when all three are equal.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub per_slider: Option<[[f64; 2]; 3]>,
     /// `rigid` (the rigid-body inverse dynamics of the reference) or `none`.
     pub feedforward: &'static str,
     /// Every run, the FEM first.
@@ -53,7 +57,10 @@ pub fn servo_summary(exp: &Experiment, case: &CaseResults) -> Option<ServoSummar
     if exp.drive.kind != DriveKind::Servo {
         return None;
     }
-    let gains = exp.drive.servo_gains(exp.robot.mpp_mpa).ok()?;
+    let robot = flexstar_model::Robot::from_params(&exp.robot).ok()?;
+    let gains = exp.drive.slider_gains(robot.beams().map(|b| b.sleeve_mass)).ok()?;
+    let per_slider = gains.map(|g| [g.kp, g.kd]);
+    let equal = per_slider.iter().all(|g| *g == per_slider[0]);
     let tracking = runs_of(case)
         .into_iter()
         .map(|(run, r)| {
@@ -64,8 +71,9 @@ pub fn servo_summary(exp: &Experiment, case: &CaseResults) -> Option<ServoSummar
     Some(ServoSummary {
         bandwidth_hz: exp.drive.bandwidth_hz,
         damping_ratio: exp.drive.damping_ratio,
-        kp: gains.kp,
-        kd: gains.kd,
+        kp: gains[0].kp,
+        kd: gains[0].kd,
+        per_slider: (!equal).then_some(per_slider),
         feedforward: match exp.drive.feedforward.unwrap_or_default() {
             Feedforward::Rigid => "rigid",
             Feedforward::None => "none",
@@ -81,11 +89,18 @@ impl ServoSummary {
         if let (Some(f), Some(z)) = (self.bandwidth_hz, self.damping_ratio) {
             let _ = write!(s, "bandwidth {f} Hz, damping ratio {z}, so ");
         }
-        let _ = write!(
-            s,
-            "kp = {:.4e} N/m, kd = {:.4e} N s/m; feedforward {}",
-            self.kp, self.kd, self.feedforward
-        );
+        match self.per_slider {
+            None => {
+                let _ = write!(s, "kp = {:.4e} N/m, kd = {:.4e} N s/m", self.kp, self.kd);
+            }
+            Some(g) => {
+                for (i, [kp, kd]) in g.iter().enumerate() {
+                    let sep = if i == 0 { "" } else { ", " };
+                    let _ = write!(s, "{sep}slider {}: kp = {kp:.4e} N/m, kd = {kd:.4e} N s/m", i + 1);
+                }
+            }
+        }
+        let _ = write!(s, "; feedforward {}", self.feedforward);
         s
     }
 

@@ -128,6 +128,17 @@ impl ApiError {
         })
     }
 
+    /// For a command `by` that does not model friction yet (`docs/friction.md` 6): a config error
+    /// naming the file, the key `friction` and the command when `exp` has friction.
+    pub fn frictionless(
+        exp: &flexstar_model::Experiment,
+        file: impl std::fmt::Display,
+        by: &str,
+    ) -> std::result::Result<(), ApiError> {
+        exp.frictionless(by)
+            .map_err(|e| Self::model_in(&file, Path::new(&file.to_string()), e))
+    }
+
     /// A model error: reading and validation are config errors, writing an output error.
     pub fn from_model(e: ModelError) -> Self {
         let message = e.to_string();

@@ -25,6 +25,7 @@ fn from_kinematics(source: &str, e: KinematicsError) -> ApiError {
 pub fn table(exp: &Experiment, source: &str) -> Result<Vec<RigidState>> {
     // the rigid inverse dynamics of the table reads the paper's form
     crate::ApiError::paper_robot(exp, source, "flexstar kinematics")?;
+    crate::ApiError::frictionless(exp, source, "flexstar kinematics (the rigid inverse dynamics)")?;
     kinematics_table(exp).map_err(|e| from_kinematics(source, e))
 }
 

@@ -62,6 +62,7 @@ fn from_plan(source: &str, e: PlanError) -> ApiError {
 pub fn load_plan(config: &Path) -> Result<PlanConfig> {
     let cfg = flexstar_plan::read_plan_config(config).map_err(|e| from_plan(&config.display().to_string(), e))?;
     crate::ApiError::paper_robot(&cfg.exp, config.display(), "flexstar plan")?;
+    crate::ApiError::frictionless(&cfg.exp, config.display(), "flexstar plan")?;
     Ok(cfg)
 }
 

@@ -149,6 +149,7 @@ const DIRECT_EXTRA: [&str; 9] = ["s1", "s2", "s3", "sd1", "sd2", "sd3", "Gx", "G
 /// `settings.elements` must be a positive multiple of 3 ([`FemError::Elements`]): each beam gets
 /// a third of them.
 pub fn solve(problem: &Problem, settings: &FemSettings, request: SolveRequest) -> Result<Solved<Stats>, FemError> {
+    problem.frictionless("the FEM").map_err(FemError::Problem)?;
     let (mut response, stats) = match request.drive {
         Drive::Motion => solve_prescribed(problem, settings, request.proof, request.progress)?,
         Drive::Law(law) => solve_direct(problem, settings, law, request.progress)?,

@@ -11,7 +11,7 @@
 //!   beam i (0-based) has nodes `1 + i ne + (k - 1)` at material coordinates `k h_i`, k = 1..ne;
 //! - sleeve i: its rotation `psi_i` and the material coordinates `xi_ic, xi_il, xi_ir` of its
 //!   centre and edges on beam i ([`sleeve`], which says what a sleeve is: its coordinates, its 7
-//!   constraint rows and their Jacobian blocks, the forces it transmits, where friction would enter).
+//!   constraint rows and their Jacobian blocks, the forces it transmits; [`friction`] what friction adds to it).
 //!
 //! Equations of motion (Lagrange): `M(q) q_dd + f_conv(q, q_d) + f_int(q) + Phi_q^T lambda = 0`,
 //! `Phi(q, t) = 0` the sleeves' rows. This module assembles them: the element pass
@@ -165,7 +165,7 @@ pub(crate) struct Star {
     off_sl: usize,
     /// Offset of the tangent rows' multiplier block (Eq. S9, [`NU_SLOTS`] per sleeve).
     off_nu: usize,
-    /// With friction: offset of the friction slot group ([`FRICTION_SLOTS`] per sleeve, after
+    /// With friction in a sleeve: offset of the friction slot group ([`FRICTION_SLOTS`] per sleeve, after
     /// everything else; `friction.rs`).
     off_fr: usize,
     /// Friction in the sleeves and on the rails and the contacts' states (`docs/friction.md`;

@@ -80,7 +80,8 @@ impl Star {
             }
         }
         self.off_fr = slots.len();
-        if self.friction.is_some() {
+        let sleeves_rub = self.friction.as_ref().is_some_and(|f| f.law.sleeves_rub());
+        if sleeves_rub {
             for i in 0..3 {
                 let xc = self.xi(i, 0);
                 for r in 0..FRICTION_SLOTS {
@@ -98,7 +99,7 @@ impl Star {
             ww: self.ww,
             off_sl: self.direct.then_some(self.off_sl),
             off_nu: self.off_nu,
-            off_fr: self.friction.is_some().then_some(self.off_fr),
+            off_fr: sleeves_rub.then_some(self.off_fr),
         }));
         self.vals = vec![0.0; slots.len()];
         self.slots = slots;

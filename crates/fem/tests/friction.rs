@@ -74,6 +74,44 @@ fn energy_balance_with_friction() {
     }
 }
 
+/// The energy balance in the direct problem: the inverse run's actuator forces (with sleeve and
+/// rail friction) fed back as a force table, the sliders then feeling the rails' friction and
+/// the sleeves' through the pins; `W` of the fed-back forces is the change of kinetic and strain
+/// energy plus `E_f` to 1e-3 of the work, and the sliders follow the inverse run's motion
+/// (the same equations solved the other way round) to 1e-4 of their travel (measured: 1e-5;
+/// the sliders stick on their rails once the forces stop).
+#[test]
+fn energy_balance_with_friction_in_the_direct_problem() {
+    let mut exp = quintic(0.45);
+    exp.time.dt_out = 5e-4;
+    exp.friction = Some(friction("mu = 0.2\nmodel = \"edges\"\n[rails]\nFc = 0.3\nb = 0.5\n"));
+    let inverse = fem(&exp, &coarse(), SolveRequest::motion());
+    let rows = (0..inverse.len())
+        .map(|k| [inverse.fa[0][k], inverse.fa[1][k], inverse.fa[2][k]])
+        .collect();
+    let table = flexstar_drive::ForceTable::new(inverse.t.clone(), rows).unwrap();
+    let r = fem(&exp, &coarse(), SolveRequest::law(&table));
+    let (defect, w, ef) = energy_defect(&r);
+    let robot = exp.problem().unwrap().robot().clone();
+    let (mut off, mut travel) = (0.0f64, 0.0f64);
+    for k in 0..r.len() {
+        let rigid = flexstar_kinematics::RigidState::at(&robot, &exp.trajectory, r.t[k]).unwrap();
+        for i in 0..3 {
+            let s = col(&r, &format!("s{}", i + 1))[k];
+            off = off.max((s - rigid.s[i].v).abs());
+            travel = travel.max((rigid.s[i].v - col(&r, &format!("s{}", i + 1))[0]).abs());
+        }
+    }
+    eprintln!(
+        "direct: defect {defect:.2e} of the work, W {w:.4e} J, E_f {ef:.4e} J, sliders off the motion by \
+         {off:.2e} m of {travel:.3e} m, {:?}",
+        r.friction
+    );
+    assert!(ef > 0.05 * w, "E_f {ef} J of W {w} J");
+    assert!(defect < 1e-3, "energy defect {defect:.3e} of the work");
+    assert!(off < 1e-4 * travel, "the sliders left the motion by {off} m");
+}
+
 /// A force pulse on slider 1, `F0 sin(pi t / T)` [N] for `t < T`, zero after; nothing on the
 /// other two.
 struct Pulse {

@@ -554,6 +554,7 @@ mod tests {
             damping: Default::default(),
             load: Default::default(),
             gravity: Default::default(),
+            friction: None,
             shaper: None,
             report: Default::default(),
             source: Default::default(),

@@ -114,18 +114,15 @@ impl ApiError {
         }
     }
 
-    /// The robot of `exp` (from `file`) in the paper's form, for a command `by` that takes only
-    /// the paper's robot so far (`docs/as-built.md` 6); a config error naming the file, the
-    /// command and the datum that differs otherwise.
-    pub fn paper_robot<'a>(
-        exp: &'a flexstar_model::Experiment,
+    /// For a command `by` that does not model friction yet (`docs/friction.md` 6): a config error
+    /// naming the file, the key `friction` and the command when `exp` has friction.
+    pub fn frictionless(
+        exp: &flexstar_model::Experiment,
         file: impl std::fmt::Display,
         by: &str,
-    ) -> std::result::Result<&'a flexstar_model::RobotParams, ApiError> {
-        exp.paper_robot(by).map_err(|e| {
-            let reason = e.to_string();
-            Self::config_text(&file, Some("robot"), &reason, format!("{file}: {reason}"))
-        })
+    ) -> std::result::Result<(), ApiError> {
+        exp.frictionless(by)
+            .map_err(|e| Self::model_in(&file, Path::new(&file.to_string()), e))
     }
 
     /// A model error: reading and validation are config errors, writing an output error.

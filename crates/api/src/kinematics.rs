@@ -26,6 +26,7 @@ fn from_kinematics(source: &str, e: KinematicsError) -> ApiError {
 /// (from `source`), after the feasibility scan of the whole motion; the paper's robot or one as
 /// built (`docs/as-built.md` 3).
 pub fn table(exp: &Experiment, source: &str) -> Result<Vec<RigidState>> {
+    crate::ApiError::frictionless(exp, source, "flexstar kinematics (the rigid inverse dynamics)")?;
     kinematics_table(exp).map_err(|e| from_kinematics(source, e))
 }
 

@@ -69,6 +69,7 @@ pub fn check_k(k: usize) -> Result<()> {
 /// The rest pose of the experiment's robot, checked against its workspace (the error names the
 /// limit).
 pub fn resolve_pose(exp: &Experiment, source: &str, spec: &PoseSpec) -> Result<RestPose> {
+    ApiError::frictionless(exp, source, "modes at a pose (modal, linearize)")?;
     match spec {
         PoseSpec::At(t) => pose_at_time(exp, *t).map_err(|e| from_modal(Some(source), *t, e)),
         PoseSpec::Task {
@@ -276,6 +277,7 @@ pub fn freqmap<P>(
 where
     P: Fn(usize, usize) + Sync,
 {
+    ApiError::frictionless(exp, source, "flexstar freqmap")?;
     check_grid(&s.gx, &s.gy).map_err(|e| from_modal(None, f64::NAN, e))?;
     check_k(s.k)?;
     if !s.theta.is_finite() {

@@ -60,7 +60,9 @@ fn from_plan(source: &str, e: PlanError) -> ApiError {
 
 /// Read and check a plan file (every check of 4.8 that needs no solver).
 pub fn load_plan(config: &Path) -> Result<PlanConfig> {
-    flexstar_plan::read_plan_config(config).map_err(|e| from_plan(&config.display().to_string(), e))
+    let cfg = flexstar_plan::read_plan_config(config).map_err(|e| from_plan(&config.display().to_string(), e))?;
+    crate::ApiError::frictionless(&cfg.exp, config.display(), "flexstar plan")?;
+    Ok(cfg)
 }
 
 /// The whole command: plan, run the three motions on both solvers, write everything into

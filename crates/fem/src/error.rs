@@ -64,6 +64,11 @@ pub enum FemError {
     /// The run was stopped on request ([`flexstar_model::cancel`]) at output time `t` [s].
     #[error("cancelled at t = {t} s")]
     Cancelled { t: f64 },
+    /// A stick-slip event the time step cannot resolve (`docs/friction.md` 8.3): at time `t` [s]
+    /// the contact (`sleeve 2`, `slider 1`) found neither sticking nor slipping consistent with
+    /// the step's equations; no result is written.
+    #[error("unresolved stick-slip event of {contact} at t = {t} s: {reason}")]
+    StickSlip { t: f64, contact: String, reason: String },
     /// A sleeve contact point left the beam: its material coordinate is outside (0, L_i), `l`
     /// the beam's length [m].
     #[error(

@@ -3,7 +3,8 @@
 //! The independent finite-element reference model of the flexible star-triangle robot
 //! (docs/paper-defects.md, "independent reference"): three co-rotational Euler-Bernoulli beams in absolute
 //! coordinates welded at one node G ([`element`]), three rigid sleeves with inertia Jp pinned at
-//! the revolute points of Eqs. 1-3 through which the beams slide without friction (`star::sleeve`), index-3
+//! the revolute points of Eqs. 1-3 through which the beams slide (`star::sleeve`; with the friction of an
+//! experiment's `[friction]`, stick and slip by switching constraint sets, `docs/friction.md` 8), index-3
 //! generalized-alpha integration with a structured direct solver (banded beam blocks and a dense
 //! border, `bordered`). The driving forces follow from the pin
 //! reactions (Eq. 33). Its equations use only the robot parameters, `s_i(t)` and the start

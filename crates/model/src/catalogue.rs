@@ -41,6 +41,7 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         damping: Default::default(),
         load: Default::default(),
         gravity: Default::default(),
+        friction: None,
         shaper: None,
         report: Default::default(),
         source: Default::default(),

@@ -424,6 +424,10 @@ pub struct Experiment {
     /// absent from the resolved experiment, so that the experiment's hash is unchanged).
     #[serde(default, skip_serializing_if = "crate::Gravity::is_none")]
     pub gravity: crate::Gravity,
+    /// Friction in the sleeves and on the rails (`[friction]`, `docs/friction.md`); none by
+    /// default (and then absent from the resolved experiment).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<crate::Friction>,
     /// Input shaping of the motion (`[shaper]`, `docs/motions.md` 3.7); none by
     /// default. Given frequencies are applied when the file is read ([`Experiment::apply_shaper`]);
     /// `f_hz = "auto"` waits for the explicit step `flexstar_shaping::shape`.
@@ -544,15 +548,13 @@ impl Experiment {
 }
 
 impl Experiment {
-    /// The robot in the paper's compact form, for a command `by` that does not model a robot
-    /// as built yet (`docs/as-built.md` 6): an error naming it and the datum that differs
-    /// otherwise.
-    pub fn paper_robot(&self, by: &str) -> Result<&RobotParams, ModelError> {
-        if self.robot.as_built.is_none() {
-            return Ok(&self.robot);
+    /// For a command or solver `by` that does not model friction yet (`docs/friction.md` 6): an
+    /// error naming the `[friction]` key and `by` when the experiment has friction.
+    pub fn frictionless(&self, by: &str) -> Result<(), ModelError> {
+        match &self.friction {
+            Some(f) if !f.is_none() => Err(crate::friction::unsupported(by)),
+            _ => Ok(()),
         }
-        crate::Robot::from_params(&self.robot)?.paper_form_for(by)?;
-        Ok(&self.robot)
     }
 
     /// `[base]` into the robot: the paper's equilateral base sets `robot.d` (its in-radius; the
@@ -727,8 +729,8 @@ mod tests {
             robot.axes(),
             &crate::ActuatorAxis::from_sides([0.626, 0.618, 0.631]).unwrap()
         );
-        assert!(built
-            .paper_robot("a command")
+        assert!(robot
+            .paper_form_for("a command")
             .unwrap_err()
             .to_string()
             .contains("a command"));

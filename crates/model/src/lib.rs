@@ -16,6 +16,7 @@ pub mod config;
 pub mod damping;
 pub mod drive_section;
 pub mod error;
+pub mod friction;
 pub mod geometry;
 pub mod gravity;
 pub mod hash;
@@ -42,6 +43,7 @@ pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, Mode
 pub use damping::ModeValues;
 pub use drive_section::{DriveKind, DriveSettings, Feedforward, ForceSamples};
 pub use error::{ModelError, SampleError};
+pub use friction::{Friction, FrictionSummary, NormalLoad, RailFriction, RailLaw, SleeveLaw};
 pub use gravity::Gravity;
 pub use motion::{TableMotion, TableSpace, ViaMotion, ViaPoint};
 pub use params::RobotParams;

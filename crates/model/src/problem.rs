@@ -25,6 +25,7 @@ pub struct Problem {
     damping: Damping,
     load: LoadSettings,
     gravity: [f64; 2],
+    friction: Option<crate::Friction>,
 }
 
 impl Problem {
@@ -56,6 +57,7 @@ impl Problem {
             damping: exp.damping,
             load: exp.load.clone(),
             gravity: exp.gravity.g,
+            friction: exp.friction.filter(|f| !f.is_none()),
         })
     }
 
@@ -125,6 +127,21 @@ impl Problem {
     pub fn gravity(&self) -> [f64; 2] {
         self.gravity
     }
+
+    /// Friction in the sleeves and on the rails (`docs/friction.md`); `None`: none (also for a
+    /// `[friction]` whose coefficients are all zero, which is the frictionless run bit for bit).
+    pub fn friction(&self) -> Option<&crate::Friction> {
+        self.friction.as_ref()
+    }
+
+    /// For a solver or command `by` that does not model friction yet: an error naming the key
+    /// `friction` and `by` when the problem has friction (`docs/friction.md` 6).
+    pub fn frictionless(&self, by: &str) -> Result<(), ModelError> {
+        match self.friction {
+            Some(_) => Err(crate::friction::unsupported(by)),
+            None => Ok(()),
+        }
+    }
 }
 
 /// Check every physical value of `exp` (all but a pending shaper): the robot it describes.
@@ -138,6 +155,9 @@ pub(crate) fn check_physics(exp: &Experiment) -> Result<Robot, ModelError> {
     exp.damping.validate()?;
     exp.load.validate(exp.time.t_end)?;
     exp.gravity.validate()?;
+    if let Some(f) = &exp.friction {
+        f.validate()?;
+    }
     Ok(robot)
 }
 

@@ -103,6 +103,15 @@ pub const QUANTITIES: &[Quantity] = &[
         "J",
         "potential energy of the weights (beams, payload, sleeves, sliders)",
     ),
+    // friction (FEM), only with a [friction] section (docs/friction.md 7)
+    q(
+        "Ff{i}",
+        "N",
+        "friction force of sleeve i on beam i along e_xi (stuck: the force the stick needs)",
+    ),
+    q("vs{i}", "m/s", "sliding speed of sleeve i along beam i (> 0: towards the tip)"),
+    q("stick{i}", "-", "1 while sleeve i is stuck on its beam, 0 while it slips"),
+    q("E_f", "J", "energy dissipated by the friction of the sleeves and rails since t = 0"),
     // a direct run's columns and kinematics.csv
     q("s{i}", "m", "position of slider i along its axis (Eqs. 1-3)"),
     q("sd{i}", "m/s", "velocity of slider i"),

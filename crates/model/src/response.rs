@@ -93,6 +93,9 @@ pub struct Response {
     /// which its residual vibration is measured (`docs/as-built.md` 5.5); `None` without gravity
     /// or without a rest.
     pub rest_offset: Option<RestOffset>,
+    /// With friction (`docs/friction.md` 7): the time stuck and the energy dissipated; `None`
+    /// without friction.
+    pub friction: Option<crate::friction::FrictionSummary>,
 }
 
 /// The static equilibrium's elastic outputs at the final rest pose (`docs/as-built.md` 5.5).
@@ -121,6 +124,7 @@ impl Response {
             frames: Vec::new(),
             info: RunInfo::default(),
             rest_offset: None,
+            friction: None,
         }
     }
 
@@ -178,6 +182,7 @@ impl Response {
             shapes: self.shapes.clone(),
             frames: self.frames.clone(),
             rest_offset: self.rest_offset,
+            friction: self.friction,
         }
     }
 
@@ -403,6 +408,7 @@ impl Response {
             experiment: self.resolved_experiment(experiment),
             residual: None,
             rest_offset: self.rest_offset,
+            friction: self.friction,
             frames_hash: None,
             validated_envelope: None,
             validated_envelope_reasons: None,

@@ -12,14 +12,41 @@
 use std::fmt;
 
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize, Serializer};
 
 use crate::params::RobotParams;
 use crate::robot::{ActuatorAxis, AsBuilt};
 
-/// A `[robot]` value for the three beams: one number or a list of three.
+/// A `[robot]` value for the three beams: one number or a list of three (also the per-sleeve
+/// and per-slider values of `[friction]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PerBeam(pub [f64; 3]);
+
+impl PerBeam {
+    /// The same value for all three.
+    pub fn all(v: f64) -> Self {
+        PerBeam([v; 3])
+    }
+}
+
+impl Default for PerBeam {
+    /// Zero for all three (the `[friction]` coefficients left out).
+    fn default() -> Self {
+        PerBeam::all(0.0)
+    }
+}
+
+impl Serialize for PerBeam {
+    /// Written back as it reads: one number when the three are equal (by bits), else the list.
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let v = self.0;
+        if v[1].to_bits() == v[0].to_bits() && v[2].to_bits() == v[0].to_bits() {
+            s.serialize_f64(v[0])
+        } else {
+            v.serialize(s)
+        }
+    }
+}
 
 impl<'de> Deserialize<'de> for PerBeam {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {

@@ -205,6 +205,10 @@ pub struct RunSidecar {
     /// measured (`docs/as-built.md` 5.5).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rest_offset: Option<crate::RestOffset>,
+    /// With friction: the time each sleeve (and slider) stayed stuck and the energy the friction
+    /// dissipated (`docs/friction.md` 7).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<crate::friction::FrictionSummary>,
     /// The hash of the run's frames files (`crate::animation::FRAMES_HASH_KEY`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frames_hash: Option<String>,

@@ -134,6 +134,8 @@ fn solve_under(
     let request = SolveRequest { drive, proof, progress };
     Ok(match settings {
         Settings::Amm(s) => {
+            // the AMM does not model friction yet (docs/friction.md 6): refused before any work
+            problem.frictionless("the AMM (--solver amm)")?;
             let r = flexstar_amm::solve(problem, s, request)?;
             Solved {
                 response: r.response,
@@ -200,6 +202,24 @@ mod tests {
         assert!(exp.shaper_pending());
         let e = exp.problem().unwrap_err();
         assert!(e.to_string().contains("shaper.f_hz"), "{e}");
+    }
+
+    /// Friction reaches the problem, and the AMM, which does not model it yet, refuses it by
+    /// name before any work (`docs/friction.md` 6).
+    #[test]
+    fn the_amm_refuses_friction_by_name() {
+        let exp = Experiment::from_toml_str(
+            "name = \"f\"\n[time]\nt_end = 0.01\n[trajectory]\nkind = \"polynomial\"\n\
+             s1 = [0.0]\ns2 = [0.0]\ns3 = [0.0]\n[friction]\nmu = 0.1\n",
+            std::path::Path::new("f.toml"),
+        )
+        .unwrap();
+        let problem = exp.problem().unwrap();
+        assert_eq!(problem.friction().map(|f| f.sleeve(0).mu), Some(0.1));
+        let e = solve(&problem, Settings::of(&exp, Solver::Amm), None, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("friction") && e.contains("AMM"), "{e}");
     }
 
     /// A robot other than the paper's form (here beam 3 shorter, its slider heavier) is solved by

@@ -116,7 +116,23 @@ impl Bordered {
                 self.s[row * ns + border_nu(i, r)] += vals[l.off_nu + NU_SLOTS * i + k];
             }
         }
+        if let Some(off) = l.off_fr {
+            self.friction_border(off, vals);
+        }
         self.lu_schur()
+    }
+
+    /// With friction: the sleeve centres' rows against their multipliers (`crate::star::friction`),
+    /// added to the symmetric entries `border_columns` wrote.
+    #[cold]
+    fn friction_border(&mut self, off: usize, vals: &[f64]) {
+        let ns = self.ns;
+        for i in 0..3 {
+            let row = border_xi(i, 0);
+            for r in 0..ROWS {
+                self.s[row * ns + border_nu(i, r)] += vals[off + ROWS * i + r];
+            }
+        }
     }
 
     /// Direct problem: the slider coordinates' diagonal and their coupling with the position

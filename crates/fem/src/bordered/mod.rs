@@ -91,6 +91,10 @@ pub(crate) struct Layout {
     /// `(tangent, tangent)`, `(tangent, centre x)`, `(tangent, centre y)`; Eq. S9 of
     /// `docs/fem.md` section 2.1), all within the border.
     pub off_nu: usize,
+    /// With friction only: offset of the friction slot group (per sleeve, the centre
+    /// coordinate's row against the sleeve's 7 multipliers, `crate::star::friction`), within
+    /// the border and added to the symmetric entries there.
+    pub off_fr: Option<usize>,
 }
 
 /// Values per sleeve in the multiplier-block slot group (see [`Layout::off_nu`]).
@@ -350,6 +354,7 @@ mod tests {
             ww: 0,
             off_sl: None,
             off_nu: 0,
+            off_fr: None,
         };
         let mut b = Bordered::new(lay);
         let n = 3 * lay.ne;

@@ -18,18 +18,21 @@ use flexstar_model::{Robot, Trajectory};
 use flexstar_numerics::GenAlpha;
 
 use crate::error::PivotError;
-use crate::star::{pin_forces, Attached, Factors, InitialState, Iterate, Pins, SliderRows, Star, ROWS};
+use crate::star::{pin_forces, Attached, Factors, InitialState, Iterate, Pins, SliderRows, Star, StarFriction, ROWS};
 use crate::{FemError, NewtonFailure};
 
+mod friction;
 mod motion;
 mod recorder;
 mod static_start;
 mod step;
 
+use friction::friction_start;
+pub(crate) use friction::FrictionLog;
 pub(crate) use motion::Motion;
 use motion::{pins_at, power};
 use recorder::{event_times, Recorder};
-pub(crate) use recorder::{Sample, Snapshot};
+pub(crate) use recorder::{FrictionSample, Sample, Snapshot};
 pub(crate) use static_start::static_equilibrium;
 use step::{step, Workspace};
 
@@ -87,6 +90,8 @@ pub(crate) struct History {
     pub load: bool,
     pub damping: bool,
     pub gravity: bool,
+    /// With friction: its dissipation and time stuck over the run.
+    pub friction: Option<FrictionLog>,
 }
 
 /// Work and dissipated energy since t = 0 [J], by the trapezoidal rule on the integration steps,
@@ -98,6 +103,8 @@ pub(crate) struct Works {
     pub w_load: f64,
     pub e_d: f64,
     powers: [f64; 3],
+    /// With friction: its dissipation and time stuck (`friction.rs`).
+    pub friction: Option<FrictionLog>,
 }
 
 impl Works {
@@ -114,6 +121,7 @@ impl Works {
     fn start(star: &Star, st: &State, fa: &[f64; 3]) -> Result<Self, FemError> {
         Ok(Works {
             powers: Self::powers(star, st, fa, 0.0)?,
+            friction: star.friction.is_some().then(|| FrictionLog::start(star, st)),
             ..Works::default()
         })
     }
@@ -125,6 +133,9 @@ impl Works {
         self.w_load += 0.5 * h * (self.powers[1] + p[1]);
         self.e_d += 0.5 * h * (self.powers[2] + p[2]);
         self.powers = p;
+        if let Some(f) = &mut self.friction {
+            f.advance(star, st, h);
+        }
         Ok(())
     }
 }
@@ -273,7 +284,12 @@ impl Stepper<'_, '_> {
         if depth < MAX_HALVINGS {
             backup.clone_from(self.st);
         }
-        match step(self.motion, self.star, self.ga, self.st, self.ws, self.stats, t1, h) {
+        let stepped = if self.star.friction.is_some() {
+            self.switching_step(t1, h)
+        } else {
+            step(self.motion, self.star, self.ga, self.st, self.ws, self.stats, t1, h)
+        };
+        match stepped {
             Ok(()) => self.finish(t1, h),
             Err(FemError::Newton { .. } | FemError::NonFinite { .. }) if depth < MAX_HALVINGS => {
                 self.st.clone_from(backup);
@@ -320,13 +336,22 @@ pub(crate) fn integrate(
     }
     let (mut star, mut q, v) = Star::new(robot, run.ne, init, motion.slider_unknowns())?;
     star.attached = attached.clone();
+    if let Some(law) = attached.friction {
+        let xi = [0, 1, 2].map(|i| q[star.xi(i, 0)]);
+        let xi_dot = [0, 1, 2].map(|i| v[star.xi(i, 0)]);
+        star.friction = Some(StarFriction::start(law, xi, xi_dot, motion.slider_unknowns()));
+    }
     if attached.weighs() {
         // Eq. G8: start in the deflected static equilibrium, the sliders held where they start
         let s0 = motion.start_sliders(&star)?;
         let (_, sag) = static_equilibrium(robot, run.ne, init, attached, s0, 0.0)?;
         q[..sag.len()].copy_from_slice(&sag);
     }
-    let mut st = initial_state(motion, &mut star, q, v)?;
+    let mut st = if star.friction.is_some() {
+        friction_start(motion, &mut star, q, v)?
+    } else {
+        initial_state(motion, &mut star, q, v)?
+    };
     motion.check_feasible(&star, &st.pins, 0.0)?;
 
     let t_end = *t_out.last().unwrap_or(&0.0);
@@ -379,5 +404,6 @@ pub(crate) fn integrate(
         load: attached.load.is_some(),
         damping: attached.beta > 0.0 || attached.alpha > 0.0,
         gravity: attached.weighs(),
+        friction: works.friction,
     })
 }

@@ -15,7 +15,7 @@ pub(super) fn pins_at(star: &Star, traj: &Trajectory, t: f64) -> Result<Pins, Fe
 /// Driving force (Eq. 33): `Fa_i = (mpp + mpa)_i s_i'' - F_i . u_i`, F_i the force of the beam on
 /// sleeve i (the sleeve is translationally massless: F_i passes through the pin to the slider);
 /// under gravity less the weight of sleeve and slider along the rail, `- (mpp + mpa)_i g . u_i`
-/// (Eqs. G2, G7).
+/// (Eqs. G2, G7); with rail friction plus `Fc_i sign(s_i') + b_i s_i'` (Eq. F4).
 pub(super) fn driving_forces(star: &Star, pins: &Pins, lam: &[f64]) -> ([f64; 3], [[f64; 2]; 3]) {
     let f = pin_forces(lam);
     let mut fa = [0, 1, 2].map(|i| {
@@ -25,6 +25,12 @@ pub(super) fn driving_forces(star: &Star, pins: &Pins, lam: &[f64]) -> ([f64; 3]
     if star.attached.weighs() {
         for (i, fa) in fa.iter_mut().enumerate() {
             *fa -= star.beam(i).sleeve_mass * star.gravity_along(i);
+        }
+    }
+    if star.friction.is_some() {
+        // the rails' friction against the prescribed sliding (Eq. F4)
+        for (i, fa) in fa.iter_mut().enumerate() {
+            *fa += star.rail_force(i, pins.s[i][1]);
         }
     }
     (fa, f)

@@ -38,6 +38,21 @@ pub(crate) struct Sample {
     /// Slider positions s_i [m] and speeds s_i' [m/s] (prescribed, or simulated).
     pub s: [f64; 3],
     pub sd: [f64; 3],
+    /// With friction: the sleeves' friction and its energy.
+    pub friction: Option<FrictionSample>,
+}
+
+/// The sleeves' friction at one output time (`docs/friction.md` 7).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FrictionSample {
+    /// Friction force of sleeve i on beam i along its tangent [N] (stuck: the force the stick needs).
+    pub ff: [f64; 3],
+    /// Sliding speed `xi_ic'` [m/s].
+    pub vs: [f64; 3],
+    /// Whether sleeve i is stuck.
+    pub stuck: [bool; 3],
+    /// Energy dissipated by the friction of the sleeves and rails since t = 0 [J].
+    pub e_f: f64,
 }
 
 /// Deformed star at one instant: node positions of each beam from G to the tip [m].
@@ -123,6 +138,12 @@ impl<'a> Recorder<'a> {
                 v_g: star.gravity_potential(q, pins),
                 s: pins.s.map(|s| s[0]),
                 sd: pins.s.map(|s| s[1]),
+                friction: star.friction.as_ref().map(|fr| FrictionSample {
+                    ff: [0, 1, 2].map(|i| star.sleeve_friction_force(i, q, &st.lam, pins)),
+                    vs: [0, 1, 2].map(|i| v[star.xi(i, 0)]),
+                    stuck: fr.sleeves.map(|c| c.stuck().is_some()),
+                    e_f: works.friction.map_or(0.0, |f| f.sleeves_j + f.rails_j),
+                }),
             });
             self.out_k += 1;
         }

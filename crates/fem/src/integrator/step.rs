@@ -133,6 +133,9 @@ flexstar_numerics::dispatch_avx2! {
         let load = star.attached.load_at(t1);
         // predictor: constant acceleration, previous multipliers
         predict(ga, h, bp, gp, st, ws);
+        if star.friction.is_some() {
+            super::friction::freeze(star, &mut ws.q1, &mut ws.v1, &mut ws.qdd1);
+        }
         for k in 0..ws.nu.len() {
             ws.nu[k] = bp * st.lam[k];
         }
@@ -156,6 +159,9 @@ flexstar_numerics::dispatch_avx2! {
                 stale = false;
             }
             let dq_max = update_coordinates(ws, inv_bp, gp);
+            if star.friction.is_some() {
+                super::friction::freeze(star, &mut ws.q1, &mut ws.v1, &mut ws.qdd1);
+            }
             let (dl_max, l_max) = update_multipliers(ws, n_dof, bp);
             if !(dq_max.is_finite() && dl_max.is_finite()) {
                 return Err(FemError::Newton {
@@ -271,6 +277,11 @@ fn accept(ga: &GenAlpha, star: &Star, st: &mut State, ws: &mut Workspace, fixed:
     let apq = ga.a_per_qdd();
     for ((a, ap), qdd) in st.a[..n_dof].iter_mut().zip(&ws.a_part[..n_dof]).zip(&ws.qdd1[..n_dof]) {
         *a = ap + apq * qdd;
+    }
+    if star.friction.is_some() {
+        for (k, _) in star.stuck_coordinates() {
+            st.a[k] = 0.0;
+        }
     }
     st.pins = fixed.unwrap_or_else(|| star.pins_of(&ws.q1, &ws.v1, &ws.qdd1));
     std::mem::swap(&mut st.q, &mut ws.q1);

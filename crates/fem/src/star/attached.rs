@@ -98,10 +98,12 @@ pub(crate) struct Attached {
     pub load: Option<LoadSettings>,
     /// Gravity `[gx, gy]` [m/s^2], fixed (base) frame (Eqs. G6-G7; `[0, 0]`: none).
     pub gravity: [f64; 2],
+    /// Friction in the sleeves and on the rails (`docs/friction.md`; `friction.rs`), none by default.
+    pub friction: Option<flexstar_model::Friction>,
 }
 
 impl Attached {
-    /// The `[payload]`, `[damping]`, `[load]` and `[gravity]` of `problem` for a star starting at
+    /// The `[payload]`, `[damping]`, `[load]`, `[gravity]` and `[friction]` of `problem` for a star starting at
     /// the orientation `theta0` [rad].
     pub fn of(problem: &Problem, theta0: f64) -> Self {
         let load = problem.load();
@@ -111,6 +113,7 @@ impl Attached {
             alpha: problem.damping().alpha(),
             load: (!load.is_none()).then(|| load.clone()),
             gravity: problem.gravity(),
+            friction: problem.friction().copied(),
         }
     }
 

@@ -11,7 +11,7 @@
 //!   beam i (0-based) has nodes `1 + i ne + (k - 1)` at material coordinates `k h_i`, k = 1..ne;
 //! - sleeve i: its rotation `psi_i` and the material coordinates `xi_ic, xi_il, xi_ir` of its
 //!   centre and edges on beam i ([`sleeve`], which says what a sleeve is: its coordinates, its 7
-//!   constraint rows and their Jacobian blocks, the forces it transmits, where friction would enter).
+//!   constraint rows and their Jacobian blocks, the forces it transmits; [`friction`] what friction adds to it).
 //!
 //! Equations of motion (Lagrange): `M(q) q_dd + f_conv(q, q_d) + f_int(q) + Phi_q^T lambda = 0`,
 //! `Phi(q, t) = 0` the sleeves' rows. This module assembles them: the element pass
@@ -43,12 +43,15 @@ use crate::FemError;
 
 mod attached;
 mod axes;
+pub(crate) mod friction;
 mod gravity;
 mod pattern;
 mod rigid;
 pub(crate) mod sleeve;
 
 pub(crate) use attached::Attached;
+use friction::FRICTION_SLOTS;
+pub(crate) use friction::{Contact, StarFriction};
 pub(crate) use rigid::RigidTwist;
 use sleeve::{initial_sleeves, SLEEVE_COORDINATES};
 pub(crate) use sleeve::{pin_forces, ROWS, ROW_POINT};
@@ -162,6 +165,12 @@ pub(crate) struct Star {
     off_sl: usize,
     /// Offset of the tangent rows' multiplier block (Eq. S9, [`NU_SLOTS`] per sleeve).
     off_nu: usize,
+    /// With friction in a sleeve: offset of the friction slot group ([`FRICTION_SLOTS`] per sleeve, after
+    /// everything else; `friction.rs`).
+    off_fr: usize,
+    /// Friction in the sleeves and on the rails and the contacts' states (`docs/friction.md`;
+    /// `None`: frictionless, and nothing of `friction.rs` runs).
+    pub friction: Option<StarFriction>,
     /// Payload, damping and load (`docs/fem.md` section 9; none by default).
     pub attached: Attached,
     /// Work array of the mass-proportional damping: the shifted accelerations of Eq. D16
@@ -291,6 +300,8 @@ impl Star {
             direct: sliders.is_some(),
             off_sl: 0,
             off_nu: 0,
+            off_fr: 0,
+            friction: None,
             attached: Attached::default(),
             shifted: Vec::new(),
         };
@@ -426,8 +437,20 @@ impl Star {
         for i in 0..3 {
             self.sleeve_rows(i, &it, cf, compliance, res, matrix);
         }
+        if self.friction.is_some() {
+            for i in 0..3 {
+                self.sleeve_friction_rows(i, &it, fac, res, matrix);
+            }
+        }
         match (self.direct, sliders) {
-            (true, Some(sl)) => self.assemble_sliders(sl, qdd, lam, cf, res, matrix),
+            (true, Some(sl)) => {
+                self.assemble_sliders(sl, qdd, lam, cf, res, matrix);
+                if self.friction.is_some() {
+                    for i in 0..3 {
+                        self.rail_friction_rows(i, v, fac, res, matrix);
+                    }
+                }
+            }
             (false, None) => {}
             _ => {
                 return Err(FemError::Input(

@@ -79,6 +79,16 @@ impl Star {
                 slots.push((tangent, self.n_dof + ROWS * i + r));
             }
         }
+        self.off_fr = slots.len();
+        let sleeves_rub = self.friction.as_ref().is_some_and(|f| f.law.sleeves_rub());
+        if sleeves_rub {
+            for i in 0..3 {
+                let xc = self.xi(i, 0);
+                for r in 0..FRICTION_SLOTS {
+                    slots.push((xc, self.n_dof + ROWS * i + r));
+                }
+            }
+        }
         self.bordered = Some(Bordered::new(Layout {
             ne: self.ne,
             n_nodes: self.n_nodes,
@@ -89,6 +99,7 @@ impl Star {
             ww: self.ww,
             off_sl: self.direct.then_some(self.off_sl),
             off_nu: self.off_nu,
+            off_fr: sleeves_rub.then_some(self.off_fr),
         }));
         self.vals = vec![0.0; slots.len()];
         self.slots = slots;

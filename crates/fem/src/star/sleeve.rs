@@ -40,16 +40,16 @@
 //! reads the sleeve as `xp_i` = `xi_ic` ([`Star::sleeve_centre`]), `thp_i` = the sleeve angle
 //! `gamma0_i + psi_i` ([`Star::sleeve_angle`]) less the rigid beam direction, and `Fn_i = -F_i . e_wi`.
 //!
-//! **Frictionless, and where friction would enter.** Nothing but the constraints acts on the
-//! contact coordinates: the equation of `xi_p` in the Newton imbalance is
-//! `res[xi_p] = sum_r (d Phi_r / d xi_p) lambda_r = lambda_p . dr/dxi` (the `gxi * l` terms of
-//! [`Star::sleeve_rows`]), which sets to zero the component of each contact force along the beam,
-//! and its diagonal slot in the matrix (`vals[off_psi + 4 i + 1 + p]`) is 0. A friction force
-//! along the beam at contact point p is a generalized force on `xi_p`: it adds to `res[xi_p]` (slip:
-//! `mu |normal force|` against the sliding speed `xi_p'`, with its derivatives in that diagonal
-//! slot and the multipliers' columns), or, in stick, the equation of `xi_p` becomes `xi_p' = 0`
-//! and the tangential force `lambda_p . dr/dxi` is free up to `mu |normal force|`. The pin force
-//! `F_i` then carries the tangential part by itself, so Eq. 33 and `Fn_i` need no change.
+//! **Friction** (`docs/friction.md` 8, `crate::star::friction`). Without friction nothing but
+//! the constraints acts on the contact coordinates: the equation of `xi_p` in the Newton
+//! imbalance is `res[xi_p] = sum_r (d Phi_r / d xi_p) lambda_r = lambda_p . dr/dxi` (the `gxi * l`
+//! terms of [`Star::sleeve_rows`]), which sets to zero the component of each contact force along
+//! the beam, and its diagonal slot in the matrix (`vals[off_psi + 4 i + 1 + p]`) is 0. With
+//! `[friction]` the centre's equation gains the friction force `F_fi` (Eq. F8: slipping, the law
+//! of Eq. F5 with its derivatives in that diagonal slot and in the friction slot group against
+//! the sleeve's multipliers), or, stuck, `xi_ic` is frozen (Eq. F9) and the tangential force
+//! `lambda_c . dr/dxi` is what the stick needs. The pin force `F_i` carries the tangential part by
+//! itself, so Eq. 33 and `Fn_i` need no change.
 //!
 //! **Direct problem** (`docs/fem.md` section 8): the pins move with the slider unknowns
 //! (`P_i = P_i(s_i)`, linear), so the six position rows gain the gradient `-u_i` in `s_i`

@@ -157,11 +157,11 @@ impl Star {
                 }
             }
             Contact::Slip(sign) => {
+                // the load is homogeneous of degree 1 in the multipliers: that of the scaled ones
+                // `nu = cf lambda` over cf, with the same gradient
                 let cf = fac.cf;
-                let lam: Vec<f64> = it.lam[ROWS * i..ROWS * i + ROWS].iter().map(|l| l / cf).collect();
-                let mut full = [0.0; 3 * ROWS];
-                full[ROWS * i..ROWS * i + ROWS].copy_from_slice(&lam);
-                let (load, grad) = self.sleeve_load(i, it.q, &full, model);
+                let (load_nu, grad) = self.sleeve_load(i, it.q, it.lam, model);
+                let load = load_nu / cf;
                 let v = it.v[xc];
                 res[xc] += cf * law.slip_force(v, load, sign);
                 if matrix {

@@ -17,6 +17,7 @@ use flexstar_model::config::check_step;
 use flexstar_model::Experiment;
 use flexstar_model::{AmmSettings, DriveKind, ModeCount, ModeFamily, Problem, Response, RunInfo};
 use flexstar_numerics::GenAlpha;
+use num_dual::Dual2;
 
 use crate::adaptive::{self, Pass};
 use crate::error::AmmError;
@@ -438,11 +439,15 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let kin = |t: f64| problem.state(t);
 
-    // the start: undeformed, or under gravity the static equilibrium of the start pose (Eq. G4);
-    // then consistent initial accelerations: M qdd = f - K q + C^T lambda, C qdd = 0 (q' = 0)
+    // the start: undeformed, or under gravity the static equilibrium of the start pose (Eq. G4)
+    // at rest, the rigid velocities and accelerations zero (a motion may start accelerating, as a
+    // polynomial one does: its initial inertia is not part of the sag it starts from, as in the
+    // direct run's start and the FEM's); then consistent initial accelerations:
+    // M qdd = f - K q + C^T lambda, C qdd = 0 (q' = 0)
     let mut st = kin(0.0)?;
     if problem.gravity != [0.0; 2] {
-        crate::static_start::static_equilibrium(&mut sys, &st, star_time_scale(problem), &mut q)?;
+        let still = problem.state_from(st.s.map(|j| Dual2::new(j.v, 0.0, 0.0)), 0.0)?;
+        crate::static_start::static_equilibrium(&mut sys, &still, star_time_scale(problem), &mut q)?;
     }
     sys.solve(&st, 0.0, 0.0, &q, &v, &mut qdd).map_err(|e| match e {
         AmmError::SingularConstraints { t, source } => AmmError::TooFewModes {

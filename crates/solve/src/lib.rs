@@ -164,14 +164,23 @@ pub fn response(
 
 /// The refined FEM that the accurate model's error estimate is judged against
 /// (`docs/validation.md` section 8: "never below half the true EVP against the converged FEM"):
-/// four times the elements and an eighth of the default step. *Measured* on case 4, the accurate
-/// model's mean EVP against it is 0.1273 % (0.1218 % at a quarter of the step, 0.2 % at the
-/// default FEM: the reference's own error is of the size of the model's), about 2 % below the
-/// Richardson limit of the two.
+/// four times the elements (a multiple of 3 when `[fem] elements` is one, as the FEM requires:
+/// the same count on each beam) and an eighth of the step, `[fem] dt` or the FEM's
+/// robot-dependent default ([`flexstar_fem::default_dt_of`], Eq. S10 of `docs/fem.md` 4.1 at the
+/// stiffest beam of a robot as built, section 10; on the paper's form exactly
+/// [`flexstar_fem::default_dt`] of its parameters). *Measured* on case 4, the accurate model's
+/// mean EVP against it is 0.1273 % (0.1218 % at a quarter of the step, 0.2 % at the default FEM:
+/// the reference's own error is of the size of the model's), about 2 % below the Richardson
+/// limit of the two. A robot that does not validate keeps beam 1's step here; the FEM refuses
+/// it with the reason.
 pub fn reference_fem(exp: &Experiment) -> FemSettings {
+    let default_dt = || match flexstar_model::Robot::from_params(&exp.robot) {
+        Ok(robot) => flexstar_fem::default_dt_of(&robot),
+        Err(_) => flexstar_fem::default_dt(&exp.robot),
+    };
     FemSettings {
         elements: 4 * exp.fem.elements,
-        dt: Some(exp.fem.dt.unwrap_or_else(|| flexstar_fem::default_dt(&exp.robot)) / 8.0),
+        dt: Some(exp.fem.dt.unwrap_or_else(default_dt) / 8.0),
         snapshots: Vec::new(),
         frames: 0,
         ..exp.fem.clone()
@@ -189,6 +198,31 @@ mod tests {
             assert_eq!(s.to_string(), s.name());
         }
         assert!("abaqus".parse::<Solver>().unwrap_err().contains("expected amm or fem"));
+    }
+
+    /// The refined FEM of a robot as built steps at an eighth of the default of its stiffest beam:
+    /// beam 3 at 0.3 m (the paper's section) has `omega_1` `(0.5 / 0.3)^2` times the paper's, so
+    /// Eq. S10 gives `5e-4 (0.3 / 0.5)^3` s; the elements stay a multiple of 3. The paper's robot
+    /// keeps `default_dt / 8` bit for bit.
+    #[test]
+    fn the_reference_steps_at_the_stiffest_beam_of_a_robot_as_built() {
+        let text = |robot: &str| {
+            format!(
+                "name = \"p\"\n{robot}[time]\nt_end = 0.01\n[trajectory]\nkind = \"polynomial\"\n\
+                 s1 = [0.0]\ns2 = [0.0]\ns3 = [0.0]\n"
+            )
+        };
+        let built = Experiment::from_toml_str(&text("[robot]\nL = [0.5, 0.5, 0.3]\n"), std::path::Path::new("p.toml"))
+            .unwrap();
+        let r = reference_fem(&built);
+        let expected = 5e-4 * 0.6f64.powi(3) / 8.0;
+        assert!((r.dt.unwrap() / expected - 1.0).abs() < 1e-12, "{:?} vs {expected}", r.dt);
+        assert!(r.elements.is_multiple_of(3) && r.elements == 4 * built.fem.elements);
+        let paper = Experiment::from_toml_str(&text(""), std::path::Path::new("p.toml")).unwrap();
+        assert_eq!(
+            reference_fem(&paper).dt.unwrap().to_bits(),
+            (flexstar_fem::default_dt(&paper.robot) / 8.0).to_bits()
+        );
     }
 
     /// A loaded `f_hz = "auto"` waits for the explicit shaping step: it does not become a

@@ -10,6 +10,7 @@
 //! runs the cases in parallel (rayon), appending one row per case and solver to `results.csv`
 //! as they finish and skipping those already there (resume); [`shard`] slices a study for
 //! clusters and [`merge`] joins the slices; [`report`] draws the plots and `study.html`.
+//! A key may name one beam of a per-beam key, `robot.L[2]` ([`key`]).
 //! Metrics are in [`metrics`]: peaks of the tips, of G and of the driving forces, the residual
 //! vibration after a rest-to-rest motion, and the AMM's mean EVP against the FEM (Eq. 45).
 
@@ -18,6 +19,7 @@ pub mod error;
 /// The hash of run ids and study fingerprints (it lives in the model crate, shared with the
 /// sidecars).
 pub use flexstar_model::hash;
+pub mod key;
 pub mod merge;
 pub mod metrics;
 pub mod patch;

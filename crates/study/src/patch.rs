@@ -16,9 +16,9 @@
 ///   `docs/motions.md` section 1.5).
 pub const SCALE_DURATION: &str = "scale.duration";
 
-/// The base document with `values[j]` set at `keys[j]` (derived keys applied last). An error is a
-/// structural problem of the key (a path through a value that is not a table, a non-numeric
-/// scale).
+/// The base document with `values[j]` set at `keys[j]` (one entry of a list key for an indexed
+/// key, [`crate::key`]; derived keys applied last). An error is a structural problem of the key
+/// (a path through a value that is not a table, a non-numeric scale, a list of another length).
 pub fn case_document(base: &toml::Table, keys: &[String], values: &[toml::Value]) -> Result<toml::Table, String> {
     let mut doc = base.clone();
     let mut scale = None;
@@ -29,7 +29,7 @@ pub fn case_document(base: &toml::Table, keys: &[String], values: &[toml::Value]
         } else if crate::derived::is_derived(key) {
             derived.push((key.as_str(), value));
         } else {
-            set_dotted(&mut doc, key, value.clone())?;
+            crate::key::set(&mut doc, &crate::key::Key::parse(key)?, value.clone())?;
         }
     }
     crate::derived::apply(&mut doc, &derived)?;
@@ -61,6 +61,16 @@ pub fn set_dotted(doc: &mut toml::Table, key: &str, value: toml::Value) -> Resul
     }
     table.insert(last.to_string(), value);
     Ok(())
+}
+
+/// The value at the dotted `key` of a TOML document, if there is one.
+pub fn get_dotted<'a>(doc: &'a toml::Table, key: &str) -> Option<&'a toml::Value> {
+    let mut parts = key.split('.');
+    let mut value = doc.get(parts.next()?)?;
+    for p in parts {
+        value = value.as_table()?.get(p)?;
+    }
+    Some(value)
 }
 
 /// A TOML number as f64.

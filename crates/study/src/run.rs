@@ -275,16 +275,56 @@ fn solve(exp: &Experiment, solver: Solver, fem_reference: FemReference) -> Solve
     }));
     let result = match result {
         Ok(r) => r.map_err(Failure::from),
-        Err(panic) => Err(Failure::Panicked(
-            panic
-                .downcast_ref::<String>()
-                .map(String::as_str)
-                .or_else(|| panic.downcast_ref::<&str>().copied())
-                .unwrap_or("(no message)")
-                .to_string(),
-        )),
+        Err(panic) => Err(Failure::Panicked(panic_text(&panic))),
     };
     (result, started.elapsed().as_secs_f64())
+}
+
+/// The modal metrics of a case, once per case: the end of the motion with the settling hold
+/// (`residual_*`, `settle_s`) and the first frequency at the start pose (`f1_hz`). A metric that
+/// fails (a modal analysis that refuses the robot, a pose it cannot hold) leaves its columns
+/// empty and says why on stderr, naming the study and the case; the solver columns stay.
+fn case_metrics(study: &Study, case: &Case, exp: &Experiment) -> (Option<(f64, f64)>, Option<f64>) {
+    let note = |columns: &str, reason: String| {
+        eprintln!(
+            "{}: case {}: {columns} left empty: {}",
+            study.file.display(),
+            case.run_id,
+            reason.replace(['\n', '\r'], " ")
+        );
+    };
+    let guarded = |f: &dyn Fn() -> Result<Option<f64>, String>| -> Result<Option<f64>, String> {
+        catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| Err(format!("the modal analysis panicked: {}", panic_text(&p))))
+    };
+    let rest = flexstar_modal::settle::motion_end(exp).and_then(|t_rest| {
+        match guarded(&|| flexstar_modal::settle::settle_hold_s(exp).map_err(|e| e.to_string())) {
+            Ok(hold) => hold.map(|h| (t_rest, h)),
+            Err(e) => {
+                note("residual_tip_m, residual_G_m, settle_s", e);
+                None
+            }
+        }
+    });
+    let f1 = guarded(&|| {
+        flexstar_modal::analysis::start_pose_frequencies(exp, 1)
+            .map(|f| f.first().copied())
+            .map_err(|e| e.to_string())
+    });
+    let f1_hz = f1.unwrap_or_else(|e| {
+        note("f1_hz", e);
+        None
+    });
+    (rest, f1_hz)
+}
+
+/// The message of a caught panic.
+fn panic_text(panic: &Box<dyn std::any::Any + Send>) -> String {
+    panic
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| panic.downcast_ref::<&str>().copied())
+        .unwrap_or("(no message)")
+        .to_string()
 }
 
 /// Run every solver of the study on one case and make its rows (one per solver).
@@ -313,19 +353,10 @@ pub fn run_case(study: &Study, case: &Case) -> Vec<Row> {
         _ => None,
     };
     let exp = exp.as_ref().ok();
-    // the end of the motion and the settling hold, once per case (one modal analysis)
-    let rest = exp.and_then(|e| {
-        let t_rest = flexstar_modal::settle::motion_end(e)?;
-        let hold = flexstar_modal::settle::settle_hold_s(e).ok().flatten()?;
-        Some((t_rest, hold))
-    });
-    // the robot's first frequency where the motion starts (one more modal analysis)
-    let f1_hz = exp.and_then(|e| {
-        flexstar_modal::analysis::start_pose_frequencies(e, 1)
-            .ok()?
-            .first()
-            .copied()
-    });
+    let (rest, f1_hz) = match exp {
+        Some(e) => case_metrics(study, case, e),
+        None => (None, None),
+    };
     solved
         .iter()
         .map(|(solver, (result, wall_s))| {

@@ -22,6 +22,7 @@ use serde::Deserialize;
 
 use crate::error::StudyError;
 use crate::hash::hex64;
+use crate::key::{self, Key};
 use crate::patch::{self, SCALE_DURATION};
 
 /// Largest number of cases a study may expand to.
@@ -151,6 +152,9 @@ struct VaryFile {
     logspace: Option<Vec<toml::Value>>,
     normal: Option<Vec<toml::Value>>,
     uniform: Option<Vec<toml::Value>>,
+    /// Draw each beam of a whole beam key on its own: the key becomes three columns `key[1..3]`.
+    #[serde(default)]
+    per_beam: bool,
 }
 
 impl Study {
@@ -185,7 +189,14 @@ impl Study {
                 message: e.to_string(),
             },
         })?;
-        let vary_list: Vec<Vary> = raw.vary.into_iter().map(|v| vary(path, v)).collect::<Result<_, _>>()?;
+        let vary_list: Vec<Vary> = raw
+            .vary
+            .into_iter()
+            .map(|v| vary(path, v))
+            .collect::<Result<Vec<_>, _>>()?
+            .into_iter()
+            .flatten()
+            .collect();
         let ties = ties(path, raw.tie, &vary_list, &base)?;
         let study = Study {
             file: path.to_path_buf(),
@@ -212,7 +223,8 @@ impl Study {
         self.vary.iter().map(|v| v.key.clone()).collect()
     }
 
-    /// At least one key, no key twice, and not more than [`MAX_CASES`] cases.
+    /// At least one key, no key twice (nor a whole key and one of its beams), no side of the base
+    /// with the in-radius it replaces, and not more than [`MAX_CASES`] cases.
     fn check_shape(&self) -> Result<(), StudyError> {
         if self.vary.is_empty() {
             return Err(StudyError::invalid(
@@ -221,9 +233,35 @@ impl Study {
                 "a study needs at least one [[vary]] entry",
             ));
         }
+        let parsed: Vec<Key> = self
+            .vary
+            .iter()
+            .map(|v| Key::parse(&v.key).map_err(|e| self.vary_error(&v.key, e)))
+            .collect::<Result<_, _>>()?;
+        let tied: Vec<Key> = self.ties.iter().filter_map(|t| Key::parse(&t.key).ok()).collect();
+        let sides = parsed
+            .iter()
+            .chain(&tied)
+            .find(|k| k.path == "base.sides")
+            .map(Key::text);
         for (i, v) in self.vary.iter().enumerate() {
             if self.vary[..i].iter().any(|w| w.key == v.key) {
                 return Err(self.vary_error(&v.key, "the key is varied twice"));
+            }
+            if let Some(w) = parsed[..i].iter().find(|w| w.overlaps(&parsed[i])) {
+                return Err(self.vary_error(
+                    &v.key,
+                    format!("{} is also varied: vary the whole key or its beams, not both", w.text()),
+                ));
+            }
+            if let (Some(side), "robot.d" | "derived.d_share") = (&sides, v.key.as_str()) {
+                return Err(self.vary_error(
+                    &v.key,
+                    format!(
+                        "{side} gives the base by its sides, which replace robot.d: vary derived.dev.sides[i] \
+                         (a factor on the sides of the base that robot.d or derived.d_share makes) instead"
+                    ),
+                ));
             }
             if v.levels.is_distribution() && self.sampling == Sampling::Grid {
                 return Err(self.vary_error(
@@ -455,10 +493,14 @@ fn sampling(
     }
 }
 
-fn vary(file: &Path, v: VaryFile) -> Result<Vary, StudyError> {
-    let err = |reason: String| StudyError::VaryKey {
+/// One `[[vary]]` entry: one key, or with `per_beam = true` the three beams of a whole beam key
+/// (`robot.L[1]`, `robot.L[2]`, `robot.L[3]`, each with the entry's levels: three columns of a
+/// grid or a hypercube, three independent draws).
+fn vary(file: &Path, v: VaryFile) -> Result<Vec<Vary>, StudyError> {
+    let name = v.key.clone();
+    let err = move |reason: String| StudyError::VaryKey {
         file: file.to_path_buf(),
-        key: v.key.clone(),
+        key: name.clone(),
         reason,
     };
     let key_ok = !v.key.is_empty() && v.key.split('.').all(|p| !p.is_empty()) && v.key.contains('.');
@@ -467,15 +509,43 @@ fn vary(file: &Path, v: VaryFile) -> Result<Vary, StudyError> {
             "a key is a dotted experiment key such as robot.Lp or time.t_end, or scale.duration".into(),
         ));
     }
+    let parsed = Key::parse(&v.key).map_err(&err)?;
     if v.key.starts_with("scale.") && v.key != SCALE_DURATION {
         return Err(err(format!("the only scale key is {SCALE_DURATION}")));
     }
     if v.key.starts_with("derived.") && !crate::derived::is_derived(&v.key) {
         return Err(err(format!(
-            "unknown derived key; the derived keys are {}",
+            "unknown derived key; the derived keys are {} (derived.dev.* with an optional index [i])",
             crate::derived::DERIVED.join(", ")
         )));
     }
+    if v.per_beam && (parsed.index.is_some() || !key::per_beam_allowed(&parsed.path)) {
+        return Err(err(if parsed.index.is_some() {
+            "per_beam = true draws each beam of a whole key: give the key without an index".into()
+        } else {
+            format!(
+                "per_beam = true takes a beam key of [robot] ({}) or a derived deviation derived.dev.*; \
+                 vary the entries of other list keys one by one ({}[2])",
+                key::BEAM_KEYS.join(", "),
+                v.key
+            )
+        }));
+    }
+    let per_beam = v.per_beam;
+    let one = one_vary(v, err)?;
+    if !per_beam {
+        return Ok(vec![one]);
+    }
+    Ok((1..=3)
+        .map(|i| Vary {
+            key: parsed.at(i).text(),
+            levels: one.levels.clone(),
+        })
+        .collect())
+}
+
+/// The levels of one `[[vary]]` entry, checked.
+fn one_vary(v: VaryFile, err: impl Fn(String) -> StudyError) -> Result<Vary, StudyError> {
     let given = [
         v.values.is_some(),
         v.linspace.is_some(),

@@ -75,6 +75,9 @@ def test_a_robot_as_built_from_a_dict(root):
     assert not np.array_equal(run["w2tip"], flexstar.run(exp)["w2tip"])
     m = flexstar.modal(built, at=0.3, modes=4)
     np.testing.assert_allclose(m["amm_hz"], m["fem_hz"], rtol=0.01)
+    # one beam by the sweeps' per-beam key: the others keep the file's value
+    one = exp.with_values({"robot.L[2]": 0.47})
+    assert one.to_dict()["robot"]["L"] == [0.5, 0.47, 0.5]
 
 
 @pytest.mark.parametrize(

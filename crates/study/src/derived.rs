@@ -115,7 +115,10 @@ struct Values<'a>(Vec<(Key, &'a toml::Value)>);
 
 impl Values<'_> {
     fn get(&self, path: &str) -> Option<&toml::Value> {
-        self.0.iter().find(|(k, _)| k.path == path && k.index.is_none()).map(|(_, v)| *v)
+        self.0
+            .iter()
+            .find(|(k, _)| k.path == path && k.index.is_none())
+            .map(|(_, v)| *v)
     }
 
     fn num(&self, path: &str) -> Result<Option<f64>, String> {
@@ -211,7 +214,9 @@ fn deviations(doc: &mut toml::Table, values: &Values) -> Result<(), String> {
 /// `derived.d_share = v` (module docs).
 fn d_share(doc: &mut toml::Table, v: f64) -> Result<(), String> {
     if crate::patch::get_dotted(doc, "base.sides").is_some() {
-        return Err("derived.d_share sets robot.d, but the base gives base.sides: vary derived.dev.sides instead".into());
+        return Err(
+            "derived.d_share sets robot.d, but the base gives base.sides: vary derived.dev.sides instead".into(),
+        );
     }
     let (l, lp) = (beams(doc, "L")?, beams(doc, "Lp")?);
     let lo = max3(std::array::from_fn(|k| lp[k] / 2.0 + D_MARGIN * l[k]));
@@ -295,7 +300,9 @@ fn gravity(doc: &mut toml::Table, share: Option<f64>, deg: Option<f64>) -> Resul
         G_SAG_SHARE * DEFLECTION_LIMIT * o.l[k] * 8.0 * o.ei[k] / (o.rho[k] * o.overhang[k].powi(4))
     }));
     if !(cap.is_finite() && cap > 0.0) {
-        return Err(format!("derived.g_share: no positive gravity for this robot (cap {cap})"));
+        return Err(format!(
+            "derived.g_share: no positive gravity for this robot (cap {cap})"
+        ));
     }
     let g = share * G_EARTH.min(cap);
     let angle = deg.unwrap_or(G_DEG_DEFAULT).to_radians();
@@ -437,7 +444,10 @@ mod tests {
         assert!(g[0].abs() < 1e-12 && g[1] < 0.0, "straight down: {g:?}");
         let overhang = 0.4 - flexstar_model::RobotParams::paper().d;
         let sag = 0.1 * -g[1] * overhang.powi(4) / (8.0 * 70e9 * 2.5e-13);
-        assert!(-g[1] < 9.81 && (sag / (0.05 * 0.4) - 0.25).abs() < 1e-9, "{g:?}, sag {sag}");
+        assert!(
+            -g[1] < 9.81 && (sag / (0.05 * 0.4) - 0.25).abs() < 1e-9,
+            "{g:?}, sag {sag}"
+        );
         let e = apply(&mut doc(), &[("derived.g_deg", &deg)]).unwrap_err();
         assert!(e.contains("derived.g_share"), "{e}");
     }

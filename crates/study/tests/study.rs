@@ -412,3 +412,16 @@ fn bad_distributions_and_ties_are_refused_naming_the_key() {
     let e = load_err(&study_with(random, not_a_key));
     assert!(e.contains("robot.Lq"), "{e}");
 }
+
+/// The AMM does not model friction yet (docs/friction.md 6): a study running it that varies a
+/// `friction.*` key is refused at load, naming the key; the FEM alone takes it.
+#[test]
+fn friction_is_refused_for_the_amm_before_any_run() {
+    let vary = "[[vary]]\nkey = \"friction.mu\"\nvalues = [0.0, 0.1]\n";
+    let e = load_err(&study_text(vary));
+    assert!(e.contains("friction.mu") && e.contains("AMM"), "{e}");
+    let (_d, p) = setup(&format!(
+        "name = \"s\"\nbase = \"base.toml\"\nsolvers = [\"fem\"]\n{vary}"
+    ));
+    assert!(Study::load(&p).is_ok());
+}

@@ -2,6 +2,11 @@
 //! model, against references independent of both solvers' assembly (docs/amm.md 11.5, Eqs.
 //! C1-C4; docs/modes.md, Eqs. D11-D13, L4).
 
+// its saddle-point matrix only
+#[allow(dead_code)]
+#[path = "support/inertia_relief.rs"]
+mod inertia_relief;
+
 use flexstar_modal::analysis::{amm_pose_model, fem_pose_modes, modal};
 use flexstar_modal::linear::{linearize_with, Holding, LinearSettings};
 use flexstar_modal::pose::pose_from_task;
@@ -204,18 +209,7 @@ fn load_channel_static_gain_matches_the_fem_static_deflection() {
     let sys = flexstar_fem::pose_modes::pose_system(&exp.robot, &pose, Sliders::Locked, 150).unwrap();
     let (n, rows) = (sys.n, sys.rows);
     let size = n + rows;
-    let mut kkt = faer::Mat::<f64>::zeros(size, size);
-    for i in 0..n {
-        for j in 0..n {
-            kkt[(i, j)] = sys.k[i * n + j];
-        }
-    }
-    for r in 0..rows {
-        for j in 0..n {
-            kkt[(n + r, j)] = sys.c[r * n + j];
-            kkt[(j, n + r)] = sys.c[r * n + j];
-        }
-    }
+    let kkt = inertia_relief::saddle_matrix(&sys, 0);
     let lu = kkt.partial_piv_lu();
     let (mut worst, mut scale) = (0.0f64, 0.0f64);
     for k in 0..3 {

@@ -177,9 +177,11 @@ fn default_list(doc: &toml::Table, path: &str) -> Result<Vec<toml::Value>, Strin
             }
             f(2.0 * 3f64.sqrt() * in_radius(doc), 3)
         }
-        other => return Err(format!(
+        other => {
+            return Err(format!(
             "the base sets no {other} for the other entries to keep: give {other} (one number or a list) in the base"
-        )),
+        ))
+        }
     })
 }
 

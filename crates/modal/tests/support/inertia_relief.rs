@@ -29,18 +29,7 @@ pub fn elastic_static_gain_error(robot: &Robot, ss: &StateSpace) -> (f64, f64) {
         .map(|x| (0..n).map(|i| (0..n).map(|j| sys.m[i * n + j] * x[j]).sum()).collect())
         .collect();
     let size = n + rows + 3;
-    let mut kkt = faer::Mat::<f64>::zeros(size, size);
-    for i in 0..n {
-        for j in 0..n {
-            kkt[(i, j)] = sys.k[i * n + j];
-        }
-    }
-    for r in 0..rows {
-        for j in 0..n {
-            kkt[(n + r, j)] = sys.c[r * n + j];
-            kkt[(j, n + r)] = sys.c[r * n + j];
-        }
-    }
+    let mut kkt = saddle_matrix(&sys, 3);
     for (q, mp) in mphi.iter().enumerate() {
         for j in 0..n {
             kkt[(n + rows + q, j)] = mp[j];
@@ -88,4 +77,24 @@ pub fn elastic_static_gain_error(robot: &Robot, ss: &StateSpace) -> (f64, f64) {
         }
     }
     (worst, scale)
+}
+
+/// The static saddle-point matrix `[[K, Phi_q^T], [Phi_q, 0]]` of a FEM system at a pose, with
+/// `extra` further rows and columns left zero for the caller's own constraints.
+pub fn saddle_matrix(sys: &flexstar_fem::pose_modes::PoseSystem, extra: usize) -> faer::Mat<f64> {
+    let (n, rows) = (sys.n, sys.rows);
+    let size = n + rows + extra;
+    let mut kkt = faer::Mat::<f64>::zeros(size, size);
+    for i in 0..n {
+        for j in 0..n {
+            kkt[(i, j)] = sys.k[i * n + j];
+        }
+    }
+    for r in 0..rows {
+        for j in 0..n {
+            kkt[(n + r, j)] = sys.c[r * n + j];
+            kkt[(j, n + r)] = sys.c[r * n + j];
+        }
+    }
+    kkt
 }

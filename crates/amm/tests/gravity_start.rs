@@ -13,9 +13,13 @@
 use flexstar_model::{AmmSettings, Experiment, FemSettings, Response};
 
 fn amm(exp: &Experiment, settings: &AmmSettings) -> Response {
-    flexstar_amm::solve(&exp.problem().unwrap(), settings, flexstar_drive::SolveRequest::motion())
-        .unwrap()
-        .response
+    flexstar_amm::solve(
+        &exp.problem().unwrap(),
+        settings,
+        flexstar_drive::SolveRequest::motion(),
+    )
+    .unwrap()
+    .response
 }
 
 /// Eq. 45 on the output grid: `int |a - b| dt / int |b| dt` [%].

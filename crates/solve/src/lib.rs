@@ -212,11 +212,15 @@ mod tests {
                  s1 = [0.0]\ns2 = [0.0]\ns3 = [0.0]\n"
             )
         };
-        let built = Experiment::from_toml_str(&text("[robot]\nL = [0.5, 0.5, 0.3]\n"), std::path::Path::new("p.toml"))
-            .unwrap();
+        let built =
+            Experiment::from_toml_str(&text("[robot]\nL = [0.5, 0.5, 0.3]\n"), std::path::Path::new("p.toml")).unwrap();
         let r = reference_fem(&built);
         let expected = 5e-4 * 0.6f64.powi(3) / 8.0;
-        assert!((r.dt.unwrap() / expected - 1.0).abs() < 1e-12, "{:?} vs {expected}", r.dt);
+        assert!(
+            (r.dt.unwrap() / expected - 1.0).abs() < 1e-12,
+            "{:?} vs {expected}",
+            r.dt
+        );
         assert!(r.elements.is_multiple_of(3) && r.elements == 4 * built.fem.elements);
         let paper = Experiment::from_toml_str(&text(""), std::path::Path::new("p.toml")).unwrap();
         assert_eq!(

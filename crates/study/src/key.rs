@@ -100,7 +100,9 @@ impl Key {
     pub fn parse(text: &str) -> Result<Key, String> {
         let Some(open) = text.find('[') else {
             if text.contains(']') {
-                return Err(format!("`{text}`: an index is a whole number in brackets at the end: robot.L[2]"));
+                return Err(format!(
+                    "`{text}`: an index is a whole number in brackets at the end: robot.L[2]"
+                ));
             }
             return Ok(Key {
                 path: text.to_string(),
@@ -113,7 +115,9 @@ impl Key {
             .and_then(|r| r.strip_suffix(']'))
             .filter(|d| !d.is_empty() && d.chars().all(|c| c.is_ascii_digit()));
         let Some(digits) = digits else {
-            return Err(format!("`{text}`: an index is a whole number in brackets at the end: robot.L[2]"));
+            return Err(format!(
+                "`{text}`: an index is a whole number in brackets at the end: robot.L[2]"
+            ));
         };
         let Some(kind) = entries(path) else {
             return Err(format!(
@@ -127,10 +131,7 @@ impl Key {
                 path: path.to_string(),
                 index: Some(i),
             }),
-            _ => Err(format!(
-                "`{text}`: {} index {digits} is out of 1..{n}",
-                kind.word()
-            )),
+            _ => Err(format!("`{text}`: {} index {digits} is out of 1..{n}", kind.word())),
         }
     }
 
@@ -178,8 +179,8 @@ fn default_list(doc: &toml::Table, path: &str) -> Result<Vec<toml::Value>, Strin
         }
         other => {
             return Err(format!(
-                "the base sets no {other} for the other entries to keep: give {other} (one number or a list) in the base"
-            ))
+            "the base sets no {other} for the other entries to keep: give {other} (one number or a list) in the base"
+        ))
         }
     })
 }
@@ -203,14 +204,15 @@ pub fn in_radius(doc: &toml::Table) -> f64 {
 /// The entries of the list key `path` in `doc`: its list, its number repeated, or its default
 /// (module docs). An error: a list of another length, a value that is neither, or no default.
 pub fn list_at(doc: &toml::Table, path: &str) -> Result<Vec<toml::Value>, String> {
-    let n = entries(path)
-        .ok_or_else(|| format!("{path} takes no index"))?
-        .count();
+    let n = entries(path).ok_or_else(|| format!("{path} takes no index"))?.count();
     match get_dotted(doc, path) {
         Some(toml::Value::Array(a)) if a.len() == n => Ok(a.clone()),
         Some(toml::Value::Array(a)) => Err(format!("{path} lists {} values in the base, not {n}", a.len())),
         Some(v) if number(v).is_some() => Ok(vec![v.clone(); n]),
-        Some(v) => Err(format!("{path} is a {} in the base, not a number or a list", v.type_str())),
+        Some(v) => Err(format!(
+            "{path} is a {} in the base, not a number or a list",
+            v.type_str()
+        )),
         None => default_list(doc, path),
     }
 }
@@ -277,7 +279,10 @@ mod tests {
         let e = Key::parse("robot.d[2]").unwrap_err();
         assert!(e.contains("robot.d takes no index") && e.contains("robot.Jp"), "{e}");
         for bad in ["robot.L[x]", "robot.L[2", "robot.L[2]x", "robot.L]"] {
-            assert!(Key::parse(bad).unwrap_err().contains("whole number in brackets"), "{bad}");
+            assert!(
+                Key::parse(bad).unwrap_err().contains("whole number in brackets"),
+                "{bad}"
+            );
         }
     }
 
@@ -289,9 +294,22 @@ mod tests {
         // the paper's value for the beams the base does not set
         set(&mut doc, &Key::parse("robot.Lp[1]").unwrap(), toml::Value::Float(0.031)).unwrap();
         assert_eq!(doc["robot"]["Lp"], toml::Value::try_from([0.031, 0.03, 0.03]).unwrap());
-        set(&mut doc, &Key::parse("robot.weld_deg[2]").unwrap(), toml::Value::Float(121.0)).unwrap();
-        assert_eq!(doc["robot"]["weld_deg"], toml::Value::try_from([0.0, 121.0, 240.0]).unwrap());
-        set(&mut doc, &Key::parse("gravity.g[2]").unwrap(), toml::Value::Float(-9.81)).unwrap();
+        set(
+            &mut doc,
+            &Key::parse("robot.weld_deg[2]").unwrap(),
+            toml::Value::Float(121.0),
+        )
+        .unwrap();
+        assert_eq!(
+            doc["robot"]["weld_deg"],
+            toml::Value::try_from([0.0, 121.0, 240.0]).unwrap()
+        );
+        set(
+            &mut doc,
+            &Key::parse("gravity.g[2]").unwrap(),
+            toml::Value::Float(-9.81),
+        )
+        .unwrap();
         assert_eq!(doc["gravity"]["g"], toml::Value::try_from([0.0, -9.81]).unwrap());
         // a side of the base of in-radius d = 0.2: the others 2 sqrt(3) d, and robot.d goes
         set(&mut doc, &Key::parse("base.sides[2]").unwrap(), toml::Value::Float(0.7)).unwrap();

@@ -294,7 +294,8 @@ fn case_metrics(study: &Study, case: &Case, exp: &Experiment) -> (Option<(f64, f
         );
     };
     let guarded = |f: &dyn Fn() -> Result<Option<f64>, String>| -> Result<Option<f64>, String> {
-        catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| Err(format!("the modal analysis panicked: {}", panic_text(&p))))
+        catch_unwind(AssertUnwindSafe(f))
+            .unwrap_or_else(|p| Err(format!("the modal analysis panicked: {}", panic_text(&p))))
     };
     let rest = flexstar_modal::settle::motion_end(exp).and_then(|t_rest| {
         match guarded(&|| flexstar_modal::settle::settle_hold_s(exp).map_err(|e| e.to_string())) {

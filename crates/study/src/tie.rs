@@ -116,7 +116,11 @@ impl Tie {
 /// a reference that is neither varied, nor tied, nor a number of `base`, of a whole beam key read
 /// as one number while the study sets it beam by beam, or of a cycle.
 pub fn ordered(ties: Vec<Tie>, varied: &[String], base: &toml::Table) -> Result<Vec<Tie>, (String, String)> {
-    let varied: Vec<Key> = varied.iter().map(|v| Key::parse(v)).collect::<Result<_, _>>().map_err(|e| (String::new(), e))?;
+    let varied: Vec<Key> = varied
+        .iter()
+        .map(|v| Key::parse(v))
+        .collect::<Result<_, _>>()
+        .map_err(|e| (String::new(), e))?;
     let set_by_beam = |path: &str| {
         varied
             .iter()
@@ -125,15 +129,20 @@ pub fn ordered(ties: Vec<Tie>, varied: &[String], base: &toml::Table) -> Result<
     };
     for t in &ties {
         if let Some(v) = varied.iter().find(|v| v.overlaps(&t.target)) {
-            return Err((t.key.clone(), format!("the key is both varied (as {}) and tied", v.text())));
+            return Err((
+                t.key.clone(),
+                format!("the key is both varied (as {}) and tied", v.text()),
+            ));
         }
-        if let Some(u) = ties.iter().find(|u| !std::ptr::eq(*u, t) && u.target.overlaps(&t.target)) {
+        if let Some(u) = ties
+            .iter()
+            .find(|u| !std::ptr::eq(*u, t) && u.target.overlaps(&t.target))
+        {
             return Err((t.key.clone(), format!("the key is tied twice (also as {})", u.key)));
         }
         for r in &t.refs {
-            let known = varied.iter().any(|v| v.overlaps(r))
-                || ties.iter().any(|u| u.target.overlaps(r))
-                || t.in_base(base, r);
+            let known =
+                varied.iter().any(|v| v.overlaps(r)) || ties.iter().any(|u| u.target.overlaps(r)) || t.in_base(base, r);
             if !known {
                 return Err((
                     t.key.clone(),
@@ -268,22 +277,43 @@ mod tests {
         assert_eq!(number_at(&doc, "robot.Jp[3]"), Some(2.5e-5));
         // the other beams keep the paper's slider mass
         assert_eq!(number_at(&doc, "robot.mpp_mpa[1]"), Some(0.2));
-        assert_eq!(number_at(&doc, "robot.mpp_mpa[3]"), Some(crate::sample::tidy(0.2 + 10.0 * (0.015 - 0.03))));
+        assert_eq!(
+            number_at(&doc, "robot.mpp_mpa[3]"),
+            Some(crate::sample::tidy(0.2 + 10.0 * (0.015 - 0.03)))
+        );
     }
 
     #[test]
     fn per_beam_overlaps_unknown_beams_and_whole_reads_are_refused() {
         let lp_by_beam = ["robot.Lp[2]".to_string()];
         // robot.Jp[2] varied and robot.Jp tied overlap
-        let e = ordered(vec![Tie::new("robot.Jp", "1e-4").unwrap()], &["robot.Jp[2]".into()], &base()).unwrap_err();
+        let e = ordered(
+            vec![Tie::new("robot.Jp", "1e-4").unwrap()],
+            &["robot.Jp[2]".into()],
+            &base(),
+        )
+        .unwrap_err();
         assert!(e.1.contains("both varied (as robot.Jp[2])"), "{e:?}");
-        let twice = vec![Tie::new("robot.Jp", "1e-4").unwrap(), Tie::new("robot.Jp[1]", "2e-4").unwrap()];
+        let twice = vec![
+            Tie::new("robot.Jp", "1e-4").unwrap(),
+            Tie::new("robot.Jp[1]", "2e-4").unwrap(),
+        ];
         assert!(ordered(twice, &[], &base()).unwrap_err().1.contains("tied twice"));
         // a whole key read as one number while it is set beam by beam
-        let e = ordered(vec![Tie::new("time.t_end", "10 * robot.Lp").unwrap()], &lp_by_beam, &base()).unwrap_err();
+        let e = ordered(
+            vec![Tie::new("time.t_end", "10 * robot.Lp").unwrap()],
+            &lp_by_beam,
+            &base(),
+        )
+        .unwrap_err();
         assert!(e.1.contains("name the beam, robot.Lp[1]"), "{e:?}");
         // a beam the base does not set, a beam out of range
-        let e = ordered(vec![Tie::new("robot.Jp[1]", "robot.rho[1] * 1e-3").unwrap()], &[], &base()).unwrap_err();
+        let e = ordered(
+            vec![Tie::new("robot.Jp[1]", "robot.rho[1] * 1e-3").unwrap()],
+            &[],
+            &base(),
+        )
+        .unwrap_err();
         assert!(e.1.contains("robot.rho[1]"), "{e:?}");
         let e = Tie::new("robot.Jp", "robot.Lp[4] * 2").unwrap_err();
         assert!(e.contains("out of 1..3"), "{e}");

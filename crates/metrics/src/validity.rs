@@ -37,7 +37,12 @@ pub const G_BOUND: f64 = 0.05;
 /// `robot`: each beam's length L_i [m] ([`RobotGeometry::beam_length`]; on a robot as built each
 /// beam is judged against its own).
 pub fn small_deflection_check(r: &Response, robot: &impl RobotGeometry) -> Option<ValidityExceeded> {
-    let l = |i: usize| robot.beam_length(i);
+    small_deflection_check_lengths(r, std::array::from_fn(|i| robot.beam_length(i)))
+}
+
+/// [`small_deflection_check`] with beam i judged against the length `lengths[i]` [m].
+pub fn small_deflection_check_lengths(r: &Response, lengths: [f64; 3]) -> Option<ValidityExceeded> {
+    let l = |i: usize| lengths[i];
     let mut series: Vec<(String, Vec<f64>, f64)> = (0..3)
         .map(|i| {
             (

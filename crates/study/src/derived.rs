@@ -26,12 +26,13 @@
 //!   rest-to-rest quintic of G by `0.1 L_min` along x and `-0.05 L_min` along y whose peak
 //!   acceleration `5.77 D / T^2` is `a`, with `t_end = 2.5 T` (a residual window after it);
 //! - `derived.g_share` [0, 1] and `derived.g_deg` [deg]: gravity `|g| (cos, sin)(g_deg)` in the
-//!   plane (`g_deg` from the X axis, counter-clockwise; default 270, straight down), with
-//!   `|g| = v min(9.81, g_cap)`: `g_cap` is the gravity under which the static sag of the most
-//!   flexible overhang, `rho_k g l_k^4 / (8 EI_k)`, is a quarter of the small-deflection limit
-//!   `0.05 L_k` ([`G_SAG_SHARE`]), so that the sag stays well inside the range however soft
-//!   the robot (on three quarters of the envelope's robots `g_cap` exceeds 9.81 and `|g|`
-//!   spans 0-9.81);
+//!   plane (`g_deg` from the X axis, counter-clockwise; default 270, straight down; `g_share`
+//!   default 1 when only `g_deg` is given), with `|g| = v min(9.81, g_cap)`: `g_cap` is the gravity
+//!   along `g_deg` under which the star's static sag at the start (a linear estimate,
+//!   [`crate::sag`], Eqs. D1-D4 of `docs/studies.md`) reaches a quarter ([`G_SAG_SHARE`]) of the
+//!   nearest small-deflection bound (`|w_iG|`, the tips, the sleeves' slope), so that the sag
+//!   stays well inside the range however soft the robot (a quarter of the envelope's robots take
+//!   the whole 9.81 m/s^2, the median about 3 m/s^2);
 //! - `derived.dev.sides[k]` [-]: a factor on side k of the base, the sides of the base set
 //!   before (`base.sides`, or `2 sqrt(3) d` of `robot.d`, which it then removes).
 
@@ -71,8 +72,8 @@ const DYNAMIC: f64 = 4.0;
 const QUINTIC_PEAK: f64 = 5.773_502_691_896_258;
 /// The largest gravity of `derived.g_share` [m/s^2].
 pub const G_EARTH: f64 = 9.81;
-/// The share of the small-deflection limit that the static sag of the most flexible overhang may
-/// take under `derived.g_share = 1` (module docs).
+/// The share of the nearest small-deflection bound that the star's static sag may reach under
+/// `derived.g_share = 1` (module docs).
 pub const G_SAG_SHARE: f64 = 0.25;
 /// The default direction of gravity [deg]: straight down (-Y).
 const G_DEG_DEFAULT: f64 = 270.0;
@@ -286,28 +287,48 @@ fn motion(doc: &mut toml::Table, q: f64, quintic: bool) -> Result<(), String> {
 
 /// Gravity of `derived.g_share` and `derived.g_deg` (module docs); nothing when neither is given.
 fn gravity(doc: &mut toml::Table, share: Option<f64>, deg: Option<f64>) -> Result<(), String> {
-    let Some(share) = share else {
-        return match deg {
-            Some(_) => Err("derived.g_deg gives gravity's direction: give its size by derived.g_share".into()),
-            None => Ok(()),
-        };
+    let share = match (share, deg) {
+        (None, None) => return Ok(()),
+        (Some(v), _) => v,
+        (None, Some(_)) => 1.0,
     };
     if !(share.is_finite() && share >= 0.0) {
         return Err(format!("derived.g_share must be a share >= 0, got {share}"));
     }
-    let o = overhangs(doc)?;
-    let cap = min3(std::array::from_fn(|k| {
-        G_SAG_SHARE * DEFLECTION_LIMIT * o.l[k] * 8.0 * o.ei[k] / (o.rho[k] * o.overhang[k].powi(4))
-    }));
+    let angle = deg.unwrap_or(G_DEG_DEFAULT).to_radians();
+    let unit = [angle.cos(), angle.sin()];
+    let cap = G_SAG_SHARE / sag_share(doc, unit)?;
     if !(cap.is_finite() && cap > 0.0) {
         return Err(format!(
             "derived.g_share: no positive gravity for this robot (cap {cap})"
         ));
     }
     let g = share * G_EARTH.min(cap);
-    let angle = deg.unwrap_or(G_DEG_DEFAULT).to_radians();
-    let v = toml::Value::Array(vec![float(g * angle.cos()), float(g * angle.sin())]);
+    let v = toml::Value::Array(vec![float(g * unit[0]), float(g * unit[1])]);
     crate::patch::set_dotted(doc, "gravity.g", v)
+}
+
+/// The largest share of a small-deflection bound (`flexstar_metrics::validity`: `|w_iG|` and the
+/// tips against 0.05 of the shortest beam, the sleeves' slope against 0.075 rad) that the sag of
+/// Eqs. D1-D4 (`crate::sag`) reaches under the unit gravity `unit` [m/s^2] at the start of the
+/// motion (the sleeves at `d` from G).
+fn sag_share(doc: &toml::Table, unit: [f64; 2]) -> Result<f64, String> {
+    use flexstar_metrics::validity::{G_BOUND, SLOPE_BOUND, TIP_BOUND};
+    let (l, rho, e, i) = (beams(doc, "L")?, beams(doc, "rho")?, beams(doc, "E")?, beams(doc, "I")?);
+    let weld = key::numbers_at(doc, "robot.weld_deg")?;
+    let arms: [crate::sag::Arm; 3] = std::array::from_fn(|k| crate::sag::Arm {
+        l: l[k],
+        ei: e[k] * i[k],
+        rho: rho[k],
+        weld: weld[k].to_radians(),
+    });
+    let sag = crate::sag::star_sag(&arms, key::in_radius(doc), unit)
+        .ok_or("derived.g_share: the star's statics are singular for this robot")?;
+    let l_min = min3(l);
+    let largest = |v: [f64; 3]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    Ok((largest(sag.w_g) / (G_BOUND * l_min))
+        .max(largest(sag.w_tip) / (TIP_BOUND * l_min))
+        .max(largest(sag.slope) / SLOPE_BOUND))
 }
 
 #[cfg(test)]
@@ -426,13 +447,14 @@ mod tests {
     }
 
     /// Gravity's size is the share of min(9.81, the cap) and its direction the angle: a stiff
-    /// robot gets the whole 9.81, a soft one the sag of a quarter of the limit
-    /// (rho g l^4 / (8 EI) = 0.25 x 0.05 L, the cantilever formula written out here).
+    /// robot gets the whole 9.81, a soft one the gravity whose sag (Eqs. D1-D4, `crate::sag`,
+    /// checked there by hand statics) reaches a quarter of the nearest bound.
     #[test]
-    fn gravity_is_capped_by_the_sag_of_the_softest_overhang() {
+    fn gravity_is_capped_by_the_sag_of_the_star() {
         let share = toml::Value::Float(0.5);
         let deg = toml::Value::Float(30.0);
         let mut stiff = doc();
+        crate::patch::set_dotted(&mut stiff, "robot.I", toml::Value::Float(2.5e-11)).unwrap();
         apply(&mut stiff, &[("derived.g_share", &share), ("derived.g_deg", &deg)]).unwrap();
         let g = key::numbers_at(&stiff, "gravity.g").unwrap();
         assert!((g[0].hypot(g[1]) - 0.5 * 9.81).abs() < 1e-9 && (g[1].atan2(g[0]).to_degrees() - 30.0).abs() < 1e-9);
@@ -441,14 +463,25 @@ mod tests {
         let one = toml::Value::Float(1.0);
         apply(&mut soft, &[("derived.g_share", &one)]).unwrap();
         let g = key::numbers_at(&soft, "gravity.g").unwrap();
-        assert!(g[0].abs() < 1e-12 && g[1] < 0.0, "straight down: {g:?}");
-        let overhang = 0.4 - flexstar_model::RobotParams::paper().d;
-        let sag = 0.1 * -g[1] * overhang.powi(4) / (8.0 * 70e9 * 2.5e-13);
         assert!(
-            -g[1] < 9.81 && (sag / (0.05 * 0.4) - 0.25).abs() < 1e-9,
-            "{g:?}, sag {sag}"
+            g[0].abs() < 1e-12 && g[1] < 0.0 && -g[1] < 9.81,
+            "straight down, capped: {g:?}"
         );
-        let e = apply(&mut doc(), &[("derived.g_deg", &deg)]).unwrap_err();
-        assert!(e.contains("derived.g_share"), "{e}");
+        let arms: [crate::sag::Arm; 3] = std::array::from_fn(|k| crate::sag::Arm {
+            l: 0.4,
+            ei: 70e9 * 2.5e-13,
+            rho: 0.1,
+            weld: (120.0 * k as f64).to_radians(),
+        });
+        let s = crate::sag::star_sag(&arms, flexstar_model::RobotParams::paper().d, [g[0], g[1]]).unwrap();
+        let big = |v: [f64; 3]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let share = (big(s.w_g) / 0.02).max(big(s.w_tip) / 0.02).max(big(s.slope) / 0.075);
+        assert!((share - 0.25).abs() < 1e-9, "{share}");
+        // the direction alone: the whole of min(9.81, cap)
+        let mut d = stiff.clone();
+        d.remove("gravity");
+        apply(&mut d, &[("derived.g_deg", &deg)]).unwrap();
+        let g = key::numbers_at(&d, "gravity.g").unwrap();
+        assert!((g[0].hypot(g[1]) - 9.81).abs() < 1e-9, "{g:?}");
     }
 }

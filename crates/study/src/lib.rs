@@ -19,6 +19,7 @@ pub mod error;
 /// The hash of run ids and study fingerprints (it lives in the model crate, shared with the
 /// sidecars).
 pub use flexstar_model::hash;
+pub mod in_range;
 pub mod key;
 pub mod merge;
 pub mod metrics;
@@ -26,6 +27,7 @@ pub mod patch;
 pub mod plots;
 pub mod report;
 pub mod run;
+pub mod sag;
 pub mod sample;
 pub mod shard;
 pub mod spec;

@@ -387,12 +387,23 @@ impl Study {
         self.experiment_with(&self.keys(), values)
     }
 
-    fn experiment_with(&self, keys: &[String], values: &[toml::Value]) -> Result<Experiment, String> {
+    /// The experiment file of one case as TOML text: the base document with the case's values
+    /// and ties (what [`Study::experiment`] loads; `examples/case_toml.rs` writes it, to rerun
+    /// a case with `flexstar run`). Paths in it are relative to the base file's folder.
+    pub fn case_toml(&self, values: &[toml::Value]) -> Result<String, String> {
+        self.case_text(&self.keys(), values)
+    }
+
+    fn case_text(&self, keys: &[String], values: &[toml::Value]) -> Result<String, String> {
         let mut doc = patch::case_document(&self.base, keys, values)?;
         if keys.len() == self.vary.len() {
             crate::tie::apply(&mut doc, &self.ties)?;
         }
-        let text = toml::to_string(&doc).map_err(|e| e.to_string())?;
+        toml::to_string(&doc).map_err(|e| e.to_string())
+    }
+
+    fn experiment_with(&self, keys: &[String], values: &[toml::Value]) -> Result<Experiment, String> {
+        let text = self.case_text(keys, values)?;
         let exp = Experiment::from_toml_str(&text, &self.base_file).map_err(|e| e.to_string())?;
         flexstar_shaping::shape_loaded(exp).map_err(|e| e.to_string())
     }

@@ -1,0 +1,32 @@
+//! The experiment file of one case of a study, to rerun it alone (`flexstar run`, `flexstar
+//! compare`): `cargo run --release -p flexstar-study --example case_toml -- STUDY.toml RUN_ID`
+//! writes its TOML to stdout. Paths in it (a table trajectory, a forces file) are relative to the
+//! study's base file: write it beside the base.
+
+use std::path::Path;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let [_, study, run_id] = args.as_slice() else {
+        eprintln!("usage: case_toml STUDY.toml RUN_ID");
+        std::process::exit(2);
+    };
+    let study = match flexstar_study::Study::load(Path::new(study)) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(1);
+        }
+    };
+    let Some(case) = study.cases().into_iter().find(|c| &c.run_id == run_id) else {
+        eprintln!("{}: no case with run id {run_id}", study.file.display());
+        std::process::exit(1);
+    };
+    match study.case_toml(&case.values) {
+        Ok(text) => print!("{text}"),
+        Err(e) => {
+            eprintln!("{}: case {run_id}: {e}", study.file.display());
+            std::process::exit(1);
+        }
+    }
+}

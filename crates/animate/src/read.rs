@@ -225,9 +225,12 @@ struct Facts {
 /// `t_rest` [s] (a top-level `t_rest` key, else the experiment's trajectory), L [m], the robot
 /// and the payload from a sidecar document; `None` for what it does not say.
 fn sidecar_facts(doc: &serde_json::Value) -> Facts {
-    let exp = doc
-        .get("experiment")
-        .and_then(|e| serde_json::from_value::<flexstar_model::Experiment>(e.clone()).ok());
+    let exp = doc.get("experiment").and_then(|e| {
+        let mut exp = serde_json::from_value::<flexstar_model::Experiment>(e.clone()).ok()?;
+        // a robot as built on its own base (serde alone leaves the paper's axes)
+        exp.place_base().ok()?;
+        Some(exp)
+    });
     let t_rest = doc
         .get("t_rest")
         .and_then(serde_json::Value::as_f64)

@@ -561,9 +561,9 @@ impl Experiment {
     /// section is then not written back), any other base makes the robot one as built
     /// ([`RobotParams::as_built`], `docs/as-built.md` 2); giving `robot.d` too is refused.
     fn read_base(&mut self, text: &str) -> Result<(), ModelError> {
-        let Some(base) = &self.base else {
+        if self.base.is_none() {
             return Ok(());
-        };
+        }
         let d_given = toml::from_str::<toml::Table>(text)
             .ok()
             .and_then(|t| t.get("robot").and_then(|r| r.get("d")).cloned())
@@ -574,6 +574,17 @@ impl Experiment {
                 "give the base once: robot.d (the paper's equilateral triangle of that in-radius) or [base]",
             ));
         }
+        self.place_base()
+    }
+
+    /// The `[base]` section placed into the robot (a no-op without one): the paper's equilateral
+    /// base sets `robot.d`, any other the axes of [`RobotParams::as_built`] (`docs/as-built.md`
+    /// 2). Also for an experiment deserialised from a sidecar's JSON, which serde alone leaves on
+    /// the paper's axes.
+    pub fn place_base(&mut self) -> Result<(), ModelError> {
+        let Some(base) = &self.base else {
+            return Ok(());
+        };
         let axes = base.axes().map_err(|(key, reason)| ModelError::invalid(key, reason))?;
         let paper_d = crate::robot_section::BaseSection::paper_in_radius(&axes);
         // the in-radius of the paper's base, or the distance from O to axis 1 (its in-radius

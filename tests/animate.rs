@@ -357,3 +357,51 @@ fn the_page_has_the_base_triangle_and_the_payload() {
     }
     assert_eq!(data["sliders"].as_array().unwrap().len(), 6);
 }
+
+/// A robot as built drawn from its run's sidecar (the route `flexstar run` -> `flexstar animate`):
+/// the corners where the drawn axes meet are the uneven base's vertices, so their distances are
+/// the file's sides (`[base] sides`, `docs/as-built.md` 2), not the paper's 2 sqrt(3) d.
+#[test]
+fn the_page_draws_a_robot_as_built_on_its_own_base() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let cfg = config(tmp.path(), "b.toml", 50, 0, 0.05);
+    let sides = [0.63, 0.6235, 0.61];
+    // the base is given once: its sides instead of the paper's in-radius d
+    let mut text: String = std::fs::read_to_string(&cfg)
+        .unwrap()
+        .lines()
+        .filter(|l| l.split_whitespace().next() != Some("d"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    text.push_str(&format!(
+        "\n[base]\nsides = [{}, {}, {}]\n",
+        sides[0], sides[1], sides[2]
+    ));
+    std::fs::write(&cfg, text).unwrap();
+    run(&cfg, "amm", &out);
+    let dir = out.join("case3");
+    let o = flexstar(&["animate", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let data = page_data(&std::fs::read_to_string(dir.join("animate.html")).unwrap());
+    let corners: Vec<(f64, f64)> = data["base"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| (c[0].as_f64().unwrap(), c[1].as_f64().unwrap()))
+        .collect();
+    assert_eq!(corners.len(), 3);
+    let mut drawn: Vec<f64> = (0..3)
+        .map(|k| {
+            let (a, b) = (corners[k], corners[(k + 1) % 3]);
+            (a.0 - b.0).hypot(a.1 - b.1) * 1e-6
+        })
+        .collect();
+    drawn.sort_by(f64::total_cmp);
+    let mut want = sides.to_vec();
+    want.sort_by(f64::total_cmp);
+    for (d, w) in drawn.iter().zip(&want) {
+        // the page's coordinates are whole micrometres
+        assert!((d - w).abs() <= 3e-6, "drawn sides {drawn:?}, file's {want:?}");
+    }
+}

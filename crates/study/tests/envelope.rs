@@ -10,12 +10,8 @@
 //! the whole of both draws every target holds (estimate / true 0.50-1.89, validation.md
 //! section 8); these nine are the part the test suite can afford.
 
-use std::path::Path;
-
-use flexstar_metrics::validity::small_deflection_check;
-use flexstar_study::run::run_case;
-use flexstar_study::Study;
-use rayon::prelude::*;
+mod support;
+use support::envelope_cases::assert_chosen_meet_the_targets;
 
 /// Run ids of the chosen cases (the study's stable FNV-1a ids of their values; validation.md 8
 /// gives each one's robot, motion and measured numbers).
@@ -33,45 +29,5 @@ const CHOSEN: [&str; 9] = [
 
 #[test]
 fn nine_envelope_cases_meet_the_evp_bounds_and_their_estimates_are_within_a_factor_two() {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/studies/envelope.toml");
-    let study = Study::load(&file).expect("the envelope study loads");
-    let cases: Vec<_> = study
-        .cases()
-        .into_iter()
-        .filter(|c| CHOSEN.contains(&c.run_id.as_str()))
-        .collect();
-    assert_eq!(cases.len(), CHOSEN.len(), "every chosen run id is in the draw");
-    let results: Vec<String> = cases
-        .par_iter()
-        .map(|case| {
-            let exp = study.experiment(&case.values).expect("a valid case");
-            let problem = exp.problem().unwrap();
-            let amm = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::motion())
-                .map(|s| s.response)
-                .expect("the AMM run");
-            let range = small_deflection_check(&amm, &exp.robot);
-            assert!(
-                range.is_none(),
-                "{}: in the small-deflection range: {range:?}",
-                case.run_id
-            );
-            let rows = run_case(&study, case);
-            let row = rows.iter().find(|r| r.solver == "amm").expect("an AMM row");
-            assert_eq!(row.status, "ok", "{}", case.run_id);
-            let mean = row.evp_percent.expect("mean EVP against the refined FEM");
-            let largest = row.evp_max_percent.expect("largest point EVP");
-            let estimate = row.error_estimate_percent.expect("the automatic N's estimate");
-            let ratio = estimate / mean;
-            let line = format!(
-                "{}: mean {mean:.3} %, largest {largest:.3} %, estimate {estimate:.3} % ({ratio:.2})",
-                case.run_id
-            );
-            assert!(mean <= 1.0 && largest <= 2.0, "{line}");
-            assert!((0.5..=2.0).contains(&ratio), "{line}");
-            line
-        })
-        .collect();
-    for line in results {
-        eprintln!("{line}");
-    }
+    assert_chosen_meet_the_targets("envelope.toml", &CHOSEN, |_, _| String::new());
 }

@@ -258,7 +258,8 @@ fn inverse3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     };
     let det: f64 = (0..3).map(|k| m[0][k] * c(0, k)).sum();
     let scale = m.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
-    if !(det.abs() > 1e-12 * scale.powi(3)) {
+    // a NaN determinant is singular too
+    if det.is_nan() || det.abs() <= 1e-12 * scale.powi(3) {
         return None;
     }
     // inverse = adjugate / det, adj[k][r] = cofactor(r, k)
@@ -313,11 +314,15 @@ fn amm_modes(
 /// The model's matrices on the modal coordinates: `omega2` (nr), the loop's stiffness and
 /// damping on the modes (`kp S^T S`, `kd S^T S`; none in open loop), `bm` (nr x nu, the lower
 /// block of B), `cq` (ny x nr, the left block of C) and D (ny x nu, dense).
+/// A dense matrix as rows.
+type Matrix = Vec<Vec<f64>>;
+
 struct Blocks {
     omega2: Vec<f64>,
     /// `Phi^T C Phi` (nr x nr) of the material damping (Eq. D13); `None` without damping.
     damping: Option<Vec<Vec<f64>>>,
-    feedback: Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)>,
+    /// The loop's `(kp S^T S, kd S^T S)` on the modes; `None` in open loop.
+    feedback: Option<(Matrix, Matrix)>,
     bm: Vec<Vec<f64>>,
     cq: Vec<Vec<f64>>,
     d: Vec<Vec<f64>>,

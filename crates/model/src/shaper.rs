@@ -437,7 +437,7 @@ impl ShaperSection {
                     .trim()
                     .parse()
                     .map_err(|_| bad(format!("\"{s}\": write \"+-x %\" (x in 0..100) or [f_lo, f_hi] in Hz")))?;
-                if !(x > 0.0 && x < 100.0) || !s.trim().starts_with(['+', '\u{b1}']) {
+                if !(x > 0.0 && x < 100.0 && s.trim().starts_with(['+', '\u{b1}'])) {
                     return Err(bad(format!("\"{s}\": write \"+-x %\" with 0 < x < 100")));
                 }
                 Ok((f * (1.0 - x / 100.0), f * (1.0 + x / 100.0)))

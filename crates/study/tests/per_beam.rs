@@ -8,35 +8,14 @@ use flexstar_model::{Experiment, RobotParams};
 use flexstar_solve::Settings;
 use flexstar_study::Study;
 
-/// A short case-3-like experiment (50 ms, 6 free-free modes: fast).
-const BASE: &str = r#"
-name = "tiny"
-[time]
-t_end = 0.05
-dt_out = 0.005
-[trajectory]
-kind = "polynomial"
-s1 = [0.0, 0.0, 1.0]
-s2 = [0.0]
-s3 = [0.0, 0.0, 0.5]
-[amm]
-family = "free-free"
-model = "paper"
-modes = 6
-[fem]
-elements = 150
-"#;
+#[path = "support/tiny_study.rs"]
+mod tiny_study;
+use tiny_study::{write_study, BASE};
 
 fn setup(top: &str, vary: &str) -> (tempfile::TempDir, PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("base.toml"), BASE).unwrap();
-    let p = dir.path().join("study.toml");
-    std::fs::write(
-        &p,
-        format!("name = \"s\"\nbase = \"base.toml\"\nsolvers = [\"amm\"]\n{top}{vary}"),
-    )
-    .unwrap();
-    (dir, p)
+    write_study(&format!(
+        "name = \"s\"\nbase = \"base.toml\"\nsolvers = [\"amm\"]\n{top}{vary}"
+    ))
 }
 
 fn load_err(top: &str, vary: &str) -> String {

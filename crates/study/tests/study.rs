@@ -6,31 +6,12 @@ use std::path::{Path, PathBuf};
 use flexstar_study::table::Table;
 use flexstar_study::{run_study, RunOptions, Sampling, Study};
 
-/// A short case-3-like experiment: 50 ms, 10 output steps, 6 free-free modes (fast).
-const BASE: &str = r#"
-name = "tiny"
-[time]
-t_end = 0.05
-dt_out = 0.005
-[trajectory]
-kind = "polynomial"
-s1 = [0.0, 0.0, 1.0]
-s2 = [0.0]
-s3 = [0.0, 0.0, 0.5]
-[amm]
-family = "free-free"
-model = "paper"
-modes = 6
-[fem]
-elements = 150
-"#;
+#[path = "support/tiny_study.rs"]
+mod tiny_study;
+use tiny_study::{write_study, BASE};
 
 fn setup(study: &str) -> (tempfile::TempDir, PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("base.toml"), BASE).unwrap();
-    let p = dir.path().join("study.toml");
-    std::fs::write(&p, study).unwrap();
-    (dir, p)
+    write_study(study)
 }
 
 fn study_text(vary: &str) -> String {

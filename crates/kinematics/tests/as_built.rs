@@ -5,7 +5,11 @@
 //! sleeves' limits; and the paper's robot given as data against the paper's form, bit for bit.
 
 use flexstar_kinematics::{check_configuration, check_trajectory, RigidState, Violation};
-use flexstar_model::{ActuatorAxis, Pose, Robot, RobotGeometry, RobotParams, Trajectory};
+use flexstar_model::{ActuatorAxis, Robot, RobotGeometry, RobotParams, Trajectory};
+
+#[path = "support/quintic.rs"]
+mod quintic;
+use quintic::quintic;
 
 /// Unequal beams (beam 3 shorter, its sleeve longer), welds at 0, 117 and 243.5 degrees, an
 /// uneven base.
@@ -21,17 +25,7 @@ fn as_built() -> Robot {
 }
 
 fn move_of(from: [f64; 3], to: [f64; 3]) -> Trajectory {
-    let pose = |p: [f64; 3]| Pose {
-        gx: p[0],
-        gy: p[1],
-        theta: p[2],
-    };
-    Trajectory::Quintic {
-        from: pose(from),
-        to: pose(to),
-        t0: 0.0,
-        t1: 0.4,
-    }
+    quintic(from, to, 0.4)
 }
 
 #[test]

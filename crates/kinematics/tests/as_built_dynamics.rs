@@ -9,8 +9,12 @@
 use flexstar_kinematics::as_built::rigid_pose;
 use flexstar_kinematics::{rigid_inverse_dynamics_of, rigid_inverse_dynamics_with, RigidState, StarMasses};
 use flexstar_model::{
-    ActuatorAxis, Attachments, Gravity, LoadSettings, Payload, Pose, Robot, RobotGeometry, RobotParams, Trajectory,
+    ActuatorAxis, Attachments, Gravity, LoadSettings, Payload, Robot, RobotGeometry, RobotParams, Trajectory,
 };
+
+#[path = "support/quintic.rs"]
+mod quintic;
+use quintic::quintic;
 
 /// Every beam its own length, mass per length, sleeve inertia and slider mass; welds at 0, 117 and
 /// 243.5 degrees; the base from uneven sides.
@@ -41,19 +45,8 @@ fn attached() -> Attachments {
     }
 }
 
-/// A rest-to-rest quintic of G and theta in 0.4 s.
 fn motion() -> Trajectory {
-    let pose = |p: [f64; 3]| Pose {
-        gx: p[0],
-        gy: p[1],
-        theta: p[2],
-    };
-    Trajectory::Quintic {
-        from: pose([0.004, -0.003, 0.01]),
-        to: pose([0.03, -0.02, 0.2]),
-        t0: 0.0,
-        t1: 0.4,
-    }
+    quintic([0.004, -0.003, 0.01], [0.03, -0.02, 0.2], 0.4)
 }
 
 fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -280,20 +273,7 @@ fn the_paper_robot_through_the_general_formulas_is_the_paper_form() {
         nudged.paper_form().is_none(),
         "the nudged robot takes the general formulas"
     );
-    let traj = Trajectory::Quintic {
-        from: Pose {
-            gx: 0.0,
-            gy: 0.0,
-            theta: 0.0,
-        },
-        to: Pose {
-            gx: 0.03,
-            gy: -0.02,
-            theta: 0.3,
-        },
-        t0: 0.0,
-        t1: 0.5,
-    };
+    let traj = quintic([0.0; 3], [0.03, -0.02, 0.3], 0.5);
     for a in [Attachments::default(), attached()] {
         for t in [0.1, 0.25, 0.4] {
             let st = RigidState::at(&p, &traj, t).unwrap();

@@ -7,8 +7,12 @@ use flexstar_kinematics::{
     check_trajectory, direct_kinematics, inverse_kinematics, rigid_inverse_dynamics, RigidState, Violation,
 };
 use flexstar_model::geometry::{revolute_point, slider_direction};
-use flexstar_model::{Pose, RobotParams, Trajectory};
+use flexstar_model::{RobotParams, Trajectory};
 use proptest::prelude::*;
+
+#[path = "support/quintic.rs"]
+mod quintic;
+use quintic::quintic;
 
 fn paper() -> RobotParams {
     RobotParams::paper()
@@ -240,20 +244,7 @@ fn rigid_inverse_dynamics_balances_power() {
 
 /// The task-space quintic from the origin to (0.03, -0.02, 0.3) in 0.5 s.
 fn general_quintic() -> Trajectory {
-    Trajectory::Quintic {
-        from: Pose {
-            gx: 0.0,
-            gy: 0.0,
-            theta: 0.0,
-        },
-        to: Pose {
-            gx: 0.03,
-            gy: -0.02,
-            theta: 0.3,
-        },
-        t0: 0.0,
-        t1: 0.5,
-    }
+    quintic([0.0; 3], [0.03, -0.02, 0.3], 0.5)
 }
 
 /// The rate of the kinetic energy of star, sleeves, sliders and a payload [W] (`1/2 m |v_c|^2 +

@@ -562,6 +562,7 @@ mod tests {
             friction: None,
             shaper: None,
             report: Default::default(),
+            sensors: Vec::new(),
             source: Default::default(),
             hash: String::new(),
         }

@@ -94,7 +94,11 @@ fn shape_at(r: &Response, t: f64) -> &StarShape {
 
 /// Index of the shape point of beam `beam` at material coordinate `x` [m].
 fn point(s: &StarShape, beam: usize, x: f64) -> usize {
-    s.beams[beam].x.iter().position(|v| (v - x).abs() < 1e-9).expect("a shape point")
+    s.beams[beam]
+        .x
+        .iter()
+        .position(|v| (v - x).abs() < 1e-9)
+        .expect("a shape point")
 }
 
 /// `r''` of the point (beam, x) at T0 by second central differences of the shape output.
@@ -144,15 +148,26 @@ fn every_channel_against_its_second_route_and_amm_against_fem() {
             let read = [channel(r, &format!("{col}_x"))[k], channel(r, &format!("{col}_y"))[k]];
             let scale = peak(channel(r, &format!("{col}_x"))).max(peak(channel(r, &format!("{col}_y"))));
             let err = ((read[0] - fd[0]).powi(2) + (read[1] - fd[1]).powi(2)).sqrt();
-            eprintln!("{name} {col}: read {read:?}, differenced {fd:?}, error {:.3} % of peak {scale:.3}", 100.0 * err / scale);
+            eprintln!(
+                "{name} {col}: read {read:?}, differenced {fd:?}, error {:.3} % of peak {scale:.3}",
+                100.0 * err / scale
+            );
             assert!(err < 0.01 * scale, "{name} {col}: {read:?} vs {fd:?}");
         }
         // strain against the curvature of the shape output
         let (_, curv) = shape_slope_curvature(r, T0, 2, 0.05);
         let eps = channel(r, "eps");
         let want = -0.001 * curv;
-        eprintln!("{name} eps: read {:.4e}, from the shape {want:.4e}, peak {:.4e}", eps[k], peak(eps));
-        assert!((eps[k] - want).abs() < 0.03 * peak(eps), "{name} strain: {} vs {want}", eps[k]);
+        eprintln!(
+            "{name} eps: read {:.4e}, from the shape {want:.4e}, peak {:.4e}",
+            eps[k],
+            peak(eps)
+        );
+        assert!(
+            (eps[k] - want).abs() < 0.03 * peak(eps),
+            "{name} strain: {} vs {want}",
+            eps[k]
+        );
         // body axes: the fixed reading rotated by the tangent's angle (rigid theta + the shape's slope)
         let (slope, _) = shape_slope_curvature(r, T0, 0, 0.45);
         let beta = rigid.theta.v + slope.atan();
@@ -162,7 +177,10 @@ fn every_channel_against_its_second_route_and_amm_against_fem() {
         let rotated = [f[0] * t[0] + f[1] * t[1], f[0] * n[0] + f[1] * n[1]];
         let scale = peak(channel(r, "tipf_x")).max(peak(channel(r, "tipf_y")));
         for c in 0..2 {
-            assert!((body[c] - rotated[c]).abs() < 1e-4 * scale, "{name} body {body:?} vs {rotated:?}");
+            assert!(
+                (body[c] - rotated[c]).abs() < 1e-4 * scale,
+                "{name} body {body:?} vs {rotated:?}"
+            );
         }
         // and at every time the rotation keeps the length
         for j in 0..eps.len() {
@@ -174,11 +192,16 @@ fn every_channel_against_its_second_route_and_amm_against_fem() {
         let s = r.sensors.as_ref().unwrap();
         for (j, &t) in s.t.iter().enumerate() {
             let st = RigidState::at(&exp.robot, &exp.trajectory, t).unwrap();
-            assert!((channel(r, "enc2")[j] - st.s[1].v).abs() < 1e-12, "{name} encoder at {t}");
+            assert!(
+                (channel(r, "enc2")[j] - st.s[1].v).abs() < 1e-12,
+                "{name} encoder at {t}"
+            );
         }
         assert_eq!(channel(r, "fc3"), r.fa[2].as_slice(), "{name} force cell");
     }
-    let cols = ["tipf_x", "tipf_y", "tipb_x", "tipb_y", "midf_x", "midf_y", "gb_x", "gb_y", "eps"];
+    let cols = [
+        "tipf_x", "tipf_y", "tipb_x", "tipb_y", "midf_x", "midf_y", "gb_x", "gb_y", "eps",
+    ];
     let mean = mean_evp(&amm, &fem, &cols, "smooth");
     assert!(mean < 2.0, "mean EVP {mean} %");
 }
@@ -235,7 +258,12 @@ c = 0.001
     let strain = evp(t, channel(&amm, "eps"), channel(&fem, "eps")).unwrap();
     eprintln!("case 1: EVP of the raw strain {strain:.3} %");
     assert!(strain < 2.0, "strain EVP {strain} %");
-    let mean = mean_evp(&amm, &fem, &["tip_x", "tip_y", "mid_x", "mid_y", "eps"], "case 1, 100 Hz");
+    let mean = mean_evp(
+        &amm,
+        &fem,
+        &["tip_x", "tip_y", "mid_x", "mid_y", "eps"],
+        "case 1, 100 Hz",
+    );
     assert!(mean < 2.5, "mean EVP {mean} %");
 }
 

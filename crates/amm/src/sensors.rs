@@ -92,13 +92,8 @@ impl AmmInstant<'_> {
     fn deflection(&self, p: &ModalPoint) -> [[f64; 3]; 3] {
         let base = p.beam * self.nb;
         p.phi.each_ref().map(|phi| {
-            self.q.map(|c| {
-                c[base..base + self.nm]
-                    .iter()
-                    .zip(phi)
-                    .map(|(a, b)| a * b)
-                    .sum::<f64>()
-            })
+            self.q
+                .map(|c| c[base..base + self.nm].iter().zip(phi).map(|(a, b)| a * b).sum::<f64>())
         })
     }
 

@@ -460,9 +460,10 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     })?;
     acc.copy_from_slice(&qdd);
 
-    let mut record = |st: &RigidState, stop: &Stop, q: &[f64], rates: [&[f64]; 2], lam: &[f64], axial: &[[f64; 3]; 3]| {
-        rec.record(st, stop, q, rates, lam, axial, None);
-    };
+    let mut record =
+        |st: &RigidState, stop: &Stop, q: &[f64], rates: [&[f64]; 2], lam: &[f64], axial: &[[f64; 3]; 3]| {
+            rec.record(st, stop, q, rates, lam, axial, None);
+        };
 
     record(&st, &stops[0], &q, [&v, &qdd], &sys.lam, sys.sleeves.axial());
     for w in stops.windows(2) {

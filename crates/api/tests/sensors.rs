@@ -69,7 +69,10 @@ fn a_run_with_sensors_writes_their_file_and_units_and_one_without_writes_none() 
     assert!(!run.files.iter().any(|f| f.to_string_lossy().contains("sensors")));
     let doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("bench/amm-free-free.json")).unwrap()).unwrap();
-    assert!(doc["experiment"].get("sensors").is_none(), "no sensors key without sensors");
+    assert!(
+        doc["experiment"].get("sensors").is_none(),
+        "no sensors key without sensors"
+    );
 }
 
 #[test]
@@ -82,6 +85,9 @@ fn a_sensor_where_the_sleeve_passes_is_refused_before_any_work() {
     let e = run_to_dir(exp, &source, &RunSettings::new(Solver::Fem), &out, |_| {}, None)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("bench.toml") && e.contains("sensors[1].x") && e.contains("sleeve"), "{e}");
+    assert!(
+        e.contains("bench.toml") && e.contains("sensors[1].x") && e.contains("sleeve"),
+        "{e}"
+    );
     assert!(!out.join("bench").exists(), "nothing written");
 }

@@ -28,14 +28,7 @@ impl SensorRecorder {
     /// Record the readings at time `t` [s]: coordinates `q`, velocities `v`, consistent
     /// accelerations `qdd` of `star`, slider positions `s` [m] and actuator forces `fa` [N].
     pub(crate) fn record(&mut self, star: &Star, t: f64, [q, v, qdd]: [&[f64]; 3], s: [f64; 3], fa: [f64; 3]) {
-        let at = FemInstant {
-            star,
-            q,
-            v,
-            qdd,
-            s,
-            fa,
-        };
+        let at = FemInstant { star, q, v, qdd, s, fa };
         let mut row = Vec::with_capacity(self.raw.columns.len());
         self.sensors.read(&at, self.gravity, &mut row);
         self.raw.push_row(t, &row);

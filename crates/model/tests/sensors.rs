@@ -85,12 +85,32 @@ fn bad_sensors_are_refused_naming_the_key() {
     refused(&format!("{acc}beam = 1\nx = -0.1\n"), "sensors[1].x", "beyond beam 1");
     refused(&format!("{acc}beam = 4\nx = 0.1\n"), "sensors[1].beam", "1, 2 or 3");
     refused(&format!("{acc}at = \"G\"\nc = 0.1\n"), "sensors[1].c", "does not apply");
-    refused(&format!("{acc}at = \"payload\"\noffset = [0.0, 0.0]\n"), "sensors[1].at", "no [payload]");
-    refused(&format!("{acc}at = \"G\"\naxes = \"tilted\"\n"), "sensors[1].axes", "unknown axes");
-    refused(&format!("{acc}at = \"G\"\nrate_hz = 0.0\n"), "sensors[1].rate_hz", "positive");
-    refused(&format!("{acc}at = \"G\"\nrate_hz = 2000.0\n"), "sensors[1].rate_hz", "output rate");
+    refused(
+        &format!("{acc}at = \"payload\"\noffset = [0.0, 0.0]\n"),
+        "sensors[1].at",
+        "no [payload]",
+    );
+    refused(
+        &format!("{acc}at = \"G\"\naxes = \"tilted\"\n"),
+        "sensors[1].axes",
+        "unknown axes",
+    );
+    refused(
+        &format!("{acc}at = \"G\"\nrate_hz = 0.0\n"),
+        "sensors[1].rate_hz",
+        "positive",
+    );
+    refused(
+        &format!("{acc}at = \"G\"\nrate_hz = 2000.0\n"),
+        "sensors[1].rate_hz",
+        "output rate",
+    );
     refused(&format!("{acc}at = \"G\"\nnoise = -1.0\n"), "sensors[1].noise", ">= 0");
-    refused(&format!("{acc}at = \"G\"\nlowpass_hz = 600.0\n"), "sensors[1].lowpass_hz", "Nyquist");
+    refused(
+        &format!("{acc}at = \"G\"\nlowpass_hz = 600.0\n"),
+        "sensors[1].lowpass_hz",
+        "Nyquist",
+    );
     refused(&format!("{acc}at = \"G\"\ncolour = 1\n"), "colour", "unknown field");
     refused(
         "[[sensors]]\nname = \"a\"\nkind = \"thermometer\"\n",
@@ -144,7 +164,10 @@ fn the_filter_is_3_db_down_at_lowpass_hz_and_follows_its_formula() {
     assert!((lowpass_gain(fc, fc, dt) - 0.5f64.sqrt()).abs() < 1e-12);
     for f in [10.0, 25.0, 100.0, 200.0] {
         let (m, want) = (measured_gain(f, fc, dt), lowpass_gain(f, fc, dt));
-        assert!((m - want).abs() < 1e-3 * want.max(1e-3) + 1e-6, "f = {f}: {m} vs {want}");
+        assert!(
+            (m - want).abs() < 1e-3 * want.max(1e-3) + 1e-6,
+            "f = {f}: {m} vs {want}"
+        );
     }
     // a constant passes unchanged from the first sample (steady start)
     let t: Vec<f64> = (0..100).map(|k| k as f64 * dt).collect();
@@ -189,5 +212,8 @@ fn samples_lie_on_one_clock_and_interpolate_linearly() {
     assert!((t[50] - 0.2).abs() < 1e-15);
     let x = [0.0, 1e-3, 2e-3];
     let y = [0.0, 2.0, 6.0];
-    assert_eq!(interpolate(&x, &y, &[0.0, 0.5e-3, 1.5e-3, 2e-3]), vec![0.0, 1.0, 4.0, 6.0]);
+    assert_eq!(
+        interpolate(&x, &y, &[0.0, 0.5e-3, 1.5e-3, 2e-3]),
+        vec![0.0, 1.0, 4.0, 6.0]
+    );
 }

@@ -94,11 +94,7 @@ pub(super) struct Recorder<'a> {
 impl<'a> Recorder<'a> {
     /// The recorder of the output times `t_out` and the snapshots `snap_times` [s], with the
     /// readings of `sensors` (none when `None`).
-    pub(super) fn new(
-        t_out: &'a [f64],
-        snap_times: &[f64],
-        sensors: Option<crate::sensors::SensorRecorder>,
-    ) -> Self {
+    pub(super) fn new(t_out: &'a [f64], snap_times: &[f64], sensors: Option<crate::sensors::SensorRecorder>) -> Self {
         let mut snaps = snap_times.to_vec();
         snaps.sort_by(|a, b| a.total_cmp(b));
         Recorder {

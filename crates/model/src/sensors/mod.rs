@@ -41,10 +41,18 @@ impl Sensors {
             if let Some(j) = list.iter().position(|o| o.name == sensor.name) {
                 return Err(ModelError::invalid(
                     key("name"),
-                    format!("{:?} is also the name of sensors[{}]: names must be unique", sensor.name, j + 1),
+                    format!(
+                        "{:?} is also the name of sensors[{}]: names must be unique",
+                        sensor.name,
+                        j + 1
+                    ),
                 ));
             }
-            if let Some(c) = sensor.columns().iter().find(|c| crate::quantity::column_unit(c).is_some() || *c == "t") {
+            if let Some(c) = sensor
+                .columns()
+                .iter()
+                .find(|c| crate::quantity::column_unit(c).is_some() || *c == "t")
+            {
                 return Err(ModelError::invalid(
                     key("name"),
                     format!("its column {c} is the name of a result column: choose another name"),

@@ -159,7 +159,12 @@ impl SensorSpec {
             "strain" => {
                 self.only(&["beam", "x", "c"], &key)?;
                 let (beam, x) = self.beam_x(cx, &key)?;
-                let c = self.c.ok_or_else(|| bad("c", "a strain gauge needs c, its distance from the neutral axis [m]".into()))?;
+                let c = self.c.ok_or_else(|| {
+                    bad(
+                        "c",
+                        "a strain gauge needs c, its distance from the neutral axis [m]".into(),
+                    )
+                })?;
                 if !c.is_finite() {
                     return Err(bad("c", format!("must be finite, got {c}")));
                 }
@@ -216,7 +221,10 @@ impl SensorSpec {
                     ModelError::invalid(key("offset"), "a payload point needs offset = [ox, oy] [m] from G")
                 })?;
                 if offset.iter().any(|v| !v.is_finite()) {
-                    return Err(ModelError::invalid(key("offset"), format!("must be finite, got {offset:?}")));
+                    return Err(ModelError::invalid(
+                        key("offset"),
+                        format!("must be finite, got {offset:?}"),
+                    ));
                 }
                 Place::Payload { offset }
             }
@@ -275,7 +283,10 @@ impl SensorSpec {
         let out_rate = 1.0 / cx.dt_out;
         if let Some(r) = self.rate_hz {
             if !(r.is_finite() && r > 0.0) {
-                return Err(ModelError::invalid(key("rate_hz"), format!("must be positive, got {r}")));
+                return Err(ModelError::invalid(
+                    key("rate_hz"),
+                    format!("must be positive, got {r}"),
+                ));
             }
             if r > out_rate * (1.0 + 1e-9) {
                 return Err(ModelError::invalid(
@@ -320,7 +331,10 @@ fn index(v: Option<usize>, name: &str, key: &dyn Fn(&str) -> String) -> Result<u
     match v {
         Some(i @ 1..=3) => Ok(i - 1),
         Some(i) => Err(ModelError::invalid(key(name), format!("must be 1, 2 or 3, got {i}"))),
-        None => Err(ModelError::invalid(key(name), format!("this kind needs {name} = 1, 2 or 3"))),
+        None => Err(ModelError::invalid(
+            key(name),
+            format!("this kind needs {name} = 1, 2 or 3"),
+        )),
     }
 }
 

@@ -94,7 +94,12 @@ impl SensorTable {
         if let Some(c) = self.columns.iter().find(|c| c.values.len() != self.t.len()) {
             return Err(ModelError::Write {
                 file: dest.path(),
-                reason: format!("sensor column {} has {} rows, expected {}", c.name, c.values.len(), self.t.len()),
+                reason: format!(
+                    "sensor column {} has {} rows, expected {}",
+                    c.name,
+                    c.values.len(),
+                    self.t.len()
+                ),
             });
         }
         dest.write(|w| {

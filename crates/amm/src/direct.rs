@@ -430,8 +430,15 @@ impl DirectOutput {
             .law
             .force(t, s, sd)
             .map_err(|source| AmmError::Drive { t, source })?;
-        self.rec
-            .record(&st, stop, &x.q, &ctx.sys.lam, ctx.sys.sleeves.axial(), Some(fa));
+        self.rec.record(
+            &st,
+            stop,
+            &x.q,
+            [&x.v, &x.qdd],
+            &ctx.sys.lam,
+            ctx.sys.sleeves.axial(),
+            Some(fa),
+        );
         if stop.output.is_some() {
             let vals = [s[0], s[1], s[2], sd[0], sd[1], sd[2], st.g[0].v, st.g[1].v, st.theta.v];
             for (c, v) in self.cols.iter_mut().zip(vals) {

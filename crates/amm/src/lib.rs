@@ -35,6 +35,7 @@ pub mod pose_modes;
 #[cfg(test)]
 mod rayleigh_decay;
 mod record;
+mod sensors;
 mod sleeve;
 pub mod solver;
 mod star;

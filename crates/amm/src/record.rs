@@ -5,6 +5,7 @@ use flexstar_kinematics::RigidState;
 use flexstar_model::animation::ShapeTimes;
 use flexstar_model::{AmmModel, AmmSettings, BeamShape, Frame, FramePose, Response, StarShape};
 
+use crate::sensors::SensorRecorder;
 use crate::sleeve::{self, SleeveRow};
 use crate::solver::{Stop, EXTRA_COLUMNS, SHAPE_POINTS};
 use crate::star::{Star, Weld};
@@ -37,6 +38,8 @@ pub(crate) struct Recorder {
     gravity_along: [f64; 3],
     /// The rails and the weld (Eq. J7).
     weld: Weld,
+    /// The sensors' readings (`docs/sensors.md`), `None` without sensors.
+    sensors: Option<SensorRecorder>,
 }
 
 impl Recorder {
@@ -108,6 +111,7 @@ impl Recorder {
             mpp_mpa: problem.beams.map(|b| b.mpp_mpa),
             gravity_along: problem.weld.along_rails(sys.gravity()),
             weld: problem.weld,
+            sensors: SensorRecorder::new(problem.sensors, sys, problem.gravity, n_out),
         }
     }
 
@@ -134,13 +138,17 @@ impl Recorder {
         sleeve::rows::push(self.full, i, st, thp, forces, axial[i], &self.weld)
     }
 
-    /// Record the state at `stop`: a snapshot of the deformed star and/or an output row. `fa`:
-    /// the actuator forces to write (a direct run's law); `None` computes them by Eq. 33.
+    /// Record the state at `stop`: a snapshot of the deformed star and/or an output row (with
+    /// the sensors' readings, from q, the rates `v` and the consistent accelerations `qdd` of
+    /// `rates`). `fa`: the actuator forces to write (a direct run's law); `None` computes them by
+    /// Eq. 33.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn record(
         &mut self,
         st: &RigidState,
         stop: &Stop,
         q: &[f64],
+        [v, qdd]: [&[f64]; 2],
         lam: &[f64],
         axial: &[[f64; 3]; 3],
         fa: Option<[f64; 3]>,
@@ -179,6 +187,9 @@ impl Recorder {
                 })
             });
             self.resp.push(st.t, w_g, w_tip, fa);
+            if let Some(s) = &mut self.sensors {
+                s.record(st, (nm, nb), [q, v, qdd], fa);
+            }
             let dg = self.weld.dg(w_g, [0, 1, 2].map(|i| st.e_w(i)));
             for k in 0..self.extra.len() {
                 let val = match k {
@@ -206,6 +217,7 @@ impl Recorder {
             })
             .collect();
         resp.shapes = self.times.snap_idx.iter().map(|&k| self.shapes[k].clone()).collect();
+        resp.sensors = self.sensors.map(SensorRecorder::finish);
         resp
     }
 }

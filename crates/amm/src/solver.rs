@@ -460,11 +460,12 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     })?;
     acc.copy_from_slice(&qdd);
 
-    let mut record = |st: &RigidState, stop: &Stop, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]| {
-        rec.record(st, stop, q, lam, axial, None);
-    };
+    let mut record =
+        |st: &RigidState, stop: &Stop, q: &[f64], rates: [&[f64]; 2], lam: &[f64], axial: &[[f64; 3]; 3]| {
+            rec.record(st, stop, q, rates, lam, axial, None);
+        };
 
-    record(&st, &stops[0], &q, &sys.lam, sys.sleeves.axial());
+    record(&st, &stops[0], &q, [&v, &qdd], &sys.lam, sys.sleeves.axial());
     for w in stops.windows(2) {
         let (t0, t1) = (w[0].t, w[1].t);
         let nsub = (((t1 - t0) / dt_max) - 1e-9).ceil().max(1.0) as usize;
@@ -494,7 +495,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
             }
             observe(&sys, &q);
         }
-        record(&st, &w[1], &q, &sys.lam, sys.sleeves.axial());
+        record(&st, &w[1], &q, [&v, &qdd], &sys.lam, sys.sleeves.axial());
         if flexstar_model::cancel::cancelled() {
             return Err(AmmError::Cancelled { t: t1 });
         }
@@ -562,6 +563,7 @@ mod tests {
             friction: None,
             shaper: None,
             report: Default::default(),
+            sensors: Vec::new(),
             source: Default::default(),
             hash: String::new(),
         }

@@ -128,6 +128,8 @@ pub(crate) struct Star<'a> {
     pub(crate) load: &'a LoadSettings,
     /// Gravity `[gx, gy]` [m/s^2], base frame.
     pub(crate) gravity: [f64; 2],
+    /// The sensors read at the output times (`docs/sensors.md`; empty without).
+    pub(crate) sensors: &'a flexstar_model::sensors::Sensors,
 }
 
 impl<'a> Star<'a> {
@@ -157,6 +159,7 @@ impl<'a> Star<'a> {
             damping: problem.damping(),
             load: problem.load(),
             gravity: problem.gravity(),
+            sensors: problem.sensors(),
         }
     }
 

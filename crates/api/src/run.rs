@@ -189,6 +189,9 @@ pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Res
     let problem = exp
         .problem()
         .map_err(|e| ApiError::model_in(source, Path::new(source), e))?;
+    // a sensor where a sleeve passes (docs/sensors.md Eq. S10), before any work
+    flexstar_kinematics::check_sensor_mounts(&exp, problem.sensors())
+        .map_err(|e| ApiError::model_in(source, Path::new(source), e))?;
     if settings.solver == Solver::Amm {
         if let Some(lost) = flexstar_amm::attachments_lost(exp.amm.family, &problem) {
             notes.push(format!("note: {source}: {lost}"));
@@ -476,6 +479,7 @@ fn direct_columns(servo: bool) -> Vec<&'static str> {
 
 /// Write a run's files in `dir` (already `DIR/<name>/`): `<stem>.csv` (a direct run: the
 /// sliders first, then the fixed columns, the pose, a servo's errors), `<stem>-shapes.csv`,
+/// `<stem>-sensors.csv` with `[[sensors]]` (`docs/sensors.md`),
 /// `<stem>-dwells.csv` when the motion has a dwell (`docs/motions.md` 2.5), `<stem>.json` (the
 /// outcome's sidecar) and with `figures` the figures in `dir/figures/`.
 /// The CSV files and the sidecar are one run set ([`RunSet`]): published together.
@@ -494,6 +498,7 @@ pub fn write_run(out: &mut RunOutcome, dir: &Path, figures: bool) -> Result<()> 
     }
     let shapes = dir.join(format!("{stem}-shapes.csv"));
     r.stage_shapes_csv(&mut set, &format!("{stem}-shapes.csv"))?;
+    r.stage_sensors_csv(&mut set, stem)?;
     let frames_hash = flexstar_model::animation::stage_run_frames(&r.frames, &mut set, stem)?;
     out.sidecar.frames_hash.clone_from(&frames_hash);
     let dwells = out.sidecar.residual.as_ref().and_then(|k| k.dwells.clone());
@@ -505,6 +510,9 @@ pub fn write_run(out: &mut RunOutcome, dir: &Path, figures: bool) -> Result<()> 
     set.text(&format!("{stem}.json"), &sidecar_text(&json, &doc)?)?;
     set.commit()?;
     out.files.extend([csv.clone(), shapes, json]);
+    if r.sensors.is_some() {
+        out.files.push(dir.join(format!("{stem}-sensors.csv")));
+    }
     if dwells.is_some() {
         out.files.push(dir.join(format!("{stem}-dwells.csv")));
     }

@@ -183,7 +183,10 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
             source,
         })?;
         motions.push(motion);
-        problems.push(exp.problem().map_err(|e| input(e.detail()))?);
+        let problem = exp.problem().map_err(|e| input(e.detail()))?;
+        // a sensor where a sleeve passes (docs/sensors.md Eq. S10)
+        flexstar_kinematics::check_sensor_mounts(exp, problem.sensors()).map_err(|e| input(e.detail()))?;
+        problems.push(problem);
     }
     Ok(Checked {
         specs,

@@ -28,6 +28,7 @@ pub mod error;
 mod integrator;
 pub mod modal_solver;
 pub mod pose_modes;
+mod sensors;
 mod solve;
 mod sparse;
 mod star;

@@ -415,6 +415,7 @@ fn post_process(
 ) -> Result<Response, FemError> {
     let n = hist.samples.len();
     let mut resp = Response::with_capacity(label, n);
+    resp.sensors.clone_from(&hist.sensors);
     let mut extra: Vec<Vec<f64>> = vec![Vec::with_capacity(n); EXTRA.len()];
     let mut lead: Vec<Vec<f64>> = vec![Vec::with_capacity(n); if direct { DIRECT_EXTRA.len() } else { 0 }];
     for s in &hist.samples {

@@ -21,6 +21,7 @@ pub mod as_built;
 pub mod direct;
 pub mod feasibility;
 pub mod inverse_dynamics;
+pub mod sleeve_bands;
 pub mod star_masses;
 pub mod state;
 pub mod table;
@@ -31,6 +32,7 @@ pub use feasibility::{
 };
 pub use flexstar_model::geometry::inverse_kinematics;
 pub use inverse_dynamics::{rigid_inverse_dynamics, rigid_inverse_dynamics_with, RigidForces};
+pub use sleeve_bands::{check_sensor_mounts, sleeve_bands};
 pub use star_masses::{rigid_inverse_dynamics_of, StarMasses};
 pub use state::RigidState;
 

@@ -44,6 +44,7 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         friction: None,
         shaper: None,
         report: Default::default(),
+        sensors: Vec::new(),
         source: Default::default(),
         hash: String::new(),
     }

@@ -436,6 +436,10 @@ pub struct Experiment {
     /// How reports measure the run (`[report]`: the settling band, `docs/motions.md` 2.3).
     #[serde(default)]
     pub report: ReportSettings,
+    /// The sensors read during a run (`[[sensors]]`, `docs/sensors.md`); none by default (and
+    /// then absent from the resolved experiment).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sensors: Vec<crate::sensors::SensorSpec>,
     /// Where the experiment was read from (not a TOML key).
     #[serde(skip)]
     pub source: PathBuf,

@@ -26,6 +26,7 @@ pub struct Problem {
     load: LoadSettings,
     gravity: [f64; 2],
     friction: Option<crate::Friction>,
+    sensors: crate::sensors::Sensors,
 }
 
 impl Problem {
@@ -48,6 +49,7 @@ impl Problem {
             ));
         }
         let robot = check_physics(exp)?;
+        let sensors = sensors_of(exp, &robot)?;
         Ok(Problem {
             robot,
             time: exp.time,
@@ -58,6 +60,7 @@ impl Problem {
             load: exp.load.clone(),
             gravity: exp.gravity.g,
             friction: exp.friction.filter(|f| !f.is_none()),
+            sensors,
         })
     }
 
@@ -130,6 +133,11 @@ impl Problem {
 
     /// Friction in the sleeves and on the rails (`docs/friction.md`); `None`: none (also for a
     /// `[friction]` whose coefficients are all zero, which is the frictionless run bit for bit).
+    /// The sensors read during the run (`[[sensors]]`, `docs/sensors.md`; empty without).
+    pub fn sensors(&self) -> &crate::sensors::Sensors {
+        &self.sensors
+    }
+
     pub fn friction(&self) -> Option<&crate::Friction> {
         self.friction.as_ref()
     }
@@ -158,10 +166,16 @@ pub(crate) fn check_physics(exp: &Experiment) -> Result<Robot, ModelError> {
     if let Some(f) = &exp.friction {
         f.validate()?;
     }
+    sensors_of(exp, &robot)?;
     Ok(robot)
 }
 
 /// Each slider's mass with its sleeve, `mpp_mpa_i` [kg] (a servo's gains from a bandwidth).
+/// The checked `[[sensors]]` of `exp` on `robot` (`docs/sensors.md` section 5).
+fn sensors_of(exp: &Experiment, robot: &Robot) -> Result<crate::sensors::Sensors, ModelError> {
+    crate::sensors::Sensors::from_specs(&exp.sensors, robot, !exp.payload.is_none(), exp.time.dt_out)
+}
+
 fn slider_masses(robot: &Robot) -> [f64; 3] {
     robot.beams().map(|b| b.sleeve_mass)
 }

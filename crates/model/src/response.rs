@@ -96,6 +96,10 @@ pub struct Response {
     /// With friction (`docs/friction.md` 7): the time stuck and the energy dissipated; `None`
     /// without friction.
     pub friction: Option<crate::friction::FrictionSummary>,
+    /// With `[[sensors]]` (`docs/sensors.md`): what the sensors read, as the data acquisition
+    /// records it (the solver's readings at the output times, then filtered, sampled and with
+    /// noise by `Sensors::acquire`); `None` without sensors.
+    pub sensors: Option<crate::sensors::SensorTable>,
 }
 
 /// The static equilibrium's elastic outputs at the final rest pose (`docs/as-built.md` 5.5).
@@ -125,6 +129,7 @@ impl Response {
             info: RunInfo::default(),
             rest_offset: None,
             friction: None,
+            sensors: None,
         }
     }
 
@@ -157,7 +162,8 @@ impl Response {
 
     /// Rows 0, `every`, 2 `every`, ... and the last row: the response on a coarser output grid
     /// whose interval is `every` times this one's (both end at t_end; `TimeSpan::output_times`).
-    /// Every column is kept; the deformed-star snapshots are kept as they are. `every = 0` is
+    /// Every column is kept; the deformed-star snapshots and the sensors' samples (their own
+    /// clock) are kept as they are. `every = 0` is
     /// taken as 1.
     pub fn every_nth(&self, every: usize) -> Response {
         let every = every.max(1);
@@ -183,6 +189,7 @@ impl Response {
             frames: self.frames.clone(),
             rest_offset: self.rest_offset,
             friction: self.friction,
+            sensors: self.sensors.clone(),
         }
     }
 
@@ -404,7 +411,7 @@ impl Response {
             label: self.label.clone(),
             info: self.info.clone(),
             small_deflection,
-            column_units: column_units(&self.header()),
+            column_units: self.column_units(),
             experiment: self.resolved_experiment(experiment),
             residual: None,
             rest_offset: self.rest_offset,
@@ -412,6 +419,27 @@ impl Response {
             frames_hash: None,
             validated_envelope: None,
             validated_envelope_reasons: None,
+        }
+    }
+
+    /// `{column: unit}` of every column of the run's CSV ([`crate::quantity`]) and, with sensors,
+    /// of every column of its sensors' file but `t` (`docs/sensors.md`).
+    fn column_units(&self) -> serde_json::Value {
+        let mut units = column_units(&self.header());
+        if let (Some(table), serde_json::Value::Object(map)) = (&self.sensors, &mut units) {
+            for (c, unit) in table.columns.iter().zip(&table.units) {
+                map.insert(c.name.clone(), unit.as_str().into());
+            }
+        }
+        units
+    }
+
+    /// Stage the sensors' file `<stem>-sensors.csv` into `set` when the run has sensors
+    /// (header `t,<columns>`, `docs/outputs.md`); nothing without.
+    pub fn stage_sensors_csv(&self, set: &mut RunSet, stem: &str) -> Result<(), ModelError> {
+        match &self.sensors {
+            Some(table) => table.stage_csv(set, &format!("{stem}-sensors.csv")),
+            None => Ok(()),
         }
     }
 
@@ -445,6 +473,7 @@ impl Response {
             None => self.stage_csv(set, &csv)?,
         }
         self.stage_shapes_csv(set, &format!("{stem}-shapes.csv"))?;
+        self.stage_sensors_csv(set, stem)?;
         let frames = crate::animation::stage_run_frames(&self.frames, set, stem)?;
         let name = format!("{stem}.json");
         let path = set.path(&name);

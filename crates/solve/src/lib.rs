@@ -119,7 +119,16 @@ pub fn solve(
     if law.is_some() && problem.drive().kind == DriveKind::Servo {
         flexstar_drive::add_tracking_errors(&mut solved.response, problem).map_err(SolveError::Tracking)?;
     }
+    acquire_sensors(problem, &mut solved.response);
     Ok(solved)
+}
+
+/// The sensors' readings at the output times, which the solver returns, replaced by what the
+/// data acquisition records of them (`docs/sensors.md` section 6: filter, sampling, noise).
+fn acquire_sensors(problem: &Problem, response: &mut Response) {
+    if let Some(raw) = response.sensors.take() {
+        response.sensors = Some(problem.sensors().acquire(&raw, problem.time().t_end));
+    }
 }
 
 /// [`solve`] with the drive given: `law` (the direct problem) or `None` (the prescribed motion).

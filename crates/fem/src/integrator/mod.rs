@@ -92,6 +92,8 @@ pub(crate) struct History {
     pub gravity: bool,
     /// With friction: its dissipation and time stuck over the run.
     pub friction: Option<FrictionLog>,
+    /// With sensors: their readings at the output times (`docs/sensors.md`).
+    pub sensors: Option<flexstar_model::SensorTable>,
 }
 
 /// Work and dissipated energy since t = 0 [J], by the trapezoidal rule on the integration steps,
@@ -357,7 +359,8 @@ pub(crate) fn integrate(
     let t_end = *t_out.last().unwrap_or(&0.0);
     let events = event_times(t_out, snap_times);
     let ga = GenAlpha::new(run.rho_inf);
-    let mut rec = Recorder::new(t_out, snap_times);
+    let sensors = crate::sensors::SensorRecorder::new(&attached.sensors, attached.gravity, t_out.len());
+    let mut rec = Recorder::new(t_out, snap_times, sensors);
     let mut stats = Stats::default();
     let (fa0, pf0) = motion.forces(&star, &st.pins, &st.lam, 0.0)?;
     let mut works = Works::start(&star, &st, &fa0)?;
@@ -405,5 +408,6 @@ pub(crate) fn integrate(
         damping: attached.beta > 0.0 || attached.alpha > 0.0,
         gravity: attached.weighs(),
         friction: works.friction,
+        sensors: rec.sensors.map(crate::sensors::SensorRecorder::finish),
     })
 }

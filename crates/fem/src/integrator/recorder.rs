@@ -87,10 +87,14 @@ pub(super) struct Recorder<'a> {
     snap_k: usize,
     pub(super) samples: Vec<Sample>,
     pub(super) snapshots: Vec<Snapshot>,
+    /// The sensors' readings (`docs/sensors.md`), `None` without sensors.
+    pub(super) sensors: Option<crate::sensors::SensorRecorder>,
 }
 
 impl<'a> Recorder<'a> {
-    pub(super) fn new(t_out: &'a [f64], snap_times: &[f64]) -> Self {
+    /// The recorder of the output times `t_out` and the snapshots `snap_times` [s], with the
+    /// readings of `sensors` (none when `None`).
+    pub(super) fn new(t_out: &'a [f64], snap_times: &[f64], sensors: Option<crate::sensors::SensorRecorder>) -> Self {
         let mut snaps = snap_times.to_vec();
         snaps.sort_by(|a, b| a.total_cmp(b));
         Recorder {
@@ -100,6 +104,7 @@ impl<'a> Recorder<'a> {
             snap_k: 0,
             samples: Vec::with_capacity(t_out.len()),
             snapshots: Vec::new(),
+            sensors,
         }
     }
 
@@ -145,6 +150,9 @@ impl<'a> Recorder<'a> {
                     e_f: works.friction.map_or(0.0, |f| f.sleeves_j + f.rails_j),
                 }),
             });
+            if let Some(s) = &mut self.sensors {
+                s.record(star, self.t_out[self.out_k], [q, v, &st.qdd], pins.s.map(|s| s[0]), fa);
+            }
             self.out_k += 1;
         }
         while self.snap_k < self.snaps.len() && (self.snaps[self.snap_k] - t).abs() < 1e-12 {

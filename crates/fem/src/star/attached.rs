@@ -100,6 +100,9 @@ pub(crate) struct Attached {
     pub gravity: [f64; 2],
     /// Friction in the sleeves and on the rails (`docs/friction.md`; `friction.rs`), none by default.
     pub friction: Option<flexstar_model::Friction>,
+    /// The sensors read at the output times (`docs/sensors.md`; massless: they add nothing to
+    /// the equations), none by default.
+    pub sensors: flexstar_model::sensors::Sensors,
 }
 
 impl Attached {
@@ -114,6 +117,7 @@ impl Attached {
             load: (!load.is_none()).then(|| load.clone()),
             gravity: problem.gravity(),
             friction: problem.friction().copied(),
+            sensors: problem.sensors().clone(),
         }
     }
 

@@ -282,8 +282,10 @@ pub struct PlanConfig {
     pub exp: Experiment,
     pub plan: PlanSection,
     pub limits: Limits,
-    /// The file's table without `[plan]` and `[limits]`.
+    /// The file's table without `[plan]`, `[limits]` and `[robust]`.
     pub table: toml::Table,
+    /// `[robust]`: the uncertainty a robust plan holds over (`docs/motions.md` 4.11).
+    pub robust: Option<crate::uncertainty::Uncertainty>,
 }
 
 /// Read and check a plan file: TOML syntax, the two sections (unknown keys refused), no
@@ -324,6 +326,7 @@ pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanE
         ))
     })?;
     let limits: Limits = section(&mut table, "limits", path)?.unwrap_or_default();
+    let robust: Option<toml::Table> = section(&mut table, "robust", path)?;
     plan.validate().map_err(in_file)?;
     limits.validate().map_err(in_file)?;
     let t_move = plan.t_move.unwrap_or(1.0);
@@ -342,12 +345,36 @@ pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanE
         },
         other => other,
     })?;
+    let robust = match robust {
+        Some(r) => Some(read_robust(r, &plan, &with_motion, path)?),
+        None => None,
+    };
     Ok(PlanConfig {
         exp,
         plan,
         limits,
         table,
+        robust,
     })
+}
+
+/// `[robust]` against the file's experiment document (`docs/motions.md` 4.11); refused with
+/// `objective = "time"` (a robust time search is not designed).
+fn read_robust(
+    section: toml::Table,
+    plan: &PlanSection,
+    doc: &toml::Table,
+    path: &Path,
+) -> Result<crate::uncertainty::Uncertainty, PlanError> {
+    if plan.objective == Objective::Time {
+        return Err(ModelError::invalid(
+            "robust",
+            "applies to the residual objective only (t_move given); objective = \"time\" is not robust",
+        )
+        .in_file(path)
+        .into());
+    }
+    Ok(crate::uncertainty::Uncertainty::read(section, doc, path)?)
 }
 
 /// Take the table `key` out of `table` and deserialize it (errors name the section).

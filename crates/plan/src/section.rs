@@ -451,6 +451,60 @@ mod tests {
         assert_eq!(read("peak_factor = 2\n").unwrap().plan.peak_factor(), Some(2.0));
     }
 
+    /// `[robust]` as read (`docs/motions.md` 4.11): quoted and bare dotted keys, an indexed
+    /// key, the nominal value taken from the file or the paper's default list, the defaults.
+    #[test]
+    fn robust_ranges_read_with_their_nominal_values() {
+        let c = read("[payload]\nmass = 0.25\n[robust]\n\"payload.mass\" = [0.0, 0.5]\nrobot.E = [180e9, 220e9]\n\"robot.L[2]\" = [0.49, 0.51]\n")
+            .unwrap();
+        let u = c.robust.expect("[robust]");
+        let mut got: Vec<(String, f64, f64, f64)> =
+            u.ranges.iter().map(|r| (r.key.clone(), r.lo, r.hi, r.nominal)).collect();
+        got.sort_by(|a, b| a.0.cmp(&b.0));
+        assert_eq!(
+            got,
+            vec![
+                ("payload.mass".to_string(), 0.0, 0.5, 0.25),
+                ("robot.E".to_string(), 180e9, 220e9, 200e9),
+                ("robot.L[2]".to_string(), 0.49, 0.51, 0.5),
+            ]
+        );
+        assert_eq!((u.quantile, u.draws, u.seed), (1.0, 20, 1));
+        // a model at given values carries them (the study's setter, then the loader)
+        let ends: Vec<f64> = u.ranges.iter().map(|r| r.hi).collect();
+        let m = u.model_at(&ends).unwrap();
+        assert_eq!(m.payload.mass, 0.5);
+        let draws = u.fresh_draws();
+        assert_eq!(draws.len(), 20);
+        assert!(draws
+            .iter()
+            .all(|d| d.iter().zip(&u.ranges).all(|(v, r)| *v >= r.lo && *v <= r.hi)));
+        assert_eq!(u.candidates().len(), 8);
+    }
+
+    /// Bad `[robust]` entries are refused before any work, naming the file and the key.
+    #[test]
+    fn bad_robust_entries_are_refused_with_the_key() {
+        let with = |body: &str| format!("[payload]\nmass = 0.25\n[robust]\n{body}");
+        refused(&with("\"payload.mass\" = [0.3, 0.5]\n"), "robust.\"payload.mass\"");
+        refused(&with("\"payload.mass\" = [0.5, 0.0]\n"), "robust.\"payload.mass\"");
+        refused(&with("\"payload.mass\" = [0.5, 0.5]\n"), "robust.\"payload.mass\"");
+        refused(&with("\"payload.mass\" = 0.5\n"), "robust.\"payload.mass\"");
+        refused(&with("\"payload.mass\" = [-1.0, 0.5]\n"), "robust.\"payload.mass\"");
+        refused(&with("\"robot.Q\" = [1.0, 2.0]\n"), "robust.\"robot.Q\"");
+        refused(&with("\"amm.family\" = [1.0, 2.0]\n"), "robust.\"amm.family\"");
+        refused(&with("\"robot.L[4]\" = [0.4, 0.6]\n"), "robust.\"robot.L[4]\"");
+        refused(&with("\"payload.mass\" = [0.0, 0.5]\nquantile = 0.0\n"), "robust.quantile");
+        refused(&with("\"payload.mass\" = [0.0, 0.5]\nquantile = 1.5\n"), "robust.quantile");
+        refused(&with("\"payload.mass\" = [0.0, 0.5]\ndraws = 0\n"), "robust.draws");
+        refused(&with("quantile = 0.5\n"), "robust");
+        let msg = match read(&with("\"payload.mass\" = [0.3, 0.5]\n")) {
+            Err(PlanError::Input(e)) => e.to_string(),
+            other => panic!("{other:?}"),
+        };
+        assert!(msg.contains("excludes the experiment's own value 0.25"), "{msg}");
+    }
+
     /// Bad values of the new keys are refused with the file and the key (4.8, 4.10).
     #[test]
     fn bad_smooth_keys_are_refused_with_the_key() {

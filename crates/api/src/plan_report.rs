@@ -403,7 +403,10 @@ pub fn write_figures(exp: &Experiment, o: &PlanOutcome) -> Result<Vec<PathBuf>> 
         crate::plan_figures::path_figure(exp, o),
     ];
     let mut files = Vec::new();
-    let robust = o.robust.as_ref().map(|c| crate::plan_robust_report::curves_figure(n, c));
+    let robust = o
+        .robust
+        .as_ref()
+        .map(|c| crate::plan_robust_report::curves_figure(n, c));
     for fig in figures.into_iter().chain(robust) {
         fig.write(&dir)?;
         files.extend(["svg", "png"].map(|e| dir.join(format!("{}.{e}", fig.name))));

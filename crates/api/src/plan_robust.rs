@@ -64,11 +64,17 @@ pub fn check(info: &RobustInfo, motions: &[(String, Trajectory)]) -> RobustCheck
     let f_min = info.sample.iter().map(|m| m.f1_hz).fold(f64::INFINITY, f64::min);
     let window_s = 2.0 / f_min;
     let mut failures = Vec::new();
-    let sample_models: Vec<(Vec<f64>, Result<Experiment>)> =
-        info.sample.iter().map(|m| (m.values.clone(), Ok(m.exp.clone()))).collect();
+    let sample_models: Vec<(Vec<f64>, Result<Experiment>)> = info
+        .sample
+        .iter()
+        .map(|m| (m.values.clone(), Ok(m.exp.clone())))
+        .collect();
     let sample = rows(&sample_models, motions, Solver::Amm, window_s, &mut failures);
-    let draw_models: Vec<(Vec<f64>, Result<Experiment>)> =
-        unc.fresh_draws().into_iter().map(|v| (v.clone(), model(unc, &v))).collect();
+    let draw_models: Vec<(Vec<f64>, Result<Experiment>)> = unc
+        .fresh_draws()
+        .into_iter()
+        .map(|v| (v.clone(), model(unc, &v)))
+        .collect();
     let draws = rows(&draw_models, motions, Solver::Fem, window_s, &mut failures);
     let curves = curves(unc, motions, window_s, &mut failures);
     let labels: Vec<String> = motions.iter().map(|(l, _)| l.clone()).collect();
@@ -117,7 +123,12 @@ fn rows(
     for (&(i, k), r) in jobs.iter().zip(results) {
         match r {
             Ok(v) => out[i].residual_m[k] = Some(v),
-            Err(e) => failures.push(format!("{} on {:?} ({}): {e}", motions[k].0, models[i].0, solver.name())),
+            Err(e) => failures.push(format!(
+                "{} on {:?} ({}): {e}",
+                motions[k].0,
+                models[i].0,
+                solver.name()
+            )),
         }
     }
     out
@@ -125,7 +136,12 @@ fn rows(
 
 /// The residual peak of |dG| [m] over `[t_rest, t_rest + window_s]` of `traj` on the model `exp`
 /// (its trajectory replaced; the accurate AMM or the FEM at the model's own settings).
-pub fn residual_on(exp: &Experiment, traj: &Trajectory, solver: Solver, window_s: f64) -> std::result::Result<f64, String> {
+pub fn residual_on(
+    exp: &Experiment,
+    traj: &Trajectory,
+    solver: Solver,
+    window_s: f64,
+) -> std::result::Result<f64, String> {
     let mut x = exp.clone();
     let t_rest = traj.t_rest().ok_or("the motion never comes to rest")?;
     x.trajectory = traj.clone();
@@ -137,7 +153,12 @@ pub fn residual_on(exp: &Experiment, traj: &Trajectory, solver: Solver, window_s
 }
 
 /// The robustness curves: each key over its range, the others nominal, every motion on the AMM.
-fn curves(unc: &Uncertainty, motions: &[(String, Trajectory)], window_s: f64, failures: &mut Vec<String>) -> Vec<Curve> {
+fn curves(
+    unc: &Uncertainty,
+    motions: &[(String, Trajectory)],
+    window_s: f64,
+    failures: &mut Vec<String>,
+) -> Vec<Curve> {
     (0..unc.ranges.len())
         .map(|j| {
             let values = unc.sweep(j, CURVE_POINTS);

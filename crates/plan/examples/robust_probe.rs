@@ -12,7 +12,12 @@ fn main() {
         return;
     };
     for m in &r.sample {
-        println!("sample {:?} f1 = {:.3} Hz{}", m.values, m.f1_hz, if m.nominal { " (nominal)" } else { "" });
+        println!(
+            "sample {:?} f1 = {:.3} Hz{}",
+            m.values,
+            m.f1_hz,
+            if m.nominal { " (nominal)" } else { "" }
+        );
     }
     for row in &p.trace {
         println!(
@@ -22,7 +27,12 @@ fn main() {
     }
     println!(
         "objective (Eq. U1): plain {:.3e}, nominal plan {:.3e}, robust {:.3e} (start {}); {}; {} runs; {:.2} s",
-        r.objective_plain_m, r.objective_nominal_m, r.objective_m, r.start, p.reason, p.evaluations,
+        r.objective_plain_m,
+        r.objective_nominal_m,
+        r.objective_m,
+        r.start,
+        p.reason,
+        p.evaluations,
         t.elapsed().as_secs_f64()
     );
     println!(

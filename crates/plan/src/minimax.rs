@@ -182,8 +182,10 @@ impl State {
             let dx = epigraph_step(&blocks, *mu * scale, limits.as_ref())?;
             let trial: Vec<f64> = self.x.iter().zip(&dx).map(|(x, d)| x + d).collect();
             self.evaluations += models.count();
-            let evals: Vec<Result<Eval, Rejected>> =
-                (0..models.count()).into_par_iter().map(|k| models.eval(k, &trial)).collect();
+            let evals: Vec<Result<Eval, Rejected>> = (0..models.count())
+                .into_par_iter()
+                .map(|k| models.eval(k, &trial))
+                .collect();
             let ok: Option<Vec<Eval>> = evals
                 .into_iter()
                 .enumerate()

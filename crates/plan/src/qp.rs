@@ -208,7 +208,11 @@ mod tests {
                 .map(|v| v * v)
                 .sum::<f64>()
                 .sqrt();
-            assert!((blk.norm_at(&dx) - direct).abs() < 1e-10 * direct, "{} against {direct}", blk.norm_at(&dx));
+            assert!(
+                (blk.norm_at(&dx) - direct).abs() < 1e-10 * direct,
+                "{} against {direct}",
+                blk.norm_at(&dx)
+            );
         }
     }
 

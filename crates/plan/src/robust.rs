@@ -14,9 +14,9 @@ use crate::family::Family;
 use crate::minimax::{self, Models};
 use crate::objective::{Eval, Evaluator, Rejected, SmoothRef, Terms};
 use crate::planner::{effective_bounds, evaluate, peak_warnings, PeakComparison, PeakSet, Planned, Setup};
+use crate::planner::{FLOOR_SHARE, WINDOW_PERIODS};
 use crate::section::{Limits, PlanConfig};
 use crate::uncertainty::Uncertainty;
-use crate::planner::{FLOOR_SHARE, WINDOW_PERIODS};
 use crate::PlanError;
 
 /// Neighbouring sample models (sorted by their first frequency at the final pose) are at most
@@ -154,7 +154,12 @@ pub fn plan_robust(
 /// Eq. U1 at the nominal plan (infinite when it breaks a sample model's limits).
 fn e_nominal_score(nominal: &Planned, set: &SampleSet, quantile: f64) -> f64 {
     let norms: Option<Vec<f64>> = (0..set.count())
-        .map(|k| set.eval(k, &nominal.x).ok().filter(|e| set.accept(k, e)).map(|e| e.norm()))
+        .map(|k| {
+            set.eval(k, &nominal.x)
+                .ok()
+                .filter(|e| set.accept(k, e))
+                .map(|e| e.norm())
+        })
         .collect();
     norms.map_or(f64::INFINITY, |n| minimax::objective(&n, quantile))
 }

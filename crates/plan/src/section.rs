@@ -458,8 +458,11 @@ mod tests {
         let c = read("[payload]\nmass = 0.25\n[robust]\n\"payload.mass\" = [0.0, 0.5]\nrobot.E = [180e9, 220e9]\n\"robot.L[2]\" = [0.49, 0.51]\n")
             .unwrap();
         let u = c.robust.expect("[robust]");
-        let mut got: Vec<(String, f64, f64, f64)> =
-            u.ranges.iter().map(|r| (r.key.clone(), r.lo, r.hi, r.nominal)).collect();
+        let mut got: Vec<(String, f64, f64, f64)> = u
+            .ranges
+            .iter()
+            .map(|r| (r.key.clone(), r.lo, r.hi, r.nominal))
+            .collect();
         got.sort_by(|a, b| a.0.cmp(&b.0));
         assert_eq!(
             got,
@@ -494,8 +497,14 @@ mod tests {
         refused(&with("\"robot.Q\" = [1.0, 2.0]\n"), "robust.\"robot.Q\"");
         refused(&with("\"amm.family\" = [1.0, 2.0]\n"), "robust.\"amm.family\"");
         refused(&with("\"robot.L[4]\" = [0.4, 0.6]\n"), "robust.\"robot.L[4]\"");
-        refused(&with("\"payload.mass\" = [0.0, 0.5]\nquantile = 0.0\n"), "robust.quantile");
-        refused(&with("\"payload.mass\" = [0.0, 0.5]\nquantile = 1.5\n"), "robust.quantile");
+        refused(
+            &with("\"payload.mass\" = [0.0, 0.5]\nquantile = 0.0\n"),
+            "robust.quantile",
+        );
+        refused(
+            &with("\"payload.mass\" = [0.0, 0.5]\nquantile = 1.5\n"),
+            "robust.quantile",
+        );
         refused(&with("\"payload.mass\" = [0.0, 0.5]\ndraws = 0\n"), "robust.draws");
         refused(&with("quantile = 0.5\n"), "robust");
         let msg = match read(&with("\"payload.mass\" = [0.3, 0.5]\n")) {

@@ -76,7 +76,11 @@ impl Uncertainty {
             }
         }
         if u.ranges.is_empty() {
-            return Err(bad(file, "", "names no uncertain key: give at least one \"key\" = [lo, hi]"));
+            return Err(bad(
+                file,
+                "",
+                "names no uncertain key: give at least one \"key\" = [lo, hi]",
+            ));
         }
         Ok(u)
     }
@@ -219,7 +223,11 @@ impl Uncertainty {
 /// bare dotted key (`payload.mass = ...`, a nested table in TOML) is joined back.
 fn flatten(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)>) {
     for (k, v) in table {
-        let name = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+        let name = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
         match v {
             toml::Value::Table(t) => flatten(t, &name, out),
             _ => out.push((name, v.clone())),

@@ -42,10 +42,7 @@ pub fn shape_over(exp: &Experiment, models: &[Experiment]) -> Result<Covering, M
         .iter()
         .map(|&f| band(f, &nominal, &others))
         .collect();
-    let half = bands
-        .iter()
-        .map(|(lo, hi)| (hi - lo) / (hi + lo))
-        .fold(0.0, f64::max);
+    let half = bands.iter().map(|(lo, hi)| (hi - lo) / (hi + lo)).fold(0.0, f64::max);
     let centres: Vec<f64> = bands.iter().map(|(lo, hi)| 0.5 * (lo + hi)).collect();
     let mut section = ShaperSection::new(ShaperKind::Si, &centres);
     // rounded up to 0.1 %: the band written covers the computed one

@@ -33,7 +33,10 @@ fn the_shaper_over_the_uncertainty_keeps_every_band_within_its_tolerance() {
             .map(|k| lo + (hi - lo) * k as f64 / 2047.0)
             .map(|f| residual(&section.impulses, f, 0.0))
             .fold(0.0, f64::max);
-        assert!(worst <= 0.05 * (1.0 + 1e-3), "band {lo:.3}-{hi:.3} Hz: residual {worst}");
+        assert!(
+            worst <= 0.05 * (1.0 + 1e-3),
+            "band {lo:.3}-{hi:.3} Hz: residual {worst}"
+        );
     }
     let t_rest = c.exp.trajectory.t_rest().unwrap();
     assert!((t_rest - 0.42 - section.penalty_s).abs() < 1e-12);

@@ -15,6 +15,8 @@ pub mod modes;
 pub mod plan;
 mod plan_figures;
 mod plan_report;
+pub mod plan_robust;
+mod plan_robust_report;
 pub mod run;
 pub mod sidecar;
 mod solver_errors;

@@ -23,6 +23,13 @@ pub const MOTIONS: [(&str, &str); 3] = [
     ("planned", "planned"),
 ];
 
+/// With `[robust]` (`docs/motions.md` 4.11) the comparison has two motions more, after these:
+/// the nominal plan and the quintic shaped over the uncertainty; `planned` is the robust plan.
+pub const ROBUST_MOTIONS: [(&str, &str); 2] = [
+    ("nominal", "nominal plan (the file's model)"),
+    ("shaped", "quintic shaped over the uncertainty (si)"),
+];
+
 /// One motion of the comparison with its AMM and FEM runs.
 #[derive(Debug, Clone)]
 pub struct MotionRuns {
@@ -47,6 +54,8 @@ pub struct PlanOutcome {
     pub notes: Vec<String>,
     /// Wall time of the whole command [s] and of the planning alone.
     pub wall_s: f64,
+    /// With `[robust]`: the motions on the sample (AMM) and on fresh draws (FEM), the curves.
+    pub robust: Option<crate::plan_robust::RobustCheck>,
 }
 
 /// A planner error as the command reports it (bad input names the file and key).
@@ -80,6 +89,13 @@ pub fn plan_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Planned))
     let rows = plan_rows(&cfg.exp, &planned)?;
     let exps = motion_experiments(&cfg, &planned, &rows)?;
     let motions = run_motions(exps, &source)?;
+    let robust = planned.robust.as_ref().map(|info| {
+        let trajectories: Vec<(String, Trajectory)> = motions
+            .iter()
+            .map(|m| (m.key.to_string(), m.exp.trajectory.clone()))
+            .collect();
+        crate::plan_robust::check(info, &trajectories)
+    });
     let mut files = write_runs(&motions, &dir)?;
     let wall_s = started.elapsed().as_secs_f64();
     let outcome = PlanOutcome {
@@ -89,6 +105,7 @@ pub fn plan_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Planned))
         files: Vec::new(),
         notes,
         wall_s,
+        robust,
     };
     files.extend(write_plan_files(&cfg, &outcome, &rows)?);
     files.extend(crate::plan_report::write_figures(&cfg.exp, &outcome)?);
@@ -128,11 +145,18 @@ fn motion_experiments(cfg: &PlanConfig, p: &Planned, rows: &[[f64; 7]]) -> Resul
         e.trajectory = traj;
         e
     };
-    Ok(vec![
+    let mut exps = vec![
         with(p.family.quintic(p.t_move)),
         p.zvd.clone(),
         with(table_trajectory(&cfg.exp, rows)?),
-    ])
+    ];
+    if let Some(info) = &p.robust {
+        exps.push(with(info.nominal.trajectory.clone()));
+        let mut shaped = with(info.shaped.exp.trajectory.clone());
+        shaped.shaper = info.shaped.exp.shaper.clone();
+        exps.push(shaped);
+    }
+    Ok(exps)
 }
 
 /// Run every motion on the accurate AMM and the FEM (the six runs in parallel).
@@ -149,7 +173,7 @@ fn run_motions(exps: Vec<Experiment>, source: &str) -> Result<Vec<MotionRuns>> {
         .collect();
     let mut outcomes = outcomes.into_iter().collect::<Result<Vec<_>>>()?.into_iter();
     let mut motions = Vec::new();
-    for (exp, (key, label)) in exps.into_iter().zip(MOTIONS) {
+    for (exp, (key, label)) in exps.into_iter().zip(MOTIONS.into_iter().chain(ROBUST_MOTIONS)) {
         let (fem, amm) = (outcomes.next(), outcomes.next());
         let (Some(fem), Some(amm)) = (fem, amm) else {
             return Err(ApiError::solver(source, "a run of the comparison is missing"));

@@ -97,7 +97,7 @@ fn zero_peak() -> Peak {
 pub fn plan_json(cfg: &PlanConfig, o: &PlanOutcome) -> Value {
     let p = &o.planned;
     let points = p.family.points(&p.x, p.t_move);
-    json!({
+    let mut v = json!({
         "provenance": crate::provenance(),
         "experiment": cfg.exp.name,
         "plan": cfg.plan,
@@ -110,7 +110,11 @@ pub fn plan_json(cfg: &PlanConfig, o: &PlanOutcome) -> Value {
         "planned_r_norm_m": p.eval.norm_g(),
         "comparison": o.motions.iter().map(motion_row).collect::<Vec<_>>(),
         "wall_s": o.wall_s,
-    })
+    });
+    if let (Some(info), Some(check)) = (&p.robust, &o.robust) {
+        v["robust"] = crate::plan_robust_report::robust_json(info, check);
+    }
+    v
 }
 
 fn mm(v: Option<f64>) -> String {
@@ -145,6 +149,9 @@ pub fn plan_markdown(cfg: &PlanConfig, o: &PlanOutcome) -> String {
     s += &peaks_text(p);
     s += &comparison_table(&rows);
     s += &reading_text(&rows);
+    if let (Some(info), Some(check)) = (&p.robust, &o.robust) {
+        s += &crate::plan_robust_report::robust_markdown(info, check, &cfg.exp.name);
+    }
     s += &format!(
         "\n## Figures\n\n![G](figures/{n}-plan-G.svg)\n\n![tips](figures/{n}-plan-tips.svg)\n\n![sliders](figures/{n}-plan-sliders.svg)\n\n![forces](figures/{n}-plan-forces.svg)\n\n![path](figures/{n}-plan-path.svg)\n",
         n = cfg.exp.name
@@ -295,10 +302,11 @@ fn tip_series(r: &Response) -> Vec<f64> {
         .collect()
 }
 
-/// The colour of motion `k` (plain red, ZVD blue, planned orange).
+/// The colour of motion `k` (plain red, ZVD blue, planned orange; with `[robust]` the nominal
+/// plan and the shaper over the uncertainty in the two other colours).
 pub fn style(k: usize, dashed: bool) -> Style {
     Style {
-        color: FAMILY_COLORS[[0, 1, 4][k % 3]],
+        color: FAMILY_COLORS[[0, 1, 4, 2, 3][k % 5]],
         width: 2,
         dashed,
     }
@@ -395,7 +403,11 @@ pub fn write_figures(exp: &Experiment, o: &PlanOutcome) -> Result<Vec<PathBuf>> 
         crate::plan_figures::path_figure(exp, o),
     ];
     let mut files = Vec::new();
-    for fig in figures {
+    let robust = o
+        .robust
+        .as_ref()
+        .map(|c| crate::plan_robust_report::curves_figure(n, c));
+    for fig in figures.into_iter().chain(robust) {
         fig.write(&dir)?;
         files.extend(["svg", "png"].map(|e| dir.join(format!("{}.{e}", fig.name))));
     }

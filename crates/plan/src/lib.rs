@@ -11,7 +11,9 @@
 //! - [`limits`]: slider peaks, the shortest move the limits allow, the refusals of 4.8;
 //! - [`objective`]: one evaluation (an AMM run over the move and a residual window);
 //! - [`lm`]: the Levenberg-Marquardt search;
-//! - [`planner`]: the residual objective; [`time`]: the time objective.
+//! - [`planner`]: the residual objective; [`time`]: the time objective;
+//! - [`uncertainty`], [`robust`], [`minimax`]: `[robust]`, the plan that holds over an
+//!   uncertainty (4.11: the worst sample model's residual minimised on the epigraph).
 //!
 //! This crate plans; writing the files and checking the motions on the FEM is the command's
 //! (`flexstar_api::plan`).
@@ -19,11 +21,14 @@
 pub mod family;
 pub mod limits;
 pub mod lm;
+pub mod minimax;
 pub mod objective;
 pub mod planner;
 pub mod qp;
+pub mod robust;
 pub mod section;
 pub mod time;
+pub mod uncertainty;
 
 pub use planner::{plan, Planned};
 pub use section::{read_plan_config, Limits, Objective, PlanConfig, PlanSection, Shape};

@@ -19,17 +19,17 @@ use serde::Serialize;
 use crate::objective::{Eval, Rejected};
 
 /// Relative step of the forward differences (4.5: derivatives to about 1e-7).
-const FD_STEP: f64 = 1e-6;
+pub(crate) const FD_STEP: f64 = 1e-6;
 /// Initial damping, relative to the largest diagonal entry of `J^T J`.
-const MU0: f64 = 1e-4;
+pub(crate) const MU0: f64 = 1e-4;
 /// Damping at which the search gives up on a step.
-const MU_MAX: f64 = 1e8;
+pub(crate) const MU_MAX: f64 = 1e8;
 /// Most iterations.
-const MAX_ITERATIONS: usize = 40;
+pub(crate) const MAX_ITERATIONS: usize = 40;
 /// A step landing below this share of the model floor is shortened onto the floor.
 const FLOOR_LANDING: f64 = 0.8;
 /// Stop when `|r|^2` fell by less than this share in one iteration.
-const STALL: f64 = 1e-2;
+pub(crate) const STALL: f64 = 1e-2;
 
 /// When the search stops.
 #[derive(Debug, Clone, Copy)]
@@ -256,7 +256,7 @@ pub struct Jacobian {
 
 /// The Jacobians of `r` and of the usage at `x` by forward differences (a backward difference
 /// where the forward point is rejected), the columns in parallel.
-fn jacobian<F>(f: &F, x: &[f64], e0: &Eval) -> Result<Jacobian, Rejected>
+pub(crate) fn jacobian<F>(f: &F, x: &[f64], e0: &Eval) -> Result<Jacobian, Rejected>
 where
     F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
 {

@@ -77,6 +77,10 @@ pub struct Planned {
     /// same nominal duration, or at the same residual for `objective = "time"`).
     #[serde(skip)]
     pub zvd: Experiment,
+    /// With `[robust]` (`docs/motions.md` 4.11): the sample, the nominal plan, the shaper over
+    /// the uncertainty; this plan is then the robust one, its `eval` on the nominal model.
+    #[serde(skip)]
+    pub robust: Option<Box<crate::robust::RobustInfo>>,
 }
 
 /// The peaks of one motion: `|s_i'|` [m/s], `|s_i''|` [m/s^2], `|s_i'''|` [m/s^3] and the AMM's
@@ -182,7 +186,10 @@ pub fn plan(cfg: &PlanConfig) -> Result<Planned, PlanError> {
     match cfg.plan.objective {
         Objective::Residual => {
             let zvd = zvd_experiment(&cfg.exp, setup.family.quintic(t_ref))?;
-            plan_residual(cfg, &setup, t_ref, zvd)
+            match &cfg.robust {
+                None => plan_residual(cfg, &setup, t_ref, zvd),
+                Some(unc) => crate::robust::plan_robust(cfg, &setup, t_ref, zvd, unc),
+            }
         }
         Objective::Time => crate::time::plan_time(cfg, &setup),
     }
@@ -300,7 +307,7 @@ pub fn zvd_experiment(exp: &Experiment, base: Trajectory) -> Result<Experiment, 
 }
 
 /// The residual objective: LM from the plain quintic at the fixed `t_move`.
-fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Experiment) -> Result<Planned, PlanError> {
+pub(crate) fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Experiment) -> Result<Planned, PlanError> {
     let deadline = s.started + Duration::from_secs_f64(cfg.plan.budget());
     let x0 = s.family.plain();
     let plain = evaluate(&s.evaluator, &s.family, &x0, t_move)
@@ -355,6 +362,7 @@ fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Experiment) -> R
         wall_s: s.started.elapsed().as_secs_f64(),
         time_search: None,
         zvd,
+        robust: None,
     })
 }
 

@@ -5,7 +5,9 @@
 //! Clarabel's interior-point method.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SecondOrderConeT, SolverStatus, SupportedConeT,
+};
 use faer::Mat;
 
 /// Samples below this usage are left out of the step's constraints (a step of the damped search
@@ -88,6 +90,93 @@ pub fn damped_step_within(jtj: &Mat<f64>, jtr: &Mat<f64>, lambda: f64, lim: &Lin
     .then(|| solver.solution.x.clone())
 }
 
+/// One model's linearised residual in compressed form (`docs/motions.md` 4.11, Eq. U3):
+/// `|r_k + J_k dx| = |a dx + b|` with `[a | b]` the triangular factor `R` of the thin QR of
+/// `[J_k | r_k]` (`n + 1` rows instead of the window's thousands; exact, `Q` is orthonormal).
+#[derive(Debug, Clone)]
+pub struct Block {
+    /// `(n + 1) x n`.
+    pub a: Vec<Vec<f64>>,
+    /// `n + 1`.
+    pub b: Vec<f64>,
+}
+
+impl Block {
+    /// The compressed block of `r + J dx` (`j`: rows x n, `r`: rows).
+    pub fn of(j: &Mat<f64>, r: &[f64]) -> Block {
+        let n = j.ncols();
+        let m = Mat::from_fn(r.len(), n + 1, |i, c| if c < n { j[(i, c)] } else { r[i] });
+        let qr = m.qr();
+        let rr = qr.thin_R();
+        let rows = rr.nrows();
+        let at = |i: usize, c: usize| if i <= c { rr[(i, c)] } else { 0.0 };
+        Block {
+            a: (0..rows).map(|i| (0..n).map(|c| at(i, c)).collect()).collect(),
+            b: (0..rows).map(|i| at(i, n)).collect(),
+        }
+    }
+
+    /// `|a dx + b|`.
+    pub fn norm_at(&self, dx: &[f64]) -> f64 {
+        self.a
+            .iter()
+            .zip(&self.b)
+            .map(|(row, b)| row.iter().zip(dx).map(|(a, d)| a * d).sum::<f64>() + b)
+            .map(|v| v * v)
+            .sum::<f64>()
+            .sqrt()
+    }
+}
+
+/// The epigraph step of Eq. U3 (`docs/motions.md` 4.11): minimise `t + lambda/2 |dx|^2` subject
+/// to `|a_k dx + b_k| <= t` for every block and the linearised limits `lim`; a second-order cone
+/// program in `(dx, t)`. The blocks should be scaled to order 1 (Clarabel's tolerances are
+/// absolute). `None` when the program has no solution.
+pub fn epigraph_step(blocks: &[Block], lambda: f64, lim: Option<&LinearLimits>) -> Option<Vec<f64>> {
+    let n = blocks.first()?.a.first().map_or(0, |r| r.len());
+    let p = CscMatrix::from(
+        &(0..=n)
+            .map(|i| (0..=n).map(|j| if i == j && i < n { lambda } else { 0.0 }).collect())
+            .collect::<Vec<Vec<f64>>>(),
+    );
+    let mut q = vec![0.0; n + 1];
+    q[n] = 1.0;
+    let mut rows: Vec<Vec<f64>> = Vec::new();
+    let mut rhs = Vec::new();
+    let mut cones: Vec<SupportedConeT<f64>> = Vec::new();
+    if let Some(lim) = lim {
+        for (g, h) in lim.g.iter().zip(&lim.h) {
+            rows.push(g.iter().copied().chain([0.0]).collect());
+            rhs.push(*h);
+        }
+        cones.push(NonnegativeConeT(lim.h.len()));
+    }
+    for blk in blocks {
+        let mut t_row = vec![0.0; n + 1];
+        t_row[n] = -1.0;
+        rows.push(t_row);
+        rhs.push(0.0);
+        for (a, b) in blk.a.iter().zip(&blk.b) {
+            rows.push(a.iter().map(|v| -v).chain([0.0]).collect());
+            rhs.push(*b);
+        }
+        cones.push(SecondOrderConeT(blk.b.len() + 1));
+    }
+    let a = CscMatrix::from(&rows);
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(100)
+        .build()
+        .ok()?;
+    let mut solver = DefaultSolver::new(&p, &q, &a, &rhs, &cones, settings).ok()?;
+    solver.solve();
+    matches!(
+        solver.solution.status,
+        SolverStatus::Solved | SolverStatus::AlmostSolved
+    )
+    .then(|| solver.solution.x[..n].to_vec())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -104,5 +193,52 @@ mod tests {
         };
         let dx = damped_step_within(&jtj, &jtr, 0.0, &lim).unwrap();
         assert!((dx[0] - 0.5).abs() < 1e-6 && (dx[1] - 0.5).abs() < 1e-6, "{dx:?}");
+    }
+
+    /// The compressed block keeps the norm: `|a dx + b| = |r + J dx|` at random `dx` (direct
+    /// products against the factor).
+    #[test]
+    fn the_compressed_block_keeps_the_norm() {
+        let j = Mat::from_fn(40, 3, |i, c| ((i * 7 + c * 3) % 11) as f64 - 5.0 + 0.1 * c as f64);
+        let r: Vec<f64> = (0..40).map(|i| (i as f64 * 0.37).sin()).collect();
+        let blk = Block::of(&j, &r);
+        for dx in [[0.0, 0.0, 0.0], [0.3, -1.2, 0.5], [2.0, 0.1, -0.7]] {
+            let direct = (0..40)
+                .map(|i| r[i] + (0..3).map(|c| j[(i, c)] * dx[c]).sum::<f64>())
+                .map(|v| v * v)
+                .sum::<f64>()
+                .sqrt();
+            assert!(
+                (blk.norm_at(&dx) - direct).abs() < 1e-10 * direct,
+                "{} against {direct}",
+                blk.norm_at(&dx)
+            );
+        }
+    }
+
+    /// The epigraph step of the minimax of two affine residuals in one variable, `|x - 1|` and
+    /// `|x + 1|` from `x = 3` (blocks `r = x0 - 1 + dx`, `x0 + 1 + dx`): without damping the
+    /// minimax point x = 0 (the two balance), i.e. `dx = -3`.
+    #[test]
+    fn the_epigraph_step_balances_two_models() {
+        let blocks = [
+            Block {
+                a: vec![vec![1.0]],
+                b: vec![2.0],
+            },
+            Block {
+                a: vec![vec![1.0]],
+                b: vec![4.0],
+            },
+        ];
+        let dx = epigraph_step(&blocks, 0.0, None).unwrap();
+        assert!((dx[0] + 3.0).abs() < 1e-6, "{dx:?}");
+        // with a limit dx >= -2 (-dx <= 2) it stops there
+        let lim = LinearLimits {
+            g: vec![vec![-1.0]],
+            h: vec![2.0],
+        };
+        let dx = epigraph_step(&blocks, 0.0, Some(&lim)).unwrap();
+        assert!((dx[0] + 2.0).abs() < 1e-6, "{dx:?}");
     }
 }

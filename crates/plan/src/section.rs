@@ -282,8 +282,10 @@ pub struct PlanConfig {
     pub exp: Experiment,
     pub plan: PlanSection,
     pub limits: Limits,
-    /// The file's table without `[plan]` and `[limits]`.
+    /// The file's table without `[plan]`, `[limits]` and `[robust]`.
     pub table: toml::Table,
+    /// `[robust]`: the uncertainty a robust plan holds over (`docs/motions.md` 4.11).
+    pub robust: Option<crate::uncertainty::Uncertainty>,
 }
 
 /// Read and check a plan file: TOML syntax, the two sections (unknown keys refused), no
@@ -324,6 +326,7 @@ pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanE
         ))
     })?;
     let limits: Limits = section(&mut table, "limits", path)?.unwrap_or_default();
+    let robust: Option<toml::Table> = section(&mut table, "robust", path)?;
     plan.validate().map_err(in_file)?;
     limits.validate().map_err(in_file)?;
     let t_move = plan.t_move.unwrap_or(1.0);
@@ -342,12 +345,36 @@ pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanE
         },
         other => other,
     })?;
+    let robust = match robust {
+        Some(r) => Some(read_robust(r, &plan, &with_motion, path)?),
+        None => None,
+    };
     Ok(PlanConfig {
         exp,
         plan,
         limits,
         table,
+        robust,
     })
+}
+
+/// `[robust]` against the file's experiment document (`docs/motions.md` 4.11); refused with
+/// `objective = "time"` (a robust time search is not designed).
+fn read_robust(
+    section: toml::Table,
+    plan: &PlanSection,
+    doc: &toml::Table,
+    path: &Path,
+) -> Result<crate::uncertainty::Uncertainty, PlanError> {
+    if plan.objective == Objective::Time {
+        return Err(ModelError::invalid(
+            "robust",
+            "applies to the residual objective only (t_move given); objective = \"time\" is not robust",
+        )
+        .in_file(path)
+        .into());
+    }
+    Ok(crate::uncertainty::Uncertainty::read(section, doc, path)?)
 }
 
 /// Take the table `key` out of `table` and deserialize it (errors name the section).
@@ -422,6 +449,69 @@ mod tests {
         assert!(!c.plan.monotone() && c.plan.smoothness() == 0.5 && c.plan.tip_weight() == 2.0);
         assert_eq!(c.limits.j_max, Some(80.0));
         assert_eq!(read("peak_factor = 2\n").unwrap().plan.peak_factor(), Some(2.0));
+    }
+
+    /// `[robust]` as read (`docs/motions.md` 4.11): quoted and bare dotted keys, an indexed
+    /// key, the nominal value taken from the file or the paper's default list, the defaults.
+    #[test]
+    fn robust_ranges_read_with_their_nominal_values() {
+        let c = read("[payload]\nmass = 0.25\n[robust]\n\"payload.mass\" = [0.0, 0.5]\nrobot.E = [180e9, 220e9]\n\"robot.L[2]\" = [0.49, 0.51]\n")
+            .unwrap();
+        let u = c.robust.expect("[robust]");
+        let mut got: Vec<(String, f64, f64, f64)> = u
+            .ranges
+            .iter()
+            .map(|r| (r.key.clone(), r.lo, r.hi, r.nominal))
+            .collect();
+        got.sort_by(|a, b| a.0.cmp(&b.0));
+        assert_eq!(
+            got,
+            vec![
+                ("payload.mass".to_string(), 0.0, 0.5, 0.25),
+                ("robot.E".to_string(), 180e9, 220e9, 200e9),
+                ("robot.L[2]".to_string(), 0.49, 0.51, 0.5),
+            ]
+        );
+        assert_eq!((u.quantile, u.draws, u.seed), (1.0, 20, 1));
+        // a model at given values carries them (the study's setter, then the loader)
+        let ends: Vec<f64> = u.ranges.iter().map(|r| r.hi).collect();
+        let m = u.model_at(&ends).unwrap();
+        assert_eq!(m.payload.mass, 0.5);
+        let draws = u.fresh_draws();
+        assert_eq!(draws.len(), 20);
+        assert!(draws
+            .iter()
+            .all(|d| d.iter().zip(&u.ranges).all(|(v, r)| *v >= r.lo && *v <= r.hi)));
+        assert_eq!(u.candidates().len(), 8);
+    }
+
+    /// Bad `[robust]` entries are refused before any work, naming the file and the key.
+    #[test]
+    fn bad_robust_entries_are_refused_with_the_key() {
+        let with = |body: &str| format!("[payload]\nmass = 0.25\n[robust]\n{body}");
+        refused(&with("\"payload.mass\" = [0.3, 0.5]\n"), "robust.\"payload.mass\"");
+        refused(&with("\"payload.mass\" = [0.5, 0.0]\n"), "robust.\"payload.mass\"");
+        refused(&with("\"payload.mass\" = [0.5, 0.5]\n"), "robust.\"payload.mass\"");
+        refused(&with("\"payload.mass\" = 0.5\n"), "robust.\"payload.mass\"");
+        refused(&with("\"payload.mass\" = [-1.0, 0.5]\n"), "robust.\"payload.mass\"");
+        refused(&with("\"robot.Q\" = [1.0, 2.0]\n"), "robust.\"robot.Q\"");
+        refused(&with("\"amm.family\" = [1.0, 2.0]\n"), "robust.\"amm.family\"");
+        refused(&with("\"robot.L[4]\" = [0.4, 0.6]\n"), "robust.\"robot.L[4]\"");
+        refused(
+            &with("\"payload.mass\" = [0.0, 0.5]\nquantile = 0.0\n"),
+            "robust.quantile",
+        );
+        refused(
+            &with("\"payload.mass\" = [0.0, 0.5]\nquantile = 1.5\n"),
+            "robust.quantile",
+        );
+        refused(&with("\"payload.mass\" = [0.0, 0.5]\ndraws = 0\n"), "robust.draws");
+        refused(&with("quantile = 0.5\n"), "robust");
+        let msg = match read(&with("\"payload.mass\" = [0.3, 0.5]\n")) {
+            Err(PlanError::Input(e)) => e.to_string(),
+            other => panic!("{other:?}"),
+        };
+        assert!(msg.contains("excludes the experiment's own value 0.25"), "{msg}");
     }
 
     /// Bad values of the new keys are refused with the file and the key (4.8, 4.10).

@@ -369,6 +369,7 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
         reason,
         wall_s: s.started.elapsed().as_secs_f64(),
         zvd: zvd_experiment(&cfg.exp, s.family.quintic(zvd_base))?,
+        robust: None,
         time_search: Some(TimeSearch {
             residual_max_m: r_max,
             zvd_base_s: zvd_base,

@@ -12,10 +12,14 @@
 //! given without `f_hz` holds at the first elastic frequency at the start pose
 //! ([`resolve_damping`], `docs/usage.md`, damping), which the automatic shaper then designs with.
 //!
+//! [`robust::shape_over`] is the automatic shaper over an uncertainty (`docs/motions.md` 4.11):
+//! the nominal choice's bands of frequencies over several models, covered by `si` shapers.
+//!
 //! Both read the experiment's robot, the paper's or one as built: its own modes at its own start
 //! and final poses (`flexstar_modal`, `docs/modes.md`, a robot as built).
 
 mod auto;
+pub mod robust;
 
 use flexstar_model::{Experiment, ModelError};
 

@@ -410,7 +410,7 @@ impl Study {
 }
 
 /// The line of a TOML parse message that says why (the message also quotes the patched document).
-fn parse_reason(message: &str) -> String {
+pub fn parse_reason(message: &str) -> String {
     message
         .lines()
         .map(str::trim)

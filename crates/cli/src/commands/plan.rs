@@ -65,6 +65,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             peak(&m.fem)
         );
     }
+    if let Some(c) = &outcome.robust {
+        for (a, d) in c.sample_summary.iter().zip(&c.draws_summary) {
+            eprintln!(
+                "plan: robust: {:<8} worst residual peak of G: {:.3e} m over {} sample models (AMM), {:.3e} m over {} fresh draws (FEM); q-quantile {:.3e} m",
+                a.motion,
+                a.worst_m,
+                c.sample.len(),
+                d.worst_m,
+                c.draws.len(),
+                d.quantile_m
+            );
+        }
+        for f in &c.failures {
+            eprintln!("warning: robust check: {f}");
+        }
+    }
     eprintln!(
         "plan: {} files in {} in {:.2} s (plan.md: the comparison)",
         outcome.files.len(),

@@ -1,0 +1,281 @@
+//! The robust plan (`docs/motions.md` 4.11): the nominal plan of 4.9-4.10 first, then the sample
+//! models (Eq. U2), then the worst-case (quantile) search over them (Eq. U1, [`crate::minimax`])
+//! from the better of the plain quintic and the nominal plan; and the automatic shaper over the
+//! same sample ([`flexstar_shaping::robust::shape_over`]). This crate plans; checking the motions
+//! on the sample (AMM) and on fresh draws (FEM) is the command's (`flexstar_api::plan`).
+
+use std::time::Duration;
+
+use serde::Serialize;
+
+use flexstar_model::{Experiment, ModelError};
+
+use crate::family::Family;
+use crate::minimax::{self, Models};
+use crate::objective::{Eval, Evaluator, Rejected, SmoothRef, Terms};
+use crate::planner::{effective_bounds, evaluate, peak_warnings, PeakComparison, PeakSet, Planned, Setup};
+use crate::planner::{FLOOR_SHARE, WINDOW_PERIODS};
+use crate::section::{Limits, PlanConfig};
+use crate::uncertainty::Uncertainty;
+use crate::PlanError;
+
+/// Neighbouring sample models (sorted by their first frequency at the final pose) are at most
+/// this ratio apart (Eq. U2).
+pub const MAX_GAP: f64 = 1.25;
+
+/// One sample model: its values (one per uncertain key) and first elastic frequency at the final
+/// pose [Hz].
+#[derive(Debug, Clone, Serialize)]
+pub struct SampleModel {
+    pub values: Vec<f64>,
+    pub f1_hz: f64,
+    /// Is it the file's own model?
+    pub nominal: bool,
+    #[serde(skip)]
+    pub exp: Experiment,
+}
+
+/// What a robust plan adds to [`Planned`] (which holds the robust plan itself, evaluated on the
+/// nominal model).
+#[derive(Debug, Clone)]
+pub struct RobustInfo {
+    pub uncertainty: Uncertainty,
+    /// The sample the search held over.
+    pub sample: Vec<SampleModel>,
+    /// The candidates (corners or ends) with their first frequency, the sample chosen from them.
+    pub candidates: Vec<(Vec<f64>, f64)>,
+    /// The nominal plan (4.9-4.10 on the file's model).
+    pub nominal: Planned,
+    /// The objective of Eq. U1 [m] (RMS over each model's window) at the plain quintic, the
+    /// nominal plan and the robust plan.
+    pub objective_plain_m: f64,
+    pub objective_nominal_m: f64,
+    pub objective_m: f64,
+    /// Which the search started from (`"plain"` or `"nominal"`).
+    pub start: &'static str,
+    /// The shaped quintic over the uncertainty.
+    pub shaped: flexstar_shaping::robust::Covering,
+}
+
+/// The sample models' evaluators and limits: what [`minimax::minimise`] searches over.
+struct SampleSet<'a> {
+    family: &'a Family,
+    t_move: f64,
+    evaluators: Vec<Evaluator>,
+    bounds: Vec<Limits>,
+}
+
+impl Models for SampleSet<'_> {
+    fn count(&self) -> usize {
+        self.evaluators.len()
+    }
+
+    fn eval(&self, k: usize, x: &[f64]) -> Result<Eval, Rejected> {
+        evaluate(&self.evaluators[k], self.family, x, self.t_move)
+    }
+
+    fn accept(&self, k: usize, e: &Eval) -> bool {
+        e.within(&self.bounds[k])
+    }
+}
+
+/// Plan robustly (the residual objective, `t_move` given): the nominal plan, the sample, the
+/// search, the shaper over the sample.
+pub fn plan_robust(
+    cfg: &PlanConfig,
+    s: &Setup,
+    t_move: f64,
+    zvd: Experiment,
+    unc: &Uncertainty,
+) -> Result<Planned, PlanError> {
+    let nominal = crate::planner::plan_residual(cfg, s, t_move, zvd)?;
+    let (candidates, sample) = choose_sample(unc, &s.family.quintic(t_move), s.f1_hz)?;
+    let plain_x = s.family.plain();
+    let (set, plains) = sample_set(cfg, s, t_move, &sample)?;
+    let floors: Vec<f64> = plains.iter().map(|p| FLOOR_SHARE * p.norm_g()).collect();
+    let evals_at = |x: &[f64]| -> Option<Vec<Eval>> {
+        (0..set.count())
+            .map(|k| set.eval(k, x).ok().filter(|e| set.accept(k, e)))
+            .collect()
+    };
+    let score = |e: &[Eval]| minimax::objective(&e.iter().map(Eval::norm).collect::<Vec<_>>(), unc.quantile);
+    let e_plain = evals_at(&plain_x)
+        .ok_or_else(|| PlanError::Solver("the plain quintic breaks a sample model's limits".into()))?;
+    let e_nominal = evals_at(&nominal.x);
+    let (start, x0, e0) = match e_nominal {
+        Some(e) if score(&e) < score(&e_plain) => ("nominal", nominal.x.clone(), e),
+        _ => ("plain", plain_x.clone(), e_plain.clone()),
+    };
+    let stop = minimax::Stop {
+        floors,
+        deadline: s.started + Duration::from_secs_f64(cfg.plan.budget()),
+    };
+    let sol = minimax::minimise(&set, unc.quantile, x0, e0, &stop).map_err(|e| PlanError::Solver(e.to_string()))?;
+    let k_nom = sample.iter().position(|m| m.nominal).unwrap_or(0);
+    let shaped = flexstar_shaping::robust::shape_over(
+        &with_trajectory(&s.frozen, s.family.quintic(t_move)),
+        &sample.iter().map(|m| m.exp.clone()).collect::<Vec<_>>(),
+    )
+    .map_err(|e| PlanError::Solver(format!("the shaper over the uncertainty: {}", e.detail())))?;
+    let runs: usize = set.evaluators.iter().map(Evaluator::runs).sum::<usize>() + s.evaluator.runs();
+    let info = RobustInfo {
+        uncertainty: unc.clone(),
+        candidates,
+        objective_plain_m: score(&e_plain),
+        objective_nominal_m: e_nominal_score(&nominal, &set, unc.quantile),
+        objective_m: sol.objective,
+        start,
+        shaped,
+        sample,
+        nominal: nominal.clone(),
+    };
+    let peaks = PeakComparison {
+        plain: PeakSet::of(&plains[k_nom]),
+        planned: PeakSet::of(&sol.evals[k_nom]),
+    };
+    Ok(Planned {
+        warnings: peak_warnings(&peaks.plain, &peaks.planned),
+        peaks,
+        trajectory: s.family.trajectory(&sol.x, t_move),
+        x: sol.x,
+        eval: sol.evals[k_nom].clone(),
+        plain: plains[k_nom].clone(),
+        bounds: set.bounds[k_nom],
+        r_floor_m: stop.floors[k_nom],
+        trace: sol.trace,
+        evaluations: runs,
+        reason: sol.reason,
+        wall_s: s.started.elapsed().as_secs_f64(),
+        robust: Some(Box::new(info)),
+        ..nominal
+    })
+}
+
+/// Eq. U1 at the nominal plan (infinite when it breaks a sample model's limits).
+fn e_nominal_score(nominal: &Planned, set: &SampleSet, quantile: f64) -> f64 {
+    let norms: Option<Vec<f64>> = (0..set.count())
+        .map(|k| {
+            set.eval(k, &nominal.x)
+                .ok()
+                .filter(|e| set.accept(k, e))
+                .map(|e| e.norm())
+        })
+        .collect();
+    norms.map_or(f64::INFINITY, |n| minimax::objective(&n, quantile))
+}
+
+/// `exp` with its trajectory replaced.
+fn with_trajectory(exp: &Experiment, traj: flexstar_model::Trajectory) -> Experiment {
+    let mut e = exp.clone();
+    e.trajectory = traj;
+    e
+}
+
+/// The candidates and the sample of Eq. U2: the nominal model and every candidate (corners),
+/// each with its first frequency at the final pose of `quintic`; kept the nominal, the lowest and
+/// the highest, then the candidate nearest the geometric middle of the widest gap while a gap
+/// exceeds [`MAX_GAP`].
+#[allow(clippy::type_complexity)]
+pub fn choose_sample(
+    unc: &Uncertainty,
+    quintic: &flexstar_model::Trajectory,
+    f1_nominal: f64,
+) -> Result<(Vec<(Vec<f64>, f64)>, Vec<SampleModel>), PlanError> {
+    let model = |values: &[f64]| -> Result<SampleModel, PlanError> {
+        let mut exp = unc.model_at(values).map_err(PlanError::from)?;
+        exp.trajectory = quintic.clone();
+        let f1_hz = first_frequency(&exp)?;
+        Ok(SampleModel {
+            values: values.to_vec(),
+            f1_hz,
+            nominal: false,
+            exp,
+        })
+    };
+    let mut pool: Vec<SampleModel> = unc.candidates().iter().map(|v| model(v)).collect::<Result<_, _>>()?;
+    let candidates = pool.iter().map(|m| (m.values.clone(), m.f1_hz)).collect();
+    let mut nominal = model(&unc.nominal_values())?;
+    nominal.nominal = true;
+    nominal.f1_hz = f1_nominal;
+    pool.sort_by(|a, b| a.f1_hz.total_cmp(&b.f1_hz));
+    let mut chosen = vec![nominal];
+    for end in [pool.first().cloned(), pool.last().cloned()].into_iter().flatten() {
+        if !chosen.iter().any(|m| m.values == end.values) {
+            chosen.push(end);
+        }
+    }
+    loop {
+        chosen.sort_by(|a, b| a.f1_hz.total_cmp(&b.f1_hz));
+        let gap = chosen
+            .windows(2)
+            .enumerate()
+            .map(|(i, w)| (i, w[1].f1_hz / w[0].f1_hz))
+            .filter(|(_, r)| *r > MAX_GAP)
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        let Some((i, _)) = gap else { break };
+        let middle = (chosen[i].f1_hz * chosen[i + 1].f1_hz).sqrt();
+        let fill = pool
+            .iter()
+            .filter(|m| m.f1_hz > chosen[i].f1_hz && m.f1_hz < chosen[i + 1].f1_hz)
+            .filter(|m| !chosen.iter().any(|c| c.values == m.values))
+            .min_by(|a, b| (a.f1_hz / middle).ln().abs().total_cmp(&(b.f1_hz / middle).ln().abs()));
+        match fill {
+            Some(m) => chosen.push(m.clone()),
+            None => break,
+        }
+    }
+    Ok((candidates, chosen))
+}
+
+/// The first elastic frequency at the final pose [Hz] (accurate AMM, sliders locked).
+fn first_frequency(exp: &Experiment) -> Result<f64, PlanError> {
+    flexstar_modal::analysis::final_pose_frequencies(exp, 1)
+        .map_err(|e| PlanError::Solver(format!("modes at the final pose of a sample model: {e}")))?
+        .and_then(|f| f.first().copied())
+        .filter(|f| *f > 0.0)
+        .ok_or_else(|| PlanError::Solver("a sample model has no elastic mode at the final pose".into()))
+}
+
+/// Each sample model's evaluator (N frozen at the nominal's, the window two periods of its own
+/// first frequency), its plain quintic and its limits (4.10's, from its own plain quintic).
+fn sample_set<'a>(
+    cfg: &PlanConfig,
+    s: &'a Setup,
+    t_move: f64,
+    sample: &[SampleModel],
+) -> Result<(SampleSet<'a>, Vec<Eval>), PlanError> {
+    let mut set = SampleSet {
+        family: &s.family,
+        t_move,
+        evaluators: Vec::new(),
+        bounds: Vec::new(),
+    };
+    let mut plains = Vec::new();
+    for m in sample {
+        let base = Evaluator::new(&m.exp, s.modes, WINDOW_PERIODS / m.f1_hz);
+        let plain = evaluate(&base, &s.family, &s.family.plain(), t_move)
+            .map_err(|e| PlanError::Solver(format!("the plain quintic on a sample model {:?}: {e}", m.values)))?;
+        let bounds = effective_bounds(&cfg.limits, cfg.plan.peak_factor(), &plain);
+        if let Some(max) = cfg.limits.fa_max.filter(|m| plain.fa.value > *m) {
+            return Err(ModelError::invalid(
+                "limits.Fa_max",
+                format!(
+                    "the plain quintic on the sample model {:?} of [robust] reaches |Fa| = {:.3} N, above Fa_max = {max} N",
+                    m.values, plain.fa.value
+                ),
+            )
+            .in_file(&cfg.exp.source)
+            .into());
+        }
+        let floor = FLOOR_SHARE * plain.norm_g();
+        let ev = base.with_limits(bounds).with_terms(Terms {
+            tip_weight: cfg.plan.tip_weight(),
+            smooth: SmoothRef::new(&plain, cfg.plan.smoothness(), floor),
+            monotone: cfg.plan.monotone().then(|| s.family.clone()),
+        });
+        set.evaluators.push(ev);
+        set.bounds.push(bounds);
+        plains.push(plain);
+    }
+    Ok((set, plains))
+}

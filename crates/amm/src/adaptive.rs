@@ -107,14 +107,17 @@ pub const SAG_COEFF: f64 = 1.75;
 
 /// Eq. V3 [%]: the estimate's part for the vibration about the sag under gravity, from the run
 /// `r` of `problem`: `SAG_COEFF * 100 * S^2`, S [rad] the largest `|thp_i|` of the first output
-/// row (the static equilibrium of the start pose, `docs/as-built.md` 5.4). Zero without gravity.
+/// row (the static equilibrium of the start pose, `docs/as-built.md` 5.4). Zero without gravity,
+/// and for a motion that does not come to rest within the run (no residual vibration about the
+/// sag; the motion's own deflection dominates its response, 12.13).
 pub fn sag_part(problem: &Problem, r: &Response) -> f64 {
     sag_part_of(&Star::new(problem), r)
 }
 
 /// [`sag_part`] of the AMM's view of a problem.
 pub(crate) fn sag_part_of(problem: &Star, r: &Response) -> f64 {
-    if problem.gravity == [0.0; 2] {
+    let rests = problem.trajectory.t_rest().is_some_and(|t| t <= problem.time.t_end);
+    if problem.gravity == [0.0; 2] || !rests {
         return 0.0;
     }
     let s = start_sleeve_rotation(r);

@@ -128,6 +128,8 @@ pub(crate) struct Star<'a> {
     pub(crate) load: &'a LoadSettings,
     /// Gravity `[gx, gy]` [m/s^2], base frame.
     pub(crate) gravity: [f64; 2],
+    /// Friction in the sleeves and on the rails (`docs/friction.md` 9); `None`: none.
+    pub(crate) friction: Option<&'a flexstar_model::Friction>,
 }
 
 impl<'a> Star<'a> {
@@ -139,7 +141,9 @@ impl<'a> Star<'a> {
             Some(p) => [*p; 3],
             None => beam_params(robot),
         };
-        let shared = beams[1] == beams[0] && beams[2] == beams[0];
+        // viscous sleeve friction puts each sleeve's own term on its beam's arrowhead (Eq. F14)
+        let viscous = problem.friction().is_some_and(|f| f.c.0.iter().any(|c| *c != 0.0));
+        let shared = beams[1] == beams[0] && beams[2] == beams[0] && !viscous;
         Star {
             robot,
             paper,
@@ -157,6 +161,7 @@ impl<'a> Star<'a> {
             damping: problem.damping(),
             load: problem.load(),
             gravity: problem.gravity(),
+            friction: problem.friction(),
         }
     }
 

@@ -645,7 +645,14 @@ struct DirectOutput {
 impl DirectOutput {
     /// Record the state at a stop: the configuration reached is checked (leaving the feasible
     /// range stops the run with the time and the reason), the law's forces evaluated.
-    fn record(&mut self, sys: &System, ctx: &StepContext, stop: &Stop, t: f64, x: &DirectState) -> Result<(), AmmError> {
+    fn record(
+        &mut self,
+        sys: &System,
+        ctx: &StepContext,
+        stop: &Stop,
+        t: f64,
+        x: &DirectState,
+    ) -> Result<(), AmmError> {
         let (s, sd, sdd) = (x.s, x.sd, x.sdd);
         check_reached(ctx.star, s, t)?;
         let st = rigid_at(ctx.star, s, sd, sdd, t)?;
@@ -656,7 +663,11 @@ impl DirectOutput {
         self.rec
             .record(&st, stop, &x.q, &sys.lam, sys.sleeves.axial(), Some(fa));
         if let (Some(out), Some(_)) = (self.friction.as_mut(), stop.output) {
-            out.sample(sys, stick_slip::sleeve_forces(sys, &x.qdd), stick_slip::speeds(sys, &st, &x.v));
+            out.sample(
+                sys,
+                stick_slip::sleeve_forces(sys, &x.qdd),
+                stick_slip::speeds(sys, &st, &x.v),
+            );
         }
         if stop.output.is_some() {
             let vals = [s[0], s[1], s[2], sd[0], sd[1], sd[2], st.g[0].v, st.g[1].v, st.theta.v];

@@ -102,7 +102,6 @@ impl SleeveFriction {
     pub(crate) fn load_at(&self, i: usize, lam: &[f64]) -> f64 {
         load(self.law.model, self.hp[i], self.rows[i].map(|r| lam[r])).0
     }
-
 }
 
 impl System {

@@ -38,9 +38,9 @@ mod rayleigh_decay;
 mod record;
 mod sleeve;
 pub mod solver;
-mod stick_slip;
 mod star;
 mod static_start;
+mod stick_slip;
 mod system;
 
 pub use direct::DIRECT_COLUMNS;

@@ -471,7 +471,12 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     })?;
     acc.copy_from_slice(&qdd);
 
-    let record = |rec: &mut Recorder, out: Option<&mut FrictionOutput>, sys: &System, st: &RigidState, stop: &Stop, (q, v, qdd): (&[f64], &[f64], &[f64])| {
+    let record = |rec: &mut Recorder,
+                  out: Option<&mut FrictionOutput>,
+                  sys: &System,
+                  st: &RigidState,
+                  stop: &Stop,
+                  (q, v, qdd): (&[f64], &[f64], &[f64])| {
         let out = out.zip(problem.friction);
         let fa = out.as_ref().map(|(_, law)| friction_fa(rec, sys, st, q, qdd, law));
         rec.record(st, stop, q, &sys.lam, sys.sleeves.axial(), fa);

@@ -91,6 +91,17 @@ impl ConstraintLu {
         }
     }
 
+    /// For an m x m system factored densely whatever its structure (with the stick rows of
+    /// friction, `docs/friction.md` 9, the rows no longer have the block structure).
+    pub(crate) fn dense(m: usize) -> Self {
+        ConstraintLu {
+            m,
+            nj: m,
+            blocks: None,
+            dense: None,
+        }
+    }
+
     /// Factor A (`a`, m x m, row-major). Fails with the reason when A is rank deficient.
     pub(crate) fn factor(&mut self, a: &[f64]) -> Result<(), RankError> {
         self.blocks = self.block_factor(a);

@@ -30,7 +30,9 @@ use crate::error::{AmmError, RankError};
 use crate::record::Recorder;
 use crate::solver::{shape_times, star_time_scale, stops, validate, Stats, Stop, RHO_INF};
 use crate::star::Star;
+use crate::stick_slip::{self, FrictionOutput, Rails, StepEnd};
 use crate::system::System;
+use flexstar_model::Contact;
 
 /// Columns a direct run writes first among its extra columns: the sliders `s_i` [m] and `s_i'`
 /// [m/s], and the rigid pose of the simulated sliders by the exact direct kinematics: `Gx`, `Gy`
@@ -156,6 +158,7 @@ fn coupled_step(
     (shat, sdhat, x_pred): ([f64; 3], [f64; 3], [f64; 3]),
     (qhat, vhat): (&[f64], &[f64]),
     qdd: &mut [f64],
+    rails: Option<&Rails>,
 ) -> Result<[f64; 3], AmmError> {
     let s = [0, 1, 2].map(|i| shat[i] + bp * x_pred[i]);
     let sd = [0, 1, 2].map(|i| sdhat[i] + gp * x_pred[i]);
@@ -164,6 +167,9 @@ fn coupled_step(
     let sens = sensitivity(star, s, sd, gp, t)?;
 
     // base solution at the predictor, then the sensitivities with the same factors
+    if sys.friction.is_some() {
+        sys.predict_friction(&st, vhat, (bp, gp));
+    }
     sys.prepare(&st, bp, gp, qhat)?;
     sys.forcing(&st, qhat, vhat);
     sys.solve_prepared(bp, Some(qhat), &mut buf.qdd0);
@@ -192,6 +198,9 @@ fn coupled_step(
         row[3] = fa[i] + m * rec.gravity_along(i)
             - m * x_pred[i]
             - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
+        if sys.friction.is_some() || rails.is_some() {
+            friction_row(sys, rec, buf, &st, i, row, rails.map(|r| (r, sd[i], x_pred[i], gp)));
+        }
     }
     let dx = solve3(a).ok_or(AmmError::SingularConstraints {
         t,
@@ -210,6 +219,58 @@ fn coupled_step(
     }
     sys.set_axial_acceleration(qdd);
     Ok([0, 1, 2].map(|i| x_pred[i] + dx[i]))
+}
+
+/// Friction in slider i's row of the 3 x 3 system (Eq. F17, `docs/friction.md` 9.1): the
+/// sleeve's friction along the rail (`F_fi (e_xi . u_i)`, affine in the multipliers and `u_i''`:
+/// its change along each sensitivity in the columns, its base value on the right), and the rail
+/// (`rail`: the rails, the slider's predicted speed [m/s] and s'' [m/s^2], gamma' [s]):
+/// slipping, `Fc s + b s'` with `b gamma'` on the diagonal; stuck, the row `ds''_i = -s''_pred`.
+fn friction_row(
+    sys: &System,
+    rec: &Recorder,
+    buf: &Coupled,
+    st: &RigidState,
+    i: usize,
+    row: &mut [f64; 4],
+    rail: Option<(&Rails, f64, f64, f64)>,
+) {
+    let u = sys.nb * i + sys.nm;
+    if sys.friction.is_some() {
+        let along = rec.along_rail(i, st);
+        for (k, (dlam, dqdd)) in buf.dlam.iter().zip(&buf.dqdd).enumerate() {
+            row[k] += along * sys.sleeve_friction_force(i, dlam, dqdd[u], false);
+        }
+        row[3] -= along * sys.sleeve_friction_force(i, &buf.lam0, buf.qdd0[u], true);
+    }
+    let Some((rails, sd, x_pred, gp)) = rail else {
+        return;
+    };
+    let law = rails.law[i];
+    match rails.contacts[i] {
+        Contact::Free => {}
+        Contact::Slip(s) => {
+            row[i] += law.b * gp;
+            row[3] -= law.fc * s + law.b * sd;
+        }
+        Contact::Stuck(_) => {
+            *row = [0.0; 4];
+            row[i] = 1.0;
+            row[3] = -x_pred;
+        }
+    }
+}
+
+/// The force a stuck slider i needs from its rail [N] (Eq. F17 at `s_i'' = 0`) after the step's
+/// solve (`sys.lam` its multipliers, `qdd` its accelerations) at the rigid state `st`.
+fn rail_need(sys: &System, rec: &Recorder, fa: [f64; 3], st: &RigidState, q: &[f64], qdd: &[f64]) -> [f64; 3] {
+    let ff = stick_slip::sleeve_forces(sys, qdd);
+    [0, 1, 2].map(|i| {
+        let m = rec.mass(i);
+        fa[i] + m * rec.gravity_along(i)
+            - rec.sleeve_push(i, st, q, &sys.lam, sys.sleeves.axial())
+            - ff[i] * rec.along_rail(i, st)
+    })
 }
 
 /// The 3 x 3 system given as augmented rows, by nalgebra's LU with partial pivoting; `None` when
@@ -245,17 +306,24 @@ fn integrate_direct(
         cols: (0..DIRECT_COLUMNS.len())
             .map(|_| Vec::with_capacity(out_times.len()))
             .collect(),
+        friction: None,
     };
     let mut buf = Coupled::new(n, sys.lam.len());
     let mut ctx = StepContext {
-        sys: &mut sys,
         buf: &mut buf,
         law,
         star: problem,
     };
 
-    let mut state = initial_state(problem, &mut ctx, &out.rec, n)?;
-    out.record(&ctx, &stops[0], 0.0, &state)?;
+    let (mut state, mut rails) = match problem.friction {
+        None => (initial_state(problem, &mut sys, &mut ctx, &out.rec, n, None)?, None),
+        Some(fr) => {
+            let (state, rails, output) = friction_start(problem, &mut sys, &mut ctx, &out.rec, n, fr)?;
+            out.friction = Some(output);
+            (state, Some(rails))
+        }
+    };
+    out.record(&sys, &ctx, &stops[0], 0.0, &state)?;
 
     let ga = GenAlpha::new(RHO_INF);
     let mut scratch = Predictors::new(n);
@@ -265,26 +333,36 @@ fn integrate_direct(
         let h = (t1 - t0) / nsub as f64;
         for k in 1..=nsub {
             let t = if k == nsub { t1 } else { t0 + k as f64 * h };
-            substep(&mut ctx, &out.rec, &ga, h, t, &mut state, &mut scratch)?;
+            match (rails.as_mut(), out.friction.as_mut()) {
+                (Some(rails), Some(output)) => {
+                    let step = FrictionStep {
+                        rec: &out.rec,
+                        ga: &ga,
+                        h,
+                        t,
+                    };
+                    step.take(&mut sys, &mut ctx, rails, output, &mut state, &mut scratch)?;
+                }
+                _ => substep(&mut sys, &mut ctx, &out.rec, &ga, h, t, &mut state, &mut scratch, None)?,
+            }
             steps += 1;
         }
-        out.record(&ctx, &w[1], t1, &state)?;
+        out.record(&sys, &ctx, &w[1], t1, &state)?;
         if flexstar_model::cancel::cancelled() {
             return Err(AmmError::Cancelled { t: t1 });
         }
     }
     runs.push((n_modes, steps));
     let mut resp = out.finish(settings, n_modes, dt_max, started);
+    sys.release_contacts();
     // the residual's reference: the static equilibrium where the reference motion rests
     let scale = star_time_scale(problem);
     resp.rest_offset = crate::static_start::rest_offset(&mut sys, problem, scale)?;
     Ok(resp)
 }
 
-/// What every coupled step of one run borrows: the system, the step buffers, the actuator law
-/// and the robot.
+/// What every coupled step of one run borrows: the step buffers, the actuator law and the robot.
 struct StepContext<'a> {
-    sys: &'a mut System,
     buf: &'a mut Coupled,
     law: &'a dyn ActuatorLaw,
     star: &'a Star<'a>,
@@ -293,6 +371,7 @@ struct StepContext<'a> {
 /// The state of a direct run at a step: elastic coordinates q [-], their rates and the
 /// generalized-alpha acceleration-like variable `acc`, q''; the sliders s [m], s' [m/s], s''
 /// [m/s^2] and their `sacc`.
+#[derive(Clone)]
 struct DirectState {
     q: Vec<f64>,
     v: Vec<f64>,
@@ -323,8 +402,16 @@ impl Predictors {
 
 /// The initial state: s, s' of the trajectory at t = 0, the star at rest elastically (undeformed,
 /// or under gravity in the static equilibrium of the start pose with the sliders held, Eq. G4);
-/// consistent accelerations of both (bp = gp = 0: the step is linear, the solve exact).
-fn initial_state(problem: &Star, ctx: &mut StepContext, rec: &Recorder, n: usize) -> Result<DirectState, AmmError> {
+/// consistent accelerations of both (bp = gp = 0: the step is linear, the solve exact). `rails`:
+/// with friction, the rails' contacts (a stuck slider's s'' is 0).
+fn initial_state(
+    problem: &Star,
+    sys: &mut System,
+    ctx: &mut StepContext,
+    rec: &Recorder,
+    n: usize,
+    rails: Option<&Rails>,
+) -> Result<DirectState, AmmError> {
     let (mut q, v) = (vec![0.0; n], vec![0.0; n]);
     let mut qdd = vec![0.0; n];
     let jets = problem.jets(0.0)?;
@@ -332,19 +419,31 @@ fn initial_state(problem: &Star, ctx: &mut StepContext, rec: &Recorder, n: usize
     if problem.gravity != [0.0; 2] {
         let rest = rigid_at(ctx.star, s, [0.0; 3], [0.0; 3], 0.0)?;
         let scale = star_time_scale(ctx.star);
-        crate::static_start::static_equilibrium(ctx.sys, &rest, scale, &mut q)?;
+        let free = sys.friction.as_ref().map(|f| f.contacts);
+        sys.release_contacts();
+        crate::static_start::static_equilibrium(sys, &rest, scale, &mut q)?;
+        if let (Some(f), Some(c)) = (sys.friction.as_mut(), free) {
+            f.contacts = c;
+        }
+    }
+    let mut x_pred = jets.map(|j| j.d2);
+    if let Some(r) = rails {
+        for i in (0..3).filter(|&i| r.contacts[i].stuck().is_some()) {
+            x_pred[i] = 0.0;
+        }
     }
     let sdd = coupled_step(
-        ctx.sys,
+        sys,
         rec,
         ctx.buf,
         ctx.law,
         ctx.star,
         0.0,
         (0.0, 0.0),
-        (s, sd, jets.map(|j| j.d2)),
+        (s, sd, x_pred),
         (&q, &v),
         &mut qdd,
+        rails,
     )?;
     let acc = qdd.clone();
     Ok(DirectState {
@@ -360,8 +459,11 @@ fn initial_state(problem: &Star, ctx: &mut StepContext, rec: &Recorder, n: usize
 }
 
 /// One generalized-alpha substep of length `h` ending at `t`: predict q and s, solve the coupled
-/// step, correct; a non-finite state stops the run with the time and the step.
+/// step, correct; a non-finite state stops the run with the time and the step. `rails`: with
+/// friction, the rails' contacts (a stuck slider frozen: `s = s*`, `s' = s'' = 0`, Eq. F17).
+#[allow(clippy::too_many_arguments)]
 fn substep(
+    sys: &mut System,
     ctx: &mut StepContext,
     rec: &Recorder,
     ga: &GenAlpha,
@@ -369,6 +471,7 @@ fn substep(
     t: f64,
     x: &mut DirectState,
     p: &mut Predictors,
+    rails: Option<&Rails>,
 ) -> Result<(), AmmError> {
     let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
     let apq = ga.a_per_qdd();
@@ -382,8 +485,14 @@ fn substep(
     for i in 0..3 {
         (sa_part[i], shat[i], sdhat[i]) = predict(x.s[i], x.sd[i], x.sacc[i], x.sdd[i]);
     }
+    let stuck = rails.map_or([None; 3], |r| r.contacts.map(|c| c.stuck()));
+    for (i, at) in stuck.iter().enumerate() {
+        if let Some(at) = at {
+            (shat[i], sdhat[i], x.sdd[i], sa_part[i]) = (*at, 0.0, 0.0, 0.0);
+        }
+    }
     x.sdd = coupled_step(
-        ctx.sys,
+        sys,
         rec,
         ctx.buf,
         ctx.law,
@@ -393,6 +502,7 @@ fn substep(
         (shat, sdhat, x.sdd),
         (&p.qhat, &p.vhat),
         &mut x.qdd,
+        rails,
     )?;
     let mut norm = 0.0;
     for i in 0..n {
@@ -413,16 +523,136 @@ fn substep(
     Ok(())
 }
 
+/// The consistent start with friction (`docs/friction.md` 9.1): the sleeves and sliders at
+/// rest stuck, the moving ones slipping, the start solved again (four times) so that the load's
+/// signs and a stuck sleeve's `xp''` are those of its own solution, and a contact that cannot
+/// hold released (`stick_slip::switching_step`).
+fn friction_start(
+    problem: &Star,
+    sys: &mut System,
+    ctx: &mut StepContext,
+    rec: &Recorder,
+    n: usize,
+    law: &flexstar_model::Friction,
+) -> Result<(DirectState, Rails, FrictionOutput), AmmError> {
+    let jets = problem.jets(0.0)?;
+    let (s, sd) = (jets.map(|j| j.v), jets.map(|j| j.d1));
+    let mut rails = Rails::start(law, s, sd);
+    let st = rigid_at(ctx.star, s, sd, jets.map(|j| j.d2), 0.0)?;
+    let zero = vec![0.0; n];
+    sys.start_contacts(&st, &zero, &zero);
+    let xi_start = stick_slip::coordinates(sys, &st, &zero);
+    let mut state = None;
+    let end = stick_slip::switching_step(sys, Some(&mut rails), 0.0, 0.0, |sys, rails, _| {
+        let mut x = initial_state(problem, sys, ctx, rec, n, rails)?;
+        for _ in 0..4 {
+            let sdd = coupled_step(
+                sys,
+                rec,
+                ctx.buf,
+                ctx.law,
+                ctx.star,
+                0.0,
+                (0.0, 0.0),
+                (x.s, x.sd, x.sdd),
+                (&x.q, &x.v),
+                &mut x.qdd,
+                rails,
+            )?;
+            (x.sdd, x.sacc) = (sdd, sdd);
+        }
+        x.acc.copy_from_slice(&x.qdd);
+        let end = step_end(sys, ctx, rec, &x, (xi_start, s), 0.0)?;
+        state = Some(x);
+        Ok(end)
+    })?;
+    let x = state.expect("the start was solved");
+    let (ff, vs) = (stick_slip::sleeve_forces(sys, &x.qdd), end.vs);
+    let output = FrictionOutput::start(sys, ff, vs, rails.power(x.sd));
+    Ok((x, rails, output))
+}
+
+/// What the judging of a converged direct step reads (`stick_slip::StepEnd`) at its end state
+/// `x` and time `t`; `(xi_start, s_start)`: the sleeves' material coordinates and the sliders'
+/// positions at the step's start [m].
+fn step_end(
+    sys: &System,
+    ctx: &StepContext,
+    rec: &Recorder,
+    x: &DirectState,
+    (xi_start, s_start): ([f64; 3], [f64; 3]),
+    t: f64,
+) -> Result<StepEnd, AmmError> {
+    let st = rigid_at(ctx.star, x.s, x.sd, x.sdd, t)?;
+    let fa = ctx
+        .law
+        .force(t, x.s, x.sd)
+        .map_err(|source| AmmError::Drive { t, source })?;
+    Ok(StepEnd {
+        xi_start,
+        vs: stick_slip::speeds(sys, &st, &x.v),
+        s_start,
+        sd: x.sd,
+        rail_need: rail_need(sys, rec, fa, &st, &x.q, &x.qdd),
+    })
+}
+
+/// One step of a direct run with friction: [`substep`] with the switching of the contacts.
+struct FrictionStep<'a> {
+    rec: &'a Recorder,
+    ga: &'a GenAlpha,
+    h: f64,
+    t: f64,
+}
+
+impl FrictionStep<'_> {
+    /// Take the step from `x` (module doc of `stick_slip`), the friction's tally advanced.
+    fn take(
+        &self,
+        sys: &mut System,
+        ctx: &mut StepContext,
+        rails: &mut Rails,
+        output: &mut FrictionOutput,
+        x: &mut DirectState,
+        p: &mut Predictors,
+    ) -> Result<(), AmmError> {
+        let (h, t) = (self.h, self.t);
+        let start = x.clone();
+        let st0 = rigid_at(ctx.star, x.s, x.sd, x.sdd, t - h)?;
+        let starts = (stick_slip::coordinates(sys, &st0, &x.q), x.s);
+        let end = stick_slip::switching_step(sys, Some(rails), t, h, |sys, rails, retake| {
+            if retake {
+                x.clone_from(&start);
+                sys.set_axial_acceleration(&start.qdd);
+            }
+            substep(sys, ctx, self.rec, self.ga, h, t, x, p, rails)?;
+            step_end(sys, ctx, self.rec, x, starts, t)
+        })?;
+        let ff = stick_slip::sleeve_forces(sys, &x.qdd);
+        output.advance(sys, (ff, end.vs), (&rails.contacts, rails.power(x.sd)), h);
+        Ok(())
+    }
+}
+
 /// The recorder of a direct run and its [`DIRECT_COLUMNS`] at the output times.
 struct DirectOutput {
     rec: Recorder,
     cols: Vec<Vec<f64>>,
+    /// With friction: its outputs (`docs/friction.md` 7).
+    friction: Option<FrictionOutput>,
 }
 
 impl DirectOutput {
     /// Record the state at a stop: the configuration reached is checked (leaving the feasible
     /// range stops the run with the time and the reason), the law's forces evaluated.
-    fn record(&mut self, ctx: &StepContext, stop: &Stop, t: f64, x: &DirectState) -> Result<(), AmmError> {
+    fn record(
+        &mut self,
+        sys: &System,
+        ctx: &StepContext,
+        stop: &Stop,
+        t: f64,
+        x: &DirectState,
+    ) -> Result<(), AmmError> {
         let (s, sd, sdd) = (x.s, x.sd, x.sdd);
         check_reached(ctx.star, s, t)?;
         let st = rigid_at(ctx.star, s, sd, sdd, t)?;
@@ -430,15 +660,15 @@ impl DirectOutput {
             .law
             .force(t, s, sd)
             .map_err(|source| AmmError::Drive { t, source })?;
-        self.rec.record(
-            &st,
-            stop,
-            &x.q,
-            [&x.v, &x.qdd],
-            &ctx.sys.lam,
-            ctx.sys.sleeves.axial(),
-            Some(fa),
-        );
+        self.rec
+            .record(&st, stop, &x.q, [&x.v, &x.qdd], &sys.lam, sys.sleeves.axial(), Some(fa));
+        if let (Some(out), Some(_)) = (self.friction.as_mut(), stop.output) {
+            out.sample(
+                sys,
+                stick_slip::sleeve_forces(sys, &x.qdd),
+                stick_slip::speeds(sys, &st, &x.v),
+            );
+        }
         if stop.output.is_some() {
             let vals = [s[0], s[1], s[2], sd[0], sd[1], sd[2], st.g[0].v, st.g[1].v, st.theta.v];
             for (c, v) in self.cols.iter_mut().zip(vals) {
@@ -462,6 +692,9 @@ impl DirectOutput {
             .collect();
         extra.append(&mut resp.extra);
         resp.extra = extra;
+        if let Some(out) = self.friction {
+            out.finish(&mut resp);
+        }
         resp.info = crate::solver::run_info("amm-direct", settings, n_modes, dt_max, started);
         resp
     }

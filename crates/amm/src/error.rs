@@ -76,6 +76,11 @@ pub enum AmmError {
     /// The run was stopped on request ([`flexstar_model::cancel`]) at output time `t` [s].
     #[error("amm: cancelled at t = {t} s")]
     Cancelled { t: f64 },
+    /// A stick-slip event the time step cannot resolve (`docs/friction.md` 9.1, as 8.3): at time
+    /// `t` [s] the contact (`sleeve 2`, `slider 1 on its rail`) found neither sticking nor
+    /// slipping consistent with the step's equations; no result is written.
+    #[error("amm: unresolved stick-slip event of {contact} at t = {t} s: {reason}")]
+    StickSlip { t: f64, contact: String, reason: String },
 }
 
 impl AmmError {

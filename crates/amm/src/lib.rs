@@ -29,6 +29,7 @@ mod constraint_lu;
 pub mod direct;
 pub mod error;
 mod foreshortening;
+mod friction;
 mod geometric;
 pub mod modes;
 pub mod pose_modes;
@@ -40,6 +41,7 @@ mod sleeve;
 pub mod solver;
 mod star;
 mod static_start;
+mod stick_slip;
 mod system;
 
 pub use direct::DIRECT_COLUMNS;

@@ -115,6 +115,11 @@ impl Recorder {
         }
     }
 
+    /// `(mpp + mpa)_i` [kg] of slider i (Eq. 33).
+    pub(crate) fn mass(&self, i: usize) -> f64 {
+        self.mpp_mpa[i]
+    }
+
     /// `g . u_i` [m/s^2] of slider i's rail (Eq. G2).
     pub(crate) fn gravity_along(&self, i: usize) -> f64 {
         self.gravity_along[i]
@@ -136,6 +141,19 @@ impl Recorder {
         ];
         let thp = q[i * self.nb + self.nm + 1];
         sleeve::rows::push(self.full, i, st, thp, forces, axial[i], &self.weld)
+    }
+
+    /// Eq. 33 with the sleeve and slider's weight along the rail (Eq. G2): the actuator force of
+    /// slider i [N] of a prescribed motion at the rigid state `st`, coordinates `q`, multipliers
+    /// `lam` and the rows' u gradients `axial`.
+    pub(crate) fn eq33(&self, i: usize, st: &RigidState, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]) -> f64 {
+        self.mpp_mpa[i] * (st.s[i].d2 - self.gravity_along[i]) + self.sleeve_push(i, st, q, lam, axial)
+    }
+
+    /// `e_xi . u_i` [-]: beam i's axis at the rigid state `st` along its slider's rail (Eq. F12).
+    pub(crate) fn along_rail(&self, i: usize, st: &RigidState) -> f64 {
+        let (ex, d) = (st.e_x(i), self.weld.rails[i]);
+        ex[0] * d[0] + ex[1] * d[1]
     }
 
     /// Record the state at `stop`: a snapshot of the deformed star and/or an output row (with
@@ -180,12 +198,7 @@ impl Recorder {
             use crate::system::pick;
             let w_g = [0, 1, 2].map(|i| beam_val(i, pick::<Vec<f64>>(&self.phi0, i)));
             let w_tip = [0, 1, 2].map(|i| beam_val(i, pick::<Vec<f64>>(&self.phil, i)));
-            let fa = fa.unwrap_or_else(|| {
-                // Eq. 33 with the sleeve and slider's weight along the rail (Eq. G2)
-                [0, 1, 2].map(|i| {
-                    self.mpp_mpa[i] * (st.s[i].d2 - self.gravity_along[i]) + self.sleeve_push(i, st, q, lam, axial)
-                })
-            });
+            let fa = fa.unwrap_or_else(|| [0, 1, 2].map(|i| self.eq33(i, st, q, lam, axial)));
             self.resp.push(st.t, w_g, w_tip, fa);
             if let Some(s) = &mut self.sensors {
                 s.record(st, (nm, nb), [q, v, qdd], fa);

@@ -24,7 +24,9 @@ use crate::error::AmmError;
 use crate::modes::{ModeSet, MAX_MODES};
 use crate::record::Recorder;
 use crate::star::Star;
+use crate::stick_slip::{self, FrictionOutput, StepEnd};
 use crate::system::System;
+use flexstar_model::{Contact, Friction};
 
 /// Default integration step [s], 1/6 ms (six steps per default output interval), from the
 /// convergence study in `docs/amm.md`: halving it changes every tip and junction response of the
@@ -380,6 +382,9 @@ pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, problem: &Sta
         .map(|p| ModeSet::new(settings.family, n_modes, p))
         .collect::<Result<Vec<_>, _>>()?;
     let mut sys = System::new(modes, &problem.beams, &problem.weld, settings.model);
+    if let Some(law) = problem.friction.filter(|f| f.sleeves_rub()) {
+        sys.attach_friction(*law, &problem.beams, &problem.weld);
+    }
     sys.attach(problem.payload, problem.damping, problem.load, problem.gravity);
     Ok(sys)
 }
@@ -437,6 +442,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let ga = GenAlpha::new(RHO_INF);
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut qdd_start = vec![0.0; if problem.friction.is_some() { n } else { 0 }];
     let kin = |t: f64| problem.state(t);
 
     // the start: undeformed, or under gravity the static equilibrium of the start pose (Eq. G4)
@@ -449,7 +455,12 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
         let still = problem.state_from(st.s.map(|j| Dual2::new(j.v, 0.0, 0.0)), 0.0)?;
         crate::static_start::static_equilibrium(&mut sys, &still, star_time_scale(problem), &mut q)?;
     }
-    sys.solve(&st, 0.0, 0.0, &q, &v, &mut qdd).map_err(|e| match e {
+    let mut friction = None;
+    let first = match problem.friction {
+        None => sys.solve(&st, 0.0, 0.0, &q, &v, &mut qdd),
+        Some(law) => friction_start(&mut sys, &st, (&q, &v), &mut qdd, law).map(|out| friction = Some(out)),
+    };
+    first.map_err(|e| match e {
         AmmError::SingularConstraints { t, source } => AmmError::TooFewModes {
             t,
             modes: nm,
@@ -460,12 +471,21 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     })?;
     acc.copy_from_slice(&qdd);
 
-    let mut record =
-        |st: &RigidState, stop: &Stop, q: &[f64], rates: [&[f64]; 2], lam: &[f64], axial: &[[f64; 3]; 3]| {
-            rec.record(st, stop, q, rates, lam, axial, None);
-        };
+    let record = |rec: &mut Recorder,
+                  out: Option<&mut FrictionOutput>,
+                  sys: &System,
+                  st: &RigidState,
+                  stop: &Stop,
+                  (q, v, qdd): (&[f64], &[f64], &[f64])| {
+        let out = out.zip(problem.friction);
+        let fa = out.as_ref().map(|(_, law)| friction_fa(rec, sys, st, q, qdd, law));
+        rec.record(st, stop, q, [v, qdd], &sys.lam, sys.sleeves.axial(), fa);
+        if let (Some((out, _)), Some(_)) = (out, stop.output) {
+            out.sample(sys, stick_slip::sleeve_forces(sys, qdd), stick_slip::speeds(sys, st, v));
+        }
+    };
 
-    record(&st, &stops[0], &q, [&v, &qdd], &sys.lam, sys.sleeves.axial());
+    record(&mut rec, friction.as_mut(), &sys, &st, &stops[0], (&q, &v, &qdd));
     for w in stops.windows(2) {
         let (t0, t1) = (w[0].t, w[1].t);
         let nsub = (((t1 - t0) / dt_max) - 1e-9).ceil().max(1.0) as usize;
@@ -478,33 +498,126 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
             for (((ap, qh), vh), ((&qi, &vi), (&ai, &di))) in predicted.zip(state) {
                 (*ap, *qh, *vh) = ga.predict(h, qi, vi, ai, di);
             }
+            let xi_start = friction.as_ref().map(|_| stick_slip::coordinates(&sys, &st, &q));
             st = kin(t)?;
-            sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)?;
-            let apq = ga.a_per_qdd();
-            let mut finite = true;
-            let state = q.iter_mut().zip(v.iter_mut()).zip(acc.iter_mut());
-            let parts = qhat.iter().zip(&vhat).zip(a_part.iter().zip(&qdd));
-            for (((qi, vi), ai), ((&qh, &vh), (&ap, &di))) in state.zip(parts) {
-                *qi = qh + bp * di;
-                *vi = vh + gp * di;
-                *ai = ap + apq * di;
-                finite &= qi.is_finite();
-            }
-            if !finite {
-                return Err(AmmError::NonFinite { t, dt: h });
+            let predicted = (&qhat[..], &vhat[..], &a_part[..]);
+            match (friction.as_mut(), xi_start) {
+                (Some(out), Some(xi_start)) => {
+                    qdd_start.copy_from_slice(&qdd);
+                    let end = stick_slip::switching_step(&mut sys, None, t, h, |sys, _, retake| {
+                        if retake {
+                            sys.set_axial_acceleration(&qdd_start);
+                        }
+                        sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)?;
+                        if !accept(&ga, (bp, gp), predicted, &qdd, (&mut q, &mut v, &mut acc)) {
+                            return Err(AmmError::NonFinite { t, dt: h });
+                        }
+                        Ok(StepEnd {
+                            xi_start,
+                            vs: stick_slip::speeds(sys, &st, &v),
+                            ..StepEnd::default()
+                        })
+                    })?;
+                    let ff = stick_slip::sleeve_forces(&sys, &qdd);
+                    let rails = problem.friction.map_or(0.0, |law| prescribed_rails_power(law, &st));
+                    out.advance(&sys, (ff, end.vs), (&[Contact::Free; 3], rails), h);
+                }
+                _ => {
+                    sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)?;
+                    if !accept(&ga, (bp, gp), predicted, &qdd, (&mut q, &mut v, &mut acc)) {
+                        return Err(AmmError::NonFinite { t, dt: h });
+                    }
+                }
             }
             observe(&sys, &q);
         }
-        record(&st, &w[1], &q, [&v, &qdd], &sys.lam, sys.sleeves.axial());
+        record(&mut rec, friction.as_mut(), &sys, &st, &w[1], (&q, &v, &qdd));
         if flexstar_model::cancel::cancelled() {
             return Err(AmmError::Cancelled { t: t1 });
         }
     }
 
     let mut resp = rec.finish(format!("amm-{}", settings.family.name()));
+    if let Some(out) = friction {
+        out.finish(&mut resp);
+        sys.release_contacts();
+    }
     resp.rest_offset = crate::static_start::rest_offset(&mut sys, problem, star_time_scale(problem))?;
     resp.info = run_info("amm", settings, n_modes, dt_max, started);
     Ok(resp)
+}
+
+/// Accept a step: `q = q^ + bp q''`, `q' = v^ + gp q''` and the generalized-alpha acceleration
+/// variable from the predictors `(q^, v^, a^)` and the step's `q''`; whether q is finite.
+fn accept(
+    ga: &GenAlpha,
+    (bp, gp): (f64, f64),
+    (qhat, vhat, a_part): (&[f64], &[f64], &[f64]),
+    qdd: &[f64],
+    (q, v, acc): (&mut [f64], &mut [f64], &mut [f64]),
+) -> bool {
+    let apq = ga.a_per_qdd();
+    let mut finite = true;
+    let state = q.iter_mut().zip(v.iter_mut()).zip(acc.iter_mut());
+    let parts = qhat.iter().zip(vhat).zip(a_part.iter().zip(qdd));
+    for (((qi, vi), ai), ((&qh, &vh), (&ap, &di))) in state.zip(parts) {
+        *qi = qh + bp * di;
+        *vi = vh + gp * di;
+        *ai = ap + apq * di;
+        finite &= qi.is_finite();
+    }
+    finite
+}
+
+/// The consistent start of a prescribed motion with friction (`docs/friction.md` 9.1): the
+/// sleeves at rest stuck, the moving ones slipping, the start solved again with the signs of
+/// its own multipliers while a sleeve slips on a load, and a stuck sleeve that cannot hold
+/// released (`stick_slip::switching_step`). Returns the friction's outputs from t = 0.
+fn friction_start(
+    sys: &mut System,
+    st: &RigidState,
+    (q, v): (&[f64], &[f64]),
+    qdd: &mut [f64],
+    law: &Friction,
+) -> Result<FrictionOutput, AmmError> {
+    sys.start_contacts(st, q, v);
+    let xi_start = stick_slip::coordinates(sys, st, q);
+    let end = stick_slip::switching_step(sys, None, 0.0, 0.0, |sys, _, _| {
+        sys.solve(st, 0.0, 0.0, q, v, qdd)?;
+        if stick_slip::slipping_on_a_load(sys) {
+            for _ in 0..3 {
+                sys.solve(st, 0.0, 0.0, q, v, qdd)?;
+            }
+        }
+        Ok(StepEnd {
+            xi_start,
+            vs: stick_slip::speeds(sys, st, v),
+            ..StepEnd::default()
+        })
+    })?;
+    let ff = stick_slip::sleeve_forces(sys, qdd);
+    Ok(FrictionOutput::start(sys, ff, end.vs, prescribed_rails_power(law, st)))
+}
+
+/// The power the rails' friction dissipates under the prescribed sliders of `st` [W] (Eqs. F4, F18).
+fn prescribed_rails_power(law: &Friction, st: &RigidState) -> f64 {
+    (0..3)
+        .map(|i| {
+            let v = st.s[i].d1;
+            stick_slip::rail_force(&law.rail(i), v) * v
+        })
+        .sum()
+}
+
+/// Eq. F12 of a prescribed motion: Eq. 33 ([`Recorder::eq33`]) with the sleeve's friction
+/// along the rail and the rail's friction (F4) [N].
+fn friction_fa(rec: &Recorder, sys: &System, st: &RigidState, q: &[f64], qdd: &[f64], law: &Friction) -> [f64; 3] {
+    let ff = stick_slip::sleeve_forces(sys, qdd);
+    [0, 1, 2].map(|i| {
+        rec.eq33(i, st, q, &sys.lam, sys.sleeves.axial())
+            + ff[i] * rec.along_rail(i, st)
+            + stick_slip::rail_force(&law.rail(i), st.s[i].d1)
+    })
 }
 
 /// What an AMM run reports about itself (sidecar JSON): `solver` ("amm" or "amm-direct"), the

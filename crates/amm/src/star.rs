@@ -130,6 +130,8 @@ pub(crate) struct Star<'a> {
     pub(crate) gravity: [f64; 2],
     /// The sensors read at the output times (`docs/sensors.md`; empty without).
     pub(crate) sensors: &'a flexstar_model::sensors::Sensors,
+    /// Friction in the sleeves and on the rails (`docs/friction.md` 9); `None`: none.
+    pub(crate) friction: Option<&'a flexstar_model::Friction>,
 }
 
 impl<'a> Star<'a> {
@@ -141,7 +143,9 @@ impl<'a> Star<'a> {
             Some(p) => [*p; 3],
             None => beam_params(robot),
         };
-        let shared = beams[1] == beams[0] && beams[2] == beams[0];
+        // viscous sleeve friction puts each sleeve's own term on its beam's arrowhead (Eq. F14)
+        let viscous = problem.friction().is_some_and(|f| f.c.0.iter().any(|c| *c != 0.0));
+        let shared = beams[1] == beams[0] && beams[2] == beams[0] && !viscous;
         Star {
             robot,
             paper,
@@ -160,6 +164,7 @@ impl<'a> Star<'a> {
             load: problem.load(),
             gravity: problem.gravity(),
             sensors: problem.sensors(),
+            friction: problem.friction(),
         }
     }
 

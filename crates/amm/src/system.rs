@@ -29,6 +29,7 @@ use crate::attach::{Mat3, PayloadTerms, RigidTerms};
 use crate::constraint_lu::{ConstraintLu, MAX_JUNCTION_ROWS};
 use crate::error::{AmmError, RankError};
 use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
+use crate::friction::SleeveFriction;
 use crate::geometric::{self, GeometricStiffness};
 use crate::modes::{dot, ModeSet};
 use crate::sleeve::{SleeveRow, Sleeves, B_MID, B_MSLOPE, SLEEVE_ROWS};
@@ -43,6 +44,10 @@ pub(crate) enum Row {
     Fix(usize),
     /// Eq. 40: `w_1G + w_2G + w_3G = 0` (Eq. J5: `sum c_i w_iG = 0` for other welds); multiplier `Fw`.
     Fw,
+    /// Eq. F16 (`docs/friction.md` 9): sleeve i stuck on its beam, `u_i - xp_i(t) + xi_i* = 0`;
+    /// multiplier the friction force on beam i along `e_xi` [N]. Only with friction; empty (its
+    /// multiplier 0) while the sleeve is not stuck (`crate::friction`).
+    Stick(usize),
     /// Eq. 39: `w_1'(0) - w_2'(0) = 0`; multiplier `M1G`.
     M1G,
     /// Eq. 39: `w_3'(0) - w_2'(0) = 0`; multiplier `M3G`.
@@ -58,10 +63,11 @@ pub(crate) enum Row {
 const B_PHI0: usize = 0; // phi_j(0)          (Fix, Fw)
 const B_DPHI0: usize = 1; // phi_j'(0)        (MiG)
 const NB: usize = B_MSLOPE + 1;
-/// Most constraint rows that touch one beam (three Fix, Fw, two slope rows, four sleeve rows).
-const MAX_BEAM_ROWS: usize = MAX_JUNCTION_ROWS + SLEEVE_ROWS;
+/// Most constraint rows that touch one beam (three Fix, Fw, two slope rows, four sleeve rows,
+/// and with friction the stick row of Eq. F16, `docs/friction.md` 9).
+const MAX_BEAM_ROWS: usize = MAX_JUNCTION_ROWS + SLEEVE_ROWS + 1;
 /// "This row has no alpha part."
-const NONE: usize = usize::MAX;
+pub(crate) const NONE: usize = usize::MAX;
 
 /// A row of the form of [`BeamRows`]: (basis vector, its factor, u coefficient, thp coefficient).
 pub(crate) type RowForm = (usize, f64, f64, f64);
@@ -81,7 +87,7 @@ pub(crate) struct BeamRows {
     pub(crate) cu: Vec<f64>,
     /// Coefficient of u_i in the row's own value (1 for the Fix rows; 0 for the sleeve rows, where
     /// u_i enters the full model only through the material point xp_i - u_i).
-    gu: Vec<f64>,
+    pub(crate) gu: Vec<f64>,
     pub(crate) ct: Vec<f64>,
     /// The part of each row's value at the predictor that its Jacobian entries do not give:
     /// `r(qhat) - c . qhat` (0 but for the full model's sleeve rows, Eqs. S3-S4 of `docs/amm.md`
@@ -236,6 +242,9 @@ pub(crate) struct BeamModel {
     pub(crate) phil: Vec<f64>,
     /// Full model: the axial flexibility `L / (3 EA)` [m/N] (Eq. A2); 0 in the paper's model.
     axial_flex: f64,
+    /// The viscous sleeve friction on the u diagonal of the step matrix, `c gamma'` [kg]
+    /// (Eq. F14, `docs/friction.md` 9); 0 without it.
+    pub(crate) u_drag: f64,
     // arrowhead data of the step (Eq. J2), per step
     /// The thp diagonal of the step matrix, `Jp (1 + gamma' alpha)` (Eq. D19).
     jp_step: f64,
@@ -269,6 +278,7 @@ impl BeamModel {
                 AmmModel::Paper => 0.0,
             },
             jp_step: params.jp,
+            u_drag: 0.0,
             inv_d: vec![0.0; nm],
             w: vec![0.0; nm],
             p: 0.0,
@@ -291,6 +301,9 @@ impl BeamModel {
         let mass = 1.0 + gp * alpha;
         self.jp_step = self.jp * mass;
         let mut sigma = rho * self.l * (mass - bp * thd * thd);
+        if self.u_drag != 0.0 {
+            sigma += self.u_drag;
+        }
         let damped = gp * beta;
         for j in 0..self.lambda_m.len() {
             let d = if beta > 0.0 {
@@ -318,7 +331,7 @@ impl BeamModel {
 
     /// `x = S_i^-1 x` for this beam's arrowhead (N + 2 entries).
     #[inline]
-    fn arrow_solve(&self, x: &mut [f64]) {
+    pub(crate) fn arrow_solve(&self, x: &mut [f64]) {
         let nm = self.lambda_m.len();
         let y = (x[nm] + self.p * dot(&self.w, &x[..nm])) * self.inv_sigma;
         for ((xj, pj), dj) in x[..nm].iter_mut().zip(&self.phi).zip(&self.inv_d) {
@@ -343,7 +356,7 @@ pub(crate) struct System {
     pub(crate) nm: usize,
     pub(crate) nb: usize,
     pub(crate) rows: Vec<Row>,
-    beams: [BeamRows; 3],
+    pub(crate) beams: [BeamRows; 3],
     /// Full model: the geometric stiffness of the axial inertia force (Eq. 23) on the modes
     /// that carry it, and its products with the predicted modal coordinates.
     geometric: Option<GeometricStiffness>,
@@ -357,8 +370,8 @@ pub(crate) struct System {
     fore: Option<Foreshortening>,
     // per-step buffers
     dinv_r: Vec<f64>,
-    resid: Vec<f64>,
-    a: Vec<f64>,
+    pub(crate) resid: Vec<f64>,
+    pub(crate) a: Vec<f64>,
     rhs: Vec<f64>,
     /// Factors of the Schur complement `a`.
     lu: ConstraintLu,
@@ -377,6 +390,8 @@ pub(crate) struct System {
     load: Option<LoadSettings>,
     /// Workspace of the payload's Woodbury correction, N + 2.
     pay_tmp: Vec<f64>,
+    /// The sleeves' friction (`crate::friction`, `docs/friction.md` 9); `None` without it.
+    pub(crate) friction: Option<SleeveFriction>,
 }
 
 /// Is a vector of mode values zero to round-off? `scale[m]` is the size a non-zero entry would have.
@@ -443,6 +458,7 @@ fn row_entry(row: Row, b: usize, has_w0: bool, hp: f64, weld: &Weld) -> Option<R
             }
         }
         Row::Sleeve(i, row) => (b == i).then(|| row.form(hp)),
+        Row::Stick(i) => (b == i).then_some((NONE, 0.0, 0.0, 0.0)),
     }
 }
 
@@ -543,6 +559,7 @@ impl System {
             gravity: [0.0; 2],
             load: None,
             pay_tmp: vec![0.0; nb],
+            friction: None,
         }
     }
 
@@ -565,6 +582,26 @@ impl System {
         self.load = (!load.is_none()).then(|| load.clone());
     }
 
+    /// Friction in the sleeves (`docs/friction.md` 9): the stick rows of Eq. F16 (one per
+    /// sleeve, after the others; the Schur complement then factored densely) and the law. Call
+    /// before [`System::attach`] (the payload's workspaces are sized by beam 1's rows); `params`
+    /// and `weld` those of [`System::new`].
+    pub(crate) fn attach_friction(&mut self, law: flexstar_model::Friction, params: &[RobotParams; 3], weld: &Weld) {
+        let has_w0 = self.rows.contains(&Row::Fw);
+        let first = self.rows.len();
+        self.rows.extend((0..3).map(Row::Stick));
+        let hp = params.map(|p| 0.5 * p.lp);
+        self.beams = beam_rows(&self.rows, has_w0, hp, self.nm, weld);
+        let m = self.rows.len();
+        (self.a, self.rhs, self.lam) = (vec![0.0; m * m], vec![0.0; m], vec![0.0; m]);
+        self.lu = ConstraintLu::dense(m);
+        let index = |r: Row| self.rows.iter().position(|x| *x == r).expect("a sleeve row");
+        let rows = std::array::from_fn(|i| SleeveRow::ALL.map(|r| index(Row::Sleeve(i, r))));
+        let stick = [first, first + 1, first + 2];
+        let ea = params.map(|p| p.ea());
+        self.friction = Some(SleeveFriction::new(law, (rows, stick), hp, ea, self.nb));
+    }
+
     /// The system with Eq. 23's product on the first `analytic` analytic modes (and the junction
     /// shapes) instead of [`geometric::KEPT_ANALYTIC`], for the test of that truncation.
     #[cfg(test)]
@@ -580,7 +617,7 @@ impl System {
     }
 
     /// Basis vector `a` of beam `i` (rows `beam`).
-    fn basis<'s>(&'s self, i: usize, beam: &'s BeamRows, a: usize) -> &'s [f64] {
+    pub(crate) fn basis<'s>(&'s self, i: usize, beam: &'s BeamRows, a: usize) -> &'s [f64] {
         match a {
             B_PHI0 => &self.beam(i).phi0,
             B_DPHI0 => &self.beam(i).dphi0,
@@ -638,6 +675,9 @@ impl System {
         vhat: &[f64],
         qdd: &mut [f64],
     ) -> Result<(), AmmError> {
+        if self.friction.is_some() {
+            self.predict_friction(st, vhat, (bp, gp));
+        }
         self.prepare(st, bp, gp, qhat)?;
         self.forcing(st, qhat, vhat);
         self.solve_prepared(bp, Some(qhat), qdd);
@@ -713,6 +753,9 @@ impl System {
         }
         if self.payload.is_some() || self.load.is_some() {
             self.attachment_forcing(st, qhat, vhat, None);
+        }
+        if self.friction.is_some() {
+            self.friction_forcing();
         }
     }
 
@@ -905,6 +948,9 @@ impl System {
         let thd = st.theta.d1;
         let thdd = st.theta.d2;
         self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
+        if self.friction.is_some() {
+            self.set_friction_drag(gp);
+        }
         // each beam's arrowhead and the Gram data of its junction vectors (once for equal beams)
         self.factor_s(bp, gp, thd, thdd);
 
@@ -922,6 +968,9 @@ impl System {
         self.add_axial_flexibility(bp);
         if self.payload.is_some() {
             self.payload_block(st, self.payload_motion(st), bp, gp)?;
+        }
+        if self.friction.is_some() {
+            self.add_friction_to_schur();
         }
         self.lu
             .factor(&self.a)
@@ -983,7 +1032,7 @@ impl System {
 
     /// Beam 1's block `x = S^-1 v` becomes `(S + P^T S_p P)^-1 v = x - S^-1 P^T W P x` (Woodbury,
     /// module docs of `attach`); a no-op without a payload.
-    fn payload_correct(&mut self, x: &mut [f64]) {
+    pub(crate) fn payload_correct(&mut self, x: &mut [f64]) {
         let Some(pl) = self.payload.as_ref() else {
             return;
         };
@@ -1076,6 +1125,9 @@ impl System {
         let (nm, nb) = (self.nm, self.nb);
         // collect the multipliers per basis vector, then one axpy each
         qdd.copy_from_slice(&self.resid);
+        if self.friction.is_some() {
+            self.add_coulomb(&self.lam, qdd);
+        }
         for (i, beam) in self.beams.iter().enumerate() {
             let o = i * nb;
             let mut coef = [0.0; NB];
@@ -1192,17 +1244,30 @@ pub(crate) mod tests {
 
     /// The energy balance of `problem` run with the sliders held (its trajectory constant).
     pub(crate) fn energy_balance_on(problem: &flexstar_model::Problem) {
+        energy_balance_of(problem, 1e-4);
+    }
+
+    /// The energy balance of `problem` with the sliders held, to `tolerance` of the largest work:
+    /// the load's work is the change of kinetic and strain energy plus the dissipation of the
+    /// damping (Eqs. D4, D20) and the work of the sleeves' friction forces on the sliding
+    /// coordinates, `int F_fi d xi_i` (Eq. F18 while slipping; while stuck, the energy the stick
+    /// row's compliance stores, Eq. F16). Returns (largest work, dissipated, worst imbalance) [J].
+    pub(crate) fn energy_balance_of(problem: &flexstar_model::Problem, tolerance: f64) -> (f64, f64, f64) {
         let exp = crate::star::Star::new(problem);
         let st0 = exp.state(0.0).unwrap();
         let (ex, ew) = (st0.e_x(0), st0.e_w(0));
         let settings = AmmSettings::paper(ModeFamily::FreeFree, 20);
         let mut qs: Vec<Vec<f64>> = vec![vec![0.0; 3 * 22]];
+        // the friction forces at each step (Coulomb and stick only: no u'' term, c = 0)
+        let mut forces: Vec<[f64; 3]> = vec![[0.0; 3]];
         let mut sys_copy = None;
         integrate(&exp, &settings, 20, true, |sys, q| {
             qs.push(q.to_vec());
+            forces.push([0, 1, 2].map(|i| sys.sleeve_friction_force(i, &sys.lam, 0.0, true)));
             sys_copy.get_or_insert_with(|| sys.clone());
         })
         .unwrap();
+        assert!(exp.friction.is_none_or(|f| f.c.0 == [0.0; 3]), "the test takes c = 0");
         let sys = sys_copy.unwrap();
         let h = exp.time.t_end / (qs.len() - 1) as f64;
         let (nm, nb) = (sys.nm, sys.nb);
@@ -1253,6 +1318,10 @@ pub(crate) mod tests {
             // Eq. D20: alpha v^T M v, with v = dq / h on the step
             let v: Vec<f64> = dq.iter().map(|d| d / h).collect();
             dissipated += alpha * 2.0 * kinetic(&v) * h;
+            // the friction's work on xi_i = xp_i - u_i (xp_i held): trapezoidal on the step
+            for i in 0..3 {
+                dissipated -= 0.5 * (forces[n][i] + forces[n + 1][i]) * dq[i * nb + nm];
+            }
             if n >= 1 {
                 worst = worst.max((energy(n + 1) + dissipated - work).abs());
                 work_max = work_max.max(work.abs());
@@ -1264,8 +1333,9 @@ pub(crate) mod tests {
             "the damping must matter: {dissipated:e} of {work_max:e}"
         );
         assert!(
-            worst < 1e-4 * work_max,
+            worst < tolerance * work_max,
             "imbalance {worst:e} J against the work {work_max:e} J"
         );
+        (work_max, dissipated, worst)
     }
 }

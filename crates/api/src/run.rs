@@ -166,9 +166,6 @@ pub fn prepare(mut exp: Experiment, source: &str, settings: &RunSettings) -> Res
     if let Some(dt) = settings.dt {
         check_step("--dt", dt, exp.time.dt_out).map_err(|e| ApiError::from_flag("--dt", e))?;
     }
-    if settings.solver == Solver::Amm {
-        ApiError::frictionless(&exp, source, "--solver amm")?;
-    }
     let checked = preflight(&exp, source)?;
     let direct = exp.drive.is_direct();
     let stem = match settings.solver {

@@ -159,9 +159,6 @@ pub fn preflight(specs: &[CaseSpec]) -> Result<Checked<'_>, RunError> {
             file: file.clone(),
             reason,
         };
-        // a comparison's AMM does not model friction yet (docs/friction.md 6)
-        exp.frictionless("flexstar compare (the AMM)")
-            .map_err(|e| input(e.to_string()))?;
         for run in spec.amm.iter().chain(&spec.extra) {
             run.settings
                 .validate(exp.time.dt_out)

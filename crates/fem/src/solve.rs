@@ -9,8 +9,8 @@ use flexstar_kinematics::as_built::rigid_pose;
 use flexstar_kinematics::{check_trajectory, preflight_step, CheckedMotion, KinematicsError, RigidState};
 use flexstar_model::animation::{frame_times, ShapeTimes};
 use flexstar_model::{
-    Beam, BeamShape, FemSettings, FramePose, FrictionSummary, Problem, Response, RestOffset, Robot, RobotGeometry,
-    RobotParams, RunInfo, StarShape, Trajectory,
+    Beam, BeamShape, FemSettings, FramePose, Problem, Response, RestOffset, Robot, RobotGeometry, RobotParams, RunInfo,
+    StarShape, Trajectory,
 };
 
 use crate::integrator::{
@@ -464,37 +464,18 @@ fn post_process(
     names.extend(friction.iter().map(|(n, _)| n.as_str()));
     lead.extend(friction.iter().map(|(_, c)| c.clone()));
     resp.set_extra(&names, lead);
-    resp.friction = hist.friction.map(|f| FrictionSummary {
-        stuck_s: f.sleeves_stuck_s,
-        rails_stuck_s: f.rails_stuck_s,
-        sleeves_dissipated_j: f.sleeves_j,
-        rails_dissipated_j: f.rails_j,
-    });
+    resp.friction = hist.friction.map(|f| f.tally.summary());
     Ok(resp)
 }
 
-/// With friction, its columns after all others (`docs/friction.md` 7): `Ff1..3` [N], `vs1..3`
-/// [m/s], `stick1..3` (1 stuck, 0 slipping), `E_f` [J]; none without friction.
+/// With friction, its columns after all others (`docs/friction.md` 7,
+/// [`flexstar_model::friction_run::friction_columns`]); none without friction.
 fn friction_columns(hist: &History) -> Vec<(String, Vec<f64>)> {
     let rows: Vec<FrictionSample> = hist.samples.iter().filter_map(|s| s.friction).collect();
     if hist.friction.is_none() || rows.len() != hist.samples.len() {
         return Vec::new();
     }
-    let mut cols = Vec::new();
-    for (name, value) in [
-        (
-            "Ff",
-            (|f: &FrictionSample, i: usize| f.ff[i]) as fn(&FrictionSample, usize) -> f64,
-        ),
-        ("vs", |f, i| f.vs[i]),
-        ("stick", |f, i| if f.stuck[i] { 1.0 } else { 0.0 }),
-    ] {
-        for i in 0..3 {
-            cols.push((format!("{name}{}", i + 1), rows.iter().map(|f| value(f, i)).collect()));
-        }
-    }
-    cols.push(("E_f".to_string(), rows.iter().map(|f| f.e_f).collect()));
-    cols
+    flexstar_model::friction_run::friction_columns(&rows)
 }
 
 /// `w_iG = (G_fem - G_rigid) . e_wi` and `w_i(L_i) = (tip_fem - (G_rigid + L_i e_xi)) . e_wi` [m]

@@ -103,7 +103,7 @@ pub const QUANTITIES: &[Quantity] = &[
         "J",
         "potential energy of the weights (beams, payload, sleeves, sliders)",
     ),
-    // friction (FEM), only with a [friction] section (docs/friction.md 7)
+    // friction (both solvers), only with a [friction] section (docs/friction.md 7, 9)
     q(
         "Ff{i}",
         "N",

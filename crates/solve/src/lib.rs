@@ -143,8 +143,6 @@ fn solve_under(
     let request = SolveRequest { drive, proof, progress };
     Ok(match settings {
         Settings::Amm(s) => {
-            // the AMM does not model friction yet (docs/friction.md 6): refused before any work
-            problem.frictionless("the AMM (--solver amm)")?;
             let r = flexstar_amm::solve(problem, s, request)?;
             Solved {
                 response: r.response,
@@ -251,10 +249,10 @@ mod tests {
         assert!(e.to_string().contains("shaper.f_hz"), "{e}");
     }
 
-    /// Friction reaches the problem, and the AMM, which does not model it yet, refuses it by
-    /// name before any work (`docs/friction.md` 6).
+    /// Friction reaches the problem, and both solvers take it (`docs/friction.md` 9): each
+    /// response carries the friction's summary and columns.
     #[test]
-    fn the_amm_refuses_friction_by_name() {
+    fn both_solvers_take_friction() {
         let exp = Experiment::from_toml_str(
             "name = \"f\"\n[time]\nt_end = 0.01\n[trajectory]\nkind = \"polynomial\"\n\
              s1 = [0.0]\ns2 = [0.0]\ns3 = [0.0]\n[friction]\nmu = 0.1\n",
@@ -263,10 +261,12 @@ mod tests {
         .unwrap();
         let problem = exp.problem().unwrap();
         assert_eq!(problem.friction().map(|f| f.sleeve(0).mu), Some(0.1));
-        let e = solve(&problem, Settings::of(&exp, Solver::Amm), None, None)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("friction") && e.contains("AMM"), "{e}");
+        for solver in [Solver::Amm, Solver::Fem] {
+            let r = solve(&problem, Settings::of(&exp, solver), None, None)
+                .unwrap()
+                .response;
+            assert!(r.friction.is_some() && r.column("stick1").is_some(), "{solver:?}");
+        }
     }
 
     /// A robot other than the paper's form (here beam 3 shorter, its slider heavier) is solved by

@@ -214,7 +214,6 @@ impl Study {
         };
         study.check_shape()?;
         study.check_keys()?;
-        study.check_friction()?;
         let hash = study.fingerprint(&text, &base_text);
         Ok(Study { hash, ..study })
     }
@@ -329,26 +328,6 @@ impl Study {
             }
         }
         Ok(())
-    }
-
-    /// The AMM does not model friction yet (`docs/friction.md` 6): a study that runs it on a base
-    /// with friction, or varies a `friction.*` key, is refused before any run, naming the key.
-    fn check_friction(&self) -> Result<(), StudyError> {
-        if !self.solvers.contains(&Solver::Amm) {
-            return Ok(());
-        }
-        let by = "a study's AMM runs";
-        if let Err(e) = self.base_experiment.frictionless(by) {
-            return Err(StudyError::Base {
-                study: self.file.clone(),
-                source: e,
-            });
-        }
-        let keys = self.vary.iter().map(|v| &v.key).chain(self.ties.iter().map(|t| &t.key));
-        match keys.into_iter().find(|k| k.starts_with("friction.")) {
-            Some(k) => Err(self.vary_error(k, format!("{by} do not model friction yet (docs/friction.md 6)"))),
-            None => Ok(()),
-        }
     }
 
     /// The study's hash: FNV-1a of the study file, the base file and the contents of every file

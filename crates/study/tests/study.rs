@@ -394,13 +394,13 @@ fn bad_distributions_and_ties_are_refused_naming_the_key() {
     assert!(e.contains("robot.Lq"), "{e}");
 }
 
-/// The AMM does not model friction yet (docs/friction.md 6): a study running it that varies a
-/// `friction.*` key is refused at load, naming the key; the FEM alone takes it.
+/// Both solvers model friction (docs/friction.md 9): a study running the AMM that varies a
+/// `friction.*` key loads, as one running the FEM alone.
 #[test]
-fn friction_is_refused_for_the_amm_before_any_run() {
+fn friction_is_varied_for_the_amm_and_the_fem() {
     let vary = "[[vary]]\nkey = \"friction.mu\"\nvalues = [0.0, 0.1]\n";
-    let e = load_err(&study_text(vary));
-    assert!(e.contains("friction.mu") && e.contains("AMM"), "{e}");
+    let (_d, p) = setup(&study_text(vary));
+    assert!(Study::load(&p).is_ok());
     let (_d, p) = setup(&format!(
         "name = \"s\"\nbase = \"base.toml\"\nsolvers = [\"fem\"]\n{vary}"
     ));

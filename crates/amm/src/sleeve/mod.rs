@@ -23,20 +23,10 @@
 //! The force the sleeve passes through its pin to the slider enters the driving force of Eq. 33
 //! ([`rows::push`]).
 //!
-//! **Where friction would enter.** The sleeve transmits no force along the beam: none of its
-//! rows has a multiplier along `e_xi`, and the beam's axial coordinate u_i (its sliding through
-//! the sleeve together with `xp_i(t)`) is held only by the weld rows at G (Eq. 38). The sleeve's
-//! part of the u row (Eqs. 30, 44: `(C^T lambda)_u`, the sleeve rows' `cu` of `system::BeamRows`)
-//! is zero in the paper model and `-w' (Fp, FR, FL)` in the full one, the axial components of the
-//! normal forces, never a tangential force. A friction force `F_t,i` along `e_xi` on beam i at
-//! `x_c` would add `F_t,i` to beam i's u row of the step's forcing (`System::forcing`,
-//! `resid[i * nb + nm]`; in the full model also `-F_t,i g` on the kept modes of [`shift`], since
-//! the material point's axial position is `x + u - f(x)`), and `F_t,i (e_xi . u_i)` to
-//! [`rows::push`] (Eq. 33); in slip it is `mu |normal force|` against the beam's sliding speed
-//! through the sleeve, `u_i' - xp_i'` along `e_xi`. Stick is a fifth sleeve row
-//! ([`rows::SleeveRow`]), `u_i - xp_i(t) = const` (u coefficient 1, its value's time part carried
-//! like the full model's `gv`), whose multiplier is the friction force; the sleeve blocks of
-//! `constraint_lu`, sized by [`SLEEVE_ROWS`] but written as 4 x 4 (`Matrix4`), then grow to 5 x 5.
+//! **Friction** (`docs/friction.md` 9, `crate::friction`): the sleeve's rows carry no force
+//! along the beam; friction is the generalized force `F_fi` on beam i's `u_i` (its material
+//! coordinate in the sleeve being `xp_i - u_i`), its load the multipliers of these rows (Eq.
+//! F13), and a stuck sleeve a row of its own (`system::Row::Stick`, Eq. F16).
 
 mod compliance;
 pub(crate) mod rows;

@@ -12,16 +12,8 @@ use crate::star::Contact;
 /// unresolved ([`FemError::StickSlip`]).
 const MAX_ROUNDS: usize = 7;
 
-/// A stuck contact breaks loose when the force it needs exceeds its limit `F_lim` by more than
-/// `FORCE_TOL (1 + F_lim / 1 N)` [N]: the Newton iteration resolves the multipliers to
-/// `1e-6 (1 + |lambda|)` N (`step.rs`), so a smaller excess is not resolved (at rest with no
-/// load both the limit and the force the stick needs are zero to that level).
-const FORCE_TOL: f64 = 1e-6;
-
-/// Whether the force `need` [N] exceeds the limit `limit` [N] beyond [`FORCE_TOL`].
-fn exceeds(need: f64, limit: f64) -> bool {
-    need.abs() > limit + FORCE_TOL * (1.0 + limit)
-}
+use flexstar_model::friction_run::exceeds;
+use flexstar_model::FrictionTally;
 
 /// One contact: sleeve i (`Sleeve(i)`) or slider i on its rail (`Rail(i)`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -270,16 +262,11 @@ fn correct_start(motion: &Motion, star: &mut Star, st: &mut State) -> Result<(),
     Ok(())
 }
 
-/// Dissipation and time stuck of the friction since t = 0 (trapezoidal rule on the steps).
+/// Dissipation and time stuck of the friction since t = 0 (trapezoidal rule on the steps,
+/// [`FrictionTally`]).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct FrictionLog {
-    /// Energy dissipated by the sleeves' and the rails' friction [J].
-    pub sleeves_j: f64,
-    pub rails_j: f64,
-    /// Time each sleeve and each slider was stuck [s] (a step counts when it ends stuck).
-    pub sleeves_stuck_s: [f64; 3],
-    pub rails_stuck_s: [f64; 3],
-    powers: [f64; 2],
+    pub tally: FrictionTally,
 }
 
 impl FrictionLog {
@@ -314,26 +301,14 @@ impl FrictionLog {
 
     pub(super) fn start(star: &Star, st: &State) -> Self {
         FrictionLog {
-            powers: Self::powers(star, st),
-            ..Self::default()
+            tally: FrictionTally::start(Self::powers(star, st)),
         }
     }
 
     /// One step of length `h` [s] ending in the state `st`.
     pub(super) fn advance(&mut self, star: &Star, st: &State, h: f64) {
-        let p = Self::powers(star, st);
-        self.sleeves_j += 0.5 * h * (self.powers[0] + p[0]);
-        self.rails_j += 0.5 * h * (self.powers[1] + p[1]);
-        self.powers = p;
         if let Some(fr) = &star.friction {
-            for i in 0..3 {
-                if fr.sleeves[i].stuck().is_some() {
-                    self.sleeves_stuck_s[i] += h;
-                }
-                if fr.rails[i].stuck().is_some() {
-                    self.rails_stuck_s[i] += h;
-                }
-            }
+            self.tally.advance(Self::powers(star, st), &fr.sleeves, &fr.rails, h);
         }
     }
 }

@@ -42,18 +42,7 @@ pub(crate) struct Sample {
     pub friction: Option<FrictionSample>,
 }
 
-/// The sleeves' friction at one output time (`docs/friction.md` 7).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct FrictionSample {
-    /// Friction force of sleeve i on beam i along its tangent [N] (stuck: the force the stick needs).
-    pub ff: [f64; 3],
-    /// Sliding speed `xi_ic'` [m/s].
-    pub vs: [f64; 3],
-    /// Whether sleeve i is stuck.
-    pub stuck: [bool; 3],
-    /// Energy dissipated by the friction of the sleeves and rails since t = 0 [J].
-    pub e_f: f64,
-}
+pub(crate) use flexstar_model::FrictionSample;
 
 /// Deformed star at one instant: node positions of each beam from G to the tip [m].
 #[derive(Debug, Clone)]
@@ -147,7 +136,7 @@ impl<'a> Recorder<'a> {
                     ff: [0, 1, 2].map(|i| star.sleeve_friction_force(i, q, &st.lam, pins)),
                     vs: [0, 1, 2].map(|i| v[star.xi(i, 0)]),
                     stuck: fr.sleeves.map(|c| c.stuck().is_some()),
-                    e_f: works.friction.map_or(0.0, |f| f.sleeves_j + f.rails_j),
+                    e_f: works.friction.map_or(0.0, |f| f.tally.dissipated()),
                 }),
             });
             if let Some(s) = &mut self.sensors {

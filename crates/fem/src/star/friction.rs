@@ -26,26 +26,7 @@ use super::*;
 /// sleeve's [`ROWS`] multipliers.
 pub(crate) const FRICTION_SLOTS: usize = ROWS;
 
-/// The state of one frictional contact (sleeve on its beam, slider on its rail).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Contact {
-    /// No friction coefficient: frictionless.
-    Free,
-    /// Stuck at the coordinate [m].
-    Stuck(f64),
-    /// Slipping in the direction `+1` or `-1` (of the sliding velocity); also a contact with
-    /// only viscous friction (it never sticks), whose sign is then unused.
-    Slip(f64),
-}
-
-impl Contact {
-    pub fn stuck(&self) -> Option<f64> {
-        match self {
-            Contact::Stuck(at) => Some(*at),
-            _ => None,
-        }
-    }
-}
+pub(crate) use flexstar_model::friction_run::Contact;
 
 /// The friction of a star and the contacts' states.
 #[derive(Debug, Clone)]
@@ -58,33 +39,24 @@ pub(crate) struct StarFriction {
 
 impl StarFriction {
     /// The contacts at the start: those with a Coulomb limit stuck where they are when at rest
-    /// (`|v| <= V_REST`), slipping along their velocity otherwise; viscous-only contacts slip,
+    /// (`|v| <=` `flexstar_model::friction_run::V_REST`), slipping along their velocity otherwise; viscous-only contacts slip,
     /// frictionless ones are free. `xi`, `xi_dot`: the sleeves' centre coordinates and speeds;
     /// `sliders`: `[s, s']` of each slider in the direct problem.
     pub fn start(law: Friction, xi: [f64; 3], xi_dot: [f64; 3], sliders: Option<[[f64; 2]; 3]>) -> Self {
-        let initial = |coulomb: bool, viscous: bool, x: f64, v: f64| match (coulomb, viscous) {
-            (false, false) => Contact::Free,
-            (false, true) => Contact::Slip(1.0),
-            (true, _) if v.abs() <= V_REST => Contact::Stuck(x),
-            _ => Contact::Slip(v.signum()),
-        };
         let sleeves = std::array::from_fn(|i| {
             let l = law.sleeve(i);
-            initial(l.mu_static > 0.0, l.c > 0.0, xi[i], xi_dot[i])
+            Contact::start(l.mu_static > 0.0, l.c > 0.0, xi[i], xi_dot[i])
         });
         let rails = std::array::from_fn(|i| match sliders {
             Some(sl) => {
                 let r = law.rail(i);
-                initial(r.fc > 0.0, r.b > 0.0, sl[i][0], sl[i][1])
+                Contact::start(r.fc > 0.0, r.b > 0.0, sl[i][0], sl[i][1])
             }
             None => Contact::Free,
         });
         StarFriction { law, sleeves, rails }
     }
 }
-
-/// A contact moving slower than this [m/s] at the start is at rest (sticks if it can).
-pub(crate) const V_REST: f64 = 1e-12;
 
 impl Star {
     /// The normal and edge load `L_i` [N] that bounds sleeve i's friction (Eqs. F2-F3) at the

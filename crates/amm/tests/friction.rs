@@ -1,0 +1,203 @@
+//! Friction in the AMM (`docs/friction.md` 9) against references independent of the code under
+//! test: the closed-form stick-slip of a block on a rail (shared with the FEM's test), the FEM
+//! (an independent discretisation with its own friction code) on the paper's robot, and the
+//! frictionless run bit for bit with `mu = 0`.
+
+use flexstar_drive::SolveRequest;
+use flexstar_model::{
+    catalogue, AmmModel, AmmSettings, Experiment, FemSettings, Friction, ModeFamily, Response, RobotParams,
+};
+
+#[path = "../../../tests/support/block_on_rail.rs"]
+mod block;
+use block::{block_on_rail, Pulse};
+
+fn amm(exp: &Experiment, settings: &AmmSettings, request: SolveRequest) -> Response {
+    flexstar_amm::solve(&exp.problem().unwrap(), settings, request)
+        .map(|s| s.response)
+        .unwrap()
+}
+
+fn col<'r>(r: &'r Response, name: &str) -> &'r [f64] {
+    r.column(name).unwrap_or_else(|| panic!("no column {name}"))
+}
+
+/// `[friction]` from its TOML text.
+fn friction(text: &str) -> Friction {
+    toml::from_str(text).unwrap()
+}
+
+/// A block on a rail: slider 1 (500 kg, `Fc = 1000 N`) pushed by a force pulse of 2000 N over
+/// 0.2 s, sliders 2 and 3 held by their rails (`Fc = 1e5 N`), the star stiff (EI x 100) and
+/// frictionless in its sleeves (0.07 % of the slider's mass). The AMM's direct run against the
+/// closed-form stick-slip: it breaks loose and sticks again within one step of the closed
+/// form's times, travels its distance to 0.2 % and the rail dissipates `Fc` times the travel.
+#[test]
+fn a_slider_on_its_rail_sticks_and_slips_as_a_block_with_coulomb_friction() {
+    let (m, fc, h) = (500.0, 1000.0, 2.5e-4);
+    let pulse = Pulse {
+        f0: 2000.0,
+        t_pulse: 0.2,
+    };
+    let mut robot = RobotParams::paper();
+    robot.i *= 100.0;
+    robot.mpp_mpa = m;
+    let traj = flexstar_model::Trajectory::Polynomial {
+        s1: vec![0.0],
+        s2: vec![0.0],
+        s3: vec![0.0],
+    };
+    let mut exp = catalogue::experiment("block", robot, traj, 0.35, h);
+    exp.friction = Some(friction("[rails]\nFc = [1000.0, 1e5, 1e5]\n"));
+    let settings = AmmSettings {
+        dt: Some(h),
+        ..AmmSettings::paper(ModeFamily::FreeFree, 12)
+    };
+    let r = amm(&exp, &settings, SolveRequest::law(&pulse));
+    let (t1, t2, travel) = block_on_rail(m, fc, &pulse);
+    let (s1, sd1) = (col(&r, "s1"), col(&r, "sd1"));
+    let first = (0..r.len()).find(|&k| s1[k] != s1[0]).expect("the slider moves");
+    let last = (0..r.len()).rev().find(|&k| sd1[k] != 0.0).expect("the slider moves");
+    let moved = s1[r.len() - 1] - s1[0];
+    let held = (1..3)
+        .flat_map(|i| col(&r, &format!("s{}", i + 1)).iter().map(|s| s.abs()))
+        .fold(0.0, f64::max);
+    let summary = r.friction.expect("the friction summary");
+    eprintln!(
+        "block: breaks loose at {:.5} s (closed form {t1:.5} s), sticks after {:.5} s (closed form {t2:.5} s), \
+         travels {moved:.6e} m (closed form {travel:.6e} m, {:.2e}), sliders 2, 3 within {held:.1e} m, {summary:?}",
+        r.t[first],
+        r.t[last],
+        moved / travel - 1.0,
+    );
+    assert!(
+        (r.t[first] - t1).abs() <= h * 1.001,
+        "breaks loose at {} s, closed form {t1} s",
+        r.t[first]
+    );
+    assert!(
+        (r.t[last] - t2).abs() <= h * 1.001,
+        "sticks at {} s, closed form {t2} s",
+        r.t[last]
+    );
+    assert!(
+        (moved / travel - 1.0).abs() < 2e-3,
+        "travel {moved} m, closed form {travel} m"
+    );
+    let dissipated = summary.rails_dissipated_j;
+    assert!(
+        (dissipated / (fc * moved) - 1.0).abs() < 1e-3,
+        "dissipated {dissipated} J"
+    );
+    assert!(held == 0.0, "sliders 2 and 3 must stay stuck: {held} m");
+    assert!(
+        (summary.rails_stuck_s[0] - (0.35 - (t2 - t1))).abs() <= 2.0 * h + 1e-9,
+        "slider 1 stuck {} s",
+        summary.rails_stuck_s[0]
+    );
+}
+
+/// `mu = 0` (and a `[friction]` whose coefficients are all zero) is the frictionless run bit for
+/// bit, inverse and direct: the problem then carries no friction.
+#[test]
+fn zero_friction_is_the_frictionless_run() {
+    let mut exp = catalogue::paper_case(3);
+    exp.time.t_end = 0.1;
+    let settings = AmmSettings::paper(ModeFamily::FreeFree, 20);
+    let plain = amm(&exp, &settings, SolveRequest::motion());
+    exp.friction = Some(friction("mu = 0.0\n[rails]\nFc = 0.0\n"));
+    let zero = amm(&exp, &settings, SolveRequest::motion());
+    let bits = |r: &Response| -> Vec<u64> {
+        let mut v: Vec<u64> = r.fa.iter().flatten().map(|x| x.to_bits()).collect();
+        v.extend(r.extra.iter().flat_map(|c| c.values.iter().map(|x| x.to_bits())));
+        v
+    };
+    assert!(zero.friction.is_none() && zero.column("Ff1").is_none());
+    assert_eq!(bits(&plain), bits(&zero));
+}
+
+/// Mean EVP [%] over A, B, C and G of the AMM against the FEM (Eq. 45, as `flexstar compare`).
+fn mean_evp(a: &Response, f: &Response) -> f64 {
+    flexstar_metrics::evp::point_evps(a, f).unwrap().mean.unwrap()
+}
+
+/// Eq. 45 on the columns `name1..3` of `a` against `f` (`Fa`: the actuator forces): the
+/// integral of the difference over that of the reference [-], summed over the three columns.
+/// The friction forces carry the sleeves' high-frequency couples (the edges' load, F3), which the
+/// two discretisations resolve differently sample by sample, so they are compared in the mean.
+fn column_error(a: &Response, f: &Response, name: &str) -> f64 {
+    let of = |r: &'_ Response, i: usize| -> Vec<f64> {
+        match name {
+            "Fa" => r.fa[i - 1].clone(),
+            _ => col(r, &format!("{name}{i}")).to_vec(),
+        }
+    };
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 1..=3 {
+        let (x, y) = (of(a, i), of(f, i));
+        num += x.iter().zip(&y).map(|(a, b)| (a - b).abs()).sum::<f64>();
+        den += y.iter().map(|b| b.abs()).sum::<f64>();
+    }
+    num / den
+}
+
+/// The accurate AMM against the FEM on the paper's robot with sleeve friction, `mu` 0.1 and
+/// 0.3, both load models, on paper case 3 and a rest-to-rest quintic: the tips and G within
+/// 1 % mean EVP (1.5 % for the move with mu = 0.3), the friction forces within 10 % and the
+/// actuator forces within 5 % in the
+/// integral measure of Eq. 45 ([`column_error`]), the energy the friction dissipates within 2 %. (Measured: see `docs/friction.md` 9.3.)
+#[test]
+fn the_amm_agrees_with_the_fem_with_friction() {
+    let quintic = {
+        let traj = catalogue::quintic_from_origin(catalogue::GENERAL_TARGET, 0.3);
+        catalogue::experiment("quintic", RobotParams::paper(), traj, 0.45, 1e-3)
+    };
+    let case3 = catalogue::paper_case(3);
+    let settings = AmmSettings {
+        family: ModeFamily::Enriched,
+        model: AmmModel::Full,
+        modes: Some(40),
+        tol: None,
+        ..AmmSettings::accurate()
+    };
+    let fem_settings = FemSettings {
+        elements: 600,
+        ..FemSettings::default()
+    };
+    for (name, base) in [("case 3", &case3), ("quintic", &quintic)] {
+        let plain_a = amm(base, &settings, SolveRequest::motion());
+        let plain_f = flexstar_fem::solve(&base.problem().unwrap(), &fem_settings, SolveRequest::motion())
+            .unwrap()
+            .response;
+        eprintln!(
+            "{name} without friction: mean EVP {:.3} %",
+            mean_evp(&plain_a, &plain_f)
+        );
+        for mu in [0.1, 0.3] {
+            for model in ["normal", "edges"] {
+                let mut exp = base.clone();
+                exp.friction = Some(friction(&format!("mu = {mu}\nmodel = \"{model}\"\n")));
+                let a = amm(&exp, &settings, SolveRequest::motion());
+                let f = flexstar_fem::solve(&exp.problem().unwrap(), &fem_settings, SolveRequest::motion())
+                    .unwrap()
+                    .response;
+                let evp = mean_evp(&a, &f);
+                let (ff, fa) = (column_error(&a, &f, "Ff"), column_error(&a, &f, "Fa"));
+                let (ea, ef) = (
+                    a.friction.unwrap().sleeves_dissipated_j,
+                    f.friction.unwrap().sleeves_dissipated_j,
+                );
+                eprintln!(
+                    "{name}, mu {mu}, {model}: mean EVP {evp:.3} %, Ff {ff:.3}, Fa {fa:.3} of their largest, \
+                     dissipated {ea:.4e} J (FEM {ef:.4e} J)"
+                );
+                // the rest-to-rest move with mu = 0.3 ends with the sleeves sticking on a strained
+                // star: 1.1 % at the default steps, 0.93-1.02 % at 1e-4 s (docs/friction.md 9.3)
+                let bound = if name == "quintic" && mu == 0.3 { 1.5 } else { 1.0 };
+                assert!(evp < bound, "{name} mu {mu} {model}: mean EVP {evp} %");
+                assert!(ff < 0.1 && fa < 0.05, "{name} mu {mu} {model}: Ff {ff}, Fa {fa}");
+                assert!((ea / ef - 1.0).abs() < 0.02, "{name} mu {mu} {model}: {ea} J vs {ef} J");
+            }
+        }
+    }
+}

@@ -20,8 +20,9 @@
 //! [`MAX_ESTIMATE_TIME_ERROR`] the pairs are run again at the delivered step.
 //!
 //! The reported estimate is the truncation plus the delivered run's time error, from one more run
-//! of the chosen N at 2 h ([`time_error_estimate`], Eq. T1 of `docs/amm.md` 12.10), plus the
-//! geometric part the AMM leaves out ([`geometric_part`], Eq. G1, 12.9).
+//! of the chosen N at 2 h ([`time_error_estimate`], Eq. T1 of `docs/amm.md` 12.10; also on spans
+//! too short for the coarse grid, 12.13), plus the geometric part the AMM leaves out
+//! ([`geometric_part`], Eq. G1, 12.9).
 
 use flexstar_metrics::evp::point_evps;
 use flexstar_model::{Problem, Response};
@@ -261,7 +262,13 @@ where
             time_part = Some(time_check_part(&check, &delivered, k));
         }
         if time_error <= MAX_ESTIMATE_TIME_ERROR {
-            return Ok(finish(problem, delivered, estimate + time_part.unwrap_or(0.0), tol, wall));
+            return Ok(finish(
+                problem,
+                delivered,
+                estimate + time_part.unwrap_or(0.0),
+                tol,
+                wall,
+            ));
         }
     }
     let (n, estimate, delivered, pair_wall) = raise_until_below(problem, tol, Pass::Deliver, &mut run)?;
@@ -271,7 +278,13 @@ where
         wall += check.info.wall_s;
         time_part = Some(time_check_part(&check, &delivered, k));
     }
-    Ok(finish(problem, delivered, estimate + time_part.unwrap_or(0.0), tol, wall))
+    Ok(finish(
+        problem,
+        delivered,
+        estimate + time_part.unwrap_or(0.0),
+        tol,
+        wall,
+    ))
 }
 
 /// Eq. T1 [%] from the time check's run `check` (the chosen N at 2 h on every `check_every`-th

@@ -61,7 +61,15 @@ fn the_estimate_of_a_short_motion_carries_the_delivered_steps_error() {
             "{}: N = {n}, h = {h:.3e} s: own error {truth:.4} %, estimate {estimate:.4} %, ratio {ratio:.2}",
             exp.name
         );
-        assert!(truth > 0.01, "{}: the step must matter in this test: {truth} %", exp.name);
-        assert!((0.5..=2.0).contains(&ratio), "{}: {estimate} % against {truth} %", exp.name);
+        assert!(
+            truth > 0.01,
+            "{}: the step must matter in this test: {truth} %",
+            exp.name
+        );
+        assert!(
+            (0.5..=2.0).contains(&ratio),
+            "{}: {estimate} % against {truth} %",
+            exp.name
+        );
     }
 }

@@ -20,9 +20,10 @@
 //! [`MAX_ESTIMATE_TIME_ERROR`] the pairs are run again at the delivered step.
 //!
 //! The reported estimate is the truncation plus the delivered run's time error, from one more run
-//! of the chosen N at 2 h ([`time_error_estimate`], Eq. T1 of `docs/amm.md` 12.10), plus the
-//! geometric part the AMM leaves out ([`geometric_part`], Eq. G1, 12.9), plus under gravity the
-//! part for the vibration about the sag ([`sag_part`], Eq. V3, 12.13).
+//! of the chosen N at 2 h ([`time_error_estimate`], Eq. T1 of `docs/amm.md` 12.10; also on spans
+//! too short for the coarse grid, 12.13), plus the geometric part the AMM leaves out
+//! ([`geometric_part`], Eq. G1, 12.9), plus under gravity the part for the vibration about the
+//! sag ([`sag_part`], Eq. V3, 12.14).
 
 use flexstar_metrics::evp::point_evps;
 use flexstar_model::{Problem, Response};
@@ -94,10 +95,10 @@ pub(crate) fn geometric_part_of(problem: &Star, r: &Response) -> f64 {
     GEOMETRIC_COEFF * 100.0 * a * a
 }
 
-/// Coefficient `C_V` of the estimate's sag part, Eq. V3 of `docs/amm.md` 12.13:
+/// Coefficient `C_V` of the estimate's sag part, Eq. V3 of `docs/amm.md` 12.14:
 /// `e_sag = C_V * 100 * S^2` [%], S the largest sleeve rotation of the static start under
 /// gravity. Under gravity the star vibrates about its sag, and the terms third order in the
-/// deflection that the AMM leaves out (12.13: the curvature of the inextensible beam, the
+/// deflection that the AMM leaves out (12.14: the curvature of the inextensible beam, the
 /// foreshortening's own inertia) change its stiffness and mass about the sag by a relative
 /// `~ S^2`: the sag is off by that much and the vibration's frequency too (measured `0.74 S^2`),
 /// so the error is second order in g and lasts the whole run. Chosen on the in-range cases of
@@ -109,7 +110,7 @@ pub const SAG_COEFF: f64 = 1.75;
 /// `r` of `problem`: `SAG_COEFF * 100 * S^2`, S [rad] the largest `|thp_i|` of the first output
 /// row (the static equilibrium of the start pose, `docs/as-built.md` 5.4). Zero without gravity,
 /// and for a motion that does not come to rest within the run (no residual vibration about the
-/// sag; the motion's own deflection dominates its response, 12.13).
+/// sag; the motion's own deflection dominates its response, 12.14).
 pub fn sag_part(problem: &Problem, r: &Response) -> f64 {
     sag_part_of(&Star::new(problem), r)
 }
@@ -216,8 +217,8 @@ pub(crate) enum Pass {
     /// A run of the estimate's pair: step [`ESTIMATE_STEP_FACTOR`] times the delivered one, on
     /// an output grid `every` times coarser (module docs).
     Estimate { every: usize },
-    /// The time check's run: step [`TIME_CHECK_STEP_FACTOR`] times the delivered one, on the
-    /// estimate's output grid (`every` as in `Estimate`).
+    /// The time check's run: step [`TIME_CHECK_STEP_FACTOR`] times the delivered one, on an
+    /// output grid `every` times coarser ([`time_check_grid`]).
     TimeCheck { every: usize },
     /// A run at the delivered step and output grid.
     Deliver,
@@ -266,6 +267,10 @@ where
 /// time part, Eq. T1) and once at
 /// the delivered step; if the coarse step's own time error, the EVP of the chosen N's two runs, is above
 /// [`MAX_ESTIMATE_TIME_ERROR`], or with `every = None`, the pairs run at the delivered step.
+/// With `every = None` (a span too short for the coarse grid) the time check follows the pairs:
+/// the chosen N at 2 h after its delivered run (`docs/amm.md` 12.13), so that there the delivered
+/// run is the last at the delivered step, not the last run. `check_every = None`: no time check
+/// (the direct problem's pairs, which run at the delivered step only).
 /// Returns the delivered run with `info.modes`, `info.error_estimate_percent` and
 /// `info.tol_percent` set, its wall time the sum over the runs. Fails with the estimate reached
 /// when the tolerance is not met at [`MAX_AUTO_MODES`].
@@ -273,32 +278,59 @@ pub(crate) fn solve_to_tolerance<F>(
     problem: &Star,
     tol: f64,
     every: Option<usize>,
-    check_every: usize,
+    check_every: Option<usize>,
     mut run: F,
 ) -> Result<Response, AmmError>
 where
     F: FnMut(usize, Pass) -> Result<Response, AmmError>,
 {
     let mut wall = 0.0;
-    // the delivered run's time error from the time check at 2 h, where a coarse grid exists
-    let mut time_part = 0.0;
+    // the delivered run's time error from the time check at 2 h (Eq. T1)
+    let mut time_part = None;
     if let Some(every) = every {
         let pass = Pass::Estimate { every };
         let (n, estimate, coarse, pair_wall) = raise_until_below(problem, tol, pass, &mut run)?;
         // the time check before the delivered run, so that the delivered run is the last one
-        let check = run(n, Pass::TimeCheck { every: check_every })?;
+        let check = check_every.map(|k| run(n, Pass::TimeCheck { every: k })).transpose()?;
         let delivered = run(n, Pass::Deliver)?;
-        wall += pair_wall + check.info.wall_s + delivered.info.wall_s;
+        wall += pair_wall + delivered.info.wall_s;
         let on_coarse_grid = delivered.every_nth(every);
         let time_error = mean_evp(&coarse, &on_coarse_grid);
         // (also the fallback's time part: its delivered run takes the same step h)
-        time_part = time_error_estimate(mean_evp(&check, &delivered.every_nth(check_every)));
+        if let (Some(check), Some(k)) = (check, check_every) {
+            wall += check.info.wall_s;
+            time_part = Some(time_check_part(&check, &delivered, k));
+        }
         if time_error <= MAX_ESTIMATE_TIME_ERROR {
-            return Ok(finish(problem, delivered, estimate + time_part, tol, wall));
+            return Ok(finish(
+                problem,
+                delivered,
+                estimate + time_part.unwrap_or(0.0),
+                tol,
+                wall,
+            ));
         }
     }
-    let (_, estimate, delivered, pair_wall) = raise_until_below(problem, tol, Pass::Deliver, &mut run)?;
-    Ok(finish(problem, delivered, estimate + time_part, tol, wall + pair_wall))
+    let (n, estimate, delivered, pair_wall) = raise_until_below(problem, tol, Pass::Deliver, &mut run)?;
+    wall += pair_wall;
+    if let (None, Some(k)) = (time_part, check_every) {
+        let check = run(n, Pass::TimeCheck { every: k })?;
+        wall += check.info.wall_s;
+        time_part = Some(time_check_part(&check, &delivered, k));
+    }
+    Ok(finish(
+        problem,
+        delivered,
+        estimate + time_part.unwrap_or(0.0),
+        tol,
+        wall,
+    ))
+}
+
+/// Eq. T1 [%] from the time check's run `check` (the chosen N at 2 h on every `check_every`-th
+/// output time) and the `delivered` run at h: [`time_error_estimate`] of their mean EVP.
+fn time_check_part(check: &Response, delivered: &Response, check_every: usize) -> f64 {
+    time_error_estimate(mean_evp(check, &delivered.every_nth(check_every)))
 }
 
 /// Mean EVP [%] (Eq. 45) of `run` against `reference` on the reference's times; `None` when the
@@ -375,7 +407,7 @@ mod tests {
         for (coarse_time_error, delivered_runs) in [(0.02, 1), (0.3, 3)] {
             let c = coarse_time_error / (8f64.powf(order) - 1.0);
             let mut passes = Vec::new();
-            let r = solve_to_tolerance(&exp, 0.5, Some(every), 1, |n, pass| {
+            let r = solve_to_tolerance(&exp, 0.5, Some(every), Some(1), |n, pass| {
                 passes.push((n, pass));
                 Ok(match pass {
                     Pass::Estimate { every } => model(&exp, every, n, c * 8f64.powf(order)),

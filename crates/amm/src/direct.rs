@@ -64,8 +64,9 @@ pub(crate) fn solve_direct_scanned(
             validate(problem, settings, adaptive::first_modes_of(problem), scan)?;
             // the pairs at the delivered step: the coarse-step estimate (`adaptive`) is measured
             // on inverse runs only, and a servo's loop may not tolerate the coarse step
-            // (the reference was scanned once just above: not again per N)
-            adaptive::solve_to_tolerance(problem, tol, None, 1, |n, _| {
+            // (the reference was scanned once just above: not again per N); no time check, so
+            // the delivered run is the last
+            adaptive::solve_to_tolerance(problem, tol, None, None, |n, _| {
                 integrate_direct(problem, settings, law, n, false, &mut runs)
             })?
         }

@@ -255,8 +255,9 @@ pub struct Stats {
     /// Modes per beam N of the delivered run.
     pub modes: usize,
     /// N of every integration run, in the order run: for the automatic N the estimate's runs
-    /// (at the coarse step, or the delivered one) and the delivered run last; one entry for a
-    /// fixed N.
+    /// (at the coarse step, or the delivered one), the time check's run at 2 h and the delivered
+    /// run, last but on a span too short for the coarse grid, where the time check follows it
+    /// (`adaptive` module); one entry for a fixed N.
     pub modes_tried: Vec<usize>,
     /// Time steps of the delivered run.
     pub steps: usize,
@@ -270,8 +271,13 @@ pub struct Stats {
 impl Stats {
     /// The counters of the runs `(N, steps)` in the order run, the delivered one last.
     pub(crate) fn from_runs(runs: &[(usize, usize)]) -> Self {
+        Self::delivering(runs, runs.len().saturating_sub(1))
+    }
+
+    /// The counters of the runs `(N, steps)` in the order run, `runs[delivered]` the delivered one.
+    pub(crate) fn delivering(runs: &[(usize, usize)], delivered: usize) -> Self {
         let total_steps = runs.iter().map(|r| r.1).sum();
-        let (modes, steps) = runs.last().copied().unwrap_or_default();
+        let (modes, steps) = runs.get(delivered).copied().unwrap_or_default();
         Stats {
             modes,
             modes_tried: runs.iter().map(|r| r.0).collect(),
@@ -290,36 +296,38 @@ pub(crate) fn covers(checked: &CheckedMotion, problem: &Star) -> bool {
 /// [`solve`] of the prescribed motion; `scan`: check the trajectory's feasibility over the whole span first.
 fn solve_scanned(problem: &Star, settings: &AmmSettings, scan: bool) -> Result<(Response, Stats), AmmError> {
     let mut runs = Vec::new();
-    let resp = match settings.mode_count() {
+    let (resp, delivered) = match settings.mode_count() {
         ModeCount::Fixed(n) => {
             let mut steps = 0;
             let r = integrate(problem, settings, n, scan, |_, _| steps += 1)?;
             runs.push((n, steps));
-            r
+            (r, 0)
         }
         ModeCount::Tolerance(tol) => solve_to_tolerance(problem, settings, tol, scan, &mut runs)?,
     };
-    Ok((resp, Stats::from_runs(&runs)))
+    Ok((resp, Stats::delivering(&runs, delivered)))
 }
 
 /// [`solve`] with N chosen for the tolerance `tol` [%] (`adaptive` module): the estimate's pairs
 /// at the coarse step on the coarse output grid, the chosen N at the delivered step `h`. The
 /// system of the last N is built once and reused by its runs at both steps. `runs` receives
-/// `(N, steps)` of every integration run, in order.
+/// `(N, steps)` of every integration run, in order; returns the delivered run and its index in
+/// `runs` (the last run at the delivered step: the time check may follow it, `adaptive` module).
 fn solve_to_tolerance(
     problem: &Star,
     settings: &AmmSettings,
     tol: f64,
     scan: bool,
     runs: &mut Vec<(usize, usize)>,
-) -> Result<Response, AmmError> {
+) -> Result<(Response, usize), AmmError> {
     // every input error before any work, at the first N; the trajectory is scanned once here
     // (unless the caller has)
     let h = validate(problem, settings, adaptive::first_modes_of(problem), scan)?;
     let every = adaptive::estimate_grid_of(problem, h);
     let check_every = adaptive::time_check_grid_of(problem, h);
     let mut built: Option<(usize, System)> = None;
-    adaptive::solve_to_tolerance(problem, tol, every, check_every, |n, pass| {
+    let mut delivered = 0;
+    let response = adaptive::solve_to_tolerance(problem, tol, every, Some(check_every), |n, pass| {
         let started = std::time::Instant::now();
         let sys = match &built {
             Some((m, sys)) if *m == n => sys.clone(),
@@ -342,9 +350,13 @@ fn solve_to_tolerance(
                 integrate_coarse(problem, settings, sys, h, factor, every, started, |_, _| steps += 1)
             }
         };
+        if pass == Pass::Deliver {
+            delivered = runs.len();
+        }
         runs.push((n, steps));
         resp
-    })
+    })?;
+    Ok((response, delivered))
 }
 
 /// A run of the automatic choice at `factor` times the delivered step `h` [s] (at most the

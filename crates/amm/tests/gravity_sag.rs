@@ -1,4 +1,4 @@
-//! The estimate's part for the vibration about the sag under gravity (`docs/amm.md` 12.13,
+//! The estimate's part for the vibration about the sag under gravity (`docs/amm.md` 12.14,
 //! Eq. V3), against the refined FEM.
 //!
 //! The robot and motion are the case `f3263dfe592ef0d7` of `configs/studies/envelope-as-built.toml`

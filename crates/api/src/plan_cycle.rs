@@ -62,7 +62,10 @@ pub fn plan_cycle_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Pla
     let cfg = load_plan(config)?;
     let source = config.display().to_string();
     if cfg.cycle.is_none() {
-        return Err(ApiError::solver(&source, "not a cycle: [plan] has from and to (use plan_to_dir)"));
+        return Err(ApiError::solver(
+            &source,
+            "not a cycle: [plan] has from and to (use plan_to_dir)",
+        ));
     }
     let dir = crate::case_dir(out, &cfg.exp)?;
     let notes = flexstar_model::identity::other_experiment_note(&dir, &cfg.exp)
@@ -114,8 +117,8 @@ pub fn cycle_rows(exp: &Experiment, p: &PlannedCycle) -> Result<Vec<[f64; 7]>> {
 /// the planned table has the plain cycle's moves, times and dwell poses).
 fn measure_dwells(plain: &Experiment, run: &mut RunOutcome, source: &str) -> Result<()> {
     let pinned = run.stem.starts_with("amm") && run.exp.amm.family == ModeFamily::PinnedFree;
-    let dwells = flexstar_modal::settle::run_dwells(plain, &run.response, pinned)
-        .map_err(|e| ApiError::solver(source, e))?;
+    let dwells =
+        flexstar_modal::settle::run_dwells(plain, &run.response, pinned).map_err(|e| ApiError::solver(source, e))?;
     if let Some(keys) = run.sidecar.residual.as_mut() {
         keys.dwells = dwells;
     }

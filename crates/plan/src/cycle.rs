@@ -71,12 +71,18 @@ impl Cycle {
     /// `[plan]` default duration. Errors name `plan.points[k]` (0-based, as written).
     pub fn from_points(value: toml::Value, t_move: Option<f64>, t0: f64) -> Result<Cycle, ModelError> {
         let toml::Value::Array(items) = value else {
-            return Err(ModelError::invalid("plan.points", "must be an interior point count or an array of cycle points"));
+            return Err(ModelError::invalid(
+                "plan.points",
+                "must be an interior point count or an array of cycle points",
+            ));
         };
         if items.len() < 2 {
             return Err(ModelError::invalid(
                 "plan.points",
-                format!("a cycle needs at least two points (a start and one move's end), got {}", items.len()),
+                format!(
+                    "a cycle needs at least two points (a start and one move's end), got {}",
+                    items.len()
+                ),
             ));
         }
         let mut entries = Vec::with_capacity(items.len());
@@ -91,7 +97,13 @@ impl Cycle {
         let mut t = t0;
         for k in 1..entries.len() {
             let (from, to, (dwell, t_move)) = (entries[k - 1].0, entries[k].0, entries[k].1);
-            moves.push(CycleMove { from, to, t_start: t, t_move, dwell });
+            moves.push(CycleMove {
+                from,
+                to,
+                t_start: t,
+                t_move,
+                dwell,
+            });
             t += t_move + dwell;
         }
         let cycle = Cycle { t0, moves };
@@ -114,21 +126,30 @@ impl Cycle {
             theta: f64,
         }
         let Some(toml::Value::Array(items)) = traj.get("points") else {
-            return Err(ModelError::invalid("trajectory.points", "missing: a via cycle lists its points"));
+            return Err(ModelError::invalid(
+                "trajectory.points",
+                "missing: a via cycle lists its points",
+            ));
         };
         let mut pts = Vec::with_capacity(items.len());
         for (k, item) in items.iter().enumerate() {
-            let p: ViaPoint = item
-                .clone()
-                .try_into()
-                .map_err(|e: toml::de::Error| ModelError::invalid(format!("trajectory.points[{k}]"), e.message().trim_end()))?;
+            let p: ViaPoint = item.clone().try_into().map_err(|e: toml::de::Error| {
+                ModelError::invalid(format!("trajectory.points[{k}]"), e.message().trim_end())
+            })?;
             pts.push(p);
         }
         let Some(first) = pts.first() else {
-            return Err(ModelError::invalid("trajectory.points", "a cycle needs at least two points"));
+            return Err(ModelError::invalid(
+                "trajectory.points",
+                "a cycle needs at least two points",
+            ));
         };
         let t0 = first.t;
-        let pose = |p: &ViaPoint| Pose { gx: p.gx, gy: p.gy, theta: p.theta };
+        let pose = |p: &ViaPoint| Pose {
+            gx: p.gx,
+            gy: p.gy,
+            theta: p.theta,
+        };
         let mut moves: Vec<CycleMove> = Vec::new();
         for w in pts.windows(2) {
             let (a, b) = (&w[0], &w[1]);
@@ -138,10 +159,19 @@ impl Cycle {
             if let Some(last) = moves.last_mut() {
                 last.dwell = a.t - last.t_end();
             }
-            moves.push(CycleMove { from: pose(a), to: pose(b), t_start: a.t, t_move: b.t - a.t, dwell: 0.0 });
+            moves.push(CycleMove {
+                from: pose(a),
+                to: pose(b),
+                t_start: a.t,
+                t_move: b.t - a.t,
+                dwell: 0.0,
+            });
         }
         let Some(last) = moves.last_mut() else {
-            return Err(ModelError::invalid("trajectory.points", "a cycle needs at least one move (two distinct poses)"));
+            return Err(ModelError::invalid(
+                "trajectory.points",
+                "a cycle needs at least one move (two distinct poses)",
+            ));
         };
         last.dwell = t_end - last.t_end();
         for (k, m) in moves.iter().enumerate() {
@@ -214,7 +244,11 @@ fn check_entry(e: PointEntry, k: usize, t_move: Option<f64>) -> Result<(Pose, (f
     if ![e.gx, e.gy, e.theta].iter().all(|v| v.is_finite()) {
         return Err(ModelError::invalid(&key, "Gx, Gy and theta must be finite"));
     }
-    let pose = Pose { gx: e.gx, gy: e.gy, theta: e.theta };
+    let pose = Pose {
+        gx: e.gx,
+        gy: e.gy,
+        theta: e.theta,
+    };
     if k == 0 {
         if e.dwell.is_some() || e.t_move.is_some() {
             return Err(ModelError::invalid(
@@ -226,7 +260,12 @@ fn check_entry(e: PointEntry, k: usize, t_move: Option<f64>) -> Result<(Pose, (f
     }
     let dwell = match e.dwell {
         Some(d) if d.is_finite() && d > 0.0 => d,
-        Some(d) => return Err(ModelError::invalid(format!("{key}.dwell"), format!("must be > 0 s, got {d}"))),
+        Some(d) => {
+            return Err(ModelError::invalid(
+                format!("{key}.dwell"),
+                format!("must be > 0 s, got {d}"),
+            ))
+        }
         None => {
             return Err(ModelError::invalid(
                 format!("{key}.dwell"),
@@ -236,8 +275,18 @@ fn check_entry(e: PointEntry, k: usize, t_move: Option<f64>) -> Result<(Pose, (f
     };
     let t = match e.t_move.or(t_move) {
         Some(t) if t.is_finite() && t > 0.0 => t,
-        Some(t) => return Err(ModelError::invalid(format!("{key}.t_move"), format!("must be > 0 s, got {t}"))),
-        None => return Err(ModelError::invalid(format!("{key}.t_move"), "missing: give plan.t_move or the point's t_move [s]")),
+        Some(t) => {
+            return Err(ModelError::invalid(
+                format!("{key}.t_move"),
+                format!("must be > 0 s, got {t}"),
+            ))
+        }
+        None => {
+            return Err(ModelError::invalid(
+                format!("{key}.t_move"),
+                "missing: give plan.t_move or the point's t_move [s]",
+            ))
+        }
     };
     Ok((pose, (dwell, t)))
 }
@@ -277,7 +326,12 @@ pub fn take_cycle(table: &mut toml::Table, path: &Path) -> Result<Option<Cycle>,
             .get("time")
             .and_then(|t| t.get("t_end"))
             .and_then(toml::Value::as_float)
-            .ok_or_else(|| in_file(ModelError::invalid("time.t_end", "missing: a via cycle's last dwell runs to it")))?;
+            .ok_or_else(|| {
+                in_file(ModelError::invalid(
+                    "time.t_end",
+                    "missing: a via cycle's last dwell runs to it",
+                ))
+            })?;
         for key in ["t0", "t_move"] {
             if has(key) {
                 return Err(in_file(ModelError::invalid(
@@ -322,5 +376,69 @@ fn first_move_keys(table: &mut toml::Table, cycle: &Cycle) {
         plan.insert("to".into(), pose(m.to));
         plan.insert("t0".into(), toml::Value::Float(m.t_start));
         plan.insert("t_move".into(), toml::Value::Float(m.t_move));
+    }
+}
+
+/// The key and reason of an error of the plain cycle's `via` list (`trajectory.points`, "point
+/// n ...", 1-based over the list of [`Cycle::plain_trajectory`], two entries per move) said of
+/// the cycle's point: `plan.points[k]`, k = n / 2 (the start, then each move's end, 0-based).
+pub fn via_error_key(reason: &str) -> (String, String) {
+    let parsed = reason
+        .strip_prefix("point ")
+        .and_then(|r| r.split_once(' '))
+        .and_then(|(n, rest)| n.parse::<usize>().ok().map(|n| (n, rest)));
+    match parsed {
+        Some((n, rest)) if n >= 1 => (format!("plan.points[{}]", n / 2), format!("the point {rest}")),
+        _ => ("plan.points".to_string(), reason.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEAD: &str = "name = \"t\"\n[time]\nt_end = 1.5\ndt_out = 0.001\n";
+
+    fn cycle_of(text: &str) -> Cycle {
+        let cfg = crate::section::plan_config_from_str(text, Path::new("c.toml")).unwrap();
+        cfg.cycle.expect("a cycle")
+    }
+
+    /// The pick-and-place cycle written as `[plan] points` and as the via cycle of
+    /// `configs/motions/pick-place.toml` read to the same moves and dwells (Eq. C1 by hand).
+    #[test]
+    fn points_and_via_cycles_read_alike() {
+        let points = cycle_of(&format!(
+            "{HEAD}[plan]\nt_move = 0.4\npoints = [{{ Gx = 0.0, Gy = 0.0, theta = 0.0 }}, \
+             {{ Gx = 0.03, Gy = -0.02, theta = 0.2, dwell = 0.3 }}, {{ Gx = 0.0, Gy = 0.0, theta = 0.0, dwell = 0.4 }}]\n"
+        ));
+        let via = cycle_of(&format!(
+            "{HEAD}[plan]\n[trajectory]\nkind = \"via\"\npoints = [{{ t = 0.0, Gx = 0.0, Gy = 0.0, theta = 0.0 }}, \
+             {{ t = 0.4, Gx = 0.03, Gy = -0.02, theta = 0.2 }}, {{ t = 0.7, Gx = 0.03, Gy = -0.02, theta = 0.2 }}, \
+             {{ t = 1.1, Gx = 0.0, Gy = 0.0, theta = 0.0 }}]\n"
+        ));
+        let starts: Vec<f64> = points.moves.iter().map(|m| m.t_start).collect();
+        let dwells: Vec<f64> = points.moves.iter().map(|m| m.dwell).collect();
+        assert_eq!(starts, [0.0, 0.7]);
+        assert_eq!(dwells, [0.3, 0.4]);
+        assert_eq!(points.moves.len(), via.moves.len());
+        for (a, b) in points.moves.iter().zip(&via.moves) {
+            assert_eq!((a.from, a.to), (b.from, b.to));
+            for (x, y) in [(a.t_start, b.t_start), (a.t_move, b.t_move), (a.dwell, b.dwell)] {
+                assert!((x - y).abs() < 1e-12, "{a:?} vs {b:?}");
+            }
+        }
+        assert!((points.end() - 1.5).abs() < 1e-12);
+    }
+
+    /// A via list's point n (1-based, two per move) is the cycle's point n / 2.
+    #[test]
+    fn via_errors_name_the_cycle_point() {
+        let poses = ["P0", "P1", "P1", "P2", "P2", "P3"];
+        for (j, want) in poses.iter().enumerate() {
+            let (key, _) = via_error_key(&format!("point {} (Gx = 1) is outside", j + 1));
+            assert_eq!(key, format!("plan.points[{}]", &want[1..]));
+        }
+        assert_eq!(via_error_key("other").0, "plan.points");
     }
 }

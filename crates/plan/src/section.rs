@@ -346,6 +346,10 @@ pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanE
     })?;
     // the stand-in quintic's keys are the plan's (`trajectory.to` is `plan.to`)
     let exp = Experiment::from_toml_str(&rebuilt, path).map_err(|e| match e {
+        ModelError::Invalid { file, key, reason } if cycle.is_some() && key == "trajectory.points" => {
+            let (key, reason) = crate::cycle::via_error_key(&reason);
+            ModelError::Invalid { file, key, reason }
+        }
         ModelError::Invalid { file, key, reason } if key.starts_with("trajectory") => ModelError::Invalid {
             file,
             key: key.replacen("trajectory", "plan", 1),

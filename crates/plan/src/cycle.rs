@@ -60,13 +60,6 @@ impl Cycle {
         self.moves.last().map_or(self.t0, CycleMove::t_end)
     }
 
-    /// The poses: the start, then each move's end.
-    pub fn poses(&self) -> Vec<Pose> {
-        let mut p: Vec<Pose> = self.moves.first().map(|m| m.from).into_iter().collect();
-        p.extend(self.moves.iter().map(|m| m.to));
-        p
-    }
-
     /// `[plan] points` (an array of tables) read with Eq. C1 from `t0` [s]; `t_move` is the
     /// `[plan]` default duration. Errors name `plan.points[k]` (0-based, as written).
     pub fn from_points(value: toml::Value, t_move: Option<f64>, t0: f64) -> Result<Cycle, ModelError> {

@@ -13,6 +13,8 @@ pub mod kinematics;
 pub mod modal;
 pub mod modes;
 pub mod plan;
+pub mod plan_cycle;
+mod plan_cycle_report;
 mod plan_figures;
 mod plan_report;
 pub mod plan_robust;

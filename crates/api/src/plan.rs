@@ -59,7 +59,7 @@ pub struct PlanOutcome {
 }
 
 /// A planner error as the command reports it (bad input names the file and key).
-fn from_plan(source: &str, e: PlanError) -> ApiError {
+pub(crate) fn from_plan(source: &str, e: PlanError) -> ApiError {
     match e {
         PlanError::Input(m) => ApiError::from_model(m),
         PlanError::Infeasible { what, reason } => ApiError::solver(source, format!("{what}: infeasible at {reason}")),
@@ -80,6 +80,12 @@ pub fn plan_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Planned))
     let started = Instant::now();
     let cfg = load_plan(config)?;
     let source = config.display().to_string();
+    if cfg.cycle.is_some() {
+        return Err(ApiError::solver(
+            &source,
+            "the file is a cycle ([plan] points or a via cycle): plan it with flexstar_api::plan_cycle::plan_cycle_to_dir",
+        ));
+    }
     let dir = crate::case_dir(out, &cfg.exp)?;
     let notes = flexstar_model::identity::other_experiment_note(&dir, &cfg.exp)
         .into_iter()
@@ -88,7 +94,8 @@ pub fn plan_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Planned))
     on_planned(&planned);
     let rows = plan_rows(&cfg.exp, &planned)?;
     let exps = motion_experiments(&cfg, &planned, &rows)?;
-    let motions = run_motions(exps, &source)?;
+    let labels: Vec<(&'static str, &'static str)> = MOTIONS.into_iter().chain(ROBUST_MOTIONS).collect();
+    let motions = run_motions(exps, &labels, &source)?;
     let robust = planned.robust.as_ref().map(|info| {
         let trajectories: Vec<(String, Trajectory)> = motions
             .iter()
@@ -128,7 +135,7 @@ pub fn plan_rows(exp: &Experiment, p: &Planned) -> Result<Vec<[f64; 7]>> {
 }
 
 /// The table trajectory of the rows (what `plan.toml` runs).
-fn table_trajectory(exp: &Experiment, rows: &[[f64; 7]]) -> Result<Trajectory> {
+pub(crate) fn table_trajectory(exp: &Experiment, rows: &[[f64; 7]]) -> Result<Trajectory> {
     let t = rows.iter().map(|r| r[0]).collect();
     let v = rows.iter().map(|r| [r[1], r[2], r[3]]).collect();
     TableMotion::from_rows(PathBuf::from("plan.csv"), TableSpace::Task, t, v, &exp.robot)
@@ -159,8 +166,13 @@ fn motion_experiments(cfg: &PlanConfig, p: &Planned, rows: &[[f64; 7]]) -> Resul
     Ok(exps)
 }
 
-/// Run every motion on the accurate AMM and the FEM (the six runs in parallel).
-fn run_motions(exps: Vec<Experiment>, source: &str) -> Result<Vec<MotionRuns>> {
+/// Run every motion on the accurate AMM and the FEM (the runs in parallel); `labels` the
+/// motions' folder names and labels, in the order of `exps`.
+pub(crate) fn run_motions(
+    exps: Vec<Experiment>,
+    labels: &[(&'static str, &'static str)],
+    source: &str,
+) -> Result<Vec<MotionRuns>> {
     let jobs: Vec<(usize, Solver)> = (0..exps.len())
         .flat_map(|k| [(k, Solver::Fem), (k, Solver::Amm)])
         .collect();
@@ -173,7 +185,7 @@ fn run_motions(exps: Vec<Experiment>, source: &str) -> Result<Vec<MotionRuns>> {
         .collect();
     let mut outcomes = outcomes.into_iter().collect::<Result<Vec<_>>>()?.into_iter();
     let mut motions = Vec::new();
-    for (exp, (key, label)) in exps.into_iter().zip(MOTIONS.into_iter().chain(ROBUST_MOTIONS)) {
+    for (exp, &(key, label)) in exps.into_iter().zip(labels) {
         let (fem, amm) = (outcomes.next(), outcomes.next());
         let (Some(fem), Some(amm)) = (fem, amm) else {
             return Err(ApiError::solver(source, "a run of the comparison is missing"));
@@ -190,7 +202,7 @@ fn run_motions(exps: Vec<Experiment>, source: &str) -> Result<Vec<MotionRuns>> {
 }
 
 /// Write each motion's runs into `dir/<key>/`.
-fn write_runs(motions: &[MotionRuns], dir: &Path) -> Result<Vec<PathBuf>> {
+pub(crate) fn write_runs(motions: &[MotionRuns], dir: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for m in motions {
         let sub = dir.join(m.key);
@@ -224,7 +236,7 @@ fn write_plan_files(cfg: &PlanConfig, o: &PlanOutcome, rows: &[[f64; 7]]) -> Res
 
 /// `plan.csv`: the header and the rows, every number in its shortest exact form (the table read
 /// back is the same spline).
-fn plan_csv(rows: &[[f64; 7]]) -> String {
+pub(crate) fn plan_csv(rows: &[[f64; 7]]) -> String {
     let mut s = String::from("t,Gx,Gy,theta,s1,s2,s3\n");
     for r in rows {
         let cells: Vec<String> = r.iter().map(|v| format!("{v:e}")).collect();
@@ -237,7 +249,7 @@ fn plan_csv(rows: &[[f64; 7]]) -> String {
 /// `plan.toml`: the file's experiment with `[plan]` and `[limits]` replaced by the table
 /// trajectory of `plan.csv` (task columns). A relative `[load] file` is made absolute, as
 /// `plan.toml` lives in another folder.
-fn plan_toml(cfg: &PlanConfig) -> Result<String> {
+pub(crate) fn plan_toml(cfg: &PlanConfig) -> Result<String> {
     let mut table = cfg.table.clone();
     if let Some(toml::Value::Table(load)) = table.get_mut("load") {
         if let Some(toml::Value::String(f)) = load.get("file").cloned() {

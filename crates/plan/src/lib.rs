@@ -12,12 +12,15 @@
 //! - [`objective`]: one evaluation (an AMM run over the move and a residual window);
 //! - [`lm`]: the Levenberg-Marquardt search;
 //! - [`planner`]: the residual objective; [`time`]: the time objective;
+//! - [`cycle`], [`cycle_plan`]: whole cycles (4.12), planned move by move;
 //! - [`uncertainty`], [`robust`], [`minimax`]: `[robust]`, the plan that holds over an
 //!   uncertainty (4.11: the worst sample model's residual minimised on the epigraph).
 //!
 //! This crate plans; writing the files and checking the motions on the FEM is the command's
 //! (`flexstar_api::plan`).
 
+pub mod cycle;
+pub mod cycle_plan;
 pub mod family;
 pub mod limits;
 pub mod lm;
@@ -30,6 +33,8 @@ pub mod section;
 pub mod time;
 pub mod uncertainty;
 
+pub use cycle::{Cycle, CycleMove};
+pub use cycle_plan::{plan_cycle, PlannedCycle, PlannedMove};
 pub use planner::{plan, Planned};
 pub use section::{read_plan_config, Limits, Objective, PlanConfig, PlanSection, Shape};
 

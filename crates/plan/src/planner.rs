@@ -197,7 +197,7 @@ pub fn plan(cfg: &PlanConfig) -> Result<Planned, PlanError> {
 
 /// The checks of 4.8 that need the robot but no solver: a motion drive, reachable poses,
 /// `t_move` within the limits, the plain quintic's slider peaks within the limits.
-fn check_plan_input(cfg: &PlanConfig) -> Result<(), PlanError> {
+pub(crate) fn check_plan_input(cfg: &PlanConfig) -> Result<(), PlanError> {
     let file = &cfg.exp.source;
     let bad = |e: ModelError| PlanError::from(e.in_file(file));
     if cfg.exp.drive.kind != DriveKind::Motion {

@@ -286,6 +286,9 @@ pub struct PlanConfig {
     pub table: toml::Table,
     /// `[robust]`: the uncertainty a robust plan holds over (`docs/motions.md` 4.11).
     pub robust: Option<crate::uncertainty::Uncertainty>,
+    /// `[plan] points` or a `via` cycle (`docs/motions.md` 4.12): the moves and dwells; then
+    /// `plan` holds the first move and `exp` runs the plain quintic cycle.
+    pub cycle: Option<crate::cycle::Cycle>,
 }
 
 /// Read and check a plan file: TOML syntax, the two sections (unknown keys refused), no
@@ -305,6 +308,7 @@ pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanE
         file: path.to_path_buf(),
         message: e.to_string().trim_end().to_string(),
     })?;
+    let cycle = crate::cycle::take_cycle(&mut table, path)?;
     for (key, why) in [
         (
             "trajectory",
@@ -331,13 +335,21 @@ pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanE
     limits.validate().map_err(in_file)?;
     let t_move = plan.t_move.unwrap_or(1.0);
     let mut with_motion = table.clone();
-    with_motion.insert("trajectory".into(), quintic_table(&plan, t_move));
+    let motion = match &cycle {
+        Some(c) => c.plain_trajectory(),
+        None => quintic_table(&plan, t_move),
+    };
+    with_motion.insert("trajectory".into(), motion);
     let rebuilt = toml::to_string(&with_motion).map_err(|e| ModelError::Parse {
         file: path.to_path_buf(),
         message: e.to_string(),
     })?;
     // the stand-in quintic's keys are the plan's (`trajectory.to` is `plan.to`)
     let exp = Experiment::from_toml_str(&rebuilt, path).map_err(|e| match e {
+        ModelError::Invalid { file, key, reason } if cycle.is_some() && key == "trajectory.points" => {
+            let (key, reason) = crate::cycle::via_error_key(&reason);
+            ModelError::Invalid { file, key, reason }
+        }
         ModelError::Invalid { file, key, reason } if key.starts_with("trajectory") => ModelError::Invalid {
             file,
             key: key.replacen("trajectory", "plan", 1),
@@ -346,15 +358,25 @@ pub fn plan_config_from_str(text: &str, path: &Path) -> Result<PlanConfig, PlanE
         other => other,
     })?;
     let robust = match robust {
+        Some(_) if cycle.is_some() => {
+            return Err(in_file(ModelError::invalid(
+                "robust",
+                "a robust plan is not designed for cycles (docs/motions.md 4.12): remove [robust] or plan one move",
+            )))
+        }
         Some(r) => Some(read_robust(r, &plan, &with_motion, path)?),
         None => None,
     };
+    if let Some(c) = &cycle {
+        c.check_t_end(exp.time.t_end).map_err(in_file)?;
+    }
     Ok(PlanConfig {
         exp,
         plan,
         limits,
         table,
         robust,
+        cycle,
     })
 }
 

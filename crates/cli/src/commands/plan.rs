@@ -16,6 +16,9 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if flexstar_api::plan_cycle::is_cycle(&args.config)? {
+        return run_cycle(args);
+    }
     let outcome = flexstar_api::plan::plan_to_dir(&args.config, &args.out, |p| {
         eprintln!(
             "plan: move {:.4} s; AMM RMS of |dG| over {:.3} s after the move {:.3e} m (plain quintic {:.3e} m); \
@@ -83,6 +86,54 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     eprintln!(
         "plan: {} files in {} in {:.2} s (plan.md: the comparison)",
+        outcome.files.len(),
+        outcome.dir.display(),
+        outcome.wall_s
+    );
+    Ok(())
+}
+
+/// A whole cycle (`docs/motions.md` 4.12): one line per move planned, one per dwell measured.
+fn run_cycle(args: Args) -> anyhow::Result<()> {
+    let outcome = flexstar_api::plan_cycle::plan_cycle_to_dir(&args.config, &args.out, |c| {
+        for (k, m) in c.moves.iter().enumerate() {
+            let p = &m.planned;
+            eprintln!(
+                "plan: move {} at {:.4} s for {:.4} s; AMM RMS of |dG| after it {:.3e} m (plain quintic {:.3e} m); \
+                 {} evaluations in {:.2} s ({})",
+                k + 1,
+                m.span.t_start,
+                p.t_move,
+                p.eval.norm_g(),
+                p.plain.norm_g(),
+                p.evaluations,
+                p.wall_s,
+                p.reason
+            );
+            for w in &p.warnings {
+                eprintln!("warning: move {}: {w}", k + 1);
+            }
+        }
+    })?;
+    for n in &outcome.notes {
+        eprintln!("{n}");
+    }
+    let mm = |v: Option<f64>| v.map_or(f64::NAN, |v| v);
+    for d in &outcome.dwells {
+        eprintln!(
+            "plan: dwell {} [{:.3}, {:.3}] s residual peak of G: plain AMM {:.3e} FEM {:.3e} m, planned AMM {:.3e} FEM {:.3e} m (FEM ratio {:.4})",
+            d.dwell,
+            d.t_start,
+            d.t_end,
+            mm(d.plain_amm_m),
+            mm(d.plain_fem_m),
+            mm(d.planned_amm_m),
+            mm(d.planned_fem_m),
+            mm(d.ratio_fem)
+        );
+    }
+    eprintln!(
+        "plan: {} files in {} in {:.2} s (plan.md: the comparison per dwell)",
         outcome.files.len(),
         outcome.dir.display(),
         outcome.wall_s

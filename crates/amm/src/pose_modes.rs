@@ -31,7 +31,7 @@
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
-use flexstar_model::{AmmModel, ModeFamily, Payload, RestPose, Robot, RobotParams, Sliders};
+use flexstar_model::{AmmModel, ModeFamily, Payload, RestPose, Robot, RobotParams, Sleeves, Sliders};
 use flexstar_numerics::eigen::{constrained_modes, rigid_shift};
 
 use crate::error::AmmError;
@@ -66,6 +66,8 @@ pub struct PoseSystem {
     pub rows: usize,
     /// How the sliders are held.
     pub sliders: Sliders,
+    /// Which linear system of the sleeves (stuck: the springs of Eq. S1 in K).
+    pub sleeves: Sleeves,
     /// The mode set of the beams (beam 1's on a robot as built, [`PoseSystem::beam_modes`]).
     pub modes: ModeSet,
     /// Each beam's mode set on a robot as built (`docs/amm.md` 13, Eq. J1); empty when the three
@@ -159,6 +161,12 @@ impl PoseSystem {
         i * (self.nm + 2)
     }
 
+    /// The number of zero-frequency (rigid) modes reported first: three with free sliders and
+    /// sliding sleeves, else none (stuck sleeves hold the mechanism, `docs/modes.md` Eq. S3).
+    pub fn rigid_modes(&self) -> usize {
+        rigid_count(self.sliders, self.sleeves)
+    }
+
     /// Index of the slider coordinate ds_i (sliders free only).
     pub fn slider_index(&self, i: usize) -> Option<usize> {
         (self.sliders == Sliders::Free).then(|| 3 * (self.nm + 2) + i)
@@ -197,6 +205,17 @@ pub struct PoseModel {
     weld: Weld,
     payload: Payload,
     sys: System,
+    /// Which linear system of the sleeves ([`PoseModel::with_sleeves`]).
+    sleeves: Sleeves,
+}
+
+/// Zero-frequency modes reported first (see [`PoseSystem::rigid_modes`]).
+fn rigid_count(sliders: Sliders, sleeves: Sleeves) -> usize {
+    if sliders == Sliders::Free && sleeves == Sleeves::Sliding {
+        3
+    } else {
+        0
+    }
 }
 
 impl PoseModel {
@@ -238,6 +257,7 @@ impl PoseModel {
             weld,
             payload: Payload::default(),
             sys,
+            sleeves: Sleeves::Sliding,
         })
     }
 
@@ -263,6 +283,13 @@ impl PoseModel {
         let mut model = Self::new(params, family, nm)?;
         model.payload = *payload;
         Ok(model)
+    }
+
+    /// The model with the sleeves held as `sleeves` (`docs/modes.md`, stuck sleeves, Eq. S1);
+    /// [`Sleeves::Sliding`] is the model as built.
+    pub fn with_sleeves(mut self, sleeves: Sleeves) -> Self {
+        self.sleeves = sleeves;
+        self
     }
 
     /// The mode set of the beams (beam 1's on a robot as built).
@@ -322,6 +349,7 @@ impl PoseModel {
             c,
             rows,
             sliders,
+            sleeves: self.sleeves,
             modes,
             beam_modes,
             theta: pose.theta,
@@ -330,7 +358,31 @@ impl PoseModel {
         if !self.payload.is_none() {
             add_payload_mass(&mut system);
         }
+        if self.sleeves == Sleeves::Stuck {
+            self.add_stick_springs(&mut system, pose);
+        }
         system
+    }
+
+    /// Eq. S1 (`docs/modes.md`, stuck sleeves): the stick row of Eq. F16 at the pose,
+    /// `u_i - a_i ds_i + (xp_i / EA_i) F_ti = 0` with `a_i = u_i . e_xi` (free sliders; no `ds_i`
+    /// when locked), its massless multiplier eliminated: the spring `EA_i / xp_i` [N/m] on
+    /// `r_i . q = u_i - a_i ds_i` (the slide of the beam's material point under the sleeve),
+    /// `K += (EA_i / xp_i) r_i r_i^T`.
+    fn add_stick_springs(&self, sys: &mut PoseSystem, pose: &RestPose) {
+        let n = sys.n;
+        for i in 0..3 {
+            let k = self.beams[i].ea() / pose.xp[i];
+            let mut r = vec![(sys.beam_offset(i) + sys.nm, 1.0)];
+            if let Some(si) = sys.slider_index(i) {
+                r.push((si, -self.weld.axial_along_rail(i, pose.theta, 0.0)));
+            }
+            for &(a, ra) in &r {
+                for &(b, rb) in &r {
+                    sys.k[a * n + b] += k * ra * rb;
+                }
+            }
+        }
     }
 
     /// The first `count` natural frequencies [Hz] at `pose`, values only (the per-point work of a
@@ -346,8 +398,8 @@ impl PoseModel {
     /// the paper robot's f1 at N = 60). Checked against [`PoseModel::modes_at`] (test
     /// `frequencies_only_match_the_full_solver`).
     pub fn frequencies_at(&self, pose: &RestPose, sliders: Sliders, count: usize) -> Result<Vec<f64>, AmmError> {
-        if !self.payload.is_none() {
-            // M is not diagonal with a payload: the general solver
+        if !self.payload.is_none() || self.sleeves == Sleeves::Stuck {
+            // M is not diagonal with a payload, nor K with stuck sleeves: the general solver
             return Ok(self.modes_at(pose, sliders, count)?.freq_hz);
         }
         let sys = self.system_at(pose, sliders);
@@ -371,7 +423,7 @@ impl PoseModel {
     /// sends the pose to the general constrained solver, which the sliders-free case always uses.
     pub fn modes_at(&self, pose: &RestPose, sliders: Sliders, count: usize) -> Result<PoseModes, AmmError> {
         let sys = self.system_at(pose, sliders);
-        if sliders == Sliders::Locked && self.payload.is_none() {
+        if sliders == Sliders::Locked && self.payload.is_none() && self.sleeves == Sleeves::Sliding {
             let proj = Projected::new(&sys)?;
             let omega2: Vec<f64> = proj.w.iter().skip(proj.r).take(count).copied().collect();
             if let Some(shapes) = proj.shapes(&omega2) {
@@ -596,7 +648,7 @@ pub fn pose_modes(
 
 /// The constrained eigenproblem of an assembled system.
 fn solve_modes(system: PoseSystem, count: usize) -> Result<PoseModes, AmmError> {
-    let rigid = if system.sliders == Sliders::Free { 3 } else { 0 };
+    let rigid = system.rigid_modes();
     let out = constrained_modes(
         system.n,
         &system.m,

@@ -76,6 +76,16 @@ impl Weld {
         }
     }
 
+    /// `u_i . e_xi = sin(theta + phi_i - a_i + thp)`: rail i along the sleeve's axis (Eq. J7's
+    /// companion, `e_x = [sin b, -cos b]`, `u_i = [cos a_i, sin a_i]`); `sin(theta + thp)` on the
+    /// paper's robot. The slide of the sleeve along its beam per unit slider displacement.
+    pub(crate) fn axial_along_rail(&self, i: usize, theta: f64, thp: f64) -> f64 {
+        match self.rail_offset {
+            None => (theta + thp).sin(),
+            Some(off) => (theta + off[i] + thp).sin(),
+        }
+    }
+
     /// `g . u_i` [m/s^2]: gravity `g` along each rail (Eq. G2).
     pub(crate) fn along_rails(&self, g: [f64; 2]) -> [f64; 3] {
         self.rails.map(|u| g[0] * u[0] + g[1] * u[1])

@@ -12,7 +12,7 @@ use flexstar_modal::linear::{Holding, LinearSettings, StateSpace};
 use flexstar_modal::plots::{mode_shapes_figure, trajectory_path, FreqMapFigure};
 use flexstar_modal::pose::{pose_at_time, pose_from_task};
 use flexstar_modal::ModalError;
-use flexstar_model::{DriveKind, Experiment, ModeFamily, RestPose, Sliders};
+use flexstar_model::{DriveKind, Experiment, ModeFamily, RestPose, Sleeves, Sliders};
 use flexstar_plot::write_svg_png;
 use serde_json::{json, Map, Value};
 
@@ -67,9 +67,9 @@ pub fn check_k(k: usize) -> Result<()> {
 }
 
 /// The rest pose of the experiment's robot, checked against its workspace (the error names the
-/// limit).
+/// limit). A `[friction]` section is taken as it is: its coefficients do not enter the linear
+/// systems, which `--sleeves` chooses (`docs/modes.md`, stuck sleeves).
 pub fn resolve_pose(exp: &Experiment, source: &str, spec: &PoseSpec) -> Result<RestPose> {
-    ApiError::frictionless(exp, source, "modes at a pose (modal, linearize)")?;
     match spec {
         PoseSpec::At(t) => pose_at_time(exp, *t).map_err(|e| from_modal(Some(source), *t, e)),
         PoseSpec::Task {
@@ -124,18 +124,33 @@ fn fem_json(exp: &Experiment) -> Value {
     json!({ "solver": "fem", "elements": exp.fem.elements })
 }
 
-/// The settings of `modal`, as its sidecar records and a rerun compares them.
-fn modal_settings(
-    exp: &Experiment,
-    spec: &PoseSpec,
-    pose: &RestPose,
-    sliders: Sliders,
-    k: usize,
-) -> Map<String, Value> {
+/// How a modal analysis holds the robot: its sliders and its sleeves (`--sliders`, `--sleeves`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ModalHold {
+    pub sliders: Sliders,
+    pub sleeves: Sleeves,
+}
+
+impl From<Sliders> for ModalHold {
+    /// The sliders held as `sliders`, the sleeves sliding (the frictionless systems).
+    fn from(sliders: Sliders) -> Self {
+        ModalHold {
+            sliders,
+            sleeves: Sleeves::Sliding,
+        }
+    }
+}
+
+/// The settings of `modal`, as its sidecar records and a rerun compares them (`sleeves` only
+/// when stuck: a sliding analysis's sidecar is as before).
+fn modal_settings(exp: &Experiment, spec: &PoseSpec, pose: &RestPose, hold: ModalHold, k: usize) -> Map<String, Value> {
     let mut m = Map::new();
     m.insert("solvers".into(), json!([amm_json(exp), fem_json(exp)]));
     m.insert("pose".into(), pose_json(spec, pose));
-    m.insert("sliders".into(), sliders.name().into());
+    m.insert("sliders".into(), hold.sliders.name().into());
+    if hold.sleeves == Sleeves::Stuck {
+        m.insert("sleeves".into(), hold.sleeves.name().into());
+    }
     m.insert("K".into(), k.into());
     m
 }
@@ -153,20 +168,34 @@ pub fn modal(
     out: Option<&Path>,
     force: bool,
 ) -> Result<ModalOutcome> {
+    modal_held(exp, source, spec, sliders.into(), k, out, force)
+}
+
+/// [`modal`] with the robot held as `hold`: the sleeves sliding (the frictionless systems,
+/// [`modal`]) or stuck (`docs/modes.md`, stuck sleeves; the sidecar then records `sleeves`).
+pub fn modal_held(
+    exp: &Experiment,
+    source: &str,
+    spec: &PoseSpec,
+    hold: ModalHold,
+    k: usize,
+    out: Option<&Path>,
+    force: bool,
+) -> Result<ModalOutcome> {
     check_k(k)?;
     let pose = resolve_pose(exp, source, spec)?;
     let sidecar = TableSidecar {
         command: "modal",
         csv: "modal.csv",
-        settings: modal_settings(exp, spec, &pose, sliders, k),
+        settings: modal_settings(exp, spec, &pose, hold, k),
         experiment: exp,
     };
     let dir = out.map(|o| crate::case_dir(o, exp)).transpose()?;
     if let Some(dir) = &dir {
         sidecar.check_rerun(dir, force)?;
     }
-    let m =
-        flexstar_modal::analysis::modal(exp, &pose, sliders, k).map_err(|e| from_modal(Some(source), f64::NAN, e))?;
+    let m = flexstar_modal::analysis::modal_held(exp, &pose, hold.sliders, hold.sleeves, k)
+        .map_err(|e| from_modal(Some(source), f64::NAN, e))?;
     let mut files = Vec::new();
     if let Some(dir) = dir {
         let mut set = RunSet::begin(&dir)?;
@@ -359,6 +388,8 @@ pub struct LinearizeOptions {
     pub sliders: Option<Sliders>,
     /// Servo loop (`--loop`).
     pub loop_kind: Option<LoopKind>,
+    /// The sleeves' linear system (`--sleeves`; default sliding).
+    pub sleeves: Option<Sleeves>,
 }
 
 /// The model's settings from `opts` and the experiment (defaults: [`LinearizeOptions`]); a closed
@@ -382,7 +413,11 @@ pub fn linear_settings(exp: &Experiment, source: &str, opts: &LinearizeOptions) 
         (false, Sliders::Free) => Holding::Free,
         (false, Sliders::Locked) => Holding::Locked,
     };
-    Ok(LinearSettings { modes, holding })
+    Ok(LinearSettings {
+        modes,
+        holding,
+        sleeves: opts.sleeves.unwrap_or_default(),
+    })
 }
 
 /// The linear state-space model about a pose with the settings of `opts` ([`linear_settings`];

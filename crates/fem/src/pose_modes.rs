@@ -18,7 +18,7 @@
 use std::borrow::Cow;
 
 use flexstar_model::geometry::e_x;
-use flexstar_model::{Payload, RestPose, Robot, RobotGeometry, RobotParams, Sliders};
+use flexstar_model::{Payload, RestPose, Robot, RobotGeometry, RobotParams, Sleeves, Sliders};
 use flexstar_numerics::eigen::{constrained_modes, rigid_shift, ConstrainedModes};
 
 use crate::element::ElementState;
@@ -247,7 +247,7 @@ pub struct SparsePoseSystem {
     pub k: Triplets,
     /// Constraint Jacobian Phi_q triplets (rows x n).
     pub c: Triplets,
-    /// Number of constraint rows (21).
+    /// Number of constraint rows (21; 24 with stuck sleeves, Eq. S2).
     pub rows: usize,
     /// How the sliders are held.
     pub sliders: Sliders,
@@ -267,6 +267,18 @@ pub struct SparsePoseSystem {
 
 impl SparsePoseSystem {
     coordinate_helpers!();
+
+    /// Eq. S2 (`docs/modes.md`, stuck sleeves; `docs/friction.md` Eq. F9 at the pose): one row
+    /// `d xi_ic = 0` per sleeve after the 21 sleeve rows, the centre's contact coordinate
+    /// (`crate::star` layout: after the nodes and the three sleeve rotations, three per sleeve)
+    /// held, so the beam's material point under the sleeve cannot slide.
+    fn stick_sleeves(&mut self) {
+        let n_nodes = 1 + 3 * self.ne;
+        for i in 0..3 {
+            self.c.push((self.rows + i, 3 * n_nodes + 3 + 3 * i, 1.0));
+        }
+        self.rows += 3;
+    }
 
     /// The star's coordinates (nodes, sleeve rotations, contact coordinates): all but the sliders.
     fn star_coordinates(&self) -> usize {
@@ -363,6 +375,35 @@ pub fn pose_system_with(
     elements: usize,
 ) -> Result<PoseSystem, FemError> {
     Ok(pose_triplets_with(robot, payload, pose, sliders, elements)?.to_dense())
+}
+
+/// [`pose_triplets_with`] with the sleeves held as `sleeves` (stuck: the rows of Eq. S2 added,
+/// `docs/modes.md`).
+pub fn pose_triplets_held(
+    robot: &(impl PoseRobot + ?Sized),
+    payload: &Payload,
+    pose: &RestPose,
+    sliders: Sliders,
+    sleeves: Sleeves,
+    elements: usize,
+) -> Result<SparsePoseSystem, FemError> {
+    let mut sparse = pose_triplets_with(robot, payload, pose, sliders, elements)?;
+    if sleeves == Sleeves::Stuck {
+        sparse.stick_sleeves();
+    }
+    Ok(sparse)
+}
+
+/// [`pose_system_with`] with the sleeves held as `sleeves` (dense, [`pose_triplets_held`]).
+pub fn pose_system_held(
+    robot: &(impl PoseRobot + ?Sized),
+    payload: &Payload,
+    pose: &RestPose,
+    sliders: Sliders,
+    sleeves: Sleeves,
+    elements: usize,
+) -> Result<PoseSystem, FemError> {
+    Ok(pose_triplets_held(robot, payload, pose, sliders, sleeves, elements)?.to_dense())
 }
 
 /// Assemble M, K and Phi_q at `pose` with `elements` elements in the whole star, as triplets.
@@ -554,8 +595,27 @@ pub fn pose_modes_with(
     elements: usize,
     count: usize,
 ) -> Result<PoseModes, FemError> {
-    let sparse = pose_triplets_with(robot, payload, pose, sliders, elements)?;
-    let rigid = if sliders == Sliders::Free { 3 } else { 0 };
+    pose_modes_held(robot, payload, pose, sliders, Sleeves::Sliding, elements, count)
+}
+
+/// [`pose_modes_with`] with the sleeves held as `sleeves` (stuck: Eq. S2, `docs/modes.md`; no
+/// rigid modes are then reported first, Eq. S3: the modes near 0 Hz a pose may keep are listed
+/// as the others).
+pub fn pose_modes_held(
+    robot: &(impl PoseRobot + ?Sized),
+    payload: &Payload,
+    pose: &RestPose,
+    sliders: Sliders,
+    sleeves: Sleeves,
+    elements: usize,
+    count: usize,
+) -> Result<PoseModes, FemError> {
+    let sparse = pose_triplets_held(robot, payload, pose, sliders, sleeves, elements)?;
+    let rigid = if sliders == Sliders::Free && sleeves == Sleeves::Sliding {
+        3
+    } else {
+        0
+    };
     let out = sparse_constrained_modes(
         sparse.n,
         &sparse.m,

@@ -3,7 +3,7 @@
 use flexstar_amm::pose_modes::DEFAULT_MODAL_MODES;
 use flexstar_io::output::{fmt_number, Dest};
 use flexstar_model::ModeFamily;
-use flexstar_model::{Experiment, RestPose, Sliders};
+use flexstar_model::{Experiment, RestPose, Sleeves, Sliders};
 
 use crate::ModalError;
 
@@ -50,11 +50,23 @@ pub fn fem_pose_modes(
     sliders: Sliders,
     k: usize,
 ) -> Result<flexstar_fem::pose_modes::PoseModes, ModalError> {
-    Ok(flexstar_fem::pose_modes::pose_modes_with(
+    fem_pose_modes_held(exp, pose, sliders, Sleeves::Sliding, k)
+}
+
+/// [`fem_pose_modes`] with the sleeves held as `sleeves` (`docs/modes.md`, stuck sleeves, Eq. S2).
+pub fn fem_pose_modes_held(
+    exp: &Experiment,
+    pose: &RestPose,
+    sliders: Sliders,
+    sleeves: Sleeves,
+    k: usize,
+) -> Result<flexstar_fem::pose_modes::PoseModes, ModalError> {
+    Ok(flexstar_fem::pose_modes::pose_modes_held(
         &crate::robot(exp)?,
         &exp.payload,
         pose,
         sliders,
+        sleeves,
         exp.fem.elements,
         k,
     )?)
@@ -94,10 +106,24 @@ impl Modal {
 /// FEM (`[fem] elements`): the first `k` elastic modes, after the three rigid ones when the
 /// sliders are free.
 pub fn modal(exp: &Experiment, pose: &RestPose, sliders: Sliders, k: usize) -> Result<Modal, ModalError> {
+    modal_held(exp, pose, sliders, Sleeves::Sliding, k)
+}
+
+/// [`modal`] with the sleeves held as `sleeves`: sliding (the frictionless systems, [`modal`]) or
+/// stuck (each sleeve holds its beam's material point: Eq. S1 in the AMM, S2 in the FEM,
+/// `docs/modes.md`; no rigid modes are then reported first). Friction's coefficients do not
+/// enter either system: they only say which one holds (`docs/modes.md`, stuck sleeves).
+pub fn modal_held(
+    exp: &Experiment,
+    pose: &RestPose,
+    sliders: Sliders,
+    sleeves: Sleeves,
+    k: usize,
+) -> Result<Modal, ModalError> {
     crate::check_k(k)?;
     crate::check_damping(exp)?;
-    let amm = amm_pose_model(exp)?.modes_at(pose, sliders, k)?;
-    let fem = fem_pose_modes(exp, pose, sliders, k)?;
+    let amm = amm_pose_model(exp)?.with_sleeves(sleeves).modes_at(pose, sliders, k)?;
+    let fem = fem_pose_modes_held(exp, pose, sliders, sleeves, k)?;
     if amm.freq_hz.len() < amm.rigid + k {
         return Err(ModalError::Input(format!(
             "--modes {k}: the AMM with N = {} modes per beam has only {} modes",

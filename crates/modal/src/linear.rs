@@ -42,7 +42,7 @@ use std::path::Path;
 use flexstar_amm::pose_modes::{PoseModel, PoseModes, PoseSystem};
 use flexstar_io::output::write_atomically;
 use flexstar_kinematics::RigidState;
-use flexstar_model::{DriveKind, Experiment, RestPose, Robot, RobotGeometry, Sliders};
+use flexstar_model::{DriveKind, Experiment, RestPose, Robot, RobotGeometry, Sleeves, Sliders};
 use num_dual::Dual2;
 use sprs::{CsMat, TriMat};
 
@@ -126,6 +126,9 @@ pub struct LinearSettings {
     pub modes: usize,
     /// How the sliders are held.
     pub holding: Holding,
+    /// Which linear system of the sleeves (`docs/modes.md`, stuck sleeves); stuck sleeves with
+    /// locked sliders are refused ([`linearize_with`]).
+    pub sleeves: Sleeves,
 }
 
 impl Default for LinearSettings {
@@ -134,6 +137,7 @@ impl Default for LinearSettings {
         LinearSettings {
             modes: ELASTIC_MODES,
             holding: Holding::Free,
+            sleeves: Sleeves::Sliding,
         }
     }
 }
@@ -299,6 +303,13 @@ fn amm_modes(
     settings: &LinearSettings,
 ) -> Result<PoseModes, ModalError> {
     crate::check_k(settings.modes)?;
+    if settings.sleeves == Sleeves::Stuck && settings.holding == Holding::Locked {
+        return Err(ModalError::Input(
+            "--sleeves stuck with --sliders locked: the base excitation of a star held by stuck sleeves \
+             (the prescribed slider motion strains it) is not built; give --sliders free"
+                .into(),
+        ));
+    }
     let modes = model.modes_at(pose, settings.holding.sliders(), settings.modes)?;
     if modes.shapes.len() < modes.rigid + settings.modes {
         return Err(ModalError::Input(format!(
@@ -370,7 +381,7 @@ pub fn linearize(exp: &Experiment, pose: &RestPose) -> Result<StateSpace, ModalE
 pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettings) -> Result<StateSpace, ModalError> {
     crate::check_damping(exp)?;
     let robot = crate::robot(exp)?;
-    let model = crate::analysis::amm_pose_model(exp)?;
+    let model = crate::analysis::amm_pose_model(exp)?.with_sleeves(settings.sleeves);
     let modes = amm_modes(exp, &model, pose, settings)?;
     let phi = &modes.shapes;
     let deflections: Vec<Vec<f64>> = deflection_rows(&robot, pose, &modes.system)?
@@ -620,7 +631,7 @@ fn statespace_json(exp: &Experiment, ss: &StateSpace, fem: &flexstar_fem::pose_m
         Holding::Servo { kp, kd } => serde_json::json!({"kp": kp, "kd": kd}),
         _ => serde_json::Value::Null,
     };
-    serde_json::json!({
+    let mut json = serde_json::json!({
         "description": format!("continuous-time state-space model x' = A x + B u, y = C x + D u of the small motion about the pose, {description} (flexstar, AMM modal coordinates: x = [eta; eta'], rigid modes first when the sliders are free)"),
         "sliders": h.sliders().name(),
         "loop": if matches!(h, Holding::Servo { .. }) { "closed" } else { "open" },
@@ -638,7 +649,12 @@ fn statespace_json(exp: &Experiment, ss: &StateSpace, fem: &flexstar_fem::pose_m
         "payload": exp.payload,
         "damping": damping_json(exp),
         "modal_damping_ratios": (!ss.damping_ratios.is_empty()).then_some(&ss.damping_ratios),
-    })
+    });
+    // only a stuck model says so: the sliding one's file is as before
+    if ss.settings.sleeves == Sleeves::Stuck {
+        json["sleeves"] = ss.settings.sleeves.name().into();
+    }
+    json
 }
 
 /// The damping of the model in `statespace.json`: `null` without a `[damping]` section, else the
@@ -663,7 +679,14 @@ fn damping_json(exp: &Experiment) -> serde_json::Value {
 pub fn write_linear(dir: &Path, exp: &Experiment, ss: &StateSpace) -> Result<(), ModalError> {
     let sliders = ss.settings.holding.sliders();
     let robot = crate::robot(exp)?;
-    let fem = flexstar_fem::pose_modes::pose_system_with(&robot, &exp.payload, &ss.pose, sliders, exp.fem.elements)?;
+    let fem = flexstar_fem::pose_modes::pose_system_held(
+        &robot,
+        &exp.payload,
+        &ss.pose,
+        sliders,
+        ss.settings.sleeves,
+        exp.fem.elements,
+    )?;
     let (fm, fk, fc) = (
         dense(fem.n, fem.n, &fem.m),
         dense(fem.n, fem.n, &fem.k),

@@ -153,7 +153,16 @@ fn to_faer(m: &sprs::CsMat<f64>) -> faer::Mat<f64> {
 fn linear(exp: &Experiment, holding: Holding) -> StateSpace {
     let [gx, gy, th] = POSES[0];
     let pose = pose_from_task(&robot(exp), gx, gy, th).unwrap();
-    linearize_with(exp, &pose, &LinearSettings { modes: 8, holding }).unwrap()
+    linearize_with(
+        exp,
+        &pose,
+        &LinearSettings {
+            modes: 8,
+            holding,
+            ..Default::default()
+        },
+    )
+    .unwrap()
 }
 
 /// `linearize` of the robot as built, free and locked sliders, K = 8: the eigenvalues of A
@@ -253,6 +262,7 @@ fn elastic_static_gain_of_the_robot_as_built_matches_the_fem() {
     let settings = LinearSettings {
         modes: flexstar_modal::linear::ELASTIC_MODES,
         holding: Holding::Free,
+        ..Default::default()
     };
     let [gx, gy, th] = POSES[0];
     let pose = pose_from_task(&robot(&exp), gx, gy, th).unwrap();

@@ -111,6 +111,7 @@ fn damped_poles_leave_the_imaginary_axis_by_zeta_omega() {
     let settings = LinearSettings {
         modes: 8,
         holding: Holding::Free,
+        ..Default::default()
     };
     let ss = linearize_with(&exp, &pose, &settings).unwrap();
     let d = ss.a.to_dense();
@@ -159,7 +160,16 @@ fn rayleigh_poles_follow_the_two_ratio_law() {
     let pose = pose_from_task(&flexstar_modal::robot(&exp).unwrap(), 0.03, -0.02, 0.1).unwrap();
     let two_pi = 2.0 * std::f64::consts::PI;
     let eigen = |holding| {
-        let ss = linearize_with(&exp, &pose, &LinearSettings { modes: 8, holding }).unwrap();
+        let ss = linearize_with(
+            &exp,
+            &pose,
+            &LinearSettings {
+                modes: 8,
+                holding,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         let d = ss.a.to_dense();
         let a = faer::Mat::from_fn(d.nrows(), d.ncols(), |r, c| d[[r, c]]);
         (a.eigenvalues().unwrap(), ss)
@@ -199,6 +209,7 @@ fn load_channel_static_gain_matches_the_fem_static_deflection() {
     let settings = LinearSettings {
         modes: 40,
         holding: Holding::Locked,
+        ..Default::default()
     };
     let ss = linearize_with(&exp, &pose, &settings).unwrap();
     let names: Vec<&str> = ss.inputs.iter().map(|s| s.name.as_str()).collect();

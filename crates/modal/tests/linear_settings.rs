@@ -30,7 +30,16 @@ fn to_faer(m: &sprs::CsMat<f64>) -> faer::Mat<f64> {
 }
 
 fn build(exp: &Experiment, modes: usize, holding: Holding) -> StateSpace {
-    linearize_with(exp, &pose(exp), &LinearSettings { modes, holding }).unwrap()
+    linearize_with(
+        exp,
+        &pose(exp),
+        &LinearSettings {
+            modes,
+            holding,
+            ..Default::default()
+        },
+    )
+    .unwrap()
 }
 
 /// `--modes K` and `--sliders`: 2 (rigid + K) states, and the eigenvalues of A are `+- i omega`

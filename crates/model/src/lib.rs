@@ -53,7 +53,7 @@ pub use params::RobotParams;
 pub use problem::{EqualBeams, Problem};
 pub use provenance::Provenance;
 pub use response::{BeamShape, Column, Response, RestOffset, RunInfo, StarShape};
-pub use rest_pose::{RestPose, Sliders};
+pub use rest_pose::{RestPose, Sleeves, Sliders};
 pub use robot::{ActuatorAxis, Beam, Robot};
 pub use robot_geometry::{FeasibilityKey, RobotGeometry};
 pub use sensors::{SensorSpec, SensorTable, Sensors};

@@ -19,6 +19,27 @@ impl Sliders {
     }
 }
 
+/// Which of the two linear systems of a robot whose sleeves can stick a modal analysis or a
+/// linear model takes (`docs/modes.md`, stuck sleeves; `docs/friction.md` 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Sleeves {
+    /// Each beam slides through its sleeve (the frictionless rows only; today's systems).
+    #[default]
+    Sliding,
+    /// Each sleeve holds the material point of its beam (Eq. S1 in the AMM, S2 in the FEM).
+    Stuck,
+}
+
+impl Sleeves {
+    /// The command-line name (`sliding`, `stuck`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Sleeves::Sliding => "sliding",
+            Sleeves::Stuck => "stuck",
+        }
+    }
+}
+
 /// The robot at rest at one pose: actuator coordinates and the rigid star they hold. Prepared by
 /// the caller (inverse and direct rigid kinematics); the solvers take it as data.
 #[derive(Debug, Clone, Copy, PartialEq)]

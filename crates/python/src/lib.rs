@@ -274,6 +274,7 @@ fn linearize<'py>(
         modes: Some(modes),
         sliders: Some(convert::sliders(sliders)?),
         loop_kind: convert::loop_kind(r#loop)?,
+        sleeves: None,
     };
     let doc = &exp.inner;
     let source = doc.source.display().to_string();

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use flexstar_api::modal::{FreqmapSettings, LinearizeOptions, LoopKind, PoseSpec};
 use flexstar_io::output::fmt_fixed;
-use flexstar_model::{Experiment, Sliders};
+use flexstar_model::{Experiment, Sleeves, Sliders};
 
 use crate::progress::Reporter;
 
@@ -55,6 +55,24 @@ impl From<SlidersArg> for Sliders {
     }
 }
 
+/// Which linear system of the sleeves (`--sleeves`, `docs/modes.md` stuck sleeves).
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum SleevesArg {
+    /// Each beam slides through its sleeve (the frictionless systems)
+    Sliding,
+    /// Each sleeve holds its beam's material point (a sticking robot's other linear system)
+    Stuck,
+}
+
+impl From<SleevesArg> for Sleeves {
+    fn from(s: SleevesArg) -> Sleeves {
+        match s {
+            SleevesArg::Sliding => Sleeves::Sliding,
+            SleevesArg::Stuck => Sleeves::Stuck,
+        }
+    }
+}
+
 /// Modes at a pose from the AMM and the FEM: DIR/<name>/modal.csv and the first six shapes
 #[derive(clap::Args)]
 pub struct ModalArgs {
@@ -68,7 +86,10 @@ pub struct ModalArgs {
     /// How the sliders are held
     #[arg(long, value_enum, default_value = "locked")]
     sliders: SlidersArg,
-    /// Replace a modal.csv that other settings (pose, sliders, K, solvers) wrote in DIR/<name>/
+    /// Sleeves sliding on their beams or stuck (holding each beam's material point)
+    #[arg(long, value_enum, default_value = "sliding")]
+    sleeves: SleevesArg,
+    /// Replace a modal.csv that other settings (pose, sliders, sleeves, K, solvers) wrote in DIR/<name>/
     #[arg(long)]
     force: bool,
     /// Output directory
@@ -132,6 +153,9 @@ pub struct LinearizeArgs {
     /// Servo loop open or closed [default: closed when [drive] kind = "servo" and the sliders are free, else open]
     #[arg(long = "loop", value_enum)]
     loop_kind: Option<LoopArg>,
+    /// Sleeves sliding on their beams or stuck (stuck needs --sliders free)
+    #[arg(long, value_enum, default_value = "sliding")]
+    sleeves: SleevesArg,
     /// Output directory
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -154,7 +178,11 @@ pub fn run_modal(args: ModalArgs) -> anyhow::Result<()> {
     flexstar_api::modal::check_k(args.k)?;
     let spec = args.pose.spec(&args.config)?;
     let start = Instant::now();
-    let o = flexstar_api::modal::modal(&exp, &source, &spec, sliders, args.k, Some(&args.out), args.force)?;
+    let hold = flexstar_api::modal::ModalHold {
+        sliders,
+        sleeves: args.sleeves.into(),
+    };
+    let o = flexstar_api::modal::modal_held(&exp, &source, &spec, hold, args.k, Some(&args.out), args.force)?;
     eprintln!(
         "{}: {} ({:.2} s)",
         exp.name,
@@ -220,6 +248,7 @@ pub fn run_linearize(args: LinearizeArgs) -> anyhow::Result<()> {
             LoopArg::Open => LoopKind::Open,
             LoopArg::Closed => LoopKind::Closed,
         }),
+        sleeves: Some(args.sleeves.into()),
     };
     let ss = flexstar_api::modal::linearize(&exp, &source, &spec, &opts, Some(&args.out))?;
     let h = ss.settings.holding;

@@ -118,3 +118,76 @@ fn compare_without_sensors_writes_no_sensor_output() {
     assert!(!names.iter().any(|n| n.contains("-sensor-")), "{names:?}");
     assert!(!case.join("fem-sensors.csv").exists());
 }
+
+/// Column `name` of a study's results table, as text.
+fn study_column(t: &flexstar_study::table::Table, name: &str) -> Vec<String> {
+    let k = t.column(name).unwrap_or_else(|| panic!("no column {name}"));
+    t.rows.iter().map(|r| r[k].clone()).collect()
+}
+
+/// A study that moves the sleeve over a strain gauge (a longer sleeve: its band of Eq. S10
+/// widens) or shortens the beam below it: those cases are refused with the reason, the others
+/// run. The gauge sits 25 mm past the farthest point of sleeve 1 over the motion, read from the
+/// FEM's `xp1` column of a run without sensors (its contact coordinate: the rigid `xp` within a
+/// deflection, micrometres here): outside the band of a 30 mm sleeve (half 15 mm), inside that of
+/// an 80 mm one (half 40 mm).
+#[test]
+fn a_study_refuses_the_cases_whose_sleeve_or_beam_no_longer_holds_a_sensor() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = write_case1(dir.path(), "base", "");
+    let base_text = std::fs::read_to_string(&base)
+        .unwrap()
+        .replace("t_end = 0.1", "t_end = 0.02");
+    std::fs::write(&base, &base_text).unwrap();
+    let o = flexstar(&["run", &base, "--solver", "fem", "--out", dir.path().to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let xp1 = column(&dir.path().join("base/fem.csv"), "xp1");
+    let far = xp1.iter().fold(f64::NEG_INFINITY, |m, v| m.max(*v));
+    let x = far + 0.025;
+    let gauge = format!("[[sensors]]\nname = \"eps\"\nkind = \"strain\"\nbeam = 1\nx = {x}\nc = 0.001\n");
+    std::fs::write(&base, format!("{base_text}\n{gauge}")).unwrap();
+    let short = x - 0.005;
+    let study = dir.path().join("study.toml");
+    std::fs::write(
+        &study,
+        format!(
+            "name = \"moved\"\nbase = \"base.toml\"\nsolvers = [\"amm\"]\n[[vary]]\nkey = \"robot.Lp\"\n\
+             values = [0.03, 0.08]\n[[vary]]\nkey = \"robot.L\"\nvalues = [0.5, {short}]\n"
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("studies");
+    let o = flexstar(&[
+        "sweep",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--no-plots",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = flexstar_study::table::Table::read(&out.join("moved/results.csv")).unwrap();
+    let (lp, l, status) = (
+        study_column(&t, "robot.Lp"),
+        study_column(&t, "robot.L"),
+        study_column(&t, "status"),
+    );
+    for k in 0..status.len() {
+        let (lp, l): (f64, f64) = (lp[k].parse().unwrap(), l[k].parse().unwrap());
+        eprintln!("Lp = {lp}, L = {l}: {}", status[k]);
+        match (lp < 0.05, l > 0.49) {
+            (true, true) => assert_eq!(status[k], "ok"),
+            (false, true) => assert!(
+                status[k].starts_with("invalid") && status[k].contains("sensors[1].x") && status[k].contains("sleeve"),
+                "{}",
+                status[k]
+            ),
+            (true, false) => assert!(
+                status[k].starts_with("invalid") && status[k].contains("beyond beam 1"),
+                "{}",
+                status[k]
+            ),
+            (false, false) => assert!(status[k].starts_with("invalid"), "{}", status[k]),
+        }
+    }
+    assert_eq!(status.len(), 4);
+}

@@ -341,3 +341,49 @@ axes = "fixed"
         }
     }
 }
+
+/// `Problem::with_robot` (a robot swapped in after the file was read): a beam shortened below a
+/// strain gauge is refused there (`docs/sensors.md` section 5), and a longer sleeve whose band
+/// (Eq. S10) now covers the gauge is refused by the solve before any step, with the reason; the
+/// same swap with the file's sleeve solves. Case 1 turns in place: the rigid `xp_1(t)` of the
+/// kinematics moves less than 1 mm over the 20 ms, and the gauge sits 25 mm past its farthest
+/// value: outside a 30 mm sleeve's band (half 15 mm), inside an 80 mm one's (half 40 mm).
+#[test]
+fn a_robot_swapped_in_that_no_longer_holds_a_sensor_is_refused() {
+    let base = include_str!("../configs/case1.toml").replace("t_end = 0.5", "t_end = 0.02");
+    let xp = |t: f64| {
+        let exp = experiment(&base, "");
+        RigidState::at(&exp.robot, &exp.trajectory, t).unwrap().xp[0].v
+    };
+    let path: Vec<f64> = (0..=20).map(|k| xp(k as f64 * 1e-3)).collect();
+    let (lo, hi) = path
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+    assert!(hi - lo < 1e-3, "xp_1 moves {} m", hi - lo);
+    let x = hi + 0.025;
+    let gauge = format!("[[sensors]]\nname = \"eps\"\nkind = \"strain\"\nbeam = 1\nx = {x}\nc = 0.001\n");
+    let problem = experiment(&base, &gauge).problem().unwrap();
+    let robot = |from: &str, to: &str| {
+        let text = base.replace(from, to);
+        assert_ne!(text, base, "{from}");
+        flexstar_model::Robot::from_params(&experiment(&text, "").robot).unwrap()
+    };
+    let short = problem
+        .with_robot(robot("L = 0.5 ", "L = 0.2 "))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        short.contains("sensors[1].x") && short.contains("beyond beam 1"),
+        "{short}"
+    );
+    let amm = AmmSettings::default();
+    let solve = |p: &flexstar_model::Problem| flexstar_solve::response(p, Settings::Amm(&amm), None, None);
+    let wide = problem.with_robot(robot("Lp = 0.03", "Lp = 0.08")).unwrap();
+    let refused = solve(&wide).unwrap_err().to_string();
+    assert!(
+        refused.contains("sensors[1].x") && refused.contains("sleeve"),
+        "{refused}"
+    );
+    let same = problem.with_robot(robot("Lp = 0.03", "Lp = 0.03 ")).unwrap();
+    assert!(solve(&same).unwrap().sensors.is_some());
+}

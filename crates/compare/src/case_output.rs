@@ -157,6 +157,7 @@ pub fn case_figures(
             .collect::<Result<_, _>>()?;
         figs.push(figure_sliders(&exp.name, &runs, t, &reference));
     }
+    figs.extend(crate::sensors::sensor_figures(exp, &runs));
     if let Some(t_rest) = flexstar_modal::settle::motion_end(exp) {
         let zooms = hold.map_or_else(Vec::new, |h| crate::residual::time_zooms(t_rest, h, exp.time.t_end));
         for f in figs.iter_mut().filter(|f| !f.name.ends_with("-star")) {
@@ -328,6 +329,10 @@ pub fn compare_markdown(
             if e.correct { "yes" } else { "no" }
         );
     }
+    let sensors = crate::sensors::sensors_markdown(&crate::sensors::sensor_evps(case));
+    if !sensors.is_empty() {
+        let _ = write!(s, "\n{sensors}");
+    }
     if let Some(res) = residuals {
         let _ = write!(s, "\n{}", residual_markdown(res));
     }
@@ -426,6 +431,10 @@ pub fn compare_json(
     let mut doc = doc;
     for (k, v) in flexstar_model::identity::fields(exp) {
         doc[k] = v;
+    }
+    let sensors = crate::sensors::sensor_evps(case);
+    if !sensors.is_empty() {
+        doc["sensors"] = serde_json::to_value(&sensors).expect("plain data serialises");
     }
     if let Some(res) = residuals {
         let list: Vec<_> = res

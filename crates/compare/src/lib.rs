@@ -22,6 +22,7 @@ pub mod report;
 pub mod residual;
 pub mod runs;
 pub mod sensitivity;
+pub mod sensors;
 pub mod servo;
 pub mod table;
 pub mod thresholds;

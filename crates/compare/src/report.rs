@@ -296,9 +296,19 @@ fn case_html(h: &mut String, c: &ReportCase) {
     runs_html(h, c);
     servo_html(h, c);
     evps_html(h, c);
+    sensors_html(h, c);
     residual_html(h, c);
     figures_html(h, c);
     h.push_str("</section>\n");
+}
+
+/// The sensors' EVP per channel (`docs/sensors.md` Eq. S14), as in `compare.md`; nothing
+/// without sensors.
+fn sensors_html(h: &mut String, c: &ReportCase) {
+    let md = crate::sensors::sensors_markdown(&crate::sensors::sensor_evps(c.case));
+    if !md.is_empty() {
+        h.push_str(&markdown_to_html(&md));
+    }
 }
 
 /// The section's heading, what was run, the behaviour of G, the closest run and the warnings.

@@ -32,7 +32,7 @@ pub use feasibility::{
 };
 pub use flexstar_model::geometry::inverse_kinematics;
 pub use inverse_dynamics::{rigid_inverse_dynamics, rigid_inverse_dynamics_with, RigidForces};
-pub use sleeve_bands::{check_sensor_mounts, sleeve_bands};
+pub use sleeve_bands::{check_problem_sensor_mounts, check_sensor_mounts, sleeve_bands};
 pub use star_masses::{rigid_inverse_dynamics_of, StarMasses};
 pub use state::RigidState;
 

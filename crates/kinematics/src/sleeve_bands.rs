@@ -1,7 +1,7 @@
 //! Where the sleeves pass over the beams during a motion: the band of Eq. S10 of
 //! `docs/sensors.md`, in which no sensor can be mounted.
 
-use flexstar_model::{Experiment, ModelError, RobotGeometry, Sensors, Trajectory};
+use flexstar_model::{Experiment, ModelError, Problem, RobotGeometry, Sensors, TimeSpan, Trajectory};
 
 use crate::{KinematicsError, RigidState};
 
@@ -34,11 +34,28 @@ pub fn sleeve_bands<K: RobotGeometry + ?Sized>(
 /// `[trajectory]`, at the preflight's step; `Sensors::check_mounts`). Nothing to do without a
 /// sensor on a beam.
 pub fn check_sensor_mounts(exp: &Experiment, sensors: &Sensors) -> Result<(), ModelError> {
+    check_mounts_on(&exp.robot, &exp.trajectory, &exp.time, sensors)
+}
+
+/// [`check_sensor_mounts`] on the robot of `problem` (which `Problem::with_robot` may have
+/// changed since the experiment was read): its sensors against the sleeve bands (Eq. S10) of
+/// its own robot and motion.
+pub fn check_problem_sensor_mounts(problem: &Problem) -> Result<(), ModelError> {
+    check_mounts_on(problem.robot(), problem.trajectory(), problem.time(), problem.sensors())
+}
+
+/// Eq. S10 for `sensors` on `robot` moved by `traj` over `time`, at the preflight's step.
+fn check_mounts_on<K: RobotGeometry + ?Sized>(
+    robot: &K,
+    traj: &Trajectory,
+    time: &TimeSpan,
+    sensors: &Sensors,
+) -> Result<(), ModelError> {
     if sensors.list().iter().all(|s| s.beam_point().is_none()) {
         return Ok(());
     }
-    let step = crate::preflight_step(exp.time.dt_out);
-    let bands = sleeve_bands(&exp.robot, &exp.trajectory, exp.time.t_end, step)
-        .map_err(|e| ModelError::invalid("trajectory", e.to_string()))?;
+    let step = crate::preflight_step(time.dt_out);
+    let bands =
+        sleeve_bands(robot, traj, time.t_end, step).map_err(|e| ModelError::invalid("trajectory", e.to_string()))?;
     sensors.check_mounts(&bands)
 }

@@ -87,12 +87,16 @@ impl Problem {
     }
 
     /// The same run on another robot. The checks that depend on the robot are run again: the
-    /// servo's slider masses on any robot, the trajectory's start on a robot in the paper's form.
+    /// servo's slider masses on any robot, the trajectory's start on a robot in the paper's form,
+    /// every sensor's point on its beam (`docs/sensors.md` section 5; where the sleeves pass,
+    /// Eq. S10, needs the kinematics: `flexstar_kinematics::check_problem_sensor_mounts`, which
+    /// `flexstar_solve` runs before any solve).
     pub fn with_robot(&self, robot: Robot) -> Result<Self, ModelError> {
         if let Ok(p) = robot.equal_beams() {
             self.trajectory.validate(p)?;
         }
         self.drive.validate(self.time.t_end, slider_masses(&robot))?;
+        self.sensors.check_on(&robot)?;
         Ok(Problem { robot, ..self.clone() })
     }
 

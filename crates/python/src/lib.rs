@@ -154,6 +154,20 @@ impl PyRun {
             .ok_or_else(|| PyKeyError::new_err(format!("no column `{name}`")))
     }
 
+    /// The sensors' readings (`docs/sensors.md`): `{"t": times, "<column>": channel, ...}` as new
+    /// float64 arrays on the sensors' own clock, in the order of `<stem>-sensors.csv`; an empty
+    /// dict for a run without `[[sensors]]`.
+    fn sensors<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        if let Some(table) = &self.inner.response.sensors {
+            d.set_item("t", PyArray1::from_slice(py, &table.t))?;
+            for c in &table.columns {
+                d.set_item(&c.name, PyArray1::from_slice(py, &c.values))?;
+            }
+        }
+        Ok(d)
+    }
+
     /// The sidecar document as JSON text.
     fn meta_json(&self) -> PyResult<String> {
         self.inner.sidecar_json().map(|v| v.to_string()).map_err(py_err)

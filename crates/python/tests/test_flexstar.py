@@ -282,3 +282,40 @@ def test_the_package_is_the_installed_wheel_and_needs_no_rust():
     assert site in ext.parents, f"{ext} is not under {site}"
     assert ".abi3." in ext.name, ext.name
     assert shutil.which("cargo") is None and shutil.which("rustc") is None
+
+
+@pytest.mark.parametrize("solver", ["amm", "fem"])
+def test_run_sensors_encoder_is_the_rigid_slider_position(root, tmp_path, solver):
+    """`run.sensors` (docs/sensors.md): an accelerometer at G gives `<name>_x`, `<name>_y`, an
+    encoder reads slider 2's s_2(t) of the prescribed polynomial (evaluated here with numpy, not
+    by the library), the arrays equal the `<stem>-sensors.csv` that `save` writes, and a run
+    without sensors gives an empty dict."""
+    exp = flexstar.Experiment.load(root / "configs/case3.toml")
+    d = exp.to_dict()
+    d["time"]["t_end"] = 0.05
+    d["fem"]["elements"] = 120
+    d["trajectory"]["s2"] = [0.01, 0.0, -0.4, 1.5]
+    d["sensors"] = [
+        {"name": "ga", "kind": "accelerometer", "at": "G", "axes": "fixed"},
+        {"name": "enc", "kind": "encoder", "slider": 2},
+    ]
+    with_sensors = flexstar.Experiment.from_dict(d, source=str(root / "configs/case3.toml"))
+    run = flexstar.run(with_sensors, solver=solver)
+    s = run.sensors
+    assert list(s) == ["t", "ga_x", "ga_y", "enc"]
+    t = s["t"]
+    np.testing.assert_allclose(t, run["t"], rtol=0, atol=1e-12)  # no rate_hz: the output times
+    s2 = np.polynomial.polynomial.polyval(t, d["trajectory"]["s2"])
+    np.testing.assert_allclose(s["enc"], s2, rtol=0, atol=1e-12)
+    assert all(a.dtype == np.float64 and a.shape == t.shape for a in s.values())
+    assert run.meta["column_units"]["ga_x"] == "m/s^2" and run.meta["column_units"]["enc"] == "m"
+    files = run.save(tmp_path)
+    csv = next(f for f in files if f.endswith("-sensors.csv"))
+    header = pathlib.Path(csv).read_text().splitlines()[0].split(",")
+    table = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert header == list(s)
+    for k, name in enumerate(header):
+        np.testing.assert_allclose(s[name], table[:, k], rtol=1e-12, atol=1e-300)
+    d.pop("sensors")
+    plain = flexstar.run(flexstar.Experiment.from_dict(d, source=str(root / "configs/case3.toml")), solver=solver)
+    assert plain.sensors == {}

@@ -96,7 +96,8 @@ pub enum SolveError {
     /// A servo's tracking errors could not be evaluated (its reference, at a time).
     #[error(transparent)]
     Tracking(flexstar_drive::DriveError),
-    /// The problem's robot is not one a part of the solve models yet (`Problem::equal_beams`).
+    /// The problem's robot is not one a part of the solve models yet (`Problem::equal_beams`),
+    /// or a sensor sits where a sleeve of that robot passes (`docs/sensors.md` Eq. S10).
     #[error(transparent)]
     Robot(#[from] ModelError),
 }
@@ -114,6 +115,9 @@ pub fn solve(
     proof: Option<&CheckedMotion>,
     progress: Option<Progress>,
 ) -> Result<Solved<Stats>, SolveError> {
+    // a sensor on the problem's own robot where a sleeve passes (docs/sensors.md Eq. S10): the
+    // robot may differ from the file's (`Problem::with_robot`, a study's case)
+    flexstar_kinematics::check_problem_sensor_mounts(problem)?;
     let law = flexstar_drive::law_for(problem)?;
     let mut solved = solve_under(problem, settings, law.as_deref(), proof, progress)?;
     if law.is_some() && problem.drive().kind == DriveKind::Servo {

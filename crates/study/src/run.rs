@@ -264,7 +264,12 @@ fn solve(exp: &Experiment, solver: Solver, fem_reference: FemReference) -> Solve
         FemReference::Defaults => exp.fem.clone(),
         FemReference::Refined => flexstar_solve::reference_fem(exp),
     };
-    let problem = match exp.problem() {
+    // the case's sensors on the case's robot: beyond a beam (`problem`), where a sleeve passes
+    // (Eq. S10 of docs/sensors.md): an invalid case with the reason, never read
+    let problem = match exp
+        .problem()
+        .and_then(|p| flexstar_kinematics::check_problem_sensor_mounts(&p).map(|()| p))
+    {
         Ok(p) => p,
         Err(e) => return (Err(Failure::Invalid(e.detail())), started.elapsed().as_secs_f64()),
     };

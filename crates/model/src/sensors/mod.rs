@@ -102,6 +102,17 @@ impl Sensors {
         self.list.iter().find_map(|s| s.daq.rate_hz)
     }
 
+    /// Section 5 on another robot (`Problem::with_robot`): every point on a beam still lies on
+    /// that beam of `robot`, `0 <= x <= L_i`; the error names the `k`-th sensor's `x`.
+    pub fn check_on(&self, robot: &Robot) -> Result<(), ModelError> {
+        for (k, s) in self.list.iter().enumerate() {
+            if let Some((beam, x)) = s.beam_point() {
+                spec::check_on_beam(beam, x, robot, &format!("sensors[{}].x", k + 1))?;
+            }
+        }
+        Ok(())
+    }
+
     /// Eq. S10: refuse a sensor mounted where its sleeve passes. `bands[i] = [lo, hi]` [m]: the
     /// material coordinates of beam i that sleeve i covers over the motion (the rigid `xp_i`
     /// range widened by `Lp_i / 2` each side). The error names the `k`-th sensor's `x`.

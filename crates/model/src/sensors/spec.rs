@@ -137,6 +137,19 @@ impl Sensor {
     }
 }
 
+/// `docs/sensors.md` section 5: the point `x` [m] from G of beam `beam` (0-based) lies on that
+/// beam of `robot`, `0 <= x <= L_i`; the error names `key` (`sensors[k].x`).
+pub(crate) fn check_on_beam(beam: usize, x: f64, robot: &Robot, key: &str) -> Result<(), ModelError> {
+    let l = robot.beams()[beam].length;
+    if !(x.is_finite() && (0.0..=l).contains(&x)) {
+        return Err(ModelError::invalid(
+            key,
+            format!("x = {x} m lies beyond beam {} (it spans 0..L = {l} m from G)", beam + 1),
+        ));
+    }
+    Ok(())
+}
+
 /// What the checks of a sensor need to know about the experiment.
 pub(crate) struct Context<'a> {
     pub robot: &'a Robot,
@@ -244,13 +257,7 @@ impl SensorSpec {
         let x = self
             .x
             .ok_or_else(|| ModelError::invalid(key("x"), "a point on a beam needs x [m] from G"))?;
-        let l = cx.robot.beams()[beam].length;
-        if !(x.is_finite() && (0.0..=l).contains(&x)) {
-            return Err(ModelError::invalid(
-                key("x"),
-                format!("x = {x} m lies beyond beam {} (it spans 0..L = {l} m from G)", beam + 1),
-            ));
-        }
+        check_on_beam(beam, x, cx.robot, &key("x"))?;
         Ok((beam, x))
     }
 

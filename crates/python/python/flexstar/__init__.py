@@ -102,6 +102,7 @@ class Run:
     """A solver's output: every column (``t`` included) as a numpy array.
 
     ``run["w1tip"]``, ``run.columns``, ``run.meta`` (the sidecar JSON as a dict),
+    ``run.sensors`` (the sensors' readings as a dict of arrays; ``{}`` without sensors),
     ``run.to_pandas()``, ``run.save(dir)`` (the CLI's files, in ``dir/<name>/``).
     """
 
@@ -110,6 +111,7 @@ class Run:
         self.columns: List[str] = list(inner.columns())
         self._cache: Dict[str, np.ndarray] = {}
         self._meta: Optional[Dict[str, Any]] = None
+        self._sensors: Optional[Dict[str, np.ndarray]] = None
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name not in self._cache:
@@ -128,6 +130,19 @@ class Run:
         if self._meta is None:
             self._meta = json.loads(self._inner.meta_json())
         return self._meta
+
+    @property
+    def sensors(self) -> Dict[str, np.ndarray]:
+        """The sensors' readings (``[[sensors]]``, docs/sensors.md), as ``<stem>-sensors.csv``.
+
+        A dict of float64 arrays: ``"t"`` (the sensors' own sample times [s], ``rate_hz``) then one
+        entry per channel in the file's order (``<name>_x``, ``<name>_y`` of an accelerometer
+        [m/s^2]; ``<name>`` of a strain gauge [m/m], an encoder [m], a force cell [N]; the units
+        are ``run.meta["column_units"]``). A run without sensors gives an empty dict ``{}``.
+        """
+        if self._sensors is None:
+            self._sensors = dict(self._inner.sensors())
+        return self._sensors
 
     @property
     def stem(self) -> str:

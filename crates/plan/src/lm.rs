@@ -308,27 +308,7 @@ fn damped_step(jtj: &Mat<f64>, jtr: &Mat<f64>, lambda: f64) -> Option<Vec<f64>> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::limits::Peak;
-
-    fn eval_of(r: Vec<f64>) -> Eval {
-        let p = Peak {
-            value: 0.0,
-            slider: 1,
-            t: 0.0,
-        };
-        Eval {
-            n_g: r.len(),
-            r,
-            window_peak_m: 0.0,
-            fa: p,
-            v: p,
-            a: p,
-            j: p,
-            usage: Vec::new(),
-            progress: Vec::new(),
-            jerk: Vec::new(),
-        }
-    }
+    use crate::objective::eval_of;
 
     /// Rosenbrock's function as least squares, `r = (10 (y - x^2), 1 - x)`: the textbook minimum
     /// at (1, 1) from the textbook start (-1.2, 1).

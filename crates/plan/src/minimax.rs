@@ -227,27 +227,7 @@ impl State {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::limits::Peak;
-
-    fn eval_of(r: Vec<f64>) -> Eval {
-        let p = Peak {
-            value: 0.0,
-            slider: 1,
-            t: 0.0,
-        };
-        Eval {
-            n_g: r.len(),
-            r,
-            window_peak_m: 0.0,
-            fa: p,
-            v: p,
-            a: p,
-            j: p,
-            usage: Vec::new(),
-            progress: Vec::new(),
-            jerk: Vec::new(),
-        }
-    }
+    use crate::objective::eval_of;
 
     /// Three "models" `r_k(x) = (x_0 - c_k, 0.5 (x_1 - d_k))`: the minimax point is the centre
     /// of the smallest circle (in the scaled metric) through the three targets, here known in

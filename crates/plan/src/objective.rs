@@ -366,3 +366,25 @@ pub fn force_peak(resp: &Response) -> Peak {
     }
     best
 }
+
+/// A test's evaluation with residuals `r` (all on G) and no peaks, usage or progress.
+#[cfg(test)]
+pub(crate) fn eval_of(r: Vec<f64>) -> Eval {
+    let p = crate::limits::Peak {
+        value: 0.0,
+        slider: 1,
+        t: 0.0,
+    };
+    Eval {
+        n_g: r.len(),
+        r,
+        window_peak_m: 0.0,
+        fa: p,
+        v: p,
+        a: p,
+        j: p,
+        usage: Vec::new(),
+        progress: Vec::new(),
+        jerk: Vec::new(),
+    }
+}

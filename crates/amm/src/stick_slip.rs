@@ -10,25 +10,8 @@ use flexstar_model::{Column, Contact, Friction, FrictionSample, FrictionTally, R
 use crate::error::AmmError;
 use crate::system::System;
 
-/// Rounds of switching allowed in one step (each retakes the step with the new contact states):
-/// a contact switches at most once in a step, so six contacts need at most 7 rounds.
-const MAX_ROUNDS: usize = 7;
-
-/// One contact: sleeve i or slider i on its rail (0-based).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Which {
-    Sleeve(usize),
-    Rail(usize),
-}
-
-impl Which {
-    fn name(&self) -> String {
-        match self {
-            Which::Sleeve(i) => format!("sleeve {}", i + 1),
-            Which::Rail(i) => format!("slider {} on its rail", i + 1),
-        }
-    }
-}
+pub(crate) use flexstar_model::friction_run::Which;
+use flexstar_model::friction_run::MAX_ROUNDS;
 
 /// The sliders on their rails in the direct problem (Eq. F17).
 #[derive(Debug, Clone, Copy)]

@@ -44,6 +44,28 @@ impl Contact {
 pub const V_REST: f64 = 1e-12;
 
 /// A stuck contact breaks loose when the force it needs exceeds its limit `F_lim` by more than
+/// Rounds of switching allowed in one step of either solver (each retakes the step with the new
+/// contact states): a contact switches at most once in a step, so six contacts need at most 7
+/// rounds; beyond, the event is unresolved (`docs/friction.md` 3).
+pub const MAX_ROUNDS: usize = 7;
+
+/// One contact that can stick: sleeve i or slider i on its rail (0-based).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Which {
+    Sleeve(usize),
+    Rail(usize),
+}
+
+impl Which {
+    /// The contact as messages name it: `sleeve 2`, `slider 3 on its rail` (1-based).
+    pub fn name(&self) -> String {
+        match self {
+            Which::Sleeve(i) => format!("sleeve {}", i + 1),
+            Which::Rail(i) => format!("slider {} on its rail", i + 1),
+        }
+    }
+}
+
 /// `FORCE_TOL (1 + F_lim / 1 N)` [N]: the resolution of the multipliers (at rest with no load
 /// both the limit and the force the stick needs are zero to that level).
 pub const FORCE_TOL: f64 = 1e-6;

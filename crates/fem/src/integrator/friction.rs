@@ -6,30 +6,8 @@
 use super::*;
 use crate::star::Contact;
 
-/// Rounds of switching allowed in one step (each retakes the step with the new contact states).
-/// A contact switches at most once in a step ([`changes`]), so six contacts need at most 7
-/// rounds; beyond, or when the contacts return to states they had in the same step, the event is
-/// unresolved ([`FemError::StickSlip`]).
-const MAX_ROUNDS: usize = 7;
-
-use flexstar_model::friction_run::exceeds;
+use flexstar_model::friction_run::{exceeds, Which, MAX_ROUNDS};
 use flexstar_model::FrictionTally;
-
-/// One contact: sleeve i (`Sleeve(i)`) or slider i on its rail (`Rail(i)`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Which {
-    Sleeve(usize),
-    Rail(usize),
-}
-
-impl Which {
-    fn name(&self) -> String {
-        match self {
-            Which::Sleeve(i) => format!("sleeve {}", i + 1),
-            Which::Rail(i) => format!("slider {} on its rail", i + 1),
-        }
-    }
-}
 
 /// Hold every stuck coordinate of `star` at its value, at rest (Eq. F9): `q = q*`, `v = q_dd = 0`.
 #[inline]

@@ -63,8 +63,8 @@ pub fn sensors_markdown(evps: &[ChannelEvp]) -> String {
     }
     let mut s = String::from("## Sensors: EVP (Eq. 45) per channel, % of the FEM's channel\n\n");
     s.push_str(
-        "`EVP = int |y_AMM - y_FEM| dt / int |y_FEM| dt * 100` on the sensors' sample times \
-         (docs/sensors.md Eq. S14); *n/a*: the FEM's channel is zero throughout.\n\n",
+        "`EVP = int |y_AMM - y_FEM| dt / int |y_FEM| dt x 100` on the sensors' sample times \
+         (docs/sensors.md Eq. S14); n/a: the FEM's channel is zero throughout.\n\n",
     );
     s.push_str("| run | channel | unit | EVP [%] |\n|---|---|---|---|\n");
     for e in evps {

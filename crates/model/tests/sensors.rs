@@ -107,6 +107,11 @@ fn bad_sensors_are_refused_naming_the_key() {
     );
     refused(&format!("{acc}at = \"G\"\nnoise = -1.0\n"), "sensors[1].noise", ">= 0");
     refused(
+        &format!("{acc}at = \"G\"\nnoise = [0.1, -1.0]\n"),
+        "sensors[1].noise",
+        ">= 0",
+    );
+    refused(
         &format!("{acc}at = \"G\"\nlowpass_hz = 600.0\n"),
         "sensors[1].lowpass_hz",
         "Nyquist",
@@ -203,6 +208,43 @@ seed = 11
     assert!((mean - 1.0).abs() < 4.0 * 0.3 / (n as f64).sqrt(), "mean {mean}");
     assert_eq!(p.sensors().acquire(&raw, 20.0), got, "the same seed, the same noise");
     assert_eq!(got.units, ["m"]);
+}
+
+/// `noise = [nx, ny]`: each accelerometer axis gets its own standard deviation (Eq. S13).
+#[test]
+fn an_accelerometer_takes_one_noise_level_per_axis() {
+    let text = r#"
+[time]
+t_end = 20.0
+dt_out = 0.001
+[[sensors]]
+name = "acc"
+kind = "accelerometer"
+at = "G"
+noise = [0.1, 0.4]
+seed = 3
+"#;
+    let text = BASE.replace("[time]\nt_end = 0.2\ndt_out = 0.001\n", "") + text;
+    let exp = Experiment::from_toml_str(&text, Path::new("n.toml")).unwrap();
+    let p = exp.problem().unwrap();
+    let n = 20_001;
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+    let mut raw = SensorTable::new(t);
+    raw.push_column("acc_x".into(), "m/s^2", vec![0.0; n]);
+    raw.push_column("acc_y".into(), "m/s^2", vec![0.0; n]);
+    let got = p.sensors().acquire(&raw, 20.0);
+    for (column, want) in [("acc_x", 0.1), ("acc_y", 0.4)] {
+        let y = got.column(column).unwrap();
+        let sd = (y.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
+        assert!((sd / want - 1.0).abs() < 0.03, "{column}: sample sd {sd}, asked {want}");
+    }
+    let enc = "[[sensors]]\nname = \"e\"\nkind = \"encoder\"\nslider = 1\nnoise = [0.1, 0.2]\n";
+    let bad = BASE.to_string() + enc;
+    let e = Experiment::from_toml_str(&bad, Path::new("n.toml"))
+        .and_then(|x| x.problem().map(|_| ()))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("sensors[1].noise") && e.contains("one column"), "{e}");
 }
 
 #[test]

@@ -149,7 +149,7 @@ impl Sensors {
         let mut out = SensorTable::new(t.clone());
         let mut channel = 0u64;
         for s in self.list() {
-            for name in s.columns() {
+            for (axis, name) in s.columns().into_iter().enumerate() {
                 let x = raw.column(&name).unwrap_or_default();
                 let filtered = match s.daq.lowpass_hz {
                     Some(fc) => lowpass(&raw.t, x, fc),
@@ -159,9 +159,10 @@ impl Sensors {
                     Some(_) => interpolate(&raw.t, &filtered, &t),
                     None => filtered,
                 };
-                if s.daq.noise > 0.0 {
+                let sigma = s.daq.noise[axis];
+                if sigma > 0.0 {
                     let mut n = Normal::new(s.daq.seed, channel);
-                    y.iter_mut().for_each(|v| *v += s.daq.noise * n.draw());
+                    y.iter_mut().for_each(|v| *v += sigma * n.draw());
                 }
                 out.push_column(name, s.unit(), y);
                 channel += 1;

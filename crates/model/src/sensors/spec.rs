@@ -39,9 +39,10 @@ pub struct SensorSpec {
     /// Sampling rate [Hz]; default: the output times.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rate_hz: Option<f64>,
-    /// Standard deviation of the added white noise, in the sensor's unit; default 0.
+    /// Standard deviation of the added white noise, in the sensor's unit; default 0. One value
+    /// for every column, or `[nx, ny]` for an accelerometer's two axes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub noise: Option<f64>,
+    pub noise: Option<Noise>,
     /// Seed of the noise; default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
@@ -84,13 +85,22 @@ pub enum Kind {
     Force { slider: usize },
 }
 
-/// The data acquisition of one channel (`docs/sensors.md` section 6).
+/// `noise` as written: one standard deviation, or one per accelerometer axis `[nx, ny]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Noise {
+    One(f64),
+    PerAxis([f64; 2]),
+}
+
+/// The data acquisition of one sensor (`docs/sensors.md` section 6).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Acquisition {
     /// Sampling rate [Hz]; `None`: the output times.
     pub rate_hz: Option<f64>,
-    /// Standard deviation of the white noise, in the sensor's unit (Eq. S13).
-    pub noise: f64,
+    /// Standard deviation of the white noise of each column, in the sensor's unit (Eq. S13):
+    /// `[x, y]` for an accelerometer, the first entry alone for the others.
+    pub noise: [f64; 2],
     /// Seed of the noise.
     pub seed: u64,
     /// -3 dB frequency of the 4th-order Butterworth anti-aliasing filter [Hz] (Eq. S11).
@@ -305,11 +315,25 @@ impl SensorSpec {
                 ));
             }
         }
-        let noise = self.noise.unwrap_or(0.0);
-        if !(noise.is_finite() && noise >= 0.0) {
+        let noise = match self.noise {
+            None => [0.0; 2],
+            Some(Noise::One(n)) => [n; 2],
+            Some(Noise::PerAxis(pair)) if self.kind == "accelerometer" => pair,
+            Some(Noise::PerAxis(_)) => {
+                return Err(ModelError::invalid(
+                    key("noise"),
+                    format!(
+                        "a {} has one column: give one standard deviation (a pair [nx, ny] is for an \
+                         accelerometer's two axes)",
+                        self.kind
+                    ),
+                ))
+            }
+        };
+        if let Some(n) = noise.iter().find(|n| !(n.is_finite() && **n >= 0.0)) {
             return Err(ModelError::invalid(
                 key("noise"),
-                format!("the standard deviation must be >= 0, got {noise}"),
+                format!("the standard deviation must be >= 0, got {n}"),
             ));
         }
         if let Some(f) = self.lowpass_hz {

@@ -440,6 +440,11 @@ pub struct Experiment {
     /// then absent from the resolved experiment).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sensors: Vec<crate::sensors::SensorSpec>,
+    /// The parameters `flexstar fit` calibrates on a recording (`[fit]`, `docs/measured.md`
+    /// section 4); none by default (and then absent from the resolved experiment). Other commands
+    /// read past it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fit: Option<crate::fit_section::FitSection>,
     /// Where the experiment was read from (not a TOML key).
     #[serde(skip)]
     pub source: PathBuf,
@@ -530,6 +535,10 @@ impl Experiment {
                     format!("need 0 <= rho_inf <= 1, got {r}"),
                 ));
             }
+        }
+        if let Some(fit) = &self.fit {
+            let names: Vec<&str> = self.sensors.iter().map(|s| s.name.as_str()).collect();
+            fit.validate(&names)?;
         }
         crate::animation::check_frames("amm.frames", self.amm.frames, self.time.t_end)?;
         crate::animation::check_frames("fem.frames", self.fem.frames, self.time.t_end)?;

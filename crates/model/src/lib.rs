@@ -16,6 +16,7 @@ pub mod config;
 pub mod damping;
 pub mod drive_section;
 pub mod error;
+pub mod fit_section;
 pub mod friction;
 pub mod friction_run;
 pub mod geometry;
@@ -45,6 +46,7 @@ pub use config::{AmmModel, AmmSettings, Experiment, FemSettings, ModeCount, Mode
 pub use damping::ModeValues;
 pub use drive_section::{DriveKind, DriveSettings, Feedforward, ForceSamples};
 pub use error::{ModelError, SampleError};
+pub use fit_section::{FitParam, FitSection};
 pub use friction::{Friction, FrictionSummary, NormalLoad, RailFriction, RailLaw, SleeveLaw};
 pub use friction_run::{Contact, FrictionSample, FrictionTally};
 pub use gravity::Gravity;

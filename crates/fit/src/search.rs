@@ -1,0 +1,394 @@
+//! The search (`docs/measured.md` 4.4-4.6, Eqs. LS6-LS10): Levenberg-Marquardt on the scaled
+//! parameters, kept inside their box by an active set and a projection.
+//!
+//! Each iteration: the gradient `g = J^T r` and the Gauss-Newton matrix `A = J^T J` (Eq. LS6);
+//! the parameters at a bound whose gradient pushes them outwards are held (Eq. LS7); the damped
+//! step of the others solves `(A_F + mu diag A_F) d = -g_F` (Eq. LS8) and is projected onto the
+//! box; it is taken when the cost falls, the damping then lowered by the gain ratio (Nielsen's
+//! rule), else the damping is raised and the step tried again. The search stops on the relative
+//! offset (Eq. LS10), a statistical criterion: the distance left to the optimum is below a
+//! thousandth of the estimates' own uncertainty.
+
+use std::time::Instant;
+
+use nalgebra::{DMatrix, DVector};
+
+use flexstar_model::SensorTable;
+
+use crate::identifiability::Verdict;
+use crate::jacobian::jacobian;
+use crate::outcome::{ChannelFit, Estimate, Fit, Iteration, Stop};
+use crate::problem::Problem;
+use crate::{FitError, Model};
+
+/// The damping of the first step, relative to the diagonal of `A`.
+pub const MU0: f64 = 1e-3;
+/// The damping at which no step is left to try.
+pub const MU_MAX: f64 = 1e10;
+
+/// How long the search may go on and when it stops.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    /// The most iterations (accepted steps).
+    pub max_iterations: usize,
+    /// Eq. LS10: the relative offset below which the search has converged.
+    pub offset_tol: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            max_iterations: 50,
+            offset_tol: 1e-3,
+        }
+    }
+}
+
+/// An iterate: scaled parameters, residuals, the model's readings and the Jacobian there.
+struct State {
+    u: Vec<f64>,
+    r: Vec<f64>,
+    table: SensorTable,
+    j: DMatrix<f64>,
+}
+
+impl State {
+    fn cost(&self) -> f64 {
+        cost(&self.r)
+    }
+}
+
+/// Eq. LS4: `|r|^2 / 2`.
+fn cost(r: &[f64]) -> f64 {
+    0.5 * r.iter().map(|v| v * v).sum::<f64>()
+}
+
+/// Fit `problem` with `model`: the start evaluated with its Jacobian, refused when that Jacobian
+/// is rank-deficient (Eq. LS15: the data cannot separate the parameters, named by their
+/// combination), the search, the statistics and the identifiability at the end. `on_iteration`
+/// sees the start and each accepted iterate. A search that does not converge is still a [`Fit`]
+/// (its [`Fit::stop`] says why); an error is a start that cannot be evaluated or separated.
+pub fn fit<M: Model + ?Sized>(
+    problem: &Problem,
+    model: &M,
+    settings: &Settings,
+    on_iteration: &dyn Fn(&Iteration),
+) -> Result<Fit, FitError> {
+    let started = Instant::now();
+    let start = evaluate_start(problem, model)?;
+    refuse_unidentifiable(problem, &start)?;
+    let before = start.table.clone();
+    let mut run = Run {
+        problem,
+        model,
+        settings,
+        started,
+        evaluations: 1 + problem.params.len(),
+        trace: Vec::new(),
+    };
+    run.record(&start, 0, 0.0, on_iteration);
+    let (end, stop) = run.search(start, on_iteration);
+    Ok(run.finish(end, stop, before))
+}
+
+/// The model and its Jacobian at the start.
+fn evaluate_start<M: Model + ?Sized>(problem: &Problem, model: &M) -> Result<State, FitError> {
+    let u = problem.start_scaled();
+    let at = |u: &[f64]| describe(problem, &problem.physical(u));
+    let (r, table) = problem
+        .evaluate(model, &u)
+        .map_err(|reason| FitError::Evaluation { at: at(&u), reason })?;
+    let j = jacobian(problem, model, &u, &r).map_err(|(k, reason)| FitError::Evaluation {
+        at: format!("{} (the step of {})", at(&u), problem.params[k].key),
+        reason,
+    })?;
+    Ok(State { u, r, table, j })
+}
+
+/// `key = value` of every parameter.
+fn describe(problem: &Problem, theta: &[f64]) -> String {
+    problem
+        .params
+        .iter()
+        .zip(theta)
+        .map(|(p, v)| format!("{} = {v}", p.key))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Eq. LS15 at the start: a rank-deficient Jacobian is refused before the search.
+fn refuse_unidentifiable(problem: &Problem, s: &State) -> Result<(), FitError> {
+    let theta = problem.physical(&s.u);
+    let check = crate::identifiability::check(&physical_jacobian(problem, &s.j), &problem.params, &theta);
+    if check.verdict == Verdict::RankDeficient {
+        return Err(FitError::Unidentifiable(format!(
+            "at the start ({}): {}",
+            describe(problem, &theta),
+            check.message
+        )));
+    }
+    Ok(())
+}
+
+/// `dr/dtheta` from `dr/du` (Eq. LS5: `du = dtheta / (hi - lo)`).
+fn physical_jacobian(problem: &Problem, j: &DMatrix<f64>) -> DMatrix<f64> {
+    DMatrix::from_fn(j.nrows(), j.ncols(), |i, k| j[(i, k)] / problem.params[k].width())
+}
+
+/// Eq. LS6: `A = J^T J` and `g = J^T r`.
+fn normal_equations(j: &DMatrix<f64>, r: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
+    let rv = DVector::from_column_slice(r);
+    (j.tr_mul(j), j.tr_mul(&rv))
+}
+
+/// Eq. LS7: the parameters free to move: not at a bound with the descent direction `-g` leaving
+/// the box.
+fn free_set(u: &[f64], g: &DVector<f64>) -> Vec<bool> {
+    u.iter()
+        .zip(g.iter())
+        .map(|(&u, &g)| !((u <= 0.0 && g > 0.0) || (u >= 1.0 && g < 0.0)))
+        .collect()
+}
+
+/// The rows and columns `idx` of `a`, the entries `idx` of `g`.
+fn restrict(a: &DMatrix<f64>, g: &DVector<f64>, idx: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
+    let m = idx.len();
+    (
+        DMatrix::from_fn(m, m, |x, y| a[(idx[x], idx[y])]),
+        DVector::from_fn(m, |x, _| g[idx[x]]),
+    )
+}
+
+/// Eq. LS10: the relative offset `sqrt(g_F^T A_F^+ g_F / p_F) / sqrt(|r|^2 / (n - p_F))` over
+/// the free parameters (Bates & Watts 1981): the Gauss-Newton step's length in the metric of
+/// the estimates' uncertainty. 0 for an exact fit or no free parameter.
+fn relative_offset(a: &DMatrix<f64>, g: &DVector<f64>, free: &[bool], r: &[f64]) -> f64 {
+    let idx: Vec<usize> = (0..free.len()).filter(|&k| free[k]).collect();
+    let rr: f64 = r.iter().map(|v| v * v).sum();
+    if idx.is_empty() || rr == 0.0 {
+        return 0.0;
+    }
+    let (af, gf) = restrict(a, g, &idx);
+    let x = match af.svd(true, true).solve(&gf, 0.0) {
+        Ok(x) => x,
+        Err(_) => return f64::INFINITY,
+    };
+    let p = idx.len() as f64;
+    let dof = (r.len() as f64 - p).max(1.0);
+    ((gf.dot(&x) / p).max(0.0) / (rr / dof)).sqrt()
+}
+
+/// Eq. LS8: the damped step of the free parameters (0 for the held ones); `None` when the
+/// damped matrix cannot be factored (then the damping is raised).
+fn damped_step(a: &DMatrix<f64>, g: &DVector<f64>, free: &[bool], mu: f64) -> Option<Vec<f64>> {
+    let idx: Vec<usize> = (0..free.len()).filter(|&k| free[k]).collect();
+    let (mut af, gf) = restrict(a, g, &idx);
+    let top = (0..idx.len()).fold(0.0f64, |m, k| m.max(af[(k, k)]));
+    for k in 0..idx.len() {
+        // Marquardt's scaling by the diagonal, kept positive for a parameter that changes nothing
+        af[(k, k)] += mu * af[(k, k)].max(1e-12 * top).max(f64::MIN_POSITIVE);
+    }
+    let d = af.cholesky()?.solve(&(-gf));
+    let mut step = vec![0.0; free.len()];
+    for (x, &k) in idx.iter().enumerate() {
+        step[k] = d[x];
+    }
+    Some(step)
+}
+
+/// `u + d` projected onto the box `[0, 1]^p`.
+fn project(u: &[f64], d: &[f64]) -> Vec<f64> {
+    u.iter().zip(d).map(|(u, d)| (u + d).clamp(0.0, 1.0)).collect()
+}
+
+/// The cost's decrease that the Gauss-Newton model predicts for the step `d`:
+/// `-(g^T d + d^T A d / 2)`.
+fn predicted_decrease(a: &DMatrix<f64>, g: &DVector<f64>, d: &[f64]) -> f64 {
+    let dv = DVector::from_column_slice(d);
+    -(g.dot(&dv) + 0.5 * dv.dot(&(a * &dv)))
+}
+
+/// The search's bookkeeping.
+struct Run<'a, M: Model + ?Sized> {
+    problem: &'a Problem,
+    model: &'a M,
+    settings: &'a Settings,
+    started: Instant,
+    evaluations: usize,
+    trace: Vec<Iteration>,
+}
+
+/// The outcome of one iteration.
+enum Step {
+    Accepted(State, f64),
+    Stopped(Stop),
+}
+
+impl<M: Model + ?Sized> Run<'_, M> {
+    /// Iterate from `s` until Eq. LS10 holds or the search gives up.
+    fn search(&mut self, mut s: State, on_iteration: &dyn Fn(&Iteration)) -> (State, Stop) {
+        let mut mu = MU0;
+        for iteration in 1..=self.settings.max_iterations {
+            let (a, g) = normal_equations(&s.j, &s.r);
+            let free = free_set(&s.u, &g);
+            if !free.contains(&true) {
+                return (s, Stop::AtBounds);
+            }
+            let offset = relative_offset(&a, &g, &free, &s.r);
+            if offset <= self.settings.offset_tol {
+                return (s, Stop::Converged { offset });
+            }
+            match self.iterate(&s, &a, &g, &free, &mut mu, offset) {
+                Step::Accepted(next, damping) => {
+                    s = next;
+                    self.record(&s, iteration, damping, on_iteration);
+                }
+                Step::Stopped(stop) => return (s, stop),
+            }
+        }
+        let (a, g) = normal_equations(&s.j, &s.r);
+        let free = free_set(&s.u, &g);
+        let offset = relative_offset(&a, &g, &free, &s.r);
+        let stop = if offset <= self.settings.offset_tol {
+            Stop::Converged { offset }
+        } else {
+            Stop::MaxIterations { offset }
+        };
+        (s, stop)
+    }
+
+    /// Try damped steps from `s` until one lowers the cost (then the Jacobian at the new
+    /// iterate) or the damping passes [`MU_MAX`].
+    fn iterate(
+        &mut self,
+        s: &State,
+        a: &DMatrix<f64>,
+        g: &DVector<f64>,
+        free: &[bool],
+        mu: &mut f64,
+        offset: f64,
+    ) -> Step {
+        let mut nu = 2.0;
+        let cost0 = s.cost();
+        while *mu <= MU_MAX {
+            let Some(d) = damped_step(a, g, free, *mu) else {
+                *mu *= nu;
+                nu *= 2.0;
+                continue;
+            };
+            let u = project(&s.u, &d);
+            let taken: Vec<f64> = u.iter().zip(&s.u).map(|(a, b)| a - b).collect();
+            let predicted = predicted_decrease(a, g, &taken);
+            self.evaluations += 1;
+            let trial = self.problem.evaluate(self.model, &u);
+            if let Ok((r, table)) = trial {
+                let actual = cost0 - cost(&r);
+                if actual > 0.0 && predicted > 0.0 {
+                    let rho = actual / predicted;
+                    let damping = *mu;
+                    *mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                    return self.accept(u, r, table, damping);
+                }
+            }
+            *mu *= nu;
+            nu *= 2.0;
+        }
+        Step::Stopped(Stop::NoDecrease { offset })
+    }
+
+    /// The Jacobian at an accepted iterate.
+    fn accept(&mut self, u: Vec<f64>, r: Vec<f64>, table: SensorTable, damping: f64) -> Step {
+        self.evaluations += u.len();
+        match jacobian(self.problem, self.model, &u, &r) {
+            Ok(j) => Step::Accepted(State { u, r, table, j }, damping),
+            Err((k, reason)) => Step::Stopped(Stop::EvaluationFailed {
+                reason: format!(
+                    "at {} (the step of {}): {reason}",
+                    describe(self.problem, &self.problem.physical(&u)),
+                    self.problem.params[k].key
+                ),
+            }),
+        }
+    }
+
+    fn record(&mut self, s: &State, iteration: usize, damping: f64, on_iteration: &dyn Fn(&Iteration)) {
+        let (a, g) = normal_equations(&s.j, &s.r);
+        let row = Iteration {
+            iteration,
+            evaluations: self.evaluations,
+            cost: s.cost(),
+            theta: self.problem.physical(&s.u),
+            offset: relative_offset(&a, &g, &free_set(&s.u, &g), &s.r),
+            damping,
+            wall_s: self.started.elapsed().as_secs_f64(),
+        };
+        on_iteration(&row);
+        self.trace.push(row);
+    }
+
+    /// The estimates, the statistics (Eqs. LS11-LS14) and the identifiability (Eqs. LS15-LS16)
+    /// at the last iterate.
+    fn finish(self, s: State, stop: Stop, before: SensorTable) -> Fit {
+        let p = self.problem;
+        let theta = p.physical(&s.u);
+        let at_bound: Vec<bool> = s.u.iter().map(|&u| u <= 0.0 || u >= 1.0).collect();
+        let free: Vec<bool> = at_bound.iter().map(|b| !b).collect();
+        let jp = physical_jacobian(p, &s.j);
+        let statistics = crate::stats::statistics(&jp, &s.r, &theta, &free);
+        let identifiability = crate::identifiability::check(&jp, &p.params, &theta);
+        let estimates = p
+            .params
+            .iter()
+            .enumerate()
+            .map(|(k, q)| Estimate {
+                key: q.key.clone(),
+                lo: q.lo,
+                hi: q.hi,
+                start: q.start,
+                estimate: theta[k],
+                standard_error: statistics.standard_errors[k],
+                interval: statistics.intervals[k],
+                at_bound: at_bound[k],
+            })
+            .collect();
+        let channels = channel_fits(p, &before, &s.table);
+        let reason = stop.text(self.settings.offset_tol);
+        Fit {
+            estimates,
+            statistics,
+            channels,
+            identifiability,
+            stop,
+            reason,
+            iterations: self.trace.len().saturating_sub(1),
+            evaluations: self.evaluations,
+            wall_s: self.started.elapsed().as_secs_f64(),
+            trace: self.trace,
+            before,
+            after: s.table,
+        }
+    }
+}
+
+/// Every channel's RMS error before and after (the tables were evaluated on the recording's
+/// times, so their errors exist).
+fn channel_fits(p: &Problem, before: &SensorTable, after: &SensorTable) -> Vec<ChannelFit> {
+    let rms_of = |t: &SensorTable| -> Vec<f64> {
+        p.errors(t)
+            .map(|e| e.iter().map(|x| crate::noise::rms(x)).collect())
+            .unwrap_or_else(|_| vec![f64::NAN; p.channels.len()])
+    };
+    let (b, a) = (rms_of(before), rms_of(after));
+    p.channels
+        .iter()
+        .enumerate()
+        .map(|(k, c)| ChannelFit {
+            column: c.column.clone(),
+            unit: c.unit.clone(),
+            weight: c.weight,
+            noise: c.sigma,
+            rms_before: b[k],
+            rms_after: a[k],
+        })
+        .collect()
+}

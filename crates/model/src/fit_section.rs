@@ -1,0 +1,236 @@
+//! `[fit]`: the physical parameters that `flexstar fit` calibrates on a recording
+//! (`docs/measured.md` section 4.1).
+//!
+//! ```toml
+//! [fit]
+//! params = [
+//!   { key = "payload.mass", lo = 0.0, hi = 1.0 },            # start: the experiment's own value
+//!   { key = "robot.E", lo = 150e9, hi = 250e9, start = 2e11 },
+//!   { key = "robot.L[2]", lo = 0.45, hi = 0.55 },            # one beam's entry
+//! ]
+//! weights = { accG = 2.0, enc1 = 0.0 }                         # per sensor; default 1
+//! ```
+//! What needs no document is checked here, when the file is read: bounds, starts, weights. That
+//! each key is a number the experiment accepts, at its bounds too, is checked by the command
+//! before any run (it patches the document, `flexstar_api::fit`).
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::ModelError;
+
+/// One fitted parameter: a dotted numeric key of the experiment and its box.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitParam {
+    /// A dotted key as sweeps take it (`payload.mass`, `damping.zeta`, `robot.L[2]`).
+    pub key: String,
+    /// Lower bound, in the key's unit.
+    pub lo: f64,
+    /// Upper bound, in the key's unit; `lo < hi`.
+    pub hi: f64,
+    /// Where the search starts; default: the experiment's own value at `key`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<f64>,
+}
+
+/// `[fit]` (see the module doc).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitSection {
+    /// The parameters, in the order of every output.
+    pub params: Vec<FitParam>,
+    /// A weight >= 0 per sensor name (`[[sensors]] name`), multiplying its channels' residuals
+    /// (`docs/measured.md` Eq. LS1); a sensor not named has weight 1, weight 0 leaves it out.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub weights: BTreeMap<String, f64>,
+}
+
+impl FitSection {
+    /// Check what needs no document (keys named `fit.params[k].lo`, `fit.weights.<name>`):
+    /// at least one parameter, each key non-empty, finite bounds with `lo < hi`, a start inside
+    /// them; weights finite and >= 0, each naming one of `sensors` (the `[[sensors]]` names), not
+    /// all of them 0.
+    pub fn validate(&self, sensors: &[&str]) -> Result<(), ModelError> {
+        if self.params.is_empty() {
+            return Err(ModelError::invalid(
+                "fit.params",
+                "name at least one parameter: params = [{ key = \"payload.mass\", lo = 0.0, hi = 1.0 }]",
+            ));
+        }
+        for (k, p) in self.params.iter().enumerate() {
+            p.validate(&format!("fit.params[{}]", k + 1))?;
+        }
+        self.validate_weights(sensors)
+    }
+
+    fn validate_weights(&self, sensors: &[&str]) -> Result<(), ModelError> {
+        for (name, w) in &self.weights {
+            let key = format!("fit.weights.{name}");
+            if !sensors.contains(&name.as_str()) {
+                let known = if sensors.is_empty() {
+                    "the experiment has no [[sensors]]".to_string()
+                } else {
+                    format!("the sensors are {}", sensors.join(", "))
+                };
+                return Err(ModelError::invalid(
+                    key,
+                    format!("names no sensor ({known}); a weight is per [[sensors]] name"),
+                ));
+            }
+            if !(w.is_finite() && *w >= 0.0) {
+                return Err(ModelError::invalid(
+                    key,
+                    format!("must be a finite number >= 0, got {w}"),
+                ));
+            }
+        }
+        let all_zero = !sensors.is_empty() && sensors.iter().all(|s| self.weight(s) == 0.0);
+        if all_zero {
+            return Err(ModelError::invalid(
+                "fit.weights",
+                "every sensor has weight 0: nothing is left to fit to",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The weight of sensor `name` (1 unless given).
+    pub fn weight(&self, name: &str) -> f64 {
+        self.weights.get(name).copied().unwrap_or(1.0)
+    }
+}
+
+impl FitParam {
+    /// Check bounds and start; `at` names the entry (`fit.params[2]`).
+    fn validate(&self, at: &str) -> Result<(), ModelError> {
+        if self.key.trim().is_empty() {
+            return Err(ModelError::invalid(
+                format!("{at}.key"),
+                "is empty: give a dotted key of the experiment (payload.mass, robot.L[2])",
+            ));
+        }
+        for (name, v) in [("lo", self.lo), ("hi", self.hi)] {
+            if !v.is_finite() {
+                return Err(ModelError::invalid(
+                    format!("{at}.{name}"),
+                    format!("{}: the bound must be a finite number, got {v}", self.key),
+                ));
+            }
+        }
+        if self.lo >= self.hi {
+            return Err(ModelError::invalid(
+                format!("{at}.hi"),
+                format!("{}: need lo < hi, got lo = {} and hi = {}", self.key, self.lo, self.hi),
+            ));
+        }
+        if let Some(s) = self.start {
+            if !(s.is_finite() && (self.lo..=self.hi).contains(&s)) {
+                return Err(ModelError::invalid(
+                    format!("{at}.start"),
+                    format!(
+                        "{}: start = {s} lies outside [lo, hi] = [{}, {}]",
+                        self.key, self.lo, self.hi
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn section(params: &str, weights: &str) -> FitSection {
+        toml::from_str(&format!("params = [{params}]\n{weights}")).unwrap()
+    }
+
+    /// Each refusal names its key and says why.
+    #[test]
+    fn bad_bounds_starts_and_weights_are_named() {
+        let sensors = ["accG", "enc1"];
+        let cases = [
+            (
+                "{ key = \"payload.mass\", lo = 1.0, hi = 1.0 }",
+                "",
+                "fit.params[1].hi",
+                "lo < hi",
+            ),
+            (
+                "{ key = \"payload.mass\", lo = 2.0, hi = 1.0 }",
+                "",
+                "fit.params[1].hi",
+                "lo < hi",
+            ),
+            (
+                "{ key = \"payload.mass\", lo = 0.0, hi = inf }",
+                "",
+                "fit.params[1].hi",
+                "finite",
+            ),
+            (
+                "{ key = \"a.b\", lo = 0.0, hi = 1.0 }, { key = \"payload.J\", lo = 0.0, hi = 1.0, start = 2.0 }",
+                "",
+                "fit.params[2].start",
+                "outside [lo, hi]",
+            ),
+            ("{ key = \" \", lo = 0.0, hi = 1.0 }", "", "fit.params[1].key", "empty"),
+            (
+                "{ key = \"a\", lo = 0.0, hi = 1.0 }",
+                "weights = { accB = 1.0 }",
+                "fit.weights.accB",
+                "accG, enc1",
+            ),
+            (
+                "{ key = \"a\", lo = 0.0, hi = 1.0 }",
+                "weights = { accG = -1.0 }",
+                "fit.weights.accG",
+                ">= 0",
+            ),
+            (
+                "{ key = \"a\", lo = 0.0, hi = 1.0 }",
+                "weights = { accG = 0.0, enc1 = 0 }",
+                "fit.weights",
+                "nothing is left",
+            ),
+        ];
+        for (params, weights, key, why) in cases {
+            let e = section(params, weights).validate(&sensors).unwrap_err().to_string();
+            assert!(e.contains(key) && e.contains(why), "{params} {weights}: {e}");
+        }
+        let e = FitSection {
+            params: Vec::new(),
+            weights: BTreeMap::new(),
+        }
+        .validate(&sensors)
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("fit.params") && e.contains("at least one"), "{e}");
+        let ok = section(
+            "{ key = \"a\", lo = 0.0, hi = 1.0, start = 1.0 }",
+            "weights = { accG = 2 }",
+        );
+        ok.validate(&sensors).unwrap();
+        assert_eq!((ok.weight("accG"), ok.weight("enc1")), (2.0, 1.0));
+        let e = section("{ key = \"a\", lo = 0.0, hi = 1.0 }", "weights = { accG = 1.0 }")
+            .validate(&[])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no [[sensors]]"), "{e}");
+    }
+
+    #[test]
+    fn unknown_keys_in_the_section_are_refused() {
+        let e = toml::from_str::<FitSection>("params = [{ key = \"a\", lo = 0.0, hi = 1.0, step = 2 }]")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("step"), "{e}");
+        let e = toml::from_str::<FitSection>("params = []\nmethod = \"lm\"")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("method"), "{e}");
+    }
+}

@@ -49,7 +49,7 @@ impl ExperimentDoc {
     }
 
     /// Load a document (checked by the experiment loader).
-    fn from_table(doc: toml::Table, source: &Path) -> Result<Self> {
+    pub(crate) fn from_table(doc: toml::Table, source: &Path) -> Result<Self> {
         let text = toml::to_string(&doc).map_err(|e| ApiError::config(source.display(), None, e.to_string()))?;
         Self::from_toml(&text, source)
     }

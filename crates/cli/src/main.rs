@@ -48,6 +48,9 @@ enum Command {
     /// A run's or a plan's motion for a motion controller: DIR/setpoints.csv (t, s, v, a, j, F at
     /// k / rate) and setpoints.json
     Export(commands::export::Args),
+    /// Calibrate the physical parameters of [fit] on a recording of the sensors: DIR/<name>/fit.toml
+    /// (the calibrated experiment), fit.json, fit.md, report.html
+    Fit(commands::fit::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -65,6 +68,7 @@ fn main() -> std::process::ExitCode {
         Command::Animate(args) => commands::animate::run(args),
         Command::Plan(args) => commands::plan::run(args),
         Command::Export(args) => commands::export::run(args),
+        Command::Fit(args) => commands::fit::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -12,9 +12,10 @@ use crate::problem::Param;
 /// rho))`), their standard errors inflated a hundredfold over separable ones.
 pub const ILL_CONDITIONED: f64 = 1e2;
 /// Above this condition number the Jacobian is rank-deficient within its accuracy: a singular
-/// value below 1e-5 of the largest is of the size of the forward differences' own error (Eq. LS9,
-/// `docs/measured.md` 4.5), so the data say nothing along its direction.
-pub const RANK_DEFICIENT: f64 = 1e5;
+/// value below 1e-4 of the largest is of the size of the forward differences' own error (Eq. LS9:
+/// 5e-5 to 4e-4 of a column measured on the AMM, `docs/measured.md` 4.5), so the data say nothing
+/// along its direction.
+pub const RANK_DEFICIENT: f64 = 1e4;
 /// Entries of the combination smaller than this share of its largest are left out of its name.
 const NAMED_SHARE: f64 = 0.05;
 
@@ -35,8 +36,9 @@ pub enum Verdict {
 /// (`d theta_j / (hi_j - lo_j)`) otherwise, of unit length.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Combination {
-    /// `(key, entry, relative)`: the parameters with an entry of at least 5 % of the largest, the
-    /// largest first; `relative` false: the entry is in units of the box.
+    /// `(key, entry, relative)`: the parameters with an entry of at least 5 % of the largest, in
+    /// the order of the parameters, the first positive; `relative` false: the entry is in units
+    /// of the box.
     pub entries: Vec<(String, f64, bool)>,
     /// For two relative entries `(a, b)`: the product `theta_1^e1 theta_2^e2` that the data do fix
     /// (exponents `(b, -a)` scaled to a largest of 1), as text.
@@ -133,20 +135,20 @@ pub fn check(j: &DMatrix<f64>, params: &[Param], theta: &[f64]) -> Identifiabili
     }
 }
 
-/// The direction `dir` (relative or box units per `rel`) normalised, its small entries dropped.
+/// The direction `dir` (relative or box units per `rel`) normalised, its small entries dropped,
+/// in the order of the parameters, the first one named positive.
 fn combination(params: &[Param], rel: &[bool], dir: &[f64]) -> Combination {
     let len = dir.iter().map(|v| v * v).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
     let big = dir.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    // the largest entry positive
-    let sign = match dir.iter().max_by(|a, b| a.abs().total_cmp(&b.abs())) {
-        Some(v) if *v < 0.0 => -1.0,
+    let named: Vec<usize> = (0..dir.len()).filter(|&k| dir[k].abs() >= NAMED_SHARE * big).collect();
+    let sign = match named.first() {
+        Some(&k) if dir[k] < 0.0 => -1.0,
         _ => 1.0,
     };
-    let mut entries: Vec<(String, f64, bool)> = (0..dir.len())
-        .filter(|&k| dir[k].abs() >= NAMED_SHARE * big)
-        .map(|k| (params[k].key.clone(), sign * dir[k] / len, rel[k]))
+    let entries: Vec<(String, f64, bool)> = named
+        .iter()
+        .map(|&k| (params[k].key.clone(), sign * dir[k] / len, rel[k]))
         .collect();
-    entries.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
     let determined = match entries.as_slice() {
         [(ka, a, true), (kb, b, true)] => {
             // the data fix e . ln(theta) with e orthogonal to (a, b): e = (b, -a), largest 1

@@ -8,7 +8,7 @@ use crate::problem::{Param, Problem};
 use crate::Model;
 
 /// The relative step of Eq. LS9: `h_j = FD_STEP max(|theta_j|, FD_FLOOR (hi_j - lo_j))`.
-pub const FD_STEP: f64 = 1e-6;
+pub const FD_STEP: f64 = 1e-4;
 /// The share of the box below which a parameter's own value no longer sets the step (a value
 /// at or near zero).
 pub const FD_FLOOR: f64 = 1e-3;

@@ -95,6 +95,17 @@ pub struct ChannelFit {
     pub rms_after: f64,
 }
 
+/// A channel whose error after the fit is more than this many times its noise level carries
+/// something the model does not explain (`docs/measured.md` 4.7): flagged in the report.
+pub const MISFIT: f64 = 3.0;
+
+impl ChannelFit {
+    /// Its error after the fit over its noise level, above [`MISFIT`]?
+    pub fn misfit(&self) -> bool {
+        self.rms_after > MISFIT * self.noise
+    }
+}
+
 /// A fit.
 #[derive(Debug, Clone, Serialize)]
 pub struct Fit {

@@ -47,6 +47,8 @@ impl Default for Settings {
 /// An iterate: scaled parameters, residuals, the model's readings and the Jacobian there.
 struct State {
     u: Vec<f64>,
+    /// The parameters in their units: the starts as given at the start, `u` through Eq. LS5 after.
+    theta: Vec<f64>,
     r: Vec<f64>,
     table: SensorTable,
     j: DMatrix<f64>,
@@ -91,18 +93,18 @@ pub fn fit<M: Model + ?Sized>(
     Ok(run.finish(end, stop, before))
 }
 
-/// The model and its Jacobian at the start.
+/// The model and its Jacobian at the start (the starts as given, not through Eq. LS5).
 fn evaluate_start<M: Model + ?Sized>(problem: &Problem, model: &M) -> Result<State, FitError> {
     let u = problem.start_scaled();
-    let at = |u: &[f64]| describe(problem, &problem.physical(u));
-    let (r, table) = problem
-        .evaluate(model, &u)
-        .map_err(|reason| FitError::Evaluation { at: at(&u), reason })?;
+    let theta: Vec<f64> = problem.params.iter().map(|p| p.start).collect();
+    let at = describe(problem, &theta);
+    let evaluated = model.evaluate(&theta).and_then(|t| Ok((problem.residuals(&t)?, t)));
+    let (r, table) = evaluated.map_err(|reason| FitError::Evaluation { at: at.clone(), reason })?;
     let j = jacobian(problem, model, &u, &r).map_err(|(k, reason)| FitError::Evaluation {
-        at: format!("{} (the step of {})", at(&u), problem.params[k].key),
+        at: format!("{at} (the step of {})", problem.params[k].key),
         reason,
     })?;
-    Ok(State { u, r, table, j })
+    Ok(State { u, theta, r, table, j })
 }
 
 /// `key = value` of every parameter.
@@ -111,19 +113,27 @@ fn describe(problem: &Problem, theta: &[f64]) -> String {
         .params
         .iter()
         .zip(theta)
-        .map(|(p, v)| format!("{} = {v}", p.key))
+        .map(|(p, v)| format!("{} = {}", p.key, number(*v)))
         .collect::<Vec<_>>()
         .join(", ")
 }
 
+/// A number in messages: plain between 1e-3 and 1e6, else with an exponent (`2.5e-12`).
+fn number(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e6).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// Eq. LS15 at the start: a rank-deficient Jacobian is refused before the search.
 fn refuse_unidentifiable(problem: &Problem, s: &State) -> Result<(), FitError> {
-    let theta = problem.physical(&s.u);
-    let check = crate::identifiability::check(&physical_jacobian(problem, &s.j), &problem.params, &theta);
+    let check = crate::identifiability::check(&physical_jacobian(problem, &s.j), &problem.params, &s.theta);
     if check.verdict == Verdict::RankDeficient {
         return Err(FitError::Unidentifiable(format!(
             "at the start ({}): {}",
-            describe(problem, &theta),
+            describe(problem, &s.theta),
             check.message
         )));
     }
@@ -300,7 +310,10 @@ impl<M: Model + ?Sized> Run<'_, M> {
     fn accept(&mut self, u: Vec<f64>, r: Vec<f64>, table: SensorTable, damping: f64) -> Step {
         self.evaluations += u.len();
         match jacobian(self.problem, self.model, &u, &r) {
-            Ok(j) => Step::Accepted(State { u, r, table, j }, damping),
+            Ok(j) => {
+                let theta = self.problem.physical(&u);
+                Step::Accepted(State { u, theta, r, table, j }, damping)
+            }
             Err((k, reason)) => Step::Stopped(Stop::EvaluationFailed {
                 reason: format!(
                     "at {} (the step of {}): {reason}",
@@ -317,7 +330,7 @@ impl<M: Model + ?Sized> Run<'_, M> {
             iteration,
             evaluations: self.evaluations,
             cost: s.cost(),
-            theta: self.problem.physical(&s.u),
+            theta: s.theta.clone(),
             offset: relative_offset(&a, &g, &free_set(&s.u, &g), &s.r),
             damping,
             wall_s: self.started.elapsed().as_secs_f64(),
@@ -330,7 +343,7 @@ impl<M: Model + ?Sized> Run<'_, M> {
     /// at the last iterate.
     fn finish(self, s: State, stop: Stop, before: SensorTable) -> Fit {
         let p = self.problem;
-        let theta = p.physical(&s.u);
+        let theta = s.theta.clone();
         let at_bound: Vec<bool> = s.u.iter().map(|&u| u <= 0.0 || u >= 1.0).collect();
         let free: Vec<bool> = at_bound.iter().map(|b| !b).collect();
         let jp = physical_jacobian(p, &s.j);

@@ -537,8 +537,12 @@ impl Experiment {
             }
         }
         if let Some(fit) = &self.fit {
-            let names: Vec<&str> = self.sensors.iter().map(|s| s.name.as_str()).collect();
-            fit.validate(&names)?;
+            let sensors: Vec<(String, Vec<String>)> = self
+                .sensors
+                .iter()
+                .map(|s| (s.name.clone(), crate::fit_section::spec_columns(s)))
+                .collect();
+            fit.validate(&sensors)?;
         }
         crate::animation::check_frames("amm.frames", self.amm.frames, self.time.t_end)?;
         crate::animation::check_frames("fem.frames", self.fem.frames, self.time.t_end)?;

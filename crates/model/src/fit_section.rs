@@ -8,7 +8,8 @@
 //!   { key = "robot.E", lo = 150e9, hi = 250e9, start = 2e11 },
 //!   { key = "robot.L[2]", lo = 0.45, hi = 0.55 },            # one beam's entry
 //! ]
-//! weights = { accG = 2.0, enc1 = 0.0 }                         # per sensor; default 1
+//! weights = { accG = 2.0, enc1 = 0.0, accB_x = 0.0 }           # per sensor or column; default 1
+//! max_iterations = 50                                          # of the search (default 50)
 //! ```
 //! What needs no document is checked here, when the file is read: bounds, starts, weights. That
 //! each key is a number the experiment accepts, at its bounds too, is checked by the command
@@ -41,18 +42,26 @@ pub struct FitParam {
 pub struct FitSection {
     /// The parameters, in the order of every output.
     pub params: Vec<FitParam>,
-    /// A weight >= 0 per sensor name (`[[sensors]] name`), multiplying its channels' residuals
-    /// (`docs/measured.md` Eq. LS1); a sensor not named has weight 1, weight 0 leaves it out.
+    /// A weight >= 0 per sensor name (`[[sensors]] name`) or per column (`accB_x`), multiplying
+    /// the residuals of its channels (`docs/measured.md` Eq. LS1); a column's own weight comes
+    /// before its sensor's, one named by neither has weight 1, weight 0 leaves it out.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub weights: BTreeMap<String, f64>,
+    /// The most iterations of the search (default [`DEFAULT_MAX_ITERATIONS`]; 1..=1000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_iterations: Option<usize>,
 }
+
+/// The most iterations of the search when `[fit] max_iterations` is not given
+/// (`docs/measured.md` 4.6).
+pub const DEFAULT_MAX_ITERATIONS: usize = 50;
 
 impl FitSection {
     /// Check what needs no document (keys named `fit.params[k].lo`, `fit.weights.<name>`):
     /// at least one parameter, each key non-empty, finite bounds with `lo < hi`, a start inside
-    /// them; weights finite and >= 0, each naming one of `sensors` (the `[[sensors]]` names), not
-    /// all of them 0.
-    pub fn validate(&self, sensors: &[&str]) -> Result<(), ModelError> {
+    /// them; weights finite and >= 0, each naming one of `sensors` (`(name, columns)` of the
+    /// `[[sensors]]`) or one of their columns, not all of them 0.
+    pub fn validate(&self, sensors: &[(String, Vec<String>)]) -> Result<(), ModelError> {
         if self.params.is_empty() {
             return Err(ModelError::invalid(
                 "fit.params",
@@ -62,21 +71,34 @@ impl FitSection {
         for (k, p) in self.params.iter().enumerate() {
             p.validate(&format!("fit.params[{}]", k + 1))?;
         }
+        if let Some(n) = self.max_iterations {
+            if !(1..=1000).contains(&n) {
+                return Err(ModelError::invalid(
+                    "fit.max_iterations",
+                    format!("need 1 <= max_iterations <= 1000, got {n}"),
+                ));
+            }
+        }
         self.validate_weights(sensors)
     }
 
-    fn validate_weights(&self, sensors: &[&str]) -> Result<(), ModelError> {
+    fn validate_weights(&self, sensors: &[(String, Vec<String>)]) -> Result<(), ModelError> {
         for (name, w) in &self.weights {
             let key = format!("fit.weights.{name}");
-            if !sensors.contains(&name.as_str()) {
+            let known = sensors.iter().any(|(s, cols)| s == name || cols.contains(name));
+            if !known {
                 let known = if sensors.is_empty() {
                     "the experiment has no [[sensors]]".to_string()
                 } else {
-                    format!("the sensors are {}", sensors.join(", "))
+                    let names: Vec<String> = sensors
+                        .iter()
+                        .map(|(s, cols)| format!("{s} ({})", cols.join(", ")))
+                        .collect();
+                    format!("the sensors (columns) are {}", names.join(", "))
                 };
                 return Err(ModelError::invalid(
                     key,
-                    format!("names no sensor ({known}); a weight is per [[sensors]] name"),
+                    format!("names no sensor and no sensor column ({known})"),
                 ));
             }
             if !(w.is_finite() && *w >= 0.0) {
@@ -86,7 +108,10 @@ impl FitSection {
                 ));
             }
         }
-        let all_zero = !sensors.is_empty() && sensors.iter().all(|s| self.weight(s) == 0.0);
+        let all_zero = !sensors.is_empty()
+            && sensors
+                .iter()
+                .all(|(s, cols)| cols.iter().all(|c| self.weight(s, c) == 0.0));
         if all_zero {
             return Err(ModelError::invalid(
                 "fit.weights",
@@ -96,9 +121,30 @@ impl FitSection {
         Ok(())
     }
 
-    /// The weight of sensor `name` (1 unless given).
-    pub fn weight(&self, name: &str) -> f64 {
-        self.weights.get(name).copied().unwrap_or(1.0)
+    /// The most iterations of the search.
+    pub fn iterations(&self) -> usize {
+        self.max_iterations.unwrap_or(DEFAULT_MAX_ITERATIONS)
+    }
+
+    /// The weight of column `column` of sensor `sensor`: the column's own, else the sensor's,
+    /// else 1.
+    pub fn weight(&self, sensor: &str, column: &str) -> f64 {
+        self.weights
+            .get(column)
+            .or_else(|| self.weights.get(sensor))
+            .copied()
+            .unwrap_or(1.0)
+    }
+}
+
+/// The columns a `[[sensors]]` table will have (`Sensor::columns` of the checked sensor: an
+/// accelerometer's `<name>_x`, `<name>_y`, any other's `<name>`), for the weights' names, which
+/// are checked with the file before the sensors are.
+pub fn spec_columns(spec: &crate::sensors::SensorSpec) -> Vec<String> {
+    if spec.kind == "accelerometer" {
+        vec![format!("{}_x", spec.name), format!("{}_y", spec.name)]
+    } else {
+        vec![spec.name.clone()]
     }
 }
 
@@ -151,7 +197,10 @@ mod tests {
     /// Each refusal names its key and says why.
     #[test]
     fn bad_bounds_starts_and_weights_are_named() {
-        let sensors = ["accG", "enc1"];
+        let sensors = [
+            ("accG".to_string(), vec!["accG_x".to_string(), "accG_y".to_string()]),
+            ("enc1".to_string(), vec!["enc1".to_string()]),
+        ];
         let cases = [
             (
                 "{ key = \"payload.mass\", lo = 1.0, hi = 1.0 }",
@@ -201,9 +250,15 @@ mod tests {
             let e = section(params, weights).validate(&sensors).unwrap_err().to_string();
             assert!(e.contains(key) && e.contains(why), "{params} {weights}: {e}");
         }
+        let e = section("{ key = \"a\", lo = 0.0, hi = 1.0 }", "max_iterations = 0")
+            .validate(&sensors)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("fit.max_iterations"), "{e}");
         let e = FitSection {
             params: Vec::new(),
             weights: BTreeMap::new(),
+            max_iterations: None,
         }
         .validate(&sensors)
         .unwrap_err()
@@ -220,6 +275,23 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("no [[sensors]]"), "{e}");
+    }
+
+    /// The columns the weights may name are those the checked sensors have, for every kind.
+    #[test]
+    fn spec_columns_are_the_sensors_columns() {
+        let text = "name = \"s\"\n[time]\nt_end = 0.1\n[trajectory]\nkind = \"polynomial\"\n\
+                    s1 = [0.0]\ns2 = [0.0]\ns3 = [0.0]\n[payload]\nmass = 0.1\n\
+                    [[sensors]]\nname = \"a\"\nkind = \"accelerometer\"\nat = \"G\"\n\
+                    [[sensors]]\nname = \"g\"\nkind = \"strain\"\nbeam = 1\nx = 0.45\nc = 1e-3\n\
+                    [[sensors]]\nname = \"e\"\nkind = \"encoder\"\nslider = 1\n\
+                    [[sensors]]\nname = \"f\"\nkind = \"force\"\nslider = 2\n";
+        let exp = crate::Experiment::from_toml_str(text, std::path::Path::new("s.toml")).unwrap();
+        let problem = exp.problem().unwrap();
+        let checked: Vec<Vec<String>> = problem.sensors().list().iter().map(|s| s.columns()).collect();
+        let from_specs: Vec<Vec<String>> = exp.sensors.iter().map(spec_columns).collect();
+        assert_eq!(from_specs, checked);
+        assert_eq!(checked.len(), 4);
     }
 
     #[test]

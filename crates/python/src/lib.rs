@@ -351,6 +351,7 @@ fn _flexstar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reports::verify, m)?)?;
     m.add_function(wrap_pyfunction!(reports::freqmap, m)?)?;
     m.add_function(wrap_pyfunction!(reports::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(reports::fit, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -167,3 +167,32 @@ pub fn plan<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bou
     d.set_item("residual_G_peak_m", peaks)?;
     Ok(d)
 }
+
+/// Calibrate the parameters of `[fit]` on a recording (as `flexstar fit`; docs/measured.md
+/// section 4): writes `out/<name>/`; returns `{"dir", "fit_json", "fit_toml", "calibrated"}`:
+/// the text of fit.json, the path of fit.toml and the calibrated experiment (both `None` when
+/// the fit is no calibration).
+#[pyfunction]
+#[pyo3(signature = (config, measured, out))]
+pub fn fit<'py>(py: Python<'py>, config: PathBuf, measured: PathBuf, out: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    let o = interrupt::interruptible(py, "flexstar.fit", false, |_| {
+        flexstar_api::fit::fit_to_dir(&config, &measured, &out, &|_| {})
+    })?
+    .map_err(py_err)?;
+    for note in &o.notes {
+        let text = std::ffi::CString::new(note.trim_start_matches("note: ")).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &text, 1)?;
+    }
+    let json = serde_json::to_string(&flexstar_api::fit_report::fit_json(&o))
+        .map_err(|e| crate::SolverError::new_err(format!("fit.json: {e}")))?;
+    let d = PyDict::new(py);
+    d.set_item("dir", o.dir.display().to_string())?;
+    d.set_item("fit_json", json)?;
+    let calibrated = o.fitted.calibrated.clone();
+    d.set_item(
+        "fit_toml",
+        calibrated.as_ref().map(|_| o.dir.join("fit.toml").display().to_string()),
+    )?;
+    d.set_item("calibrated", calibrated.map(|inner| PyExperiment { inner }))?;
+    Ok(d)
+}

@@ -3,6 +3,7 @@
 pub mod animate;
 pub mod compare;
 pub mod export;
+pub mod fit;
 pub mod kinematics;
 pub mod modal;
 pub mod modes;

@@ -35,6 +35,7 @@ __all__ = [
     "verify",
     "freqmap",
     "plan",
+    "fit",
 ]
 __version__ = _flexstar.__version__
 
@@ -324,6 +325,27 @@ def plan(config: "os.PathLike[str] | str", out: "os.PathLike[str] | str" = "out"
     ``planned`` the ``(AMM, FEM)`` residual peaks of |dG| after the move [m]. Errors:
     ConfigError (naming file and key), SolverError."""
     return _flexstar.plan(os.fspath(config), os.fspath(out))
+
+
+def fit(
+    config: "os.PathLike[str] | str",
+    measured: "os.PathLike[str] | str",
+    out: "os.PathLike[str] | str" = "out",
+) -> Dict[str, Any]:
+    """Calibrate the physical parameters of the file's ``[fit]`` on a recording (as ``flexstar
+    fit``; docs/measured.md section 4): ``measured`` is a CSV of ``t`` and the sensors' columns on
+    the run's sensor times. Writes ``out/<name>/`` (fit.json, fit.md, report.html, the figures and,
+    when the fit converged to identifiable estimates, fit.toml). Returns the content of fit.json
+    as a dict (``converged``, ``calibrated``, ``parameters`` with estimates, standard errors and
+    95 % intervals, ``correlation``, ``channels``, ``identifiability``, ...) with ``dir``,
+    ``fit_toml`` (its path, or None) and ``experiment``: the calibrated Experiment (or None).
+    Errors: ConfigError (naming file and key), SolverError."""
+    r = _flexstar.fit(os.fspath(config), os.fspath(measured), os.fspath(out))
+    d: Dict[str, Any] = json.loads(r["fit_json"])
+    d["dir"] = r["dir"]
+    d["fit_toml"] = r["fit_toml"]
+    d["experiment"] = Experiment(r["calibrated"]) if r["calibrated"] is not None else None
+    return d
 
 
 def verify(

@@ -102,7 +102,8 @@ pub fn fit_experiment(
         other => ApiError::solver(&src, other),
     })?;
     let calibrated = if fit.calibrated() {
-        Some(model.experiment(&fit.theta()).map_err(|e| ApiError::solver(&src, e))?)
+        let cal = model.experiment(&fit.theta()).map_err(|e| ApiError::solver(&src, e))?;
+        Some(with_damping_frequencies(cal, &input.doc)?)
     } else {
         None
     };
@@ -116,6 +117,26 @@ pub fn fit_experiment(
         dt,
         calibrated,
     })
+}
+
+/// The calibrated experiment with the frequencies its damping ratios hold at written out
+/// (`damping.f_hz`) when the input left them to the start pose (4.9): the fitted ratio and that
+/// frequency are the material's damping (Eq. D5's beta), which other moves and other start poses
+/// keep, and a plan takes it.
+fn with_damping_frequencies(cal: ExperimentDoc, input: &toml::Table) -> Result<ExperimentDoc> {
+    let given = flexstar_study::patch::get_dotted(input, "damping.f_hz").is_some();
+    let Some(f) = cal
+        .exp
+        .damping
+        .f_hz
+        .filter(|_| !given && cal.exp.damping.zeta.is_some())
+    else {
+        return Ok(cal);
+    };
+    let mut doc = cal.doc.clone();
+    let value = toml::Value::try_from(f).map_err(|e| ApiError::Output(format!("damping.f_hz: {e}")))?;
+    flexstar_study::patch::set_dotted(&mut doc, "damping.f_hz", value).map_err(ApiError::Output)?;
+    ExperimentDoc::from_table(doc, &cal.source)
 }
 
 /// The `[fit]` section, and sensors to fit to.

@@ -231,7 +231,7 @@ mod tests {
                 "{ key = \"a\", lo = 0.0, hi = 1.0 }",
                 "weights = { accB = 1.0 }",
                 "fit.weights.accB",
-                "accG, enc1",
+                "accG (accG_x, accG_y), enc1 (enc1)",
             ),
             (
                 "{ key = \"a\", lo = 0.0, hi = 1.0 }",
@@ -266,10 +266,15 @@ mod tests {
         assert!(e.contains("fit.params") && e.contains("at least one"), "{e}");
         let ok = section(
             "{ key = \"a\", lo = 0.0, hi = 1.0, start = 1.0 }",
-            "weights = { accG = 2 }",
+            "weights = { accG = 2, accG_y = 0.5 }",
         );
         ok.validate(&sensors).unwrap();
-        assert_eq!((ok.weight("accG"), ok.weight("enc1")), (2.0, 1.0));
+        let w = |s, c| ok.weight(s, c);
+        assert_eq!((w("accG", "accG_x"), w("accG", "accG_y"), w("enc1", "enc1")), (2.0, 0.5, 1.0));
+        // one column weighted 0 and the other columns weighted is a fit
+        section("{ key = \"a\", lo = 0.0, hi = 1.0 }", "weights = { accG_x = 0.0, enc1 = 0.0 }")
+            .validate(&sensors)
+            .unwrap();
         let e = section("{ key = \"a\", lo = 0.0, hi = 1.0 }", "weights = { accG = 1.0 }")
             .validate(&[])
             .unwrap_err()

@@ -270,11 +270,17 @@ mod tests {
         );
         ok.validate(&sensors).unwrap();
         let w = |s, c| ok.weight(s, c);
-        assert_eq!((w("accG", "accG_x"), w("accG", "accG_y"), w("enc1", "enc1")), (2.0, 0.5, 1.0));
+        assert_eq!(
+            (w("accG", "accG_x"), w("accG", "accG_y"), w("enc1", "enc1")),
+            (2.0, 0.5, 1.0)
+        );
         // one column weighted 0 and the other columns weighted is a fit
-        section("{ key = \"a\", lo = 0.0, hi = 1.0 }", "weights = { accG_x = 0.0, enc1 = 0.0 }")
-            .validate(&sensors)
-            .unwrap();
+        section(
+            "{ key = \"a\", lo = 0.0, hi = 1.0 }",
+            "weights = { accG_x = 0.0, enc1 = 0.0 }",
+        )
+        .validate(&sensors)
+        .unwrap();
         let e = section("{ key = \"a\", lo = 0.0, hi = 1.0 }", "weights = { accG = 1.0 }")
             .validate(&[])
             .unwrap_err()

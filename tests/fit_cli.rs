@@ -1,0 +1,98 @@
+//! `flexstar fit` through the built binary (`docs/measured.md` sections 4 and 5): the worked
+//! example's record-then-fit writes the calibrated experiment, which `flexstar run` then runs;
+//! bad input exits with status 1 and the file, key and reason on stderr, writing nothing.
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::{flexstar, stderr};
+
+fn config(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../configs/measured")
+        .join(name)
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Section 5, steps 1 and 3: the FEM's recording of the truth, the fit of the drawn robot to it
+/// (its files, `fit.json`'s verdict), and the calibrated experiment run by `flexstar run`.
+#[test]
+fn record_fit_and_run_the_calibrated_experiment() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = flexstar(&[
+        "run",
+        path(&config("truth.toml")),
+        "--solver",
+        "fem",
+        "--out",
+        path(&out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let rec = out.join("truth/fem-sensors.csv");
+    let o = flexstar(&[
+        "fit",
+        path(&config("nominal.toml")),
+        "--measured",
+        path(&rec),
+        "--out",
+        path(&out),
+    ]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("fit: converged") && err.contains("payload.mass"), "{err}");
+    assert!(
+        err.contains("warning: accB_x"),
+        "the unfitted channel is flagged: {err}"
+    );
+    for f in [
+        "fit.toml",
+        "fit.json",
+        "fit.md",
+        "report.html",
+        "nominal-fit-overlay.svg",
+        "nominal-fit-errors.svg",
+    ] {
+        assert!(out.join("nominal").join(f).exists(), "{f} missing");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("nominal/fit.json")).unwrap()).unwrap();
+    assert_eq!(json["calibrated"], true);
+    assert_eq!(json["identifiability"]["verdict"], "identifiable");
+    let o = flexstar(&[
+        "run",
+        path(&out.join("nominal/fit.toml")),
+        "--solver",
+        "amm",
+        "--out",
+        path(&out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// A recording without a sensor's column: status 1, the recording and the column named, nothing
+/// written.
+#[test]
+fn a_recording_without_a_column_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("rec.csv");
+    // on the run's sensor times (1 kHz over 1.3 s), without accB, enc1, enc2, enc3
+    let rows: String = (0..=1300).map(|k| format!("{},0,0\n", k as f64 / 1000.0)).collect();
+    std::fs::write(&rec, format!("t,accG_x,accG_y\n{rows}")).unwrap();
+    let out = dir.path().join("out");
+    let o = flexstar(&[
+        "fit",
+        path(&config("nominal.toml")),
+        "--measured",
+        path(&rec),
+        "--out",
+        path(&out),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("rec.csv") && err.contains("no column accB_y"), "{err}");
+    assert!(!out.join("nominal/fit.json").exists());
+}

@@ -77,3 +77,48 @@ fn bad_coefficients_are_refused_with_file_and_key() {
         assert!(!out.join("rub").exists(), "{extra}: something was written");
     }
 }
+
+/// The accurate AMM's automatic choice with friction runs its pairs at the delivered step
+/// (`docs/amm.md` 12.15): target move 1 with `mu = 0.1` at the default tolerance is solved (at
+/// the coarse step its pairs read the stick and slip events' timing, 26 %, and the choice gave
+/// up at N = 200), and its estimate lies within [0.5, 2] of its mean EVP (Eq. 45) against the
+/// refined FEM (600 elements, 1e-4 s), which `compare` measures without the estimate's code.
+#[test]
+fn the_accurate_amm_with_friction_meets_its_tolerance_and_estimates_its_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let motion = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/motions/move-centre.toml"),
+    )
+    .unwrap();
+    let cfg = dir.path().join("rub.toml");
+    std::fs::write(
+        &cfg,
+        format!("{motion}\n[friction]\nmu = 0.1\n[fem]\nelements = 600\ndt = 1e-4\n"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = common::flexstar(&[
+        "compare",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--no-figures",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let case = out.join("move-centre");
+    let csv = std::fs::read_to_string(case.join("compare.csv")).unwrap();
+    let mut lines = csv.lines().map(|l| l.split(',').collect::<Vec<_>>());
+    let header = lines.next().unwrap();
+    let amm = lines
+        .find(|r| r[0] == "amm-enriched")
+        .expect("compare.csv: the accurate AMM's row");
+    let truth: f64 = amm[header.iter().position(|h| *h == "evp_mean").unwrap()]
+        .parse()
+        .unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(case.join("amm-enriched.json")).unwrap()).unwrap();
+    let estimate = json["error_estimate_percent"].as_f64().unwrap();
+    eprintln!("mean EVP against the refined FEM {truth:.3} %, estimate {estimate:.3} %");
+    assert!(truth < 1.0, "{truth} %");
+    assert!((0.5..=2.0).contains(&(estimate / truth)), "{estimate} / {truth}");
+}

@@ -58,5 +58,5 @@ pub use robot::{ActuatorAxis, Beam, Robot};
 pub use robot_geometry::{FeasibilityKey, RobotGeometry};
 pub use sensors::{SensorSpec, SensorTable, Sensors};
 pub use shaper::{Impulse, ShaperKind, ShaperSection};
-pub use sidecar::{DwellKeys, ResidualKeys, RunSidecar, ValidityExceeded};
+pub use sidecar::{DwellKeys, FrictionRestKeys, ResidualKeys, RunSidecar, ValidityExceeded};
 pub use trajectory::{Pose, ShapedMotion, Trajectory};

@@ -155,5 +155,40 @@ fn attachments(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, paper_cases, accurate_model, direct_vs_inverse, attachments);
+/// Friction (`docs/friction.md` 6, 9): the accurate model at its defaults on the four paper cases,
+/// without friction and with Coulomb friction in the sleeves (`mu = 0.1`, normal load); target at
+/// most 1.5 times the frictionless time.
+fn friction(c: &mut Criterion) {
+    let mut group = c.benchmark_group("amm_friction");
+    group.sample_size(10);
+    let settings = flexstar_model::AmmSettings::accurate();
+    for case in [1, 2, 3, 4] {
+        let bare = common::paper_case(case);
+        let mut rubbing = bare.clone();
+        rubbing.friction = Some(flexstar_model::Friction {
+            mu: flexstar_model::robot_section::PerBeam([0.1; 3]),
+            ..Default::default()
+        });
+        for (label, exp) in [("frictionless", &bare), ("mu0.1", &rubbing)] {
+            group.bench_function(format!("case{case}_{label}"), |b| {
+                let problem = exp.problem().unwrap();
+                b.iter(|| {
+                    flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+                        .map(|s| s.response)
+                        .unwrap()
+                })
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    paper_cases,
+    accurate_model,
+    direct_vs_inverse,
+    attachments,
+    friction
+);
 criterion_main!(benches);

@@ -141,13 +141,18 @@ pub const MIN_ESTIMATE_ROWS: usize = 20;
 /// The coarse output grid of the estimate's runs for a delivered step `h` [s]: its interval is
 /// `every` times `problem.time.dt_out`, the first multiple at least [`ESTIMATE_STEP_FACTOR`] h, so that
 /// its times are a subset of the delivered ones. `None` (pairs at the delivered step) when that grid
-/// would have fewer than [`MIN_ESTIMATE_ROWS`] rows.
+/// would have fewer than [`MIN_ESTIMATE_ROWS`] rows, or with friction (`docs/amm.md` 12.15: a run
+/// resolves its stick and slip events to its own step, so a pair at the coarse step differs by
+/// the events' timing, not by the truncation).
 pub fn estimate_grid(problem: &Problem, h: f64) -> Option<usize> {
     estimate_grid_of(&Star::new(problem), h)
 }
 
 /// [`estimate_grid`] of the AMM's view of a problem.
 pub(crate) fn estimate_grid_of(problem: &Star, h: f64) -> Option<usize> {
+    if problem.friction.is_some() {
+        return None;
+    }
     let every = output_multiple(problem, ESTIMATE_STEP_FACTOR * h);
     let rows = (problem.time.t_end / (every as f64 * problem.time.dt_out) - 1e-9).ceil() + 1.0;
     (rows >= MIN_ESTIMATE_ROWS as f64).then_some(every)

@@ -689,6 +689,7 @@ mod tests {
             shaper: None,
             report: Default::default(),
             sensors: Vec::new(),
+            measured: None,
             fit: None,
             source: Default::default(),
             hash: String::new(),

@@ -132,6 +132,7 @@ pub fn fit_json(o: &FitOutcome) -> Value {
             "s2": st.s2,
             "t_quantile": st.t_quantile,
         },
+        "not_recorded": f.not_recorded,
         "channels": fit.channels.iter().map(|c| json!({
             "column": c.column,
             "unit": c.unit,
@@ -183,6 +184,13 @@ pub fn fit_markdown(o: &FitOutcome) -> String {
         fit.wall_s,
         o.wall_s,
     );
+    if !f.not_recorded.is_empty() {
+        let _ = writeln!(
+            s,
+            "Not in the recording, so not fitted: {}.\n",
+            f.not_recorded.join(", ")
+        );
+    }
     estimates_table(&mut s, f);
     correlation_table(&mut s, f);
     channels_table(&mut s, f);

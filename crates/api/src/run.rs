@@ -448,8 +448,11 @@ pub fn residual_line(sidecar: &flexstar_model::RunSidecar) -> Option<String> {
         _ => String::new(),
     };
     let tol = finite(keys.settle_tol).unwrap_or(f64::NAN);
+    let friction = keys.friction.as_ref().map_or(String::new(), |f| {
+        format!("; {}", flexstar_metrics::residual::friction_rest_text(f))
+    });
     Some(format!(
-        "after t_rest = {} s: peak |dG| = {g}, peak |tip| = {tip:.3e} m, {settle} (band {} m){sliders}",
+        "after t_rest = {} s: peak |dG| = {g}, peak |tip| = {tip:.3e} m, {settle} (band {} m){sliders}{friction}",
         flexstar_io::output::fmt_sig(t_rest, 5),
         flexstar_io::output::fmt_display(tol)
     ))

@@ -345,19 +345,19 @@ fn bad_input_is_refused_with_file_key_and_reason() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("fit.params[1].key") && e.contains("give start"), "{e}");
-    // the recording: a column missing, other times
+    // the recording: none of the fitted columns (accB_x has weight 0), other times, a bad cell
     let input = ExperimentDoc::load(&config("nominal.toml")).unwrap();
-    let mut short = rec.clone();
-    short.columns.retain(|c| c.name != "enc2");
-    let e = fit_experiment(&input, &short, "rec.csv", &quiet)
+    let mut only_b = rec.clone();
+    only_b.columns.retain(|c| c.name == "accB_x");
+    let e = fit_experiment(&input, &only_b, "rec.csv", &quiet)
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("rec.csv") && e.contains("no column enc2") && e.contains("weight 0"),
+        e.contains("rec.csv") && e.contains("none of the fitted") && e.contains("accB_y"),
         "{e}"
     );
     let mut late = rec.clone();
-    late.t.iter_mut().for_each(|t| *t += 0.002);
+    late.t.iter_mut().for_each(|t| *t += 0.0005);
     let e = fit_experiment(&input, &late, "rec.csv", &quiet)
         .unwrap_err()
         .to_string();
@@ -367,21 +367,25 @@ fn bad_input_is_refused_with_file_key_and_reason() {
     );
     let bad_csv = dir.path().join("bad.csv");
     std::fs::write(&bad_csv, "t,accG_x\n0,1\n0.001,x\n").unwrap();
-    let e = flexstar_api::fit::read_recording(&bad_csv).unwrap_err().to_string();
-    assert!(
-        e.contains("bad.csv") && e.contains("row 3") && e.contains("not a number"),
-        "{e}"
-    );
+    let e = flexstar_api::fit::fit_file(&input, &bad_csv, &quiet)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad.csv") && e.contains("column accG_x"), "{e}");
 }
 
 /// A search cut at one iteration does not converge: `fit.json` says so with its last estimates,
-/// no `fit.toml` is written and an older one is removed.
+/// no `fit.toml` is written and an older one is removed. The recording holds the accelerometers
+/// only: the encoders are reported as not fitted.
 #[test]
 fn a_fit_cut_short_writes_no_fit_toml() {
     let dir = tempfile::tempdir().unwrap();
     let truth = flexstar_api::load(&config("truth.toml")).unwrap();
+    // a recording without the encoders: fitted on the accelerometers alone
     let recording = dir.path().join("amm-sensors.csv");
-    readings(noiseless(truth), Solver::Amm).write_csv(&recording).unwrap();
+    let mut rec = readings(noiseless(truth), Solver::Amm);
+    rec.columns.retain(|c| !c.name.starts_with("enc"));
+    rec.units.truncate(rec.columns.len());
+    rec.write_csv(&recording).unwrap();
     let text = std::fs::read_to_string(config("nominal.toml"))
         .unwrap()
         .replace("[fit]\n", "[fit]\nmax_iterations = 1\n");
@@ -392,6 +396,7 @@ fn a_fit_cut_short_writes_no_fit_toml() {
     std::fs::write(out.join("nominal/fit.toml"), "# an older calibration\n").unwrap();
     let o = fit_to_dir(&cfg, &recording, &out, &quiet).unwrap();
     assert!(!o.fitted.fit.converged() && o.fitted.calibrated.is_none());
+    assert_eq!(o.fitted.not_recorded, ["enc1", "enc2", "enc3"]);
     assert!(!out.join("nominal/fit.toml").exists());
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("nominal/fit.json")).unwrap()).unwrap();

@@ -110,5 +110,33 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+/// Friction (`docs/friction.md` 6, 8): the four paper cases at 300 elements, without friction and
+/// with Coulomb friction in the sleeves (`mu = 0.1`, normal load); target at most 1.5 times the
+/// frictionless time.
+fn friction(c: &mut Criterion) {
+    let mut g = c.benchmark_group("fem_friction");
+    g.sample_size(10);
+    let settings = FemSettings::default();
+    for case in [1, 2, 3, 4] {
+        let bare = catalogue::paper_case(case);
+        let mut rubbing = bare.clone();
+        rubbing.friction = Some(flexstar_model::Friction {
+            mu: flexstar_model::robot_section::PerBeam([0.1; 3]),
+            ..Default::default()
+        });
+        for (label, exp) in [("frictionless", &bare), ("mu0.1", &rubbing)] {
+            g.bench_function(format!("case{case}_{label}"), |b| {
+                let problem = exp.problem().unwrap();
+                b.iter(|| {
+                    flexstar_fem::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+                        .map(|s| s.response)
+                        .unwrap()
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, friction);
 criterion_main!(benches);

@@ -2,3 +2,15 @@
 //!
 //! What a researcher brings from the real robot, and what can be read from it without a model
 //! (`docs/measured.md`). Data in, numbers out: no solver, no files written.
+//!
+//! - [`recording`]: a CSV recording read, mapped onto the experiment's sensor columns, scaled,
+//!   shifted onto the run's clock (given or estimated, [`offset`]) and resampled onto the run's
+//!   sensor times (section 1).
+
+pub mod csv_table;
+pub mod error;
+pub mod offset;
+pub mod recording;
+
+pub use error::MeasuredError;
+pub use recording::{Channel, Recording};

@@ -6,6 +6,7 @@
 //! the last dwell, whose window is `residual_after`'s, is a check of both (the equality is tested
 //! through the binary, `tests/residual.rs`).
 
+use crate::friction_rest::FrictionRest;
 use flexstar_model::sidecar::DwellKeys;
 use flexstar_model::{Response, Trajectory};
 
@@ -142,7 +143,13 @@ pub fn dwell_residual(
         );
         return keys;
     }
-    let offset = r.rest_offset.unwrap_or_default();
+    // with friction about the rest state the dwell ends in, once every sleeve has stuck
+    // (docs/friction.md 5)
+    let rest = crate::friction_rest::friction_rest_before(r, t1, hold);
+    let offset = match rest {
+        Some(FrictionRest::Stuck(o)) => o,
+        _ => r.rest_offset.unwrap_or_default(),
+    };
     let t: Vec<f64> = rows.iter().map(|&k| r.t[k]).collect();
     let dg: Vec<f64> = rows
         .iter()

@@ -9,6 +9,7 @@
 pub mod dwell;
 pub mod envelope;
 pub mod evp;
+pub mod friction_rest;
 pub mod residual;
 pub mod validity;
 

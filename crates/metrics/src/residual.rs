@@ -12,6 +12,8 @@ use serde::Serialize;
 use flexstar_model::sidecar::ResidualKeys;
 use flexstar_model::Response;
 
+use crate::friction_rest::{friction_rest, FrictionRest};
+
 /// |dG| [m] from the projections `w_iG` [m] on the three rigid beam frames (Eq. R1).
 pub fn dg_magnitude(w_g: [f64; 3]) -> f64 {
     (2.0 / 3.0 * (w_g[0] * w_g[0] + w_g[1] * w_g[1] + w_g[2] * w_g[2])).sqrt()
@@ -65,6 +67,11 @@ pub struct Residual {
     /// A servo's run: the largest of the three tracking errors at `t_end` [m]: how far the
     /// sliders still are from where the motion put them.
     pub tracking_end_m: Option<f64>,
+    /// A run with friction: the rest state the measures above are taken about, or the sleeve
+    /// still slipping at the end (the measures then about the rest state without friction, to
+    /// which the star still relaxes; `docs/friction.md` 5).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_rest: Option<FrictionRest>,
 }
 
 impl Residual {
@@ -75,20 +82,27 @@ impl Residual {
 }
 
 /// The residual of `r` after `t_rest` [s]: peaks and RMS of |dG| and of the tips (about the
-/// static equilibrium of the rest pose, `Response::rest_offset`, under gravity), and the
-/// settling time in the band `settle_tol` [m]. Settled when the run ends with at least `hold_s`
-/// [s] below the band after its last excursion (one period of the first elastic mode at the final
-/// pose: an undamped oscillation above the band leaves it at least twice a period, so it never
-/// counts as settled). `None` when fewer than two output times lie at or after `t_rest`.
+/// static equilibrium of the rest pose, `Response::rest_offset`, under gravity; with friction
+/// about the rest state the run ends in once every sleeve has stuck, [`friction_rest`],
+/// `docs/friction.md` 5), and the settling time in the band `settle_tol` [m]. Settled when the run
+/// ends with at least `hold_s` [s] below the band after its last excursion (one period of the
+/// first elastic mode at the final pose: an undamped oscillation above the band leaves it at
+/// least twice a period, so it never counts as settled). `None` when fewer than two output times
+/// lie at or after `t_rest`.
 pub fn residual_after(r: &Response, t_rest: f64, settle_tol: f64, hold_s: f64) -> Option<Residual> {
     let first = r.t.partition_point(|&t| t < t_rest - 1e-12);
     if r.t.len() < first + 2 {
         return None;
     }
     let t = &r.t[first..];
-    // about the static equilibrium where the motion rests (under gravity; else zero)
-    let offset = r.rest_offset.unwrap_or_default();
-    let w_g = |i: usize, k: usize| r.w_g_about_rest(i, k);
+    // about the static equilibrium where the motion rests (under gravity; else zero), or with
+    // friction about the rest state the run ends in
+    let rest = friction_rest(r, hold_s);
+    let offset = match rest {
+        Some(FrictionRest::Stuck(o)) => o,
+        _ => r.rest_offset.unwrap_or_default(),
+    };
+    let w_g = |i: usize, k: usize| r.w_g[i][k] - offset.w_g[i];
     let w_tip = |i: usize, k: usize| r.w_tip[i][k] - offset.w_tip[i];
     let dg: Vec<f64> = (first..r.t.len())
         .map(|k| dg_magnitude([w_g(0, k), w_g(1, k), w_g(2, k)]))
@@ -130,6 +144,7 @@ pub fn residual_after(r: &Response, t_rest: f64, settle_tol: f64, hold_s: f64) -
         settle_predicted_s,
         tracking_peak_m: tracking.map(|(peak, _)| peak),
         tracking_end_m: tracking.map(|(_, end)| end),
+        friction_rest: rest,
     })
 }
 
@@ -297,6 +312,7 @@ pub fn sidecar_keys(res: Option<&Residual>, settle_tol: f64, g_pinned: bool) -> 
         tracking_end_m: tracking.map(|r| r.tracking_end_m),
         residual_note: None,
         dwells: None,
+        friction: res.and_then(|r| r.friction_rest).map(friction_keys),
     };
     if g_pinned && res.is_some() {
         keys.g_peak_m = None;
@@ -308,6 +324,37 @@ pub fn sidecar_keys(res: Option<&Residual>, settle_tol: f64, g_pinned: bool) -> 
         keys.residual_note = Some("G is pinned in this family".into());
     }
     keys
+}
+
+/// The sidecar's `residual_friction` of a run with friction (`docs/friction.md` 5).
+fn friction_keys(rest: FrictionRest) -> flexstar_model::FrictionRestKeys {
+    match rest {
+        FrictionRest::Stuck(o) => flexstar_model::FrictionRestKeys {
+            rest_g_m: Some(dg_magnitude(o.w_g)),
+            rest_w_g_m: Some(o.w_g),
+            slipping_sleeve: None,
+            slipping_t: None,
+        },
+        FrictionRest::Slipping { sleeve, t } => flexstar_model::FrictionRestKeys {
+            rest_g_m: None,
+            rest_w_g_m: None,
+            slipping_sleeve: Some(sleeve),
+            slipping_t: Some(t),
+        },
+    }
+}
+
+/// What a report adds for a run with friction (`docs/friction.md` 5): the rest offset the
+/// residual is measured about, or the sleeve that keeps the run from settling.
+pub fn friction_rest_text(keys: &flexstar_model::FrictionRestKeys) -> String {
+    match (keys.rest_g_m, keys.slipping_sleeve, keys.slipping_t) {
+        (Some(g), _, _) => format!("about the rest state friction holds (|dG| = {g:.3e} m, every sleeve stuck)"),
+        (None, Some(i), Some(t)) => format!(
+            "sleeve {i} still slips at t = {t:.3} s: measured about the rest state without friction, to which the \
+             star still relaxes"
+        ),
+        _ => "no rest state".to_string(),
+    }
 }
 
 #[cfg(test)]

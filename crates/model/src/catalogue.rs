@@ -45,6 +45,7 @@ pub fn experiment(name: &str, robot: RobotParams, trajectory: Trajectory, t_end:
         shaper: None,
         report: Default::default(),
         sensors: Vec::new(),
+        measured: None,
         fit: None,
         source: Default::default(),
         hash: String::new(),

@@ -440,6 +440,10 @@ pub struct Experiment {
     /// then absent from the resolved experiment).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sensors: Vec<crate::sensors::SensorSpec>,
+    /// How a recording maps onto the sensors' columns (`[measured]`, `docs/measured.md` section
+    /// 1); none by default (and then absent from the resolved experiment).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured: Option<crate::measured_section::MeasuredSection>,
     /// The parameters `flexstar fit` calibrates on a recording (`[fit]`, `docs/measured.md`
     /// section 4); none by default (and then absent from the resolved experiment). Other commands
     /// read past it.

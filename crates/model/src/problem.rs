@@ -170,7 +170,10 @@ pub(crate) fn check_physics(exp: &Experiment) -> Result<Robot, ModelError> {
     if let Some(f) = &exp.friction {
         f.validate()?;
     }
-    sensors_of(exp, &robot)?;
+    let sensors = sensors_of(exp, &robot)?;
+    if let Some(m) = &exp.measured {
+        m.validate(&sensors.columns(), exp.time.t_end)?;
+    }
     Ok(robot)
 }
 

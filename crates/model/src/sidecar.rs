@@ -55,6 +55,28 @@ pub struct ResidualKeys {
     /// `t_end`). The last entry is the window of the keys above.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dwells: Option<Vec<DwellKeys>>,
+    /// A run with friction (`docs/friction.md` 5): the rest state the keys above are measured
+    /// about, or the sleeve still slipping at the end; the key only for such a run.
+    #[serde(rename = "residual_friction", default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionRestKeys>,
+}
+
+/// How a run with friction ends (`docs/friction.md` 5): every sleeve stuck over the last hold
+/// window, with the rest state's elastic displacement of G, or a sleeve still slipping.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrictionRestKeys {
+    /// |dG| of the rest state [m] (Eq. R1 of `docs/motions.md` 2.1): the offset friction holds.
+    /// Null while a sleeve slips.
+    #[serde(rename = "rest_G_m")]
+    pub rest_g_m: Option<f64>,
+    /// `w_iG` of the rest state [m], each in its beam's rigid frame. Null while a sleeve slips.
+    #[serde(rename = "rest_w_G_m")]
+    pub rest_w_g_m: Option<[f64; 3]>,
+    /// The sleeve (1-3) still slipping in the last hold window, the last such time [s]; null
+    /// when all are stuck. The keys above are then measured about the rest state without
+    /// friction (the static sag under gravity, else zero), to which the star still relaxes.
+    pub slipping_sleeve: Option<usize>,
+    pub slipping_t: Option<f64>,
 }
 
 /// The residual vibration and settling of one dwell (`docs/motions.md` 2.5): the interval from

@@ -143,14 +143,14 @@ pub fn freqmap<'py>(
 #[pyfunction]
 #[pyo3(signature = (config, out))]
 pub fn plan<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    if flexstar_api::plan_cycle::is_cycle(&config).map_err(py_err)? {
+        return plan_cycle(py, config, out);
+    }
     let o = interrupt::interruptible(py, "flexstar.plan", false, |_| {
         flexstar_api::plan::plan_to_dir(&config, &out, |_| {})
     })?
     .map_err(py_err)?;
-    for note in &o.notes {
-        let text = std::ffi::CString::new(note.trim_start_matches("note: ")).unwrap_or_default();
-        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &text, 1)?;
-    }
+    warn_notes(py, &o.notes)?;
     let d = PyDict::new(py);
     d.set_item("dir", o.dir.display().to_string())?;
     d.set_item("plan_toml", o.dir.join("plan.toml").display().to_string())?;
@@ -159,13 +159,69 @@ pub fn plan<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bou
     d.set_item("evaluations", o.planned.evaluations)?;
     d.set_item("reason", o.planned.reason.clone())?;
     d.set_item("warnings", o.planned.warnings.clone())?;
+    d.set_item("residual_G_peak_m", motion_peaks(py, &o.motions)?)?;
+    Ok(d)
+}
+
+/// A whole cycle (`[plan] points`, `docs/motions.md` 4.12), as `flexstar plan` plans it: the
+/// dict of a single move's plan with per-move lists (`moves`: `t_start`, `t_move`,
+/// `evaluations`, `reason`, `warnings`) and the residual per dwell (`dwells`: `dwell`,
+/// `t_start`, `t_end`, `plain` and `planned` as `(AMM, FEM)` residual peaks of |dG| [m],
+/// `ratio_fem`).
+fn plan_cycle<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    let o = interrupt::interruptible(py, "flexstar.plan", false, |_| {
+        flexstar_api::plan_cycle::plan_cycle_to_dir(&config, &out, |_| {})
+    })?
+    .map_err(py_err)?;
+    warn_notes(py, &o.notes)?;
+    let d = PyDict::new(py);
+    d.set_item("dir", o.dir.display().to_string())?;
+    d.set_item("plan_toml", o.dir.join("plan.toml").display().to_string())?;
+    d.set_item("plan_csv", o.dir.join("plan.csv").display().to_string())?;
+    let moves = pyo3::types::PyList::empty(py);
+    for m in &o.planned.moves {
+        let e = PyDict::new(py);
+        e.set_item("t_start", m.span.t_start)?;
+        e.set_item("t_move", m.planned.t_move)?;
+        e.set_item("evaluations", m.planned.evaluations)?;
+        e.set_item("reason", m.planned.reason.clone())?;
+        e.set_item("warnings", m.planned.warnings.clone())?;
+        moves.append(e)?;
+    }
+    d.set_item("moves", moves)?;
+    let dwells = pyo3::types::PyList::empty(py);
+    for w in &o.dwells {
+        let e = PyDict::new(py);
+        e.set_item("dwell", w.dwell)?;
+        e.set_item("t_start", w.t_start)?;
+        e.set_item("t_end", w.t_end)?;
+        e.set_item("plain", (w.plain_amm_m, w.plain_fem_m))?;
+        e.set_item("planned", (w.planned_amm_m, w.planned_fem_m))?;
+        e.set_item("ratio_fem", w.ratio_fem)?;
+        dwells.append(e)?;
+    }
+    d.set_item("dwells", dwells)?;
+    d.set_item("residual_G_peak_m", motion_peaks(py, &o.motions)?)?;
+    Ok(d)
+}
+
+/// The notes of a plan as Python warnings.
+fn warn_notes(py: Python<'_>, notes: &[String]) -> PyResult<()> {
+    for note in notes {
+        let text = std::ffi::CString::new(note.trim_start_matches("note: ")).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &text, 1)?;
+    }
+    Ok(())
+}
+
+/// `{motion: (AMM, FEM)}`: each motion's residual peak of |dG| after its rest [m].
+fn motion_peaks<'py>(py: Python<'py>, motions: &[flexstar_api::plan::MotionRuns]) -> PyResult<Bound<'py, PyDict>> {
     let peaks = PyDict::new(py);
-    for m in &o.motions {
+    for m in motions {
         let peak = |r: &flexstar_api::RunOutcome| r.residual_g_peak_m();
         peaks.set_item(m.key, (peak(&m.amm), peak(&m.fem)))?;
     }
-    d.set_item("residual_G_peak_m", peaks)?;
-    Ok(d)
+    Ok(peaks)
 }
 
 /// Calibrate the parameters of `[fit]` on a recording (as `flexstar fit`; docs/measured.md

@@ -319,3 +319,25 @@ def test_run_sensors_encoder_is_the_rigid_slider_position(root, tmp_path, solver
     d.pop("sensors")
     plain = flexstar.run(flexstar.Experiment.from_dict(d, source=str(root / "configs/case3.toml")), solver=solver)
     assert plain.sensors == {}
+
+
+def test_plan_of_a_whole_cycle_reports_each_move_and_dwell(root, tmp_path):
+    """flexstar.plan plans a cycle (`[plan] points`, docs/motions.md 4.12) as `flexstar plan`
+    does: one entry per move and per dwell; each dwell's residual peaks are those of the runs'
+    `-dwells.csv` files the command writes (read here); the planned cycle's table has the pose
+    and slider columns. The planner's budget is cut to keep the test short: the 1/20 target of
+    the cycle is checked by the Rust test of `flexstar plan` (tests/plan_cycle.rs)."""
+    text = (root / "configs/motions/plan-pick-place.toml").read_text().replace("budget_s = 60", "budget_s = 2")
+    cfg = tmp_path / "cycle.toml"
+    cfg.write_text(text)
+    res = flexstar.plan(cfg, tmp_path / "out")
+    assert len(res["moves"]) == 2 and len(res["dwells"]) == 2
+    assert [m["t_start"] for m in res["moves"]] == pytest.approx([0.0, 0.7])
+    assert all(m["t_move"] == pytest.approx(0.4) for m in res["moves"])
+    header = pathlib.Path(res["plan_csv"]).read_text().splitlines()[0]
+    assert header == "t,Gx,Gy,theta,s1,s2,s3"
+    for motion, stem in (("plain", "plain"), ("planned", "planned")):
+        rows = (pathlib.Path(res["dir"]) / stem / "fem-dwells.csv").read_text().splitlines()
+        cols = rows[0].split(",")
+        peaks = [float(r.split(",")[cols.index("G_peak_m")]) for r in rows[1:]]
+        assert [d[motion][1] for d in res["dwells"]] == pytest.approx(peaks, rel=1e-12)

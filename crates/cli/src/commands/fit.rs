@@ -10,7 +10,8 @@ use std::path::PathBuf;
 pub struct Args {
     /// Experiment with [fit] and [[sensors]]: the recorded move, the values to start from
     config: PathBuf,
-    /// The recording: a CSV with t and the sensors' columns on the run's sensor times
+    /// The recording: a CSV of t and sensor columns, read as the experiment's [measured] maps it
+    /// (docs/measured.md section 1)
     #[arg(long)]
     measured: PathBuf,
     /// Output directory; results go to DIR/<name>/
@@ -33,6 +34,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     })?;
     for n in &outcome.notes {
         eprintln!("{n}");
+    }
+    if !outcome.fitted.not_recorded.is_empty() {
+        eprintln!(
+            "note: not in the recording, so not fitted: {}",
+            outcome.fitted.not_recorded.join(", ")
+        );
     }
     let fit = &outcome.fitted.fit;
     eprintln!("fit: {}", fit.reason);

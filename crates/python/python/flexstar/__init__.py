@@ -322,8 +322,12 @@ def plan(config: "os.PathLike[str] | str", out: "os.PathLike[str] | str" = "out"
     plan.json, plan.md, the plain, ZVD-shaped and planned runs on the AMM and the FEM, figures).
     Returns the folder, the paths of plan.toml and plan.csv, the move time, the search's
     evaluations and stop reason, and ``residual_G_peak_m``: for ``plain``, ``zvd`` and
-    ``planned`` the ``(AMM, FEM)`` residual peaks of |dG| after the move [m]. Errors:
-    ConfigError (naming file and key), SolverError."""
+    ``planned`` the ``(AMM, FEM)`` residual peaks of |dG| after the move [m]. A whole cycle
+    (``[plan] points``, docs/motions.md 4.12) is planned as the command plans it: the dict then
+    has ``moves`` (per move: ``t_start``, ``t_move``, ``evaluations``, ``reason``, ``warnings``)
+    and ``dwells`` (per dwell: ``dwell``, ``t_start``, ``t_end``, ``plain`` and ``planned`` as
+    ``(AMM, FEM)`` residual peaks of |dG| in the dwell [m], ``ratio_fem``). Errors: ConfigError
+    (naming file and key), SolverError."""
     return _flexstar.plan(os.fspath(config), os.fspath(out))
 
 

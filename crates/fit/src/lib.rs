@@ -18,6 +18,7 @@ pub mod outcome;
 pub mod problem;
 pub mod search;
 pub mod stats;
+mod step;
 
 pub use identifiability::{Combination, Identifiability, Verdict};
 pub use outcome::{ChannelFit, Estimate, Fit, Iteration, Stop};

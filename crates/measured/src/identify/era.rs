@@ -38,15 +38,15 @@ impl Plan {
     /// `f_max` [Hz] and the orders `[lo, hi]` (3.2): at most [`MAX_HANKEL_ROWS`] rows, enough for
     /// the largest order, block rows spanning [`ROW_SPAN`] of the window with the stride that
     /// keeps the band below the stride's Nyquist frequency.
-    pub fn new(n: usize, m: usize, dt: f64, f_max: f64, orders: [usize; 2]) -> Result<Self, MeasuredError> {
-        let rows = (MAX_HANKEL_ROWS / m).max((orders[1] + 2).div_ceil(m)).max(2);
+    pub fn new(n: usize, m: usize, dt: f64, f_max: f64, range: [usize; 2]) -> Result<Self, MeasuredError> {
+        let rows = (MAX_HANKEL_ROWS / m).max((range[1] + 2).div_ceil(m)).max(2);
         let span = ((n as f64) * ROW_SPAN) as usize;
         let band_stride = ((1.0 / dt) / (2.0 * NYQUIST_MARGIN * f_max)).floor().max(1.0) as usize;
         let stride = (span / rows).clamp(1, band_stride);
         let rows = rows.min((span / stride).max(2));
         let cols = n.saturating_sub(rows * stride);
         let rank = (rows * m).min(cols);
-        let orders: Vec<usize> = (orders[0].next_multiple_of(2)..=orders[1])
+        let orders: Vec<usize> = (range[0].next_multiple_of(2)..=range[1])
             .step_by(2)
             .filter(|&o| o < rank)
             .collect();
@@ -55,9 +55,8 @@ impl Plan {
                 "window",
                 format!(
                     "{n} samples of {m} channel(s) give Hankel matrices of rank at most {rank}: \
-                     too few for two orders of [{}, {}]",
-                    orders.first().copied().unwrap_or(0),
-                    orders.last().copied().unwrap_or(0)
+                     too few for two even orders of [{}, {}]",
+                    range[0], range[1]
                 ),
             ));
         }

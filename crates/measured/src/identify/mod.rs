@@ -166,12 +166,8 @@ fn normalised(window: &window::Window) -> Vec<Vec<f64>> {
     window
         .y
         .iter()
-        .map(|y| {
-            let n = y.len() as f64;
-            let mean = y.iter().sum::<f64>() / n;
-            let rms = (y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
-            y.iter().map(|v| v / rms).collect()
-        })
+        .zip(window.rms())
+        .map(|(y, rms)| y.iter().map(|v| v / rms).collect())
         .collect()
 }
 

@@ -13,7 +13,7 @@ use super::window::Window;
 
 /// Most Levenberg-Marquardt iterations of one fit.
 const MAX_ITERATIONS: usize = 200;
-/// Initial damping, relative to the largest diagonal entry of `J^T J`.
+/// Initial damping: this share of the diagonal of `J^T J` is added to it (Marquardt's scaling).
 const MU0: f64 = 1e-3;
 /// Damping at which a fit stops (no step lowers the residual any more).
 const MU_MAX: f64 = 1e12;
@@ -24,6 +24,9 @@ const STEP_TOLERANCE: f64 = 1e-10;
 const STALL: f64 = 1e-12;
 /// Largest lag-1 correlation of a residual taken into Eq. I11.
 const RHO_MAX: f64 = 0.99;
+/// Smallest noise level of a channel, relative to its RMS (Eq. I9): a record that the fit holds
+/// to round-off keeps finite weights.
+const NOISE_FLOOR: f64 = 1e-15;
 /// False-alarm probability of the significance test of a mode (Eq. I8), over the whole record.
 pub(crate) const FALSE_ALARM: f64 = 1e-3;
 
@@ -54,13 +57,13 @@ pub(crate) struct Limits {
 /// limits, is not identifiable (`zeta_std >= zeta`), is not significant (Eq. I8) or makes the
 /// problem singular is dropped (the weakest first) and the rest fitted again.
 pub(crate) fn fit(window: &Window, starts: &[Start], limits: Limits) -> Result<Vec<Fitted>, MeasuredError> {
-    let first = Problem::new(window, signal_weights(window));
+    let first = Problem::new(window, window.rms().iter().map(|r| 1.0 / r).collect());
     let theta = first.levenberg_marquardt(parameters(starts.iter().map(|s| s.s)));
     let weights: Vec<f64> = first
         .noise_levels(&theta)
         .iter()
         .zip(&first.weights)
-        .map(|(sigma, w)| w / sigma.max(f64::MIN_POSITIVE.sqrt()))
+        .map(|(sigma, w)| w / sigma.max(NOISE_FLOOR))
         .collect();
     let problem = Problem::new(window, weights);
     let mut kept: Vec<Start> = starts.to_vec();
@@ -94,18 +97,12 @@ fn poles(theta: &[f64]) -> Vec<c64> {
     theta.chunks_exact(2).map(|p| c64::new(p[0], p[1])).collect()
 }
 
-/// `1 / rms` of each channel about its mean (the first pass's weights).
-fn signal_weights(window: &Window) -> Vec<f64> {
-    window
-        .y
-        .iter()
-        .map(|y| {
-            let n = y.len() as f64;
-            let mean = y.iter().sum::<f64>() / n;
-            let var = y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
-            1.0 / var.sqrt()
-        })
-        .collect()
+/// An accepted Levenberg-Marquardt step.
+struct Accepted {
+    theta: Vec<f64>,
+    proj: Projection,
+    /// The step was below [`STEP_TOLERANCE`] or the sum of squares stalled.
+    converged: bool,
 }
 
 /// The weighted data of one fit.
@@ -204,63 +201,66 @@ impl<'a> Problem<'a> {
     }
 
     /// Levenberg-Marquardt on the projected residual from `theta` (Marquardt's scaling by the
-    /// diagonal of `J^T J`); stops when no pole moves by [`STEP_TOLERANCE`] of its modulus or no
-    /// step lowers the residual. Every iterate keeps `Im s > 0`.
+    /// diagonal of `J^T J`); stops when no pole moves by [`STEP_TOLERANCE`] of its modulus, the
+    /// sum of squares stalls ([`STALL`]) or no step lowers it. Every iterate keeps `Im s > 0`.
     fn levenberg_marquardt(&self, mut theta: Vec<f64>) -> Vec<f64> {
         let mut proj = self.project(&theta);
-        let mut cost = dot(&proj.r, &proj.r);
-        let mut mu = None;
+        let mut mu = MU0;
         for _ in 0..MAX_ITERATIONS {
-            let jac = self.jacobian(&theta, &proj);
-            let jtj = jac.transpose() * &jac;
-            let g = jac.transpose() * Mat::from_fn(proj.r.len(), 1, |k, _| proj.r[k]);
-            let top = (0..jtj.nrows()).map(|i| jtj[(i, i)]).fold(0.0, f64::max);
-            if top == 0.0 {
+            let Some(step) = self.damped_step(&theta, &proj, &mut mu) else {
+                break;
+            };
+            theta = step.theta;
+            proj = step.proj;
+            if step.converged {
                 break;
             }
-            let mu = mu.get_or_insert(MU0);
-            let mut moved = None;
-            while *mu < MU_MAX {
-                let a = Mat::from_fn(jtj.nrows(), jtj.ncols(), |i, j| {
-                    jtj[(i, j)] + if i == j { *mu * (jtj[(i, i)] + 1e-12 * top) } else { 0.0 }
-                });
-                let Ok(llt) = a.llt(Side::Lower) else {
-                    *mu *= 4.0;
-                    continue;
-                };
-                let step: Vec<f64> = llt.solve(-&g).col(0).iter().copied().collect();
-                let trial: Vec<f64> = theta.iter().zip(&step).map(|(t, d)| t + d).collect();
-                if trial
-                    .chunks_exact(2)
-                    .any(|p| p[1].is_nan() || p[1] <= 0.0 || !p[0].is_finite())
-                {
-                    *mu *= 4.0;
-                    continue;
-                }
-                let pt = self.project(&trial);
-                let ct = dot(&pt.r, &pt.r);
-                if ct < cost {
-                    let previous = cost;
-                    let largest = trial
+        }
+        theta
+    }
+
+    /// The first step from `theta` that lowers the sum of squares, raising the damping `mu` (x4)
+    /// until one does and lowering it (/3) after; `None` when none does below [`MU_MAX`].
+    fn damped_step(&self, theta: &[f64], proj: &Projection, mu: &mut f64) -> Option<Accepted> {
+        let jac = self.jacobian(theta, proj);
+        let jtj = jac.transpose() * &jac;
+        let g = jac.transpose() * Mat::from_fn(proj.r.len(), 1, |k, _| proj.r[k]);
+        let top = (0..jtj.nrows()).map(|i| jtj[(i, i)]).fold(0.0, f64::max);
+        if top == 0.0 {
+            return None;
+        }
+        let cost = dot(&proj.r, &proj.r);
+        while *mu < MU_MAX {
+            let a = Mat::from_fn(jtj.nrows(), jtj.ncols(), |i, j| {
+                jtj[(i, j)] + if i == j { *mu * (jtj[(i, i)] + 1e-12 * top) } else { 0.0 }
+            });
+            let Ok(llt) = a.llt(Side::Lower) else {
+                *mu *= 4.0;
+                continue;
+            };
+            let step: Vec<f64> = llt.solve(-&g).col(0).iter().copied().collect();
+            let trial: Vec<f64> = theta.iter().zip(&step).map(|(t, d)| t + d).collect();
+            let valid = trial.chunks_exact(2).all(|p| p[0].is_finite() && p[1] > 0.0);
+            let next = valid.then(|| self.project(&trial));
+            match next {
+                Some(next) if dot(&next.r, &next.r) < cost => {
+                    let moved = trial
                         .chunks_exact(2)
                         .zip(step.chunks_exact(2))
                         .map(|(p, d)| d[0].hypot(d[1]) / p[0].hypot(p[1]))
                         .fold(0.0, f64::max);
-                    theta = trial;
-                    proj = pt;
-                    cost = ct;
+                    let stalled = cost - dot(&next.r, &next.r) < STALL * cost;
                     *mu = (*mu / 3.0).max(1e-12);
-                    moved = Some(if previous - ct < STALL * previous { 0.0 } else { largest });
-                    break;
+                    return Some(Accepted {
+                        theta: trial,
+                        proj: next,
+                        converged: moved <= STEP_TOLERANCE || stalled,
+                    });
                 }
-                *mu *= 4.0;
-            }
-            match moved {
-                Some(largest) if largest > STEP_TOLERANCE => {}
-                _ => break,
+                _ => *mu *= 4.0,
             }
         }
-        theta
+        None
     }
 
     /// Each channel's noise level in weighted units (Eq. I9).
@@ -272,11 +272,12 @@ impl<'a> Problem<'a> {
     }
 
     /// The modes at the optimum `theta`, or the index of the one to drop: the weakest of those
-    /// outside `limits` or not identifiable, or the weakest of all when `J^T J` is singular.
+    /// outside `limits`, not identifiable or not significant (Eq. I8), or the weakest of all
+    /// when `J^T J` is singular.
     fn assess(&self, theta: &[f64], starts: &[Start], limits: Limits) -> Result<Vec<Fitted>, usize> {
         let proj = self.project(theta);
         let amplitudes = self.amplitudes(&proj.coef, theta.len() / 2);
-        let strength = self.energies(theta, &proj.coef);
+        let strength = energies(&proj);
         let chance = chance_energy(self.y.ncols(), self.y.nrows());
         let weakest = |of: &[usize]| of.iter().copied().min_by(|&a, &b| strength[a].total_cmp(&strength[b]));
         let all: Vec<usize> = (0..starts.len()).collect();
@@ -310,27 +311,6 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// Each mode's energy in the weighted record, `sum_c sum_j (coef_cos phi_cos + coef_sin
-    /// phi_sin)^2` (Eq. I8; in units of the noise variance once the weights are the noise levels).
-    fn energies(&self, theta: &[f64], coef: &Mat<f64>) -> Vec<f64> {
-        let phi = self.basis(theta);
-        (0..theta.len() / 2)
-            .map(|k| {
-                (0..self.y.ncols())
-                    .map(|c| {
-                        (0..phi.nrows())
-                            .map(|j| {
-                                (coef[(1 + 2 * k, c)] * phi[(j, 1 + 2 * k)]
-                                    + coef[(2 + 2 * k, c)] * phi[(j, 2 + 2 * k)])
-                                    .powi(2)
-                            })
-                            .sum::<f64>()
-                    })
-                    .sum()
-            })
-            .collect()
-    }
-
     /// The complex amplitudes `a_ck` (Eq. I1) in the channels' units from the coefficients of
     /// the basis (Eq. I6): `a = coef_cos - i coef_sin`, unweighted.
     fn amplitudes(&self, coef: &Mat<f64>, modes: usize) -> Vec<Vec<c64>> {
@@ -357,6 +337,25 @@ impl<'a> Problem<'a> {
         let finite = (0..p).all(|i| (0..p).all(|j| inv[(i, j)].is_finite()));
         finite.then(|| inv * faer::Scale(kappa * s2))
     }
+}
+
+/// Each mode's energy in the weighted record at a projection, `sum_c sum_j (coef_cos phi_cos +
+/// coef_sin phi_sin)^2` (Eq. I8; in units of the noise variance once the weights are the noise
+/// levels).
+fn energies(proj: &Projection) -> Vec<f64> {
+    let (phi, coef) = (&proj.phi, &proj.coef);
+    (0..(phi.ncols() - 1) / 2)
+        .map(|k| {
+            let (cc, cs) = (1 + 2 * k, 2 + 2 * k);
+            (0..coef.ncols())
+                .map(|c| {
+                    (0..phi.nrows())
+                        .map(|j| (coef[(cc, c)] * phi[(j, cc)] + coef[(cs, c)] * phi[(j, cs)]).powi(2))
+                        .sum::<f64>()
+                })
+                .sum()
+        })
+        .collect()
 }
 
 /// The energy that white noise of unit variance in `m` channels of `n` samples puts into the

@@ -28,6 +28,19 @@ impl Window {
     pub fn len(&self) -> usize {
         self.y[0].len()
     }
+
+    /// Each channel's RMS about its mean over the window, in its unit (the first weights, 3.4;
+    /// positive: a constant channel is refused).
+    pub fn rms(&self) -> Vec<f64> {
+        self.y
+            .iter()
+            .map(|y| {
+                let n = y.len() as f64;
+                let mean = y.iter().sum::<f64>() / n;
+                (y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt()
+            })
+            .collect()
+    }
 }
 
 /// The window of `channels` (each sampled at `t` [s]) that `opts` asks for, after the checks of

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 /// Why a recording, or an analysis of measured data, cannot be used. Rows are the data rows,
 /// 1-based (the header is not a row); `line` is the line of the file.
-#[derive(Debug, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeasuredError {
     /// The file as a whole: cannot be read, no time column, too few rows, no sensors.
     #[error("{file}: {reason}")]
@@ -37,6 +37,12 @@ pub enum MeasuredError {
     /// names the input.
     #[error("{what}: {reason}")]
     Input { what: String, reason: String },
+    /// The data hold nothing of what was asked (no mode in a free decay), with the reason.
+    #[error("{0}")]
+    NotFound(String),
+    /// A dense linear-algebra step (faer) failed on these data.
+    #[error("{step}: {reason}")]
+    Numerical { step: &'static str, reason: String },
 }
 
 impl MeasuredError {

@@ -6,9 +6,11 @@
 //! - [`recording`]: a CSV recording read, mapped onto the experiment's sensor columns, scaled,
 //!   shifted onto the run's clock (given or estimated, [`offset`]) and resampled onto the run's
 //!   sensor times (section 1).
+//! - [`identify`]: the model-free identification of a free decay (section 3).
 
 pub mod csv_table;
 pub mod error;
+pub mod identify;
 pub mod offset;
 pub mod recording;
 

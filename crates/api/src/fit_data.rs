@@ -14,18 +14,20 @@ use crate::{ApiError, Result};
 /// before any run).
 pub(crate) fn read(path: &Path, exp: &flexstar_model::Experiment, sensors: &Sensors) -> Result<Recording> {
     let section = exp.measured.clone().unwrap_or_default();
-    Recording::read(path, &section, sensors).map_err(measured_error)
+    Recording::read(path, &section, sensors).map_err(|e| measured_error(path, e))
 }
 
 /// The recording on the run's sensor times `run` (its offset estimated against them when
 /// `offset = "auto"`, Eq. M3; resampled by Eq. M4).
 pub(crate) fn on_run_times(rec: &mut Recording, run: &SensorTable) -> Result<SensorTable> {
-    rec.align(run).map_err(measured_error)?;
-    rec.on_times(&run.t).map_err(measured_error)
+    let path = rec.file().to_path_buf();
+    rec.align(run).map_err(|e| measured_error(&path, e))?;
+    rec.on_times(&run.t).map_err(|e| measured_error(&path, e))
 }
 
-/// A reader's error as bad input: its own message (file, row, column, reason).
-fn measured_error(e: MeasuredError) -> ApiError {
+/// A reader's error as bad input: its own message (file, row, column, reason); an error of
+/// another kind (the reader has none) as the recording's.
+fn measured_error(path: &Path, e: MeasuredError) -> ApiError {
     let message = e.to_string();
     let (file, key, reason) = match e {
         MeasuredError::File { file, reason } => (file.display().to_string(), None, reason),
@@ -33,7 +35,7 @@ fn measured_error(e: MeasuredError) -> ApiError {
         MeasuredError::Row { file, reason, .. } | MeasuredError::Cell { file, reason, .. } => {
             (file.display().to_string(), None, reason)
         }
-        MeasuredError::Input { what, reason } => (what, None, reason),
+        other => (path.display().to_string(), None, other.to_string()),
     };
     ApiError::config_text(file, key.as_deref(), &reason, message)
 }

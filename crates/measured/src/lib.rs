@@ -6,11 +6,14 @@
 //! - [`recording`]: a CSV recording read, mapped onto the experiment's sensor columns, scaled,
 //!   shifted onto the run's clock (given or estimated, [`offset`]) and resampled onto the run's
 //!   sensor times (section 1).
+//! - [`welch`]: Welch's power spectral density (section 2).
 
 pub mod csv_table;
 pub mod error;
 pub mod offset;
 pub mod recording;
+pub mod welch;
 
 pub use error::MeasuredError;
 pub use recording::{Channel, Recording};
+pub use welch::{welch, Psd, WelchOptions};

@@ -41,6 +41,13 @@ pub fn api_error(e: CompareError) -> ApiError {
         },
         CompareError::Run(run) => run_error(run, message),
         CompareError::Figure(_) => ApiError::Output(message),
+        // a recording (`--measured`) is bad input, named by its file
+        CompareError::Measured(m) => ApiError::Config {
+            file: m.path().map_or_else(|| "measured".into(), |p| p.display().to_string()),
+            key: None,
+            reason: message.clone(),
+            message,
+        },
         CompareError::Compare(_) | CompareError::Kinematics { .. } => ApiError::Solver { message },
     }
 }

@@ -105,19 +105,7 @@ pub fn case_figures(
     hold: Option<f64>,
     dwells: &[RunDwells],
 ) -> Result<Vec<Figure>, Error> {
-    let mut runs = vec![Run {
-        label: "FEM".into(),
-        response: &case.fem,
-        style: FEM_STYLE,
-    }];
-    let mut used = Vec::new();
-    for (run, r) in &case.amm {
-        runs.push(Run {
-            label: format!("AMM {}", run.label),
-            response: r,
-            style: run_style(run.settings.family, &mut used),
-        });
-    }
+    let runs = styled_runs(case);
     let kin = |t: f64| {
         RigidState::at(&exp.robot, &exp.trajectory, t).map_err(|source| Error::Kinematics {
             file: exp.source.display().to_string(),
@@ -193,6 +181,25 @@ pub fn case_figures(
     }
     figs.extend(crate::sensitivity::figure_sensitivity(exp)?);
     Ok(figs)
+}
+
+/// The runs of a case as every figure draws them: the FEM (black) first, then the AMM runs in
+/// their family's colour ([`run_style`]).
+pub(crate) fn styled_runs(case: &CaseResults) -> Vec<Run<'_>> {
+    let mut runs = vec![Run {
+        label: "FEM".into(),
+        response: &case.fem,
+        style: FEM_STYLE,
+    }];
+    let mut used = Vec::new();
+    for (run, r) in &case.amm {
+        runs.push(Run {
+            label: format!("AMM {}", run.label),
+            response: r,
+            style: run_style(run.settings.family, &mut used),
+        });
+    }
+    runs
 }
 
 /// The caption of the forces figure of a direct experiment (`None`: the motion is prescribed and
@@ -283,7 +290,7 @@ pub fn compare_markdown(
     row: &TableRow,
     (checks, warnings): (&RunChecks, &[ValidityWarning]),
     figures: &[RenderedFigure],
-    (residuals, dwells): (Option<&[RunResidual]>, &[RunDwells]),
+    (residuals, dwells, measured): (Option<&[RunResidual]>, &[RunDwells], Option<&str>),
 ) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# {}: AMM against FEM\n", exp.name);
@@ -332,6 +339,9 @@ pub fn compare_markdown(
     let sensors = crate::sensors::sensors_markdown(&crate::sensors::sensor_evps(case));
     if !sensors.is_empty() {
         let _ = write!(s, "\n{sensors}");
+    }
+    if let Some(md) = measured {
+        let _ = write!(s, "\n{md}");
     }
     if let Some(res) = residuals {
         let _ = write!(s, "\n{}", residual_markdown(res));
@@ -408,7 +418,7 @@ pub fn compare_json(
     case: &CaseResults,
     row: &TableRow,
     prov: &Provenance,
-    (checks, residuals): (&RunChecks, Option<&[RunResidual]>),
+    (checks, residuals, measured): (&RunChecks, Option<&[RunResidual]>, Option<serde_json::Value>),
 ) -> String {
     let runs: Vec<RunJson> = runs_of(case)
         .into_iter()
@@ -435,6 +445,9 @@ pub fn compare_json(
     let sensors = crate::sensors::sensor_evps(case);
     if !sensors.is_empty() {
         doc["sensors"] = serde_json::to_value(&sensors).expect("plain data serialises");
+    }
+    if let Some(m) = measured {
+        doc["measured"] = m;
     }
     if let Some(res) = residuals {
         let list: Vec<_> = res
@@ -466,6 +479,8 @@ pub struct WrittenCase {
     /// Every run's residual per dwell (`docs/motions.md` 2.5; empty without a dwell), written as
     /// `<stem>-dwells.csv` and the sidecars' `dwells`.
     pub dwells: Vec<RunDwells>,
+    /// The section of a recording laid over the runs (`compare --measured`), as in `compare.md`.
+    pub measured_markdown: Option<String>,
 }
 
 /// Write every output of one case into `dir` (see the module docs).
@@ -477,14 +492,38 @@ pub fn write_case(
     prov: &Provenance,
     figures: bool,
 ) -> Result<WrittenCase, Error> {
+    write_case_measured(dir, exp, case, row, (prov, figures), None)
+}
+
+/// [`write_case`] with a recording laid over the runs (`compare --measured`,
+/// [`crate::measured`]): its figures after the others, its section in `compare.md` and the key
+/// `measured` of `compare.json`.
+pub fn write_case_measured(
+    dir: &Path,
+    exp: &Experiment,
+    case: &CaseResults,
+    row: &TableRow,
+    (prov, figures): (&Provenance, bool),
+    measured: Option<&crate::measured::MeasuredOverlay>,
+) -> Result<WrittenCase, Error> {
     let residuals = case_residuals(exp, case)?;
     let dwells = case_dwells(exp, case)?;
     let hold = residuals.iter().flatten().next().map(|r| r.residual.hold_s);
-    let drawn = if figures {
+    let mut drawn = if figures {
         case_figures(exp, case, hold, &dwells)?
     } else {
         Vec::new()
     };
+    if let (Some(m), true) = (measured, figures) {
+        let t_rest = flexstar_modal::settle::motion_end(exp);
+        drawn.extend(crate::measured_figures::measured_figures(
+            &exp.name,
+            m,
+            &styled_runs(case),
+            t_rest,
+        ));
+    }
+    let measured_markdown = measured.map(|m| m.markdown());
     let figdir = dir.join("figures");
     let figs = drawn.iter().map(|f| f.write(&figdir)).collect::<Result<Vec<_>, _>>()?;
     let csv = compare_csv(row);
@@ -514,12 +553,18 @@ pub fn write_case(
             row,
             (&checks, &warnings),
             &figs,
-            (residuals.as_deref(), &dwells),
+            (residuals.as_deref(), &dwells, measured_markdown.as_deref()),
         ),
     )?;
     set.text(
         "compare.json",
-        &compare_json(exp, case, row, prov, (&checks, residuals.as_deref())),
+        &compare_json(
+            exp,
+            case,
+            row,
+            prov,
+            (&checks, residuals.as_deref(), measured.map(|m| m.json())),
+        ),
     )?;
     if let Some(res) = &residuals {
         set.text("residual.csv", &residual_csv(res))?;
@@ -532,6 +577,7 @@ pub fn write_case(
         compare_csv: csv,
         residuals,
         dwells,
+        measured_markdown,
     })
 }
 

@@ -1,6 +1,7 @@
 //! `flexstar compare CONFIG`: the AMM (the experiment's `[amm]` settings, plus any mode families
 //! asked) and the FEM on any experiment, written to `DIR/<name>/`: the runs' CSVs and sidecars,
-//! `compare.md`, `compare.csv`, `compare.json`, the figure set and `report.html`.
+//! `compare.md`, `compare.csv`, `compare.json`, the figure set and `report.html`; with
+//! `--measured FILE.csv` a recording laid over the runs ([`crate::measured`]).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -8,7 +9,7 @@ use std::time::Instant;
 use flexstar_io::output::{ensure_writable_dir, write_string_atomically};
 use flexstar_model::{AmmSettings, Experiment, ModeFamily, Provenance};
 
-use crate::case_output::{write_case, ValidityWarning};
+use crate::case_output::{write_case_measured, ValidityWarning};
 use crate::report::case_report;
 use crate::runs::{preflight, run_cases, AmmRun, CaseSpec, ProgressFn};
 use crate::servo::{servo_summary, ServoSummary};
@@ -30,6 +31,8 @@ pub struct CompareOptions {
     pub figures: bool,
     /// Version, commit and date written into every output.
     pub provenance: Provenance,
+    /// A recording of the real robot laid over the runs (`--measured`, `docs/measured.md`).
+    pub measured: Option<PathBuf>,
 }
 
 /// The result of a comparison.
@@ -91,6 +94,10 @@ pub fn run_compare(opts: &CompareOptions, progress: Option<ProgressFn>) -> Resul
     let start = Instant::now();
     let exp = flexstar_shaping::shape_loaded(Experiment::load(&opts.config)?)?;
     check_flags(&exp, opts.modes)?;
+    let recording = match &opts.measured {
+        Some(path) => Some(crate::measured::read_recording(&exp, path)?),
+        None => None,
+    };
     let spec = CaseSpec {
         amm: compare_runs(&exp, &opts.families, opts.modes),
         extra: Vec::new(),
@@ -109,7 +116,18 @@ pub fn run_compare(opts: &CompareOptions, progress: Option<ProgressFn>) -> Resul
     let case = &cases[0];
     let table = TableI::compute(&cases, false)?;
     let row = &table.rows[0];
-    let written = write_case(&dir, &spec.exp, case, row, &opts.provenance, opts.figures)?;
+    let measured = match recording {
+        Some(rec) => Some(crate::measured::overlay(&spec.exp, case, rec)?),
+        None => None,
+    };
+    let written = write_case_measured(
+        &dir,
+        &spec.exp,
+        case,
+        row,
+        (&opts.provenance, opts.figures),
+        measured.as_ref(),
+    )?;
     if opts.figures {
         let html = case_report(&spec.exp, case, row, &written, &opts.provenance);
         write_string_atomically(&dir.join("report.html"), &html)?;

@@ -5,7 +5,8 @@
 //! ([`behaviour`]), the regenerated Table I ([`table`]) beside the paper's ([`paper`]), figures
 //! ([`figures`], drawn with `flexstar-plot`) and the HTML report ([`report`]). [`runs`] runs the
 //! solvers of an experiment (the FEM and a list of AMM runs); [`compare`] does that for any
-//! experiment file and writes its outputs ([`case_output`]); [`verify`] is compare over the paper's four cases plus Table I and
+//! experiment file and writes its outputs ([`case_output`]), with a recording laid over the
+//! runs ([`measured`], [`measured_figures`]); [`verify`] is compare over the paper's four cases plus Table I and
 //! the checks of [`thresholds`]. The EVP decisions the paper leaves open are written up in
 //! `docs/validation.md`, every output column in `docs/outputs.md`.
 
@@ -17,6 +18,8 @@ pub mod direct_figures;
 pub mod dwells;
 pub mod evp;
 pub mod figures;
+pub mod measured;
+pub mod measured_figures;
 pub mod paper;
 pub mod report;
 pub mod residual;
@@ -55,6 +58,8 @@ pub enum Error {
     },
     #[error("{file}: {reason}")]
     Input { file: String, reason: String },
+    #[error(transparent)]
+    Measured(#[from] flexstar_measured::MeasuredError),
 }
 
 impl From<flexstar_io::WriteError> for Error {

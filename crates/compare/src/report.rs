@@ -132,6 +132,8 @@ pub struct ReportCase<'a> {
     pub residuals: Option<&'a [crate::residual::RunResidual]>,
     /// Every run's residual per dwell (`write_case`'s; empty without a dwell).
     pub dwells: &'a [crate::dwells::RunDwells],
+    /// The section of a recording laid over the runs (`compare --measured`; `write_case`'s).
+    pub measured: Option<&'a str>,
 }
 
 /// What a report shows: a title, the provenance, for `verify` Table I and the checks, and the
@@ -202,6 +204,7 @@ pub fn case_report(
             dir: Path::new(""),
             residuals: written.residuals.as_deref(),
             dwells: &written.dwells,
+            measured: written.measured_markdown.as_deref(),
         }],
     })
 }
@@ -297,6 +300,9 @@ fn case_html(h: &mut String, c: &ReportCase) {
     servo_html(h, c);
     evps_html(h, c);
     sensors_html(h, c);
+    if let Some(md) = c.measured {
+        h.push_str(&markdown_to_html(md));
+    }
     residual_html(h, c);
     figures_html(h, c);
     h.push_str("</section>\n");

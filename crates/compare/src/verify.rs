@@ -205,6 +205,7 @@ fn write_summary(opts: &VerifyOptions, v: &Verified, per_case: &[WrittenCase]) -
                     dir: Path::new(&s.exp.name),
                     residuals: written.residuals.as_deref(),
                     dwells: &written.dwells,
+                    measured: written.measured_markdown.as_deref(),
                 })
                 .collect(),
         });

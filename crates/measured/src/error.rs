@@ -46,6 +46,17 @@ pub enum MeasuredError {
 }
 
 impl MeasuredError {
+    /// The file concerned, if the error is about one.
+    pub fn path(&self) -> Option<&std::path::Path> {
+        match self {
+            MeasuredError::File { file, .. }
+            | MeasuredError::Column { file, .. }
+            | MeasuredError::Row { file, .. }
+            | MeasuredError::Cell { file, .. } => Some(file),
+            MeasuredError::Input { .. } | MeasuredError::NotFound(_) | MeasuredError::Numerical { .. } => None,
+        }
+    }
+
     /// A [`MeasuredError::File`] error.
     pub fn file(file: &std::path::Path, reason: impl Into<String>) -> Self {
         MeasuredError::File {

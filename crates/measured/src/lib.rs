@@ -6,12 +6,14 @@
 //! - [`recording`]: a CSV recording read, mapped onto the experiment's sensor columns, scaled,
 //!   shifted onto the run's clock (given or estimated, [`offset`]) and resampled onto the run's
 //!   sensor times (section 1).
+//! - [`measure`]: the error of a model's channel against the recording (section 1.5).
 //! - [`welch`]: Welch's power spectral density (section 2).
 //! - [`identify`]: the model-free identification of a free decay (section 3).
 
 pub mod csv_table;
 pub mod error;
 pub mod identify;
+pub mod measure;
 pub mod offset;
 pub mod recording;
 pub mod welch;

@@ -29,8 +29,8 @@ pub struct Lag {
     pub step: f64,
 }
 
-/// The fewest of the run's samples an overlap must keep for a lag to be scored, as a fraction
-/// of the run's samples.
+/// The shortest overlap of recording and run for a lag to be scored, as a fraction of the
+/// run's span.
 const MIN_OVERLAP: f64 = 0.5;
 
 /// Golden-section iterations of the refinement: the bracket of two steps shrinks by
@@ -38,9 +38,9 @@ const MIN_OVERLAP: f64 = 0.5;
 const REFINE_ITERATIONS: usize = 60;
 
 /// Eq. M3: the shift `delta` [s] that maximises the mean over channels of the correlation
-/// coefficient between the run's channel `y(t_j)` and the recording `r(t_j - delta)`
-/// (interpolated linearly), over the run's times whose shifted time lies within the recording
-/// and at least half of the run's samples. The lags `k h`, |k h| <= `max_lag`, are scored
+/// coefficient between the recording `r(tau_k)` and the run's channel `y(tau_k + delta)`
+/// (interpolated linearly), over the recorded samples whose shifted time lies within the run,
+/// an overlap of at least half the run's span. The lags `k h`, |k h| <= `max_lag`, are scored
 /// first; the best one is refined by golden-section search between its neighbours. Errors: no
 /// channel varies on both sides, no lag keeps half the run, or the best lag lies at the edge
 /// of the window (the true one may lie beyond it).
@@ -81,26 +81,30 @@ pub fn estimate_offset(recorded: &Channels<'_>, run: &Channels<'_>, window: LagW
 /// The message when no lag keeps enough of the run.
 fn no_lag_message(max_lag: f64) -> String {
     format!(
-        "at no lag within +-{max_lag} s does the recording cover half of the run's samples with a varying \
+        "at no lag within +-{max_lag} s does the recording overlap half of the run's span with a varying \
          channel: the spans may not overlap, or every channel is constant"
     )
 }
 
-/// The mean correlation coefficient at the shift `delta` [s], or `None` when the overlap keeps
-/// less than [`MIN_OVERLAP`] of the run or no channel varies on both sides.
+/// The mean correlation coefficient at the shift `delta` [s] between the recorded samples
+/// `r_c(tau_k)` and the run interpolated at `tau_k + delta`, over the recorded samples whose
+/// shifted time lies within the run; `None` when that overlap spans less than [`MIN_OVERLAP`]
+/// of the run or no channel varies on both sides. The run, not the recording, is interpolated:
+/// interpolating a noisy recording between its samples would lower its noise's variance (by
+/// `w^2 + (1 - w)^2` at the fraction w) and pull the estimate towards half-sample lags.
 fn score(recorded: &Channels<'_>, run: &Channels<'_>, delta: f64) -> Option<f64> {
-    let (a, b) = (recorded.t[0] + delta, recorded.t[recorded.t.len() - 1] + delta);
-    let lo = run.t.partition_point(|&x| x < a);
-    let hi = run.t.partition_point(|&x| x <= b);
-    if hi < lo + 3 || ((hi - lo) as f64) < MIN_OVERLAP * run.t.len() as f64 {
+    let (t0, t1) = (run.t[0], run.t[run.t.len() - 1]);
+    let lo = recorded.t.partition_point(|&x| x + delta < t0);
+    let hi = recorded.t.partition_point(|&x| x + delta <= t1);
+    if hi < lo + 3 || recorded.t[hi - 1] - recorded.t[lo] < MIN_OVERLAP * (t1 - t0) {
         return None;
     }
-    let at: Vec<f64> = run.t[lo..hi].iter().map(|x| x - delta).collect();
+    let at: Vec<f64> = recorded.t[lo..hi].iter().map(|x| x + delta).collect();
     let coefficients: Vec<f64> = recorded
         .values
         .iter()
         .zip(&run.values)
-        .filter_map(|(r, y)| pearson(&interpolate(recorded.t, r, &at), &y[lo..hi]))
+        .filter_map(|(r, y)| pearson(&r[lo..hi], &interpolate(run.t, y, &at)))
         .collect();
     (!coefficients.is_empty()).then(|| coefficients.iter().sum::<f64>() / coefficients.len() as f64)
 }

@@ -123,7 +123,7 @@ fn windowed(seg: &[f64], window: &[f64], buf: &mut [Complex<f64>]) {
 /// The one-sided fold of Eq. W3: bins 1 .. ceil(L/2) - 1 carry their negative twin too (2); the
 /// zero frequency and, for even L, the Nyquist bin have none (1).
 fn one_sided(k: usize, l: usize) -> f64 {
-    if k == 0 || (l % 2 == 0 && k == l / 2) {
+    if k == 0 || (l.is_multiple_of(2) && k == l / 2) {
         1.0
     } else {
         2.0

@@ -10,9 +10,10 @@ use pyo3::types::PyDict;
 use crate::{convert, interrupt, py_err, ConfigError, PyExperiment};
 
 /// Compare the AMM with the FEM on an experiment file (as `flexstar compare`): writes
-/// `out/<name>/`; returns `{"dir", "behaviour", "most_accurate", "compare_csv"}`.
+/// `out/<name>/`; returns `{"dir", "behaviour", "most_accurate", "compare_csv"}`. `measured`: a
+/// recording laid over the runs (as `--measured`, `docs/measured.md`).
 #[pyfunction]
-#[pyo3(signature = (config, out, families = Vec::new(), modes = None, figures = false, progress = false))]
+#[pyo3(signature = (config, out, families = Vec::new(), modes = None, figures = false, progress = false, measured = None))]
 pub fn compare<'py>(
     py: Python<'py>,
     config: PathBuf,
@@ -21,6 +22,7 @@ pub fn compare<'py>(
     modes: Option<usize>,
     figures: bool,
     progress: bool,
+    measured: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let families = families
         .iter()
@@ -33,6 +35,7 @@ pub fn compare<'py>(
         out,
         figures,
         provenance: flexstar_api::provenance(),
+        measured,
     };
     let o = interrupt::interruptible(py, "flexstar.compare", progress, |report| {
         let tick = |p: Progress| report(p.fraction);

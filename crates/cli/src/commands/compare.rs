@@ -1,4 +1,4 @@
-//! `flexstar compare CONFIG [--families F,...] [--modes N] [--out DIR]`.
+//! `flexstar compare CONFIG [--families F,...] [--modes N] [--out DIR] [--measured FILE.csv]`.
 
 use std::path::PathBuf;
 
@@ -27,6 +27,10 @@ pub struct Args {
     /// Skip the figures and the HTML report
     #[arg(long)]
     no_figures: bool,
+    /// A recording of the real robot (CSV: t and sensor columns, mapped by [measured]) laid over
+    /// the runs: its error against each run, its spectra (docs/measured.md)
+    #[arg(long, value_name = "FILE.csv")]
+    measured: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -37,6 +41,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         out: args.out,
         figures: !args.no_figures,
         provenance: super::provenance(),
+        measured: args.measured,
     };
     let reporter = Reporter::new("compare");
     let tick = |p| reporter.update(p);

@@ -307,13 +307,16 @@ def compare(
     modes: Optional[int] = None,
     figures: bool = False,
     progress: bool = False,
+    measured: "os.PathLike[str] | str | None" = None,
 ) -> Dict[str, Any]:
     """Compare the AMM with the FEM on an experiment file (as ``flexstar compare``): writes
     ``out/<name>/``; returns the folder, compare.csv, the behaviour of G and the closest family.
+    ``measured``: a recording laid over the runs (as ``--measured``, docs/measured.md).
     Ctrl-C stops it within a second (nothing is written); ``progress=True`` prints the share done
     on stderr. Errors: ConfigError, InfeasibleMotion, SolverError."""
     _check_count("modes", modes)
-    return _flexstar.compare(os.fspath(config), os.fspath(out), list(families), modes, figures, progress)
+    rec = None if measured is None else os.fspath(measured)
+    return _flexstar.compare(os.fspath(config), os.fspath(out), list(families), modes, figures, progress, rec)
 
 
 def plan(config: "os.PathLike[str] | str", out: "os.PathLike[str] | str" = "out") -> Dict[str, Any]:

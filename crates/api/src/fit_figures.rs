@@ -1,5 +1,5 @@
 //! The figures of `flexstar fit` (`docs/measured.md` 4.9): per sensor column the recording with
-//! the model before and after the fit, and the model's errors before and after.
+//! the model before and after the fit, the model's errors before and after, and their spectra.
 
 use flexstar_model::SensorTable;
 use flexstar_plot::{Figure, Panel, Series, Style, FAMILY_COLORS, RIGID_STYLE};
@@ -48,7 +48,68 @@ pub(crate) fn figures(f: &Fitted) -> Vec<Figure> {
             panels: error_panels(f),
             zooms: Vec::new(),
         },
+        Figure {
+            name: format!("{n}-fit-spectra"),
+            title: format!("{n}: spectra of the model's error (Welch), in dB re 1 unit^2/Hz"),
+            caption: "Each sensor column: the power spectral density of model - recording before (blue) and after (orange) \
+                      the fit (docs/measured.md section 2), and the level of white noise of the channel's noise level \
+                      (grey, Eq. LS17). After a good fit the orange spectrum lies on the grey line, with no peak left at \
+                      the robot's modes; the lower row is 0-50 Hz."
+                .into(),
+            panels: spectrum_panels(f),
+            zooms: vec![flexstar_plot::Zoom {
+                label: "0-50 Hz".into(),
+                windows: vec![(0.0, 50.0)],
+            }],
+        },
     ]
+}
+
+/// One panel per channel: the Welch PSD of `model - recording` before and after [dB], and the
+/// white-noise level of Eq. LS17 for the channel's noise level.
+fn spectrum_panels(f: &Fitted) -> Vec<Panel> {
+    let m = &f.measured;
+    let Some(fs) = m.t.get(1).zip(m.t.first()).map(|(b, a)| 1.0 / (b - a)) else {
+        return Vec::new();
+    };
+    let db = |p: f64| 10.0 * p.max(f64::MIN_POSITIVE).log10();
+    let opts = flexstar_measured::welch::WelchOptions::default();
+    m.columns
+        .iter()
+        .enumerate()
+        .filter_map(|(k, c)| {
+            let psd = |model: &SensorTable| {
+                flexstar_measured::welch::welch(&error_of(model, &c.name, &c.values), fs, &opts, &c.name).ok()
+            };
+            let (before, after) = (psd(&f.fit.before)?, psd(&f.fit.after)?);
+            let noise = f.fit.channels.iter().find(|ch| ch.column == c.name)?.noise;
+            let level = db(flexstar_fit::noise::white_psd(noise, fs));
+            let curve = |label: &str, style: Style, psd: &flexstar_measured::welch::Psd| Series {
+                label: label.into(),
+                x: psd.f.clone(),
+                y: psd.p.iter().map(|p| db(*p)).collect(),
+                style,
+            };
+            let unit = m.units.get(k).map_or("", String::as_str);
+            let mut p = panel(
+                &c.name,
+                unit,
+                vec![
+                    curve("before", BEFORE, &before),
+                    curve("after", AFTER, &after),
+                    Series {
+                        label: "noise level (Eq. LS17)".into(),
+                        x: after.f.clone(),
+                        y: vec![level; after.f.len()],
+                        style: MEASURED,
+                    },
+                ],
+            );
+            p.x_label = "f [Hz]".into();
+            p.y_label = format!("PSD [dB re 1 ({unit})^2/Hz]");
+            Some(p)
+        })
+        .collect()
 }
 
 /// One panel per channel with the curves `(label, style, model)`: a model's channel, or the

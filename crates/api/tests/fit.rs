@@ -155,6 +155,35 @@ fn the_bench_robot_is_calibrated_on_its_fem_recording() {
             100.0 * target
         );
     }
+    // the spectra of the report: the encoders' error after the fit is their noise alone (the
+    // motion is prescribed); its Welch density (docs/measured.md 2) averages to the white-noise
+    // level of Eq. LS17 at the noise truth.toml declares, within the estimate's spread (7
+    // segments of 325 bins: a few %)
+    let declared = declared_noise(&truth);
+    for (k, c) in o
+        .fitted
+        .measured
+        .columns
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.name.starts_with("enc"))
+    {
+        let model = f.after.column(&c.name).unwrap();
+        let err: Vec<f64> = model.iter().zip(&c.values).map(|(y, m)| y - m).collect();
+        let psd = flexstar_measured::welch::welch(&err, 1000.0, &Default::default(), &c.name).unwrap();
+        let mean = psd.p[1..].iter().sum::<f64>() / (psd.p.len() - 1) as f64;
+        let level = flexstar_fit::noise::white_psd(declared[k], 1000.0);
+        eprintln!(
+            "{}: mean PSD of the error after the fit / Eq. LS17 = {:.4}",
+            c.name,
+            mean / level
+        );
+        assert!(
+            (mean / level - 1.0).abs() < 0.1,
+            "{}: {mean:e} against {level:e}",
+            c.name
+        );
+    }
     // the calibrated model on another move, against the FEM of the robot the recording came from
     let calibrated = ExperimentDoc::load(&o.dir.join("fit.toml")).unwrap();
     let nominal = ExperimentDoc::load(&config("nominal.toml")).unwrap();

@@ -5,7 +5,8 @@
 //! LS1-LS5, with the channels' noise levels estimated from the recording, [`noise`]), a
 //! Levenberg-Marquardt search within box bounds ([`search`], Eqs. LS6-LS10) on a forward-difference
 //! Jacobian evaluated in parallel ([`jacobian`]), the statistics at the optimum ([`stats`], Eqs.
-//! LS11-LS14) and the identifiability check ([`identifiability`], Eqs. LS15-LS16).
+//! LS11-LS14) and the identifiability check ([`identifiability`], Eqs. LS15-LS16); the white-noise
+//! density a residual spectrum is read against ([`noise::white_psd`], Eq. LS17).
 //!
 //! No solver code lives here: the crate is generic over an evaluation of the model, a [`Model`]
 //! that returns the sensor readings at given parameter values (the command runs the accurate AMM,

@@ -46,6 +46,13 @@ pub fn rms(x: &[f64]) -> f64 {
     (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
 }
 
+/// Eq. LS17: the one-sided power spectral density [unit^2/Hz] of white noise of standard
+/// deviation `sigma` sampled at `fs` [Hz]: `2 sigma^2 / fs`, flat from 0 to `fs / 2`, so that it
+/// integrates to `sigma^2` (Parseval).
+pub fn white_psd(sigma: f64, fs: f64) -> f64 {
+    2.0 * sigma * sigma / fs
+}
+
 /// Eq. LS3: the gain of the fourth difference on a sinusoid of frequency `f` [Hz] sampled every
 /// `h` [s], relative to its amplitude.
 pub fn leakage(f: f64, h: f64) -> f64 {

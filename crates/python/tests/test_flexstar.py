@@ -341,3 +341,31 @@ def test_plan_of_a_whole_cycle_reports_each_move_and_dwell(root, tmp_path):
         cols = rows[0].split(",")
         peaks = [float(r.split(",")[cols.index("G_peak_m")]) for r in rows[1:]]
         assert [d[motion][1] for d in res["dwells"]] == pytest.approx(peaks, rel=1e-12)
+
+
+def test_fit_matches_the_cli_contract(root, tmp_path):
+    """flexstar.fit is `flexstar fit` (docs/measured.md section 4): fit.json's content as a dict,
+    the calibrated Experiment that runs, the estimates within the targets of 4.11 on the FEM's
+    recording of the bench robot; a [fit] with E and I both is a ConfigError naming the product
+    the data fix."""
+    truth = flexstar.Experiment.load(root / "configs/measured/truth.toml")
+    flexstar.run(truth, solver="fem").save(tmp_path / "rec")
+    rec = tmp_path / "rec/truth/fem-sensors.csv"
+    res = flexstar.fit(root / "configs/measured/nominal.toml", rec, tmp_path / "out")
+    assert res["converged"] and res["calibrated"] and res["identifiability"]["verdict"] == "identifiable"
+    truths = {"payload.mass": (0.4, 0.02), "payload.J": (1.5e-3, 0.02), "damping.zeta": (0.02, 0.05), "robot.E": (190e9, 0.01)}
+    for p in res["parameters"]:
+        value, target = truths[p["key"]]
+        assert abs(p["estimate"] - value) <= target * value, p
+        lo, hi = p["interval_95"]
+        assert lo < p["estimate"] < hi
+    assert pathlib.Path(res["fit_toml"]).exists()
+    cal = res["experiment"]
+    assert cal.to_dict()["payload"]["mass"] == res["parameters"][0]["estimate"]
+    assert len(flexstar.run(cal, solver="amm")["t"]) == 1301
+    bad = tmp_path / "bad.toml"
+    text = (root / "configs/measured/nominal.toml").read_text()
+    bad.write_text(text.replace('{ key = "payload.J", lo = 2e-4, hi = 5e-3 },', '{ key = "robot.I", lo = 1e-12, hi = 5e-12 },'))
+    with pytest.raises(flexstar.ConfigError) as e:
+        flexstar.fit(bad, rec, tmp_path / "out")
+    assert "robot.I^1.00 x robot.E^1.00" in str(e.value) and "bad.toml" in str(e.value)

@@ -104,6 +104,22 @@ pub fn fit_experiment(
 
 /// What the experiment says before any run: its `[fit]`, the parameters resolved against its
 /// document, its sensors.
+/// The bandwidth of Eq. LS18 (`docs/measured.md` 4.7): one period of the first elastic mode at the
+/// motion's final pose (the accurate AMM, sliders locked, payload included: the slowest component
+/// of the model's error) in samples of the recording; without a rest pose or a mode, the whole
+/// record.
+fn correlation_samples(exp: &flexstar_model::Experiment, t: &[f64]) -> usize {
+    let n = t.len();
+    let dt = match n {
+        0 | 1 => return 0,
+        _ => (t[n - 1] - t[0]) / (n - 1) as f64,
+    };
+    match flexstar_modal::analysis::final_pose_frequencies(exp, 1) {
+        Ok(Some(f)) if f.first().is_some_and(|&f1| f1 > 0.0) => ((1.0 / (f[0] * dt)).round() as usize).min(n - 1),
+        _ => n - 1,
+    }
+}
+
 struct Setup<'a> {
     section: &'a FitSection,
     params: Vec<Param>,
@@ -148,6 +164,7 @@ impl<'a> Setup<'a> {
         };
         let settings = flexstar_fit::Settings {
             max_iterations: self.section.iterations(),
+            correlation_samples: correlation_samples(&input.exp, &recording.t),
             ..flexstar_fit::Settings::default()
         };
         let fit = flexstar_fit::fit(&problem, &model, &settings, on_iteration).map_err(|e| match e {

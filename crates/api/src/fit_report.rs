@@ -121,6 +121,7 @@ pub fn fit_json(o: &FitOutcome) -> Value {
             "start": e.start,
             "estimate": e.estimate,
             "standard_error": e.standard_error,
+            "standard_error_correlated": e.standard_error_correlated,
             "interval_95": e.interval,
             "at_bound": e.at_bound,
         })).collect::<Vec<_>>(),
@@ -131,6 +132,7 @@ pub fn fit_json(o: &FitOutcome) -> Value {
             "dof": st.dof,
             "s2": st.s2,
             "t_quantile": st.t_quantile,
+            "correlation_samples": st.bandwidth,
         },
         "not_recorded": f.not_recorded,
         "channels": fit.channels.iter().map(|c| json!({
@@ -200,19 +202,23 @@ pub fn fit_markdown(o: &FitOutcome) -> String {
 }
 
 fn estimates_table(s: &mut String, f: &Fitted) {
-    s.push_str("## Estimates\n\n| parameter | start | estimate | standard error | 95 % interval | box |\n|---|---|---|---|---|---|\n");
+    s.push_str(
+        "## Estimates\n\n| parameter | start | estimate | standard error, noise (LS12) | standard error, correlated (LS18) \
+         | 95 % interval (LS19) | box |\n|---|---|---|---|---|---|---|\n",
+    );
     for e in &f.fit.estimates {
         let interval = e
             .interval
             .map_or("n/a".into(), |[a, b]| format!("{} .. {}", sig(a), sig(b)));
         let _ = writeln!(
             s,
-            "| `{}` | {} | {}{} | {} | {} | {} .. {} |",
+            "| `{}` | {} | {}{} | {} | {} | {} | {} .. {} |",
             e.key,
             sig(e.start),
             sig(e.estimate),
             if e.at_bound { " (at a bound)" } else { "" },
             opt(e.standard_error),
+            opt(e.standard_error_correlated),
             interval,
             sig(e.lo),
             sig(e.hi)
@@ -222,11 +228,13 @@ fn estimates_table(s: &mut String, f: &Fitted) {
     let _ = writeln!(
         s,
         "\nResidual variance s^2 = {} over n = {} residuals, {} degrees of freedom (about 1 when the model \
-         explains everything but the noise); t quantile {}.\n",
+         explains everything but the noise); t quantile {}; residuals taken as correlated over {} samples \
+         (Eq. LS18).\n",
         sig(st.s2),
         st.n,
         st.dof,
-        sig(st.t_quantile)
+        sig(st.t_quantile),
+        st.bandwidth
     );
 }
 
@@ -313,9 +321,10 @@ fn trace_table(s: &mut String, f: &Fitted) {
 const HOW_TO_READ: &str = "## How to read this\n\n\
 Each residual is a sensor column's model - recording divided by that column's noise level (estimated from the recording, Eq. LS2) and \
 multiplied by its sensor's weight (Eq. LS1). The search stops when the relative offset (Eq. LS10) is below 1e-3: what is left to gain \
-is a thousandth of the estimates' own uncertainty. The standard errors and 95 % intervals hold when the model is right and the noise \
-white (Eqs. LS11-LS14); s^2 well above 1, or an error figure with oscillation left in it, says the model misses something the \
-recording has, and the intervals are then too narrow. A correlation near -1 or +1 and an ill-conditioned verdict say that the data \
+is a thousandth of the estimates' own uncertainty. The noise's standard errors (Eqs. LS11-LS13) hold when the model is right and the \
+noise white; the correlated ones (Eq. LS18) let the residuals stay correlated over one period of the first mode, as the model's own \
+error does, and the 95 % intervals take the wider of the two (Eq. LS19). s^2 well above 1, or an error figure with oscillation left \
+in it, says the model misses something the recording has. A correlation near -1 or +1 and an ill-conditioned verdict say that the data \
 hardly separate two parameters (Eqs. LS15-LS16). docs/measured.md section 4 has the derivation.\n";
 
 /// The report: the markdown's sections and the figures inline.

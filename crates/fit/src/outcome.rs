@@ -74,9 +74,11 @@ pub struct Estimate {
     pub hi: f64,
     pub start: f64,
     pub estimate: f64,
-    /// `None` at a bound or for a singular problem.
+    /// Eq. LS12's, the noise's alone; `None` at a bound or for a singular problem.
     pub standard_error: Option<f64>,
-    /// The 95 % interval (Eq. LS14).
+    /// Eq. LS18's, residuals correlated in time (the model's own error included).
+    pub standard_error_correlated: Option<f64>,
+    /// The 95 % interval on the wider of the two (Eqs. LS14, LS19).
     pub interval: Option<[f64; 2]>,
     /// At a bound (then left out of the statistics).
     pub at_bound: bool,

@@ -34,6 +34,9 @@ pub struct Settings {
     pub max_iterations: usize,
     /// Eq. LS10: the relative offset below which the search has converged.
     pub offset_tol: f64,
+    /// How many samples the model's error may stay correlated over: the bandwidth of Eq. LS18
+    /// (`docs/measured.md` 4.7: one period of the slowest mode; 0 treats the residuals as white).
+    pub correlation_samples: usize,
 }
 
 impl Default for Settings {
@@ -41,6 +44,7 @@ impl Default for Settings {
         Settings {
             max_iterations: 50,
             offset_tol: 1e-3,
+            correlation_samples: 0,
         }
     }
 }
@@ -275,7 +279,11 @@ impl<M: Model + ?Sized> Run<'_, M> {
         let at_bound: Vec<bool> = s.u.iter().map(|&u| u <= 0.0 || u >= 1.0).collect();
         let free: Vec<bool> = at_bound.iter().map(|b| !b).collect();
         let jp = physical_jacobian(p, &s.j);
-        let statistics = crate::stats::statistics(&jp, &s.r, &theta, &free);
+        let layout = crate::stats::Layout {
+            segment: p.t.len(),
+            bandwidth: self.settings.correlation_samples,
+        };
+        let statistics = crate::stats::statistics(&jp, &s.r, &theta, &free, layout);
         let identifiability = crate::identifiability::check(&jp, &p.params, &theta);
         let estimates = p
             .params
@@ -288,6 +296,7 @@ impl<M: Model + ?Sized> Run<'_, M> {
                 start: q.start,
                 estimate: theta[k],
                 standard_error: statistics.standard_errors[k],
+                standard_error_correlated: statistics.standard_errors_correlated[k],
                 interval: statistics.intervals[k],
                 at_bound: at_bound[k],
             })

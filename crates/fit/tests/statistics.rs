@@ -232,3 +232,50 @@ fn a_search_cut_short_says_it_did_not_converge() {
     assert!(full.converged(), "{}", full.reason);
     assert!((full.theta()[0] - 30.0).abs() < 0.05, "{:?}", full.theta());
 }
+
+/// The mean `a` of AR(1) residuals `e_k = rho e_(k-1) + u_k` (rho = 0.8, 100 000 samples): the
+/// noise's standard error (Eq. LS12) is the white one, `sd(e) / sqrt(n)`, and the correlated one of
+/// Eq. LS18 (bandwidth 400 samples) the long-run one, `sd(e) sqrt((1 + rho) / (1 - rho) / n)`
+/// (Hamilton, Time Series Analysis, 7.2), three times larger; for white residuals the two agree.
+/// Tolerances: the Bartlett estimate's own spread at this bandwidth, `sqrt(4 L / 3 n)` = 7.3 % in
+/// variance, 3.7 % in the standard error (12 % asserted: three of those).
+#[test]
+fn correlated_residuals_widen_the_standard_error_to_the_long_run_one() {
+    let n = 100_000;
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+    for (rho, seed) in [(0.8, 21), (0.0, 22)] {
+        let mut noise = Normal::new(seed, 0);
+        let mut e = 0.0;
+        let data: Vec<f64> = (0..n)
+            .map(|_| {
+                e = rho * e + noise.draw();
+                1.5 + e
+            })
+            .collect();
+        let rec = {
+            let mut s = SensorTable::new(t.clone());
+            s.push_column("y".into(), "m", data.clone());
+            s
+        };
+        let problem = Problem::with_sigmas(vec![param("a", -5.0, 5.0, 0.0)], &rec, &[1.0], &[1.0]).unwrap();
+        let model = |th: &[f64]| -> Result<SensorTable, String> { Ok(table(&t, |_| th[0])) };
+        let settings = Settings {
+            correlation_samples: 400,
+            ..Settings::default()
+        };
+        let f = fit(&problem, &model, &settings, &quiet).unwrap();
+        assert!(f.converged(), "{}", f.reason);
+        let e = &f.estimates[0];
+        let mean = data.iter().sum::<f64>() / n as f64;
+        let sd = (data.iter().map(|y| (y - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
+        let white = sd / (n as f64).sqrt();
+        let long_run = white * ((1.0 + rho) / (1.0 - rho)).sqrt();
+        let (se, se_corr) = (e.standard_error.unwrap(), e.standard_error_correlated.unwrap());
+        eprintln!("rho {rho}: se {se:.4e} (white {white:.4e}), correlated {se_corr:.4e} (long-run {long_run:.4e})");
+        assert!((se / white - 1.0).abs() < 1e-3, "{se} vs {white}");
+        assert!((se_corr / long_run - 1.0).abs() < 0.12, "{se_corr} vs {long_run}");
+        let [lo, hi] = e.interval.unwrap();
+        let half = 0.5 * (hi - lo);
+        assert!((half / (f.statistics.t_quantile * se.max(se_corr)) - 1.0).abs() < 1e-12);
+    }
+}

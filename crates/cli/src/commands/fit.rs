@@ -49,11 +49,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .interval
             .map_or("n/a".to_string(), |[a, b]| format!("{a:.6e} .. {b:.6e}"));
         eprintln!(
-            "fit: {:<16} {:.6e} (start {:.6e}), standard error {}, 95 % interval {interval}{}",
+            "fit: {:<16} {:.6e} (start {:.6e}), standard error {} (noise), {} (correlated), 95 % interval {interval}{}",
             e.key,
             e.estimate,
             e.start,
             e.standard_error.map_or("n/a".to_string(), |v| format!("{v:.3e}")),
+            e.standard_error_correlated
+                .map_or("n/a".to_string(), |v| format!("{v:.3e}")),
             if e.at_bound { ", at a bound" } else { "" }
         );
     }

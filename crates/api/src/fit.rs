@@ -36,6 +36,25 @@ pub struct Fitted {
     /// The calibrated experiment (the document with the estimates patched in) when the fit is
     /// a calibration ([`Fit::calibrated`]).
     pub calibrated: Option<ExperimentDoc>,
+    /// The FEM of the calibrated experiment against the recording and the AMM (4.9): per fitted
+    /// channel, or why it could not run; `None` without a calibration.
+    pub fem_check: Option<std::result::Result<Vec<FemCheck>, String>>,
+}
+
+/// One channel of the FEM's check of a calibration (`docs/measured.md` 4.9): RMS values in the
+/// channel's unit over the recording's times.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FemCheck {
+    pub column: String,
+    pub unit: String,
+    /// The noise level of Eq. LS2.
+    pub noise: f64,
+    /// The calibrated AMM's error against the recording (the fit's `rms_after`).
+    pub rms_amm: f64,
+    /// The calibrated FEM's error against the recording.
+    pub rms_fem: f64,
+    /// The two models' difference at the estimates.
+    pub rms_fem_amm: f64,
 }
 
 /// What `flexstar fit` made.
@@ -102,8 +121,6 @@ pub fn fit_experiment(
     setup.fit(input, recording, name, start, on_iteration)
 }
 
-/// What the experiment says before any run: its `[fit]`, the parameters resolved against its
-/// document, its sensors.
 /// The bandwidth of Eq. LS18 (`docs/measured.md` 4.7): one period of the first elastic mode at the
 /// motion's final pose (the accurate AMM, sliders locked, payload included: the slowest component
 /// of the model's error) in samples of the recording; without a rest pose or a mode, the whole
@@ -120,6 +137,8 @@ fn correlation_samples(exp: &flexstar_model::Experiment, t: &[f64]) -> usize {
     }
 }
 
+/// What the experiment says before any run: its `[fit]`, the parameters resolved against its
+/// document, its sensors.
 struct Setup<'a> {
     section: &'a FitSection,
     params: Vec<Param>,
@@ -178,6 +197,7 @@ impl<'a> Setup<'a> {
             }
             false => None,
         };
+        let fem_check = calibrated.as_ref().map(|_| fem_check(&model, &fit, &data.table));
         Ok(Fitted {
             fit,
             input: input.clone(),
@@ -188,8 +208,39 @@ impl<'a> Setup<'a> {
             modes: start.modes,
             dt: start.dt,
             calibrated,
+            fem_check,
         })
     }
+}
+
+/// The FEM's check of a calibration (4.9): the FEM of the calibrated experiment, each fitted
+/// channel's RMS error against the recording beside the AMM's, and the two models' difference.
+fn fem_check(model: &AmmEvaluation, fit: &Fit, recording: &SensorTable) -> std::result::Result<Vec<FemCheck>, String> {
+    let fem = crate::fit_model::fem_readings(model, &fit.theta())?;
+    let rms = |a: &[f64], b: &[f64]| {
+        (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len().max(1) as f64).sqrt()
+    };
+    fit.channels
+        .iter()
+        .filter(|c| c.weight > 0.0)
+        .map(|c| {
+            let (Some(y), Some(f), Some(a)) = (
+                recording.column(&c.column),
+                fem.column(&c.column),
+                fit.after.column(&c.column),
+            ) else {
+                return Err(format!("channel {} missing from the FEM's readings", c.column));
+            };
+            Ok(FemCheck {
+                column: c.column.clone(),
+                unit: c.unit.clone(),
+                noise: c.noise,
+                rms_amm: rms(a, y),
+                rms_fem: rms(f, y),
+                rms_fem_amm: rms(f, a),
+            })
+        })
+        .collect()
 }
 
 /// The `[fit]` section, and sensors to fit to.

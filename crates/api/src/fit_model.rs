@@ -85,6 +85,18 @@ impl Model for AmmEvaluation<'_> {
     }
 }
 
+/// The FEM's readings of the experiment at `theta` (its own `[fem]` mesh and step, sensors
+/// without noise), cut to the recording's times: the second model that checks a calibration
+/// (4.9).
+pub(crate) fn fem_readings(eval: &AmmEvaluation, theta: &[f64]) -> std::result::Result<SensorTable, String> {
+    let exp = noiseless(eval.experiment(theta)?.exp);
+    let src = eval.source.display().to_string();
+    let prepared = crate::run::prepare(exp, &src, &RunSettings::new(Solver::Fem)).map_err(|e| e.to_string())?;
+    let r = crate::run::solve(&prepared, None).map_err(|e| e.to_string())?;
+    let table = r.sensors.ok_or_else(|| "the FEM run read no sensors".to_string())?;
+    Ok(cut(&table, eval.window.clone()))
+}
+
 /// The rows `window` of a table.
 fn cut(table: &SensorTable, window: Range<usize>) -> SensorTable {
     if window == (0..table.t.len()) {

@@ -135,6 +135,11 @@ pub fn fit_json(o: &FitOutcome) -> Value {
             "correlation_samples": st.bandwidth,
         },
         "not_recorded": f.not_recorded,
+        "fem_check": match &f.fem_check {
+            None => serde_json::Value::Null,
+            Some(Ok(rows)) => json!({ "channels": rows }),
+            Some(Err(reason)) => json!({ "error": reason }),
+        },
         "channels": fit.channels.iter().map(|c| json!({
             "column": c.column,
             "unit": c.unit,
@@ -196,6 +201,7 @@ pub fn fit_markdown(o: &FitOutcome) -> String {
     estimates_table(&mut s, f);
     correlation_table(&mut s, f);
     channels_table(&mut s, f);
+    fem_check_table(&mut s, f);
     trace_table(&mut s, f);
     s.push_str(HOW_TO_READ);
     s
@@ -254,6 +260,43 @@ fn correlation_table(s: &mut String, f: &Fitted) {
         let _ = writeln!(s, "| `{}` | {} |", keys[k], cells.join(" | "));
     }
     s.push('\n');
+}
+
+/// The FEM of the calibrated experiment against the recording and the AMM (4.9).
+fn fem_check_table(s: &mut String, f: &Fitted) {
+    match &f.fem_check {
+        None => {}
+        Some(Err(reason)) => {
+            let _ = writeln!(
+                s,
+                "## The FEM's check\n\nThe FEM of the calibrated experiment did not run: {reason}\n"
+            );
+        }
+        Some(Ok(rows)) => {
+            s.push_str(
+                "## The FEM's check: RMS against the recording at the estimates\n\nThe calibrated experiment run on the \
+                 FEM, an independent model (docs/measured.md 4.9): where the FEM's error is the AMM's, the estimates \
+                 do not rest on the AMM's own error; where the two models differ by a good share of the noise, the \
+                 correlated standard errors (Eq. LS18) are the ones to read.\n\n\
+                 | column | unit | noise (Eq. LS2) | AMM - recording | FEM - recording | FEM - AMM | (FEM - AMM) / noise |\n\
+                 |---|---|---|---|---|---|---|\n",
+            );
+            for c in rows {
+                let _ = writeln!(
+                    s,
+                    "| `{}` | {} | {} | {} | {} | {} | {:.3} |",
+                    c.column,
+                    c.unit,
+                    sig(c.noise),
+                    sig(c.rms_amm),
+                    sig(c.rms_fem),
+                    sig(c.rms_fem_amm),
+                    c.rms_fem_amm / c.noise
+                );
+            }
+            s.push('\n');
+        }
+    }
 }
 
 fn channels_table(s: &mut String, f: &Fitted) {

@@ -126,6 +126,29 @@ fn the_bench_robot_is_calibrated_on_its_fem_recording() {
     );
     assert!(f.calibrated(), "{}", f.reason);
     assert!(o.dir.join("fit.toml").exists() && o.dir.join("report.html").exists());
+    // the FEM's check of the calibration (4.9): the FEM of the calibrated robot reads the
+    // recording to its noise, as the truth's FEM that made it does
+    let checks = o
+        .fitted
+        .fem_check
+        .as_ref()
+        .expect("a calibration is checked")
+        .as_ref()
+        .unwrap();
+    assert_eq!(checks.len(), f.channels.len());
+    for c in checks {
+        eprintln!(
+            "  FEM check {}: AMM {:.3e}, FEM {:.3e}, FEM - AMM {:.3e}, noise {:.3e}",
+            c.column, c.rms_amm, c.rms_fem, c.rms_fem_amm, c.noise
+        );
+        assert!(
+            c.rms_fem < 1.2 * c.noise,
+            "{}: FEM {} vs noise {}",
+            c.column,
+            c.rms_fem,
+            c.noise
+        );
+    }
     // the frequency at which the fitted zeta holds is written (4.9)
     let fit_toml = std::fs::read_to_string(o.dir.join("fit.toml")).unwrap();
     assert!(fit_toml.contains("f_hz = "), "{fit_toml}");

@@ -250,7 +250,9 @@ pub fn fit<'py>(py: Python<'py>, config: PathBuf, measured: PathBuf, out: PathBu
     let calibrated = o.fitted.calibrated.clone();
     d.set_item(
         "fit_toml",
-        calibrated.as_ref().map(|_| o.dir.join("fit.toml").display().to_string()),
+        calibrated
+            .as_ref()
+            .map(|_| o.dir.join("fit.toml").display().to_string()),
     )?;
     d.set_item("calibrated", calibrated.map(|inner| PyExperiment { inner }))?;
     Ok(d)

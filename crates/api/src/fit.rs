@@ -183,6 +183,7 @@ impl<'a> Setup<'a> {
         };
         let settings = flexstar_fit::Settings {
             max_iterations: self.section.iterations(),
+            starts: self.section.start_count(),
             correlation_samples: correlation_samples(&input.exp, &recording.t),
             ..flexstar_fit::Settings::default()
         };

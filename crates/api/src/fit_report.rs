@@ -135,6 +135,7 @@ pub fn fit_json(o: &FitOutcome) -> Value {
             "correlation_samples": st.bandwidth,
         },
         "not_recorded": f.not_recorded,
+        "starts": fit.starts,
         "fem_check": match &f.fem_check {
             None => serde_json::Value::Null,
             Some(Ok(rows)) => json!({ "channels": rows }),
@@ -202,6 +203,7 @@ pub fn fit_markdown(o: &FitOutcome) -> String {
     correlation_table(&mut s, f);
     channels_table(&mut s, f);
     fem_check_table(&mut s, f);
+    starts_table(&mut s, f);
     trace_table(&mut s, f);
     s.push_str(HOW_TO_READ);
     s
@@ -297,6 +299,37 @@ fn fem_check_table(s: &mut String, f: &Fitted) {
             s.push('\n');
         }
     }
+}
+
+/// Every start's search when there were several (docs/measured.md 4.6).
+fn starts_table(s: &mut String, f: &Fitted) {
+    let starts = &f.fit.starts;
+    if starts.len() < 2 {
+        return;
+    }
+    let keys: Vec<&str> = f.fit.estimates.iter().map(|e| e.key.as_str()).collect();
+    let _ = writeln!(
+        s,
+        "## Starts\n\n{} starts (the given one, then Halton points of the boxes); the estimates are the chosen \
+         search's: converged before not, then the lowest cost. Parameters in the order {}.\n\n\
+         | start | from | to | cost (Eq. LS4) | stop | chosen |\n|---|---|---|---|---|---|",
+        starts.len(),
+        keys.join(", ")
+    );
+    let list = |v: &[f64]| v.iter().map(|x| sig(*x)).collect::<Vec<_>>().join(", ");
+    for (k, o) in starts.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} |",
+            k + 1,
+            list(&o.start),
+            list(&o.end),
+            sig(o.cost),
+            o.reason,
+            if o.chosen { "yes" } else { "" }
+        );
+    }
+    s.push('\n');
 }
 
 fn channels_table(s: &mut String, f: &Fitted) {

@@ -18,11 +18,12 @@ pub mod noise;
 pub mod outcome;
 pub mod problem;
 pub mod search;
+pub mod starts;
 pub mod stats;
 mod step;
 
 pub use identifiability::{Combination, Identifiability, Verdict};
-pub use outcome::{ChannelFit, Estimate, Fit, Iteration, Stop};
+pub use outcome::{ChannelFit, Estimate, Fit, Iteration, StartOutcome, Stop};
 pub use problem::{Channel, Param, Problem};
 pub use search::{fit, Settings};
 pub use stats::Statistics;

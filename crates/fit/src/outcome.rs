@@ -108,6 +108,22 @@ impl ChannelFit {
     }
 }
 
+/// One start's search (`docs/measured.md` 4.6).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StartOutcome {
+    /// Where it started and where it ended, in the parameters' units.
+    pub start: Vec<f64>,
+    pub end: Vec<f64>,
+    /// Eq. LS4 at the end (`NaN` where the start could not be evaluated).
+    pub cost: f64,
+    pub converged: bool,
+    pub iterations: usize,
+    /// Why it stopped, in words.
+    pub reason: String,
+    /// Its estimates are the fit's.
+    pub chosen: bool,
+}
+
 /// A fit.
 #[derive(Debug, Clone, Serialize)]
 pub struct Fit {
@@ -122,6 +138,9 @@ pub struct Fit {
     pub evaluations: usize,
     pub wall_s: f64,
     pub trace: Vec<Iteration>,
+    /// Every start's search (`docs/measured.md` 4.6): the given start first; the estimates are
+    /// those of the best (converged before not, then the lowest cost).
+    pub starts: Vec<StartOutcome>,
     /// The model's readings at the start and at the estimates (for the report's overlays).
     #[serde(skip)]
     pub before: SensorTable,

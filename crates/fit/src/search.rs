@@ -17,7 +17,7 @@ use flexstar_model::SensorTable;
 
 use crate::identifiability::Verdict;
 use crate::jacobian::jacobian;
-use crate::outcome::{ChannelFit, Estimate, Fit, Iteration, Stop};
+use crate::outcome::{ChannelFit, Estimate, Fit, Iteration, StartOutcome, Stop};
 use crate::problem::Problem;
 use crate::step::{damped_step, free_set, normal_equations, predicted_decrease, project, relative_offset};
 use crate::{FitError, Model};
@@ -37,6 +37,9 @@ pub struct Settings {
     /// How many samples the model's error may stay correlated over: the bandwidth of Eq. LS18
     /// (`docs/measured.md` 4.7: one period of the slowest mode; 0 treats the residuals as white).
     pub correlation_samples: usize,
+    /// How many starts (`docs/measured.md` 4.6): the given one, then `starts - 1` Halton points
+    /// of the box ([`crate::starts::halton_starts`]); 0 and 1 are the given start alone.
+    pub starts: usize,
 }
 
 impl Default for Settings {
@@ -45,6 +48,7 @@ impl Default for Settings {
             max_iterations: 50,
             offset_tol: 1e-3,
             correlation_samples: 0,
+            starts: 1,
         }
     }
 }
@@ -72,9 +76,11 @@ fn cost(r: &[f64]) -> f64 {
 
 /// Fit `problem` with `model`: the start evaluated with its Jacobian, refused when that Jacobian
 /// is rank-deficient (Eq. LS15: the data cannot separate the parameters, named by their
-/// combination), the search, the statistics and the identifiability at the end. `on_iteration`
-/// sees the start and each accepted iterate. A search that does not converge is still a [`Fit`]
-/// (its [`Fit::stop`] says why); an error is a start that cannot be evaluated or separated.
+/// combination), the search, then a search from each further start of `settings.starts`
+/// (`docs/measured.md` 4.6), the best kept (converged before not, then the lowest cost), the
+/// statistics and the identifiability at its end. `on_iteration` sees each search's start and
+/// accepted iterates. A search that does not converge is still a [`Fit`] (its [`Fit::stop`] says
+/// why); an error is a start that cannot be evaluated or separated.
 pub fn fit<M: Model + ?Sized>(
     problem: &Problem,
     model: &M,
@@ -82,7 +88,8 @@ pub fn fit<M: Model + ?Sized>(
     on_iteration: &dyn Fn(&Iteration),
 ) -> Result<Fit, FitError> {
     let started = Instant::now();
-    let start = evaluate_start(problem, model)?;
+    let theta0: Vec<f64> = problem.params.iter().map(|p| p.start).collect();
+    let start = evaluate_state(problem, model, problem.start_scaled(), theta0.clone())?;
     refuse_unidentifiable(problem, &start)?;
     let before = start.table.clone();
     let mut run = Run {
@@ -93,15 +100,78 @@ pub fn fit<M: Model + ?Sized>(
         evaluations: 1 + problem.params.len(),
         trace: Vec::new(),
     };
-    run.record(&start, 0, 0.0, on_iteration);
-    let (end, stop) = run.search(start, on_iteration);
-    Ok(run.finish(end, stop, before))
+    let mut best = run.search_from(start, on_iteration);
+    let mut starts = vec![best.outcome(&theta0, settings.offset_tol)];
+    let mut chosen = 0;
+    for u in crate::starts::halton_starts(problem.params.len(), settings.starts.saturating_sub(1)) {
+        let theta = problem.physical(&u);
+        run.evaluations += 1 + problem.params.len();
+        match evaluate_state(problem, model, u, theta.clone()) {
+            Ok(state) => {
+                let other = run.search_from(state, on_iteration);
+                starts.push(other.outcome(&theta, settings.offset_tol));
+                if other.better_than(&best) {
+                    best = other;
+                    chosen = starts.len() - 1;
+                }
+            }
+            Err(e) => starts.push(StartOutcome {
+                start: theta.clone(),
+                end: theta,
+                cost: f64::NAN,
+                converged: false,
+                iterations: 0,
+                reason: e.to_string(),
+                chosen: false,
+            }),
+        }
+    }
+    starts[chosen].chosen = true;
+    run.trace = best.trace;
+    let mut fit = run.finish(best.end, best.stop, before);
+    fit.starts = starts;
+    Ok(fit)
 }
 
-/// The model and its Jacobian at the start (the starts as given, not through Eq. LS5).
-fn evaluate_start<M: Model + ?Sized>(problem: &Problem, model: &M) -> Result<State, FitError> {
-    let u = problem.start_scaled();
-    let theta: Vec<f64> = problem.params.iter().map(|p| p.start).collect();
+/// One start's search: where it ended, why, and its iterations.
+struct Searched {
+    end: State,
+    stop: Stop,
+    trace: Vec<Iteration>,
+}
+
+impl Searched {
+    /// Converged before not, then the lower cost.
+    fn better_than(&self, other: &Searched) -> bool {
+        match (self.stop.converged(), other.stop.converged()) {
+            (true, false) => true,
+            (false, true) => false,
+            _ => self.end.cost() < other.end.cost(),
+        }
+    }
+
+    /// Its summary, started at `start` (the parameters' units).
+    fn outcome(&self, start: &[f64], tol: f64) -> StartOutcome {
+        StartOutcome {
+            start: start.to_vec(),
+            end: self.end.theta.clone(),
+            cost: self.end.cost(),
+            converged: self.stop.converged(),
+            iterations: self.trace.len().saturating_sub(1),
+            reason: self.stop.text(tol),
+            chosen: false,
+        }
+    }
+}
+
+/// The model and its Jacobian at the scaled `u`, whose physical values are `theta` (the given
+/// start exactly as written, not through Eq. LS5).
+fn evaluate_state<M: Model + ?Sized>(
+    problem: &Problem,
+    model: &M,
+    u: Vec<f64>,
+    theta: Vec<f64>,
+) -> Result<State, FitError> {
     let at = describe(problem, &theta);
     let evaluated = model.evaluate(&theta).and_then(|t| Ok((problem.residuals(&t)?, t)));
     let (r, table) = evaluated.map_err(|reason| FitError::Evaluation { at: at.clone(), reason })?;
@@ -167,6 +237,17 @@ enum Step {
 }
 
 impl<M: Model + ?Sized> Run<'_, M> {
+    /// A search from `s`, its iterations taken out of the bookkeeping.
+    fn search_from(&mut self, s: State, on_iteration: &dyn Fn(&Iteration)) -> Searched {
+        self.record(&s, 0, 0.0, on_iteration);
+        let (end, stop) = self.search(s, on_iteration);
+        Searched {
+            end,
+            stop,
+            trace: std::mem::take(&mut self.trace),
+        }
+    }
+
     /// Iterate from `s` until Eq. LS10 holds or the search gives up.
     fn search(&mut self, mut s: State, on_iteration: &dyn Fn(&Iteration)) -> (State, Stop) {
         let mut mu = MU0;
@@ -314,6 +395,7 @@ impl<M: Model + ?Sized> Run<'_, M> {
             evaluations: self.evaluations,
             wall_s: self.started.elapsed().as_secs_f64(),
             trace: self.trace,
+            starts: Vec::new(),
             before,
             after: s.table,
         }

@@ -10,6 +10,7 @@
 //! ]
 //! weights = { accG = 2.0, enc1 = 0.0, accB_x = 0.0 }           # per sensor or column; default 1
 //! max_iterations = 50                                          # of the search (default 50)
+//! starts = 4                                                   # the given start and 3 more (default 1)
 //! ```
 //! What needs no document is checked here, when the file is read: bounds, starts, weights. That
 //! each key is a number the experiment accepts, at its bounds too, is checked by the command
@@ -50,7 +51,14 @@ pub struct FitSection {
     /// The most iterations of the search (default [`DEFAULT_MAX_ITERATIONS`]; 1..=1000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_iterations: Option<usize>,
+    /// How many starts the search takes (`docs/measured.md` 4.6): the given one, then Halton
+    /// points of the boxes; default 1, at most [`MAX_STARTS`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub starts: Option<usize>,
 }
+
+/// The most starts `[fit] starts` may ask for.
+pub const MAX_STARTS: usize = 64;
 
 /// The most iterations of the search when `[fit] max_iterations` is not given
 /// (`docs/measured.md` 4.6).
@@ -76,6 +84,14 @@ impl FitSection {
                 return Err(ModelError::invalid(
                     "fit.max_iterations",
                     format!("need 1 <= max_iterations <= 1000, got {n}"),
+                ));
+            }
+        }
+        if let Some(n) = self.starts {
+            if !(1..=MAX_STARTS).contains(&n) {
+                return Err(ModelError::invalid(
+                    "fit.starts",
+                    format!("need 1 <= starts <= {MAX_STARTS}, got {n}"),
                 ));
             }
         }
@@ -124,6 +140,11 @@ impl FitSection {
     /// The most iterations of the search.
     pub fn iterations(&self) -> usize {
         self.max_iterations.unwrap_or(DEFAULT_MAX_ITERATIONS)
+    }
+
+    /// How many starts the search takes (default 1: the given one).
+    pub fn start_count(&self) -> usize {
+        self.starts.unwrap_or(1)
     }
 
     /// The weight of column `column` of sensor `sensor`: the column's own, else the sensor's,
@@ -250,6 +271,11 @@ mod tests {
             let e = section(params, weights).validate(&sensors).unwrap_err().to_string();
             assert!(e.contains(key) && e.contains(why), "{params} {weights}: {e}");
         }
+        let e = section("{ key = \"a\", lo = 0.0, hi = 1.0 }", "starts = 0")
+            .validate(&sensors)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("fit.starts") && e.contains("1 <= starts <= 64"), "{e}");
         let e = section("{ key = \"a\", lo = 0.0, hi = 1.0 }", "max_iterations = 0")
             .validate(&sensors)
             .unwrap_err()
@@ -259,6 +285,7 @@ mod tests {
             params: Vec::new(),
             weights: BTreeMap::new(),
             max_iterations: None,
+            starts: None,
         }
         .validate(&sensors)
         .unwrap_err()

@@ -343,6 +343,26 @@ def test_plan_of_a_whole_cycle_reports_each_move_and_dwell(root, tmp_path):
         assert [d[motion][1] for d in res["dwells"]] == pytest.approx(peaks, rel=1e-12)
 
 
+def test_compare_lays_a_recording_over_the_runs(root, tmp_path):
+    """flexstar.compare(..., measured=) is `flexstar compare --measured` (docs/measured.md 1-3): the
+    bench robot's FEM recording laid over its own runs gives the FEM an error at the noise's level,
+    and the free decay's identified modes lie within 0.5 % of the AMM's frequencies at the final
+    pose, a second model that never saw the recording."""
+    import json
+
+    truth = flexstar.Experiment.load(root / "configs/measured/truth.toml")
+    flexstar.run(truth, solver="fem").save(tmp_path / "rec")
+    rec = tmp_path / "rec/truth/fem-sensors.csv"
+    res = flexstar.compare(root / "configs/measured/truth.toml", tmp_path / "cmp", measured=rec)
+    m = json.loads((pathlib.Path(res["dir"]) / "compare.json").read_text())["measured"]
+    fem_acc = [e for e in m["errors"] if e["run"] == "fem" and e["unit"] == "m/s^2"]
+    assert len(fem_acc) == 4 and all(e["rms"] < 1e-12 for e in fem_acc), fem_acc
+    model = m["modes_hz"]
+    assert len(m["identified"]) >= 3, m
+    for mode in m["identified"][:3]:
+        assert min(abs(mode["f_hz"] / f - 1.0) for f in model) < 5e-3, (mode, model)
+
+
 def test_fit_matches_the_cli_contract(root, tmp_path):
     """flexstar.fit is `flexstar fit` (docs/measured.md section 4): fit.json's content as a dict,
     the calibrated Experiment that runs, the estimates within the targets of 4.11 on the FEM's
@@ -359,6 +379,10 @@ def test_fit_matches_the_cli_contract(root, tmp_path):
         assert abs(p["estimate"] - value) <= target * value, p
         lo, hi = p["interval_95"]
         assert lo < p["estimate"] < hi
+        # the reported interval holds the truth (docs/measured.md 4.7, Eq. LS19)
+        assert lo <= value <= hi, p
+        assert p["standard_error_correlated"] >= p["standard_error"] > 0, p
+    assert all(c["rms_fem"] < 1.2 * c["noise"] for c in res["fem_check"]["channels"]), res["fem_check"]
     assert pathlib.Path(res["fit_toml"]).exists()
     cal = res["experiment"]
     assert cal.to_dict()["payload"]["mass"] == res["parameters"][0]["estimate"]

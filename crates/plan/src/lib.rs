@@ -22,6 +22,7 @@
 pub mod cycle;
 pub mod cycle_plan;
 pub mod family;
+pub mod fit_uncertainty;
 pub mod limits;
 pub mod lm;
 pub mod minimax;

@@ -507,6 +507,62 @@ mod tests {
         assert_eq!(u.candidates().len(), 8);
     }
 
+    /// `[robust] fit = "fit.json"` (`docs/motions.md` 4.11): each fitted parameter's range is the
+    /// shadow of the fit's joint 95 % region, `estimate -+ sqrt(chi2_2(0.95)) se` with
+    /// `chi2_2(0.95) = 5.9915` (tables) and `se` the wider of the two standard errors, cut to the
+    /// fit's box; a fit that is no calibration and a key given twice are refused.
+    #[test]
+    fn robust_ranges_from_a_fit_are_its_confidence_region_s_shadow() {
+        let dir = std::env::temp_dir().join(format!("flexstar-robust-fit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let fit = |calibrated: bool| {
+            format!(
+                "{{\"calibrated\": {calibrated}, \"reason\": \"converged\", \"parameters\": [\
+                 {{\"key\": \"payload.mass\", \"estimate\": 0.25, \"lo\": 0.21, \"hi\": 1.0, \
+                 \"standard_error\": 0.01, \"standard_error_correlated\": 0.02}},\
+                 {{\"key\": \"robot.E\", \"estimate\": 2e11, \"lo\": 1.5e11, \"hi\": 2.5e11, \
+                 \"standard_error\": 1e9, \"standard_error_correlated\": null}}]}}"
+            )
+        };
+        std::fs::write(dir.join("fit.json"), fit(true)).unwrap();
+        std::fs::write(dir.join("bad.json"), fit(false)).unwrap();
+        let plan = |robust: &str| {
+            plan_config_from_str(
+                &format!("{HEAD}[payload]\nmass = 0.25\n[robust]\n{robust}"),
+                &dir.join("plan.toml"),
+            )
+        };
+        let u = plan("fit = \"fit.json\"\n").unwrap().robust.unwrap();
+        let k = 5.9915f64.sqrt();
+        // the mass's lower end, 0.25 - 0.049, is cut to the fit's box at 0.21
+        let want = [
+            ("payload.mass", 0.21, 0.25 + k * 0.02),
+            ("robot.E", 2e11 - k * 1e9, 2e11 + k * 1e9),
+        ];
+        for (r, (key, lo, hi)) in u.ranges.iter().zip(want) {
+            assert_eq!(r.key, key);
+            assert!(
+                (r.lo / lo - 1.0).abs() < 1e-5 && (r.hi / hi - 1.0).abs() < 1e-5,
+                "{r:?} vs [{lo}, {hi}]"
+            );
+        }
+        for (robust, why) in [
+            ("fit = \"bad.json\"\n", "no calibration"),
+            ("fit = \"none.json\"\n", "none.json"),
+            ("fit = \"fit.json\"\n\"payload.mass\" = [0.0, 0.5]\n", "twice"),
+        ] {
+            let msg = match plan(robust) {
+                Err(PlanError::Input(e)) => e.to_string(),
+                other => panic!("{robust}: {other:?}"),
+            };
+            assert!(
+                msg.contains("plan.toml") && msg.contains("robust") && msg.contains(why),
+                "{msg}"
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     /// Bad `[robust]` entries are refused before any work, naming the file and the key.
     #[test]
     fn bad_robust_entries_are_refused_with_the_key() {

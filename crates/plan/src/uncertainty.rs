@@ -72,8 +72,25 @@ impl Uncertainty {
                 "quantile" => u.quantile = read_quantile(&value, file)?,
                 "draws" => u.draws = read_count(&value, file, "draws", 1, MAX_DRAWS)?,
                 "seed" => u.seed = read_count(&value, file, "seed", 0, usize::MAX)? as u64,
+                "fit" => {
+                    for (key, range) in crate::fit_uncertainty::ranges(&value, file)? {
+                        u.ranges.push(u.read_range(&key, &range)?);
+                    }
+                }
                 _ => u.ranges.push(u.read_range(&name, &value)?),
             }
+        }
+        if let Some(twice) = u
+            .ranges
+            .iter()
+            .enumerate()
+            .find(|(k, r)| u.ranges[..*k].iter().any(|o| o.key == r.key))
+        {
+            return Err(bad(
+                file,
+                &format!("\"{}\"", twice.1.key),
+                "is given twice (as a range and by the fit, or twice by the fit): keep one",
+            ));
         }
         if u.ranges.is_empty() {
             return Err(bad(

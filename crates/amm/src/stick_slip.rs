@@ -108,7 +108,7 @@ fn changes(
                 }
                 Contact::Stuck(_) if at_start[i] => {
                     let need = sys.lam[fr.stick[i]];
-                    if exceeds(need, law.mu_static * fr.load_at(i, &sys.lam)) {
+                    if exceeds(need, law.mu_static * fr.load_at(i, &sys.lam, need)) {
                         out.push((Which::Sleeve(i), Contact::Slip(need.signum())));
                     }
                 }

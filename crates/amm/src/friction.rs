@@ -63,8 +63,16 @@ pub(crate) struct SleeveFriction {
     pub(crate) hp: [f64; 3],
     /// The beams' axial stiffness EA_i [N] (the stick row's compliance, Eq. F16).
     ea: [f64; 3],
-    /// The stick rows' compliance `xp_i / EA_i` of the step [m/N] (0 unless stuck).
+    /// The stick rows' compliance `xp_i / (EA_i beta')` of the step (0 unless stuck).
     compliance: [f64; 3],
+    /// Whether each stick row is in use (its sleeve stuck, in a step or at an event).
+    active: [bool; 3],
+    /// At an event (`crate::events`, Eq. F26): `Some(beta')` of the run's step, with which the
+    /// stuck sleeves' rows hold their sliding accelerations' change to [`SleeveFriction::targets`]
+    /// at the acceleration level, through the compliance the step gives them (`xp / (EA beta')`).
+    pub(crate) event: Option<f64>,
+    /// The targets of the stick rows at an event: the change of `b_i . q''` [m/s^2] (Eq. F26).
+    pub(crate) targets: [f64; 3],
     // the step's terms: the rigid state and rates kept by [`System::predict_friction`], the
     // rest set by [`System::friction_terms`] once the sleeve rows are at the predictor
     /// `mu_k s l_i / (1 + mu_k s sigma thp^)` over `[Fp, FR, FL, Mp]` (0 unless slipping)
@@ -106,6 +114,9 @@ impl SleeveFriction {
             hp,
             ea,
             compliance: [0.0; 3],
+            active: [false; 3],
+            event: None,
+            targets: [0.0; 3],
             coef: [[0.0; 4]; 3],
             drag: [0.0; 3],
             v_pred: [0.0; 3],
@@ -128,6 +139,18 @@ impl SleeveFriction {
             self.thp[i] * force,
         )
         .0
+    }
+
+    /// At an event (Eq. F26): each stuck sleeve's row asks `b_i . dq''` to be its target, added
+    /// to the right-hand side `rhs` of the Schur system; nothing in a step.
+    pub(crate) fn add_targets(&self, rhs: &mut [f64]) {
+        if self.event.is_some() {
+            for i in 0..3 {
+                if self.active[i] {
+                    rhs[self.stick[i]] += self.targets[i];
+                }
+            }
+        }
     }
 
     /// Slipping sleeve i's Coulomb coefficients over `[Fp, FR, FL, Mp]` (Eqs. F14, F22: `mu_k(v^)
@@ -154,15 +177,17 @@ impl SleeveFriction {
             .position(|&g| g == self.stick[i])
             .expect("the stick row is beam i's");
         let stuck = match self.contacts[i] {
-            Contact::Stuck(at) if self.bp > 0.0 => Some(at),
+            Contact::Stuck(at) if self.bp > 0.0 || self.event.is_some() => Some(at),
             _ => None,
         };
         let f_hat = shift.map_or(0.0, |s| s.f);
         let xp = self.xp[i][0];
-        let (c, value, compliance) = match stuck {
-            Some(at) => (1.0, at - xp + f_hat, xp / self.ea[i] / self.bp),
-            None => (0.0, 0.0, 0.0),
+        let (c, value, compliance) = match (stuck, self.event) {
+            (Some(_), Some(bp)) => (1.0, 0.0, xp / self.ea[i] / bp),
+            (Some(at), None) => (1.0, at - xp + f_hat, xp / self.ea[i] / self.bp),
+            (None, _) => (0.0, 0.0, 0.0),
         };
+        self.active[i] = stuck.is_some();
         (beam.cu[k], beam.gu[k], beam.gv[k], beam.sc[k]) = (c, c, value, c);
         beam.stick.iter_mut().for_each(|x| *x = 0.0);
         if let (Some(s), Some(_)) = (shift, stuck) {
@@ -188,6 +213,15 @@ impl System {
         let (o, nm) = (i * self.nb, self.nm);
         let x = st.xp[i].v - q[o + nm];
         x + self.sleeves.shift_of(i, x, &q[o..o + nm])
+    }
+
+    /// Sleeve i's sliding acceleration `xi_i'' = xp_i'' - b_i . q''` [m/s^2] at `st` and the
+    /// accelerations `qdd` (Eq. F19 differentiated, leaving out `g' . alpha'`, second order in
+    /// the deflection's rate; `g` at the last update of the sleeve rows).
+    pub(crate) fn sliding_acceleration(&self, i: usize, st: &RigidState, qdd: &[f64]) -> f64 {
+        let (o, nm) = (i * self.nb, self.nm);
+        let shift = self.sleeves.shift_at_update(i);
+        st.xp[i].d2 - qdd[o + nm] + shift_rate(shift.as_ref(), &qdd[o..o + nm])
     }
 
     /// Sleeve i's sliding speed `v_si = xp_i' - u_i' + g_i . alpha_i'` [m/s] (Eq. F19, g at the
@@ -263,7 +297,7 @@ impl System {
 
     /// The direction `b_i` of sleeve i's friction force among beam i's coordinates (Eq. F20)
     /// into `x` (N + 2): `+1` on `u_i`, `-g_i` on the kept modes (full model), 0 elsewhere.
-    fn friction_direction(&self, i: usize, x: &mut [f64]) {
+    pub(crate) fn friction_direction(&self, i: usize, x: &mut [f64]) {
         x.iter_mut().for_each(|v| *v = 0.0);
         x[self.nm] = 1.0;
         if let Some(s) = self.sleeves.shift_at_update(i) {
@@ -284,7 +318,7 @@ impl System {
         let (nm, m) = (self.nm, self.rows.len());
         for i in 0..3 {
             let k = fr.stick[i];
-            if fr.compliance[i] > 0.0 {
+            if fr.active[i] {
                 self.a[k * m + k] += fr.compliance[i];
             } else {
                 self.a[k * m + k] = 1.0;

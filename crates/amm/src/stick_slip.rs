@@ -91,7 +91,7 @@ fn set(sys: &mut System, rails: Option<&mut Rails>, which: Which, c: Contact) {
 /// - a contact stuck since the step began whose needed force exceeds `mu_static L` (sleeve,
 ///   Eq. F6 with the load of Eq. F13 at the step's multipliers) or `Fc` (rail) slips in the
 ///   direction of that force.
-fn changes(
+pub(crate) fn changes(
     sys: &System,
     rails: Option<&Rails>,
     end: &StepEnd,

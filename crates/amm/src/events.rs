@@ -12,7 +12,6 @@
 //! at the step's start (`stick_slip::switching_step`).
 
 use flexstar_kinematics::RigidState;
-use flexstar_model::friction_run::exceeds;
 use flexstar_model::Contact;
 use flexstar_numerics::GenAlpha;
 
@@ -22,10 +21,6 @@ use crate::system::System;
 
 /// Events located in one step before the rest of the step falls back to the switch at its start.
 const MAX_SPLITS: usize = 6;
-
-/// Rounds of the jump at one event: a sleeve that sticks but cannot hold the force its stick
-/// needs there slips on at once (each round switches at least one sleeve for good).
-const MAX_JUMP_ROUNDS: usize = 4;
 
 /// An event closer than this fraction of the step, or than [`MIN_PART`], to the step's start or
 /// end is taken there: a part step of a tiny fraction would make `beta'` vanish against the
@@ -127,81 +122,48 @@ fn stick_excess(sys: &System) -> [f64; 3] {
     })
 }
 
-/// The accelerations, multipliers and friction forces just before an event, which Eq. F26
-/// jumps from.
-struct Before {
-    qdd: Vec<f64>,
-    lam: Vec<f64>,
-    /// Each sleeve's friction force [N] (Eqs. F14, F16).
-    force: [f64; 3],
-    /// Each sleeve's sliding acceleration [m/s^2].
-    sliding: [f64; 3],
-    /// Each sleeve's state.
-    contacts: [Contact; 3],
-}
-
 impl System {
-    /// Eq. F26: the accelerations `qdd` and the multipliers (`self.lam`) at the rigid state `st`
-    /// with the star at `q`, `v`, right after the contacts switched from `before`'s: the
-    /// equations of motion and the rows at the acceleration level (`C dq'' = 0`), forced by the
-    /// change of the friction forces along each `b_i` (Eq. F20); a stuck sleeve's row asks its
-    /// sliding acceleration to vanish (newly stuck: `b_i . dq''` = its `xi''` before; stuck
-    /// before: 0) through the compliance `xp / (EA beta')` that the run's step `beta'` gives its
-    /// row (Eq. F16); a sleeve that slips now has the Coulomb force of the new multipliers.
-    fn jump(
-        &mut self,
-        st: &RigidState,
-        (q, v): (&[f64], &[f64]),
-        before: &Before,
-        bp: f64,
-        qdd: &mut [f64],
-    ) -> Result<(), AmmError> {
+    /// Eqs. F25-F26: the accelerations `qdd` and the multipliers (`self.lam`) at the rigid state
+    /// `st` with the star at `q`, `v`, right after the contacts switched, from the equations of
+    /// motion and the rows at the acceleration level at that state (`beta' = 0`, as the
+    /// consistent start), not from the step's `q''`: the index-3 step's `q''` carries its rows'
+    /// position correction divided by its `beta'`, large after a short part step. A stuck
+    /// sleeve's force is that of its compliance at the state (Eq. F16), which the switch does
+    /// not change: a sleeve stuck before keeps its row's last multiplier `stuck_force`, one that
+    /// sticks now starts from zero (it sticks where it is, its compliance unstrained); these are
+    /// known forces along `b_i` (Eq. F20), not unknowns. A sleeve that slips has the Coulomb
+    /// force of the new multipliers (Eq. F15, the load's signs from `self.lam`).
+    fn jump(&mut self, st: &RigidState, (q, v): (&[f64], &[f64]), qdd: &mut [f64]) -> Result<(), AmmError> {
         let nb = self.nb;
-        if let Some(fr) = self.friction.as_mut() {
-            fr.event = Some(bp);
-            fr.targets = std::array::from_fn(|i| match (before.contacts[i], fr.contacts[i]) {
-                (Contact::Stuck(_), _) => 0.0,
-                (_, Contact::Stuck(_)) => before.sliding[i],
-                _ => 0.0,
-            });
-        }
-        self.lam.copy_from_slice(&before.lam);
-        // at beta' = 0 the step matrix is the mass matrix, the rows at the acceleration level
-        self.predict_friction(st, v, (0.0, 0.0));
-        if let Err(e) = self.prepare(st, 0.0, 0.0, q) {
-            if let Some(fr) = self.friction.as_mut() {
-                fr.event = None;
-            }
-            return Err(e);
-        }
-        // the forcing: the friction forces' change at the old multipliers, along b_i (the
-        // Coulomb forces' change with the multipliers is in the Schur complement, Eq. F15)
-        self.resid.iter_mut().for_each(|r| *r = 0.0);
-        let mut b = vec![0.0; nb];
-        for i in 0..3 {
-            let change = self.sleeve_friction_force(i, &before.lam, 0.0, true) - before.force[i];
-            if change != 0.0 {
-                self.friction_direction(i, &mut b);
-                for (r, x) in self.resid[i * nb..(i + 1) * nb].iter_mut().zip(&b) {
-                    *r += change * x;
+        let Some(fr) = self.friction.as_ref() else {
+            return Ok(());
+        };
+        let (stick, contacts) = (fr.stick, fr.contacts);
+        let stuck_force: [f64; 3] = std::array::from_fn(|i| match contacts[i] {
+            Contact::Stuck(_) => self.lam[stick[i]],
+            _ => 0.0,
+        });
+        self.solve(st, 0.0, 0.0, q, v, qdd)?;
+        if stuck_force.iter().any(|&f| f != 0.0) {
+            // the stuck sleeves' forces along b_i: the same system, forced by them alone
+            self.resid.iter_mut().for_each(|r| *r = 0.0);
+            let mut b = vec![0.0; nb];
+            for (i, &f) in stuck_force.iter().enumerate() {
+                if f != 0.0 {
+                    self.friction_direction(i, &mut b);
+                    for (r, x) in self.resid[i * nb..(i + 1) * nb].iter_mut().zip(&b) {
+                        *r += f * x;
+                    }
                 }
             }
+            let lam = self.lam.clone();
+            let mut dqdd = vec![0.0; qdd.len()];
+            self.solve_prepared(0.0, None, &mut dqdd);
+            qdd.iter_mut().zip(&dqdd).for_each(|(a, d)| *a += d);
+            self.lam.iter_mut().zip(&lam).for_each(|(l, old)| *l += old);
         }
-        let mut dqdd = vec![0.0; qdd.len()];
-        self.solve_prepared(0.0, None, &mut dqdd);
-        for ((a, old), d) in qdd.iter_mut().zip(&before.qdd).zip(&dqdd) {
-            *a = old + d;
-        }
-        for (l, old) in self.lam.iter_mut().zip(&before.lam) {
-            *l += old;
-        }
-        if let Some(fr) = self.friction.as_mut() {
-            fr.event = None;
-            for i in 0..3 {
-                if fr.contacts[i].stuck().is_none() {
-                    self.lam[fr.stick[i]] = 0.0;
-                }
-            }
+        for (i, f) in stuck_force.iter().enumerate() {
+            self.lam[stick[i]] = *f;
         }
         self.set_axial_acceleration(qdd);
         Ok(())
@@ -300,7 +262,6 @@ impl EventStepper {
         K: Fn(f64) -> Result<RigidState, AmmError>,
     {
         let end_st = kin(t1)?;
-        let grid_h = t1 - st.t;
         for split in 0..=MAX_SPLITS {
             let h = t1 - st.t;
             self.save(sys, x);
@@ -330,7 +291,7 @@ impl EventStepper {
                     *st = mid;
                 }
             }
-            self.switch_at_event(sys, st, x, &due, grid_h)?;
+            self.switch_at_event(sys, st, x, &due)?;
             if theta >= 1.0 {
                 return Ok(());
             }
@@ -351,28 +312,19 @@ impl EventStepper {
     }
 
     /// The contacts `due` switch at the rigid state `st` (a sleeve that stops sticks at its
-    /// material coordinate there) and the accelerations and multipliers jump to theirs (Eq.
-    /// F26; `h` the run's step); the method restarts from them, its acceleration variable the
-    /// new accelerations. A sleeve that sticks but cannot hold the force its stick needs there
-    /// slips on at once, in that force's direction (Eq. F6).
+    /// material coordinate there, its force starting from zero) and the accelerations and
+    /// multipliers jump to theirs (Eq. F26); the method restarts from them, its acceleration
+    /// variable the new accelerations (Eq. F25).
     fn switch_at_event(
         &mut self,
         sys: &mut System,
         st: &RigidState,
         x: &mut State,
         due: &[(Which, Contact)],
-        h: f64,
     ) -> Result<(), AmmError> {
-        let Some(contacts) = sys.friction.as_ref().map(|f| f.contacts) else {
+        if sys.friction.is_none() {
             return Ok(());
-        };
-        let before = Before {
-            qdd: x.qdd.to_vec(),
-            lam: sys.lam.clone(),
-            force: stick_slip::sleeve_forces(sys, x.qdd),
-            sliding: [0, 1, 2].map(|i| sys.sliding_acceleration(i, st, x.qdd)),
-            contacts,
-        };
+        }
         let xi = stick_slip::coordinates(sys, st, x.q);
         if let Some(fr) = sys.friction.as_mut() {
             for &(which, c) in due {
@@ -384,25 +336,7 @@ impl EventStepper {
                 }
             }
         }
-        let bp = self.ga.beta_prime(h);
-        for _ in 0..MAX_JUMP_ROUNDS {
-            sys.jump(st, (x.q, x.v), &before, bp, x.qdd)?;
-            let Some(fr) = sys.friction.as_mut() else {
-                break;
-            };
-            let mut again = false;
-            for i in 0..3 {
-                let newly = before.contacts[i].stuck().is_none() && fr.contacts[i].stuck().is_some();
-                let need = sys.lam[fr.stick[i]];
-                if newly && exceeds(need, fr.law.sleeve(i).mu_static * fr.load_at(i, &sys.lam, need)) {
-                    fr.contacts[i] = Contact::Slip(need.signum());
-                    again = true;
-                }
-            }
-            if !again {
-                break;
-            }
-        }
+        sys.jump(st, (x.q, x.v), x.qdd)?;
         x.acc.copy_from_slice(x.qdd);
         Ok(())
     }

@@ -65,14 +65,8 @@ pub(crate) struct SleeveFriction {
     ea: [f64; 3],
     /// The stick rows' compliance `xp_i / (EA_i beta')` of the step (0 unless stuck).
     compliance: [f64; 3],
-    /// Whether each stick row is in use (its sleeve stuck, in a step or at an event).
+    /// Whether each stick row is in use (its sleeve stuck, in a step).
     active: [bool; 3],
-    /// At an event (`crate::events`, Eq. F26): `Some(beta')` of the run's step, with which the
-    /// stuck sleeves' rows hold their sliding accelerations' change to [`SleeveFriction::targets`]
-    /// at the acceleration level, through the compliance the step gives them (`xp / (EA beta')`).
-    pub(crate) event: Option<f64>,
-    /// The targets of the stick rows at an event: the change of `b_i . q''` [m/s^2] (Eq. F26).
-    pub(crate) targets: [f64; 3],
     // the step's terms: the rigid state and rates kept by [`System::predict_friction`], the
     // rest set by [`System::friction_terms`] once the sleeve rows are at the predictor
     /// `mu_k s l_i / (1 + mu_k s sigma thp^)` over `[Fp, FR, FL, Mp]` (0 unless slipping)
@@ -115,8 +109,6 @@ impl SleeveFriction {
             ea,
             compliance: [0.0; 3],
             active: [false; 3],
-            event: None,
-            targets: [0.0; 3],
             coef: [[0.0; 4]; 3],
             drag: [0.0; 3],
             v_pred: [0.0; 3],
@@ -141,18 +133,6 @@ impl SleeveFriction {
         .0
     }
 
-    /// At an event (Eq. F26): each stuck sleeve's row asks `b_i . dq''` to be its target, added
-    /// to the right-hand side `rhs` of the Schur system; nothing in a step.
-    pub(crate) fn add_targets(&self, rhs: &mut [f64]) {
-        if self.event.is_some() {
-            for i in 0..3 {
-                if self.active[i] {
-                    rhs[self.stick[i]] += self.targets[i];
-                }
-            }
-        }
-    }
-
     /// Slipping sleeve i's Coulomb coefficients over `[Fp, FR, FL, Mp]` (Eqs. F14, F22: `mu_k(v^)
     /// s l_i / (1 + mu_k s sigma thp^)`, the load's signs from the last multipliers `lam`) and its
     /// viscous coefficient `c` [N s/m]; zeros unless slipping. Needs the step's `v_pred`, `thp`.
@@ -171,21 +151,22 @@ impl SleeveFriction {
 
     /// Sleeve i's stick row on its beam's rows `beam` (Eqs. F16, F23): stuck at `xi*` in a step
     /// (`bp > 0`), u coefficient 1, alpha vector `-g^` (the full model's `shift`), value
-    /// `xi* - xp(t) + f^` and compliance `xp / EA`; else empty (its multiplier 0).
+    /// `xi* - xp(t) + f^` and compliance `xp / EA`; else empty (its multiplier 0), and so at the
+    /// consistent start and at an event (`bp = 0`), where a stuck sleeve's force is that of its
+    /// compliance at the state, not an unknown (Eq. F26).
     fn set_stick_row(&mut self, i: usize, beam: &mut BeamRows, shift: Option<&ShiftAt>) {
         let k = (beam.ids.iter())
             .position(|&g| g == self.stick[i])
             .expect("the stick row is beam i's");
         let stuck = match self.contacts[i] {
-            Contact::Stuck(at) if self.bp > 0.0 || self.event.is_some() => Some(at),
+            Contact::Stuck(at) if self.bp > 0.0 => Some(at),
             _ => None,
         };
         let f_hat = shift.map_or(0.0, |s| s.f);
         let xp = self.xp[i][0];
-        let (c, value, compliance) = match (stuck, self.event) {
-            (Some(_), Some(bp)) => (1.0, 0.0, xp / self.ea[i] / bp),
-            (Some(at), None) => (1.0, at - xp + f_hat, xp / self.ea[i] / self.bp),
-            (None, _) => (0.0, 0.0, 0.0),
+        let (c, value, compliance) = match stuck {
+            Some(at) => (1.0, at - xp + f_hat, xp / self.ea[i] / self.bp),
+            None => (0.0, 0.0, 0.0),
         };
         self.active[i] = stuck.is_some();
         (beam.cu[k], beam.gu[k], beam.gv[k], beam.sc[k]) = (c, c, value, c);
@@ -213,15 +194,6 @@ impl System {
         let (o, nm) = (i * self.nb, self.nm);
         let x = st.xp[i].v - q[o + nm];
         x + self.sleeves.shift_of(i, x, &q[o..o + nm])
-    }
-
-    /// Sleeve i's sliding acceleration `xi_i'' = xp_i'' - b_i . q''` [m/s^2] at `st` and the
-    /// accelerations `qdd` (Eq. F19 differentiated, leaving out `g' . alpha'`, second order in
-    /// the deflection's rate; `g` at the last update of the sleeve rows).
-    pub(crate) fn sliding_acceleration(&self, i: usize, st: &RigidState, qdd: &[f64]) -> f64 {
-        let (o, nm) = (i * self.nb, self.nm);
-        let shift = self.sleeves.shift_at_update(i);
-        st.xp[i].d2 - qdd[o + nm] + shift_rate(shift.as_ref(), &qdd[o..o + nm])
     }
 
     /// Sleeve i's sliding speed `v_si = xp_i' - u_i' + g_i . alpha_i'` [m/s] (Eq. F19, g at the

@@ -1157,9 +1157,6 @@ impl System {
                 rhs[beam.ids[k]] -= cz + cq;
             }
         }
-        if let Some(fr) = &self.friction {
-            fr.add_targets(&mut self.rhs);
-        }
         self.lu.solve(&mut self.rhs);
         self.lam.copy_from_slice(&self.rhs);
         self.substitute(qdd);

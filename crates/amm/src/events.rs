@@ -182,6 +182,8 @@ pub(crate) struct EventStepper {
     a_part: Vec<f64>,
     /// Multipliers at the start of the (part) step.
     lam: Vec<f64>,
+    /// The coordinates at the start of the grid step.
+    grid_q: Vec<f64>,
 }
 
 impl EventStepper {
@@ -194,6 +196,7 @@ impl EventStepper {
             vhat: vec![0.0; n],
             a_part: vec![0.0; n],
             lam: vec![0.0; m],
+            grid_q: vec![0.0; n],
         }
     }
 
@@ -246,10 +249,63 @@ impl EventStepper {
         })
     }
 
+    /// A singular constraint system `e` met in the grid step of length `h` to the rigid state
+    /// `st` is a divergence ([`AmmError::Diverged`]) when the same rows at the rigid pose (every
+    /// elastic coordinate zero) are regular: the rows' rank depends on the pose, not on the small
+    /// deflections, so then the coordinates (`at`, or the step's last predictor) have left the
+    /// solution and no row lost rank. Any other error is returned as it is.
+    fn diverged(&self, sys: &mut System, st: &RigidState, h: f64, at: &[f64], e: AmmError) -> AmmError {
+        let AmmError::SingularConstraints { t, source } = e else {
+            return e;
+        };
+        let rigid = vec![0.0; at.len()];
+        if sys
+            .prepare(st, self.ga.beta_prime(h), self.ga.gamma_prime(h), &rigid)
+            .is_err()
+        {
+            return AmmError::SingularConstraints { t, source };
+        }
+        let largest = |q: &[f64]| q.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        AmmError::Diverged {
+            t,
+            dt: h,
+            reached: largest(at).max(largest(&self.qhat)),
+            start: largest(&self.grid_q),
+            source,
+        }
+    }
+
+    /// One step of the run's grid, from `st` (at its start, the rigid state at `t1` on return)
+    /// to `t1` [s], with the events in it located ([`EventStepper::step_events`]); a singular
+    /// constraint system met on the way is reported as a divergence where the rows at the
+    /// step's start are regular ([`EventStepper::diverged`]).
+    pub(crate) fn step<K>(
+        &mut self,
+        sys: &mut System,
+        kin: &K,
+        (st, t1): (&mut RigidState, f64),
+        x: &mut State,
+        out: &mut FrictionOutput,
+        rails: &dyn Fn(&RigidState) -> f64,
+    ) -> Result<(), AmmError>
+    where
+        K: Fn(f64) -> Result<RigidState, AmmError>,
+    {
+        self.grid_q.copy_from_slice(x.q);
+        let h = t1 - st.t;
+        match self.step_events(sys, kin, (st, t1), x, out, rails) {
+            Err(e @ AmmError::SingularConstraints { .. }) => {
+                let end = kin(t1)?;
+                Err(self.diverged(sys, &end, h, x.q, e))
+            }
+            other => other,
+        }
+    }
+
     /// One step of the run's grid, from `st` (at its start, the rigid state at `t1` on return)
     /// to `t1` [s], with the events in it located (module doc); the friction's tally advanced
     /// over each part.
-    pub(crate) fn step<K>(
+    fn step_events<K>(
         &mut self,
         sys: &mut System,
         kin: &K,

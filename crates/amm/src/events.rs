@@ -182,7 +182,7 @@ pub(crate) struct EventStepper {
     a_part: Vec<f64>,
     /// Multipliers at the start of the (part) step.
     lam: Vec<f64>,
-    /// The coordinates at the start of the grid step.
+    /// The coordinates at the start of the grid step (for [`EventStepper::diverged`]'s report).
     grid_q: Vec<f64>,
 }
 
@@ -277,8 +277,8 @@ impl EventStepper {
 
     /// One step of the run's grid, from `st` (at its start, the rigid state at `t1` on return)
     /// to `t1` [s], with the events in it located ([`EventStepper::step_events`]); a singular
-    /// constraint system met on the way is reported as a divergence where the rows at the
-    /// step's start are regular ([`EventStepper::diverged`]).
+    /// constraint system met on the way is reported as a divergence where the same rows at the
+    /// undeformed pose are regular ([`EventStepper::diverged`]).
     pub(crate) fn step<K>(
         &mut self,
         sys: &mut System,

@@ -78,13 +78,10 @@ fn bad_coefficients_are_refused_with_file_and_key() {
     }
 }
 
-/// The accurate AMM's automatic choice with friction runs its pairs at the delivered step
-/// (`docs/amm.md` 12.15): target move 1 with `mu = 0.1` at the default tolerance is solved (at
-/// the coarse step its pairs read the stick and slip events' timing, 26 %, and the choice gave
-/// up at N = 200), and its estimate lies within [0.5, 2] of its mean EVP (Eq. 45) against the
-/// refined FEM (600 elements, 1e-4 s), which `compare` measures without the estimate's code.
-#[test]
-fn the_accurate_amm_with_friction_meets_its_tolerance_and_estimates_its_error() {
+/// The accurate AMM's mean EVP (Eq. 45) against the refined FEM (600 elements, 1e-4 s) on target
+/// move 1 (`configs/motions/move-centre.toml`) with sleeve friction `mu` [-], as `compare`
+/// measures it without the estimate's code, and the AMM's own estimate [%].
+fn move_centre_accuracy(mu: f64) -> (f64, f64) {
     let dir = tempfile::tempdir().unwrap();
     let motion = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/motions/move-centre.toml"),
@@ -93,7 +90,7 @@ fn the_accurate_amm_with_friction_meets_its_tolerance_and_estimates_its_error() 
     let cfg = dir.path().join("rub.toml");
     std::fs::write(
         &cfg,
-        format!("{motion}\n[friction]\nmu = 0.1\n[fem]\nelements = 600\ndt = 1e-4\n"),
+        format!("{motion}\n[friction]\nmu = {mu}\n[fem]\nelements = 600\ndt = 1e-4\n"),
     )
     .unwrap();
     let out = dir.path().join("out");
@@ -118,7 +115,28 @@ fn the_accurate_amm_with_friction_meets_its_tolerance_and_estimates_its_error() 
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(case.join("amm-enriched.json")).unwrap()).unwrap();
     let estimate = json["error_estimate_percent"].as_f64().unwrap();
-    eprintln!("mean EVP against the refined FEM {truth:.3} %, estimate {estimate:.3} %");
+    eprintln!("mu = {mu}: mean EVP against the refined FEM {truth:.3} %, estimate {estimate:.3} %");
+    (truth, estimate)
+}
+
+/// The accurate AMM's automatic choice with friction runs its pairs at the delivered step
+/// (`docs/amm.md` 12.15): target move 1 with `mu = 0.1` at the default tolerance is solved (at
+/// the coarse step its pairs read the stick and slip events' timing, 26 %, and the choice gave
+/// up at N = 200), within 1 % of the refined FEM, and its estimate lies within [0.5, 2] of that
+/// mean EVP (measured 0.106 %, estimate 0.139 %: `docs/validation.md` 10).
+#[test]
+fn the_accurate_amm_with_friction_meets_its_tolerance_and_estimates_its_error() {
+    let (truth, estimate) = move_centre_accuracy(0.1);
+    assert!(truth < 1.0, "{truth} %");
+    assert!((0.5..=2.0).contains(&(estimate / truth)), "{estimate} / {truth}");
+}
+
+/// The same with `mu = 0.3`, where the sleeves stick and slip again after the move
+/// (`docs/friction.md` 9.4-9.5): 1.20 % (estimate 0.96 %) before the full model's friction terms
+/// and the located events; measured 0.149 %, estimate 0.110 %.
+#[test]
+fn the_accurate_amm_with_strong_friction_is_within_one_percent_of_the_fem() {
+    let (truth, estimate) = move_centre_accuracy(0.3);
     assert!(truth < 1.0, "{truth} %");
     assert!((0.5..=2.0).contains(&(estimate / truth)), "{estimate} / {truth}");
 }

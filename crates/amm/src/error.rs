@@ -66,6 +66,19 @@ pub enum AmmError {
         #[source]
         source: flexstar_drive::DriveError,
     },
+    /// The solution diverged in the step ending at time `t` [s] (length `dt`): its coordinates
+    /// reached `reached` in magnitude (`start` at the step's start), where the constraint system
+    /// is singular though it is regular at the same pose undeformed (`source`: the rank test
+    /// that failed); a blow-up of the time integration, not a loss of rank of the constraints.
+    #[error("amm: t = {t:.6} s: the solution diverged in the step of {dt:.3e} s: its coordinates reached {reached:.2e} in magnitude ({start:.2e} at the step's start), where the constraint system is singular ({source}) though it is regular at the undeformed pose")]
+    Diverged {
+        t: f64,
+        dt: f64,
+        reached: f64,
+        start: f64,
+        #[source]
+        source: RankError,
+    },
     /// The solution stopped being finite at time `t`.
     #[error("amm: t = {t:.6} s: the solution is no longer finite (step {dt:e} s)")]
     NonFinite { t: f64, dt: f64 },

@@ -28,6 +28,7 @@ mod attach;
 mod constraint_lu;
 pub mod direct;
 pub mod error;
+mod events;
 mod foreshortening;
 mod friction;
 mod geometric;

@@ -21,12 +21,13 @@ use num_dual::Dual2;
 
 use crate::adaptive::{self, Pass};
 use crate::error::AmmError;
+use crate::events::{EventStepper, State};
 use crate::modes::{ModeSet, MAX_MODES};
 use crate::record::Recorder;
 use crate::star::Star;
 use crate::stick_slip::{self, FrictionOutput, StepEnd};
 use crate::system::System;
-use flexstar_model::{Contact, Friction};
+use flexstar_model::Friction;
 
 /// Default integration step [s], 1/6 ms (six steps per default output interval), from the
 /// convergence study in `docs/amm.md`: halving it changes every tip and junction response of the
@@ -341,6 +342,14 @@ fn solve_to_tolerance(
         let mut steps = 0;
         let resp = match pass {
             Pass::Deliver => integrate_system(problem, settings, sys, h, started, |_, _| steps += 1),
+            Pass::Refined { halvings } => {
+                let step = h / f64::from(1u32 << halvings);
+                let refined = AmmSettings {
+                    dt: Some(step),
+                    ..settings.clone()
+                };
+                integrate_system(problem, &refined, sys, step, started, |_, _| steps += 1)
+            }
             Pass::Estimate { every } => {
                 let factor = adaptive::ESTIMATE_STEP_FACTOR;
                 integrate_coarse(problem, settings, sys, h, factor, every, started, |_, _| steps += 1)
@@ -350,7 +359,7 @@ fn solve_to_tolerance(
                 integrate_coarse(problem, settings, sys, h, factor, every, started, |_, _| steps += 1)
             }
         };
-        if pass == Pass::Deliver {
+        if matches!(pass, Pass::Deliver | Pass::Refined { .. }) {
             delivered = runs.len();
         }
         runs.push((n, steps));
@@ -454,7 +463,6 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let ga = GenAlpha::new(RHO_INF);
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let mut qdd_start = vec![0.0; if problem.friction.is_some() { n } else { 0 }];
     let kin = |t: f64| problem.state(t);
 
     // the start: undeformed, or under gravity the static equilibrium of the start pose (Eq. G4)
@@ -497,6 +505,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
         }
     };
 
+    let mut events = friction.as_ref().map(|_| EventStepper::new(ga, n, sys.rows.len()));
     record(&mut rec, friction.as_mut(), &sys, &st, &stops[0], (&q, &v, &qdd));
     for w in stops.windows(2) {
         let (t0, t1) = (w[0].t, w[1].t);
@@ -505,41 +514,29 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
         let (bp, gp) = (ga.beta_prime(h), ga.gamma_prime(h));
         for k in 1..=nsub {
             let t = if k == nsub { t1 } else { t0 + k as f64 * h };
+            if let (Some(out), Some(events)) = (friction.as_mut(), events.as_mut()) {
+                // with friction: the stick and slip events located within the step (`events`)
+                let mut x = State {
+                    q: &mut q,
+                    v: &mut v,
+                    acc: &mut acc,
+                    qdd: &mut qdd,
+                };
+                let rails = |st: &RigidState| problem.friction.map_or(0.0, |law| prescribed_rails_power(law, st));
+                events.step(&mut sys, &kin, (&mut st, t), &mut x, out, &rails)?;
+                observe(&sys, &q);
+                continue;
+            }
             let state = q.iter().zip(&v).zip(acc.iter().zip(&qdd));
             let predicted = a_part.iter_mut().zip(qhat.iter_mut()).zip(vhat.iter_mut());
             for (((ap, qh), vh), ((&qi, &vi), (&ai, &di))) in predicted.zip(state) {
                 (*ap, *qh, *vh) = ga.predict(h, qi, vi, ai, di);
             }
-            let xi_start = friction.as_ref().map(|_| stick_slip::coordinates(&sys, &st, &q));
             st = kin(t)?;
             let predicted = (&qhat[..], &vhat[..], &a_part[..]);
-            match (friction.as_mut(), xi_start) {
-                (Some(out), Some(xi_start)) => {
-                    qdd_start.copy_from_slice(&qdd);
-                    let end = stick_slip::switching_step(&mut sys, None, t, h, |sys, _, retake| {
-                        if retake {
-                            sys.set_axial_acceleration(&qdd_start);
-                        }
-                        sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)?;
-                        if !accept(&ga, (bp, gp), predicted, &qdd, (&mut q, &mut v, &mut acc)) {
-                            return Err(AmmError::NonFinite { t, dt: h });
-                        }
-                        Ok(StepEnd {
-                            xi_start,
-                            vs: stick_slip::speeds(sys, &st, &v),
-                            ..StepEnd::default()
-                        })
-                    })?;
-                    let ff = stick_slip::sleeve_forces(&sys, &qdd);
-                    let rails = problem.friction.map_or(0.0, |law| prescribed_rails_power(law, &st));
-                    out.advance(&sys, (ff, end.vs), (&[Contact::Free; 3], rails), h);
-                }
-                _ => {
-                    sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)?;
-                    if !accept(&ga, (bp, gp), predicted, &qdd, (&mut q, &mut v, &mut acc)) {
-                        return Err(AmmError::NonFinite { t, dt: h });
-                    }
-                }
+            sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)?;
+            if !accept(&ga, (bp, gp), predicted, &qdd, (&mut q, &mut v, &mut acc)) {
+                return Err(AmmError::NonFinite { t, dt: h });
             }
             observe(&sys, &q);
         }
@@ -561,7 +558,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
 
 /// Accept a step: `q = q^ + bp q''`, `q' = v^ + gp q''` and the generalized-alpha acceleration
 /// variable from the predictors `(q^, v^, a^)` and the step's `q''`; whether q is finite.
-fn accept(
+pub(crate) fn accept(
     ga: &GenAlpha,
     (bp, gp): (f64, f64),
     (qhat, vhat, a_part): (&[f64], &[f64], &[f64]),

@@ -91,7 +91,7 @@ fn set(sys: &mut System, rails: Option<&mut Rails>, which: Which, c: Contact) {
 /// - a contact stuck since the step began whose needed force exceeds `mu_static L` (sleeve,
 ///   Eq. F6 with the load of Eq. F13 at the step's multipliers) or `Fc` (rail) slips in the
 ///   direction of that force.
-fn changes(
+pub(crate) fn changes(
     sys: &System,
     rails: Option<&Rails>,
     end: &StepEnd,
@@ -108,7 +108,7 @@ fn changes(
                 }
                 Contact::Stuck(_) if at_start[i] => {
                     let need = sys.lam[fr.stick[i]];
-                    if exceeds(need, law.mu_static * fr.load_at(i, &sys.lam)) {
+                    if exceeds(need, law.mu_static * fr.load_at(i, &sys.lam, need)) {
                         out.push((Which::Sleeve(i), Contact::Slip(need.signum())));
                     }
                 }

@@ -44,9 +44,11 @@ pub(crate) enum Row {
     Fix(usize),
     /// Eq. 40: `w_1G + w_2G + w_3G = 0` (Eq. J5: `sum c_i w_iG = 0` for other welds); multiplier `Fw`.
     Fw,
-    /// Eq. F16 (`docs/friction.md` 9): sleeve i stuck on its beam, `u_i - xp_i(t) + xi_i* = 0`;
-    /// multiplier the friction force on beam i along `e_xi` [N]. Only with friction; empty (its
-    /// multiplier 0) while the sleeve is not stuck (`crate::friction`).
+    /// Eqs. F16, F23 (`docs/friction.md` 9): sleeve i stuck on its beam, its material
+    /// coordinate held, `xi_i(q) = xp_i(t) - u_i + f_i(x_c) = xi_i*` (u coefficient 1, alpha part
+    /// `-g_i` on [`B_STICK`] in the full model); multiplier the friction force on beam i along
+    /// its axis [N]. Only with friction; empty (its multiplier 0) while the sleeve is not stuck
+    /// (`crate::friction`).
     Stick(usize),
     /// Eq. 39: `w_1'(0) - w_2'(0) = 0`; multiplier `M1G`.
     M1G,
@@ -62,7 +64,11 @@ pub(crate) enum Row {
 /// `B_RIGHT` (FR), `B_LEFT` (FL), `B_MSLOPE` (Mp) of `crate::sleeve::rows`.
 const B_PHI0: usize = 0; // phi_j(0)          (Fix, Fw)
 const B_DPHI0: usize = 1; // phi_j'(0)        (MiG)
-const NB: usize = B_MSLOPE + 1;
+/// Basis vector of a stuck sleeve's row (Eq. F16, `docs/friction.md` 9.1): `-g`, the gradient of
+/// the material coordinate's foreshortening shift (full model; zero in the paper's model and
+/// while the sleeve is not stuck). Only a system with friction has it ([`BeamRows::stick`]).
+pub(crate) const B_STICK: usize = B_MSLOPE + 1;
+const NB: usize = B_STICK + 1;
 /// Most constraint rows that touch one beam (three Fix, Fw, two slope rows, four sleeve rows,
 /// and with friction the stick row of Eq. F16, `docs/friction.md` 9).
 const MAX_BEAM_ROWS: usize = MAX_JUNCTION_ROWS + SLEEVE_ROWS + 1;
@@ -95,6 +101,11 @@ pub(crate) struct BeamRows {
     pub(crate) gv: Vec<f64>,
     /// The sleeve basis vectors B_MID..B_MSLOPE of this beam (refreshed per step), N each.
     pub(crate) sleeve: [Vec<f64>; 4],
+    /// The stick row's basis vector [`B_STICK`] (set per step by `crate::friction`), N; empty
+    /// without friction (no [`B_STICK`] row, nothing computed for it).
+    pub(crate) stick: Vec<f64>,
+    /// `D^-1 B_STICK` (empty without friction).
+    stick_scaled: Vec<f64>,
     // per-step workspace
     /// `D^-1 B_a` for the sleeve vectors.
     scaled: [Vec<f64>; 4],
@@ -182,6 +193,27 @@ impl BeamRows {
         }
         self.g[B_PHI0] = w0;
         self.g[B_DPHI0] = w1;
+        if !self.stick.is_empty() {
+            self.fill_stick_gram(inv_d, [phi0, dphi0, phi]);
+        }
+    }
+
+    /// The Gram entries of the stick row's vector [`B_STICK`] against the other six and itself,
+    /// and its `g` (`docs/friction.md` 9.1, Eq. F16); a system with friction only.
+    fn fill_stick_gram(&mut self, inv_d: &[f64], [phi0, dphi0, phi]: [&[f64]; 3]) {
+        for ((s, x), d) in self.stick_scaled.iter_mut().zip(&self.stick).zip(inv_d) {
+            *s = x * d;
+        }
+        let [s0, s1, s2, s3] = [&self.sleeve[0], &self.sleeve[1], &self.sleeve[2], &self.sleeve[3]];
+        let [p0, d0, gp, m0, m1, m2, m3, ss] =
+            dots(&self.stick_scaled, [phi0, dphi0, phi, s0, s1, s2, s3, &self.stick]);
+        // against B_PHI0, B_DPHI0, B_MID, B_RIGHT, B_LEFT, B_MSLOPE in that order
+        for (b, v) in [p0, d0, m0, m1, m2, m3].into_iter().enumerate() {
+            self.gram[B_STICK][b] = v;
+            self.gram[b][B_STICK] = v;
+        }
+        self.gram[B_STICK][B_STICK] = ss;
+        self.g[B_STICK] = gp;
     }
 
     /// Add this beam's block of the Schur complement to `a_mat` (m x m, row-major):
@@ -458,7 +490,7 @@ fn row_entry(row: Row, b: usize, has_w0: bool, hp: f64, weld: &Weld) -> Option<R
             }
         }
         Row::Sleeve(i, row) => (b == i).then(|| row.form(hp)),
-        Row::Stick(i) => (b == i).then_some((NONE, 0.0, 0.0, 0.0)),
+        Row::Stick(i) => (b == i).then_some((B_STICK, 0.0, 0.0, 0.0)),
     }
 }
 
@@ -474,6 +506,8 @@ fn beam_rows(rows: &[Row], has_w0: bool, hp: [f64; 3], nm: usize, weld: &Weld) -
         ct: Vec::new(),
         gv: Vec::new(),
         sleeve: std::array::from_fn(|_| vec![0.0; nm]),
+        stick: Vec::new(),
+        stick_scaled: Vec::new(),
         scaled: std::array::from_fn(|_| vec![0.0; nm]),
         gram: [[0.0; NB]; NB],
         g: [0.0; NB],
@@ -489,6 +523,9 @@ fn beam_rows(rows: &[Row], has_w0: bool, hp: [f64; 3], nm: usize, weld: &Weld) -
                 beam.gu.push(cu);
                 beam.ct.push(ct);
                 beam.gv.push(0.0);
+                if basis == B_STICK {
+                    (beam.stick, beam.stick_scaled) = (vec![0.0; nm], vec![0.0; nm]);
+                }
             }
         }
     }
@@ -621,6 +658,7 @@ impl System {
         match a {
             B_PHI0 => &self.beam(i).phi0,
             B_DPHI0 => &self.beam(i).dphi0,
+            B_STICK => &beam.stick,
             _ => &beam.sleeve[a - B_MID],
         }
     }
@@ -949,7 +987,7 @@ impl System {
         let thdd = st.theta.d2;
         self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
         if self.friction.is_some() {
-            self.set_friction_drag(gp);
+            self.friction_terms(qhat);
         }
         // each beam's arrowhead and the Gram data of its junction vectors (once for equal beams)
         self.factor_s(bp, gp, thd, thdd);
@@ -1081,11 +1119,16 @@ impl System {
                 &beam.sleeve[2][..],
                 &beam.sleeve[3][..],
             ];
-            let bdr: [f64; NB] = dots(dinv_r, basis);
-            let bq: [f64; NB] = match qhat {
-                Some(qh) => dots(&qh[o..o + nm], basis),
-                None => [0.0; NB],
-            };
+            let mut bdr = [0.0; NB];
+            bdr[..B_STICK].copy_from_slice(&dots(dinv_r, basis));
+            let mut bq = [0.0; NB];
+            if let Some(qh) = qhat {
+                bq[..B_STICK].copy_from_slice(&dots(&qh[o..o + nm], basis));
+            }
+            if !beam.stick.is_empty() {
+                bdr[B_STICK] = dot(dinv_r, &beam.stick);
+                bq[B_STICK] = qhat.map_or(0.0, |qh| dot(&qh[o..o + nm], &beam.stick));
+            }
             // the payload's part of beam 1's C_0 S1^-1 r (Woodbury): - (C_0 S^-1 P^T) W P S^-1 r
             let corr = match (&self.payload, i) {
                 (Some(pl), 0) => Some((pl, Self::payload_rhs(pl, beam, (p, inv_jp), r[nm + 1], y_r, &bdr))),

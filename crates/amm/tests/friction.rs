@@ -143,9 +143,11 @@ fn column_error(a: &Response, f: &Response, name: &str) -> f64 {
 
 /// The accurate AMM against the FEM on the paper's robot with sleeve friction, `mu` 0.1 and
 /// 0.3, both load models, on paper case 3 and a rest-to-rest quintic: the tips and G within
-/// 1 % mean EVP (1.5 % for the move with mu = 0.3), the friction forces within 10 % and the
-/// actuator forces within 5 % in the
-/// integral measure of Eq. 45 ([`column_error`]), the energy the friction dissipates within 2 %. (Measured: see `docs/friction.md` 9.3.)
+/// 0.5 % mean EVP (measured 0.07-0.25 %; 1.1-1.2 % on the move with `mu = 0.3` before the
+/// full-model terms of `docs/friction.md` 9.4 and the located events of 9.5), the friction
+/// forces within 10 % and the actuator forces within 5 % in the integral measure of Eq. 45
+/// ([`column_error`]), the energy the friction dissipates within 2 %. (Measured: see
+/// `docs/friction.md` 9.3.)
 #[test]
 fn the_amm_agrees_with_the_fem_with_friction() {
     let quintic = {
@@ -191,13 +193,108 @@ fn the_amm_agrees_with_the_fem_with_friction() {
                     "{name}, mu {mu}, {model}: mean EVP {evp:.3} %, Ff {ff:.3}, Fa {fa:.3} of their largest, \
                      dissipated {ea:.4e} J (FEM {ef:.4e} J)"
                 );
-                // the rest-to-rest move with mu = 0.3 ends with the sleeves sticking on a strained
-                // star: 1.1 % at the default steps, 0.93-1.02 % at 1e-4 s (docs/friction.md 9.3)
-                let bound = if name == "quintic" && mu == 0.3 { 1.5 } else { 1.0 };
-                assert!(evp < bound, "{name} mu {mu} {model}: mean EVP {evp} %");
+                assert!(evp < 0.5, "{name} mu {mu} {model}: mean EVP {evp} %");
                 assert!(ff < 0.1 && fa < 0.05, "{name} mu {mu} {model}: Ff {ff}, Fa {fa}");
                 assert!((ea / ef - 1.0).abs() < 0.02, "{name} mu {mu} {model}: {ea} J vs {ef} J");
             }
         }
+    }
+}
+
+/// The stick and slip events located within the step (`docs/friction.md` 9.5, Eqs. F24-F26)
+/// make a friction run converge in the step faster than first order where its events are apart:
+/// target move 1 (`configs/motions/move-centre.toml`) to 0.7 s with `mu = 0.1`, whose sleeves stop,
+/// stick and slip again around 0.4 s, at N = 53 and steps of 1, 0.5 and 0.25 ms against the same
+/// N at 1/128 ms: the error falls by 2^1.5 or more per halving on average, `e(4 h) / e(h) >= 8`
+/// (measured 0.124, 0.033, 0.010 %: 12.4; resolved to the step only, as before 9.5, it was
+/// 0.574, 0.411, 0.091 %: 6.3).
+#[test]
+fn a_friction_run_converges_in_the_step_faster_than_first_order() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/motions/move-centre.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut exp = Experiment::from_toml_str(&text, &path).unwrap();
+    exp.time.t_end = 0.7;
+    exp.friction = Some(friction("mu = 0.1\n"));
+    let run = |h: f64| {
+        let settings = AmmSettings {
+            modes: Some(53),
+            tol: None,
+            dt: Some(h),
+            ..AmmSettings::accurate()
+        };
+        amm(&exp, &settings, SolveRequest::motion())
+    };
+    let reference = run(1e-3 / 128.0);
+    let errors: Vec<f64> = [1e-3, 5e-4, 2.5e-4]
+        .iter()
+        .map(|&h| mean_evp(&run(h), &reference))
+        .collect();
+    let stuck = col(&reference, "stick1").iter().filter(|s| **s == 1.0).count();
+    eprintln!("mean EVP against 1/128 ms at 1, 0.5, 0.25 ms: {errors:?} %; sleeve 1 stuck at {stuck} outputs");
+    assert!(
+        stuck > 0 && stuck < reference.len() / 2,
+        "the sleeve must stick and slip: {stuck}"
+    );
+    assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
+    assert!(errors[0] / errors[2] >= 8.0, "order below 1.5: {errors:?}");
+}
+
+/// A star held by friction under gravity: target move 1 with `mu = 0.3`, `zeta = 0.03` and `g`,
+/// whose sleeves come to rest at their stick limit around 0.55 s and stick and slip again several
+/// times a step. Before the restart of `docs/friction.md` 9.5 took the consistent accelerations
+/// of the state (Eq. F26), the AMM diverged there (N = 61 at 5e-4 s at 0.5605 s, N = 53 at 1e-3 s
+/// at 0.702 s, reported as a singular constraint system). Both run to 0.8 s and agree with the
+/// FEM (600 elements, its default step): the mean EVP over A, B, C and G within 0.5 % (measured
+/// 0.22 and 0.21 %), G's deflection at the end and the energy the sleeves dissipate within 1 %
+/// (measured 0.09 / 0.07 % and 0.02 %).
+#[test]
+fn a_star_held_by_friction_under_gravity_runs_through_its_chatter_with_the_fem() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/motions/move-centre.toml");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("t_end = 1.5", "t_end = 0.8");
+    // zeta at the first frequency at the start pose, as `flexstar run` resolves it
+    let text = format!(
+        "{text}\n[friction]\nmu = 0.3\n[damping]\nzeta = 0.03\nf_hz = 3.961046476688887\n[gravity]\ng = [0.0, -9.81]\n"
+    );
+    let exp = Experiment::from_toml_str(&text, &path).unwrap();
+    let fem_settings = FemSettings {
+        elements: 600,
+        ..FemSettings::default()
+    };
+    let f = flexstar_fem::solve(&exp.problem().unwrap(), &fem_settings, SolveRequest::motion())
+        .unwrap()
+        .response;
+    let g_end = |r: &Response| r.w_g.iter().map(|w| w.last().unwrap().powi(2)).sum::<f64>().sqrt();
+    for (n, h) in [(61, 5e-4), (53, 1e-3)] {
+        let settings = AmmSettings {
+            modes: Some(n),
+            tol: None,
+            dt: Some(h),
+            ..AmmSettings::accurate()
+        };
+        let a = flexstar_amm::solve(&exp.problem().unwrap(), &settings, SolveRequest::motion())
+            .unwrap_or_else(|e| panic!("N = {n}, {h} s: {e}"))
+            .response;
+        let evp = mean_evp(&a, &f);
+        let (ga, gf) = (g_end(&a), g_end(&f));
+        eprintln!("N = {n}, {h} s: mean EVP {evp:.3} % against the FEM; |w_G| at the end {ga:.4e} m (FEM {gf:.4e} m)");
+        let (ea, ef) = (
+            a.friction.unwrap().sleeves_dissipated_j,
+            f.friction.unwrap().sleeves_dissipated_j,
+        );
+        let stuck = |r: &Response| {
+            (1..=3)
+                .map(|i| col(r, &format!("stick{i}")).iter().sum::<f64>())
+                .sum::<f64>()
+        };
+        eprintln!(
+            "  dissipated {ea:.4e} J (FEM {ef:.4e} J); stuck outputs {} (FEM {})",
+            stuck(&a),
+            stuck(&f)
+        );
+        assert!(evp < 0.5, "N = {n}, {h} s: mean EVP {evp} %");
+        assert!((ga / gf - 1.0).abs() < 0.01, "N = {n}, {h} s: {ga} m vs {gf} m");
+        assert!((ea / ef - 1.0).abs() < 0.01, "N = {n}, {h} s: {ea} J vs {ef} J");
     }
 }

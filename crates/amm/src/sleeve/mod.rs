@@ -43,6 +43,16 @@ use rows::ShiftTerms;
 pub(crate) use rows::{SleeveRow, B_MID, B_MSLOPE, SLEEVE_ROWS};
 use shift::SleeveShift;
 
+/// A beam's foreshortening at the material point in its sleeve (Eqs. S1-S3).
+pub(crate) struct ShiftAt<'a> {
+    /// The kept modes (indices into the beam's alpha).
+    pub(crate) kept: &'a [usize],
+    /// `g = F(x_c) alpha` on them [-].
+    pub(crate) g: &'a [f64],
+    /// `f(x_c)` [m].
+    pub(crate) f: f64,
+}
+
 /// The three sleeves of a system: what their rows need beyond the rows' form (`system::BeamRows`),
 /// refreshed per step by [`Sleeves::update`].
 #[derive(Debug, Clone)]
@@ -65,6 +75,8 @@ pub(crate) struct Sleeves {
     res: [[[f64; 4]; 4]; 3],
     /// Sleeve positions xp_i of the last update [m].
     xp: [f64; 3],
+    /// Full model: the shift `f(x_c)` of each beam at the last update [m] (Eq. S1).
+    f: [f64; 3],
     /// Full model: u_i-gradients of the rows Fp_i, FR_i, FL_i at the last update (`-w'` at the
     /// material point in the sleeve; 0 in the paper's model): the axial direction of their forces.
     axial: [[f64; 3]; 3],
@@ -97,6 +109,7 @@ impl Sleeves {
             compliance,
             res: [[[0.0; 4]; 4]; 3],
             xp: [0.0; 3],
+            f: [0.0; 3],
             axial: [[0.0; 3]; 3],
         }
     }
@@ -106,6 +119,25 @@ impl Sleeves {
     /// [`rows::push`]).
     pub(crate) fn axial(&self) -> &[[f64; 3]; 3] {
         &self.axial
+    }
+
+    /// Full model: beam i's foreshortening at the material point in the sleeve at the last
+    /// update (Eqs. S1-S3, at the step's predictor); `None` in the paper's model.
+    pub(crate) fn shift_at_update(&self, i: usize) -> Option<ShiftAt<'_>> {
+        self.shift.as_ref().map(|s| {
+            let s = pick(s, i);
+            ShiftAt {
+                kept: s.kept(),
+                g: s.gradient(i),
+                f: self.f[i],
+            }
+        })
+    }
+
+    /// Full model: the shift `f(x)` [m] of beam i with coordinates `alpha` at the material
+    /// point `x` [m] (Eq. S2); 0 in the paper's model.
+    pub(crate) fn shift_of(&self, i: usize, x: f64, alpha: &[f64]) -> f64 {
+        self.shift.as_ref().map_or(0.0, |s| pick(s, i).value(x, alpha))
     }
 
     /// Eqs. 41-43: refresh the sleeve rows of `beams` (the rows `rows`, beam i on `modes[i]`)
@@ -138,6 +170,7 @@ impl Sleeves {
                 let n = s.len();
                 s[i.min(n - 1)].evaluate(i, x - u_hat, alpha)
             });
+            self.f[i] = shift;
             let xc = x - u_hat + shift;
             let [mid, right, left, mslope] = &mut beam.sleeve;
             let bent = &mut self.bent[i];

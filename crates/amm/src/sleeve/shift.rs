@@ -71,11 +71,7 @@ impl SleeveShift {
         for (a, &j) in self.alpha.iter_mut().zip(&self.kept) {
             *a = alpha[j];
         }
-        let z = (x / self.h).clamp(0.0, PANELS as f64);
-        let n = (z.floor() as usize).min(PANELS - 1);
-        let t = z - n as f64;
-        let lo = &self.table[n * k * k..(n + 1) * k * k];
-        let hi = &self.table[(n + 1) * k * k..(n + 2) * k * k];
+        let (lo, hi, t) = Self::panel(&self.table, k, self.h, x);
         let g = &mut self.grad[beam];
         for ((ga, rl), rh) in g.iter_mut().zip(lo.chunks_exact(k)).zip(hi.chunks_exact(k)) {
             let (mut sl, mut sh) = (0.0, 0.0);
@@ -86,6 +82,32 @@ impl SleeveShift {
             *ga = (1.0 - t) * sl + t * sh;
         }
         0.5 * g.iter().zip(&self.alpha).map(|(a, b)| a * b).sum::<f64>()
+    }
+
+    /// The table's two nodes around `x` [m] (k x k each) and the weight `t` of the upper one.
+    fn panel(table: &[f64], k: usize, h: f64, x: f64) -> (&[f64], &[f64], f64) {
+        let z = (x / h).clamp(0.0, PANELS as f64);
+        let n = (z.floor() as usize).min(PANELS - 1);
+        let lo = &table[n * k * k..(n + 1) * k * k];
+        let hi = &table[(n + 1) * k * k..(n + 2) * k * k];
+        (lo, hi, z - n as f64)
+    }
+
+    /// `f(x)` of Eq. S2 [m] for a beam's coordinates `alpha`, as [`SleeveShift::evaluate`] gives
+    /// it but keeping nothing (the sleeves' sliding coordinates of `docs/friction.md` 9.1, Eq. F11).
+    pub(crate) fn value(&self, x: f64, alpha: &[f64]) -> f64 {
+        let k = self.kept.len();
+        let (lo, hi, t) = Self::panel(&self.table, k, self.h, x);
+        let mut two_f = 0.0;
+        for ((rl, rh), &jr) in lo.chunks_exact(k).zip(hi.chunks_exact(k)).zip(&self.kept) {
+            let (mut sl, mut sh) = (0.0, 0.0);
+            for ((&fl, &fh), &jc) in rl.iter().zip(rh).zip(&self.kept) {
+                sl += fl * alpha[jc];
+                sh += fh * alpha[jc];
+            }
+            two_f += ((1.0 - t) * sl + t * sh) * alpha[jr];
+        }
+        0.5 * two_f
     }
 
     /// `g = F(x_c) alpha` of beam `beam` on the kept modes at its last evaluation (Eq. S3).
@@ -115,6 +137,10 @@ mod tests {
         for x in [0.07 * l, 0.3137 * l, 0.55 * l, 0.861 * l] {
             let exact = modes.half_squared_slope_integral(&alpha, x);
             let f = shift.evaluate(1, x, &alpha);
+            assert!(
+                (shift.value(x, &alpha) - f).abs() <= 1e-15 * f.abs().max(1e-30),
+                "value against evaluate"
+            );
             eprintln!("x = {x}: table {f:e}, quadrature {exact:e}");
             assert!((f - exact).abs() < 1e-2 * exact, "x = {x}: {f} against {exact}");
             // g is the gradient of f: central differences of the table's own f in each kept

@@ -29,7 +29,7 @@ pub(super) fn freeze(star: &Star, q: &mut [f64], v: &mut [f64], qdd: &mut [f64])
 ///   `Fc` (rail) slips in the direction of that force. One that stuck in this step keeps its
 ///   stick for the step: its force then includes stopping its slip within one step, not a load
 ///   it holds; from the next step on it is judged at rest.
-fn changes(
+pub(super) fn changes(
     motion: &Motion,
     star: &Star,
     (start, end): (&State, &State),
@@ -81,7 +81,7 @@ fn changes(
 }
 
 /// Set contact `which` of `star` to `c`.
-fn set(star: &mut Star, which: Which, c: Contact) {
+pub(super) fn set(star: &mut Star, which: Which, c: Contact) {
     if let Some(fr) = &mut star.friction {
         match which {
             Which::Sleeve(i) => fr.sleeves[i] = c,

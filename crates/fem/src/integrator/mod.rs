@@ -21,6 +21,7 @@ use crate::error::PivotError;
 use crate::star::{pin_forces, Attached, Factors, InitialState, Iterate, Pins, SliderRows, Star, StarFriction, ROWS};
 use crate::{FemError, NewtonFailure};
 
+mod events;
 mod friction;
 mod motion;
 mod recorder;
@@ -287,7 +288,7 @@ impl Stepper<'_, '_> {
             backup.clone_from(self.st);
         }
         let stepped = if self.star.friction.is_some() {
-            self.switching_step(t1, h)
+            self.event_step(t1, h)
         } else {
             step(self.motion, self.star, self.ga, self.st, self.ws, self.stats, t1, h)
         };

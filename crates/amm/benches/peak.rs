@@ -1,5 +1,5 @@
 //! The machine's rate on the kinds of work one AMM step does, at the step's sizes
-//! (`docs/amm.md` 2.2, "Cost of a step"): the accurate model at N = 53 has vectors of 53 modes,
+//! (`docs/amm.md` 2.1, "Cost of a step"): the accurate model at N = 53 has vectors of 53 modes,
 //! an 18 x 18 Schur complement (21 x 21 with friction), 4 x 4 sleeve blocks and a 6 x 6
 //! junction block, and the geometric stiffness `[G1; G2]` (36 x 18) times three beams. Each
 //! kernel's flop count is written beside it; criterion's time per iteration gives the rate.

@@ -1,5 +1,5 @@
 //! The dense LU with partial pivoting of the Schur complement (`constraint_lu`; `docs/amm.md`
-//! section 2, "Cost of a step") in storage sized once: nalgebra's `LU::new` and `LU::solve_mut`
+//! 2.1, "Cost of a step") in storage sized once: nalgebra's `LU::new` and `LU::solve_mut`
 //! step by step (the same pivot search, row swaps, Gauss steps and triangular solves, in the same
 //! order), so the factors and solutions are nalgebra's bit for bit, without the matrix, the
 //! permutation and the right-hand side that nalgebra allocates per factorisation and per solve.

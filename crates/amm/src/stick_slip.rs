@@ -170,16 +170,16 @@ pub(crate) fn switching_step<F>(
 where
     F: FnMut(&mut System, Option<&Rails>, bool) -> Result<StepEnd, AmmError>,
 {
-    // the contact states tried in this step, in order (at most one per round and the start's)
+    // the contact states tried in this step, in order: the start's, then one per round
+    // (`round + 1` of them in round `round`)
     let mut tried = [contacts(sys, rails.as_deref()); MAX_ROUNDS + 1];
-    let mut n_tried = 1;
     for round in 0..MAX_ROUNDS {
         let end = attempt(sys, rails.as_deref(), round > 0)?;
         let change = changes(
             sys,
             rails.as_deref(),
             &end,
-            stuck_in(&tried[..n_tried]),
+            stuck_in(&tried[..round + 1]),
             stuck_in(&tried[..1]),
         );
         let change = change.as_slice();
@@ -190,7 +190,7 @@ where
             set(sys, rails.as_deref_mut(), which, c);
         }
         let now = contacts(sys, rails.as_deref());
-        if tried[..n_tried].contains(&now) {
+        if tried[..round + 1].contains(&now) {
             let reason = if h > 0.0 {
                 format!("the step of {h:.3e} s finds it neither stuck nor slipping consistently: reduce amm.dt")
             } else {
@@ -202,8 +202,7 @@ where
                 reason,
             });
         }
-        tried[n_tried] = now;
-        n_tried += 1;
+        tried[round + 1] = now;
     }
     Err(AmmError::StickSlip {
         t,

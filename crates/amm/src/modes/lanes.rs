@@ -9,8 +9,9 @@
 
 use super::recurrence::{ModeTrig, Triplet, TripletOut, TAYLOR_DELTA};
 
-/// Whether [`elastic_triplets_x3`] can run here: the processor has AVX (detected once at run
-/// time) and `flexstar_numerics::lanes::force_baseline` is off.
+/// Whether [`elastic_triplets_x3`] can run here: the processor has AVX2, hence the AVX
+/// instructions used (`flexstar_numerics::lanes::has_avx2`: detected once at run time, off under
+/// `flexstar_numerics::lanes::force_baseline`).
 pub(super) fn available() -> bool {
     flexstar_numerics::lanes::has_avx2()
 }

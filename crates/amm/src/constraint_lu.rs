@@ -1,6 +1,7 @@
 //! Factorisation of the Schur complement `A = C S^-1 C^T` of the constrained step (`system`;
 //! `docs/amm.md` section 2): block elimination of its structure, with nalgebra's LU for the
-//! blocks, and nalgebra's dense LU of the whole matrix where a block is too close to singular.
+//! blocks, and nalgebra's dense LU of the whole matrix where a block is too close to singular
+//! (in storage sized once, `dense_lu`).
 //!
 //! Rows: the `nj` junction rows (Eqs. 38-40) first, then the four sleeve rows (Eqs. 41-43) of
 //! each beam in turn. S is block diagonal over the beams, so a sleeve row of beam i couples only
@@ -26,7 +27,9 @@
 //! Z's largest entry, hands the step to the dense LU with partial pivoting, whose own test
 //! ([`PIVOT_RATIO`]) decides rank deficiency.
 
-use nalgebra::{DMatrix, DVector, Matrix4, Matrix6, SMatrix, Vector4, Vector6, LU, U6};
+use nalgebra::{Matrix4, Matrix6, SMatrix, Vector4, Vector6, LU, U6};
+
+use crate::dense_lu::DenseLu;
 
 use crate::error::RankError;
 use crate::sleeve::SLEEVE_ROWS;
@@ -46,7 +49,8 @@ pub(crate) struct ConstraintLu {
     m: usize,
     nj: usize,
     blocks: Option<Blocks>,
-    dense: Option<LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    /// The dense factors (valid when `blocks` is `None` after a successful factorisation).
+    dense: DenseLu,
 }
 
 /// The block elimination's factors.
@@ -87,7 +91,7 @@ impl ConstraintLu {
             m,
             nj: m.saturating_sub(3 * SLEEVE_ROWS),
             blocks: None,
-            dense: None,
+            dense: DenseLu::new(m),
         }
     }
 
@@ -98,16 +102,15 @@ impl ConstraintLu {
             m,
             nj: m,
             blocks: None,
-            dense: None,
+            dense: DenseLu::new(m),
         }
     }
 
     /// Factor A (`a`, m x m, row-major). Fails with the reason when A is rank deficient.
     pub(crate) fn factor(&mut self, a: &[f64]) -> Result<(), RankError> {
         self.blocks = self.block_factor(a);
-        self.dense = None;
         if self.blocks.is_none() {
-            self.dense = Some(self.dense_factor(a)?);
+            self.dense_factor(a)?;
         }
         Ok(())
     }
@@ -151,8 +154,8 @@ impl ConstraintLu {
         })
     }
 
-    /// nalgebra's LU with partial pivoting of the whole A, its rank checked.
-    fn dense_factor(&self, a: &[f64]) -> Result<LU<f64, nalgebra::Dyn, nalgebra::Dyn>, RankError> {
+    /// nalgebra's LU with partial pivoting of the whole A ([`DenseLu`]), its rank checked.
+    fn dense_factor(&mut self, a: &[f64]) -> Result<(), RankError> {
         let m = self.m;
         for r in 0..m {
             let row = &a[r * m..(r + 1) * m];
@@ -161,27 +164,24 @@ impl ConstraintLu {
             }
         }
         let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-        let lu = DMatrix::from_row_slice(m, m, a).lu();
-        let u = lu.u();
-        if let Some(k) = (0..m).find(|&k| u[(k, k)].abs().is_nan() || u[(k, k)].abs() <= PIVOT_RATIO * scale) {
+        self.dense.factor(a);
+        let pivot = |k: usize| self.dense.pivot(k).abs();
+        if let Some(k) = (0..m).find(|&k| pivot(k).is_nan() || pivot(k) <= PIVOT_RATIO * scale) {
             return Err(RankError::RankDeficient {
                 step: k,
                 size: m,
-                ratio: u[(k, k)].abs() / scale,
+                ratio: pivot(k) / scale,
             });
         }
-        Ok(lu)
+        Ok(())
     }
 
     /// Solve `A x = b` in place with the last factors.
-    pub(crate) fn solve(&self, b: &mut [f64]) {
-        if let Some(lu) = &self.dense {
-            let mut v = DVector::from_column_slice(b);
-            lu.solve_mut(&mut v);
-            b.copy_from_slice(v.as_slice());
+    pub(crate) fn solve(&mut self, b: &mut [f64]) {
+        let Some(f) = &self.blocks else {
+            self.dense.solve(b);
             return;
-        }
-        let Some(f) = &self.blocks else { return };
+        };
         let nj = self.nj;
         let mut rj = Vector6::<f64>::zeros();
         for r in 0..nj {
@@ -252,10 +252,7 @@ mod tests {
             let m = nj + 12;
             let mut lu = ConstraintLu::new(m);
             lu.factor(&a).unwrap();
-            assert!(
-                lu.blocks.is_some() && lu.dense.is_none(),
-                "nj = {nj}: block path expected"
-            );
+            assert!(lu.blocks.is_some(), "nj = {nj}: block path expected");
             let b: Vec<f64> = (0..m).map(|k| (k as f64 * 0.7).sin()).collect();
             let mut x = b.clone();
             lu.solve(&mut x);
@@ -281,7 +278,7 @@ mod tests {
         }
         let mut lu = ConstraintLu::new(m);
         lu.factor(&a).unwrap();
-        assert!(lu.blocks.is_none() && lu.dense.is_some());
+        assert!(lu.blocks.is_none());
         let b: Vec<f64> = (0..m).map(|k| 1.0 + k as f64).collect();
         let mut x = b.clone();
         lu.solve(&mut x);

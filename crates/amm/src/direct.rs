@@ -569,7 +569,8 @@ fn friction_start(
     })?;
     let x = state.expect("the start was solved");
     let (ff, vs) = (stick_slip::sleeve_forces(sys, &x.qdd), end.vs);
-    let output = FrictionOutput::start(sys, ff, vs, rails.power(x.sd));
+    let rows = problem.time.output_times().len();
+    let output = FrictionOutput::start(sys, ff, vs, rails.power(x.sd), rows);
     Ok((x, rails, output))
 }
 

@@ -325,7 +325,8 @@ impl EventStepper {
             let xi_start = stick_slip::coordinates(sys, st, x.q);
             let stuck = stuck_now(sys);
             let end = self.attempt(sys, &end_st, h, x, xi_start)?;
-            let change = stick_slip::changes(sys, None, &end, stuck, stuck);
+            let changes = stick_slip::changes(sys, None, &end, stuck, stuck);
+            let change = changes.as_slice();
             if change.is_empty() {
                 advance(sys, out, x, (end.vs, rails(&end_st)), h);
                 *st = end_st;
@@ -334,7 +335,7 @@ impl EventStepper {
             if split == MAX_SPLITS {
                 break;
             }
-            let (theta, due) = probe.first_event(sys, &change, &end, h);
+            let (theta, due) = probe.first_event(sys, change, &end, h);
             if theta >= 1.0 {
                 advance(sys, out, x, (end.vs, rails(&end_st)), h);
                 *st = end_st;

@@ -26,6 +26,7 @@
 pub mod adaptive;
 mod attach;
 mod constraint_lu;
+mod dense_lu;
 pub mod direct;
 pub mod error;
 mod events;
@@ -49,8 +50,8 @@ pub use direct::DIRECT_COLUMNS;
 pub use error::{AmmError, RankError};
 pub use modes::{ModeSet, MAX_MODES};
 pub use solver::{
-    beam_time_scale, parse_family, robot_step_factor, solve, tolerance_step, Stats, DEFAULT_DT, EXTRA_COLUMNS, RHO_INF,
-    SHAPE_POINTS, TOLERANCE_DT,
+    beam_time_scale, parse_family, robot_step_factor, solve, solve_stepwise, tolerance_step, Stats, DEFAULT_DT,
+    EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS, TOLERANCE_DT,
 };
 
 /// What a mode family with a hidden support at G loses of the experiment's payload and load

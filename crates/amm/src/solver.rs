@@ -248,6 +248,29 @@ pub fn solve(problem: &Problem, settings: &AmmSettings, request: SolveRequest) -
     Ok(Solved { response, stats })
 }
 
+/// [`solve`] of the prescribed motion ([`Drive::Motion`]) at the fixed N of `settings.modes`,
+/// with `after_step(k)` called after every time step, k = 1, 2, ... (the step's solve done, its
+/// state accepted; output rows are recorded between the calls): a hook to measure a step's cost
+/// (its time, its heap allocations) from outside the crate. The response is [`solve`]'s, bit for
+/// bit. An automatic N (`settings.modes` unset) is refused: its runs would restart the count.
+pub fn solve_stepwise(
+    problem: &Problem,
+    settings: &AmmSettings,
+    mut after_step: impl FnMut(usize),
+) -> Result<Response, AmmError> {
+    let ModeCount::Fixed(n) = settings.mode_count() else {
+        return Err(AmmError::invalid(
+            "amm.modes",
+            "a stepwise run needs a fixed N (amm.modes)".to_string(),
+        ));
+    };
+    let mut k = 0;
+    integrate(&Star::new(problem), settings, n, true, |_, _| {
+        k += 1;
+        after_step(k);
+    })
+}
+
 /// Work counters of an AMM run ([`solve`]). Every integration run solves the
 /// constrained system once for the initial accelerations and once per time step, each solve one
 /// factorisation of the step matrix (the constraints move with t) and one substitution.
@@ -478,7 +501,9 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let mut friction = None;
     let first = match problem.friction {
         None => sys.solve(&st, 0.0, 0.0, &q, &v, &mut qdd),
-        Some(law) => friction_start(&mut sys, &st, (&q, &v), &mut qdd, law).map(|out| friction = Some(out)),
+        Some(law) => {
+            friction_start(&mut sys, &st, (&q, &v), &mut qdd, law, out_times.len()).map(|out| friction = Some(out))
+        }
     };
     first.map_err(|e| match e {
         AmmError::SingularConstraints { t, source } => AmmError::TooFewModes {
@@ -581,13 +606,15 @@ pub(crate) fn accept(
 /// The consistent start of a prescribed motion with friction (`docs/friction.md` 9.1): the
 /// sleeves at rest stuck, the moving ones slipping, the start solved again with the signs of
 /// its own multipliers while a sleeve slips on a load, and a stuck sleeve that cannot hold
-/// released (`stick_slip::switching_step`). Returns the friction's outputs from t = 0.
+/// released (`stick_slip::switching_step`). Returns the friction's outputs from t = 0, with
+/// room for `rows` output samples.
 fn friction_start(
     sys: &mut System,
     st: &RigidState,
     (q, v): (&[f64], &[f64]),
     qdd: &mut [f64],
     law: &Friction,
+    rows: usize,
 ) -> Result<FrictionOutput, AmmError> {
     sys.start_contacts(st, q, v);
     let xi_start = stick_slip::coordinates(sys, st, q);
@@ -605,7 +632,13 @@ fn friction_start(
         })
     })?;
     let ff = stick_slip::sleeve_forces(sys, qdd);
-    Ok(FrictionOutput::start(sys, ff, end.vs, prescribed_rails_power(law, st)))
+    Ok(FrictionOutput::start(
+        sys,
+        ff,
+        end.vs,
+        prescribed_rails_power(law, st),
+        rows,
+    ))
 }
 
 /// The power the rails' friction dissipates under the prescribed sliders of `st` [W] (Eqs. F4, F18).

@@ -83,6 +83,31 @@ fn set(sys: &mut System, rails: Option<&mut Rails>, which: Which, c: Contact) {
     }
 }
 
+/// The contact changes of one judging ([`changes`]): at most one per contact, held in place
+/// (no allocation in the time loop).
+pub(crate) struct Changes {
+    list: [(Which, Contact); 6],
+    len: usize,
+}
+
+impl Changes {
+    fn new() -> Self {
+        Changes {
+            list: [(Which::Sleeve(0), Contact::Free); 6],
+            len: 0,
+        }
+    }
+
+    fn push(&mut self, change: (Which, Contact)) {
+        self.list[self.len] = change;
+        self.len += 1;
+    }
+
+    pub(crate) fn as_slice(&self) -> &[(Which, Contact)] {
+        &self.list[..self.len]
+    }
+}
+
 /// The contact changes a converged step calls for (`docs/friction.md` 8.2), each contact
 /// switching at most once per step (`was_stuck`: stuck in any round of this step;
 /// `at_start`: stuck when the step began):
@@ -97,8 +122,8 @@ pub(crate) fn changes(
     end: &StepEnd,
     was_stuck: [bool; 6],
     at_start: [bool; 6],
-) -> Vec<(Which, Contact)> {
-    let mut out = Vec::new();
+) -> Changes {
+    let mut out = Changes::new();
     if let Some(fr) = &sys.friction {
         for i in 0..3 {
             let law = fr.law.sleeve(i);
@@ -151,18 +176,27 @@ pub(crate) fn switching_step<F>(
 where
     F: FnMut(&mut System, Option<&Rails>, bool) -> Result<StepEnd, AmmError>,
 {
-    let mut tried = vec![contacts(sys, rails.as_deref())];
+    // the contact states tried in this step, in order: the start's, then one per round
+    // (`round + 1` of them in round `round`)
+    let mut tried = [contacts(sys, rails.as_deref()); MAX_ROUNDS + 1];
     for round in 0..MAX_ROUNDS {
         let end = attempt(sys, rails.as_deref(), round > 0)?;
-        let change = changes(sys, rails.as_deref(), &end, stuck_in(&tried), stuck_in(&tried[..1]));
+        let change = changes(
+            sys,
+            rails.as_deref(),
+            &end,
+            stuck_in(&tried[..round + 1]),
+            stuck_in(&tried[..1]),
+        );
+        let change = change.as_slice();
         if change.is_empty() {
             return Ok(end);
         }
-        for &(which, c) in &change {
+        for &(which, c) in change {
             set(sys, rails.as_deref_mut(), which, c);
         }
         let now = contacts(sys, rails.as_deref());
-        if tried.contains(&now) {
+        if tried[..round + 1].contains(&now) {
             let reason = if h > 0.0 {
                 format!("the step of {h:.3e} s finds it neither stuck nor slipping consistently: reduce amm.dt")
             } else {
@@ -174,7 +208,7 @@ where
                 reason,
             });
         }
-        tried.push(now);
+        tried[round + 1] = now;
     }
     Err(AmmError::StickSlip {
         t,
@@ -214,11 +248,11 @@ pub(crate) fn sleeve_forces(sys: &System, qdd: &[f64]) -> [f64; 3] {
 
 impl FrictionOutput {
     /// The outputs of a run starting with the sleeves' forces `ff` [N] at the sliding speeds
-    /// `vs` [m/s], the rails dissipating `rails_power` [W].
-    pub(crate) fn start(sys: &System, ff: [f64; 3], vs: [f64; 3], rails_power: f64) -> Self {
+    /// `vs` [m/s], the rails dissipating `rails_power` [W]; room for `rows` output samples.
+    pub(crate) fn start(sys: &System, ff: [f64; 3], vs: [f64; 3], rails_power: f64, rows: usize) -> Self {
         FrictionOutput {
             tally: FrictionTally::start([sleeves_power(sys, ff, vs), rails_power]),
-            samples: Vec::new(),
+            samples: Vec::with_capacity(rows),
         }
     }
 

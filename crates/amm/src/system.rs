@@ -177,15 +177,13 @@ impl BeamRows {
         gram[B_PHI0][B_DPHI0] = g01;
         gram[B_DPHI0][B_PHI0] = g01;
         gram[B_DPHI0][B_DPHI0] = g11;
-        let [s0, s1, s2, s3] = [&self.sleeve[0], &self.sleeve[1], &self.sleeve[2], &self.sleeve[3]];
         for a in 0..4 {
-            // one pass over D^-1 B_a for its seven products (those with b < a are repeats)
-            let [p0, d0, gp, m0, m1, m2, m3] = dots(&self.scaled[a], [phi0, dphi0, phi, s0, s1, s2, s3]);
+            let ([p0, d0, gp], m) = sleeve_gram_row(&self.scaled[a], a, [phi0, dphi0, phi], &self.sleeve);
             gram[B_MID + a][B_PHI0] = p0;
             gram[B_MID + a][B_DPHI0] = d0;
             gram[B_PHI0][B_MID + a] = p0;
             gram[B_DPHI0][B_MID + a] = d0;
-            for (b, v) in [m0, m1, m2, m3].into_iter().enumerate().skip(a) {
+            for (b, v) in m.into_iter().enumerate().skip(a) {
                 gram[B_MID + a][B_MID + b] = v;
                 gram[B_MID + b][B_MID + a] = v;
             }
@@ -244,6 +242,37 @@ impl BeamRows {
             for s in 0..mb {
                 a_row[self.ids[s]] += left[k] * right[s] + ctk * self.ct[s] + sk * gram_k[s];
             }
+        }
+    }
+}
+
+/// Row `a` of the sleeve vectors' part of the Gram data ([`BeamRows::fill_gram`]): the products
+/// of `D^-1 B_a` (`scaled`) with the junction vectors and Phi (`[phi(0), phi'(0), Phi]`) and with
+/// the sleeve vectors `B_b`, b >= a (those with b < a are the symmetric repeats of earlier rows:
+/// left 0). One pass over `scaled` (`dots`: each product's sum is the same whatever the others).
+fn sleeve_gram_row(
+    scaled: &[f64],
+    a: usize,
+    [phi0, dphi0, phi]: [&[f64]; 3],
+    sleeve: &[Vec<f64>; 4],
+) -> ([f64; 3], [f64; 4]) {
+    let [s0, s1, s2, s3] = [&sleeve[0][..], &sleeve[1], &sleeve[2], &sleeve[3]];
+    match a {
+        0 => {
+            let [p, d, g, m0, m1, m2, m3] = dots(scaled, [phi0, dphi0, phi, s0, s1, s2, s3]);
+            ([p, d, g], [m0, m1, m2, m3])
+        }
+        1 => {
+            let [p, d, g, m1, m2, m3] = dots(scaled, [phi0, dphi0, phi, s1, s2, s3]);
+            ([p, d, g], [0.0, m1, m2, m3])
+        }
+        2 => {
+            let [p, d, g, m2, m3] = dots(scaled, [phi0, dphi0, phi, s2, s3]);
+            ([p, d, g], [0.0, 0.0, m2, m3])
+        }
+        _ => {
+            let [p, d, g, m3] = dots(scaled, [phi0, dphi0, phi, s3]);
+            ([p, d, g], [0.0, 0.0, 0.0, m3])
         }
     }
 }
@@ -981,7 +1010,8 @@ impl System {
     /// `A_ks = ca_k D^-1 ca_s + (cu_k - p g_k)(cu_s + p g_s) / sigma + ct_k ct_s / Jp`, with
     /// `g_k = ca_k . D^-1 Phi` and `sigma = s_uu + p^2 Phi D^-1 Phi`; and every alpha part is a
     /// multiple of one of six vectors (phi(0), phi'(0), phi at the three sleeve points, phi'(xp)),
-    /// so only their 6x6 Gram matrix `B D^-1 B^T` is computed (21 dot products of length N).
+    /// so only their 6x6 Gram matrix `B D^-1 B^T` is computed (21 dot products of length N, and
+    /// the six `B D^-1 Phi`).
     pub(crate) fn prepare(&mut self, st: &RigidState, bp: f64, gp: f64, qhat: &[f64]) -> Result<(), AmmError> {
         let thd = st.theta.d1;
         let thdd = st.theta.d2;

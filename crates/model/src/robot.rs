@@ -237,6 +237,12 @@ impl Robot {
         self.paper_form_for("this solver")
     }
 
+    /// The robot in the paper's form, when it is the paper's robot ([`Robot::equal_beams`]
+    /// without the error's text: nothing is allocated, for the solvers' time loops).
+    pub(crate) fn paper_params(&self) -> Option<&RobotParams> {
+        self.equal.as_ref().ok()
+    }
+
     /// [`Robot::equal_beams`] for a command or model `by` that takes only the paper's robot so
     /// far: the error names it and the datum that differs.
     pub fn paper_form_for(&self, by: &str) -> Result<&RobotParams, ModelError> {

@@ -164,7 +164,7 @@ impl RobotGeometry for Robot {
         self.beams()[i].sleeve_length
     }
     fn paper_form(&self) -> Option<&RobotParams> {
-        self.equal_beams().ok()
+        self.paper_params()
     }
 }
 

@@ -63,6 +63,7 @@ pub struct ModeSet {
 }
 
 mod families;
+mod lanes;
 mod recurrence;
 mod stiffening;
 

@@ -118,12 +118,12 @@ pub(super) fn exp_neg_small(x: f64) -> f64 {
 /// of one each per mode; the recurrence's rounding grows like k eps (2e-14 at N = 200, checked
 /// against direct evaluation at N = 400 in the tests).
 pub(super) struct ModeTrig<'r> {
-    roots: &'r NominalRoots,
-    xi: f64,
-    rot: (f64, f64),
-    q: (f64, f64),
+    pub(super) roots: &'r NominalRoots,
+    pub(super) xi: f64,
+    pub(super) rot: (f64, f64),
+    pub(super) q: (f64, f64),
     /// The four values at the next nominal root.
-    nominal: [f64; 4],
+    pub(super) nominal: [f64; 4],
 }
 
 impl<'r> ModeTrig<'r> {
@@ -178,10 +178,10 @@ impl<'r> ModeTrig<'r> {
 
 /// Output slices of [`elastic_triplets`], all of the elastic modes' length.
 pub(super) struct TripletOut<'o> {
-    left: &'o mut [f64],
-    mid: &'o mut [f64],
-    right: &'o mut [f64],
-    slope: &'o mut [f64],
+    pub(super) left: &'o mut [f64],
+    pub(super) mid: &'o mut [f64],
+    pub(super) right: &'o mut [f64],
+    pub(super) slope: &'o mut [f64],
 }
 
 /// The elastic part of [`ModeSet::triplet_at`]: values at `x - h`, `x`, `x + h` and the slope at
@@ -240,12 +240,12 @@ pub(super) fn elastic_triplets<const BENT: bool>(
 pub(crate) struct Triplet {
     h: f64,
     /// Per elastic mode (in order, after the rigid ones): the factors above.
-    f: Vec<[f64; 4]>,
+    pub(super) f: Vec<[f64; 4]>,
     /// Per elastic mode: beta L, the stable-basis coefficients and the root offset (see
     /// [`NominalRoots`]), gathered so that the kernel reads them in order.
-    bl: Vec<f64>,
-    c: Vec<[f64; 4]>,
-    delta: Vec<f64>,
+    pub(super) bl: Vec<f64>,
+    pub(super) c: Vec<[f64; 4]>,
+    pub(super) delta: Vec<f64>,
 }
 
 impl Triplet {
@@ -295,52 +295,130 @@ impl ModeSet {
         slope: &mut [f64],
         bent: Option<(&[f64], &mut SleeveBending)>,
     ) {
-        let xi = x / self.l;
-        let eta = tri.h / self.l;
-        let s = 1.0 / self.l.sqrt();
-        let sd = s / self.l;
-        let na = self.analytic_len();
-        // the bending outputs are dot products with the beam's modal coordinates; the junction
-        // shapes' parts fold into effective coordinates of the analytic modes:
-        // sum_m v_m a_m + sum_j v_(na+j) a_(na+j) with v_(na+j) = P_j - c_j . v
-        // is sum_m v_m (a_m - sum_j a_(na+j) c_jm) + sum_j a_(na+j) P_j
-        let mut bent = bent.map(|(alpha, bn)| {
-            bn.alpha_eff.copy_from_slice(&alpha[..na]);
-            for (j, sh) in self.junction.iter().enumerate() {
-                let aj = alpha[na + j];
-                for (e, c) in bn.alpha_eff.iter_mut().zip(&sh.c) {
-                    *e -= aj * c;
-                }
-            }
+        let at = TripletPoint::new(self, tri, x);
+        let bent = bent.map(|(alpha, bn)| {
+            self.fold_junction(alpha, bn);
             (alpha, bn)
         });
-        // rigid modes (first), then the elastic ones
-        let r0 = self.rigid;
-        let mut bend = [0.0; 3];
-        for (m, sh) in self.shapes[..r0].iter().enumerate() {
-            if let Shape::Rigid { a, b } = *sh {
-                mid[m] = (a + b * xi) * s;
-                left[m] = (a + b * (xi - eta)) * s;
-                right[m] = (a + b * (xi + eta)) * s;
-                slope[m] = b * sd;
-                if let Some((_, bn)) = bent.as_ref() {
-                    bend[0] += b * bn.alpha_eff[m];
-                    bend[1] += b * bn.alpha_eff[m];
-                }
-            }
-        }
+        let mut bend = self.rigid_triplet(
+            &at,
+            [left, mid, right, slope],
+            bent.as_ref().map(|b| &b.1.alpha_eff[..]),
+        );
+        let (r0, na) = (self.rigid, self.analytic_len());
         let out = TripletOut {
             left: &mut left[r0..na],
             mid: &mut mid[r0..na],
             right: &mut right[r0..na],
             slope: &mut slope[r0..na],
         };
-        let trig = ModeTrig::new(xi, &self.roots);
+        let trig = ModeTrig::new(at.xi, &self.roots);
+        let (s, sd) = (at.s, at.sd);
         match bent.as_ref() {
             Some((_, bn)) => elastic_triplets::<true>(tri, trig, out, &bn.alpha_eff[r0..na], s, sd, &mut bend),
             None => elastic_triplets::<false>(tri, trig, out, &[], s, sd, &mut bend),
         }
-        let [mut sl, mut sr, mut cv] = bend;
+        self.junction_triplet(&at, [left, mid, right, slope], bent, bend);
+    }
+
+    /// [`ModeSet::triplet_at`] with the bending for three beams on this set (equal beams): beam
+    /// i's sleeve at `x[i]` [m], its outputs `out[i] = [left, mid, right, slope]` and `bent[i]`.
+    /// The elastic modes run in the lanes of AVX where the processor has it (`lanes`: the same
+    /// values bit for bit), else beam by beam.
+    pub(crate) fn triplets_at3(
+        &self,
+        tri: &Triplet,
+        x: [f64; 3],
+        out: [[&mut [f64]; 4]; 3],
+        bent: [(&[f64], &mut SleeveBending); 3],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if lanes::available() {
+            let (mut out, mut bent) = (out, bent);
+            let at = x.map(|x| TripletPoint::new(self, tri, x));
+            let (r0, na) = (self.rigid, self.analytic_len());
+            let mut bend = [[0.0; 3]; 3];
+            for (i, (o, (alpha, bn))) in out.iter_mut().zip(bent.iter_mut()).enumerate() {
+                self.fold_junction(alpha, bn);
+                let [l, m, r, d] = o;
+                bend[i] = self.rigid_triplet(&at[i], [l, m, r, d], Some(&bn.alpha_eff[..]));
+            }
+            {
+                let kernel_out = out.each_mut().map(|[l, m, r, d]| TripletOut {
+                    left: &mut l[r0..na],
+                    mid: &mut m[r0..na],
+                    right: &mut r[r0..na],
+                    slope: &mut d[r0..na],
+                });
+                let trig = at.each_ref().map(|a| ModeTrig::new(a.xi, &self.roots));
+                let alpha_eff = bent.each_ref().map(|b| &b.1.alpha_eff[r0..na]);
+                // SAFETY: the processor has AVX (lanes::available, just above)
+                unsafe {
+                    lanes::elastic_triplets_x3(tri, trig, kernel_out, alpha_eff, (at[0].s, at[0].sd), &mut bend);
+                }
+            }
+            for (i, (o, b)) in out.into_iter().zip(bent).enumerate() {
+                self.junction_triplet(&at[i], o, Some(b), bend[i]);
+            }
+            return;
+        }
+        for (i, ([l, m, r, d], (alpha, bn))) in out.into_iter().zip(bent).enumerate() {
+            self.triplet_at(tri, x[i], l, m, r, d, Some((alpha, bn)));
+        }
+    }
+
+    /// The bending outputs are dot products with the beam's modal coordinates; the junction
+    /// shapes' parts fold into effective coordinates of the analytic modes:
+    /// `sum_m v_m a_m + sum_j v_(na+j) a_(na+j)` with `v_(na+j) = P_j - c_j . v`
+    /// is `sum_m v_m (a_m - sum_j a_(na+j) c_jm) + sum_j a_(na+j) P_j`: `bn.alpha_eff`.
+    fn fold_junction(&self, alpha: &[f64], bn: &mut SleeveBending) {
+        let na = self.analytic_len();
+        bn.alpha_eff.copy_from_slice(&alpha[..na]);
+        for (j, sh) in self.junction.iter().enumerate() {
+            let aj = alpha[na + j];
+            for (e, c) in bn.alpha_eff.iter_mut().zip(&sh.c) {
+                *e -= aj * c;
+            }
+        }
+    }
+
+    /// The rigid modes (first) of [`ModeSet::triplet_at`] into `[left, mid, right, slope]`, and
+    /// their bending sums (with `alpha_eff`), in units of `sd` (the elastic kernel's).
+    fn rigid_triplet(
+        &self,
+        at: &TripletPoint,
+        [left, mid, right, slope]: [&mut [f64]; 4],
+        alpha_eff: Option<&[f64]>,
+    ) -> [f64; 3] {
+        let (xi, eta, s, sd) = (at.xi, at.eta, at.s, at.sd);
+        let mut bend = [0.0; 3];
+        for (m, sh) in self.shapes[..self.rigid].iter().enumerate() {
+            if let Shape::Rigid { a, b } = *sh {
+                mid[m] = (a + b * xi) * s;
+                left[m] = (a + b * (xi - eta)) * s;
+                right[m] = (a + b * (xi + eta)) * s;
+                slope[m] = b * sd;
+                if let Some(alpha_eff) = alpha_eff {
+                    bend[0] += b * alpha_eff[m];
+                    bend[1] += b * alpha_eff[m];
+                }
+            }
+        }
+        bend
+    }
+
+    /// The junction shapes (last) of [`ModeSet::triplet_at`], from the analytic modes' values
+    /// already in `[left, mid, right, slope]`, and the bending's end: the sums `bend` of the
+    /// analytic modes with the junction shapes' own parts, scaled into `bent`.
+    fn junction_triplet(
+        &self,
+        at: &TripletPoint,
+        [left, mid, right, slope]: [&mut [f64]; 4],
+        bent: Option<(&[f64], &mut SleeveBending)>,
+        [mut sl, mut sr, mut cv]: [f64; 3],
+    ) {
+        let (xi, eta, s, sd) = (at.xi, at.eta, at.s, at.sd);
+        let na = self.analytic_len();
         for (j, sh) in self.junction.iter().enumerate() {
             let c = &sh.c[..];
             let at = |z: f64| junction::poly_value_slope(sh.p, z);
@@ -356,11 +434,32 @@ impl ModeSet {
                 cv += aj * junction::poly_curvature(sh.p, xi);
             }
         }
-        if let Some((_, bn)) = bent.as_mut() {
+        if let Some((_, bn)) = bent {
             // the analytic parts carry the factor sd (slopes) and sd / L (curvature) as well
             bn.slope_left = sl * sd;
             bn.slope_right = sr * sd;
             bn.curvature = cv * sd / self.l;
+        }
+    }
+}
+
+/// The point of a sleeve triplet on a beam: `xi = x / L`, `eta = h / L` and the scales
+/// `s = 1 / sqrt(L)`, `sd = s / L` of the values and slopes.
+struct TripletPoint {
+    xi: f64,
+    eta: f64,
+    s: f64,
+    sd: f64,
+}
+
+impl TripletPoint {
+    fn new(modes: &ModeSet, tri: &Triplet, x: f64) -> Self {
+        let s = 1.0 / modes.l.sqrt();
+        TripletPoint {
+            xi: x / modes.l,
+            eta: tri.h / modes.l,
+            s,
+            sd: s / modes.l,
         }
     }
 }

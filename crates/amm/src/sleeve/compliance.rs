@@ -144,7 +144,7 @@ impl SleeveCompliance {
             // the Green's function of source b (Eq. R2) read by the functionals a <= b
             let (ob, db, sb) = FUNCTIONALS[b];
             let src = GreenSource::new(self.l, xc + ob * self.hp, db == 1);
-            let kept: [f64; 4] = dots(&self.scaled[b], v);
+            let kept = kept_products(&self.scaled[b], b, v);
             for a in 0..=b {
                 let (oa, da, sa) = FUNCTIONALS[a];
                 let h = sa * sb * src.at(xc + oa * self.hp)[da];
@@ -154,6 +154,26 @@ impl SleeveCompliance {
             }
         }
         r
+    }
+}
+
+/// `scaled . v[a]` for the functionals a <= b (the others are not read: 0), in one pass over
+/// `scaled` (`dots`: each product's sum is the same whatever the others).
+fn kept_products(scaled: &[f64], b: usize, [v0, v1, v2, v3]: [&[f64]; 4]) -> [f64; 4] {
+    match b {
+        0 => {
+            let [k0] = dots(scaled, [v0]);
+            [k0, 0.0, 0.0, 0.0]
+        }
+        1 => {
+            let [k0, k1] = dots(scaled, [v0, v1]);
+            [k0, k1, 0.0, 0.0]
+        }
+        2 => {
+            let [k0, k1, k2] = dots(scaled, [v0, v1, v2]);
+            [k0, k1, k2, 0.0]
+        }
+        _ => dots(scaled, [v0, v1, v2, v3]),
     }
 }
 

@@ -163,19 +163,40 @@ impl Sleeves {
         let nb = nm + 2;
         let full = self.full;
         self.xp = xp;
-        for (i, (beam, &x)) in beams.iter_mut().zip(&xp).enumerate() {
-            let alpha = &qhat[i * nb..i * nb + nm];
+        let alpha = |i: usize| &qhat[i * nb..i * nb + nm];
+        // the material point in each sleeve (Eq. S1) and its foreshortening shift
+        let mut shifts = [0.0; 3];
+        for (i, (sh, &x)) in shifts.iter_mut().zip(&xp).enumerate() {
             let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
-            let shift = self.shift.as_mut().map_or(0.0, |s| {
+            *sh = self.shift.as_mut().map_or(0.0, |s| {
                 let n = s.len();
-                s[i.min(n - 1)].evaluate(i, x - u_hat, alpha)
+                s[i.min(n - 1)].evaluate(i, x - u_hat, alpha(i))
             });
-            self.f[i] = shift;
-            let xc = x - u_hat + shift;
+        }
+        self.f = shifts;
+        let xc: [f64; 3] = std::array::from_fn(|i| {
+            let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
+            xp[i] - u_hat + shifts[i]
+        });
+        // the modes at the sleeve points: the three beams at once on a shared set (full model)
+        let together = full && self.tri.len() == 1;
+        if together {
+            let out = beams.each_mut().map(|b| {
+                let [mid, right, left, mslope] = &mut b.sleeve;
+                [&mut left[..], &mut mid[..], &mut right[..], &mut mslope[..]]
+            });
+            let bent = self.bent.each_mut().map(|bn| &mut *bn);
+            let [b0, b1, b2] = bent;
+            modes[0].triplets_at3(&self.tri[0], xc, out, [(alpha(0), b0), (alpha(1), b1), (alpha(2), b2)]);
+        }
+        for (i, beam) in beams.iter_mut().enumerate() {
+            let (alpha, shift, xc) = (alpha(i), shifts[i], xc[i]);
             let [mid, right, left, mslope] = &mut beam.sleeve;
             let bent = &mut self.bent[i];
             let tri = pick(&self.tri, i);
-            modes[i].triplet_at(tri, xc, left, mid, right, mslope, full.then_some((alpha, &mut *bent)));
+            if !together {
+                modes[i].triplet_at(tri, xc, left, mid, right, mslope, full.then_some((alpha, &mut *bent)));
+            }
             if full {
                 let slope_mid = dot(mslope, alpha);
                 let slopes = [slope_mid, bent.slope_right, bent.slope_left];

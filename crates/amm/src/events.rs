@@ -12,6 +12,7 @@
 //! at the step's start (`stick_slip::switching_step`).
 
 use flexstar_kinematics::RigidState;
+use flexstar_model::friction_events::{crossing, first_event};
 use flexstar_model::Contact;
 use flexstar_numerics::GenAlpha;
 
@@ -21,16 +22,6 @@ use crate::system::System;
 
 /// Events located in one step before the rest of the step falls back to the switch at its start.
 const MAX_SPLITS: usize = 6;
-
-/// An event closer than this fraction of the step, or than [`MIN_PART`], to the step's start or
-/// end is taken there: a part step of a tiny fraction would make `beta'` vanish against the
-/// rows' compliances (Eqs. A3, F16, R4 divide by it; a part step of 2.6e-8 s left the Schur
-/// complement rank deficient to the LU's test) and cost a solve for nothing.
-const THETA_MIN: f64 = 0.01;
-
-/// The shortest part step [s] (see [`THETA_MIN`]): below steps of 1e-4 s the events are located
-/// to this.
-const MIN_PART: f64 = 1e-6;
 
 /// The generalized-alpha state of a run: coordinates, rates, the acceleration variable and
 /// the accelerations (each 3 (N + 2)).
@@ -82,29 +73,8 @@ impl Probe {
             crossing(a, b)
         };
         let times: Vec<f64> = change.iter().map(fraction).collect();
-        let least = THETA_MIN.max(MIN_PART / h);
-        let theta = match times.iter().copied().fold(1.0, f64::min) {
-            t if t < least => 0.0,
-            t if t > 1.0 - least => 1.0,
-            t => t,
-        };
-        let due = change
-            .iter()
-            .zip(&times)
-            .filter(|(_, &t)| t <= theta.max(least) + 1e-9)
-            .map(|(c, _)| *c)
-            .collect();
-        (theta, due)
+        first_event(change, &times, h)
     }
-}
-
-/// Where a quantity going from `a` (start) to `b` (end) of opposite sign or zero crosses zero,
-/// as a fraction of the step (Eq. F24); 0 when it already had the end's sign at the start.
-fn crossing(a: f64, b: f64) -> f64 {
-    if a == 0.0 || a.signum() == b.signum() && b != 0.0 {
-        return 0.0;
-    }
-    (a / (a - b)).clamp(0.0, 1.0)
 }
 
 /// Each stuck sleeve's excess of the force its stick needs over its limit, `|F_t| -
@@ -410,19 +380,4 @@ fn stuck_now(sys: &System) -> [bool; 6] {
 fn advance(sys: &System, out: &mut FrictionOutput, x: &State, (vs, rails): ([f64; 3], f64), h: f64) {
     let ff = stick_slip::sleeve_forces(sys, x.qdd);
     out.advance(sys, (ff, vs), (&[Contact::Free; 3], rails), h);
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_crossing_is_interpolated_linearly_within_the_step() {
-        assert_eq!(crossing(1.0, -3.0), 0.25);
-        assert_eq!(crossing(-2.0, 2.0), 0.5);
-        assert_eq!(crossing(1.0, 0.0), 1.0);
-        // the end's sign at the start: the event is at the start
-        assert_eq!(crossing(-1.0, -2.0), 0.0);
-        assert_eq!(crossing(0.0, 1.0), 0.0);
-    }
 }

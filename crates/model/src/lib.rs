@@ -18,6 +18,7 @@ pub mod drive_section;
 pub mod error;
 pub mod fit_section;
 pub mod friction;
+pub mod friction_events;
 pub mod friction_run;
 pub mod geometry;
 pub mod gravity;

@@ -14,18 +14,11 @@
 use super::friction::{changes, freeze, set};
 use super::*;
 use crate::star::Contact;
+use flexstar_model::friction_events::{crossing, first_event};
 use flexstar_model::friction_run::Which;
 
 /// Events located in one step before the rest of the step falls back to the switch at its start.
 const MAX_SPLITS: usize = 6;
-
-/// An event closer than this fraction of the step, or than [`MIN_PART`], to the step's start or
-/// end is taken there (a part step of a tiny fraction costs a Newton solve for nothing; the
-/// AMM's, whose rows' compliances divide by `beta'`, the same).
-const THETA_MIN: f64 = 0.01;
-
-/// The shortest part step [s] (see [`THETA_MIN`]).
-const MIN_PART: f64 = 1e-6;
 
 /// What locating an event reads at the start of a step: each sleeve's sliding velocity
 /// `xi_ic'` [m/s] and, stuck, its force's excess over its limit `|F_t| - mu_static L` [N].
@@ -62,27 +55,8 @@ impl Probe {
             }
         };
         let times: Vec<f64> = change.iter().map(fraction).collect();
-        let least = THETA_MIN.max(MIN_PART / h);
-        let theta = match times.iter().copied().fold(1.0, f64::min) {
-            t if t < least => 0.0,
-            t if t > 1.0 - least => 1.0,
-            t => t,
-        };
-        let due = (change.iter().zip(&times))
-            .filter(|(_, &t)| t <= theta.max(least) + 1e-9)
-            .map(|(c, _)| *c)
-            .collect();
-        (theta, due)
+        first_event(change, &times, h)
     }
-}
-
-/// Where a quantity going from `a` (start) to `b` (end) crosses zero, as a fraction of the
-/// step (Eq. F24); 0 when it already had the end's sign at the start.
-fn crossing(a: f64, b: f64) -> f64 {
-    if a == 0.0 || a.signum() == b.signum() && b != 0.0 {
-        return 0.0;
-    }
-    (a / (a - b)).clamp(0.0, 1.0)
 }
 
 /// Each stuck sleeve's excess of the force its stick needs over its limit, `|F_t| -
@@ -175,19 +149,5 @@ impl Stepper<'_, '_> {
         for (k, _) in self.star.stuck_coordinates() {
             st.a[k] = 0.0;
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_crossing_is_interpolated_linearly_within_the_step() {
-        assert_eq!(crossing(1.0, -3.0), 0.25);
-        assert_eq!(crossing(-2.0, 2.0), 0.5);
-        assert_eq!(crossing(1.0, 0.0), 1.0);
-        assert_eq!(crossing(-1.0, -2.0), 0.0);
-        assert_eq!(crossing(0.0, 1.0), 0.0);
     }
 }

@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// The crates of `crates/` (the Python package is its own workspace, drawn at the bottom).
+/// The crates of `crates/` (the Python package is drawn at the bottom).
 fn crate_dirs(root: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(root.join("crates"))
         .unwrap()

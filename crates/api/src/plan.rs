@@ -152,8 +152,10 @@ fn motion_experiments(cfg: &PlanConfig, p: &Planned, rows: &[[f64; 7]]) -> Resul
         e.trajectory = traj;
         e
     };
+    // the plain quintic at the plan's t_move (a robust plan may take longer, [robust] t_move)
+    let t_plain = p.robust.as_ref().map_or(p.t_move, |info| info.nominal.t_move);
     let mut exps = vec![
-        with(p.family.quintic(p.t_move)),
+        with(p.family.quintic(t_plain)),
         p.zvd.clone(),
         with(table_trajectory(&cfg.exp, rows)?),
     ];

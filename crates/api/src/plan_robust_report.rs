@@ -16,8 +16,13 @@ pub fn robust_json(info: &RobustInfo, c: &RobustCheck) -> Value {
         "uncertainty": info.uncertainty,
         "sample": info.sample,
         "candidates": info.candidates.iter().map(|(v, f)| json!({"values": v, "f1_hz": f})).collect::<Vec<_>>(),
+        "t_move_s": {
+            "plan": info.nominal.t_move,
+            "robust_plan": info.t_move_s,
+        },
         "objective_m": {
             "plain": info.objective_plain_m,
+            "plain_at_robust_t_move": info.objective_plain_robust_m,
             "nominal_plan": info.objective_nominal_m,
             "robust_plan": info.objective_m,
             "start": info.start,
@@ -55,7 +60,8 @@ pub fn robust_markdown(info: &RobustInfo, c: &RobustCheck, name: &str) -> String
     s += &format!(
         "; quantile {}. The search held over {} sample models (first frequency at the final pose {} Hz) and minimised \
          their {} residual: RMS over each model's window {:.3e} m for the plain quintic, {:.3e} m for the nominal plan, \
-         {:.3e} m for the robust plan (started from the {}).\n\n",
+         {:.3e} m for the robust plan (started from the {}). The plain quintic and the nominal plan take t_move = {} s, \
+         the robust plan {:.4} s{}.\n\n",
         u.quantile,
         info.sample.len(),
         info.sample.iter().map(|m| format!("{:.3}", m.f1_hz)).collect::<Vec<_>>().join(", "),
@@ -63,8 +69,20 @@ pub fn robust_markdown(info: &RobustInfo, c: &RobustCheck, name: &str) -> String
         info.objective_plain_m,
         info.objective_nominal_m,
         info.objective_m,
-        info.start
+        info.start,
+        info.nominal.t_move,
+        info.t_move_s,
+        match u.t_move {
+            flexstar_plan::uncertainty::RobustDuration::Zvd => " (the ZVD-shaped quintic's: [robust] t_move = \"zvd\")",
+            _ => "",
+        }
     );
+    if let Some(v) = info.objective_plain_robust_m {
+        s += &format!(
+            "The plain quintic of the robust plan's duration ({:.4} s) leaves {v:.3e} m by the same measure.\n\n",
+            info.t_move_s
+        );
+    }
     s += &format!(
         "The shaper over the uncertainty covers the bands {} Hz (si, +-{} %); its residual is measured below, not predicted.\n\n",
         info.shaped

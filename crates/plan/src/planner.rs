@@ -14,6 +14,7 @@ use crate::limits::{check_quintic_kinematics, check_t_move, kinematic_peaks, qui
 use crate::lm::{minimise, Stop, TraceRow};
 use crate::objective::{Eval, Evaluator, SmoothRef, Terms};
 use crate::section::{Limits, Objective, PlanConfig};
+use crate::uncertainty::RobustDuration;
 use crate::PlanError;
 
 /// The search stops when the RMS of |dG| over the window is this share of the plain quintic's
@@ -226,6 +227,14 @@ pub(crate) fn check_plan_input(cfg: &PlanConfig) -> Result<(), PlanError> {
         let knots = knot_times(&family, t_move);
         let peaks = kinematic_peaks(&cfg.exp.robot, &quintic, span, cfg.exp.time.dt_out, &knots).map_err(bad)?;
         check_quintic_kinematics(t_move, peaks, &cfg.limits).map_err(bad)?;
+        if let Some(RobustDuration::Seconds(t)) = cfg.robust.as_ref().map(|u| u.t_move) {
+            if t < t_move {
+                return Err(bad(ModelError::invalid(
+                    "robust.t_move",
+                    format!("{t} s is shorter than [plan] t_move = {t_move} s: a robust plan takes at least the nominal plan's time"),
+                )));
+            }
+        }
     }
     Ok(())
 }

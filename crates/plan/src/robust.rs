@@ -16,7 +16,7 @@ use crate::objective::{Eval, Evaluator, Rejected, SmoothRef, Terms};
 use crate::planner::{effective_bounds, evaluate, peak_warnings, PeakComparison, PeakSet, Planned, Setup};
 use crate::planner::{FLOOR_SHARE, WINDOW_PERIODS};
 use crate::section::{Limits, PlanConfig};
-use crate::uncertainty::Uncertainty;
+use crate::uncertainty::{RobustDuration, Uncertainty};
 use crate::PlanError;
 
 /// Neighbouring sample models (sorted by their first frequency at the final pose) are at most
@@ -46,9 +46,15 @@ pub struct RobustInfo {
     pub candidates: Vec<(Vec<f64>, f64)>,
     /// The nominal plan (4.9-4.10 on the file's model).
     pub nominal: Planned,
-    /// The objective of Eq. U1 [m] (RMS over each model's window) at the plain quintic, the
-    /// nominal plan and the robust plan.
+    /// The robust plan's duration [s] (`[robust] t_move`; the plain quintic and the nominal plan
+    /// keep the plan's `t_move`).
+    pub t_move_s: f64,
+    /// The objective of Eq. U1 [m] (RMS over each model's window) at the plain quintic and the
+    /// nominal plan (both at the plan's `t_move`) and the robust plan.
     pub objective_plain_m: f64,
+    /// Eq. U1 at the plain quintic of the robust plan's duration, where that differs from the
+    /// plan's `t_move` (the search's start when it started from the plain quintic) [m].
+    pub objective_plain_robust_m: Option<f64>,
     pub objective_nominal_m: f64,
     pub objective_m: f64,
     /// Which the search started from (`"plain"` or `"nominal"`).
@@ -88,10 +94,12 @@ pub fn plan_robust(
     zvd: Experiment,
     unc: &Uncertainty,
 ) -> Result<Planned, PlanError> {
+    let t_robust = robust_duration(cfg, unc.t_move, t_move, &zvd)?;
     let nominal = crate::planner::plan_residual(cfg, s, t_move, zvd)?;
     let (candidates, sample) = choose_sample(unc, &s.family.quintic(t_move), s.f1_hz)?;
+    check_window(cfg, t_robust, &sample)?;
     let plain_x = s.family.plain();
-    let (set, plains) = sample_set(cfg, s, t_move, &sample)?;
+    let (set, plains) = sample_set(cfg, s, t_robust, &sample)?;
     let floors: Vec<f64> = plains.iter().map(|p| FLOOR_SHARE * p.norm_g()).collect();
     let evals_at = |x: &[f64]| -> Option<Vec<Eval>> {
         (0..set.count())
@@ -117,12 +125,28 @@ pub fn plan_robust(
         &sample.iter().map(|m| m.exp.clone()).collect::<Vec<_>>(),
     )
     .map_err(|e| PlanError::Solver(format!("the shaper over the uncertainty: {}", e.detail())))?;
-    let runs: usize = set.evaluators.iter().map(Evaluator::runs).sum::<usize>() + s.evaluator.runs();
+    // the plain quintic's and the nominal plan's Eq. U1 at their own duration, the plan's t_move
+    let at_plan = if t_robust == t_move {
+        None
+    } else {
+        Some(sample_set(cfg, s, t_move, &sample)?)
+    };
+    let (objective_plain_m, objective_nominal_m) = match &at_plan {
+        None => (score(&e_plain), e_nominal_score(&nominal, &set, unc.quantile)),
+        Some((set_plan, plains_plan)) => (score(plains_plan), e_nominal_score(&nominal, set_plan, unc.quantile)),
+    };
+    let runs: usize = set.evaluators.iter().map(Evaluator::runs).sum::<usize>()
+        + at_plan
+            .as_ref()
+            .map_or(0, |(p, _)| p.evaluators.iter().map(Evaluator::runs).sum::<usize>())
+        + s.evaluator.runs();
     let info = RobustInfo {
         uncertainty: unc.clone(),
         candidates,
-        objective_plain_m: score(&e_plain),
-        objective_nominal_m: e_nominal_score(&nominal, &set, unc.quantile),
+        t_move_s: t_robust,
+        objective_plain_robust_m: at_plan.is_some().then(|| score(&e_plain)),
+        objective_plain_m,
+        objective_nominal_m,
         objective_m: sol.objective,
         start,
         shaped,
@@ -136,7 +160,9 @@ pub fn plan_robust(
     Ok(Planned {
         warnings: peak_warnings(&peaks.plain, &peaks.planned),
         peaks,
-        trajectory: s.family.trajectory(&sol.x, t_move),
+        t_move: t_robust,
+        t_rest: cfg.plan.t0 + t_robust,
+        trajectory: s.family.trajectory(&sol.x, t_robust),
         x: sol.x,
         eval: sol.evals[k_nom].clone(),
         plain: plains[k_nom].clone(),
@@ -149,6 +175,41 @@ pub fn plan_robust(
         robust: Some(Box::new(info)),
         ..nominal
     })
+}
+
+/// The robust plan's duration [s] (`[robust] t_move`): the plan's, the ZVD-shaped quintic's (its
+/// rest minus the plan's start) or the seconds given.
+fn robust_duration(cfg: &PlanConfig, d: RobustDuration, t_move: f64, zvd: &Experiment) -> Result<f64, PlanError> {
+    match d {
+        RobustDuration::Plan => Ok(t_move),
+        RobustDuration::Seconds(t) => Ok(t),
+        RobustDuration::Zvd => zvd
+            .trajectory
+            .t_rest()
+            .map(|t| t - cfg.plan.t0)
+            .ok_or_else(|| PlanError::Solver("the ZVD-shaped quintic has no end of motion".into())),
+    }
+}
+
+/// `time.t_end` holds the robust plan and its residual window on every sample model (two periods
+/// of the lowest first frequency after the rest), so that the comparison's runs judge it as the
+/// search did.
+fn check_window(cfg: &PlanConfig, t_robust: f64, sample: &[SampleModel]) -> Result<(), PlanError> {
+    let f_lo = sample.iter().map(|m| m.f1_hz).fold(f64::INFINITY, f64::min);
+    let needed = cfg.plan.t0 + t_robust + WINDOW_PERIODS / f_lo;
+    if cfg.exp.time.t_end + 1e-12 < needed {
+        return Err(ModelError::invalid(
+            "time.t_end",
+            format!(
+                "{} s ends before the robust plan's residual window does: the plan rests at {:.4} s and its window (two periods of the lowest sample f1, {f_lo:.3} Hz) needs t_end >= {needed:.4} s",
+                cfg.exp.time.t_end,
+                cfg.plan.t0 + t_robust
+            ),
+        )
+        .in_file(&cfg.exp.source)
+        .into());
+    }
+    Ok(())
 }
 
 /// Eq. U1 at the nominal plan (infinite when it breaks a sample model's limits).

@@ -585,11 +585,41 @@ mod tests {
         );
         refused(&with("\"payload.mass\" = [0.0, 0.5]\ndraws = 0\n"), "robust.draws");
         refused(&with("quantile = 0.5\n"), "robust");
+        for t in ["0.0", "-0.5", "nan", "\"shaped\"", "[0.5]"] {
+            refused(
+                &with(&format!("\"payload.mass\" = [0.0, 0.5]\nt_move = {t}\n")),
+                "robust.t_move",
+            );
+        }
         let msg = match read(&with("\"payload.mass\" = [0.3, 0.5]\n")) {
             Err(PlanError::Input(e)) => e.to_string(),
             other => panic!("{other:?}"),
         };
         assert!(msg.contains("excludes the experiment's own value 0.25"), "{msg}");
+    }
+
+    /// `[robust] t_move` as read: the plan's by default, `"zvd"`, seconds; seconds shorter than
+    /// `[plan] t_move` refused before any work (a robust plan takes at least the nominal time).
+    #[test]
+    fn the_robust_duration_is_read_and_checked() {
+        use crate::uncertainty::RobustDuration;
+        let with = |body: &str| format!("[payload]\nmass = 0.25\n[robust]\n\"payload.mass\" = [0.0, 0.5]\n{body}");
+        let duration = |body: &str| read(&with(body)).unwrap().robust.unwrap().t_move;
+        assert_eq!(duration(""), RobustDuration::Plan);
+        assert_eq!(duration("t_move = \"plan\"\n"), RobustDuration::Plan);
+        assert_eq!(duration("t_move = \"zvd\"\n"), RobustDuration::Zvd);
+        assert_eq!(duration("t_move = 0.9\n"), RobustDuration::Seconds(0.9));
+        assert!(crate::planner::check_plan_input(&read(&with("t_move = 0.9\n")).unwrap()).is_ok());
+        match crate::planner::check_plan_input(&read(&with("t_move = 0.3\n")).unwrap()) {
+            Err(PlanError::Input(e)) => {
+                let msg = e.to_string();
+                assert!(
+                    msg.contains("smooth.toml") && msg.contains("robust.t_move") && msg.contains("0.42"),
+                    "{msg}"
+                );
+            }
+            other => panic!("a robust plan shorter than the plan accepted: {other:?}"),
+        }
     }
 
     /// Bad values of the new keys are refused with the file and the key (4.8, 4.10).

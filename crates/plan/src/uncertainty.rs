@@ -36,6 +36,8 @@ pub struct Range {
 #[derive(Debug, Clone, Serialize)]
 pub struct Uncertainty {
     pub ranges: Vec<Range>,
+    /// The robust plan's duration (`t_move` of the section).
+    pub t_move: RobustDuration,
     /// In (0, 1]: 1 minimises the worst sample (Eq. U1).
     pub quantile: f64,
     /// Fresh models of the FEM check.
@@ -59,6 +61,7 @@ impl Uncertainty {
     pub fn read(section: toml::Table, doc: &toml::Table, file: &Path) -> Result<Uncertainty, ModelError> {
         let mut u = Uncertainty {
             ranges: Vec::new(),
+            t_move: RobustDuration::Plan,
             quantile: 1.0,
             draws: DEFAULT_DRAWS,
             seed: 1,
@@ -70,6 +73,7 @@ impl Uncertainty {
         for (name, value) in entries {
             match name.as_str() {
                 "quantile" => u.quantile = read_quantile(&value, file)?,
+                "t_move" => u.t_move = read_duration(&value, file)?,
                 "draws" => u.draws = read_count(&value, file, "draws", 1, MAX_DRAWS)?,
                 "seed" => u.seed = read_count(&value, file, "seed", 0, usize::MAX)? as u64,
                 "fit" => {
@@ -249,6 +253,30 @@ fn flatten(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value
             toml::Value::Table(t) => flatten(t, &name, out),
             _ => out.push((name, v.clone())),
         }
+    }
+}
+
+/// The robust plan's duration, `[robust] t_move` (`docs/motions.md` 4.11, "The robust plan's
+/// time"): the plan's own `t_move` (default), the ZVD-shaped quintic's (the plan's `t_move` plus
+/// the ZVD's penalty: the same time as the shaper it competes with), or seconds.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RobustDuration {
+    Plan,
+    Zvd,
+    Seconds(f64),
+}
+
+fn read_duration(v: &toml::Value, file: &Path) -> Result<RobustDuration, ModelError> {
+    match (v.as_str(), number(v)) {
+        (Some("zvd"), _) => Ok(RobustDuration::Zvd),
+        (Some("plan"), _) => Ok(RobustDuration::Plan),
+        (None, Some(t)) if t.is_finite() && t > 0.0 => Ok(RobustDuration::Seconds(t)),
+        _ => Err(bad(
+            file,
+            "t_move",
+            format!("is the robust plan's duration: seconds (> 0), \"plan\" ([plan] t_move) or \"zvd\" (the ZVD-shaped quintic's); got {v}"),
+        )),
     }
 }
 

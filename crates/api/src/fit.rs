@@ -218,9 +218,7 @@ impl<'a> Setup<'a> {
 /// channel's RMS error against the recording beside the AMM's, and the two models' difference.
 fn fem_check(model: &AmmEvaluation, fit: &Fit, recording: &SensorTable) -> std::result::Result<Vec<FemCheck>, String> {
     let fem = crate::fit_model::fem_readings(model, &fit.theta())?;
-    let rms = |a: &[f64], b: &[f64]| {
-        (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len().max(1) as f64).sqrt()
-    };
+    let rms = |a: &[f64], b: &[f64]| flexstar_fit::noise::rms(&a.iter().zip(b).map(|(x, y)| x - y).collect::<Vec<_>>());
     fit.channels
         .iter()
         .filter(|c| c.weight > 0.0)

@@ -13,7 +13,6 @@ use flexstar_model::{AmmSettings, DriveKind, Experiment, FemSettings, ModelError
 /// Which model solves an experiment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Solver {
     /// The paper's constrained assumed-modes method
     Amm,

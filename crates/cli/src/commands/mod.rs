@@ -15,6 +15,26 @@ pub mod verify;
 use std::path::Path;
 
 use flexstar_model::{Experiment, Provenance};
+use flexstar_solve::Solver;
+
+/// `--solver amm|fem`: the command line's names of [`Solver`] (the solver crate carries no
+/// command-line code).
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum SolverArg {
+    /// The paper's constrained assumed-modes method
+    Amm,
+    /// The independent finite-element reference
+    Fem,
+}
+
+impl From<SolverArg> for Solver {
+    fn from(s: SolverArg) -> Solver {
+        match s {
+            SolverArg::Amm => Solver::Amm,
+            SolverArg::Fem => Solver::Fem,
+        }
+    }
+}
 
 /// Load and validate an experiment file (errors name the file, the key and the reason).
 pub fn load(config: &Path) -> anyhow::Result<Experiment> {

@@ -116,7 +116,7 @@ pub struct FreqmapArgs {
     k: usize,
     /// Solver of the map
     #[arg(long, value_enum, default_value = "amm")]
-    solver: flexstar_solve::Solver,
+    solver: super::SolverArg,
     /// How the sliders are held (free: f1 is the first elastic frequency, the rigid modes left out)
     #[arg(long, value_enum, default_value = "locked")]
     sliders: SlidersArg,
@@ -209,7 +209,7 @@ pub fn run_freqmap(args: FreqmapArgs) -> anyhow::Result<()> {
         gy: flexstar_api::modal::parse_axis("--gy", &args.gy)?,
         theta: args.theta,
         k: args.k,
-        solver: args.solver,
+        solver: args.solver.into(),
         sliders: Sliders::from(args.sliders),
         force: args.force,
     };

@@ -18,7 +18,7 @@ pub struct Args {
     config: PathBuf,
     /// Which model to run
     #[arg(long, value_enum)]
-    solver: flexstar_solve::Solver,
+    solver: super::SolverArg,
     /// AMM mode family (overrides [amm] family): pinned-free, slide-free, free-free, clamped-free, enriched
     #[arg(long)]
     family: Option<ModeFamily>,
@@ -55,7 +55,7 @@ impl Args {
     /// The run's settings over the experiment (the flags given).
     fn settings(&self) -> RunSettings {
         RunSettings {
-            solver: self.solver,
+            solver: self.solver.into(),
             family: self.family,
             modes: self.modes,
             model: self.model,

@@ -4,6 +4,8 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use serde::Serialize;
 
 use flexstar_model::{ModelError, Pose, Trajectory};
@@ -73,7 +75,7 @@ pub fn move_config(cfg: &PlanConfig, m: &CycleMove) -> PlanConfig {
 }
 
 /// Plan the cycle of `cfg` (`docs/motions.md` 4.12; its points were checked reachable when the
-/// file was read): every move's checks of 4.8 first (nothing planned before all pass), then each move's single plan in order.
+/// file was read): every move's checks of 4.8 first (nothing planned before all pass), then the moves' single plans, side by side.
 pub fn plan_cycle(cfg: &PlanConfig) -> Result<PlannedCycle, PlanError> {
     let started = Instant::now();
     let Some(cycle) = cfg.cycle.clone() else {
@@ -83,9 +85,12 @@ pub fn plan_cycle(cfg: &PlanConfig) -> Result<PlannedCycle, PlanError> {
     for (k, sub) in subs.iter().enumerate() {
         check_plan_input(sub).map_err(|e| in_move(e, k))?;
     }
+    // the moves are independent (each from rest to rest): planned side by side, the first
+    // failing move (in the cycle's order) reported
+    let plans: Vec<Result<Planned, PlanError>> = subs.par_iter().map(crate::planner::plan).collect();
     let mut moves = Vec::with_capacity(subs.len());
-    for (k, (sub, span)) in subs.iter().zip(&cycle.moves).enumerate() {
-        let planned = crate::planner::plan(sub).map_err(|e| in_move(e, k))?;
+    for (k, (planned, span)) in plans.into_iter().zip(&cycle.moves).enumerate() {
+        let planned = planned.map_err(|e| in_move(e, k))?;
         moves.push(PlannedMove { span: *span, planned });
     }
     Ok(PlannedCycle {

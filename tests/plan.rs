@@ -347,6 +347,51 @@ fn the_time_objective_beats_the_zvd_shaped_quintic_by_thirty_percent() {
 }
 
 /// Bad input is refused before any work with the file and the key, and nothing is written.
+/// `[robust] t_move = "zvd"` (docs/motions.md 4.11, "The robust plan's time"): the robust plan
+/// takes the ZVD-shaped quintic's duration, read here from the ZVD run's own `t_rest`, while the
+/// plain quintic and the nominal plan keep the file's 0.42 s; on the FEM (its CSVs read here) the
+/// robust plan leaves far less than the plain quintic. A short search and two draws keep it cheap:
+/// even the plain quintic of the longer duration leaves a tenth of the short one's (4.11).
+#[test]
+fn a_robust_plan_in_the_zvd_time_keeps_the_plain_quintic_as_its_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/motions");
+    let text = std::fs::read_to_string(root.join("plan-robust-zvd.toml")).unwrap();
+    assert!(text.contains("budget_s = 60"));
+    let cfg = dir.path().join("plan-robust-zvd.toml");
+    std::fs::write(
+        &cfg,
+        format!("{}\ndraws = 2\n", text.replace("budget_s = 60", "budget_s = 4")),
+    )
+    .unwrap();
+    let case = plan(&cfg, dir.path());
+    let v = json(&case.join("plan.json"));
+    let rest_of = |label: &str| {
+        v["comparison"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["motion"].as_str().unwrap().starts_with(label))
+            .unwrap_or_else(|| panic!("no {label} in the comparison"))["t_rest"]
+            .as_f64()
+            .unwrap()
+    };
+    let (t_plain, t_zvd, t_planned) = (rest_of("plain quintic"), rest_of("ZVD"), rest_of("planned"));
+    assert!((t_plain - 0.42).abs() < 1e-12 && (rest_of("nominal plan") - 0.42).abs() < 1e-12);
+    assert!(
+        t_zvd > 0.8 && (t_planned - t_zvd).abs() < 1e-9,
+        "planned {t_planned} s, ZVD {t_zvd} s"
+    );
+    assert!((v["robust"]["t_move_s"]["robust_plan"].as_f64().unwrap() - t_zvd).abs() < 1e-9);
+    assert_eq!(v["robust"]["check"]["draws"].as_array().unwrap().len(), 2);
+    let plain = residual_peak(&case.join("plain/fem.csv"), t_plain);
+    let planned = residual_peak(&case.join("planned/fem.csv"), t_planned);
+    assert!(
+        planned < plain / 5.0,
+        "robust plan {planned:.3e} m against the plain quintic's {plain:.3e} m"
+    );
+}
+
 #[test]
 fn bad_plans_are_refused_with_the_key_and_nothing_is_written() {
     let out = tempfile::tempdir().unwrap();

@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use flexstar_metrics::residual::dg_magnitude;
@@ -402,14 +403,18 @@ pub fn write_figures(exp: &Experiment, o: &PlanOutcome) -> Result<Vec<PathBuf>> 
         crate::plan_figures::forces_figure(exp, o),
         crate::plan_figures::path_figure(exp, o),
     ];
-    let mut files = Vec::new();
     let robust = o
         .robust
         .as_ref()
         .map(|c| crate::plan_robust_report::curves_figure(n, c));
-    for fig in figures.into_iter().chain(robust) {
-        fig.write(&dir)?;
-        files.extend(["svg", "png"].map(|e| dir.join(format!("{}.{e}", fig.name))));
-    }
-    Ok(files)
+    // each figure drawn and rasterised on its own thread (they share nothing)
+    let figures: Vec<_> = figures.into_iter().chain(robust).collect();
+    let written: Vec<Vec<PathBuf>> = figures
+        .par_iter()
+        .map(|fig| {
+            fig.write(&dir)?;
+            Ok(["svg", "png"].map(|e| dir.join(format!("{}.{e}", fig.name))).to_vec())
+        })
+        .collect::<Result<_>>()?;
+    Ok(written.concat())
 }

@@ -256,15 +256,22 @@ pub fn setup(cfg: &PlanConfig, t_ref: f64, started: Instant) -> Result<Setup, Pl
     let family = family_of(cfg);
     let mut exp = cfg.exp.clone();
     exp.trajectory = family.quintic(t_ref);
-    let modes = match exp.amm.modes {
-        Some(n) => n,
-        None => flexstar_amm::solve(&problem_of(&exp)?, &exp.amm, flexstar_drive::SolveRequest::motion())
-            .map(|s| s.response)
-            .map_err(|e| PlanError::Solver(format!("the plain quintic's AMM run: {e}")))?
-            .info
-            .modes
-            .ok_or_else(|| PlanError::Solver("the AMM did not report its N".into()))?,
+    // N and the step as the accurate AMM's automatic choice delivers them for the plain quintic
+    // (docs/motions.md 4.9: the searches run at that N and step; a given N keeps its default step)
+    let (modes, dt) = match exp.amm.modes {
+        Some(n) => (n, exp.amm.dt),
+        None => {
+            let info = flexstar_amm::solve(&problem_of(&exp)?, &exp.amm, flexstar_drive::SolveRequest::motion())
+                .map_err(|e| PlanError::Solver(format!("the plain quintic's AMM run: {e}")))?
+                .response
+                .info;
+            let n = info
+                .modes
+                .ok_or_else(|| PlanError::Solver("the AMM did not report its N".into()))?;
+            (n, exp.amm.dt.or(Some(info.dt)))
+        }
     };
+    exp.amm.dt = dt;
     let f1_hz = flexstar_modal::analysis::final_pose_frequencies(&exp, 1)
         .map_err(|e| PlanError::Solver(format!("modes at the final pose: {e}")))?
         .and_then(|f| f.first().copied())

@@ -313,7 +313,9 @@ fn sample_set<'a>(
     };
     let mut plains = Vec::new();
     for m in sample {
-        let base = Evaluator::new(&m.exp, s.modes, WINDOW_PERIODS / m.f1_hz);
+        let mut exp = m.exp.clone();
+        exp.amm.dt = s.frozen.amm.dt;
+        let base = Evaluator::new(&exp, s.modes, WINDOW_PERIODS / m.f1_hz);
         let plain = evaluate(&base, &s.family, &s.family.plain(), t_move)
             .map_err(|e| PlanError::Solver(format!("the plain quintic on a sample model {:?}: {e}", m.values)))?;
         let bounds = effective_bounds(&cfg.limits, cfg.plan.peak_factor(), &plain);

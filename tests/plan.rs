@@ -418,6 +418,14 @@ fn bad_plans_are_refused_with_the_key_and_nothing_is_written() {
         ),
         (format!("{plan}t_move = 0.42\n[limits]\nFa_max = 0.5\n"), "limits.Fa_max"),
         (format!("{plan}t_move = 1.2\n"), "time.t_end"),
+        (
+            format!("{plan}t_move = 0.42\n[payload]\nmass = 0.25\n[robust]\n\"payload.mass\" = [0.0, 0.5]\nt_move = 0.3\n"),
+            "robust.t_move",
+        ),
+        (
+            format!("{plan}t_move = 0.42\n[payload]\nmass = 0.25\n[robust]\n\"payload.mass\" = [0.0, 0.5]\nt_move = \"zvd\"\n"),
+            "ends before the robust plan's residual window does",
+        ),
     ];
     for (body, needle) in cases {
         let cfg = out.path().join("bad.toml");

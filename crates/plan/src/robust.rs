@@ -95,9 +95,9 @@ pub fn plan_robust(
     unc: &Uncertainty,
 ) -> Result<Planned, PlanError> {
     let t_robust = robust_duration(cfg, unc.t_move, t_move, &zvd)?;
-    let nominal = crate::planner::plan_residual(cfg, s, t_move, zvd)?;
     let (candidates, sample) = choose_sample(unc, &s.family.quintic(t_move), s.f1_hz)?;
     check_window(cfg, t_robust, &sample)?;
+    let nominal = crate::planner::plan_residual(cfg, s, t_move, zvd)?;
     let plain_x = s.family.plain();
     let (set, plains) = sample_set(cfg, s, t_robust, &sample)?;
     let floors: Vec<f64> = plains.iter().map(|p| FLOOR_SHARE * p.norm_g()).collect();

@@ -68,9 +68,9 @@ fn kinematics_rates_and_forces_are_consistent(case: &str, rows: &[Vec<f64>]) {
         .map(|r| (0..3).map(|i| (r[20 + i] * r[14 + i]).abs()).sum::<f64>())
         .fold(0.0f64, f64::max);
     assert!(scale_f > 0.0, "{case}: the rigid forces are all zero");
-    for k in 2..rows.len() - 2 {
+    for (k, row) in rows.iter().enumerate().take(rows.len() - 2).skip(2) {
         for i in 0..3 {
-            let (sd, sdd) = (rows[k][14 + i], rows[k][17 + i]);
+            let (sd, sdd) = (row[14 + i], row[17 + i]);
             assert!(
                 (sd - d(k, 1 + i)).abs() < 1e-6 * (1.0 + sd.abs()),
                 "{case} row {k}: sd{} {sd}",
@@ -82,7 +82,7 @@ fn kinematics_rates_and_forces_are_consistent(case: &str, rows: &[Vec<f64>]) {
                 i + 1
             );
         }
-        let power: f64 = (0..3).map(|i| rows[k][20 + i] * rows[k][14 + i]).sum();
+        let power: f64 = (0..3).map(|i| row[20 + i] * row[14 + i]).sum();
         let dtdt = (energy(k + 1) - energy(k - 1)) / (2.0 * h);
         assert!(
             (power - dtdt).abs() < 1e-3 * scale_p.max(1e-9),

@@ -14,6 +14,7 @@ use crate::{convert, interrupt, py_err, ConfigError, PyExperiment};
 /// recording laid over the runs (as `--measured`, `docs/measured.md`).
 #[pyfunction]
 #[pyo3(signature = (config, out, families = Vec::new(), modes = None, figures = false, progress = false, measured = None))]
+#[allow(clippy::too_many_arguments)] // Python's keyword arguments, one per flag of `flexstar compare`
 pub fn compare<'py>(
     py: Python<'py>,
     config: PathBuf,

@@ -16,9 +16,9 @@ install:
 test:
     cargo test --workspace --release
 
-# Criterion benchmarks of the solvers.
+# Criterion benchmarks of the solvers (the `bench` feature of flexstar-amm, -fem and -modal: criterion is compiled only for them).
 bench:
-    cargo bench --workspace
+    cargo bench --workspace --features bench
 
 # Rigid kinematics of the four paper cases.
 kinematics:

@@ -7,7 +7,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::{flexstar, stderr};
 
 /// Case 3 of the paper over 0.2 s, default (enriched) AMM, with `extra` appended.

@@ -2,7 +2,7 @@
 //! sweep, recorded in a run's sidecar, carried by a servo in both solvers, named by `compare`.
 //! The two solvers' agreement with them is checked in `tests/attachment_models.rs`.
 
-mod common;
+use crate::common;
 use common::{flexstar, stderr};
 
 const SMOOTH: &str = include_str!("../configs/motions/smooth.toml");

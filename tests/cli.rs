@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-mod common;
+use crate::common;
 use common::{flexstar, run_solver, stderr};
 
 fn root() -> PathBuf {

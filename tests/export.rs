@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{flexstar, run_solver, stderr, table, TINY};
 
 const HEADER: &str = "t,s1,s2,s3,v1,v2,v3,a1,a2,a3,j1,j2,j3,F1,F2,F3";

@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
+use crate::common;
 
 /// 30 ms (old) or 40 ms (new) of case 3 with 5 free-free modes: same file names, other contents.
 fn config(t_end: f64) -> String {

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{flexstar, stderr};
 
 fn config(name: &str) -> PathBuf {

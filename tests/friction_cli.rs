@@ -2,7 +2,7 @@
 //! the friction columns and the sidecar's summary; bad coefficients are refused with the file
 //! and the key, nothing written.
 
-mod common;
+use crate::common;
 use common::{col, run_solver, stderr, table, TINY};
 
 /// `tiny.toml` with `extra` appended, written to `dir`.

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::{col, flexstar, stderr, table};
 
 const LAG: f64 = 7.3e-3;

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{flexstar, stderr};
 
 /// `flexstar` with the arguments `base` then `extra`.

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{col, flexstar, stderr, table};
 
 fn config(name: &str) -> String {

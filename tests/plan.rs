@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{col, flexstar, stderr, table};
 
 /// Peak of `|dG|` [m] at `t >= t_from` of a run CSV.

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{col, flexstar, stderr, table};
 
 /// Peak of `|dG|` [m] over `t_from <= t <= t_to` of a run CSV.

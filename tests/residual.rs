@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::{flexstar, stderr};
 
 /// The brisk quintic (rest at 0.2 s) over 1.5 s, with extra TOML appended.

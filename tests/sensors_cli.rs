@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::{col, flexstar, stderr, table};
 
 /// Paper case 1 (the in-place rotation) cut to 0.1 s, plus `extra` TOML.

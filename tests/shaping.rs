@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{col, flexstar, run_solver, stderr, table};
 
 /// The brisk move (configs/motions/brisk.toml: 10 mm and -0.06 rad in 0.2 s) with 0.9 s of time.

@@ -60,6 +60,20 @@ fn accurate_model(c: &mut Criterion) {
                 .unwrap()
         })
     });
+    // the run the automatic choice delivers on case 3: N = 53 at its step (tolerance_step(0.5) =
+    // 5e-4 s, 1000 steps), without the choice's other runs
+    let delivered = flexstar_model::AmmSettings {
+        dt: Some(flexstar_amm::tolerance_step(0.5)),
+        ..fixed.clone()
+    };
+    group.bench_function("case3_n53_delivered_step", |b| {
+        let problem = exp.problem().unwrap();
+        b.iter(|| {
+            flexstar_amm::solve(&problem, &delivered, flexstar_drive::SolveRequest::motion())
+                .map(|s| s.response)
+                .unwrap()
+        })
+    });
     group.finish();
 }
 

@@ -5,7 +5,7 @@
 //! three equal beams must reproduce, and a servo's reference (its tracking) and the rigid
 //! robot's forces (very stiff gains without feed-forward on a stiff robot).
 
-mod common;
+use crate::common;
 
 use flexstar_drive::{ForceTable, SolveRequest};
 use flexstar_kinematics::RigidState;

@@ -8,7 +8,7 @@
 #[allow(dead_code)]
 mod rigid_forward;
 
-mod common;
+use crate::common;
 
 use flexstar_amm::pose_modes::PoseModel;
 

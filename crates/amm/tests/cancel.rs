@@ -2,7 +2,7 @@
 //! output time (the solver polls the token once per output interval) instead of a response.
 
 #[allow(unused_imports)]
-mod common;
+use crate::common;
 
 use flexstar_amm::AmmError;
 use flexstar_model::{cancel, Cancel, ModeFamily, RobotParams};

@@ -5,7 +5,7 @@
 #[allow(dead_code)]
 mod rigid_forward;
 
-mod common;
+use crate::common;
 
 use common::paper_case;
 use flexstar_amm::DEFAULT_DT;

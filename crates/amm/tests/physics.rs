@@ -2,7 +2,7 @@
 //! family imposes at G, the stiff limit (EI x 1e4) against the rigid-body inverse dynamics of the
 //! kinematics crate, convergence with the step and with N, and input errors raised before work.
 
-mod common;
+use crate::common;
 
 use common::{evp, max_abs, paper_case, settings};
 use flexstar_amm::{AmmError, DEFAULT_DT, EXTRA_COLUMNS, SHAPE_POINTS};

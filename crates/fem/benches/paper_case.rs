@@ -2,7 +2,7 @@
 //! paper's mesh, 300 elements, in at most 0.15 s on one core; 3000 elements in at most 10 times
 //! the 300-element time). Case 2 (s = [t^2, -0.5 t^2, -0.5 t^2], 0.4 s) at 300 and 3000 elements,
 //! and cases 1, 3 and 4 (0.5 s each) at 300. Run pinned to one core:
-//! `taskset -c 1 cargo bench -p flexstar-fem --bench paper_case`.
+//! `taskset -c 1 cargo bench -p flexstar-fem --features bench --bench paper_case`.
 //!
 //! Direct dynamics (`docs/fem.md` section 8): case 2 at 300 elements driven by the forces of its own inverse
 //! run (written at every solver step, fed back through a `ForceTable`), and by a 20 Hz servo with

@@ -2,7 +2,7 @@
 //! robot at an off-centre pose, the first six modes, sliders locked and free, by the sparse
 //! subspace iteration (`pose_modes`, assembly included) and, for comparison, the dense null-space
 //! path (`pose_modes_dense`). Run pinned to one core:
-//! `taskset -c 1 cargo bench -p flexstar-fem --bench pose_modes`.
+//! `taskset -c 1 cargo bench -p flexstar-fem --features bench --bench pose_modes`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexstar_fem::pose_modes::{pose_modes, pose_modes_dense};

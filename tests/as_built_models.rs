@@ -20,8 +20,7 @@ use flexstar_kinematics::{rigid_inverse_dynamics_of, RigidState};
 use flexstar_model::{AmmSettings, Attachments, Experiment, Robot};
 use flexstar_solve::Settings;
 
-#[path = "support/models.rs"]
-mod models;
+use crate::models;
 
 const SMOOTH: &str = include_str!("../configs/motions/smooth.toml");
 const BRISK: &str = include_str!("../configs/motions/brisk.toml");

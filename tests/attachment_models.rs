@@ -11,8 +11,7 @@
 //! (`zeta = [0.02, 0.03]` at 4 and 12 Hz, so alpha and beta both act) on brisk, 0.076 % (0.168 %
 //! at G).
 
-#[path = "support/models.rs"]
-mod models;
+use crate::models;
 
 const SMOOTH: &str = include_str!("../configs/motions/smooth.toml");
 const BRISK: &str = include_str!("../configs/motions/brisk.toml");

@@ -9,5 +9,7 @@ mod direct_models;
 mod friction_models;
 mod measured;
 mod measured_identify;
+#[path = "support/models.rs"]
+mod models;
 mod sensors;
 mod verify;

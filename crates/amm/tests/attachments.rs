@@ -4,9 +4,7 @@
 //! (Eq. P9, tests/support/rigid_forward.rs), the undamped modes at the end pose (logarithmic
 //! decrement, Eq. C5), and bit-for-bit identity with the bare star at the defaults.
 
-#[path = "../../../tests/support/rigid_forward.rs"]
-#[allow(dead_code)]
-mod rigid_forward;
+use crate::rigid_forward;
 
 use crate::common;
 

@@ -1,9 +1,7 @@
 //! Direct dynamics of the AMM (`docs/amm.md` section 10) against independent references: the inverse run it must
 //! invert (round trip), and the prescribed-motion run a very stiff servo must reproduce.
 
-#[path = "../../../tests/support/rigid_forward.rs"]
-#[allow(dead_code)]
-mod rigid_forward;
+use crate::rigid_forward;
 
 use crate::common;
 

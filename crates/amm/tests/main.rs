@@ -13,6 +13,9 @@ mod gravity_sag;
 mod gravity_start;
 mod modes;
 mod physics;
+#[path = "../../../tests/support/rigid_forward.rs"]
+#[allow(dead_code)]
+mod rigid_forward;
 mod short_motion;
 mod sleeve_compliance;
 mod work_counts;

@@ -6,6 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use flexstar_api::fit::{fit_experiment, fit_to_dir};
 use flexstar_api::run::{prepare, RunSettings, Solver};
 use flexstar_api::ExperimentDoc;
@@ -253,9 +255,15 @@ fn the_standard_errors_are_the_spread_over_fresh_noise() {
     let mut ses = vec![Vec::new(); 4];
     let mut ses_corr = vec![Vec::new(); 4];
     let mut inside = [0usize; 4];
-    for seed in 0..draws {
-        let rec = with_noise(&clean, &sigma, 1000 + seed);
-        let f = fit_experiment(&input, &rec, "draw", &quiet).unwrap().fit;
+    // the draws fitted in parallel (each on its own noise seed), then judged in order
+    let fits: Vec<_> = (0..draws)
+        .into_par_iter()
+        .map(|seed| {
+            let rec = with_noise(&clean, &sigma, 1000 + seed);
+            (seed, fit_experiment(&input, &rec, "draw", &quiet).unwrap().fit)
+        })
+        .collect();
+    for (seed, f) in fits {
         assert!(f.calibrated(), "draw {seed}: {}", f.reason);
         for (k, (e, (_, truth))) in f.estimates.iter().zip(TRUTH).enumerate() {
             let [lo, hi] = e.interval.unwrap();

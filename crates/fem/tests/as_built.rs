@@ -8,8 +8,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
-#[path = "support/fit.rs"]
-mod fit;
+use crate::fit;
 use fit::quartic_at;
 use flexstar_drive::SolveRequest;
 use flexstar_fem::FemError;
@@ -20,8 +19,7 @@ use flexstar_model::{
 };
 use flexstar_numerics::measures::max_abs;
 
-#[path = "support/run.rs"]
-mod run;
+use crate::run;
 use run::{coarse, col};
 
 /// The robot as built: beam 2 shorter, stiffer and lighter, beam 3 longer, softer and heavier,

@@ -10,9 +10,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
-#[path = "../../../tests/support/rigid_forward.rs"]
-#[allow(dead_code)]
-mod rigid_forward;
+use crate::rigid_forward;
 
 use flexstar_drive::RigidInverseForces;
 use flexstar_fem::pose_modes::{pose_modes, pose_modes_with};
@@ -25,8 +23,7 @@ use flexstar_model::{
 use flexstar_numerics::measures::max_abs;
 use rigid_forward::rigid_forward_dynamics_with;
 
-#[path = "support/run.rs"]
-mod run;
+use crate::run;
 use run::{coarse, col};
 
 /// A payload with an offset from G and its own inertia (about the star's mass, 0.49 kg).

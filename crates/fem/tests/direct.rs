@@ -10,9 +10,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
-#[path = "../../../tests/support/rigid_forward.rs"]
-#[allow(dead_code)]
-mod rigid_forward;
+use crate::rigid_forward;
 
 use flexstar_drive::{ActuatorLaw, DriveError, ForcePolynomials, ForceTable, RigidInverseForces, Servo};
 use flexstar_fem::FemError;
@@ -21,8 +19,7 @@ use flexstar_model::{catalogue, Experiment, FemSettings, Pose, Response, RobotPa
 use flexstar_numerics::measures::max_abs;
 use rigid_forward::rigid_forward_dynamics;
 
-#[path = "support/run.rs"]
-mod run;
+use crate::run;
 use run::{coarse, col};
 
 /// Rest-to-rest task-space quintic, general plane motion (s'' not constant, unlike the paper's

@@ -10,8 +10,7 @@ use flexstar_model::{catalogue, Experiment, FemSettings, Friction, Response, Rob
 
 #[path = "../../../tests/support/block_on_rail.rs"]
 mod block;
-#[path = "support/run.rs"]
-mod run;
+use crate::run;
 use block::{block_on_rail, Pulse};
 use run::{coarse, col};
 

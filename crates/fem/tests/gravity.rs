@@ -15,10 +15,8 @@ use flexstar_numerics::measures::max_abs;
 
 const DOWN: [f64; 2] = [0.0, -9.81];
 
-#[path = "support/fit.rs"]
-mod fit;
-#[path = "support/run.rs"]
-mod run;
+use crate::fit;
+use crate::run;
 use fit::quartic_at;
 use run::{coarse, col};
 

@@ -7,7 +7,14 @@ mod baseline_copy;
 mod beam_benchmarks;
 mod convergence;
 mod direct;
+#[path = "support/fit.rs"]
+mod fit;
 mod friction;
 mod gravity;
+#[path = "../../../tests/support/rigid_forward.rs"]
+#[allow(dead_code)]
+mod rigid_forward;
+#[path = "support/run.rs"]
+mod run;
 mod sleeve_heavy;
 mod star;

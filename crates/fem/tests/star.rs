@@ -17,8 +17,7 @@ fn experiment(robot: RobotParams, trajectory: Trajectory, t_end: f64) -> Experim
     catalogue::experiment("test", robot, trajectory, t_end, 1e-3)
 }
 
-#[path = "support/run.rs"]
-mod run;
+use crate::run;
 use run::{coarse, col};
 
 /// Rest-to-rest task-space quintic (zero velocity and acceleration at both ends), general motion.

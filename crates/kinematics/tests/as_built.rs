@@ -7,8 +7,7 @@
 use flexstar_kinematics::{check_configuration, check_trajectory, RigidState, Violation};
 use flexstar_model::{ActuatorAxis, Robot, RobotGeometry, RobotParams, Trajectory};
 
-#[path = "support/quintic.rs"]
-mod quintic;
+use crate::quintic;
 use quintic::quintic;
 
 /// Unequal beams (beam 3 shorter, its sleeve longer), welds at 0, 117 and 243.5 degrees, an

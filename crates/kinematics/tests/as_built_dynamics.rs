@@ -12,8 +12,7 @@ use flexstar_model::{
     ActuatorAxis, Attachments, Gravity, LoadSettings, Payload, Robot, RobotGeometry, RobotParams, Trajectory,
 };
 
-#[path = "support/quintic.rs"]
-mod quintic;
+use crate::quintic;
 use quintic::quintic;
 
 /// Every beam its own length, mass per length, sleeve inertia and slider mass; welds at 0, 117 and

@@ -4,4 +4,6 @@
 mod as_built;
 mod as_built_dynamics;
 mod motions;
+#[path = "support/quintic.rs"]
+mod quintic;
 mod references;

@@ -10,8 +10,7 @@ use flexstar_model::geometry::{revolute_point, slider_direction};
 use flexstar_model::{RobotParams, Trajectory};
 use proptest::prelude::*;
 
-#[path = "support/quintic.rs"]
-mod quintic;
+use crate::quintic;
 use quintic::quintic;
 
 fn paper() -> RobotParams {

@@ -7,6 +7,8 @@
 
 use std::f64::consts::PI;
 
+use rayon::prelude::*;
+
 use flexstar_measured::identify::{identify_free_decay, IdentifiedMode, IdentifyOptions};
 use flexstar_measured::MeasuredError;
 use flexstar_model::sensors::daq::Normal;
@@ -88,8 +90,12 @@ fn three_damped_sinusoids_in_noise() {
     let mut z_est = vec![Vec::new(); 3];
     let mut f_rep = vec![Vec::new(); 3];
     let mut z_rep = vec![Vec::new(); 3];
-    for seed in 1..=SEEDS {
-        let modes = identify(&t, &noisy(&t, seed, NOISE));
+    // the draws identified in parallel (each on its own seed), then judged in order
+    let identified: Vec<(u64, Vec<IdentifiedMode>)> = (1..=SEEDS)
+        .into_par_iter()
+        .map(|seed| (seed, identify(&t, &noisy(&t, seed, NOISE))))
+        .collect();
+    for (seed, modes) in identified {
         assert_eq!(modes.len(), 3, "seed {seed}: {modes:?}");
         for (k, (m, &(f, z))) in modes.iter().zip(&MODES).enumerate() {
             let (ef, ez) = ((m.f_hz - f) / f, (m.zeta - z) / z);

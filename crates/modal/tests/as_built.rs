@@ -3,8 +3,7 @@
 //! against FEM), the rails' part in the modes (Eq. M2: the paper robot's own modes), the robot's
 //! rigid mass matrix written here from its kinetic energy, and the FEM's static deflection.
 
-#[path = "support/inertia_relief.rs"]
-mod inertia_relief;
+use crate::inertia_relief;
 
 use flexstar_modal::analysis::modal;
 use flexstar_modal::freqmap::{freqmap, Axis, Grid, Solver};

@@ -4,8 +4,7 @@
 
 // its saddle-point matrix only
 #[allow(dead_code)]
-#[path = "support/inertia_relief.rs"]
-mod inertia_relief;
+use crate::inertia_relief;
 
 use flexstar_modal::analysis::{amm_pose_model, fem_pose_modes, modal};
 use flexstar_modal::linear::{linearize_with, Holding, LinearSettings};

@@ -2,12 +2,9 @@
 //! modal analysis (eigenvalues of A), the rigid robot's mass matrix from the drive crate's
 //! forward dynamics (the rigid modes' residue of B and C).
 
-#[path = "../../../tests/support/rigid_forward.rs"]
-#[allow(dead_code)]
-mod rigid_forward;
+use crate::rigid_forward;
 
-#[path = "support/inertia_relief.rs"]
-mod inertia_relief;
+use crate::inertia_relief;
 
 use flexstar_modal::linear::{linearize, StateSpace, ELASTIC_MODES};
 use flexstar_modal::pose::pose_from_task;

@@ -4,9 +4,7 @@
 //! excitation), the rigid robot's mass matrix with the PD gains (closed-loop poles in the stiff
 //! limit) and the static limit of the servo loop.
 
-#[path = "../../../tests/support/rigid_forward.rs"]
-#[allow(dead_code)]
-mod rigid_forward;
+use crate::rigid_forward;
 
 use faer::linalg::solvers::Solve;
 use flexstar_modal::analysis::modal;

@@ -3,8 +3,13 @@
 //! "Build time").
 mod as_built;
 mod attachments;
+#[path = "support/inertia_relief.rs"]
+mod inertia_relief;
 mod limits;
 mod linear_checks;
 mod linear_settings;
 mod modal_checks;
+#[path = "../../../tests/support/rigid_forward.rs"]
+#[allow(dead_code)]
+mod rigid_forward;
 mod stuck;

@@ -10,8 +10,7 @@
 //! the whole of both draws every target holds (estimate / true 0.50-1.89, validation.md
 //! section 8); these nine are the part the test suite can afford.
 
-#[path = "support/envelope_cases.rs"]
-mod envelope_cases;
+use crate::envelope_cases;
 use envelope_cases::assert_chosen_meet_the_targets;
 
 /// Run ids of the chosen cases (the study's stable FNV-1a ids of their values; validation.md 8

@@ -3,5 +3,9 @@
 //! "Build time").
 mod envelope;
 mod envelope_as_built;
+#[path = "support/envelope_cases.rs"]
+mod envelope_cases;
 mod per_beam;
 mod study;
+#[path = "support/tiny_study.rs"]
+mod tiny_study;

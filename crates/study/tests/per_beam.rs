@@ -8,8 +8,7 @@ use flexstar_model::{Experiment, RobotParams};
 use flexstar_solve::Settings;
 use flexstar_study::Study;
 
-#[path = "support/tiny_study.rs"]
-mod tiny_study;
+use crate::tiny_study;
 use tiny_study::{write_study, BASE};
 
 fn setup(top: &str, vary: &str) -> (tempfile::TempDir, PathBuf) {

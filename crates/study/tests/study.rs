@@ -6,8 +6,7 @@ use std::path::{Path, PathBuf};
 use flexstar_study::table::Table;
 use flexstar_study::{run_study, RunOptions, Sampling, Study};
 
-#[path = "support/tiny_study.rs"]
-mod tiny_study;
+use crate::tiny_study;
 use tiny_study::{write_study, BASE};
 
 fn setup(study: &str) -> (tempfile::TempDir, PathBuf) {

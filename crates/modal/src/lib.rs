@@ -26,6 +26,7 @@ pub mod linear;
 pub mod plots;
 pub mod pose;
 pub mod settle;
+mod static_shapes;
 
 pub use error::ModalError;
 

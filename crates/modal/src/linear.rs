@@ -18,7 +18,10 @@
 //!   slider accelerations `sdd1..sdd3` [m/s^2] (base excitation): with `q = q_rel + R s`, where
 //!   `R = dq/ds` is the rigid motion the sliders impose (from the sliders-free rigid modes),
 //!   `eta'' + Omega^2 eta = -Phi^T M R s''`. Outputs `w1tip..w3tip`, `w1G..w3G` [m] (relative to
-//!   the rigid star, i.e. `H Phi eta`);
+//!   the rigid star, i.e. `H Phi eta`). With stuck sleeves R is the static shapes of unit slider
+//!   displacements instead (Eq. S4 of `docs/modes.md`), which deflect the star: the states gain
+//!   the sliders, `s1..s3` [m] and `sd1..sd3` [m/s] (`s'' = u`), and the outputs `H (R - R_rig) s`
+//!   (Eqs. S5-S6);
 //! - **servo** (closed loop, sliders free): the PD servo `Fa = ff + kp (s_ref - s) + kd (s_ref' - s')`
 //!   closes the loop around the slider coordinates `s = S eta` (S: the shapes' slider rows):
 //!   `A = [[0, I], [-Omega^2 - kp S^T S, -kd S^T S]]`, inputs `s1ref..s3ref` [m],
@@ -126,8 +129,8 @@ pub struct LinearSettings {
     pub modes: usize,
     /// How the sliders are held.
     pub holding: Holding,
-    /// Which linear system of the sleeves (`docs/modes.md`, stuck sleeves); stuck sleeves with
-    /// locked sliders are refused ([`linearize_with`]).
+    /// Which linear system of the sleeves (`docs/modes.md`, stuck sleeves; with locked sliders,
+    /// Eqs. S4-S6).
     pub sleeves: Sleeves,
 }
 
@@ -173,7 +176,8 @@ pub struct StateSpace {
     /// The settings it was built with.
     pub settings: LinearSettings,
     /// States in order: `eta1..etaN` [m kg^0.5] (modal amplitudes of the mass-normalised
-    /// shapes, mode k = row k of `modal_frequencies_hz`), then their rates `etad1..etadN`.
+    /// shapes, mode k = row k of `modal_frequencies_hz`), then their rates `etad1..etadN`; with
+    /// locked sliders and stuck sleeves then `s1..s3` [m] and `sd1..sd3` [m/s] (Eq. S6).
     pub states: Vec<Signal>,
     /// Inputs in the order of B's columns (module docs).
     pub inputs: Vec<Signal>,
@@ -270,11 +274,14 @@ fn inverse3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     Some([0, 1, 2].map(|k| [0, 1, 2].map(|r| c(r, k) / det)))
 }
 
-/// Locked sliders' base excitation: the columns `M R_j` (on the locked coordinates), where
-/// `R_j = dq/ds_j` is the rigid motion of the star when slider j moves, from the three rigid
-/// modes of the sliders-free system (their beam part times the inverse of their slider part).
-fn base_excitation(model: &PoseModel, pose: &RestPose, locked: &PoseSystem) -> Result<Vec<[f64; 3]>, ModalError> {
-    let free = model.modes_at(pose, Sliders::Free, 1)?;
+/// The rigid motion the sliders impose, `R_rig` as rows (`r[a][j]` = dq_a/ds_j on the locked
+/// coordinates): from the three rigid modes of the sliding, sliders-free system (their beam part
+/// times the inverse of their slider part).
+fn rigid_motion(model: &PoseModel, pose: &RestPose, n: usize) -> Result<Vec<[f64; 3]>, ModalError> {
+    let free = model
+        .clone()
+        .with_sleeves(Sleeves::Sliding)
+        .modes_at(pose, Sliders::Free, 1)?;
     let rigid = &free.shapes[..free.rigid];
     let mut s = [[0.0; 3]; 3];
     for (i, row) in s.iter_mut().enumerate() {
@@ -286,13 +293,18 @@ fn base_excitation(model: &PoseModel, pose: &RestPose, locked: &PoseSystem) -> R
     let s_inv = inverse3(&s).ok_or_else(|| {
         ModalError::Infeasible("the sliders do not determine the star's rigid motion at this pose".into())
     })?;
-    let n = locked.n;
-    let r: Vec<[f64; 3]> = (0..n)
-        .map(|b| [0, 1, 2].map(|j| (0..3).map(|k| rigid[k][b] * s_inv[k][j]).sum::<f64>()))
-        .collect();
     Ok((0..n)
-        .map(|a| [0, 1, 2].map(|j| (0..n).map(|b| locked.m[a * n + b] * r[b][j]).sum::<f64>()))
+        .map(|b| [0, 1, 2].map(|j| (0..3).map(|k| rigid[k][b] * s_inv[k][j]).sum::<f64>()))
         .collect())
+}
+
+/// Locked sliders' base excitation: the columns `M R_j` on the locked coordinates, `r` the
+/// motion that follows the sliders (rows, [`rigid_motion`] or the static shapes of Eq. S4).
+fn mass_times(locked: &PoseSystem, r: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let n = locked.n;
+    (0..n)
+        .map(|a| [0, 1, 2].map(|j| (0..n).map(|b| locked.m[a * n + b] * r[b][j]).sum::<f64>()))
+        .collect()
 }
 
 /// The AMM's modes at the pose for `settings` (K checked, enough modes in the basis).
@@ -303,13 +315,6 @@ fn amm_modes(
     settings: &LinearSettings,
 ) -> Result<PoseModes, ModalError> {
     crate::check_k(settings.modes)?;
-    if settings.sleeves == Sleeves::Stuck && settings.holding == Holding::Locked {
-        return Err(ModalError::Input(
-            "--sleeves stuck with --sliders locked: the base excitation of a star held by stuck sleeves \
-             (the prescribed slider motion strains it) is not built; give --sliders free"
-                .into(),
-        ));
-    }
     let modes = model.modes_at(pose, settings.holding.sliders(), settings.modes)?;
     if modes.shapes.len() < modes.rigid + settings.modes {
         return Err(ModalError::Input(format!(
@@ -337,22 +342,42 @@ struct Blocks {
     bm: Vec<Vec<f64>>,
     cq: Vec<Vec<f64>>,
     d: Vec<Vec<f64>>,
+    /// The sliders as states (locked sliders, stuck sleeves: Eqs. S5-S6); `None` otherwise.
+    sliders: Option<SliderStates>,
+}
+
+/// The slider states of the locked model with stuck sleeves (Eq. S6): `x = [eta; eta'; s; s']`,
+/// `s'' = u` (the first three inputs).
+struct SliderStates {
+    /// `R - R_rig` as rows on the locked coordinates: the deflection a unit slider displacement
+    /// leaves (the static shape less the rigid motion).
+    elastic: Vec<[f64; 3]>,
+    /// C's columns of `s`: `H (R - R_rig)` (ny x 3).
+    cs: Vec<Vec<f64>>,
+    /// The material damping's force on the modes from `s'`, `Phi^T C_d (R - R_rig)` (nr x 3);
+    /// `None` without damping.
+    coupling: Option<Vec<Vec<f64>>>,
 }
 
 impl Blocks {
     fn matrices(&self) -> [CsMat<f64>; 4] {
         let nr = self.omega2.len();
-        let n = 2 * nr;
+        let extra = if self.sliders.is_some() { 6 } else { 0 };
+        let n = 2 * nr + extra;
         let (nu, ny) = (self.d.first().map_or(0, Vec::len), self.cq.len());
         let a = dense_to_cs(n, n, |r, c| {
             if r < nr {
                 return f64::from(u8::from(c == r + nr));
             }
+            if r >= 2 * nr {
+                // the sliders' double integrator: s' = sd
+                return f64::from(u8::from(r < 2 * nr + 3 && c == r + 3));
+            }
             let k = r - nr;
             if c < nr {
                 let diag = if c == k { -self.omega2[c] } else { 0.0 };
                 self.feedback.as_ref().map_or(diag, |(kp, _)| diag - kp[k][c])
-            } else {
+            } else if c < 2 * nr {
                 let material = self.damping.as_ref().map_or(0.0, |d| d[k][c - nr]);
                 let servo = self.feedback.as_ref().map_or(0.0, |(_, kd)| kd[k][c - nr]);
                 if material == 0.0 && servo == 0.0 {
@@ -360,10 +385,34 @@ impl Blocks {
                 } else {
                     -material - servo
                 }
+            } else {
+                // the damping of the static shapes' deflection rate, from s'
+                let coupling = self.sliders.as_ref().and_then(|x| x.coupling.as_ref());
+                match coupling {
+                    Some(cp) if c >= 2 * nr + 3 => -cp[k][c - 2 * nr - 3],
+                    _ => 0.0,
+                }
             }
         });
-        let b = dense_to_cs(n, nu, |r, c| if r < nr { 0.0 } else { self.bm[r - nr][c] });
-        let c = dense_to_cs(ny, n, |r, c| if c < nr { self.cq[r][c] } else { 0.0 });
+        let b = dense_to_cs(n, nu, |r, c| {
+            if r < nr {
+                0.0
+            } else if r < 2 * nr {
+                self.bm[r - nr][c]
+            } else {
+                // sd' = sdd, the first three inputs
+                f64::from(u8::from(r >= 2 * nr + 3 && c == r - 2 * nr - 3))
+            }
+        });
+        let c = dense_to_cs(ny, n, |r, c| {
+            if c < nr {
+                self.cq[r][c]
+            } else if c >= 2 * nr && c < 2 * nr + 3 {
+                self.sliders.as_ref().map_or(0.0, |x| x.cs[r][c - 2 * nr])
+            } else {
+                0.0
+            }
+        });
         let d = dense_to_cs(ny, nu, |r, c| self.d[r][c]);
         [a, b, c, d]
     }
@@ -384,12 +433,10 @@ pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettin
     let model = crate::analysis::amm_pose_model(exp)?.with_sleeves(settings.sleeves);
     let modes = amm_modes(exp, &model, pose, settings)?;
     let phi = &modes.shapes;
-    let deflections: Vec<Vec<f64>> = deflection_rows(&robot, pose, &modes.system)?
-        .iter()
-        .map(|r| phi.iter().map(|p| dot(r, p)).collect())
-        .collect();
+    let rows = deflection_rows(&robot, pose, &modes.system)?;
+    let deflections: Vec<Vec<f64>> = rows.iter().map(|r| phi.iter().map(|p| dot(r, p)).collect()).collect();
     let (mut blocks, mut inputs, outputs) = match settings.holding {
-        Holding::Locked => locked_model(&model, pose, &modes, deflections)?,
+        Holding::Locked => locked_model(&model, pose, &modes, deflections, &rows)?,
         Holding::Free => free_model(&modes, deflections),
         Holding::Servo { kp, kd } => servo_model(&modes, deflections, kp, kd),
     };
@@ -413,6 +460,10 @@ pub fn linearize_with(exp: &Experiment, pose: &RestPose, settings: &LinearSettin
         name: format!("etad{k}"),
         unit: "m kg^0.5/s",
     }));
+    if blocks.sliders.is_some() {
+        states.extend(signals(&["s1", "s2", "s3"], "m"));
+        states.extend(signals(&["sd1", "sd2", "sd3"], "m/s"));
+    }
     Ok(StateSpace {
         a,
         b,
@@ -449,6 +500,17 @@ fn add_damping_and_load(exp: &Experiment, modes: &PoseModes, blocks: &mut Blocks
                 .map(|pk| c_phi.iter().map(|cp| dot(pk, cp)).collect())
                 .collect(),
         );
+        if let Some(x) = blocks.sliders.as_mut() {
+            // the damping acts on the velocity relative to the rigid star, eta' and (R - R_rig) s'
+            let c_e: Vec<[f64; 3]> = (0..n)
+                .map(|a| [0, 1, 2].map(|j| (0..n).map(|b| c[a * n + b] * x.elastic[b][j]).sum::<f64>()))
+                .collect();
+            x.coupling = Some(
+                phi.iter()
+                    .map(|p| (0..3).map(|j| (0..n).map(|a| p[a] * c_e[a][j]).sum::<f64>()).collect())
+                    .collect(),
+            );
+        }
     }
     if !exp.load.is_none() {
         let columns = sys.load_columns();
@@ -476,9 +538,39 @@ fn locked_model(
     pose: &RestPose,
     modes: &PoseModes,
     deflections: Vec<Vec<f64>>,
+    rows: &[Vec<f64>],
 ) -> Result<Model, ModalError> {
     let sys = &modes.system;
-    let mr = base_excitation(model, pose, sys)?;
+    let rigid = rigid_motion(model, pose, sys.n)?;
+    // the motion that follows the sliders: rigid when the sleeves slide, the static shapes of
+    // Eq. S4 (on the sliders-free stuck system) when they stick
+    let (follows, sliders) = match sys.sleeves {
+        Sleeves::Sliding => (rigid, None),
+        Sleeves::Stuck => {
+            let shapes = crate::static_shapes::static_shapes(&model.system_at(pose, Sliders::Free))?;
+            let follows: Vec<[f64; 3]> = shapes[..sys.n].to_vec();
+            let elastic: Vec<[f64; 3]> = follows
+                .iter()
+                .zip(&rigid)
+                .map(|(f, r)| [0, 1, 2].map(|j| f[j] - r[j]))
+                .collect();
+            let cs = rows
+                .iter()
+                .map(|h| {
+                    [0, 1, 2]
+                        .map(|j| h.iter().zip(&elastic).map(|(hv, e)| hv * e[j]).sum::<f64>())
+                        .to_vec()
+                })
+                .collect();
+            let states = SliderStates {
+                elastic,
+                cs,
+                coupling: None,
+            };
+            (follows, Some(states))
+        }
+    };
+    let mr = mass_times(sys, &follows);
     let bm = modes
         .shapes
         .iter()
@@ -495,6 +587,7 @@ fn locked_model(
         bm,
         cq: deflections,
         d: zeros(6, 3),
+        sliders,
     };
     Ok((
         blocks,
@@ -519,6 +612,7 @@ fn free_model(modes: &PoseModes, deflections: Vec<Vec<f64>>) -> Model {
         bm,
         cq,
         d: zeros(9, 3),
+        sliders: None,
     };
     (blocks, signals(&["Fa1", "Fa2", "Fa3"], "N"), outputs)
 }

@@ -129,8 +129,7 @@ fn a_stuck_overhang_is_a_clamped_cantilever() {
 }
 
 /// The linear model with stuck sleeves (free sliders, open loop): the eigenvalues of A are the
-/// stuck modes' `+-i omega` (its frequencies are the FEM's within 1 %, the first test); locked
-/// sliders with stuck sleeves are refused, naming the flags.
+/// stuck modes' `+-i omega` (its frequencies are the FEM's within 1 %, the first test).
 #[test]
 fn linearize_takes_stuck_sleeves_with_free_sliders() {
     let exp = experiment("");
@@ -154,13 +153,113 @@ fn linearize_takes_stuck_sleeves_with_free_sliders() {
         eprintln!("linear stuck mode {}: {f:.5} Hz, FEM {:.5} Hz", k + 1, fem[k]);
         assert!((f / fem[k] - 1.0).abs() < 0.01);
     }
-    let locked = LinearSettings {
-        holding: Holding::Locked,
-        ..settings
-    };
-    let Err(e) = linearize_with(&exp, &pose, &locked) else {
-        panic!("stuck sleeves with locked sliders must be refused")
-    };
-    let e = e.to_string();
-    assert!(e.contains("--sleeves stuck") && e.contains("--sliders"), "{e}");
+}
+
+/// Locked sliders with stuck sleeves (Eqs. S4-S6): a slider held by its drive is the limit of a
+/// servo of unbounded stiffness, so the deflection a unit slider displacement leaves at rest,
+/// `H (R - R_rig)` of Eq. S6 (the static shapes of Eq. S4, a saddle-point solve), must be the
+/// free stuck robot's static deflection with that slider displaced and the others held, from its
+/// modes and eigenvalues instead, `q_j = Phi Omega^-2 Phi^T S^T (S Phi Omega^-2 Phi^T S^T)^-1 e_j`
+/// with every mode of the free system (the spectral form of K^-1 on the constraints), less the
+/// sliding robot's rigid motion (from its rigid modes), on the deflection rows; to 1e-6 (the
+/// rigid modes' own accuracy, about 1e-7: `static_shapes.rs`' unit test). Also: A's frequencies
+/// are the FEM's locked stuck ones within 1 %, the sliders are states (`s1..s3`, `sd1..sd3`)
+/// integrating the inputs `sdd1..sdd3`, and a unit slider displacement leaves a deflection (not
+/// nil: the sleeves hold their material points). Both poses.
+#[test]
+fn locked_sliders_strain_the_stuck_star_as_a_stiff_servo_would() {
+    let exp = experiment("");
+    for p in POSES {
+        let pose = pose(&exp, p);
+        let locked = linearize_with(
+            &exp,
+            &pose,
+            &LinearSettings {
+                modes: 6,
+                holding: Holding::Locked,
+                sleeves: Sleeves::Stuck,
+            },
+        )
+        .unwrap();
+        let nr = 6;
+        assert_eq!(locked.a.rows(), 2 * nr + 6);
+        let names: Vec<&str> = locked.states.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(&names[2 * nr..], ["s1", "s2", "s3", "sd1", "sd2", "sd3"]);
+        let (a, b, c) = (locked.a.to_dense(), locked.b.to_dense(), locked.c.to_dense());
+        for i in 0..3 {
+            assert_eq!(a[[2 * nr + i, 2 * nr + 3 + i]], 1.0);
+            assert_eq!(b[[2 * nr + 3 + i, i]], 1.0);
+        }
+        let fem = modal_held(&exp, &pose, Sliders::Locked, Sleeves::Stuck, nr)
+            .unwrap()
+            .fem
+            .freq_hz;
+        for k in 0..nr {
+            let f = (-a[[nr + k, k]]).sqrt() / (2.0 * std::f64::consts::PI);
+            assert!(
+                (f / fem[k] - 1.0).abs() < 0.01,
+                "mode {}: {f} Hz, FEM {} Hz",
+                k + 1,
+                fem[k]
+            );
+        }
+        // the free stuck robot with every mode its AMM basis has: the static deflection of the
+        // sliders' unit displacements, q_j = sum_k phi_k (S phi_k)^T / omega_k^2 (S Omega^-2 S^T)^-1
+        let model = flexstar_modal::analysis::amm_pose_model(&exp).unwrap();
+        let stuck = model.clone().with_sleeves(Sleeves::Stuck);
+        let sys = stuck.system_at(&pose, Sliders::Free);
+        let free = stuck.modes_at(&pose, Sliders::Free, sys.n - sys.rows).unwrap();
+        let (phi, omega2) = (&free.shapes, &free.omega2);
+        let nf = phi.len();
+        let si = [0, 1, 2].map(|i| sys.slider_index(i).unwrap());
+        let gram =
+            nalgebra::Matrix3::from_fn(|i, j| (0..nf).map(|k| phi[k][si[i]] * phi[k][si[j]] / omega2[k]).sum::<f64>());
+        let gram_inv = gram.try_inverse().unwrap();
+        let static_shape = |j: usize| -> Vec<f64> {
+            let weights: Vec<f64> = (0..nf)
+                .map(|k| (0..3).map(|i| phi[k][si[i]] / omega2[k] * gram_inv[(i, j)]).sum())
+                .collect();
+            (0..sys.n)
+                .map(|a| (0..nf).map(|k| phi[k][a] * weights[k]).sum())
+                .collect()
+        };
+        // less the rigid motion of the sliding robot (its rigid modes), on the deflection rows
+        let sliding = model
+            .with_sleeves(Sleeves::Sliding)
+            .modes_at(&pose, Sliders::Free, 1)
+            .unwrap();
+        let rigid = &sliding.shapes[..3];
+        let rs = nalgebra::Matrix3::from_fn(|i, k| rigid[k][si[i]]);
+        let rs_inv = rs.try_inverse().unwrap();
+        let robot = flexstar_modal::robot(&exp).unwrap();
+        let mut worst = 0.0f64;
+        let mut largest = 0.0f64;
+        for j in 0..3 {
+            let q = static_shape(j);
+            let deflection: Vec<f64> = (0..sys.n)
+                .map(|a| q[a] - (0..3).map(|k| rigid[k][a] * rs_inv[(k, j)]).sum::<f64>())
+                .collect();
+            for (out, (beam, x)) in (0..3)
+                .map(|i| (i, robot.beams()[i].length))
+                .chain((0..3).map(|i| (i, 0.0)))
+                .enumerate()
+            {
+                let spectral: f64 = sys
+                    .deflection_row(beam, x)
+                    .iter()
+                    .zip(&deflection)
+                    .map(|(h, d)| h * d)
+                    .sum();
+                let from_static_shapes = c[[out, 2 * nr + j]];
+                largest = largest.max(spectral.abs());
+                worst = worst.max((from_static_shapes - spectral).abs());
+            }
+        }
+        eprintln!(
+            "pose {p:?}: {nf} free stuck modes; deflection per unit slider displacement up to {largest:.4e}, \
+             static shapes against the spectral form {worst:.3e}"
+        );
+        assert!(largest > 1e-3, "a unit slider displacement must strain the stuck star");
+        assert!(worst <= 1e-6 * largest, "{worst:e} of {largest:e}");
+    }
 }

@@ -153,7 +153,7 @@ pub struct LinearizeArgs {
     /// Servo loop open or closed [default: closed when [drive] kind = "servo" and the sliders are free, else open]
     #[arg(long = "loop", value_enum)]
     loop_kind: Option<LoopArg>,
-    /// Sleeves sliding on their beams or stuck (stuck needs --sliders free)
+    /// Sleeves sliding on their beams or stuck (with --sliders locked the sliders become states, docs/modes.md Eqs. S4-S6)
     #[arg(long, value_enum, default_value = "sliding")]
     sleeves: SleevesArg,
     /// Output directory

@@ -134,8 +134,8 @@ mod tests {
                 "{s:?}"
             );
             assert!((pose.theta - theta).abs() < 1e-12, "{s:?}: {} {theta}", pose.theta);
-            for i in 0..3 {
-                assert!((pose.xp[i] - r[i]).abs() < 1e-12, "{s:?} beam {}", i + 1);
+            for (i, ri) in r.iter().enumerate() {
+                assert!((pose.xp[i] - ri).abs() < 1e-12, "{s:?} beam {}", i + 1);
             }
             // and the inverse kinematics of the pose returns s
             let back = inverse_kinematics(&robot, pose.g, pose.theta).unwrap();

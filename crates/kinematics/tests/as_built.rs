@@ -36,9 +36,9 @@ fn the_rigid_state_satisfies_the_loop_equations_with_the_weld_angles() {
         for i in 0..3 {
             // K1: P_i = G + xp_i e_xi(theta + phi_i), with e_w normal to e_x
             let (e, w) = (st.e_x(i), st.e_w(i));
-            for k in 0..2 {
+            for (k, ek) in e.iter().enumerate() {
                 assert!(
-                    (st.p[i][k] - (st.g[k].v + st.xp[i].v * e[k])).abs() < 1e-13,
+                    (st.p[i][k] - (st.g[k].v + st.xp[i].v * ek)).abs() < 1e-13,
                     "t = {t}, beam {i}"
                 );
             }

@@ -273,7 +273,7 @@ mod tests {
             settle_hold_s: Some(0.25),
             note: Some("too short, by far".into()),
         };
-        let text = dwells_csv(&[d.clone()]);
+        let text = dwells_csv(std::slice::from_ref(&d));
         let mut lines = text.lines();
         assert_eq!(lines.next().unwrap(), DWELLS_CSV_HEADER.join(","));
         assert_eq!(

@@ -38,7 +38,7 @@ fn shaped_pose_is_the_weighted_sum_and_rests_later() {
     for t in [0.05, 0.13, 0.2, 0.27, 0.31] {
         let d = Dual2::from_re(t).derivative();
         let got = e.trajectory.pose(d).unwrap().unwrap();
-        for c in 0..3 {
+        for (c, got_c) in got.iter().enumerate() {
             let want: f64 = sh
                 .impulses
                 .iter()
@@ -51,7 +51,7 @@ fn shaped_pose_is_the_weighted_sum_and_rests_later() {
                         .v2
                 })
                 .sum();
-            assert!((got[c].v2 - want).abs() < 1e-12, "t = {t}");
+            assert!((got_c.v2 - want).abs() < 1e-12, "t = {t}");
         }
     }
     let end = e.trajectory.jets(&e.robot, 0.33).unwrap();

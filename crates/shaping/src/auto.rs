@@ -273,8 +273,10 @@ mod tests {
         let groups = [3.9, 6.5, 11.8];
         let amp = [4e-4, 2e-4, 1e-4];
         let t: Vec<f64> = (0..1500).map(|k| 0.2 + k as f64 * 1e-3).collect();
-        let mut r = flexstar_model::Response::default();
-        r.t = t.clone();
+        let mut r = flexstar_model::Response {
+            t: t.clone(),
+            ..Default::default()
+        };
         for i in 0..3 {
             // w_iG = e_i . dG with dG = sum_g a_g (cos, sin) rotating: the beams 120 deg apart
             let phi = 2.0 * PI * i as f64 / 3.0;

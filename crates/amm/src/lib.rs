@@ -45,6 +45,7 @@ mod star;
 mod static_start;
 mod stick_slip;
 mod system;
+mod system_cache;
 
 pub use direct::DIRECT_COLUMNS;
 pub use error::{AmmError, RankError};

@@ -422,10 +422,20 @@ fn integrate_coarse<F: FnMut(&System, &[f64])>(
 /// Each beam gets its own mode set of the family and N (`docs/amm.md` 13, Eq. J1); equal beams
 /// share one.
 pub(crate) fn build_system(settings: &AmmSettings, n_modes: usize, problem: &Star) -> Result<System, AmmError> {
-    let modes = (problem.mode_params().iter())
-        .map(|p| ModeSet::new(settings.family, n_modes, p))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut sys = System::new(modes, &problem.beams, &problem.weld, settings.model);
+    let key = crate::system_cache::SystemKey {
+        family: settings.family,
+        n_modes,
+        mode_params: problem.mode_params().to_vec(),
+        beams: problem.beams,
+        weld: problem.weld,
+        model: settings.model,
+    };
+    let mut sys = crate::system_cache::system(key, || {
+        let modes = (problem.mode_params().iter())
+            .map(|p| ModeSet::new(settings.family, n_modes, p))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok::<_, AmmError>(System::new(modes, &problem.beams, &problem.weld, settings.model))
+    })?;
     if let Some(law) = problem.friction.filter(|f| f.sleeves_rub()) {
         sys.attach_friction(*law, &problem.beams, &problem.weld);
     }
@@ -772,6 +782,50 @@ mod tests {
         assert!(rigid > 1e-7, "the shift must matter in this test: {rigid:e} m");
         assert!(material < 1e-3 * rigid, "{material:e} m against {rigid:e} m");
         assert!(material < 0.05 * unshifted, "{material:e} m against {unshifted:e} m");
+    }
+
+    #[test]
+    fn a_kept_system_solves_as_a_fresh_build() {
+        // docs/amm.md 2.1, the setup: a solve from the system kept for this robot, family, N and
+        // model gives the fresh build's run bit for bit, with a payload, damping and gravity
+        // attached to each (the kept system is the one System::new left, before any of them)
+        let mut exp = case([1.0, 0.0, 0.5], 0.1);
+        exp.payload = flexstar_model::Payload {
+            mass: 0.3,
+            j: 1e-3,
+            offset: [0.02, -0.01],
+        };
+        exp.damping = flexstar_model::Damping::rayleigh(2.0, 1e-4);
+        exp.gravity.g = [1.0, -9.81];
+        let problem = exp.problem().unwrap();
+        let star = Star::new(&problem);
+        let settings = AmmSettings {
+            modes: Some(24),
+            ..AmmSettings::accurate()
+        };
+        let bits = |r: &Response| {
+            let mut v: Vec<u64> = r.t.iter().map(|x| x.to_bits()).collect();
+            for h in [&r.w_g, &r.w_tip, &r.fa] {
+                v.extend(h.iter().flatten().map(|x| x.to_bits()));
+            }
+            v
+        };
+        let fresh = {
+            let sys = System::new(
+                vec![ModeSet::new(settings.family, 24, &star.beams[0]).unwrap()],
+                &star.beams,
+                &star.weld,
+                settings.model,
+            );
+            let mut sys = sys;
+            sys.attach(star.payload, star.damping, star.load, star.gravity);
+            integrate_system(&star, &settings, sys, DEFAULT_DT, std::time::Instant::now(), |_, _| {}).unwrap()
+        };
+        for _ in 0..2 {
+            let kept = integrate(&star, &settings, 24, true, |_, _| {}).unwrap();
+            assert!(kept.w_tip[0].iter().any(|w| w.abs() > 1e-5), "no motion");
+            assert_eq!(bits(&fresh), bits(&kept));
+        }
     }
 
     #[test]

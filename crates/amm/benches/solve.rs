@@ -38,43 +38,39 @@ fn accurate_model(c: &mut Criterion) {
     for case in [3, 1, 2, 4] {
         let exp = common::paper_case(case);
         let settings = flexstar_model::AmmSettings::accurate();
-        group.bench_function(format!("case{case}_auto"), |b| {
-            let problem = exp.problem().unwrap();
-            b.iter(|| {
-                flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
-                    .map(|s| s.response)
-                    .unwrap()
-            })
-        });
+        inverse_solve(&mut group, &format!("case{case}_auto"), &exp, &settings);
     }
     let exp = common::paper_case(3);
     let fixed = flexstar_model::AmmSettings {
         modes: Some(53),
         ..flexstar_model::AmmSettings::accurate()
     };
-    group.bench_function("case3_n53", |b| {
-        let problem = exp.problem().unwrap();
-        b.iter(|| {
-            flexstar_amm::solve(&problem, &fixed, flexstar_drive::SolveRequest::motion())
-                .map(|s| s.response)
-                .unwrap()
-        })
-    });
+    inverse_solve(&mut group, "case3_n53", &exp, &fixed);
     // the run the automatic choice delivers on case 3: N = 53 at its step (tolerance_step(0.5) =
     // 5e-4 s, 1000 steps), without the choice's other runs
     let delivered = flexstar_model::AmmSettings {
         dt: Some(flexstar_amm::tolerance_step(0.5)),
         ..fixed.clone()
     };
-    group.bench_function("case3_n53_delivered_step", |b| {
+    inverse_solve(&mut group, "case3_n53_delivered_step", &exp, &delivered);
+    group.finish();
+}
+
+/// One benchmark of `group`: the inverse (prescribed-motion) solve of `exp` with `settings`.
+fn inverse_solve(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    exp: &flexstar_model::Experiment,
+    settings: &flexstar_model::AmmSettings,
+) {
+    group.bench_function(name, |b| {
         let problem = exp.problem().unwrap();
         b.iter(|| {
-            flexstar_amm::solve(&problem, &delivered, flexstar_drive::SolveRequest::motion())
+            flexstar_amm::solve(&problem, settings, flexstar_drive::SolveRequest::motion())
                 .map(|s| s.response)
                 .unwrap()
         })
     });
-    group.finish();
 }
 
 /// Direct dynamics (`docs/amm.md` section 10): a direct run (forces of the inverse run fed back,

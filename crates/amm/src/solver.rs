@@ -736,6 +736,18 @@ mod tests {
         }
     }
 
+    /// `exp` with a payload off G, Rayleigh damping and gravity in the plane.
+    fn attached(mut exp: Experiment) -> Experiment {
+        exp.payload = flexstar_model::Payload {
+            mass: 0.3,
+            j: 1e-3,
+            offset: [0.02, -0.01],
+        };
+        exp.damping = flexstar_model::Damping::rayleigh(2.0, 1e-4);
+        exp.gravity.g = [1.0, -9.81];
+        exp
+    }
+
     #[test]
     fn position_constraints_hold_at_every_step() {
         // index-3 scheme: C(t_n) q_n = 0 to round-off at every step, no drift
@@ -789,15 +801,7 @@ mod tests {
         // docs/amm.md 2.1, the setup: a solve from the system kept for this robot, family, N and
         // model gives the fresh build's run bit for bit, with a payload, damping and gravity
         // attached to each (the kept system is the one System::new left, before any of them)
-        let mut exp = case([1.0, 0.0, 0.5], 0.1);
-        exp.payload = flexstar_model::Payload {
-            mass: 0.3,
-            j: 1e-3,
-            offset: [0.02, -0.01],
-        };
-        exp.damping = flexstar_model::Damping::rayleigh(2.0, 1e-4);
-        exp.gravity.g = [1.0, -9.81];
-        let problem = exp.problem().unwrap();
+        let problem = attached(case([1.0, 0.0, 0.5], 0.1)).problem().unwrap();
         let star = Star::new(&problem);
         let settings = AmmSettings {
             modes: Some(24),
@@ -833,15 +837,8 @@ mod tests {
         // docs/amm.md 13: three equal beams run through the general layout (a mode set, an
         // arrowhead, sleeve tables and G matrices per beam) give the shared layout's run exactly,
         // in both models, with a payload, damping, a load and gravity
-        let mut exp = case([1.0, 0.0, 0.5], 0.1);
-        exp.payload = flexstar_model::Payload {
-            mass: 0.3,
-            j: 1e-3,
-            offset: [0.02, -0.01],
-        };
-        exp.damping = flexstar_model::Damping::rayleigh(2.0, 1e-4);
+        let mut exp = attached(case([1.0, 0.0, 0.5], 0.1));
         exp.load = flexstar_model::LoadSettings::polynomials(Some(vec![0.0, 5.0]), None, Some(vec![0.0, 0.0, 3.0]));
-        exp.gravity.g = [1.0, -9.81];
         let problem = exp.problem().unwrap();
         let star = Star::new(&problem);
         assert!(star.shared && star.paper.is_some());

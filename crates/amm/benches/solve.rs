@@ -180,14 +180,7 @@ fn friction(c: &mut Criterion) {
             ..Default::default()
         });
         for (label, exp) in [("frictionless", &bare), ("mu0.1", &rubbing)] {
-            group.bench_function(format!("case{case}_{label}"), |b| {
-                let problem = exp.problem().unwrap();
-                b.iter(|| {
-                    flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
-                        .map(|s| s.response)
-                        .unwrap()
-                })
-            });
+            inverse_solve(&mut group, &format!("case{case}_{label}"), exp, &settings);
         }
     }
     group.finish();

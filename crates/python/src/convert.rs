@@ -81,6 +81,18 @@ pub fn sliders(s: &str) -> PyResult<Sliders> {
     }
 }
 
+/// `sleeves="sliding" | "stuck"` (`docs/modes.md`, stuck sleeves).
+pub fn sleeves(s: &str) -> PyResult<flexstar_model::Sleeves> {
+    use flexstar_model::Sleeves;
+    match s {
+        "sliding" => Ok(Sleeves::Sliding),
+        "stuck" => Ok(Sleeves::Stuck),
+        _ => Err(ConfigError::new_err(format!(
+            "sleeves: expected \"sliding\" or \"stuck\", got {s:?}"
+        ))),
+    }
+}
+
 /// `loop="open" | "closed"` (None: the default of `flexstar linearize`).
 pub fn loop_kind(s: Option<&str>) -> PyResult<Option<flexstar_api::modal::LoopKind>> {
     use flexstar_api::modal::LoopKind;

@@ -240,7 +240,7 @@ fn run(
 
 /// Modes at a pose, AMM and FEM (see `flexstar.modal`): a dict.
 #[pyfunction]
-#[pyo3(signature = (exp, at = None, pose = None, sliders = "locked", modes = 6))]
+#[pyo3(signature = (exp, at = None, pose = None, sliders = "locked", modes = 6, sleeves = "sliding"))]
 fn modal<'py>(
     py: Python<'py>,
     exp: &PyExperiment,
@@ -248,13 +248,17 @@ fn modal<'py>(
     pose: Option<[f64; 3]>,
     sliders: &str,
     modes: usize,
+    sleeves: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let spec = convert::pose_spec(at, pose)?;
-    let sliders = convert::sliders(sliders)?;
+    let hold = flexstar_api::modal::ModalHold {
+        sliders: convert::sliders(sliders)?,
+        sleeves: convert::sleeves(sleeves)?,
+    };
     let doc = &exp.inner;
     let source = doc.source.display().to_string();
     let o = py
-        .detach(|| flexstar_api::modal::modal(&doc.exp, &source, &spec, sliders, modes, None, false))
+        .detach(|| flexstar_api::modal::modal_held(&doc.exp, &source, &spec, hold, modes, None, false))
         .map_err(py_err)?;
     let d = PyDict::new(py);
     let rows = o.modal.rows();
@@ -266,6 +270,7 @@ fn modal<'py>(
         d.set_item("zeta_fem", PyArray1::from_vec(py, z.iter().map(|r| r.1).collect()))?;
     }
     d.set_item("rigid", o.modal.amm.rigid)?;
+    d.set_item("sleeves", hold.sleeves.name())?;
     d.set_item("pose", convert::pose_dict(py, &o.pose)?)?;
     Ok(d)
 }
@@ -273,7 +278,8 @@ fn modal<'py>(
 /// The linear state-space model about a pose (see `flexstar.linearize`): the matrices, the names
 /// of the states, inputs and outputs (in the matrices' order) and the settings used.
 #[pyfunction]
-#[pyo3(signature = (exp, at = None, pose = None, modes = flexstar_modal::linear::ELASTIC_MODES, sliders = "free", r#loop = None))]
+#[pyo3(signature = (exp, at = None, pose = None, modes = flexstar_modal::linear::ELASTIC_MODES, sliders = "free", r#loop = None, sleeves = "sliding"))]
+#[allow(clippy::too_many_arguments)]
 fn linearize<'py>(
     py: Python<'py>,
     exp: &PyExperiment,
@@ -282,13 +288,14 @@ fn linearize<'py>(
     modes: usize,
     sliders: &str,
     r#loop: Option<&str>,
+    sleeves: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let spec = convert::pose_spec(at, pose)?;
     let opts = flexstar_api::modal::LinearizeOptions {
         modes: Some(modes),
         sliders: Some(convert::sliders(sliders)?),
         loop_kind: convert::loop_kind(r#loop)?,
-        sleeves: None,
+        sleeves: Some(convert::sleeves(sleeves)?),
     };
     let doc = &exp.inner;
     let source = doc.source.display().to_string();
@@ -311,6 +318,7 @@ fn linearize<'py>(
     let closed = matches!(h, flexstar_modal::linear::Holding::Servo { .. });
     d.set_item("loop", if closed { "closed" } else { "open" })?;
     d.set_item("modes", ss.settings.modes)?;
+    d.set_item("sleeves", ss.settings.sleeves.name())?;
     d.set_item("modal_frequencies_hz", PyArray1::from_slice(py, &ss.modes.freq_hz))?;
     d.set_item("rigid", ss.modes.rigid)?;
     d.set_item("pose", convert::pose_dict(py, &ss.pose)?)?;

@@ -204,6 +204,27 @@ def test_linearize_settings_and_names(root):
     assert list(sys.state_labels) == lin.states and list(sys.input_labels) == lin.inputs
 
 
+def test_stuck_sleeves_in_modal_and_linearize(root):
+    """``sleeves="stuck"`` (docs/modes.md, stuck sleeves): every frequency at or above the sliding
+    one, mode by mode (Rayleigh: a constraint added), no rigid mode with free sliders; the
+    locked-slider linear model's states end with the sliders (Eqs. S4-S6), its elastic
+    eigenvalues are ``modal``'s stuck frequencies, and a bad name is refused."""
+    exp = flexstar.Experiment.load(root / "configs/case3.toml")
+    sliding = flexstar.modal(exp, at=0.3, sliders="locked", modes=6)
+    stuck = flexstar.modal(exp, at=0.3, sliders="locked", modes=6, sleeves="stuck")
+    assert (sliding["sleeves"], stuck["sleeves"]) == ("sliding", "stuck")
+    assert np.all(stuck["amm_hz"] >= sliding["amm_hz"] * (1 - 1e-9))
+    assert np.all(stuck["fem_hz"] >= sliding["fem_hz"] * (1 - 1e-9))
+    assert flexstar.modal(exp, at=0.3, sliders="free", modes=6, sleeves="stuck")["rigid"] == 0
+    lin = flexstar.linearize(exp, at=0.3, modes=6, sliders="locked", sleeves="stuck")
+    assert lin.sleeves == "stuck" and lin.A.shape == (18, 18) and lin.B.shape == (18, 3)
+    assert lin.states[12:] == ["s1", "s2", "s3", "sd1", "sd2", "sd3"]
+    f = np.sort(np.abs(np.linalg.eigvals(lin.A[:12, :12]).imag))[::2] / (2 * np.pi)
+    np.testing.assert_allclose(f, stuck["amm_hz"], rtol=1e-8)
+    with pytest.raises(flexstar.ConfigError, match="sleeves"):
+        flexstar.linearize(exp, at=0.3, sleeves="glued")
+
+
 def test_verify_reproduces_the_cli_table_and_checks(root, cli, tmp_path):
     """flexstar.verify() against `flexstar verify`: the same Table I (markdown, to the last
     digit) and the same number of checks, all holding."""

@@ -230,12 +230,15 @@ def modal(
     pose: Optional[Sequence[float]] = None,
     sliders: str = "locked",
     modes: int = 6,
+    sleeves: str = "sliding",
 ) -> Dict[str, Any]:
     """Modes at a pose (``at`` = time of the trajectory [s], or ``pose`` = (Gx, Gy, theta)),
-    AMM and FEM side by side: ``{"mode", "amm_hz", "fem_hz", "rigid", "pose"}``; with
-    ``sliders="free"`` the three rigid modes (0 Hz) come first. With a ``[damping]`` section also
-    ``"zeta_amm"``, ``"zeta_fem"``: each model's damping ratio ``alpha / (2 omega) + beta omega / 2`` of the mode."""
-    return _flexstar.modal(exp._inner, at, None if pose is None else tuple(pose), sliders, modes)
+    AMM and FEM side by side: ``{"mode", "amm_hz", "fem_hz", "rigid", "pose", "sleeves"}``; with
+    ``sliders="free"`` the three rigid modes (0 Hz) come first (none with ``sleeves="stuck"``:
+    each sleeve holding its beam's material point, docs/modes.md). With a ``[damping]`` section
+    also ``"zeta_amm"``, ``"zeta_fem"``: each model's damping ratio ``alpha / (2 omega) + beta
+    omega / 2`` of the mode."""
+    return _flexstar.modal(exp._inner, at, None if pose is None else tuple(pose), sliders, modes, sleeves)
 
 
 class LinearModel:
@@ -244,7 +247,9 @@ class LinearModel:
     ``etad1..etadN`` (modal amplitudes, rigid modes first with free sliders); inputs ``Fa1..Fa3``
     [N] (sliders free), ``sdd1..sdd3`` [m/s^2] (sliders locked) or ``s1ref..s3ref``,
     ``sd1ref..sd3ref``, ``ff1..ff3`` (servo loop closed); outputs ``s1..s3`` (sliders free),
-    ``w1tip..w3tip``, ``w1G..w3G`` [m] and, closed loop, ``e1..e3`` [m]."""
+    ``w1tip..w3tip``, ``w1G..w3G`` [m] and, closed loop, ``e1..e3`` [m]. With locked sliders and
+    stuck sleeves the states end with the sliders ``s1..s3`` [m], ``sd1..sd3`` [m/s]
+    (docs/modes.md, Eqs. S4-S6)."""
 
     def __init__(self, d: Dict[str, Any]) -> None:
         self.A: np.ndarray = d["A"]
@@ -259,6 +264,7 @@ class LinearModel:
         self.sliders: str = d["sliders"]
         self.loop: str = d["loop"]
         self.modes: int = d["modes"]
+        self.sleeves: str = d["sleeves"]
         self.modal_frequencies_hz: np.ndarray = d["modal_frequencies_hz"]
         self.rigid: int = d["rigid"]
         self.pose: Dict[str, Any] = d["pose"]
@@ -278,13 +284,15 @@ def linearize(
     modes: int = 20,
     sliders: str = "free",
     loop: Optional[str] = None,
+    sleeves: str = "sliding",
 ) -> LinearModel:
     """The linear state-space model about a pose (see :class:`LinearModel`), as ``flexstar
     linearize``: ``modes`` elastic modes, ``sliders="free"|"locked"``, ``loop="open"|"closed"``
-    (default: closed when the experiment's drive is a servo and the sliders are free)."""
+    (default: closed when the experiment's drive is a servo and the sliders are free),
+    ``sleeves="sliding"|"stuck"`` (docs/modes.md, stuck sleeves)."""
     _check_count("modes", modes)
     return LinearModel(
-        _flexstar.linearize(exp._inner, at, None if pose is None else tuple(pose), modes, sliders, loop)
+        _flexstar.linearize(exp._inner, at, None if pose is None else tuple(pose), modes, sliders, loop, sleeves)
     )
 
 

@@ -66,6 +66,7 @@ class LinearModel:
     sliders: str
     loop: str
     modes: int
+    sleeves: str
     modal_frequencies_hz: npt.NDArray[np.float64]
     rigid: int
     pose: Dict[str, Any]
@@ -90,6 +91,7 @@ def modal(
     pose: Optional[Sequence[float]] = None,
     sliders: str = "locked",
     modes: int = 6,
+    sleeves: str = "sliding",
 ) -> Dict[str, Any]: ...
 def linearize(
     exp: Experiment,
@@ -98,6 +100,7 @@ def linearize(
     modes: int = 20,
     sliders: str = "free",
     loop: Optional[str] = None,
+    sleeves: str = "sliding",
 ) -> LinearModel: ...
 def sweep(study: _Path, out: _Path, jobs: Optional[int] = None, progress: bool = False) -> Any: ...
 def plan(config: _Path, out: _Path = "out") -> Dict[str, Any]: ...

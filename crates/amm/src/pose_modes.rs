@@ -292,6 +292,11 @@ impl PoseModel {
         self
     }
 
+    /// Which linear system of the sleeves the model solves ([`PoseModel::with_sleeves`]).
+    pub fn sleeves(&self) -> Sleeves {
+        self.sleeves
+    }
+
     /// The mode set of the beams (beam 1's on a robot as built).
     pub fn modes(&self) -> &ModeSet {
         &self.sys.beam(0).modes

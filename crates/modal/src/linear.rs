@@ -278,10 +278,14 @@ fn inverse3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
 /// coordinates): from the three rigid modes of the sliding, sliders-free system (their beam part
 /// times the inverse of their slider part).
 fn rigid_motion(model: &PoseModel, pose: &RestPose, n: usize) -> Result<Vec<[f64; 3]>, ModalError> {
-    let free = model
-        .clone()
-        .with_sleeves(Sleeves::Sliding)
-        .modes_at(pose, Sliders::Free, 1)?;
+    // the sliding model: `model` itself unless its sleeves stick (a copy then)
+    let free = match model.sleeves() {
+        Sleeves::Sliding => model.modes_at(pose, Sliders::Free, 1)?,
+        Sleeves::Stuck => model
+            .clone()
+            .with_sleeves(Sleeves::Sliding)
+            .modes_at(pose, Sliders::Free, 1)?,
+    };
     let rigid = &free.shapes[..free.rigid];
     let mut s = [[0.0; 3]; 3];
     for (i, row) in s.iter_mut().enumerate() {

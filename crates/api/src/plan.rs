@@ -54,7 +54,7 @@ pub struct PlanOutcome {
     pub notes: Vec<String>,
     /// Wall time of the whole command [s] and of the planning alone.
     pub wall_s: f64,
-    /// With `[robust]`: the motions on the sample (AMM) and on fresh draws (FEM), the curves.
+    /// With `[robust]`: the motions on the sample (AMM) and on fresh draws (`[robust] check`), the curves.
     pub robust: Option<crate::plan_robust::RobustCheck>,
 }
 

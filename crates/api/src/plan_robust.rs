@@ -1,5 +1,6 @@
 //! The checks of a robust plan (`docs/motions.md` 4.11): every motion of the comparison run on
-//! each sample model (accurate AMM) and on the fresh models drawn in the box (FEM, seeded), the
+//! each sample model (accurate AMM) and on the fresh models drawn in the box (seeded; the
+//! accurate AMM or the FEM, `[robust] check`), the
 //! residual peak of |dG| after each motion's own `t_rest` over equal windows; the worst and the
 //! q-quantile per motion; the robustness curves (AMM, one key at a time over its range).
 
@@ -8,7 +9,7 @@ use serde::Serialize;
 
 use flexstar_model::{Experiment, Trajectory};
 use flexstar_plan::robust::RobustInfo;
-use flexstar_plan::uncertainty::Uncertainty;
+use flexstar_plan::uncertainty::{CheckModel, Uncertainty};
 use flexstar_solve::{Settings, Solver};
 
 use crate::{ApiError, Result};
@@ -51,6 +52,8 @@ pub struct RobustCheck {
     pub sample_summary: Vec<Summary>,
     pub draws: Vec<ModelRow>,
     pub draws_summary: Vec<Summary>,
+    /// The model the draws ran on: `"AMM"` (the accurate AMM at its automatic choice) or `"FEM"`.
+    pub draws_model: String,
     pub curves: Vec<Curve>,
     /// Runs that failed, with their reason (none expected).
     pub failures: Vec<String>,
@@ -75,12 +78,14 @@ pub fn check(info: &RobustInfo, motions: &[(String, Trajectory)]) -> RobustCheck
         .into_iter()
         .map(|v| (v.clone(), model(unc, &v)))
         .collect();
-    let draws = rows(&draw_models, motions, Solver::Fem, window_s, &mut failures);
+    let draws_solver = check_solver(unc);
+    let draws = rows(&draw_models, motions, draws_solver, window_s, &mut failures);
     let curves = curves(unc, motions, window_s, &mut failures);
     let labels: Vec<String> = motions.iter().map(|(l, _)| l.clone()).collect();
     RobustCheck {
         sample_summary: summaries(&labels, &sample, unc.quantile),
         draws_summary: summaries(&labels, &draws, unc.quantile),
+        draws_model: draws_solver.name().to_uppercase(),
         motions: labels,
         window_s,
         sample,
@@ -88,6 +93,14 @@ pub fn check(info: &RobustInfo, motions: &[(String, Trajectory)]) -> RobustCheck
         curves,
         failures,
         wall_s: started.elapsed().as_secs_f64(),
+    }
+}
+
+/// The solver of the fresh draws (`[robust] check`).
+pub fn check_solver(unc: &Uncertainty) -> Solver {
+    match unc.check {
+        CheckModel::Amm => Solver::Amm,
+        CheckModel::Fem => Solver::Fem,
     }
 }
 

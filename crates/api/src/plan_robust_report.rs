@@ -9,7 +9,8 @@ use flexstar_plot::{Figure, Panel, Series};
 use crate::plan_robust::{RobustCheck, Summary};
 
 /// `plan.json`'s `robust`: the uncertainty, the sample and its choice, the search's objective,
-/// the shaper over the uncertainty, and the checks (sample on the AMM, fresh draws on the FEM).
+/// the shaper over the uncertainty, and the checks (sample on the AMM, fresh draws on the model
+/// of `[robust] check`).
 pub fn robust_json(info: &RobustInfo, c: &RobustCheck) -> Value {
     let shaper = info.shaped.exp.shaper.as_ref();
     json!({
@@ -95,11 +96,12 @@ pub fn robust_markdown(info: &RobustInfo, c: &RobustCheck, name: &str) -> String
     );
     s += &format!(
         "Residual peak of abs(dG) after each motion's t_rest over {:.3} s, in mm: on the {} sample models (AMM) and on {} \
-         fresh models drawn uniformly in the box (FEM, seed {}):\n\n| motion | sample worst | sample q-quantile | draws worst (FEM) | draws q-quantile (FEM) | draws worst / plain's |\n|---|---|---|---|---|---|\n",
+         fresh models drawn uniformly in the box ({m}, seed {}):\n\n| motion | sample worst | sample q-quantile | draws worst ({m}) | draws q-quantile ({m}) | draws worst / plain's |\n|---|---|---|---|---|---|\n",
         c.window_s,
         c.sample.len(),
         c.draws.len(),
-        u.seed
+        u.seed,
+        m = c.draws_model,
     );
     let plain = c.draws_summary.first().map_or(f64::NAN, |p| p.worst_m);
     for (a, d) in c.sample_summary.iter().zip(&c.draws_summary) {

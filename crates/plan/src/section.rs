@@ -52,7 +52,7 @@ pub struct PlanSection {
     /// `objective = "time"`: the largest residual peak of |dG| after the move [m].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub residual_max: Option<f64>,
-    /// `"timing"` (default) or `"path"`.
+    /// `"path"` (default) or `"timing"` (`docs/motions.md` 4.10, "The default shape").
     #[serde(default = "default_shape")]
     pub shape: Shape,
     /// Interior via points (default 12 for timing, 4 for path).
@@ -99,7 +99,7 @@ fn default_objective() -> Objective {
 }
 
 fn default_shape() -> Shape {
-    Shape::Timing
+    Shape::Path
 }
 
 /// `[limits]`: bounds the planned motion keeps (each optional).
@@ -122,7 +122,7 @@ pub struct Limits {
 
 impl PlanSection {
     /// Interior via points: `points`, else 12 (timing) or 4 (path); `docs/motions.md` 4.9 says
-    /// why 12.
+    /// why 12 for timing, 4.10 ("The default shape") how 4 for path was measured.
     pub fn interior_points(&self) -> usize {
         self.points.unwrap_or(match self.shape {
             Shape::Timing => 12,

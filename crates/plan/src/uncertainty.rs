@@ -1,6 +1,6 @@
 //! `[robust]` (`docs/motions.md` 4.11): the uncertainty a robust plan must hold over, as ranges
 //! of numeric experiment keys named as sweeps name them (`"payload.mass"`, `"robot.E"`,
-//! `"robot.L[2]"`), the quantile minimised and the fresh draws of the FEM check; the models of the
+//! `"robot.L[2]"`), the quantile minimised and the fresh draws of the check; the models of the
 //! sample (Eq. U2) and of the draws, each the file's experiment with the keys set by the study's
 //! key setter ([`flexstar_study::patch::case_document`]) and read by the experiment loader.
 
@@ -13,7 +13,7 @@ use flexstar_study::key::{self, Key};
 use flexstar_study::patch::{case_document, get_dotted, number};
 use flexstar_study::spec::{Levels, Vary};
 
-/// Fresh models of the FEM check by default (`[robust] draws`).
+/// Fresh models of the check by default (`[robust] draws`).
 pub const DEFAULT_DRAWS: usize = 20;
 /// Most fresh models.
 pub const MAX_DRAWS: usize = 1000;
@@ -40,9 +40,11 @@ pub struct Uncertainty {
     pub t_move: RobustDuration,
     /// In (0, 1]: 1 minimises the worst sample (Eq. U1).
     pub quantile: f64,
-    /// Fresh models of the FEM check.
+    /// Fresh models of the check.
     pub draws: usize,
     pub seed: u64,
+    /// The model the fresh draws are run on (`[robust] check`).
+    pub check: CheckModel,
     /// The file's experiment as a TOML document (its trajectory the stand-in quintic).
     #[serde(skip)]
     doc: toml::Table,
@@ -65,6 +67,7 @@ impl Uncertainty {
             quantile: 1.0,
             draws: DEFAULT_DRAWS,
             seed: 1,
+            check: CheckModel::Amm,
             doc: doc.clone(),
             file: file.to_path_buf(),
         };
@@ -76,6 +79,7 @@ impl Uncertainty {
                 "t_move" => u.t_move = read_duration(&value, file)?,
                 "draws" => u.draws = read_count(&value, file, "draws", 1, MAX_DRAWS)?,
                 "seed" => u.seed = read_count(&value, file, "seed", 0, usize::MAX)? as u64,
+                "check" => u.check = read_check(&value, file)?,
                 "fit" => {
                     for (key, range) in crate::fit_uncertainty::ranges(&value, file)? {
                         u.ranges.push(u.read_range(&key, &range)?);
@@ -276,6 +280,28 @@ fn read_duration(v: &toml::Value, file: &Path) -> Result<RobustDuration, ModelEr
             file,
             "t_move",
             format!("is the robust plan's duration: seconds (> 0), \"plan\" ([plan] t_move) or \"zvd\" (the ZVD-shaped quintic's); got {v}"),
+        )),
+    }
+}
+
+/// The model of the fresh draws' check, `[robust] check` (`docs/motions.md` 4.11, "The check's
+/// model"): the accurate AMM at its automatic choice (default: the draws cost what a plan may
+/// take), or the FEM (the independent model, about four times the cost per run).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckModel {
+    Amm,
+    Fem,
+}
+
+fn read_check(v: &toml::Value, file: &Path) -> Result<CheckModel, ModelError> {
+    match v.as_str() {
+        Some("amm") => Ok(CheckModel::Amm),
+        Some("fem") => Ok(CheckModel::Fem),
+        _ => Err(bad(
+            file,
+            "check",
+            format!("is the model of the fresh draws: \"amm\" (the accurate AMM, default) or \"fem\"; got {v}"),
         )),
     }
 }

@@ -71,12 +71,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(c) = &outcome.robust {
         for (a, d) in c.sample_summary.iter().zip(&c.draws_summary) {
             eprintln!(
-                "plan: robust: {:<8} worst residual peak of G: {:.3e} m over {} sample models (AMM), {:.3e} m over {} fresh draws (FEM); q-quantile {:.3e} m",
+                "plan: robust: {:<8} worst residual peak of G: {:.3e} m over {} sample models (AMM), {:.3e} m over {} fresh draws ({}); q-quantile {:.3e} m",
                 a.motion,
                 a.worst_m,
                 c.sample.len(),
                 d.worst_m,
                 c.draws.len(),
+                c.draws_model,
                 d.quantile_m
             );
         }

@@ -90,12 +90,23 @@ pub fn plan_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Planned))
     let notes = flexstar_model::identity::other_experiment_note(&dir, &cfg.exp)
         .into_iter()
         .collect();
-    let planned = flexstar_plan::plan(&cfg).map_err(|e| from_plan(&source, e))?;
+    let labels: Vec<(&'static str, &'static str)> = MOTIONS.into_iter().chain(ROBUST_MOTIONS).collect();
+    // the plain and ZVD baselines run beside the search when they are known before it
+    let (planned, baselines) =
+        flexstar_plan::planner::plan_beside(&cfg, |exps| run_motions(exps, &labels[..2], &source));
+    let planned = planned.map_err(|e| from_plan(&source, e))?;
     on_planned(&planned);
     let rows = plan_rows(&cfg.exp, &planned)?;
     let exps = motion_experiments(&cfg, &planned, &rows)?;
-    let labels: Vec<(&'static str, &'static str)> = MOTIONS.into_iter().chain(ROBUST_MOTIONS).collect();
-    let motions = run_motions(exps, &labels, &source)?;
+    let motions = match baselines {
+        Some(done) => {
+            let mut motions = done?;
+            let rest = exps.into_iter().skip(motions.len()).collect();
+            motions.extend(run_motions(rest, &labels[motions.len()..], &source)?);
+            motions
+        }
+        None => run_motions(exps, &labels, &source)?,
+    };
     let robust = planned.robust.as_ref().map(|info| {
         let trajectories: Vec<(String, Trajectory)> = motions
             .iter()

@@ -177,23 +177,51 @@ pub struct Setup {
 
 /// Plan the motion of `cfg` (every check of 4.8 first; nothing is written here).
 pub fn plan(cfg: &PlanConfig) -> Result<Planned, PlanError> {
+    plan_beside(cfg, |_| ()).0
+}
+
+/// [`plan`], with `beside` run on the comparison's plain quintic and ZVD-shaped quintic (4.7, in
+/// that order) while the search runs, when they are known before it: with the residual
+/// objective (the plain quintic of `t_move`, the ZVD baseline of 4.2), robust or not. With the
+/// time objective they depend on the search, and `beside` is not called (`None`). The caller's
+/// runs of the two baselines then fill the cores the search leaves idle (its sequential trials),
+/// and the whole command waits less (`docs/motions.md` 4.9, "Wall time").
+pub fn plan_beside<R: Send>(
+    cfg: &PlanConfig,
+    beside: impl FnOnce(Vec<Experiment>) -> R + Send,
+) -> (Result<Planned, PlanError>, Option<R>) {
     let started = Instant::now();
-    check_plan_input(cfg)?;
+    if let Err(e) = check_plan_input(cfg) {
+        return (Err(e), None);
+    }
     let t_ref = cfg
         .plan
         .t_move
         .unwrap_or(cfg.exp.trajectory.t_rest().unwrap_or(1.0) - cfg.plan.t0);
-    let setup = setup(cfg, t_ref, started)?;
-    match cfg.plan.objective {
-        Objective::Residual => {
-            let zvd = zvd_experiment(&cfg.exp, setup.family.quintic(t_ref))?;
-            match &cfg.robust {
-                None => plan_residual(cfg, &setup, t_ref, zvd),
-                Some(unc) => crate::robust::plan_robust(cfg, &setup, t_ref, zvd, unc),
-            }
-        }
-        Objective::Time => crate::time::plan_time(cfg, &setup),
+    if cfg.plan.objective == Objective::Time {
+        let planned = setup(cfg, t_ref, started).and_then(|s| crate::time::plan_time(cfg, &s));
+        return (planned, None);
     }
+    let quintic = family_of(cfg).quintic(t_ref);
+    let (setup, zvd) = rayon::join(
+        || setup(cfg, t_ref, started),
+        || zvd_experiment(&cfg.exp, quintic.clone()),
+    );
+    let (setup, zvd) = match (setup, zvd) {
+        (Ok(s), Ok(z)) => (s, z),
+        (Err(e), _) | (_, Err(e)) => return (Err(e), None),
+    };
+    let mut plain = cfg.exp.clone();
+    plain.trajectory = quintic;
+    let baselines = vec![plain, zvd.clone()];
+    let (planned, beside) = rayon::join(
+        || match &cfg.robust {
+            None => plan_residual(cfg, &setup, t_ref, zvd),
+            Some(unc) => crate::robust::plan_robust(cfg, &setup, t_ref, zvd, unc),
+        },
+        || beside(baselines),
+    );
+    (planned, Some(beside))
 }
 
 /// The checks of 4.8 that need the robot but no solver: a motion drive, reachable poses,

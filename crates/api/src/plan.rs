@@ -112,7 +112,11 @@ pub fn plan_to_dir(config: &Path, out: &Path, on_planned: impl FnOnce(&Planned))
             .iter()
             .map(|m| (m.key.to_string(), m.exp.trajectory.clone()))
             .collect();
-        crate::plan_robust::check(info, &trajectories)
+        let amm = crate::plan_robust::CheckAmm {
+            modes: planned.modes,
+            dt: planned.dt,
+        };
+        crate::plan_robust::check(info, &trajectories, amm)
     });
     let mut files = write_runs(&motions, &dir)?;
     let wall_s = started.elapsed().as_secs_f64();

@@ -60,8 +60,27 @@ pub struct RobustCheck {
     pub wall_s: f64,
 }
 
-/// Run the checks of `info` for the motions `(label, trajectory)`.
-pub fn check(info: &RobustInfo, motions: &[(String, Trajectory)]) -> RobustCheck {
+/// The AMM of the checks: N and the step the plan's searches ran at (`modes`, `dt`: the accurate
+/// AMM's automatic choice for the plain quintic on the file's model), without the estimate's
+/// runs (`docs/motions.md` 4.11, "The check's model").
+#[derive(Debug, Clone, Copy)]
+pub struct CheckAmm {
+    pub modes: usize,
+    pub dt: Option<f64>,
+}
+
+impl CheckAmm {
+    /// `exp` with its AMM at this N and step.
+    fn applied(self, mut exp: Experiment) -> Experiment {
+        exp.amm.modes = Some(self.modes);
+        exp.amm.tol = None;
+        exp.amm.dt = self.dt;
+        exp
+    }
+}
+
+/// Run the checks of `info` for the motions `(label, trajectory)`, the AMM's at `amm`.
+pub fn check(info: &RobustInfo, motions: &[(String, Trajectory)], amm: CheckAmm) -> RobustCheck {
     let started = std::time::Instant::now();
     let unc = &info.uncertainty;
     let f_min = info.sample.iter().map(|m| m.f1_hz).fold(f64::INFINITY, f64::min);
@@ -70,17 +89,17 @@ pub fn check(info: &RobustInfo, motions: &[(String, Trajectory)]) -> RobustCheck
     let sample_models: Vec<(Vec<f64>, Result<Experiment>)> = info
         .sample
         .iter()
-        .map(|m| (m.values.clone(), Ok(m.exp.clone())))
+        .map(|m| (m.values.clone(), Ok(amm.applied(m.exp.clone()))))
         .collect();
     let sample = rows(&sample_models, motions, Solver::Amm, window_s, &mut failures);
     let draw_models: Vec<(Vec<f64>, Result<Experiment>)> = unc
         .fresh_draws()
         .into_iter()
-        .map(|v| (v.clone(), model(unc, &v)))
+        .map(|v| (v.clone(), model(unc, &v, amm)))
         .collect();
     let draws_solver = check_solver(unc);
     let draws = rows(&draw_models, motions, draws_solver, window_s, &mut failures);
-    let curves = curves(unc, motions, window_s, &mut failures);
+    let curves = curves(unc, motions, window_s, amm, &mut failures);
     let labels: Vec<String> = motions.iter().map(|(l, _)| l.clone()).collect();
     RobustCheck {
         sample_summary: summaries(&labels, &sample, unc.quantile),
@@ -104,8 +123,11 @@ pub fn check_solver(unc: &Uncertainty) -> Solver {
     }
 }
 
-fn model(unc: &Uncertainty, values: &[f64]) -> Result<Experiment> {
-    unc.model_at(values).map_err(ApiError::from_model)
+/// The model of `values` (its AMM at `amm`; the FEM takes no AMM settings).
+fn model(unc: &Uncertainty, values: &[f64], amm: CheckAmm) -> Result<Experiment> {
+    unc.model_at(values)
+        .map(|e| amm.applied(e))
+        .map_err(ApiError::from_model)
 }
 
 /// Every motion on every model, in parallel: the residual rows.
@@ -170,6 +192,7 @@ fn curves(
     unc: &Uncertainty,
     motions: &[(String, Trajectory)],
     window_s: f64,
+    amm: CheckAmm,
     failures: &mut Vec<String>,
 ) -> Vec<Curve> {
     (0..unc.ranges.len())
@@ -180,7 +203,7 @@ fn curves(
                 .map(|&v| {
                     let mut all = unc.nominal_values();
                     all[j] = v;
-                    (all.clone(), model(unc, &all))
+                    (all.clone(), model(unc, &all, amm))
                 })
                 .collect();
             let rows = rows(&models, motions, Solver::Amm, window_s, failures);

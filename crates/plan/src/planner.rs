@@ -57,6 +57,9 @@ pub struct Planned {
     pub plain: Eval,
     /// AMM modes per beam N (frozen), the first frequency at the final pose [Hz], the window [s].
     pub modes: usize,
+    /// The AMM step of the searches [s] (the automatic choice's delivered step; `None`: the
+    /// default step of a fixed N, 4.3).
+    pub dt: Option<f64>,
     pub f1_hz: f64,
     pub window_s: f64,
     /// The model floor of the search [m].
@@ -397,6 +400,7 @@ pub(crate) fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Exper
         eval: sol.eval,
         plain,
         modes: s.modes,
+        dt: s.frozen.amm.dt,
         f1_hz: s.f1_hz,
         window_s: s.evaluator.window,
         r_floor_m: stop.r_floor,

@@ -361,6 +361,7 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
         eval,
         plain,
         modes: s.modes,
+        dt: s.frozen.amm.dt,
         f1_hz: s.f1_hz,
         window_s: s.evaluator.window,
         r_floor_m: TIME_FLOOR_SHARE * r_max,

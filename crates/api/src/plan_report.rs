@@ -131,7 +131,7 @@ pub fn plan_markdown(cfg: &PlanConfig, o: &PlanOutcome) -> String {
     let p = &o.planned;
     let rows: Vec<MotionRow> = o.motions.iter().map(motion_row).collect();
     let mut s = format!(
-        "# {}: planned motion\n\n{} from ({}, {}, {}) to ({}, {}, {}), t0 = {} s, move time {:.4} s ({} objective, shape {:?}, {} interior points).\n\n",
+        "# {}: planned motion\n\n{} from ({}, {}, {}) to ({}, {}, {}), t0 = {} s, move time {:.4} s ({} objective, shape \"{}\", {} interior points).\n\n",
         cfg.exp.name,
         cfg.exp.description,
         cfg.plan.from.gx,
@@ -143,7 +143,7 @@ pub fn plan_markdown(cfg: &PlanConfig, o: &PlanOutcome) -> String {
         cfg.plan.t0,
         p.t_move,
         if cfg.plan.residual_max.is_some() { "time" } else { "residual" },
-        cfg.plan.shape,
+        cfg.plan.shape.word(),
         p.family.m,
     );
     s += &search_text(p);

@@ -32,6 +32,16 @@ pub enum Shape {
     Path,
 }
 
+impl Shape {
+    /// The key's word in a plan file (`"timing"`, `"path"`).
+    pub fn word(self) -> &'static str {
+        match self {
+            Shape::Timing => "timing",
+            Shape::Path => "path",
+        }
+    }
+}
+
 /// `[plan]`: a rest-to-rest move from `from` at `t0` to `to` (`docs/motions.md` 4.1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

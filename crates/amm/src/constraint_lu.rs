@@ -26,8 +26,22 @@
 //! A sleeve block whose inverse fails its check, or a pivot of Z below [`BLOCK_PIVOT_RATIO`] of
 //! Z's largest entry, hands the step to the dense LU with partial pivoting, whose own test
 //! ([`PIVOT_RATIO`]) decides rank deficiency.
+//!
+//! **Bordered rows** (friction's stick rows, `docs/friction.md` 9, one per sleeve after all
+//! others): a stick row of beam i couples with the junction rows and beam i's rows only, and the
+//! friction terms keep the structure of the rows above them, so A is bordered,
+//!
+//! ```text
+//! A = [ A_0  B ]      A_0: the structure above (m - 3 rows), D: 3 x 3
+//!     [ C    D ]
+//! ```
+//!
+//! and is factored by block elimination of A_0 (above), `Y = A_0^-1 B` (three solves) and the
+//! inverse of the 3 x 3 Schur complement `D - C Y` (nalgebra's closed form, checked like a
+//! sleeve block); anything that fails its check hands the step to the dense LU of the whole A
+//! (`docs/friction.md` 6, "Speed").
 
-use nalgebra::{Matrix4, Matrix6, SMatrix, Vector4, Vector6, LU, U6};
+use nalgebra::{Matrix3, Matrix4, Matrix6, SMatrix, Vector3, Vector4, Vector6, LU, U6};
 
 use crate::dense_lu::DenseLu;
 
@@ -49,6 +63,8 @@ pub(crate) struct ConstraintLu {
     m: usize,
     nj: usize,
     blocks: Option<Blocks>,
+    /// With bordered rows: their factors (valid when `blocks` is `Some`).
+    border: Option<Border>,
     /// The dense factors (valid when `blocks` is `None` after a successful factorisation).
     dense: DenseLu,
 }
@@ -64,6 +80,24 @@ struct Blocks {
     coupling: [SMatrix<f64, 6, 4>; 3],
     /// LU of the junction Schur complement Z (padded with the identity past nj).
     junction: LU<f64, U6, U6>,
+}
+
+/// Bordered rows' count (friction's three stick rows).
+pub(crate) const BORDER_ROWS: usize = 3;
+/// Most rows of `A_0`.
+const MAX_INNER_ROWS: usize = MAX_JUNCTION_ROWS + 3 * SLEEVE_ROWS;
+
+/// The factors of the bordered rows (module docs).
+#[derive(Debug, Clone)]
+struct Border {
+    /// `A_0` (m0 x m0, row-major) in storage sized once.
+    inner: Vec<f64>,
+    /// `Y = A_0^-1 B` (rows past m0 zero).
+    y: SMatrix<f64, MAX_INNER_ROWS, BORDER_ROWS>,
+    /// `C` (columns past m0 zero).
+    c: SMatrix<f64, BORDER_ROWS, MAX_INNER_ROWS>,
+    /// `(D - C Y)^-1`.
+    schur_inverse: Matrix3<f64>,
 }
 
 /// Largest |entry| of a matrix.
@@ -91,34 +125,77 @@ impl ConstraintLu {
             m,
             nj: m.saturating_sub(3 * SLEEVE_ROWS),
             blocks: None,
+            border: None,
             dense: DenseLu::new(m),
         }
     }
 
-    /// For an m x m system factored densely whatever its structure (with the stick rows of
-    /// friction, `docs/friction.md` 9, the rows no longer have the block structure).
-    pub(crate) fn dense(m: usize) -> Self {
+    /// For an m x m system whose last [`BORDER_ROWS`] rows border the structure (friction's stick
+    /// rows, `docs/friction.md` 9; module docs).
+    pub(crate) fn bordered(m: usize) -> Self {
+        let m0 = m.saturating_sub(BORDER_ROWS);
         ConstraintLu {
             m,
-            nj: m,
+            nj: m0.saturating_sub(3 * SLEEVE_ROWS),
             blocks: None,
+            border: Some(Border {
+                inner: vec![0.0; m0 * m0],
+                y: SMatrix::zeros(),
+                c: SMatrix::zeros(),
+                schur_inverse: Matrix3::zeros(),
+            }),
             dense: DenseLu::new(m),
         }
     }
 
     /// Factor A (`a`, m x m, row-major). Fails with the reason when A is rank deficient.
     pub(crate) fn factor(&mut self, a: &[f64]) -> Result<(), RankError> {
-        self.blocks = self.block_factor(a);
+        self.blocks = match self.border.take() {
+            None => self.block_factor(a, self.m),
+            Some(mut border) => {
+                let blocks = self.bordered_factor(a, &mut border);
+                self.border = Some(border);
+                blocks
+            }
+        };
         if self.blocks.is_none() {
             self.dense_factor(a)?;
         }
         Ok(())
     }
 
+    /// The bordered factorisation (module docs), or `None` when a check fails.
+    fn bordered_factor(&self, a: &[f64], border: &mut Border) -> Option<Blocks> {
+        let (m, m0) = (self.m, self.m - BORDER_ROWS);
+        if m0 > MAX_INNER_ROWS {
+            return None;
+        }
+        for r in 0..m0 {
+            border.inner[r * m0..(r + 1) * m0].copy_from_slice(&a[r * m..r * m + m0]);
+        }
+        let blocks = self.block_factor(&border.inner, m0)?;
+        let mut column = [0.0; MAX_INNER_ROWS];
+        for k in 0..BORDER_ROWS {
+            for (r, v) in column[..m0].iter_mut().enumerate() {
+                *v = a[r * m + m0 + k];
+            }
+            block_solve(&blocks, self.nj, &mut column[..m0]);
+            for r in 0..MAX_INNER_ROWS {
+                border.y[(r, k)] = if r < m0 { column[r] } else { 0.0 };
+            }
+            for c in 0..MAX_INNER_ROWS {
+                border.c[(k, c)] = if c < m0 { a[(m0 + k) * m + c] } else { 0.0 };
+            }
+        }
+        let d = Matrix3::from_fn(|r, c| a[(m0 + r) * m + m0 + c]);
+        border.schur_inverse = checked_inverse3(&(d - border.c * border.y))?;
+        Some(blocks)
+    }
+
     /// The block elimination, or `None` when a block pivot is too small (or the rows do not have
     /// the structure).
-    fn block_factor(&self, a: &[f64]) -> Option<Blocks> {
-        let (m, nj) = (self.m, self.nj);
+    fn block_factor(&self, a: &[f64], m: usize) -> Option<Blocks> {
+        let nj = self.nj;
         if m != nj + 3 * SLEEVE_ROWS || nj > MAX_JUNCTION_ROWS {
             return None;
         }
@@ -182,27 +259,57 @@ impl ConstraintLu {
             self.dense.solve(b);
             return;
         };
-        let nj = self.nj;
-        let mut rj = Vector6::<f64>::zeros();
-        for r in 0..nj {
-            rj[r] = b[r];
+        let Some(border) = &self.border else {
+            block_solve(f, self.nj, b);
+            return;
+        };
+        // y = A_0^-1 b_0; x_1 = (D - C Y)^-1 (b_1 - C y); x_0 = y - Y x_1
+        let m0 = self.m - BORDER_ROWS;
+        let (head, tail) = b.split_at_mut(m0);
+        block_solve(f, self.nj, head);
+        let mut cy = Vector3::<f64>::zeros();
+        for k in 0..BORDER_ROWS {
+            cy[k] = (0..m0).map(|c| border.c[(k, c)] * head[c]).sum::<f64>();
         }
-        let y = [0, 1, 2].map(|i| {
-            let s = nj + SLEEVE_ROWS * i;
-            let y = f.sleeve[i] * Vector4::from_fn(|r, _| b[s + r]);
-            rj -= f.coupling[i] * y;
-            y
-        });
-        f.junction.solve_mut(&mut rj);
-        for r in 0..nj {
-            b[r] = rj[r];
+        let x1 = border.schur_inverse * (Vector3::from_fn(|k, _| tail[k]) - cy);
+        for (r, v) in head.iter_mut().enumerate() {
+            *v -= (0..BORDER_ROWS).map(|k| border.y[(r, k)] * x1[k]).sum::<f64>();
         }
-        for (i, (yi, xi)) in y.iter().zip(&f.x).enumerate() {
-            let s = nj + SLEEVE_ROWS * i;
-            let lam = yi - xi * rj;
-            b[s..s + SLEEVE_ROWS].copy_from_slice(lam.as_slice());
-        }
+        tail.copy_from_slice(x1.as_slice());
     }
+}
+
+/// Solve `A x = b` in place with the block factors `f` of a structure with `nj` junction rows.
+fn block_solve(f: &Blocks, nj: usize, b: &mut [f64]) {
+    let mut rj = Vector6::<f64>::zeros();
+    for r in 0..nj {
+        rj[r] = b[r];
+    }
+    let y = [0, 1, 2].map(|i| {
+        let s = nj + SLEEVE_ROWS * i;
+        let y = f.sleeve[i] * Vector4::from_fn(|r, _| b[s + r]);
+        rj -= f.coupling[i] * y;
+        y
+    });
+    f.junction.solve_mut(&mut rj);
+    for r in 0..nj {
+        b[r] = rj[r];
+    }
+    for (i, (yi, xi)) in y.iter().zip(&f.x).enumerate() {
+        let s = nj + SLEEVE_ROWS * i;
+        let lam = yi - xi * rj;
+        b[s..s + SLEEVE_ROWS].copy_from_slice(lam.as_slice());
+    }
+}
+
+/// nalgebra's inverse of the bordered rows' 3 x 3 Schur complement, accepted as a sleeve
+/// block's is ([`INVERSE_CHECK`]).
+fn checked_inverse3(block: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+    let inverse = block.try_inverse()?;
+    let error = (block * inverse - Matrix3::identity())
+        .iter()
+        .fold(0.0f64, |s, v| s.max(v.abs()));
+    (error <= INVERSE_CHECK).then_some(inverse)
 }
 
 #[cfg(test)]
@@ -309,5 +416,53 @@ mod tests {
         let err = ConstraintLu::new(m).factor(&zero_row).unwrap_err();
         assert!(matches!(err, RankError::NoCoupling { row: 2 }), "{err}");
         assert!(err.to_string().contains("row 2 has no coupling"), "{err}");
+    }
+    /// The structure bordered by three rows coupled to every row (friction's stick rows): the
+    /// bordered factorisation is taken and solves `A x = b` to its definition, and agrees with
+    /// the dense LU of the same matrix; a border whose Schur complement is singular (a stick row
+    /// equal to a sleeve row) falls back to the dense LU, which reports the rank deficiency.
+    #[test]
+    fn bordered_rows_solve_the_system_and_fall_back_when_singular() {
+        for nj in 3..=MAX_JUNCTION_ROWS {
+            let m0 = nj + 12;
+            let m = m0 + BORDER_ROWS;
+            let inner = structured(nj, 7 + nj as u64);
+            let mut state = nj as u64;
+            let mut rnd = || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+            };
+            let mut a = vec![0.0; m * m];
+            for r in 0..m {
+                for c in 0..m {
+                    a[r * m + c] = if r < m0 && c < m0 { inner[r * m0 + c] } else { rnd() };
+                }
+            }
+            for k in m0..m {
+                a[k * m + k] += 4.0;
+            }
+            let b: Vec<f64> = (0..m).map(|k| (k as f64 * 0.3).cos()).collect();
+            let mut lu = ConstraintLu::bordered(m);
+            lu.factor(&a).unwrap();
+            assert!(lu.blocks.is_some(), "nj = {nj}: bordered path expected");
+            let mut x = b.clone();
+            lu.solve(&mut x);
+            assert!(residual(&a, &x, &b) < 1e-12, "nj = {nj}: {:e}", residual(&a, &x, &b));
+            let mut dense = DenseLu::new(m);
+            dense.factor(&a);
+            let mut y = b.clone();
+            dense.solve(&mut y);
+            let gap = x.iter().zip(&y).fold(0.0f64, |g, (p, q)| g.max((p - q).abs()));
+            assert!(gap < 1e-12, "nj = {nj}: bordered and dense differ by {gap:e}");
+
+            let mut singular = a.clone();
+            for c in 0..m {
+                singular[m0 * m + c] = singular[nj * m + c];
+            }
+            let err = ConstraintLu::bordered(m).factor(&singular).unwrap_err();
+            assert!(matches!(err, RankError::RankDeficient { .. }), "nj = {nj}: {err}");
+        }
     }
 }

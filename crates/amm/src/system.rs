@@ -649,7 +649,7 @@ impl System {
     }
 
     /// Friction in the sleeves (`docs/friction.md` 9): the stick rows of Eq. F16 (one per
-    /// sleeve, after the others; the Schur complement then factored densely) and the law. Call
+    /// sleeve, after the others; they border the Schur complement, `constraint_lu`) and the law. Call
     /// before [`System::attach`] (the payload's workspaces are sized by beam 1's rows); `params`
     /// and `weld` those of [`System::new`].
     pub(crate) fn attach_friction(&mut self, law: flexstar_model::Friction, params: &[RobotParams; 3], weld: &Weld) {
@@ -660,7 +660,7 @@ impl System {
         self.beams = beam_rows(&self.rows, has_w0, hp, self.nm, weld);
         let m = self.rows.len();
         (self.a, self.rhs, self.lam) = (vec![0.0; m * m], vec![0.0; m], vec![0.0; m]);
-        self.lu = ConstraintLu::dense(m);
+        self.lu = ConstraintLu::bordered(m);
         let index = |r: Row| self.rows.iter().position(|x| *x == r).expect("a sleeve row");
         let rows = std::array::from_fn(|i| SleeveRow::ALL.map(|r| index(Row::Sleeve(i, r))));
         let stick = [first, first + 1, first + 2];

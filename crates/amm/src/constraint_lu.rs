@@ -180,8 +180,8 @@ impl ConstraintLu {
                 *v = a[r * m + m0 + k];
             }
             block_solve(&blocks, self.nj, &mut column[..m0]);
-            for r in 0..MAX_INNER_ROWS {
-                border.y[(r, k)] = if r < m0 { column[r] } else { 0.0 };
+            for (r, v) in column.iter().enumerate() {
+                border.y[(r, k)] = if r < m0 { *v } else { 0.0 };
             }
             for c in 0..MAX_INNER_ROWS {
                 border.c[(k, c)] = if c < m0 { a[(m0 + k) * m + c] } else { 0.0 };

@@ -90,8 +90,6 @@ const MAX_INNER_ROWS: usize = MAX_JUNCTION_ROWS + 3 * SLEEVE_ROWS;
 /// The factors of the bordered rows (module docs).
 #[derive(Debug, Clone)]
 struct Border {
-    /// `A_0` (m0 x m0, row-major) in storage sized once.
-    inner: Vec<f64>,
     /// `Y = A_0^-1 B` (rows past m0 zero).
     y: SMatrix<f64, MAX_INNER_ROWS, BORDER_ROWS>,
     /// `C` (columns past m0 zero).
@@ -105,11 +103,12 @@ fn largest<const R: usize, const C: usize>(a: &SMatrix<f64, R, C>) -> f64 {
     a.iter().fold(0.0f64, |s, v| s.max(v.abs()))
 }
 
-/// nalgebra's inverse of a sleeve block, accepted when `block * inverse` is the identity to
-/// [`INVERSE_CHECK`] (a block too close to singular for the closed form gives `None`).
-fn checked_inverse(block: &Matrix4<f64>) -> Option<Matrix4<f64>> {
+/// nalgebra's inverse of a sleeve block or of the bordered rows' Schur complement, accepted when
+/// `block * inverse` is the identity to [`INVERSE_CHECK`] (a block too close to singular for
+/// the closed form gives `None`).
+fn checked_inverse<const N: usize>(block: &SMatrix<f64, N, N>) -> Option<SMatrix<f64, N, N>> {
     let inverse = block.try_inverse()?;
-    let error = largest(&(block * inverse - Matrix4::identity()));
+    let error = largest(&(block * inverse - SMatrix::<f64, N, N>::identity()));
     (error <= INVERSE_CHECK).then_some(inverse)
 }
 
@@ -139,7 +138,6 @@ impl ConstraintLu {
             nj: m0.saturating_sub(3 * SLEEVE_ROWS),
             blocks: None,
             border: Some(Border {
-                inner: vec![0.0; m0 * m0],
                 y: SMatrix::zeros(),
                 c: SMatrix::zeros(),
                 schur_inverse: Matrix3::zeros(),
@@ -151,7 +149,7 @@ impl ConstraintLu {
     /// Factor A (`a`, m x m, row-major). Fails with the reason when A is rank deficient.
     pub(crate) fn factor(&mut self, a: &[f64]) -> Result<(), RankError> {
         self.blocks = match self.border.take() {
-            None => self.block_factor(a, self.m),
+            None => self.block_factor(a, self.m, self.m),
             Some(mut border) => {
                 let blocks = self.bordered_factor(a, &mut border);
                 self.border = Some(border);
@@ -170,10 +168,8 @@ impl ConstraintLu {
         if m0 > MAX_INNER_ROWS {
             return None;
         }
-        for r in 0..m0 {
-            border.inner[r * m0..(r + 1) * m0].copy_from_slice(&a[r * m..r * m + m0]);
-        }
-        let blocks = self.block_factor(&border.inner, m0)?;
+        // A_0 is the leading m0 x m0 part of A, read in place (row stride m)
+        let blocks = self.block_factor(a, m0, m)?;
         let mut column = [0.0; MAX_INNER_ROWS];
         for k in 0..BORDER_ROWS {
             for (r, v) in column[..m0].iter_mut().enumerate() {
@@ -188,18 +184,19 @@ impl ConstraintLu {
             }
         }
         let d = Matrix3::from_fn(|r, c| a[(m0 + r) * m + m0 + c]);
-        border.schur_inverse = checked_inverse3(&(d - border.c * border.y))?;
+        border.schur_inverse = checked_inverse(&(d - border.c * border.y))?;
         Some(blocks)
     }
 
-    /// The block elimination, or `None` when a block pivot is too small (or the rows do not have
-    /// the structure).
-    fn block_factor(&self, a: &[f64], m: usize) -> Option<Blocks> {
+    /// The block elimination of the leading `m` x `m` part of `a` (row-major, row stride
+    /// `stride`), or `None` when a block pivot is too small (or the rows do not have the
+    /// structure).
+    fn block_factor(&self, a: &[f64], m: usize, stride: usize) -> Option<Blocks> {
         let nj = self.nj;
         if m != nj + 3 * SLEEVE_ROWS || nj > MAX_JUNCTION_ROWS {
             return None;
         }
-        let at = |r: usize, c: usize| a[r * m + c];
+        let at = |r: usize, c: usize| a[r * stride + c];
         let mut z = Matrix6::<f64>::identity();
         for r in 0..nj {
             for c in 0..nj {
@@ -300,16 +297,6 @@ fn block_solve(f: &Blocks, nj: usize, b: &mut [f64]) {
         let lam = yi - xi * rj;
         b[s..s + SLEEVE_ROWS].copy_from_slice(lam.as_slice());
     }
-}
-
-/// nalgebra's inverse of the bordered rows' 3 x 3 Schur complement, accepted as a sleeve
-/// block's is ([`INVERSE_CHECK`]).
-fn checked_inverse3(block: &Matrix3<f64>) -> Option<Matrix3<f64>> {
-    let inverse = block.try_inverse()?;
-    let error = (block * inverse - Matrix3::identity())
-        .iter()
-        .fold(0.0f64, |s, v| s.max(v.abs()));
-    (error <= INVERSE_CHECK).then_some(inverse)
 }
 
 #[cfg(test)]

@@ -52,7 +52,8 @@ pub struct RobustCheck {
     pub sample_summary: Vec<Summary>,
     pub draws: Vec<ModelRow>,
     pub draws_summary: Vec<Summary>,
-    /// The model the draws ran on: `"AMM"` (the accurate AMM at its automatic choice) or `"FEM"`.
+    /// The model the draws ran on: `"AMM"` (the accurate AMM at the plan's N and step,
+    /// [`CheckAmm`]) or `"FEM"`.
     pub draws_model: String,
     pub curves: Vec<Curve>,
     /// Runs that failed, with their reason (none expected).
@@ -116,7 +117,7 @@ pub fn check(info: &RobustInfo, motions: &[(String, Trajectory)], amm: CheckAmm)
 }
 
 /// The solver of the fresh draws (`[robust] check`).
-pub fn check_solver(unc: &Uncertainty) -> Solver {
+fn check_solver(unc: &Uncertainty) -> Solver {
     match unc.check {
         CheckModel::Amm => Solver::Amm,
         CheckModel::Fem => Solver::Fem,

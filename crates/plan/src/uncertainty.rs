@@ -285,8 +285,8 @@ fn read_duration(v: &toml::Value, file: &Path) -> Result<RobustDuration, ModelEr
 }
 
 /// The model of the fresh draws' check, `[robust] check` (`docs/motions.md` 4.11, "The check's
-/// model"): the accurate AMM at its automatic choice (default: the draws cost what a plan may
-/// take), or the FEM (the independent model, about four times the cost per run).
+/// model"): the accurate AMM at the N and step of the plan's searches (default: the draws cost
+/// what a plan may take), or the FEM (the independent model, about four times the cost per run).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CheckModel {

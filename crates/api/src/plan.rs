@@ -220,15 +220,21 @@ pub(crate) fn run_motions(
 
 /// Write each motion's runs into `dir/<key>/`.
 pub(crate) fn write_runs(motions: &[MotionRuns], dir: &Path) -> Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
     for m in motions {
-        let sub = dir.join(m.key);
-        flexstar_io::output::ensure_writable_dir(&sub)?;
-        for run in [&m.amm, &m.fem] {
-            let mut out = run.clone();
-            crate::run::write_run(&mut out, &sub, false)?;
-            files.extend(out.files);
-        }
+        flexstar_io::output::ensure_writable_dir(&dir.join(m.key))?;
+    }
+    let jobs: Vec<(&MotionRuns, &RunOutcome)> = motions.iter().flat_map(|m| [(m, &m.amm), (m, &m.fem)]).collect();
+    let written: Vec<Result<Vec<PathBuf>>> = jobs
+        .par_iter()
+        .map(|(m, run)| {
+            let mut out = (*run).clone();
+            crate::run::write_run(&mut out, &dir.join(m.key), false)?;
+            Ok(out.files)
+        })
+        .collect();
+    let mut files = Vec::new();
+    for w in written {
+        files.extend(w?);
     }
     Ok(files)
 }

@@ -1,5 +1,6 @@
 //! Levenberg-Marquardt on the residual vector of an evaluation (`docs/motions.md` 4.5): the
-//! Jacobian by forward differences, its columns evaluated in parallel. With limits, each damped
+//! Jacobian by forward differences, its columns evaluated in parallel, optionally on a cheaper
+//! model than the one that judges the iterates (4.9, "The Jacobian's step"). With limits, each damped
 //! step is a small quadratic program: the Gauss-Newton model of `|r|^2` minimised within the
 //! limits linearised at the iterate ([`crate::qp`]). A trial step that breaks a limit, leaves the
 //! workspace or does not lower `|r|` is rejected and the damping raised, so that every accepted
@@ -70,10 +71,19 @@ pub struct Solution {
 }
 
 /// Minimise `|r(x)|^2` from `x0` (whose evaluation `e0` must be feasible); `accept` tells a
-/// trial within the limits.
-pub fn minimise<F, A>(f: &F, accept: &A, x0: Vec<f64>, e0: Eval, stop: Stop) -> Result<Solution, Rejected>
+/// trial within the limits. `slope`: the model whose runs give the Jacobian (`docs/motions.md`
+/// 4.9, "The Jacobian's step"); `None`, `f` itself. Every iterate and trial is judged by `f`.
+pub fn minimise<F, G, A>(
+    f: &F,
+    slope: Option<&G>,
+    accept: &A,
+    x0: Vec<f64>,
+    e0: Eval,
+    stop: Stop,
+) -> Result<Solution, Rejected>
 where
     F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
+    G: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
     A: Fn(&Eval) -> bool,
 {
     let start = Instant::now();
@@ -85,8 +95,11 @@ where
             s.reason = reason;
             break;
         }
-        let jac = jacobian(f, &s.x, &s.eval)?;
-        s.evaluations += s.x.len();
+        let (jac, runs) = match slope {
+            None => jacobian(f, &s.x, Some(&s.eval))?,
+            Some(g) => jacobian(g, &s.x, None)?,
+        };
+        s.evaluations += runs;
         match s.step(f, accept, &jac, &mut mu, stop) {
             Some(()) => {}
             None if Instant::now() >= stop.deadline => {
@@ -254,38 +267,53 @@ pub struct Jacobian {
     pub progress: Mat<f64>,
 }
 
-/// The Jacobians of `r` and of the usage at `x` by forward differences (a backward difference
-/// where the forward point is rejected), the columns in parallel.
-pub(crate) fn jacobian<F>(f: &F, x: &[f64], e0: &Eval) -> Result<Jacobian, Rejected>
+/// The Jacobians of `r` and of the usage at `x` by forward differences of `f` (a backward
+/// difference where the forward point is rejected), the columns in parallel. `base`: `f`'s
+/// evaluation at `x` when known; `None` runs it beside the columns. Returns the Jacobian and the
+/// runs it took.
+pub(crate) fn jacobian<F>(f: &F, x: &[f64], base: Option<&Eval>) -> Result<(Jacobian, usize), Rejected>
 where
     F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
 {
-    let rows0: Vec<f64> = e0.r.iter().chain(&e0.usage).chain(&e0.progress).copied().collect();
-    let r0 = &rows0;
-    let columns: Vec<Result<Vec<f64>, Rejected>> = (0..x.len())
+    let n = x.len();
+    let extra = usize::from(base.is_none());
+    // item j < n: the column's point and the difference's sign; item n: the base point
+    let points: Vec<Result<(Eval, f64, f64), Rejected>> = (0..n + extra)
         .into_par_iter()
         .map(|j| {
+            if j == n {
+                return f(x).map(|e| (e, 0.0, 0.0));
+            }
             let h = FD_STEP * x[j].abs().max(1.0);
             let at = |sign: f64| {
                 let mut xp = x.to_vec();
                 xp[j] += sign * h;
                 f(&xp)
             };
-            let (e, sign) = match at(1.0) {
-                Ok(e) => (e, 1.0),
-                Err(_) => (at(-1.0)?, -1.0),
-            };
-            let rows = e.r.iter().chain(&e.usage).chain(&e.progress);
-            Ok(rows.zip(r0).map(|(a, b)| sign * (a - b) / h).collect())
+            match at(1.0) {
+                Ok(e) => Ok((e, 1.0, h)),
+                Err(_) => Ok((at(-1.0)?, -1.0, h)),
+            }
         })
         .collect();
-    let columns = columns.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let mut points = points.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let own_base = (extra == 1).then(|| points.pop().map(|(e, _, _)| e)).flatten();
+    let e0 = own_base.as_ref().or(base).expect("the base evaluation is given or run");
+    let rows0: Vec<f64> = e0.r.iter().chain(&e0.usage).chain(&e0.progress).copied().collect();
+    let columns: Vec<Vec<f64>> = points
+        .iter()
+        .map(|(e, sign, h)| {
+            let rows = e.r.iter().chain(&e.usage).chain(&e.progress);
+            rows.zip(&rows0).map(|(a, b)| sign * (a - b) / h).collect()
+        })
+        .collect();
     let (nr, nu) = (e0.r.len(), e0.usage.len());
-    Ok(Jacobian {
-        r: Mat::from_fn(nr, x.len(), |i, j| columns[j][i]),
-        usage: Mat::from_fn(nu, x.len(), |i, j| columns[j][nr + i]),
-        progress: Mat::from_fn(e0.progress.len(), x.len(), |i, j| columns[j][nr + nu + i]),
-    })
+    let jac = Jacobian {
+        r: Mat::from_fn(nr, n, |i, j| columns[j][i]),
+        usage: Mat::from_fn(nu, n, |i, j| columns[j][nr + i]),
+        progress: Mat::from_fn(e0.progress.len(), n, |i, j| columns[j][nr + nu + i]),
+    };
+    Ok((jac, n + extra))
 }
 
 /// `J^T J` and `J^T r`.
@@ -321,7 +349,38 @@ mod tests {
             r_floor: 1e-10,
             deadline: Instant::now() + std::time::Duration::from_secs(10),
         };
-        let s = minimise(&f, &|_: &Eval| true, x0, e0, stop).unwrap();
+        let s = minimise(
+            &f,
+            None::<&fn(&[f64]) -> Result<Eval, Rejected>>,
+            &|_: &Eval| true,
+            x0,
+            e0,
+            stop,
+        )
+        .unwrap();
+        assert!(
+            (s.x[0] - 1.0).abs() < 1e-6 && (s.x[1] - 1.0).abs() < 1e-6,
+            "{:?}: {}",
+            s.x,
+            s.reason
+        );
+    }
+
+    /// The Jacobian from a different model than the one that judges the trials (4.9, "The
+    /// Jacobian's step"): a slope model whose first residual is 5 % too large still leads the
+    /// search to Rosenbrock's textbook minimum (1, 1), because the minimum's residual is zero and
+    /// every trial is judged by the true residual.
+    #[test]
+    fn a_slope_model_still_finds_the_minimum_of_the_true_residual() {
+        let f = |x: &[f64]| Ok(eval_of(vec![10.0 * (x[1] - x[0] * x[0]), 1.0 - x[0]]));
+        let g = |x: &[f64]| Ok(eval_of(vec![10.5 * (x[1] - x[0] * x[0]), 1.0 - x[0]]));
+        let x0 = vec![-1.2, 1.0];
+        let e0 = f(&x0).unwrap();
+        let stop = Stop {
+            r_floor: 1e-10,
+            deadline: Instant::now() + std::time::Duration::from_secs(10),
+        };
+        let s = minimise(&f, Some(&g), &|_: &Eval| true, x0, e0, stop).unwrap();
         assert!(
             (s.x[0] - 1.0).abs() < 1e-6 && (s.x[1] - 1.0).abs() < 1e-6,
             "{:?}: {}",
@@ -348,7 +407,7 @@ mod tests {
             deadline: Instant::now() + std::time::Duration::from_secs(10),
         };
         let accept = |e: &Eval| e.within(&crate::section::Limits::default());
-        let s = minimise(&f, &accept, x0, e0, stop).unwrap();
+        let s = minimise(&f, None::<&fn(&[f64]) -> Result<Eval, Rejected>>, &accept, x0, e0, stop).unwrap();
         assert!(
             (s.x[0] - 1.5).abs() < 1e-4 && (s.x[1] - 0.5).abs() < 1e-4,
             "{:?}: {}",
@@ -379,7 +438,15 @@ mod tests {
             r_floor: 0.0,
             deadline: Instant::now() + std::time::Duration::from_secs(10),
         };
-        let s = minimise(&f, &|_: &Eval| true, x0, e0, stop).unwrap();
+        let s = minimise(
+            &f,
+            None::<&fn(&[f64]) -> Result<Eval, Rejected>>,
+            &|_: &Eval| true,
+            x0,
+            e0,
+            stop,
+        )
+        .unwrap();
         assert!(s.x[0] <= 1.5 && s.x[0] > 1.49, "{:?}", s.x);
     }
 }

@@ -1,7 +1,7 @@
 //! The worst-case (or quantile) search of a robust plan (`docs/motions.md` 4.11): minimise
 //! `max_{k in S_q} |r_k(x)|` over the sample models (Eq. U1) by Gauss-Newton steps on the
 //! epigraph (Eq. U3, [`crate::qp::epigraph_step`]), each model's Jacobian by forward differences
-//! ([`crate::lm::jacobian`]), the damping and the acceptance of 4.9: a trial is accepted when
+//! ([`crate::lm::jacobian`], on the model's slope runs of 4.9, "The Jacobian's step"), the damping and the acceptance of 4.9: a trial is accepted when
 //! every model's evaluation is within its limits and the objective falls.
 
 use std::time::Instant;
@@ -19,6 +19,16 @@ pub trait Models: Sync {
     fn count(&self) -> usize;
     fn eval(&self, k: usize, x: &[f64]) -> Result<Eval, Rejected>;
     fn accept(&self, k: usize, e: &Eval) -> bool;
+    /// Model `k`'s run for its Jacobian's columns (`docs/motions.md` 4.9, "The Jacobian's
+    /// step"), `None` when that is [`Models::eval`] itself.
+    fn slope_eval(&self, k: usize, x: &[f64]) -> Option<Result<Eval, Rejected>> {
+        let _ = (k, x);
+        None
+    }
+    /// Whether [`Models::slope_eval`] is a model of its own (its base point then runs too).
+    fn has_slope_model(&self) -> bool {
+        false
+    }
 }
 
 /// When the search stops.
@@ -82,8 +92,8 @@ pub fn minimise<M: Models>(
         if let Some(reason) = s.finished(stop) {
             break reason;
         }
-        let jacs = jacobians(models, &s.x, &s.evals)?;
-        s.evaluations += s.x.len() * models.count();
+        let (jacs, runs) = jacobians(models, &s.x, &s.evals)?;
+        s.evaluations += runs;
         let before = s.objective();
         if s.step(models, &jacs, &mut mu, stop).is_none() {
             break if Instant::now() >= stop.deadline {
@@ -106,11 +116,21 @@ pub fn minimise<M: Models>(
     })
 }
 
-/// Every model's Jacobian at `x`.
-fn jacobians<M: Models>(models: &M, x: &[f64], evals: &[Eval]) -> Result<Vec<Jacobian>, Rejected> {
-    (0..models.count())
-        .map(|k| jacobian(&|y: &[f64]| models.eval(k, y), x, &evals[k]))
-        .collect()
+/// Every model's Jacobian at `x`, and the runs they took.
+fn jacobians<M: Models>(models: &M, x: &[f64], evals: &[Eval]) -> Result<(Vec<Jacobian>, usize), Rejected> {
+    let mut runs = 0;
+    let mut jacs = Vec::with_capacity(models.count());
+    for (k, own) in evals.iter().enumerate().take(models.count()) {
+        let (jac, n) = if models.has_slope_model() {
+            let slope = |y: &[f64]| models.slope_eval(k, y).unwrap_or_else(|| models.eval(k, y));
+            jacobian(&slope, x, None)?
+        } else {
+            jacobian(&|y: &[f64]| models.eval(k, y), x, Some(own))?
+        };
+        runs += n;
+        jacs.push(jac);
+    }
+    Ok((jacs, runs))
 }
 
 struct State {

@@ -24,6 +24,10 @@ use crate::section::Limits;
 /// 1e-6 of the mean rate `1/T`: the QP's own tolerance; `docs/motions.md` 4.10).
 pub const PROGRESS_TOL: f64 = 1e-6;
 
+/// The Jacobian's runs take this many times fewer steps than the evaluations that judge the
+/// iterates (`docs/motions.md` 4.9, "The Jacobian's step").
+pub const SLOPE_STEP_RATIO: f64 = 2.0;
+
 /// What one evaluation gives.
 #[derive(Debug, Clone)]
 pub struct Eval {
@@ -190,6 +194,21 @@ impl Evaluator {
         Evaluator { limits, ..self.clone() }
     }
 
+    /// The evaluator of the search's Jacobian runs (`docs/motions.md` 4.9, "The Jacobian's
+    /// step"): the same model at half as many steps per output interval (at least one), `None`
+    /// when its step already spans the output interval.
+    pub fn for_slopes(&self) -> Option<Evaluator> {
+        let dt_out = self.exp.time.dt_out;
+        let per_output = |h: f64| ((dt_out / h) - 1e-9).ceil().max(1.0);
+        let fine = per_output(self.settings.dt.unwrap_or(flexstar_amm::DEFAULT_DT));
+        let coarse = (fine / SLOPE_STEP_RATIO).ceil().max(1.0);
+        (coarse < fine).then(|| {
+            let mut ev = self.clone();
+            ev.settings.dt = Some(dt_out / coarse);
+            ev
+        })
+    }
+
     /// The same evaluator with the terms of 4.10.
     pub fn with_terms(&self, terms: Terms) -> Self {
         Evaluator { terms, ..self.clone() }
@@ -227,15 +246,21 @@ impl Evaluator {
     /// the residual vector, the peaks (`knots`: extra sample times of the kinematic peaks).
     pub fn eval(&self, traj: &Trajectory, t_rest: f64, knots: &[f64]) -> Result<Eval, Rejected> {
         let resp = self.run(traj, t_rest + self.window)?;
+        self.assess(&resp, traj, t_rest, knots)
+    }
+
+    /// [`Evaluator::eval`] of a run already made: `resp`, the AMM run of `traj` by an evaluator
+    /// with the same experiment, N, step and window (the limits and terms may differ).
+    pub fn assess(&self, resp: &Response, traj: &Trajectory, t_rest: f64, knots: &[f64]) -> Result<Eval, Rejected> {
         let t0 = traj.t_start();
         let jets = slider_samples(&self.exp.robot, traj, (t0, t_rest), self.exp.time.dt_out, knots)
             .map_err(|e| Rejected::Infeasible(e.to_string()))?;
         let KinematicPeaks { v, a, j } = crate::limits::peaks_of(&jets);
         let jerk: Vec<f64> = jets.iter().flat_map(|(_, j)| j.map(|j| j.d3)).collect();
-        let mut r = residual_vector(&resp, t_rest);
+        let mut r = residual_vector(resp, t_rest);
         let n_g = r.len();
         if self.terms.tip_weight > 0.0 {
-            r.extend(tip_vector(&resp, t_rest, self.terms.tip_weight));
+            r.extend(tip_vector(resp, t_rest, self.terms.tip_weight));
         }
         if let Some(s) = &self.terms.smooth {
             r.extend(jerk.iter().zip(&s.jerk).map(|(j, q)| s.scale * (j - q)));
@@ -247,12 +272,12 @@ impl Evaluator {
         Ok(Eval {
             r,
             n_g,
-            window_peak_m: window_peak(&resp, t_rest),
-            fa: force_peak(&resp),
+            window_peak_m: window_peak(resp, t_rest),
+            fa: force_peak(resp),
             v,
             a,
             j,
-            usage: self.usage(&jets, &resp),
+            usage: self.usage(&jets, resp),
             progress,
             jerk,
         })

@@ -357,8 +357,21 @@ pub fn zvd_experiment(exp: &Experiment, base: Trajectory) -> Result<Experiment, 
 pub(crate) fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Experiment) -> Result<Planned, PlanError> {
     let deadline = s.started + Duration::from_secs_f64(cfg.plan.budget());
     let x0 = s.family.plain();
-    let plain = evaluate(&s.evaluator, &s.family, &x0, t_move)
-        .map_err(|e| PlanError::Solver(format!("the plain quintic: {e}")))?;
+    let (traj0, knots, t_rest) = (
+        s.family.trajectory(&x0, t_move),
+        knot_times(&s.family, t_move),
+        s.family.t0 + t_move,
+    );
+    let quintic_error = |e| PlanError::Solver(format!("the plain quintic: {e}"));
+    // one run of the plain quintic, assessed without and with the search's limits and terms
+    let run0 = s
+        .evaluator
+        .run(&traj0, t_rest + s.evaluator.window)
+        .map_err(quintic_error)?;
+    let plain = s
+        .evaluator
+        .assess(&run0, &traj0, t_rest, &knots)
+        .map_err(quintic_error)?;
     if let Some(max) = cfg.limits.fa_max.filter(|m| plain.fa.value > *m) {
         let msg = quintic_breaks(t_move, "|Fa|", "N", plain.fa, max, None);
         return Err(ModelError::invalid("limits.Fa_max", msg)
@@ -372,15 +385,18 @@ pub(crate) fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Exper
     let bounds = effective_bounds(&cfg.limits, cfg.plan.peak_factor(), &plain);
     let ev = search_evaluator(cfg, s, bounds, &plain, stop.r_floor);
     let f = |x: &[f64]| evaluate(&ev, &s.family, x, t_move);
+    let slopes = ev.for_slopes();
+    let g = |x: &[f64]| evaluate(slopes.as_ref().unwrap_or(&ev), &s.family, x, t_move);
     let accept = |e: &Eval| e.within(&bounds);
-    let e0 = f(&x0).map_err(|e| PlanError::Solver(format!("the plain quintic: {e}")))?;
+    let e0 = ev.assess(&run0, &traj0, t_rest, &knots).map_err(quintic_error)?;
     if !accept(&e0) {
         return Err(PlanError::Solver(format!(
             "the plain quintic, the search's start, is outside the limits it enforces ({})",
             e0.broken(&bounds).join(", ")
         )));
     }
-    let sol = minimise(&f, &accept, x0, e0, stop).map_err(|e| PlanError::Solver(e.to_string()))?;
+    let sol = minimise(&f, slopes.is_some().then_some(&g), &accept, x0, e0, stop)
+        .map_err(|e| PlanError::Solver(e.to_string()))?;
     let peaks = PeakComparison {
         plain: PeakSet::of(&plain),
         planned: PeakSet::of(&sol.eval),

@@ -68,6 +68,8 @@ struct SampleSet<'a> {
     family: &'a Family,
     t_move: f64,
     evaluators: Vec<Evaluator>,
+    /// Each model's evaluator of its Jacobian's runs ([`Evaluator::for_slopes`]).
+    slopes: Vec<Option<Evaluator>>,
     bounds: Vec<Limits>,
 }
 
@@ -82,6 +84,15 @@ impl Models for SampleSet<'_> {
 
     fn accept(&self, k: usize, e: &Eval) -> bool {
         e.within(&self.bounds[k])
+    }
+
+    fn slope_eval(&self, k: usize, x: &[f64]) -> Option<Result<Eval, Rejected>> {
+        let ev = self.slopes[k].as_ref()?;
+        Some(evaluate(ev, self.family, x, self.t_move))
+    }
+
+    fn has_slope_model(&self) -> bool {
+        self.slopes.iter().any(Option::is_some)
     }
 }
 
@@ -309,6 +320,7 @@ fn sample_set<'a>(
         family: &s.family,
         t_move,
         evaluators: Vec::new(),
+        slopes: Vec::new(),
         bounds: Vec::new(),
     };
     let mut plains = Vec::new();
@@ -336,6 +348,7 @@ fn sample_set<'a>(
             smooth: SmoothRef::new(&plain, cfg.plan.smoothness(), floor),
             monotone: cfg.plan.monotone().then(|| s.family.clone()),
         });
+        set.slopes.push(ev.for_slopes());
         set.evaluators.push(ev);
         set.bounds.push(bounds);
         plains.push(plain);

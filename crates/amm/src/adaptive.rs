@@ -303,8 +303,11 @@ where
 /// [`MAX_ESTIMATE_TIME_ERROR`], or with `every = None`, the pairs run at the delivered step.
 /// With `every = None` (a span too short for the coarse grid) the time check follows the pairs:
 /// the chosen N at 2 h after its delivered run (`docs/amm.md` 12.13), so that there the delivered
-/// run is the last at the delivered step, not the last run. `check_every = None`: no time check
-/// (the direct problem's pairs, which run at the delivered step only).
+/// run is the last at the delivered step, not the last run. With friction (`every = None`) and a
+/// time check, the pairs first run at the time check's step and the chosen N's run of the pair is
+/// the time check ([`friction_pairs_at_check_step`], `docs/amm.md` 12.15); at the delivered step
+/// only when that fails. `check_every = None`: no time check (the direct problem's pairs, which
+/// run at the delivered step only).
 /// Returns the delivered run with `info.modes`, `info.error_estimate_percent` and
 /// `info.tol_percent` set, its wall time the sum over the runs. Fails with the estimate reached
 /// when the tolerance is not met at [`MAX_AUTO_MODES`].
@@ -321,6 +324,11 @@ where
     let mut wall = 0.0;
     // the delivered run's time error from the time check at 2 h (Eq. T1)
     let mut time_part = None;
+    if let (None, Some(k), true) = (every, check_every, problem.friction.is_some()) {
+        if let Some(done) = friction_pairs_at_check_step(problem, tol, k, &mut run, &mut wall)? {
+            return Ok(done);
+        }
+    }
     if let Some(every) = every {
         let pass = Pass::Estimate { every };
         let (n, estimate, coarse, pair_wall) = raise_until_below(problem, tol, pass, &mut run)?;
@@ -364,6 +372,39 @@ where
         tol,
         wall,
     ))
+}
+
+/// With friction (`docs/amm.md` 12.15, "The pairs at the time check's step"): the estimate's pairs
+/// at the time check's step 2 h on its grid `check_every` ([`Pass::TimeCheck`]), the chosen N's
+/// run of the pair serving as the time check (Eq. T2), then the delivered run at h and the step's
+/// halvings of [`refine_step`]. `None` (the runs' wall time still added to `wall`) when the
+/// chosen N's runs at 2 h and h differ by more than [`MAX_ESTIMATE_TIME_ERROR`]: the pairs then
+/// run at the delivered step.
+fn friction_pairs_at_check_step<F>(
+    problem: &Star,
+    tol: f64,
+    check_every: usize,
+    run: &mut F,
+    wall: &mut f64,
+) -> Result<Option<Response>, AmmError>
+where
+    F: FnMut(usize, Pass) -> Result<Response, AmmError>,
+{
+    let pass = Pass::TimeCheck { every: check_every };
+    // a run at 2 h that fails (a divergence, rows that lose rank at a coarse event) sends the
+    // pairs to the delivered step, as does a tolerance not reached there
+    let Ok((n, estimate, check, pair_wall)) = raise_until_below(problem, tol, pass, run) else {
+        return Ok(None);
+    };
+    let mut delivered = run(n, Pass::Deliver)?;
+    *wall += pair_wall + delivered.info.wall_s;
+    let e_check = mean_evp(&check, &delivered.every_nth(check_every));
+    if e_check > MAX_ESTIMATE_TIME_ERROR {
+        return Ok(None);
+    }
+    let mut part = e_check / FRICTION_TIME_CHECK_RATIO;
+    *wall += refine_step(problem, tol, n, run, (&mut delivered, &mut part))?;
+    Ok(Some(finish(problem, delivered, estimate + part, tol, *wall)))
 }
 
 /// Eq. T1 [%] from the time check's run `check` (the chosen N at 2 h on every `check_every`-th

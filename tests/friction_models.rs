@@ -1,11 +1,12 @@
-//! Friction in the rigid limit (`docs/friction.md` 4): the beams stiffened, both solvers'
-//! actuator forces with Coulomb friction in the sleeves should tend to those of an independent
+//! Friction in the rigid limit (`docs/friction.md` 4 and 6, "The rigid limit"): the beams
+//! stiffened, both solvers' actuator forces with friction tend to those of an independent
 //! rigid-body model with friction (`support/rigid_friction.rs`: Newton-Euler with the normal
 //! forces as unknowns), on the smooth quintic (`configs/motions/smooth.toml`: a step of jerk, whose
 //! vibration's force falls as the stiffness rises) in a vertical plane (the sleeves carry the
-//! star's weight, so friction is a large share of the forces). Without friction the reference
-//! equals the rigid inverse dynamics of `flexstar_kinematics` to the last digits (checked while
-//! writing it).
+//! star's weight, so friction is a large share of the forces): with viscous friction in the
+//! sleeves and friction on the rails; with Coulomb friction in the sleeves they do not (the
+//! ignored test, and why). Without friction the reference equals the rigid inverse dynamics of
+//! `flexstar_kinematics` to the last digits (checked while writing it).
 
 use std::path::Path;
 
@@ -21,14 +22,27 @@ const SMOOTH: &str = include_str!("../configs/motions/smooth.toml");
 /// The sleeves' coefficient.
 const MU: f64 = 0.3;
 
+/// `(gap, friction share)` of Coulomb friction `MU` in the sleeves ([`gap_with`]).
+fn gap(solver: &str, stiff: f64) -> (f64, f64) {
+    let laws = rigid_friction::Laws {
+        mu: MU,
+        ..Default::default()
+    };
+    gap_with(solver, stiff, laws)
+}
+
 /// `(gap, friction share)`: the largest |Fa - Fa_rigid| over the sliders and the output times
 /// where every sleeve slides (|xp_i'| > 1 mm/s), relative to the largest |Fa_rigid| there; and
 /// the largest change friction makes to the rigid forces, relative to the same, for the beams'
-/// E times `stiff`.
-fn gap(solver: &str, stiff: f64) -> (f64, f64) {
+/// E times `stiff` and the friction laws `laws` (sleeves and rails alike).
+fn gap_with(solver: &str, stiff: f64, laws: rigid_friction::Laws) -> (f64, f64) {
     let text = format!(
-        "{SMOOTH}\n[robot]\nE = {}\n[friction]\nmu = {MU}\n[gravity]\ng = [0.0, -9.81]\n",
-        200e9 * stiff
+        "{SMOOTH}\n[robot]\nE = {}\n[friction]\nmu = {}\nc = {}\n[friction.rails]\nFc = {}\nb = {}\n[gravity]\ng = [0.0, -9.81]\n",
+        200e9 * stiff,
+        laws.mu,
+        laws.c,
+        laws.fc,
+        laws.b
     );
     let exp = Experiment::from_toml_str(&text, Path::new("stiff.toml")).unwrap();
     let problem = exp.problem().unwrap();
@@ -57,7 +71,7 @@ fn gap(solver: &str, stiff: f64) -> (f64, f64) {
         if st.xp.iter().any(|x| x.d1.abs() < 1e-3) {
             continue;
         }
-        let Some(rigid) = rigid_friction::rigid_forces_with_friction(&exp.robot, &st, g, MU) else {
+        let Some(rigid) = rigid_friction::rigid_forces(&exp.robot, &st, g, laws) else {
             continue;
         };
         let bare = rigid_friction::rigid_forces_with_friction(&exp.robot, &st, g, 0.0).unwrap();
@@ -70,17 +84,45 @@ fn gap(solver: &str, stiff: f64) -> (f64, f64) {
     (worst / scale, share / scale)
 }
 
-/// Fails today in both solvers (`docs/friction.md` 6, "the rigid limit"): measured 2026-12-06,
-/// the FEM's gap grows with the stiffness, 0.22, 0.73 and 2.8 for E x 1, 10, 100 (friction's
-/// share 0.16): the stiff star chatters between stick and slip (40-70 switches per sleeve in
-/// 0.4 s), its sleeves' sliding speed reaching metres per second with the robot at rest, the
-/// same at a tenth of the step; the AMM alike, and singular at E x 1e4. Run it with
-/// `cargo test --release -p flexstar-tests --test friction_models -- --ignored`.
+/// Coulomb friction in the sleeves: fails in both solvers, and is kept as the record of why
+/// (`docs/friction.md` 6, "The rigid limit"): measured 2026-12-07, the gap grows with the
+/// stiffness, 0.21 / 0.74 / 2.8 (AMM) and 0.22 / 0.73 / 2.8 (FEM) for E x 1, 10, 100 (friction's
+/// share 0.16), because steady sliding is unstable: an oscillation of the normal forces whose
+/// frequency scales as sqrt(E) grows and saturates into stick and slip, its force amplitude
+/// growing with the stiffness. Viscous sleeve friction and the rails' friction do reach the limit
+/// (the test below). Run it with
+/// `cargo test --release -p flexstar-tests --test library_checks friction_models -- --ignored`.
 #[test]
-#[ignore = "the stiff limit with friction is not reached by either solver yet: docs/friction.md 6"]
+#[ignore = "Coulomb sleeve friction has no rigid limit in this model (steady sliding is unstable): docs/friction.md 6"]
 fn stiff_beams_with_friction_tend_to_the_rigid_model_with_friction() {
     for solver in ["amm", "fem"] {
         let gaps: Vec<(f64, f64)> = [1.0, 1e1, 1e2].iter().map(|&s| gap(solver, s)).collect();
+        eprintln!("{solver}: E x 1, 10, 1e2: (gap, friction's share) {gaps:?}");
+        let (last, share) = gaps[2];
+        assert!(share > 0.05, "{solver}: friction must matter here: {share}");
+        assert!(last < 0.1 * share, "{solver}: {gaps:?}");
+        assert!(
+            gaps[2].0 < gaps[0].0,
+            "{solver}: shrinking with the stiffness: {gaps:?}"
+        );
+    }
+}
+
+/// The rigid limit where it exists (`docs/friction.md` 6, "The rigid limit"): with viscous
+/// friction in the sleeves (`c` = 20 N s/m, no Coulomb part) and Coulomb and viscous friction on
+/// the rails (`Fc` = 0.5 N, `b` = 5 N s/m), both solvers' actuator forces tend to the rigid
+/// model's as the beams stiffen (E x 1, 10, 100), while the friction changes the rigid forces by a
+/// fifth or more.
+#[test]
+fn stiff_beams_with_viscous_sleeves_and_rail_friction_tend_to_the_rigid_model() {
+    let laws = rigid_friction::Laws {
+        mu: 0.0,
+        c: 20.0,
+        fc: 0.5,
+        b: 5.0,
+    };
+    for solver in ["amm", "fem"] {
+        let gaps: Vec<(f64, f64)> = [1.0, 1e1, 1e2].iter().map(|&s| gap_with(solver, s, laws)).collect();
         eprintln!("{solver}: E x 1, 10, 1e2: (gap, friction's share) {gaps:?}");
         let (last, share) = gaps[2];
         assert!(share > 0.05, "{solver}: friction must matter here: {share}");

@@ -23,6 +23,12 @@ use crate::system::System;
 /// Events located in one step before the rest of the step falls back to the switch at its start.
 const MAX_SPLITS: usize = 6;
 
+/// The material coordinates a located step's judging carries for a sleeve that stops: none, for
+/// such a sleeve sticks at its coordinate at the event, which [`EventStepper::switch_at_event`]
+/// takes (the step-start coordinates, a sum over the modes per sleeve, are computed only for the
+/// switch at the step's start of the fallback).
+const AT_THE_EVENT: [f64; 3] = [f64::NAN; 3];
+
 /// The generalized-alpha state of a run: coordinates, rates, the acceleration variable and
 /// the accelerations (each 3 (N + 2)).
 pub(crate) struct State<'a> {
@@ -292,9 +298,8 @@ impl EventStepper {
             let h = t1 - st.t;
             self.save(sys, x);
             let probe = Probe::of(sys, st, x.v);
-            let xi_start = stick_slip::coordinates(sys, st, x.q);
             let stuck = stuck_now(sys);
-            let end = self.attempt(sys, &end_st, h, x, xi_start)?;
+            let end = self.attempt(sys, &end_st, h, x, AT_THE_EVENT)?;
             let changes = stick_slip::changes(sys, None, &end, stuck, stuck);
             let change = changes.as_slice();
             if change.is_empty() {
@@ -313,7 +318,7 @@ impl EventStepper {
                 self.restore(sys, x);
                 if theta > 0.0 {
                     let mid = kin(st.t + theta * h)?;
-                    let end = self.attempt(sys, &mid, theta * h, x, xi_start)?;
+                    let end = self.attempt(sys, &mid, theta * h, x, AT_THE_EVENT)?;
                     advance(sys, out, x, (end.vs, rails(&mid)), theta * h);
                     *st = mid;
                 }

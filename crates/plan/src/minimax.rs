@@ -121,11 +121,11 @@ fn jacobians<M: Models>(models: &M, x: &[f64], evals: &[Eval]) -> Result<(Vec<Ja
     let mut runs = 0;
     let mut jacs = Vec::with_capacity(models.count());
     for (k, own) in evals.iter().enumerate().take(models.count()) {
-        let (jac, n) = if models.has_slope_model() {
-            let slope = |y: &[f64]| models.slope_eval(k, y).unwrap_or_else(|| models.eval(k, y));
-            jacobian(&slope, x, None)?
-        } else {
-            jacobian(&|y: &[f64]| models.eval(k, y), x, Some(own))?
+        let slope = |y: &[f64]| models.slope_eval(k, y).unwrap_or_else(|| models.eval(k, y));
+        // a slope model that cannot run a column gives way to the model itself
+        let (jac, n) = match models.has_slope_model().then(|| jacobian(&slope, x, None)) {
+            Some(Ok(done)) => done,
+            _ => jacobian(&|y: &[f64]| models.eval(k, y), x, Some(own))?,
         };
         runs += n;
         jacs.push(jac);

@@ -65,7 +65,7 @@ fn gap(solver: &str, stiff: f64, laws: rigid_friction::Laws) -> (f64, f64) {
         let Some(rigid) = rigid_friction::rigid_forces(&exp.robot, &st, g, laws) else {
             continue;
         };
-        let bare = rigid_friction::rigid_forces_with_friction(&exp.robot, &st, g, 0.0).unwrap();
+        let bare = rigid_friction::rigid_forces(&exp.robot, &st, g, rigid_friction::Laws::default()).unwrap();
         for i in 0..3 {
             worst = worst.max((r.fa[i][k] - rigid[i]).abs());
             scale = scale.max(rigid[i].abs());

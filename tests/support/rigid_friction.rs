@@ -33,13 +33,8 @@ pub struct Laws {
 }
 
 /// The actuator forces [N] of the rigid robot `p` in the state `st` under gravity `g` [m/s^2]
-/// with the sleeves' Coulomb coefficient `mu`; `None` when the signs of the normal forces do not
-/// settle (a sleeve whose normal force is near zero).
-pub fn rigid_forces_with_friction(p: &RobotParams, st: &RigidState, g: [f64; 2], mu: f64) -> Option<[f64; 3]> {
-    rigid_forces(p, st, g, Laws { mu, ..Laws::default() })
-}
-
-/// [`rigid_forces_with_friction`] with the sleeves' and rails' laws `laws`.
+/// with the sleeves' and rails' friction `laws` (`Laws::default()`: none); `None` when the signs
+/// of the normal forces do not settle (a sleeve whose normal force is near zero).
 pub fn rigid_forces(p: &RobotParams, st: &RigidState, g: [f64; 2], laws: Laws) -> Option<[f64; 3]> {
     let m = 3.0 * p.rho * p.l;
     let inertia = p.rho * p.l.powi(3) + 3.0 * p.jp;

@@ -39,7 +39,9 @@
 //! and is factored by block elimination of A_0 (above), `Y = A_0^-1 B` (three solves) and the
 //! inverse of the 3 x 3 Schur complement `D - C Y` (nalgebra's closed form, checked like a
 //! sleeve block); anything that fails its check hands the step to the dense LU of the whole A
-//! (`docs/friction.md` 6, "Speed").
+//! (`docs/friction.md` 6, "Speed"). While no sleeve sticks, the stick rows are the identity and B
+//! and C are zero: then `Y = 0` is not computed and a solve is `A_0`'s and `D^-1`'s alone (the
+//! same numbers).
 
 use nalgebra::{Matrix3, Matrix4, Matrix6, SMatrix, Vector3, Vector4, Vector6, LU, U6};
 
@@ -96,6 +98,8 @@ struct Border {
     c: SMatrix<f64, BORDER_ROWS, MAX_INNER_ROWS>,
     /// `(D - C Y)^-1`.
     schur_inverse: Matrix3<f64>,
+    /// B and C are zero (no sleeve stuck): Y is zero and the rows decouple.
+    decoupled: bool,
 }
 
 /// Largest |entry| of a matrix.
@@ -141,6 +145,7 @@ impl ConstraintLu {
                 y: SMatrix::zeros(),
                 c: SMatrix::zeros(),
                 schur_inverse: Matrix3::zeros(),
+                decoupled: false,
             }),
             dense: DenseLu::new(m),
         }
@@ -170,6 +175,14 @@ impl ConstraintLu {
         }
         // A_0 is the leading m0 x m0 part of A, read in place (row stride m)
         let blocks = self.block_factor(a, m0, m)?;
+        let border_zero =
+            (0..BORDER_ROWS).all(|k| (0..m0).all(|r| a[r * m + m0 + k] == 0.0 && a[(m0 + k) * m + r] == 0.0));
+        border.decoupled = border_zero;
+        if border_zero {
+            let d = Matrix3::from_fn(|r, c| a[(m0 + r) * m + m0 + c]);
+            border.schur_inverse = checked_inverse(&d)?;
+            return Some(blocks);
+        }
         let mut column = [0.0; MAX_INNER_ROWS];
         for k in 0..BORDER_ROWS {
             for (r, v) in column[..m0].iter_mut().enumerate() {
@@ -264,6 +277,11 @@ impl ConstraintLu {
         let m0 = self.m - BORDER_ROWS;
         let (head, tail) = b.split_at_mut(m0);
         block_solve(f, self.nj, head);
+        if border.decoupled {
+            let x1 = border.schur_inverse * Vector3::from_fn(|k, _| tail[k]);
+            tail.copy_from_slice(x1.as_slice());
+            return;
+        }
         let mut cy = Vector3::<f64>::zeros();
         for k in 0..BORDER_ROWS {
             cy[k] = (0..m0).map(|c| border.c[(k, c)] * head[c]).sum::<f64>();

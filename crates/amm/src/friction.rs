@@ -170,11 +170,15 @@ impl SleeveFriction {
         };
         self.active[i] = stuck.is_some();
         (beam.cu[k], beam.gu[k], beam.gv[k], beam.sc[k]) = (c, c, value, c);
-        beam.stick.iter_mut().for_each(|x| *x = 0.0);
+        if beam.stick_live {
+            beam.stick.iter_mut().for_each(|x| *x = 0.0);
+        }
+        beam.stick_live = false;
         if let (Some(s), Some(_)) = (shift, stuck) {
             for (&j, g) in s.kept.iter().zip(s.g) {
                 beam.stick[j] = -g;
             }
+            beam.stick_live = true;
         }
         self.compliance[i] = compliance;
     }
@@ -307,7 +311,8 @@ impl System {
             let beam = &self.beams[i];
             for (k, &g) in beam.ids.iter().enumerate() {
                 let mut h = beam.cu[k] * x[nm] + beam.ct[k] * x[nm + 1];
-                if beam.basis[k] != NONE {
+                // a row without an alpha part, or a stick row not stuck (its vector zero)
+                if beam.basis[k] != NONE && beam.sc[k] != 0.0 {
                     h += beam.sc[k] * crate::modes::dot(self.basis(i, beam, beam.basis[k]), &x[..nm]);
                 }
                 for (col, f) in fr.rows[i].iter().zip(fr.coef[i]) {

@@ -106,6 +106,10 @@ pub(crate) struct BeamRows {
     pub(crate) stick: Vec<f64>,
     /// `D^-1 B_STICK` (empty without friction).
     stick_scaled: Vec<f64>,
+    /// Whether [`BeamRows::stick`] may be nonzero this step (a stuck sleeve of the full model,
+    /// whose row carries the foreshortening's modal part): otherwise its Gram entries and dot
+    /// products are zero and are not computed (set per step by `crate::friction`).
+    pub(crate) stick_live: bool,
     // per-step workspace
     /// `D^-1 B_a` for the sleeve vectors.
     scaled: [Vec<f64>; 4],
@@ -191,8 +195,16 @@ impl BeamRows {
         }
         self.g[B_PHI0] = w0;
         self.g[B_DPHI0] = w1;
-        if !self.stick.is_empty() {
+        if self.stick_live {
             self.fill_stick_gram(inv_d, [phi0, dphi0, phi]);
+        } else if !self.stick.is_empty() {
+            // a zero stick vector: its Gram row, column and g are zero (the last step may have
+            // left them set)
+            for b in 0..NB {
+                self.gram[B_STICK][b] = 0.0;
+                self.gram[b][B_STICK] = 0.0;
+            }
+            self.g[B_STICK] = 0.0;
         }
     }
 
@@ -233,14 +245,17 @@ impl BeamRows {
                 }
             }
         }
+        let (ids, ct) = (&self.ids[..mb], &self.ct[..mb]);
+        let zero = [0.0; MAX_BEAM_ROWS];
         for k in 0..mb {
             let (bk, sk) = (self.basis[k], self.sc[k]);
-            let ctk = self.ct[k] * inv_jp;
-            let a_row = &mut a_mat[self.ids[k] * m..(self.ids[k] + 1) * m];
-            let zero = [0.0; MAX_BEAM_ROWS];
+            let (ctk, left_k) = (ct[k] * inv_jp, left[k]);
+            let a_row = &mut a_mat[ids[k] * m..(ids[k] + 1) * m];
             let gram_k = if bk == NONE { &zero } else { &gram_rows[bk] };
-            for s in 0..mb {
-                a_row[self.ids[s]] += left[k] * right[s] + ctk * self.ct[s] + sk * gram_k[s];
+            // the same sums as entry by entry, without a bounds check but a_row's
+            let terms = ids.iter().zip(&right[..mb]).zip(ct).zip(&gram_k[..mb]);
+            for (((&col, &right_s), &ct_s), &gram_ks) in terms {
+                a_row[col] += left_k * right_s + ctk * ct_s + sk * gram_ks;
             }
         }
     }
@@ -537,6 +552,7 @@ fn beam_rows(rows: &[Row], has_w0: bool, hp: [f64; 3], nm: usize, weld: &Weld) -
         sleeve: std::array::from_fn(|_| vec![0.0; nm]),
         stick: Vec::new(),
         stick_scaled: Vec::new(),
+        stick_live: false,
         scaled: std::array::from_fn(|_| vec![0.0; nm]),
         gram: [[0.0; NB]; NB],
         g: [0.0; NB],
@@ -1155,7 +1171,7 @@ impl System {
             if let Some(qh) = qhat {
                 bq[..B_STICK].copy_from_slice(&dots(&qh[o..o + nm], basis));
             }
-            if !beam.stick.is_empty() {
+            if beam.stick_live {
                 bdr[B_STICK] = dot(dinv_r, &beam.stick);
                 bq[B_STICK] = qhat.map_or(0.0, |qh| dot(&qh[o..o + nm], &beam.stick));
             }

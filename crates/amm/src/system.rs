@@ -1032,6 +1032,7 @@ impl System {
         let thd = st.theta.d1;
         let thdd = st.theta.d2;
         self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
+        self.sleeves.on_beams(st.t)?;
         if self.friction.is_some() {
             self.friction_terms(qhat);
         }
@@ -1294,6 +1295,36 @@ pub(crate) mod tests {
     use super::*;
     use crate::solver::integrate;
     use flexstar_model::{AmmSettings, ModeFamily, Trajectory};
+
+    /// A sleeve carried off its beam stops the step with the sleeve, the contact point and its
+    /// coordinate named (`flexstar_model::sleeve_contact`), checked against the geometry: on the
+    /// paper's robot (L = 0.5 m, Lp = 0.03 m) the right edge of a sleeve whose centre is put at
+    /// `L - Lp/4` lies at `L + Lp/4`, the left edge of one at `Lp/4` at `-Lp/4`; at the rigid
+    /// pose of the motion every point is on its beam.
+    #[test]
+    fn a_sleeve_off_its_beam_is_named() {
+        let exp = flexstar_model::catalogue::paper_case(3);
+        let problem = exp.problem().unwrap();
+        let star = crate::star::Star::new(&problem);
+        let settings = AmmSettings::paper(ModeFamily::FreeFree, 10);
+        let mut sys = crate::solver::build_system(&settings, 10, &star).unwrap();
+        let q = vec![0.0; sys.dim()];
+        let st = star.state(0.1).unwrap();
+        let (bp, gp) = (1e-8, 1e-4);
+        assert!(sys.prepare(&st, bp, gp, &q).is_ok());
+        let (l, lp) = (0.5, 0.03);
+        for (i, xc, point, edge) in [(1, l - lp / 4.0, "right edge", l + lp / 4.0), (2, lp / 4.0, "left edge", -lp / 4.0)] {
+            let mut off = st.clone();
+            off.xp[i].v = xc;
+            match sys.prepare(&off, bp, gp, &q) {
+                Err(AmmError::SleeveOffBeam(e)) => {
+                    assert_eq!((e.sleeve, e.point, e.l, e.t), (i + 1, point, l, 0.1));
+                    assert!((e.xi - edge).abs() < 1e-15, "{e}");
+                }
+                other => panic!("sleeve {} at {xc}: {other:?}", i + 1),
+            }
+        }
+    }
 
     #[test]
     fn energy_balance_at_a_locked_pose() {

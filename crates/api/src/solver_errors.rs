@@ -11,6 +11,7 @@ pub fn from_amm(file: &str, e: AmmError) -> ApiError {
     match &e {
         AmmError::Infeasible(inf) => ApiError::infeasible(file, inf.t, &e),
         AmmError::DirectInfeasible { t, .. } => ApiError::infeasible(file, *t, &e),
+        AmmError::SleeveOffBeam(off) => ApiError::infeasible(file, off.t, &e),
         AmmError::InvalidSetting { key, reason } => ApiError::config_text(file, Some(key), reason, message),
         AmmError::UnknownFamily(_) => ApiError::config_text(file, Some("amm.family"), &e.to_string(), message),
         AmmError::Cancelled { t } => ApiError::Cancelled {
@@ -38,7 +39,7 @@ pub fn from_fem(file: &str, e: FemError) -> ApiError {
             ApiError::config_text(file, Some("fem.elements"), &e.to_string(), message)
         }
         FemError::Infeasible { t, .. }
-        | FemError::SleeveOffBeam { t, .. }
+        | FemError::SleeveOffBeam(flexstar_model::sleeve_contact::OffBeam { t, .. })
         | FemError::SliderOffBase { t, .. }
         | FemError::Trajectory { t, .. } => ApiError::infeasible(file, *t, &e),
         _ => ApiError::Solver { message },

@@ -69,18 +69,10 @@ pub enum FemError {
     /// the step's equations; no result is written.
     #[error("unresolved stick-slip event of {contact} at t = {t} s: {reason}")]
     StickSlip { t: f64, contact: String, reason: String },
-    /// A sleeve contact point left the beam: its material coordinate is outside (0, L_i), `l`
-    /// the beam's length [m].
-    #[error(
-        "sleeve {sleeve} slid off beam {sleeve} at t = {t} s: the {point} contact point is at material coordinate {xi:.5} m, outside (0, L = {l} m)"
-    )]
-    SleeveOffBeam {
-        t: f64,
-        sleeve: usize,
-        point: &'static str,
-        xi: f64,
-        l: f64,
-    },
+    /// A sleeve contact point left the beam: its material coordinate is outside (0, L_i)
+    /// (the check shared with the AMM, `flexstar_model::sleeve_contact`).
+    #[error(transparent)]
+    SleeveOffBeam(#[from] flexstar_model::sleeve_contact::OffBeam),
     /// A slider left its side of the base triangle: `s` [m] outside the open interval `travel`
     /// between the side's two corners (`(-sqrt(3) d, sqrt(3) d)` on the paper's base).
     #[error(

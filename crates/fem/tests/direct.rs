@@ -274,7 +274,7 @@ fn leaving_the_feasible_range_stops_with_time_and_reason() {
     let msg = err.to_string();
     eprintln!("{msg}");
     match err {
-        FemError::Infeasible { t, .. } | FemError::SleeveOffBeam { t, .. } => {
+        FemError::Infeasible { t, .. } | FemError::SleeveOffBeam(flexstar_model::sleeve_contact::OffBeam { t, .. }) => {
             assert!(t > 0.0 && t < exp.time.t_end, "stop time {t}");
         }
         other => panic!("expected a feasibility stop, got {other}"),

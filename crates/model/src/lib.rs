@@ -38,6 +38,7 @@ pub mod robot_section;
 pub mod sensors;
 pub mod shaper;
 pub mod sidecar;
+pub mod sleeve_contact;
 pub mod spline;
 pub mod trajectory;
 

@@ -32,6 +32,7 @@ mod compliance;
 pub(crate) mod rows;
 mod shift;
 
+use flexstar_model::sleeve_contact::{on_beam, OffBeam};
 use flexstar_model::{AmmModel, ModeFamily, RobotParams};
 
 use crate::foreshortening::KEPT_ANALYTIC;
@@ -80,6 +81,11 @@ pub(crate) struct Sleeves {
     /// Full model: u_i-gradients of the rows Fp_i, FR_i, FL_i at the last update (`-w'` at the
     /// material point in the sleeve; 0 in the paper's model): the axial direction of their forces.
     axial: [[f64; 3]; 3],
+    /// Each sleeve's material centre `xp - u + f` at the last update [m] (Eq. S1; `xp` in the
+    /// paper's model).
+    xc: [f64; 3],
+    /// The beams' lengths L_i [m].
+    lengths: [f64; 3],
 }
 
 impl Sleeves {
@@ -111,6 +117,8 @@ impl Sleeves {
             xp: [0.0; 3],
             f: [0.0; 3],
             axial: [[0.0; 3]; 3],
+            xc: [0.0; 3],
+            lengths: std::array::from_fn(|i| params[i].l),
         }
     }
 
@@ -138,6 +146,17 @@ impl Sleeves {
     /// point `x` [m] (Eq. S2); 0 in the paper's model.
     pub(crate) fn shift_of(&self, i: usize, x: f64, alpha: &[f64]) -> f64 {
         self.shift.as_ref().map_or(0.0, |s| pick(s, i).value(x, alpha))
+    }
+
+    /// The sleeves' contact points at the last update (centre `xc`, edges `xc -+ Lp/2`) inside
+    /// their beams at time `t` [s] (`flexstar_model::sleeve_contact`): a sleeve that the elastic
+    /// motion carries off its beam, where the rigid pose was checked before the run.
+    pub(crate) fn on_beams(&self, t: f64) -> Result<(), OffBeam> {
+        for (i, (&xc, &l)) in self.xc.iter().zip(&self.lengths).enumerate() {
+            let h = pick(&self.tri, i).half_length();
+            on_beam(t, i, [xc, xc - h, xc + h], l)?;
+        }
+        Ok(())
     }
 
     /// Eqs. 41-43: refresh the sleeve rows of `beams` (the rows `rows`, beam i on `modes[i]`)
@@ -178,6 +197,7 @@ impl Sleeves {
             let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
             xp[i] - u_hat + shifts[i]
         });
+        self.xc = xc;
         // the modes at the sleeve points: the three beams at once on a shared set (full model)
         let together = full && self.tri.len() == 1;
         if together {

@@ -124,19 +124,8 @@ impl Star {
     /// time `t` [s].
     pub fn check_on_beams(&self, q: &[f64], t: f64) -> Result<(), FemError> {
         for i in 0..3 {
-            let l = self.beam(i).length;
-            for (p, name) in [(0, "centre"), (1, "left edge"), (2, "right edge")] {
-                let xi = q[self.xi(i, p)];
-                if !(xi > 0.0 && xi < l) {
-                    return Err(FemError::SleeveOffBeam {
-                        t,
-                        sleeve: i + 1,
-                        point: name,
-                        xi,
-                        l,
-                    });
-                }
-            }
+            let xi = [0, 1, 2].map(|p| q[self.xi(i, p)]);
+            flexstar_model::sleeve_contact::on_beam(t, i, xi, self.beam(i).length)?;
         }
         Ok(())
     }

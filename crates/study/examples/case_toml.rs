@@ -1,7 +1,8 @@
 //! The experiment file of one case of a study, to rerun it alone (`flexstar run`, `flexstar
 //! compare`): `cargo run --release -p flexstar-study --example case_toml -- STUDY.toml RUN_ID`
 //! writes its TOML to stdout. Paths in it (a table trajectory, a forces file) are relative to the
-//! study's base file: write it beside the base.
+//! study's base file: write it beside the base. RUN_ID may be a unique prefix of the run id (the
+//! 8 characters the docs quote).
 
 use std::path::Path;
 
@@ -18,8 +19,17 @@ fn main() {
             std::process::exit(1);
         }
     };
-    let Some(case) = study.cases().into_iter().find(|c| &c.run_id == run_id) else {
-        eprintln!("{}: no case with run id {run_id}", study.file.display());
+    let matching: Vec<_> = study
+        .cases()
+        .into_iter()
+        .filter(|c| c.run_id.starts_with(run_id.as_str()))
+        .collect();
+    let [case] = matching.as_slice() else {
+        eprintln!(
+            "{}: {} cases with a run id starting {run_id}",
+            study.file.display(),
+            matching.len()
+        );
         std::process::exit(1);
     };
     match study.case_toml(&case.values) {

@@ -1313,7 +1313,10 @@ pub(crate) mod tests {
         let (bp, gp) = (1e-8, 1e-4);
         assert!(sys.prepare(&st, bp, gp, &q).is_ok());
         let (l, lp) = (0.5, 0.03);
-        for (i, xc, point, edge) in [(1, l - lp / 4.0, "right edge", l + lp / 4.0), (2, lp / 4.0, "left edge", -lp / 4.0)] {
+        for (i, xc, point, edge) in [
+            (1, l - lp / 4.0, "right edge", l + lp / 4.0),
+            (2, lp / 4.0, "left edge", -lp / 4.0),
+        ] {
             let mut off = st;
             off.xp[i].v = xc;
             match sys.prepare(&off, bp, gp, &q) {

@@ -36,3 +36,49 @@ fn nine_as_built_cases_meet_the_evp_bounds_and_their_estimates_are_within_a_fact
         format!("g = {:?}, ", exp.gravity.g)
     });
 }
+
+/// A sleeve carried off its beam by the elastic motion (`docs/validation.md` 9): case `b07127e3`
+/// of the file's second draw (seed 32), where the rigid pose keeps sleeve 3 on beam 3 to its last
+/// time and the AMM once finished the run with the sleeve's right edge past the tip. Both
+/// solvers, each with its own model of the sleeve (the AMM's material point `xp - u + f`, the
+/// FEM's contact coordinates), now stop at the same time with the same sleeve and contact point a
+/// fraction of a millimetre past the tip.
+#[test]
+fn both_solvers_stop_where_a_sleeve_leaves_its_beam() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/studies");
+    let text = std::fs::read_to_string(path.join("envelope-as-built.toml")).expect("the study file");
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let base = path.join("../paper-robot.toml");
+    let text = text.replace("seed = 31", "seed = 32").replace(
+        "\"../paper-robot.toml\"",
+        &format!("{:?}", base.to_str().expect("a UTF-8 path")),
+    );
+    let file = dir.path().join("seed-32.toml");
+    std::fs::write(&file, text).expect("written");
+    let study = flexstar_study::Study::load(&file).expect("the study loads");
+    let case = study
+        .cases()
+        .into_iter()
+        .find(|c| c.run_id.starts_with("b07127e3"))
+        .expect("the case is in the seed-32 draw");
+    let exp = study.experiment(&case.values).expect("a valid case");
+    let problem = exp.problem().expect("a valid problem");
+    let amm = flexstar_model::AmmSettings::accurate();
+    let fem = flexstar_model::FemSettings::default();
+    let stop = |settings| match flexstar_solve::response(&problem, settings, None, None) {
+        Err(flexstar_solve::SolveError::Amm(flexstar_amm::AmmError::SleeveOffBeam(off)))
+        | Err(flexstar_solve::SolveError::Fem(flexstar_fem::FemError::SleeveOffBeam(off))) => off,
+        other => panic!("a sleeve off its beam, not {other:?}"),
+    };
+    let (a, f) = (
+        stop(flexstar_solve::Settings::Amm(&amm)),
+        stop(flexstar_solve::Settings::Fem(&fem)),
+    );
+    eprintln!("AMM: {a}\nFEM: {f}");
+    for off in [a, f] {
+        assert_eq!((off.sleeve, off.point), (3, "right edge"), "{off}");
+        assert!(off.xi > off.l && off.xi < off.l + 1e-3, "{off}");
+        assert!((off.t - exp.time.t_end).abs() < 1e-3, "{off}");
+    }
+    assert_eq!(a.l, f.l, "the same beam");
+}

@@ -64,7 +64,10 @@ pub(crate) const INVERSE_CHECK: f64 = 1e-9;
 pub(crate) struct ConstraintLu {
     m: usize,
     nj: usize,
-    blocks: Option<Blocks>,
+    /// The block elimination's factors, written in place by each factorisation.
+    blocks: Blocks,
+    /// Whether `blocks` (and `border`) hold the last factorisation (else `dense` does).
+    structured: bool,
     /// With bordered rows: their factors (valid when `blocks` is `Some`).
     border: Option<Border>,
     /// The dense factors (valid when `blocks` is `None` after a successful factorisation).
@@ -82,6 +85,18 @@ struct Blocks {
     coupling: [SMatrix<f64, 6, 4>; 3],
     /// LU of the junction Schur complement Z (padded with the identity past nj).
     junction: LU<f64, U6, U6>,
+}
+
+impl Blocks {
+    /// Storage for the factors, filled by each factorisation.
+    fn new() -> Self {
+        Blocks {
+            sleeve: [Matrix4::zeros(); 3],
+            x: [SMatrix::zeros(); 3],
+            coupling: [SMatrix::zeros(); 3],
+            junction: Matrix6::<f64>::identity().lu(),
+        }
+    }
 }
 
 /// Bordered rows' count (friction's three stick rows).
@@ -127,7 +142,8 @@ impl ConstraintLu {
         ConstraintLu {
             m,
             nj: m.saturating_sub(3 * SLEEVE_ROWS),
-            blocks: None,
+            blocks: Blocks::new(),
+            structured: false,
             border: None,
             dense: DenseLu::new(m),
         }
@@ -140,7 +156,8 @@ impl ConstraintLu {
         ConstraintLu {
             m,
             nj: m0.saturating_sub(3 * SLEEVE_ROWS),
-            blocks: None,
+            blocks: Blocks::new(),
+            structured: false,
             border: Some(Border {
                 y: SMatrix::zeros(),
                 c: SMatrix::zeros(),
@@ -153,94 +170,88 @@ impl ConstraintLu {
 
     /// Factor A (`a`, m x m, row-major). Fails with the reason when A is rank deficient.
     pub(crate) fn factor(&mut self, a: &[f64]) -> Result<(), RankError> {
-        self.blocks = match self.border.take() {
-            None => self.block_factor(a, self.m, self.m),
-            Some(mut border) => {
-                let blocks = self.bordered_factor(a, &mut border);
-                self.border = Some(border);
-                blocks
-            }
+        let (m, nj) = (self.m, self.nj);
+        self.structured = match self.border.as_mut() {
+            None => block_factor(a, (m, m, nj), &mut self.blocks),
+            Some(border) => bordered_factor(a, (m, nj), &mut self.blocks, border),
         };
-        if self.blocks.is_none() {
+        if !self.structured {
             self.dense_factor(a)?;
         }
         Ok(())
     }
+}
 
-    /// The bordered factorisation (module docs), or `None` when a check fails.
-    fn bordered_factor(&self, a: &[f64], border: &mut Border) -> Option<Blocks> {
-        let (m, m0) = (self.m, self.m - BORDER_ROWS);
-        if m0 > MAX_INNER_ROWS {
-            return None;
-        }
-        // A_0 is the leading m0 x m0 part of A, read in place (row stride m)
-        let blocks = self.block_factor(a, m0, m)?;
-        let border_zero =
-            (0..BORDER_ROWS).all(|k| (0..m0).all(|r| a[r * m + m0 + k] == 0.0 && a[(m0 + k) * m + r] == 0.0));
-        border.decoupled = border_zero;
-        if border_zero {
-            let d = Matrix3::from_fn(|r, c| a[(m0 + r) * m + m0 + c]);
-            border.schur_inverse = checked_inverse(&d)?;
-            return Some(blocks);
-        }
-        let mut column = [0.0; MAX_INNER_ROWS];
-        for k in 0..BORDER_ROWS {
-            for (r, v) in column[..m0].iter_mut().enumerate() {
-                *v = a[r * m + m0 + k];
-            }
-            block_solve(&blocks, self.nj, &mut column[..m0]);
-            for (r, v) in column.iter().enumerate() {
-                border.y[(r, k)] = if r < m0 { *v } else { 0.0 };
-            }
-            for c in 0..MAX_INNER_ROWS {
-                border.c[(k, c)] = if c < m0 { a[(m0 + k) * m + c] } else { 0.0 };
-            }
-        }
+/// The bordered factorisation (module docs) of the m x m `a` with `nj` junction rows into
+/// `blocks` and `border`; false when a check fails.
+fn bordered_factor(a: &[f64], (m, nj): (usize, usize), blocks: &mut Blocks, border: &mut Border) -> bool {
+    let m0 = m - BORDER_ROWS;
+    if m0 > MAX_INNER_ROWS {
+        return false;
+    }
+    // A_0 is the leading m0 x m0 part of A, read in place (row stride m)
+    if !block_factor(a, (m0, m, nj), blocks) {
+        return false;
+    }
+    let border_zero = (0..BORDER_ROWS).all(|k| (0..m0).all(|r| a[r * m + m0 + k] == 0.0 && a[(m0 + k) * m + r] == 0.0));
+    border.decoupled = border_zero;
+    if border_zero {
         let d = Matrix3::from_fn(|r, c| a[(m0 + r) * m + m0 + c]);
-        border.schur_inverse = checked_inverse(&(d - border.c * border.y))?;
-        Some(blocks)
+        return checked_inverse(&d)
+            .map(|inverse| border.schur_inverse = inverse)
+            .is_some();
     }
-
-    /// The block elimination of the leading `m` x `m` part of `a` (row-major, row stride
-    /// `stride`), or `None` when a block pivot is too small (or the rows do not have the
-    /// structure).
-    fn block_factor(&self, a: &[f64], m: usize, stride: usize) -> Option<Blocks> {
-        let nj = self.nj;
-        if m != nj + 3 * SLEEVE_ROWS || nj > MAX_JUNCTION_ROWS {
-            return None;
+    let mut column = [0.0; MAX_INNER_ROWS];
+    for k in 0..BORDER_ROWS {
+        for (r, v) in column[..m0].iter_mut().enumerate() {
+            *v = a[r * m + m0 + k];
         }
-        let at = |r: usize, c: usize| a[r * stride + c];
-        let mut z = Matrix6::<f64>::identity();
-        for r in 0..nj {
-            for c in 0..nj {
-                z[(r, c)] = at(r, c);
-            }
+        block_solve(blocks, nj, &mut column[..m0]);
+        for (r, v) in column.iter().enumerate() {
+            border.y[(r, k)] = if r < m0 { *v } else { 0.0 };
         }
-        let mut sleeve = [Matrix4::<f64>::zeros(); 3];
-        let mut x = [SMatrix::<f64, 4, 6>::zeros(); 3];
-        let mut coupling = [SMatrix::<f64, 6, 4>::zeros(); 3];
-        for i in 0..3 {
-            let s = nj + SLEEVE_ROWS * i;
-            let block = Matrix4::from_fn(|r, c| at(s + r, s + c));
-            sleeve[i] = checked_inverse(&block)?;
-            let a_ij = SMatrix::<f64, 4, 6>::from_fn(|r, c| if c < nj { at(s + r, c) } else { 0.0 });
-            x[i] = sleeve[i] * a_ij;
-            coupling[i] = SMatrix::<f64, 6, 4>::from_fn(|r, c| if r < nj { at(r, s + c) } else { 0.0 });
-            z -= coupling[i] * x[i];
+        for c in 0..MAX_INNER_ROWS {
+            border.c[(k, c)] = if c < m0 { a[(m0 + k) * m + c] } else { 0.0 };
         }
-        let scale = largest(&z);
-        let junction = z.lu();
-        if !pivots_hold(junction.u().diagonal().iter().copied(), scale) {
-            return None;
-        }
-        Some(Blocks {
-            sleeve,
-            x,
-            coupling,
-            junction,
-        })
     }
+    let d = Matrix3::from_fn(|r, c| a[(m0 + r) * m + m0 + c]);
+    checked_inverse(&(d - border.c * border.y))
+        .map(|inverse| border.schur_inverse = inverse)
+        .is_some()
+}
 
+/// The block elimination of the leading `m` x `m` part of `a` (row-major, row stride `stride`,
+/// `nj` junction rows) into `f`; false when a block pivot is too small (or the rows do not have
+/// the structure).
+fn block_factor(a: &[f64], (m, stride, nj): (usize, usize, usize), f: &mut Blocks) -> bool {
+    if m != nj + 3 * SLEEVE_ROWS || nj > MAX_JUNCTION_ROWS {
+        return false;
+    }
+    let at = |r: usize, c: usize| a[r * stride + c];
+    let mut z = Matrix6::<f64>::identity();
+    for r in 0..nj {
+        for c in 0..nj {
+            z[(r, c)] = at(r, c);
+        }
+    }
+    for i in 0..3 {
+        let s = nj + SLEEVE_ROWS * i;
+        let block = Matrix4::from_fn(|r, c| at(s + r, s + c));
+        let Some(inverse) = checked_inverse(&block) else {
+            return false;
+        };
+        f.sleeve[i] = inverse;
+        let a_ij = SMatrix::<f64, 4, 6>::from_fn(|r, c| if c < nj { at(s + r, c) } else { 0.0 });
+        f.x[i] = f.sleeve[i] * a_ij;
+        f.coupling[i] = SMatrix::<f64, 6, 4>::from_fn(|r, c| if r < nj { at(r, s + c) } else { 0.0 });
+        z -= f.coupling[i] * f.x[i];
+    }
+    let scale = largest(&z);
+    f.junction = z.lu();
+    pivots_hold(f.junction.u().diagonal().iter().copied(), scale)
+}
+
+impl ConstraintLu {
     /// nalgebra's LU with partial pivoting of the whole A ([`DenseLu`]), its rank checked.
     fn dense_factor(&mut self, a: &[f64]) -> Result<(), RankError> {
         let m = self.m;
@@ -265,10 +276,11 @@ impl ConstraintLu {
 
     /// Solve `A x = b` in place with the last factors.
     pub(crate) fn solve(&mut self, b: &mut [f64]) {
-        let Some(f) = &self.blocks else {
+        if !self.structured {
             self.dense.solve(b);
             return;
-        };
+        }
+        let f = &self.blocks;
         let Some(border) = &self.border else {
             block_solve(f, self.nj, b);
             return;
@@ -364,7 +376,7 @@ mod tests {
             let m = nj + 12;
             let mut lu = ConstraintLu::new(m);
             lu.factor(&a).unwrap();
-            assert!(lu.blocks.is_some(), "nj = {nj}: block path expected");
+            assert!(lu.structured, "nj = {nj}: block path expected");
             let b: Vec<f64> = (0..m).map(|k| (k as f64 * 0.7).sin()).collect();
             let mut x = b.clone();
             lu.solve(&mut x);
@@ -390,7 +402,7 @@ mod tests {
         }
         let mut lu = ConstraintLu::new(m);
         lu.factor(&a).unwrap();
-        assert!(lu.blocks.is_none());
+        assert!(!lu.structured);
         let b: Vec<f64> = (0..m).map(|k| 1.0 + k as f64).collect();
         let mut x = b.clone();
         lu.solve(&mut x);
@@ -451,7 +463,7 @@ mod tests {
             let b: Vec<f64> = (0..m).map(|k| (k as f64 * 0.3).cos()).collect();
             let mut lu = ConstraintLu::bordered(m);
             lu.factor(&a).unwrap();
-            assert!(lu.blocks.is_some(), "nj = {nj}: bordered path expected");
+            assert!(lu.structured, "nj = {nj}: bordered path expected");
             let mut x = b.clone();
             lu.solve(&mut x);
             assert!(residual(&a, &x, &b) < 1e-12, "nj = {nj}: {:e}", residual(&a, &x, &b));

@@ -10,7 +10,7 @@
 /// material coordinate `xi` [m], the beam's length `l` [m].
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[error(
-    "sleeve {sleeve} slid off beam {sleeve} at t = {t} s: the {point} contact point is at material coordinate {xi:.5} m, outside (0, L = {l} m)"
+    "sleeve {sleeve} slid off beam {sleeve} at t = {t:.6} s: the {point} contact point is at material coordinate {xi:.5} m, outside (0, L = {l} m)"
 )]
 pub struct OffBeam {
     pub t: f64,
@@ -52,7 +52,7 @@ mod tests {
         assert_eq!((e.sleeve, e.point), (2, "left edge"));
         assert!(e
             .to_string()
-            .starts_with("sleeve 2 slid off beam 2 at t = 0.3 s: the left edge"));
+            .starts_with("sleeve 2 slid off beam 2 at t = 0.300000 s: the left edge"));
         assert!(on_beam(0.0, 0, [f64::NAN, 0.1, 0.2], 0.5).is_err());
     }
 }

@@ -68,9 +68,9 @@ pub(crate) struct ConstraintLu {
     blocks: Blocks,
     /// Whether `blocks` (and `border`) hold the last factorisation (else `dense` does).
     structured: bool,
-    /// With bordered rows: their factors (valid when `blocks` is `Some`).
+    /// With bordered rows: their factors (valid when `structured`).
     border: Option<Border>,
-    /// The dense factors (valid when `blocks` is `None` after a successful factorisation).
+    /// The dense factors (valid when not `structured` after a successful factorisation).
     dense: DenseLu,
 }
 

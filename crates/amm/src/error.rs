@@ -86,10 +86,10 @@ pub enum AmmError {
     /// last relative change of the coordinates).
     #[error("amm: t = {t:.6} s: the static equilibrium under gravity at the start pose did not converge (last relative change {change:.1e}): is the robot held at that pose?")]
     StaticStart { t: f64, change: f64 },
-    /// The run was stopped on request ([`flexstar_model::cancel`]) at output time `t` [s].
     /// A sleeve contact point left its beam during the run (`flexstar_model::sleeve_contact`).
     #[error("amm: {0}")]
     SleeveOffBeam(#[from] flexstar_model::sleeve_contact::OffBeam),
+    /// The run was stopped on request ([`flexstar_model::cancel`]) at output time `t` [s].
     #[error("amm: cancelled at t = {t} s")]
     Cancelled { t: f64 },
     /// A stick-slip event the time step cannot resolve (`docs/friction.md` 9.1, as 8.3): at time

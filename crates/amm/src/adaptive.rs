@@ -19,6 +19,9 @@
 //! and the time error of the coarse step is checked against it: above
 //! [`MAX_ESTIMATE_TIME_ERROR`] the pairs are run again at the delivered step.
 //!
+//! With friction the pairs are the robot's without it (`docs/amm.md` 12.16), and the chosen N runs
+//! with friction at 2 h and h.
+//!
 //! The reported estimate is the truncation plus the delivered run's time error, from one more run
 //! of the chosen N at 2 h ([`time_error_estimate`], Eq. T1 of `docs/amm.md` 12.10; also on spans
 //! too short for the coarse grid, 12.13), plus the geometric part the AMM leaves out
@@ -167,18 +170,15 @@ pub const MIN_ESTIMATE_ROWS: usize = 20;
 /// The coarse output grid of the estimate's runs for a delivered step `h` [s]: its interval is
 /// `every` times `problem.time.dt_out`, the first multiple at least [`ESTIMATE_STEP_FACTOR`] h, so that
 /// its times are a subset of the delivered ones. `None` (pairs at the delivered step) when that grid
-/// would have fewer than [`MIN_ESTIMATE_ROWS`] rows, or with friction (`docs/amm.md` 12.15: a run
-/// resolves its stick and slip events to its own step, so a pair at the coarse step differs by
-/// the events' timing, not by the truncation).
+/// would have fewer than [`MIN_ESTIMATE_ROWS`] rows. With friction the pairs on this grid are the
+/// robot's without it ([`Pass::BareEstimate`], `docs/amm.md` 12.16: at the coarse step the stick
+/// and slip events, not the truncation, would decide a pair's difference, 12.15).
 pub fn estimate_grid(problem: &Problem, h: f64) -> Option<usize> {
     estimate_grid_of(&Star::new(problem), h)
 }
 
 /// [`estimate_grid`] of the AMM's view of a problem.
 pub(crate) fn estimate_grid_of(problem: &Star, h: f64) -> Option<usize> {
-    if problem.friction.is_some() {
-        return None;
-    }
     let every = output_multiple(problem, ESTIMATE_STEP_FACTOR * h);
     let rows = (problem.time.t_end / (every as f64 * problem.time.dt_out) - 1e-9).ceil() + 1.0;
     (rows >= MIN_ESTIMATE_ROWS as f64).then_some(every)
@@ -248,6 +248,10 @@ pub(crate) enum Pass {
     /// A run of the estimate's pair: step [`ESTIMATE_STEP_FACTOR`] times the delivered one, on
     /// an output grid `every` times coarser (module docs).
     Estimate { every: usize },
+    /// With friction in the sleeves, a run of the estimate's pair of the robot without it
+    /// (`Star::without_friction`) at the step and on the grid of [`Pass::Estimate`]
+    /// (`docs/amm.md` 12.16).
+    BareEstimate { every: usize },
     /// The time check's run: step [`TIME_CHECK_STEP_FACTOR`] times the delivered one, on an
     /// output grid `every` times coarser ([`time_check_grid`]).
     TimeCheck { every: usize },
@@ -303,10 +307,12 @@ where
 /// [`MAX_ESTIMATE_TIME_ERROR`], or with `every = None`, the pairs run at the delivered step.
 /// With `every = None` (a span too short for the coarse grid) the time check follows the pairs:
 /// the chosen N at 2 h after its delivered run (`docs/amm.md` 12.13), so that there the delivered
-/// run is the last at the delivered step, not the last run. With friction (`every = None`) and a
-/// time check, the pairs first run at the time check's step and the chosen N's run of the pair is
-/// the time check ([`friction_pairs_at_check_step`], `docs/amm.md` 12.15); at the delivered step
-/// only when that fails. `check_every = None`: no time check (the direct problem's pairs, which
+/// run is the last at the delivered step, not the last run. With friction and a time check, the
+/// pairs are first the robot's without friction on the coarse grid `every`
+/// ([`friction_with_bare_pairs`], `docs/amm.md` 12.16), then (that failing, or with `every =
+/// None`) the robot's with friction at the time check's step, the chosen N's run of the pair the
+/// time check ([`friction_pairs_at_check_step`], 12.15); at the delivered step only when both
+/// fail. `check_every = None`: no time check (the direct problem's pairs, which
 /// run at the delivered step only).
 /// Returns the delivered run with `info.modes`, `info.error_estimate_percent` and
 /// `info.tol_percent` set, its wall time the sum over the runs. Fails with the estimate reached
@@ -324,12 +330,18 @@ where
     let mut wall = 0.0;
     // the delivered run's time error from the time check at 2 h (Eq. T1)
     let mut time_part = None;
-    if let (None, Some(k), true) = (every, check_every, problem.friction.is_some()) {
+    if let (true, Some(k)) = (problem.friction.is_some(), check_every) {
+        if let Some(every) = every {
+            if let Some(done) = friction_with_bare_pairs(problem, tol, (every, k), &mut run, &mut wall)? {
+                return Ok(done);
+            }
+        }
         if let Some(done) = friction_pairs_at_check_step(problem, tol, k, &mut run, &mut wall)? {
             return Ok(done);
         }
     }
-    if let Some(every) = every {
+    // with friction, what is left runs its pairs at the delivered step (docs/amm.md 12.15)
+    if let Some(every) = every.filter(|_| problem.friction.is_none()) {
         let pass = Pass::Estimate { every };
         let (n, estimate, coarse, pair_wall) = raise_until_below(problem, tol, pass, &mut run)?;
         // the time check before the delivered run, so that the delivered run is the last one
@@ -372,6 +384,43 @@ where
         tol,
         wall,
     ))
+}
+
+/// With friction (`docs/amm.md` 12.16): the truncation part from the estimate's pairs of the
+/// robot without friction at the coarse step on the grid `every` ([`Pass::BareEstimate`]), then
+/// the chosen N with friction at the time check's step 2 h on its grid `check_every` (Eq. T2) and
+/// at the delivered step h, and the step's halvings of [`refine_step`]. `None` (the runs' wall
+/// time still added to `wall`) when a pair's run fails or the tolerance is not reached without
+/// friction, or when the chosen N's runs at 2 h and h differ by more than
+/// [`MAX_ESTIMATE_TIME_ERROR`]: the pairs then take the sleeves' friction
+/// ([`friction_pairs_at_check_step`]).
+fn friction_with_bare_pairs<F>(
+    problem: &Star,
+    tol: f64,
+    (every, check_every): (usize, usize),
+    run: &mut F,
+    wall: &mut f64,
+) -> Result<Option<Response>, AmmError>
+where
+    F: FnMut(usize, Pass) -> Result<Response, AmmError>,
+{
+    let Ok((n, estimate, _, pair_wall)) = raise_until_below(problem, tol, Pass::BareEstimate { every }, run) else {
+        return Ok(None);
+    };
+    *wall += pair_wall;
+    // a run at 2 h that fails (rows that lose rank at a coarse event) sends the pairs on
+    let Ok(check) = run(n, Pass::TimeCheck { every: check_every }) else {
+        return Ok(None);
+    };
+    let mut delivered = run(n, Pass::Deliver)?;
+    *wall += check.info.wall_s + delivered.info.wall_s;
+    let e_check = mean_evp(&check, &delivered.every_nth(check_every));
+    if e_check > MAX_ESTIMATE_TIME_ERROR {
+        return Ok(None);
+    }
+    let mut part = e_check / FRICTION_TIME_CHECK_RATIO;
+    *wall += refine_step(problem, tol, n, run, (&mut delivered, &mut part))?;
+    Ok(Some(finish(problem, delivered, estimate + part, tol, *wall)))
 }
 
 /// With friction (`docs/amm.md` 12.15, "The pairs at the time check's step"): the estimate's pairs
@@ -522,7 +571,7 @@ mod tests {
                     Pass::Estimate { every } => model(&exp, every, n, c * 8f64.powf(order)),
                     Pass::TimeCheck { every } => model(&exp, every, n, c * 2f64.powf(order)),
                     Pass::Deliver => model(&exp, 1, n, c),
-                    Pass::Refined { .. } => unreachable!("no friction, no halving"),
+                    Pass::Refined { .. } | Pass::BareEstimate { .. } => unreachable!("no friction"),
                 })
             })
             .unwrap();
@@ -554,8 +603,8 @@ mod tests {
         assert_eq!(estimate_grid(&problem, 5e-4), None);
     }
 
-    /// With friction (`docs/amm.md` 12.15) the pairs run at the delivered step, the time check at
-    /// 2 h, and the step halves while the time part (Eq. T2) is above half the tolerance, each
+    /// With friction and no coarse grid (`docs/amm.md` 12.15) the pairs run at the time check's
+    /// step 2 h, the chosen N's run of the pair the time check, and the step halves while the time part (Eq. T2) is above half the tolerance, each
     /// halving's run the delivered one and the run before it its time check. A model with a time
     /// error of first order, `c h / h0` (c = 1 %): T2 reads 1 / 1.75 = 0.57 % at h0, 0.29 % at
     /// h0 / 2, 0.14 % at h0 / 4, so the step halves twice.
@@ -565,7 +614,9 @@ mod tests {
         exp.friction = Some(toml::from_str("mu = 0.1\n").unwrap());
         let problem = exp.problem().unwrap();
         let star = Star::new(&problem);
-        assert_eq!(estimate_grid(&problem, 5e-4), None, "with friction the pairs run at h");
+        // the coarse grid is the frictionless pairs' (docs/amm.md 12.16); without it, as on a
+        // span too short for it, the pairs take the friction
+        assert_eq!(estimate_grid(&problem, 5e-4), Some(4));
         let c = 0.01;
         let mut passes = Vec::new();
         let r = solve_to_tolerance(&star, 0.5, None, Some(1), |n, pass| {
@@ -574,7 +625,7 @@ mod tests {
                 Pass::TimeCheck { every } => model(&star, every, n, 2.0 * c),
                 Pass::Deliver => model(&star, 1, n, c),
                 Pass::Refined { halvings } => model(&star, 1, n, c / f64::from(1u32 << halvings)),
-                Pass::Estimate { .. } => unreachable!("no coarse grid with friction"),
+                Pass::Estimate { .. } | Pass::BareEstimate { .. } => unreachable!("no coarse grid"),
             })
         })
         .unwrap();
@@ -598,5 +649,67 @@ mod tests {
             "{est} against {}",
             0.3 + time_part
         );
+    }
+
+    /// With friction and a coarse grid (`docs/amm.md` 12.16) the pairs are the frictionless
+    /// robot's at the coarse step, then the chosen N runs with friction at 2 h and at h; the
+    /// estimate is their truncation plus Eq. T2. When a frictionless pair's run fails, or the
+    /// chosen N's runs at 2 h and h differ by more than `MAX_ESTIMATE_TIME_ERROR`, the pairs
+    /// take the friction at 2 h (12.15) and the estimate is theirs.
+    #[test]
+    fn with_friction_the_truncation_comes_from_the_frictionless_pairs_at_the_coarse_step() {
+        let mut exp = paper_case(3);
+        exp.friction = Some(toml::from_str("mu = 0.1\n").unwrap());
+        let problem = exp.problem().unwrap();
+        let star = Star::new(&problem);
+        let every = estimate_grid(&problem, 5e-4).unwrap();
+        // the frictionless robot's truncation 0.3 % (53 / N)^7 (its pairs at the coarse step with
+        // no time error of their own) and the friction run's twice it: the pairs with friction
+        // then go on to N = 61; a time error of 0.1 % at h
+        let c = 0.001;
+        let bare_model = |n: usize, every: usize| model(&star, every, n, 0.0);
+        let rubbing = |n: usize, every: usize, time_error: f64| {
+            let e = 0.003 * (53.0 / n as f64).powi(7);
+            model(&star, every, n, e + time_error)
+        };
+        for (bare_fails, check_error, pairs) in [
+            (false, 4.0 * c, "bare"),
+            (true, 4.0 * c, "rubbing"),
+            (false, 0.3, "rubbing"),
+        ] {
+            let mut passes = Vec::new();
+            let r = solve_to_tolerance(&star, 0.5, Some(every), Some(1), |n, pass| {
+                passes.push((n, pass));
+                match pass {
+                    Pass::BareEstimate { every } if bare_fails && n > 46 => {
+                        Err(AmmError::NonFinite { t: 0.1, dt: 4e-3 })
+                    }
+                    Pass::BareEstimate { every } => Ok(bare_model(n, every)),
+                    Pass::TimeCheck { every } => Ok(rubbing(n, every, check_error)),
+                    Pass::Deliver => Ok(rubbing(n, 1, c)),
+                    Pass::Refined { halvings } => Ok(rubbing(n, 1, c / f64::from(1u32 << halvings))),
+                    Pass::Estimate { .. } => unreachable!("with friction the coarse pairs are frictionless"),
+                }
+            })
+            .unwrap();
+            let count = |want: fn(&Pass) -> bool| passes.iter().filter(|(_, p)| want(p)).count();
+            let est = r.info.error_estimate_percent.unwrap() - geometric_part(&problem, &r);
+            let last_at_h = passes
+                .iter()
+                .rev()
+                .find(|(_, p)| matches!(p, Pass::Deliver | Pass::Refined { .. }));
+            if pairs == "bare" {
+                assert_eq!(count(|p| matches!(p, Pass::BareEstimate { .. })), 2, "{passes:?}");
+                assert_eq!(count(|p| matches!(p, Pass::TimeCheck { .. })), 1, "{passes:?}");
+                assert_eq!(count(|p| *p == Pass::Deliver), 1, "{passes:?}");
+                // the frictionless pair's truncation, exact for the power law, and Eq. T2
+                let time_part = 100.0 * (check_error - c) / FRICTION_TIME_CHECK_RATIO;
+                assert!((est - 0.3 - time_part).abs() < 0.01, "{est}");
+            } else {
+                // the pairs with friction (at 2 h, or at h after a time check too far off), whose
+                // truncation reaches the tolerance at N = 61 only
+                assert_eq!(last_at_h.map(|p| p.0), Some(61), "{passes:?}");
+            }
+        }
     }
 }

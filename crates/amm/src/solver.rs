@@ -353,33 +353,26 @@ fn solve_to_tolerance(
     let mut delivered = 0;
     let response = adaptive::solve_to_tolerance(problem, tol, every, Some(check_every), |n, pass| {
         let started = std::time::Instant::now();
-        let sys = match &built {
-            Some((m, sys)) if *m == n => sys.clone(),
-            _ => {
-                validate(problem, settings, n, false)?;
-                let sys = build_system(settings, n, problem)?;
-                built = Some((n, sys.clone()));
-                sys
-            }
-        };
         let mut steps = 0;
         let resp = match pass {
-            Pass::Deliver => integrate_system(problem, settings, sys, h, started, |_, _| steps += 1),
-            Pass::Refined { halvings } => {
-                let step = h / f64::from(1u32 << halvings);
-                let refined = AmmSettings {
-                    dt: Some(step),
-                    ..settings.clone()
-                };
-                integrate_system(problem, &refined, sys, step, started, |_, _| steps += 1)
-            }
-            Pass::Estimate { every } => {
+            // the robot without friction (docs/amm.md 12.16): its own system, not kept for N
+            Pass::BareEstimate { every } => {
+                let bare = problem.without_friction();
+                let sys = build_system(settings, n, &bare)?;
                 let factor = adaptive::ESTIMATE_STEP_FACTOR;
-                integrate_coarse(problem, settings, sys, h, factor, every, started, |_, _| steps += 1)
+                integrate_coarse(&bare, settings, sys, h, factor, every, started, |_, _| steps += 1)
             }
-            Pass::TimeCheck { every } => {
-                let factor = adaptive::TIME_CHECK_STEP_FACTOR;
-                integrate_coarse(problem, settings, sys, h, factor, every, started, |_, _| steps += 1)
+            _ => {
+                let sys = match &built {
+                    Some((m, sys)) if *m == n => sys.clone(),
+                    _ => {
+                        validate(problem, settings, n, false)?;
+                        let sys = build_system(settings, n, problem)?;
+                        built = Some((n, sys.clone()));
+                        sys
+                    }
+                };
+                run_pass(problem, settings, sys, (h, pass), started, &mut steps)
             }
         };
         if matches!(pass, Pass::Deliver | Pass::Refined { .. }) {
@@ -389,6 +382,39 @@ fn solve_to_tolerance(
         resp
     })?;
     Ok((response, delivered))
+}
+
+/// One run of the automatic choice on the system `sys` of `problem` at the step of `pass`, the
+/// delivered step being `h` [s]; `steps` counts its steps. [`Pass::BareEstimate`] runs another
+/// problem (the robot without friction) and is not taken here.
+fn run_pass(
+    problem: &Star,
+    settings: &AmmSettings,
+    sys: System,
+    (h, pass): (f64, Pass),
+    started: std::time::Instant,
+    steps: &mut usize,
+) -> Result<Response, AmmError> {
+    let count = |_: &System, _: &[f64]| *steps += 1;
+    match pass {
+        Pass::Deliver => integrate_system(problem, settings, sys, h, started, count),
+        Pass::Refined { halvings } => {
+            let step = h / f64::from(1u32 << halvings);
+            let refined = AmmSettings {
+                dt: Some(step),
+                ..settings.clone()
+            };
+            integrate_system(problem, &refined, sys, step, started, count)
+        }
+        Pass::Estimate { every } | Pass::BareEstimate { every } => {
+            let factor = adaptive::ESTIMATE_STEP_FACTOR;
+            integrate_coarse(problem, settings, sys, h, factor, every, started, count)
+        }
+        Pass::TimeCheck { every } => {
+            let factor = adaptive::TIME_CHECK_STEP_FACTOR;
+            integrate_coarse(problem, settings, sys, h, factor, every, started, count)
+        }
+    }
 }
 
 /// A run of the automatic choice at `factor` times the delivered step `h` [s] (at most the

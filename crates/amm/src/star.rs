@@ -186,6 +186,15 @@ impl<'a> Star<'a> {
         self
     }
 
+    /// The same problem without friction in the sleeves or on the rails: the robot of the
+    /// estimate's pairs of a run with friction (`docs/amm.md` 12.16).
+    pub(crate) fn without_friction(mut self) -> Self {
+        self.friction = None;
+        let b = self.beams[0];
+        self.shared = self.beams.iter().all(|x| *x == b);
+        self
+    }
+
     /// The parameters of beam i (0-based).
     pub(crate) fn beam(&self, i: usize) -> &RobotParams {
         &self.beams[i]

@@ -681,9 +681,7 @@ mod tests {
             let r = solve_to_tolerance(&star, 0.5, Some(every), Some(1), |n, pass| {
                 passes.push((n, pass));
                 match pass {
-                    Pass::BareEstimate { every } if bare_fails && n > 46 => {
-                        Err(AmmError::NonFinite { t: 0.1, dt: 4e-3 })
-                    }
+                    Pass::BareEstimate { .. } if bare_fails && n > 46 => Err(AmmError::NonFinite { t: 0.1, dt: 4e-3 }),
                     Pass::BareEstimate { every } => Ok(bare_model(n, every)),
                     Pass::TimeCheck { every } => Ok(rubbing(n, every, check_error)),
                     Pass::Deliver => Ok(rubbing(n, 1, c)),

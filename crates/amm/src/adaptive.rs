@@ -412,15 +412,8 @@ where
     let Ok(check) = run(n, Pass::TimeCheck { every: check_every }) else {
         return Ok(None);
     };
-    let mut delivered = run(n, Pass::Deliver)?;
-    *wall += check.info.wall_s + delivered.info.wall_s;
-    let e_check = mean_evp(&check, &delivered.every_nth(check_every));
-    if e_check > MAX_ESTIMATE_TIME_ERROR {
-        return Ok(None);
-    }
-    let mut part = e_check / FRICTION_TIME_CHECK_RATIO;
-    *wall += refine_step(problem, tol, n, run, (&mut delivered, &mut part))?;
-    Ok(Some(finish(problem, delivered, estimate + part, tol, *wall)))
+    *wall += check.info.wall_s;
+    deliver_with_friction(problem, tol, (n, estimate), (&check, check_every), run, wall)
 }
 
 /// With friction (`docs/amm.md` 12.15, "The pairs at the time check's step"): the estimate's pairs
@@ -445,9 +438,29 @@ where
     let Ok((n, estimate, check, pair_wall)) = raise_until_below(problem, tol, pass, run) else {
         return Ok(None);
     };
+    *wall += pair_wall;
+    deliver_with_friction(problem, tol, (n, estimate), (&check, check_every), run, wall)
+}
+
+/// With friction: the chosen N = `n` at the delivered step h after its time check `check` at 2 h
+/// (on every `check_every`-th output time): the time part (Eq. T2), the step's halvings of
+/// [`refine_step`], and the delivered run reported with `estimate` (the pairs' truncation) plus
+/// that part. `None` (the runs' wall time still added to `wall`) when the runs at 2 h and h
+/// differ by more than [`MAX_ESTIMATE_TIME_ERROR`].
+fn deliver_with_friction<F>(
+    problem: &Star,
+    tol: f64,
+    (n, estimate): (usize, f64),
+    (check, check_every): (&Response, usize),
+    run: &mut F,
+    wall: &mut f64,
+) -> Result<Option<Response>, AmmError>
+where
+    F: FnMut(usize, Pass) -> Result<Response, AmmError>,
+{
     let mut delivered = run(n, Pass::Deliver)?;
-    *wall += pair_wall + delivered.info.wall_s;
-    let e_check = mean_evp(&check, &delivered.every_nth(check_every));
+    *wall += delivered.info.wall_s;
+    let e_check = mean_evp(check, &delivered.every_nth(check_every));
     if e_check > MAX_ESTIMATE_TIME_ERROR {
         return Ok(None);
     }

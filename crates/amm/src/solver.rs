@@ -356,11 +356,10 @@ fn solve_to_tolerance(
         let mut steps = 0;
         let resp = match pass {
             // the robot without friction (docs/amm.md 12.16): its own system, not kept for N
-            Pass::BareEstimate { every } => {
+            Pass::BareEstimate { .. } => {
                 let bare = problem.without_friction();
                 let sys = build_system(settings, n, &bare)?;
-                let factor = adaptive::ESTIMATE_STEP_FACTOR;
-                integrate_coarse(&bare, settings, sys, h, factor, every, started, |_, _| steps += 1)
+                run_pass(&bare, settings, sys, (h, pass), started, &mut steps)
             }
             _ => {
                 let sys = match &built {
@@ -385,8 +384,8 @@ fn solve_to_tolerance(
 }
 
 /// One run of the automatic choice on the system `sys` of `problem` at the step of `pass`, the
-/// delivered step being `h` [s]; `steps` counts its steps. [`Pass::BareEstimate`] runs another
-/// problem (the robot without friction) and is not taken here.
+/// delivered step being `h` [s]; `steps` counts its steps. For [`Pass::BareEstimate`] the caller
+/// passes the robot without friction and its system.
 fn run_pass(
     problem: &Star,
     settings: &AmmSettings,

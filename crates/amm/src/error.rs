@@ -79,6 +79,20 @@ pub enum AmmError {
         #[source]
         source: RankError,
     },
+    /// The solution diverged in the step ending at time `t` [s] (length `dt`) and carried sleeve
+    /// `sleeve`'s (1-based) contact point off its beam: the point lies `shift` [m] along the beam
+    /// from where the rigid motion puts it, more than [`DIVERGED_SHIFT`] of the beam's length `l`
+    /// [m], which no elastic deflection of the model reaches (its axial and foreshortening parts
+    /// stay a small fraction of the beam); a blow-up of the time integration, not the sleeve
+    /// sliding off (`docs/friction.md` 9.5, "A divergence is named").
+    #[error("amm: t = {t:.6} s: the solution diverged in the step of {dt:.3e} s: it carried sleeve {sleeve}'s contact point {shift:.3} m along beam {sleeve} from where the rigid motion puts it (L = {l} m) and off the beam; no elastic deflection moves it that far")]
+    DivergedOffBeam {
+        t: f64,
+        dt: f64,
+        sleeve: usize,
+        shift: f64,
+        l: f64,
+    },
     /// The solution stopped being finite at time `t`.
     #[error("amm: t = {t:.6} s: the solution is no longer finite (step {dt:e} s)")]
     NonFinite { t: f64, dt: f64 },
@@ -127,4 +141,64 @@ pub enum RankError {
     /// The constrained eigenproblem of a pose (dependent constraint rows, an eigensolver failure).
     #[error(transparent)]
     Modes(#[from] NumericsError),
+}
+
+/// Share of a beam's length beyond which a sleeve's contact point, found off its beam, has moved
+/// from its rigid position by a divergence rather than by the motion ([`AmmError::DivergedOffBeam`]):
+/// a quarter, far above the elastic shifts of the small-deflection range.
+pub const DIVERGED_SHIFT: f64 = 0.25;
+
+impl AmmError {
+    /// A sleeve found off its beam ([`AmmError::SleeveOffBeam`]) in a step of length `dt` [s]
+    /// whose contact point lies more than [`DIVERGED_SHIFT`] of the beam from its rigid position
+    /// `rigid(t, i)` [m] (the material coordinate of sleeve i, 0-based, at time t with every
+    /// elastic coordinate zero) becomes [`AmmError::DivergedOffBeam`]; any other error, or an
+    /// unknown rigid position, is returned as it is.
+    pub(crate) fn judge_off_beam(self, dt: f64, rigid: impl Fn(f64, usize) -> Option<f64>) -> Self {
+        let AmmError::SleeveOffBeam(off) = &self else {
+            return self;
+        };
+        match rigid(off.t, off.sleeve - 1) {
+            Some(xp) if (off.xi - xp).abs() > DIVERGED_SHIFT * off.l || !off.xi.is_finite() => {
+                AmmError::DivergedOffBeam {
+                    t: off.t,
+                    dt,
+                    sleeve: off.sleeve,
+                    shift: off.xi - xp,
+                    l: off.l,
+                }
+            }
+            _ => self,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flexstar_model::sleeve_contact::on_beam;
+
+    /// A contact point off its beam by the rigid motion stays a sleeve sliding off; one carried a
+    /// quarter of the beam or more from its rigid position (or to a non-finite coordinate) is a
+    /// divergence, named with its shift.
+    #[test]
+    fn a_sleeve_carried_far_from_its_rigid_position_is_a_divergence() {
+        let off = |xi: f64| AmmError::from(on_beam(0.7175, 0, [xi, xi - 0.015, xi + 0.015], 0.5).unwrap_err());
+        // the rigid motion itself has the sleeve at the tip: it slides off
+        let at_tip = off(0.51).judge_off_beam(5e-4, |_, _| Some(0.499));
+        assert!(matches!(at_tip, AmmError::SleeveOffBeam(_)), "{at_tip}");
+        // 0.33 m behind G while the rigid motion has it at 0.2 m from G: a divergence
+        let far = off(-0.33).judge_off_beam(5e-4, |t, i| (t == 0.7175 && i == 0).then_some(0.2));
+        let AmmError::DivergedOffBeam { sleeve, shift, l, .. } = far else {
+            panic!("{far}");
+        };
+        assert_eq!((sleeve, l), (1, 0.5));
+        assert!((shift + 0.53).abs() < 1e-12, "{shift}");
+        assert!(far.to_string().contains("diverged"), "{far}");
+        let nan = off(f64::NAN).judge_off_beam(5e-4, |_, _| Some(0.2));
+        assert!(matches!(nan, AmmError::DivergedOffBeam { .. }), "{nan}");
+        // other errors pass through
+        let other = AmmError::NonFinite { t: 0.1, dt: 1e-3 }.judge_off_beam(1e-3, |_, _| Some(0.2));
+        assert!(matches!(other, AmmError::NonFinite { .. }));
+    }
 }

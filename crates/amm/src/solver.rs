@@ -522,6 +522,9 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let kin = |t: f64| problem.state(t);
+    // a sleeve's material coordinate at t with the star undeformed (its rigid position), for
+    // telling a divergence from a sleeve that slides off (`AmmError::judge_off_beam`)
+    let rigid_sleeve = |t: f64, i: usize| kin(t).ok().map(|st| st.xp[i].v);
 
     // the start: undeformed, or under gravity the static equilibrium of the start pose (Eq. G4)
     // at rest, the rigid velocities and accelerations zero (a motion may start accelerating, as a
@@ -583,7 +586,9 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
                     qdd: &mut qdd,
                 };
                 let rails = |st: &RigidState| problem.friction.map_or(0.0, |law| prescribed_rails_power(law, st));
-                events.step(&mut sys, &kin, (&mut st, t), &mut x, out, &rails)?;
+                events
+                    .step(&mut sys, &kin, (&mut st, t), &mut x, out, &rails)
+                    .map_err(|e| e.judge_off_beam(h, rigid_sleeve))?;
                 observe(&sys, &q);
                 continue;
             }
@@ -594,7 +599,8 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
             }
             st = kin(t)?;
             let predicted = (&qhat[..], &vhat[..], &a_part[..]);
-            sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)?;
+            sys.solve(&st, bp, gp, &qhat, &vhat, &mut qdd)
+                .map_err(|e| e.judge_off_beam(h, rigid_sleeve))?;
             if !accept(&ga, (bp, gp), predicted, &qdd, (&mut q, &mut v, &mut acc)) {
                 return Err(AmmError::NonFinite { t, dt: h });
             }

@@ -193,29 +193,29 @@ fn bordered_factor(a: &[f64], (m, nj): (usize, usize), blocks: &mut Blocks, bord
     if !block_factor(a, (m0, m, nj), blocks) {
         return false;
     }
-    let border_zero = (0..BORDER_ROWS).all(|k| (0..m0).all(|r| a[r * m + m0 + k] == 0.0 && a[(m0 + k) * m + r] == 0.0));
-    border.decoupled = border_zero;
-    if border_zero {
-        let d = Matrix3::from_fn(|r, c| a[(m0 + r) * m + m0 + c]);
-        return checked_inverse(&d)
-            .map(|inverse| border.schur_inverse = inverse)
-            .is_some();
-    }
-    let mut column = [0.0; MAX_INNER_ROWS];
-    for k in 0..BORDER_ROWS {
-        for (r, v) in column[..m0].iter_mut().enumerate() {
-            *v = a[r * m + m0 + k];
-        }
-        block_solve(blocks, nj, &mut column[..m0]);
-        for (r, v) in column.iter().enumerate() {
-            border.y[(r, k)] = if r < m0 { *v } else { 0.0 };
-        }
-        for c in 0..MAX_INNER_ROWS {
-            border.c[(k, c)] = if c < m0 { a[(m0 + k) * m + c] } else { 0.0 };
-        }
-    }
+    border.decoupled =
+        (0..BORDER_ROWS).all(|k| (0..m0).all(|r| a[r * m + m0 + k] == 0.0 && a[(m0 + k) * m + r] == 0.0));
     let d = Matrix3::from_fn(|r, c| a[(m0 + r) * m + m0 + c]);
-    checked_inverse(&(d - border.c * border.y))
+    // decoupled: Y = 0, and the Schur complement is D itself
+    let schur = if border.decoupled {
+        d
+    } else {
+        let mut column = [0.0; MAX_INNER_ROWS];
+        for k in 0..BORDER_ROWS {
+            for (r, v) in column[..m0].iter_mut().enumerate() {
+                *v = a[r * m + m0 + k];
+            }
+            block_solve(blocks, nj, &mut column[..m0]);
+            for (r, v) in column.iter().enumerate() {
+                border.y[(r, k)] = if r < m0 { *v } else { 0.0 };
+            }
+            for c in 0..MAX_INNER_ROWS {
+                border.c[(k, c)] = if c < m0 { a[(m0 + k) * m + c] } else { 0.0 };
+            }
+        }
+        d - border.c * border.y
+    };
+    checked_inverse(&schur)
         .map(|inverse| border.schur_inverse = inverse)
         .is_some()
 }

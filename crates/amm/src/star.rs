@@ -117,6 +117,13 @@ pub(crate) fn beam_params(robot: &Robot) -> [RobotParams; 3] {
     robot.beams().map(|b| b.params(0.0))
 }
 
+/// Whether the three beams share one mode set and one arrowhead: their data are equal and no
+/// sleeve has viscous friction (which puts each sleeve's own term on its beam's arrowhead, Eq. F14).
+fn shares_modes(beams: &[RobotParams; 3], friction: Option<&flexstar_model::Friction>) -> bool {
+    let viscous = friction.is_some_and(|f| f.c.0.iter().any(|c| *c != 0.0));
+    beams[1] == beams[0] && beams[2] == beams[0] && !viscous
+}
+
 /// The problem as the AMM solves it (module docs).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Star<'a> {
@@ -153,14 +160,12 @@ impl<'a> Star<'a> {
             Some(p) => [*p; 3],
             None => beam_params(robot),
         };
-        // viscous sleeve friction puts each sleeve's own term on its beam's arrowhead (Eq. F14)
-        let viscous = problem.friction().is_some_and(|f| f.c.0.iter().any(|c| *c != 0.0));
-        let shared = beams[1] == beams[0] && beams[2] == beams[0] && !viscous;
+        let friction = problem.friction();
         Star {
             robot,
             paper,
             beams,
-            shared,
+            shared: shares_modes(&beams, friction),
             weld: if paper.is_some() {
                 Weld::paper()
             } else {
@@ -174,7 +179,7 @@ impl<'a> Star<'a> {
             load: problem.load(),
             gravity: problem.gravity(),
             sensors: problem.sensors(),
-            friction: problem.friction(),
+            friction,
         }
     }
 
@@ -190,8 +195,7 @@ impl<'a> Star<'a> {
     /// estimate's pairs of a run with friction (`docs/amm.md` 12.16).
     pub(crate) fn without_friction(mut self) -> Self {
         self.friction = None;
-        let b = self.beams[0];
-        self.shared = self.beams.iter().all(|x| *x == b);
+        self.shared = shares_modes(&self.beams, None);
         self
     }
 

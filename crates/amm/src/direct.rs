@@ -309,6 +309,7 @@ fn integrate_direct(
             .collect(),
         friction: None,
     };
+    sys.set_third_order_step(GenAlpha::new(RHO_INF).beta_prime(dt_max));
     let mut buf = Coupled::new(n, sys.lam.len());
     let mut ctx = StepContext {
         buf: &mut buf,

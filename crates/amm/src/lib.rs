@@ -46,6 +46,7 @@ mod static_start;
 mod stick_slip;
 mod system;
 mod system_cache;
+mod third_order;
 
 pub use direct::DIRECT_COLUMNS;
 pub use error::{AmmError, RankError};

@@ -519,6 +519,7 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     let stops = stops(&out_times, &times.all, 1e-9 * problem.time.dt_out);
     let mut rec = Recorder::new(&sys, settings, problem, out_times.len(), times);
     let ga = GenAlpha::new(RHO_INF);
+    sys.set_third_order_step(ga.beta_prime(dt_max));
     let (mut q, mut v, mut acc, mut qdd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let (mut qhat, mut vhat, mut a_part) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let kin = |t: f64| problem.state(t);

@@ -33,6 +33,7 @@ use crate::friction::SleeveFriction;
 use crate::geometric::{self, GeometricStiffness};
 use crate::modes::{dot, ModeSet};
 use crate::sleeve::{SleeveRow, Sleeves, B_MID, B_MSLOPE, SLEEVE_ROWS};
+use crate::third_order::ThirdOrderTerms;
 use flexstar_numerics::vector::dots;
 
 /// One constraint row and its multiplier (`docs/amm.md` section 1; Eqs. 24-29, 38-43). Beams are
@@ -468,6 +469,9 @@ pub(crate) struct System {
     pay_tmp: Vec<f64>,
     /// The sleeves' friction (`crate::friction`, `docs/friction.md` 9); `None` without it.
     pub(crate) friction: Option<SleeveFriction>,
+    /// Full model under gravity: the beams' third-order terms about the sag (Eqs. V5-V6,
+    /// `crate::third_order`); `None` otherwise.
+    third_order: Option<Vec<ThirdOrderTerms>>,
 }
 
 /// Is a vector of mode values zero to round-off? `scale[m]` is the size a non-zero entry would have.
@@ -642,6 +646,7 @@ impl System {
             load: None,
             pay_tmp: vec![0.0; nb],
             friction: None,
+            third_order: None,
         }
     }
 
@@ -659,9 +664,26 @@ impl System {
     /// so the bare star's results stay bit for bit.
     pub(crate) fn attach(&mut self, payload: &Payload, damping: &Damping, load: &LoadSettings, gravity: [f64; 2]) {
         self.gravity = gravity;
+        let under_gravity = gravity != [0.0; 2] && self.geometric.is_some();
+        self.third_order = under_gravity.then(|| {
+            (0..3)
+                .map(|i| {
+                    let b = self.beam(i);
+                    ThirdOrderTerms::new(&b.modes, b.rho * b.modes.ei_over_rho(), b.rho)
+                })
+                .collect()
+        });
         self.payload = PayloadTerms::new(payload, self.beams[0].ids.len());
         (self.alpha, self.beta) = damping.coefficients();
         self.load = (!load.is_none()).then(|| load.clone());
+    }
+
+    /// The run's largest `beta' = beta h^2` [s^2], which decides the modes the beams' third-order
+    /// terms act on (`crate::third_order`); call before the static start. No-op without them.
+    pub(crate) fn set_third_order_step(&mut self, bp: f64) {
+        if let Some(terms) = self.third_order.as_mut() {
+            terms.iter_mut().for_each(|t| t.set_step(bp));
+        }
     }
 
     /// Friction in the sleeves (`docs/friction.md` 9): the stick rows of Eq. F16 (one per
@@ -777,6 +799,9 @@ impl System {
             if let Some(fore) = self.fore.as_mut() {
                 fore.remember(i, &qdd[i * nb..i * nb + nm]);
             }
+            if let Some(terms) = self.third_order.as_mut() {
+                terms[i].remember(&qdd[i * nb..i * nb + nm]);
+            }
         }
     }
 
@@ -826,6 +851,12 @@ impl System {
                 if let Some(fore) = self.fore.as_mut() {
                     r[nm] += rho * fore.second_derivative(i, geo.kept(), g2a, va);
                 }
+            }
+        }
+        if let Some(terms) = self.third_order.as_mut() {
+            for (i, t) in terms.iter_mut().enumerate() {
+                let o = i * nb;
+                t.add_forces(&qhat[o..o + nm], &vhat[o..o + nm], &mut self.resid[o..o + nm]);
             }
         }
         if self.beta > 0.0 {

@@ -37,30 +37,22 @@ fn nine_as_built_cases_meet_the_evp_bounds_and_their_estimates_are_within_a_fact
     });
 }
 
-/// A sleeve carried off its beam by the elastic motion (`docs/validation.md` 9): case `b07127e3`
-/// of the file's second draw (seed 32), where the rigid pose keeps sleeve 3 on beam 3 to its last
-/// time and the AMM once finished the run with the sleeve's right edge past the tip. Both
+/// A sleeve that leaves its beam (`docs/validation.md` 9): case `407257b1` of the file's first
+/// draw (seed 31), where sleeve 3's right edge reaches the tip of beam 3 during the motion. Both
 /// solvers, each with its own model of the sleeve (the AMM's material point `xp - u + f`, the
-/// FEM's contact coordinates), now stop at the same time with the same sleeve and contact point a
-/// fraction of a millimetre past the tip.
+/// FEM's contact coordinates), stop within a millisecond of each other with the same sleeve and
+/// contact point a fraction of a millimetre past the tip. (The earlier case of this test,
+/// `b07127e3` of seed 32, had the AMM's edge 0.05 mm past the tip at the last time; with the
+/// beams' third-order terms under gravity, `docs/amm.md` 12.14, it ends short of it.)
 #[test]
 fn both_solvers_stop_where_a_sleeve_leaves_its_beam() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/studies");
-    let text = std::fs::read_to_string(path.join("envelope-as-built.toml")).expect("the study file");
-    let dir = tempfile::tempdir().expect("a temporary directory");
-    let base = path.join("../paper-robot.toml");
-    let text = text.replace("seed = 31", "seed = 32").replace(
-        "\"../paper-robot.toml\"",
-        &format!("{:?}", base.to_str().expect("a UTF-8 path")),
-    );
-    let file = dir.path().join("seed-32.toml");
-    std::fs::write(&file, text).expect("written");
-    let study = flexstar_study::Study::load(&file).expect("the study loads");
+    let study = flexstar_study::Study::load(&path.join("envelope-as-built.toml")).expect("the study loads");
     let case = study
         .cases()
         .into_iter()
-        .find(|c| c.run_id.starts_with("b07127e3"))
-        .expect("the case is in the seed-32 draw");
+        .find(|c| c.run_id.starts_with("407257b1"))
+        .expect("the case is in the seed-31 draw");
     let exp = study.experiment(&case.values).expect("a valid case");
     let problem = exp.problem().expect("a valid problem");
     let amm = flexstar_model::AmmSettings::accurate();
@@ -78,7 +70,7 @@ fn both_solvers_stop_where_a_sleeve_leaves_its_beam() {
     for off in [a, f] {
         assert_eq!((off.sleeve, off.point), (3, "right edge"), "{off}");
         assert!(off.xi > off.l && off.xi < off.l + 1e-3, "{off}");
-        assert!((off.t - exp.time.t_end).abs() < 1e-3, "{off}");
     }
+    assert!((a.t - f.t).abs() < 1e-3, "AMM at {} s, FEM at {} s", a.t, f.t);
     assert_eq!(a.l, f.l, "the same beam");
 }

@@ -56,9 +56,10 @@ pub(crate) struct ThirdOrderTerms {
     /// point p, per unit panel length (exact for h of degree below [`POINTS`] on the panel).
     panel: f64,
     cum: [[f64; POINTS]; POINTS],
-    /// `[phi_j'(x_q), phi_j''(x_q)]`, point-major: row q holds the kept modes' slopes, then
-    /// their curvatures (2k per row).
-    table: Vec<f64>,
+    /// `phi_j'(x_q)` and `phi_j''(x_q)`, mode-major: row j holds kept mode j at every point
+    /// (so that each sum runs along the points, in vector lanes).
+    slopes: Vec<f64>,
+    curvatures: Vec<f64>,
     /// The kept modal accelerations of the last solve [m^1/2 s^-2].
     acc: Vec<f64>,
     // per step: the kept coordinates and velocities, and per point w', w'', h, and the two
@@ -90,15 +91,15 @@ impl ThirdOrderTerms {
         }
         let cum = integration_matrix(&xs);
         let k = kept.len();
-        let mut table = vec![0.0; x.len() * 2 * k];
-        for (q, &xq) in x.iter().enumerate() {
-            for (j, &m) in kept.iter().enumerate() {
+        let nq = x.len();
+        let (mut slopes, mut curvatures) = (vec![0.0; k * nq], vec![0.0; k * nq]);
+        for (j, &m) in kept.iter().enumerate() {
+            for (q, &xq) in x.iter().enumerate() {
                 let e = modes.eval(m, xq);
-                table[q * 2 * k + j] = e[1];
-                table[q * 2 * k + k + j] = e[2];
+                slopes[j * nq + q] = e[1];
+                curvatures[j * nq + q] = e[2];
             }
         }
-        let nq = x.len();
         let lambda = kept.iter().map(|&m| modes.lambda()[m]).collect();
         ThirdOrderTerms {
             lambda,
@@ -119,7 +120,8 @@ impl ThirdOrderTerms {
             weight,
             panel: h,
             cum,
-            table,
+            slopes,
+            curvatures,
         }
     }
 
@@ -153,20 +155,27 @@ impl ThirdOrderTerms {
 
     /// w', w'' and h = w_t'^2 + w' w_tt' at every point.
     fn point_values(&mut self) {
-        let k = self.kept.len();
-        for q in 0..self.x.len() {
-            let row = &self.table[q * 2 * k..(q + 1) * 2 * k];
-            let (dp, ddp) = row.split_at(k);
-            let (mut wp, mut wpp, mut wtp, mut wttp) = (0.0, 0.0, 0.0, 0.0);
-            for j in 0..self.active {
-                wp += dp[j] * self.alpha[j];
-                wtp += dp[j] * self.vel[j];
-                wttp += dp[j] * self.acc[j];
-                wpp += ddp[j] * self.alpha[j];
+        let nq = self.x.len();
+        let wtp = &mut self.on_slope; // workspaces until point_weights fills them
+        let wttp = &mut self.on_curv;
+        for v in [&mut self.slope, &mut self.curv, &mut *wtp, &mut *wttp] {
+            v.iter_mut().for_each(|x| *x = 0.0);
+        }
+        for j in 0..self.active {
+            let (dp, ddp) = (
+                &self.slopes[j * nq..(j + 1) * nq],
+                &self.curvatures[j * nq..(j + 1) * nq],
+            );
+            let (a, v, acc) = (self.alpha[j], self.vel[j], self.acc[j]);
+            for q in 0..nq {
+                self.slope[q] += a * dp[q];
+                wtp[q] += v * dp[q];
+                wttp[q] += acc * dp[q];
+                self.curv[q] += a * ddp[q];
             }
-            self.slope[q] = wp;
-            self.curv[q] = wpp;
-            self.h[q] = wtp * wtp + wp * wttp;
+        }
+        for q in 0..nq {
+            self.h[q] = wtp[q] * wtp[q] + self.slope[q] * wttp[q];
         }
     }
 
@@ -202,15 +211,17 @@ impl ThirdOrderTerms {
         }
     }
 
-    /// `r_j -= sum_q (on_slope_q phi_j'(x_q) + on_curv_q phi_j''(x_q))` on the kept rows.
+    /// `r_j -= sum_q (on_slope_q phi_j'(x_q) + on_curv_q phi_j''(x_q))` on the active kept rows.
     fn project(&self, r: &mut [f64]) {
-        let k = self.kept.len();
+        let nq = self.x.len();
         for (j, &m) in self.kept.iter().enumerate().take(self.active) {
-            let mut s = 0.0;
-            for q in 0..self.x.len() {
-                let row = &self.table[q * 2 * k..(q + 1) * 2 * k];
-                s += self.on_slope[q] * row[j] + self.on_curv[q] * row[k + j];
-            }
+            let (dp, ddp) = (
+                &self.slopes[j * nq..(j + 1) * nq],
+                &self.curvatures[j * nq..(j + 1) * nq],
+            );
+            let s: f64 = (0..nq)
+                .map(|q| self.on_slope[q] * dp[q] + self.on_curv[q] * ddp[q])
+                .sum();
             r[m] -= s;
         }
     }
@@ -219,12 +230,17 @@ impl ThirdOrderTerms {
     /// on the same points.
     #[cfg(test)]
     fn curvature_energy(&self, alpha: &[f64]) -> f64 {
-        let k = self.kept.len();
-        (0..self.x.len())
+        let nq = self.x.len();
+        let field = |table: &[f64], q: usize| -> f64 {
+            self.kept
+                .iter()
+                .enumerate()
+                .map(|(j, &m)| table[j * nq + q] * alpha[m])
+                .sum()
+        };
+        (0..nq)
             .map(|q| {
-                let row = &self.table[q * 2 * k..(q + 1) * 2 * k];
-                let wp: f64 = self.kept.iter().enumerate().map(|(j, &m)| row[j] * alpha[m]).sum();
-                let wpp: f64 = self.kept.iter().enumerate().map(|(j, &m)| row[k + j] * alpha[m]).sum();
+                let (wp, wpp) = (field(&self.slopes, q), field(&self.curvatures, q));
                 0.5 * self.weight[q] * self.ei * wpp * wpp * wp * wp
             })
             .sum()

@@ -546,6 +546,19 @@ mod tests {
         r.every_nth(every)
     }
 
+    /// Paper case 3 with Coulomb friction `mu = 0.1` in the sleeves.
+    fn case3_with_friction() -> Problem {
+        let mut exp = paper_case(3);
+        exp.friction = Some(toml::from_str("mu = 0.1\n").unwrap());
+        exp.problem().unwrap()
+    }
+
+    /// [`model`] of the robot with friction: its truncation twice the frictionless one, plus
+    /// `time_error`.
+    fn rubbing(star: &Star, n: usize, every: usize, time_error: f64) -> Response {
+        model(star, every, n, 0.003 * (53.0 / n as f64).powi(7) + time_error)
+    }
+
     #[test]
     fn coarse_pairs_then_one_delivered_run_or_the_fallback_when_the_coarse_step_is_too_rough() {
         let exp = paper_case(3);
@@ -651,9 +664,7 @@ mod tests {
     /// take the friction at 2 h (12.15) and the estimate is theirs.
     #[test]
     fn with_friction_the_truncation_comes_from_the_frictionless_pairs_at_the_coarse_step() {
-        let mut exp = paper_case(3);
-        exp.friction = Some(toml::from_str("mu = 0.1\n").unwrap());
-        let problem = exp.problem().unwrap();
+        let problem = case3_with_friction();
         let star = Star::new(&problem);
         let every = estimate_grid(&problem, 5e-4).unwrap();
         // the frictionless robot's truncation 0.3 % (53 / N)^7 (its pairs at the coarse step with
@@ -661,10 +672,7 @@ mod tests {
         // then go on to N = 61; a time error of 0.1 % at h
         let c = 0.001;
         let bare_model = |n: usize, every: usize| model(&star, every, n, 0.0);
-        let rubbing = |n: usize, every: usize, time_error: f64| {
-            let e = 0.003 * (53.0 / n as f64).powi(7);
-            model(&star, every, n, e + time_error)
-        };
+        let rubbing = |n: usize, every: usize, time_error: f64| rubbing(&star, n, every, time_error);
         for (bare_fails, check_error, pairs) in [
             (false, 4.0 * c, "bare"),
             (true, 4.0 * c, "rubbing"),
@@ -710,15 +718,11 @@ mod tests {
     /// pair. Without friction the failure still stops the run.
     #[test]
     fn with_friction_a_failing_time_check_halves_the_step() {
-        let mut exp = paper_case(3);
-        exp.friction = Some(toml::from_str("mu = 0.1\n").unwrap());
-        let problem = exp.problem().unwrap();
+        let problem = case3_with_friction();
         let star = Star::new(&problem);
         let every = estimate_grid(&problem, 5e-4).unwrap();
         let c = 0.001;
-        let rubbing = |n: usize, every: usize, time_error: f64| {
-            model(&star, every, n, 0.003 * (53.0 / n as f64).powi(7) + time_error)
-        };
+        let rubbing = |n: usize, every: usize, time_error: f64| rubbing(&star, n, every, time_error);
         let fails = || AmmError::NonFinite { t: 0.3, dt: 1e-3 };
         let mut passes = Vec::new();
         let r = solve_to_tolerance(&star, 0.5, Some(every), Some(1), |n, pass| {

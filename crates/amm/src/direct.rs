@@ -172,42 +172,110 @@ fn coupled_step(
         sys.predict_friction(&st, vhat, (bp, gp));
     }
     sys.prepare(&st, bp, gp, qhat)?;
-    sys.forcing(&st, qhat, vhat);
-    sys.solve_prepared(bp, Some(qhat), &mut buf.qdd0);
-    buf.lam0.copy_from_slice(&sys.lam);
-    for (qn, (qh, a)) in buf.qnew.iter_mut().zip(qhat.iter().zip(&buf.qdd0)) {
-        *qn = qh + bp * a;
-    }
+    base_solution(sys, buf, &st, bp, qhat, vhat);
     for k in 0..3 {
         sys.forcing_derivative(&st, sens.d_ag[k], sens.d_thd[k], sens.d_thdd[k], qhat, vhat);
         sys.solve_prepared(bp, None, &mut buf.dqdd[k]);
         buf.dlam[k].copy_from_slice(&sys.lam);
     }
+    let slider = SliderStep {
+        law,
+        star,
+        t,
+        s,
+        sd,
+        x_pred,
+        gp,
+        bp,
+        rails,
+    };
+    let mut dx = slider_correction(sys, rec, buf, &st, &slider)?;
+    compose(sys, buf, dx, qdd);
+    if sys.iterates_lagged_accelerations() {
+        // the inverse step's fixed-point pass (`System::solve`), so that a direct run inverts an
+        // inverse one under gravity: the base solution again with the accelerations just solved,
+        // the sensitivities (independent of the lagged terms) kept
+        base_solution(sys, buf, &st, bp, qhat, vhat);
+        dx = slider_correction(sys, rec, buf, &st, &slider)?;
+        compose(sys, buf, dx, qdd);
+    }
+    Ok([0, 1, 2].map(|i| x_pred[i] + dx[i]))
+}
 
-    // Eq. 33 for the correction ds'': (m + kp bp + kd gp) ds'' + dPush/ds'' ds'' = residual
-    let fa = law.force(t, s, sd).map_err(|source| AmmError::Drive { t, source })?;
-    let (kp, kd) = (law.stiffness(), law.damping());
+/// The coupled step's base solution: q'' and the multipliers at the predicted s'' (`buf.qdd0`,
+/// `buf.lam0`) and the predicted coordinates `buf.qnew`, with the factors of `System::prepare`.
+fn base_solution(sys: &mut System, buf: &mut Coupled, st: &RigidState, bp: f64, qhat: &[f64], vhat: &[f64]) {
+    sys.forcing(st, qhat, vhat);
+    sys.solve_prepared(bp, Some(qhat), &mut buf.qdd0);
+    buf.lam0.copy_from_slice(&sys.lam);
+    for (qn, (qh, a)) in buf.qnew.iter_mut().zip(qhat.iter().zip(&buf.qdd0)) {
+        *qn = qh + bp * a;
+    }
+}
+
+/// What the sliders' rows of the coupled step need: the actuator law at time `t` [s], the
+/// predicted slider positions `s` [m], rates `sd` [m/s] and accelerations `x_pred` [m/s^2], the
+/// integrator's `beta'` [s^2] and `gamma'` [s], and the rails' friction.
+struct SliderStep<'a> {
+    law: &'a dyn ActuatorLaw,
+    star: &'a Star<'a>,
+    t: f64,
+    s: [f64; 3],
+    sd: [f64; 3],
+    x_pred: [f64; 3],
+    gp: f64,
+    bp: f64,
+    rails: Option<&'a Rails>,
+}
+
+/// Eq. 33 for the correction ds'': (m + kp bp + kd gp) ds'' + dPush/ds'' ds'' = residual, from
+/// the base solution and the sensitivities in `buf`.
+fn slider_correction(
+    sys: &System,
+    rec: &Recorder,
+    buf: &Coupled,
+    st: &RigidState,
+    p: &SliderStep,
+) -> Result<[f64; 3], AmmError> {
+    let t = p.t;
+    let fa = p
+        .law
+        .force(t, p.s, p.sd)
+        .map_err(|source| AmmError::Drive { t, source })?;
+    let (kp, kd) = (p.law.stiffness(), p.law.damping());
     let mut a = [[0.0; 4]; 3];
     for (i, row) in a.iter_mut().enumerate() {
         // each slider's own sleeve and slider mass (docs/amm.md 13)
-        let m = star.beam(i).mpp_mpa;
+        let m = p.star.beam(i).mpp_mpa;
         for (k, dlam) in buf.dlam.iter().enumerate() {
-            row[k] = rec.sleeve_push(i, &st, &buf.qnew, dlam, sys.sleeves.axial());
+            row[k] = rec.sleeve_push(i, st, &buf.qnew, dlam, sys.sleeves.axial());
         }
-        row[i] += m + kp[i] * bp + kd[i] * gp;
+        row[i] += m + kp[i] * p.bp + kd[i] * p.gp;
         // Eq. 33 with the weight along the rail (Eq. G2)
         row[3] = fa[i] + m * rec.gravity_along(i)
-            - m * x_pred[i]
-            - rec.sleeve_push(i, &st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
-        if sys.friction.is_some() || rails.is_some() {
-            friction_row(sys, rec, buf, &st, i, row, rails.map(|r| (r, sd[i], x_pred[i], gp)));
+            - m * p.x_pred[i]
+            - rec.sleeve_push(i, st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
+        if sys.friction.is_some() || p.rails.is_some() {
+            friction_row(
+                sys,
+                rec,
+                buf,
+                st,
+                i,
+                row,
+                p.rails.map(|r| (r, p.sd[i], p.x_pred[i], p.gp)),
+            );
         }
     }
-    let dx = solve3(a).ok_or(AmmError::SingularConstraints {
+    solve3(a).ok_or(AmmError::SingularConstraints {
         t,
         source: RankError::Sliders,
-    })?;
+    })
+}
 
+/// q'' and the multipliers of the corrected step: the base solution plus `dx` times the
+/// sensitivities; remembers the lagged accelerations (`System::set_axial_acceleration`).
+fn compose(sys: &mut System, buf: &Coupled, dx: [f64; 3], qdd: &mut [f64]) {
     qdd.copy_from_slice(&buf.qdd0);
     sys.lam.copy_from_slice(&buf.lam0);
     for ((dxk, dq), dl) in dx.iter().zip(&buf.dqdd).zip(&buf.dlam) {
@@ -219,7 +287,6 @@ fn coupled_step(
         }
     }
     sys.set_axial_acceleration(qdd);
-    Ok([0, 1, 2].map(|i| x_pred[i] + dx[i]))
 }
 
 /// Friction in slider i's row of the 3 x 3 system (Eq. F17, `docs/friction.md` 9.1): the

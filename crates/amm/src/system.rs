@@ -787,16 +787,22 @@ impl System {
         self.forcing(st, qhat, vhat);
         self.solve_prepared(bp, Some(qhat), qdd);
         self.set_axial_acceleration(qdd);
-        if self.gravity != [0.0; 2] && self.fore.is_some() {
-            // one fixed-point pass on the full model's lagged accelerations (Eq. 23's u'', the u
-            // row's foreshortening inertia): under gravity the sag makes their u-alpha coupling
-            // first order, and taken from the last solve alone it diverges at fine steps
-            // (docs/amm.md 12.14, "A divergence at fine steps under gravity"); the same factors
+        if self.iterates_lagged_accelerations() {
             self.forcing(st, qhat, vhat);
             self.solve_prepared(bp, Some(qhat), qdd);
             self.set_axial_acceleration(qdd);
         }
         Ok(())
+    }
+
+    /// Whether each step takes one fixed-point pass on the full model's lagged accelerations
+    /// (Eq. 23's u'', the u row's foreshortening inertia): the forcing again with the
+    /// accelerations just solved, the same factors. Under gravity the sag makes their u-alpha
+    /// coupling first order, and taken from the last solve alone it diverges at fine steps
+    /// (`docs/amm.md` 12.14, "A divergence at fine steps under gravity"). Without gravity the
+    /// coupling is second order and no pass is taken.
+    pub(crate) fn iterates_lagged_accelerations(&self) -> bool {
+        self.gravity != [0.0; 2] && self.fore.is_some()
     }
 
     /// Remember the axial accelerations u_i'' of `qdd` (the full model's Eq. 23 term of the next

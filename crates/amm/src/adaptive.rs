@@ -129,8 +129,7 @@ pub(crate) fn geometric_part_of(problem: &Star, r: &Response) -> f64 {
     let a = (0..3)
         .map(|i| largest(&r.w_tip[i]).max(largest(&r.w_g[i])) / problem.beam(i).l)
         .fold(0.0f64, f64::max);
-    let third_order = problem.gravity != [0.0; 2] && r.info.model.as_deref() == Some("full");
-    let coeff = if third_order {
+    let coeff = if crate::third_order::carried(problem.gravity, r.info.model.as_deref() == Some("full")) {
         GEOMETRIC_COEFF_THIRD_ORDER
     } else {
         GEOMETRIC_COEFF

@@ -33,7 +33,7 @@ use crate::friction::SleeveFriction;
 use crate::geometric::{self, GeometricStiffness};
 use crate::modes::{dot, ModeSet};
 use crate::sleeve::{SleeveRow, Sleeves, B_MID, B_MSLOPE, SLEEVE_ROWS};
-use crate::third_order::ThirdOrderTerms;
+use crate::third_order::{self, ThirdOrderTerms};
 use flexstar_numerics::vector::dots;
 
 /// One constraint row and its multiplier (`docs/amm.md` section 1; Eqs. 24-29, 38-43). Beams are
@@ -664,14 +664,15 @@ impl System {
     /// so the bare star's results stay bit for bit.
     pub(crate) fn attach(&mut self, payload: &Payload, damping: &Damping, load: &LoadSettings, gravity: [f64; 2]) {
         self.gravity = gravity;
-        let under_gravity = gravity != [0.0; 2] && self.geometric.is_some();
-        self.third_order = under_gravity.then(|| {
-            (0..3)
-                .map(|i| {
-                    let b = self.beam(i);
-                    ThirdOrderTerms::new(&b.modes, b.rho * b.modes.ei_over_rho(), b.rho)
-                })
-                .collect()
+        self.third_order = third_order::carried(gravity, self.geometric.is_some()).then(|| {
+            // equal beams share one beam model: its tables are built once, each beam keeps its
+            // own lagged accelerations
+            let built: Vec<ThirdOrderTerms> = self
+                .bm
+                .iter()
+                .map(|b| ThirdOrderTerms::new(&b.modes, b.rho * b.modes.ei_over_rho(), b.rho))
+                .collect();
+            (0..3).map(|i| pick(&built, i).clone()).collect()
         });
         self.payload = PayloadTerms::new(payload, self.beams[0].ids.len());
         (self.alpha, self.beta) = damping.coefficients();

@@ -26,6 +26,13 @@
 use crate::geometric::KEPT_ANALYTIC;
 use crate::modes::ModeSet;
 
+/// Whether a run carries these terms: under gravity (`gravity` [m/s^2], base frame) and in the
+/// full model, whose geometric stiffness they extend (12.14). The one rule for the system that
+/// attaches them and for the estimate that calibrates what they leave (Eq. G1).
+pub(crate) fn carried(gravity: [f64; 2], full_model: bool) -> bool {
+    gravity != [0.0; 2] && full_model
+}
+
 /// Equal panels along each beam (12.14: 4 and 100 panels agree to 0.001 % mean EVP on the
 /// as-built cases measured there).
 pub(crate) const PANELS: usize = 10;

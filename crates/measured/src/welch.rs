@@ -3,7 +3,7 @@
 //! window, their periodograms averaged and scaled one-sided, in unit^2/Hz.
 
 use rustfft::num_complex::Complex;
-use rustfft::FftPlanner;
+use rustfft::FftPlannerScalar;
 
 use crate::error::MeasuredError;
 
@@ -79,7 +79,7 @@ pub fn welch(x: &[f64], fs: f64, opts: &WelchOptions, what: &str) -> Result<Psd,
     let hop = ((l as f64) * (1.0 - opts.overlap)).round().max(1.0) as usize;
     let window = hann(l);
     let w2: f64 = window.iter().map(|w| w * w).sum();
-    let fft = FftPlanner::new().plan_fft_forward(l);
+    let fft = FftPlannerScalar::new().plan_fft_forward(l);
     let half = l / 2;
     let mut sum = vec![0.0; half + 1];
     let mut segments = 0;

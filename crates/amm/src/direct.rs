@@ -125,6 +125,9 @@ fn sensitivity(star: &Star, s: [f64; 3], sd: [f64; 3], gp: f64, t: f64) -> Resul
 
 /// Buffers of the coupled step: the base solution and one sensitivity per slider.
 struct Coupled {
+    /// The base solution's forcing, kept for the fixed-point pass (the sensitivities' forcing
+    /// derivatives overwrite the system's).
+    forcing0: Vec<f64>,
     qdd0: Vec<f64>,
     lam0: Vec<f64>,
     dqdd: [Vec<f64>; 3],
@@ -136,6 +139,7 @@ impl Coupled {
     /// Buffers for `n` coordinates and `n_lam` multipliers.
     fn new(n: usize, n_lam: usize) -> Self {
         Coupled {
+            forcing0: vec![0.0; n],
             qdd0: vec![0.0; n],
             lam0: vec![0.0; n_lam],
             dqdd: std::array::from_fn(|_| vec![0.0; n]),
@@ -193,9 +197,11 @@ fn coupled_step(
     compose(sys, buf, dx, qdd);
     if sys.iterates_lagged_accelerations() {
         // the inverse step's fixed-point pass (`System::solve`), so that a direct run inverts an
-        // inverse one under gravity: the base solution again with the accelerations just solved,
-        // the sensitivities (independent of the lagged terms) kept
-        base_solution(sys, buf, &st, bp, qhat, vhat);
+        // inverse one under gravity: the base solution again with the lagged terms of the
+        // accelerations just solved, the sensitivities (independent of them) kept
+        sys.restore_forcing(&buf.forcing0);
+        sys.refresh_lagged_forcing();
+        substitute_base(sys, buf, bp, qhat);
         dx = slider_correction(sys, rec, buf, &st, &slider)?;
         compose(sys, buf, dx, qdd);
     }
@@ -206,6 +212,14 @@ fn coupled_step(
 /// `buf.lam0`) and the predicted coordinates `buf.qnew`, with the factors of `System::prepare`.
 fn base_solution(sys: &mut System, buf: &mut Coupled, st: &RigidState, bp: f64, qhat: &[f64], vhat: &[f64]) {
     sys.forcing(st, qhat, vhat);
+    if sys.iterates_lagged_accelerations() {
+        buf.forcing0.copy_from_slice(sys.forcing_values());
+    }
+    substitute_base(sys, buf, bp, qhat);
+}
+
+/// The base solution's substitution with the system's current forcing.
+fn substitute_base(sys: &mut System, buf: &mut Coupled, bp: f64, qhat: &[f64]) {
     sys.solve_prepared(bp, Some(qhat), &mut buf.qdd0);
     buf.lam0.copy_from_slice(&sys.lam);
     for (qn, (qh, a)) in buf.qnew.iter_mut().zip(qhat.iter().zip(&buf.qdd0)) {

@@ -101,6 +101,14 @@ impl Foreshortening {
         e2
     }
 
+    /// The acceleration part of [`Foreshortening::second_derivative`]: `(G2 alpha) . alpha''` on
+    /// the modes `rows`, with alpha'' of the last solve [m^2/s^2]; the same sum in the same order.
+    pub(crate) fn acceleration_part(&self, beam: usize, rows: &[usize], g2_alpha: ColRef<'_, f64>) -> f64 {
+        let n = self.alpha_dd.len() / 3;
+        let add = &self.alpha_dd[beam * n..(beam + 1) * n];
+        rows.iter().enumerate().map(|(k, &j)| add[j] * g2_alpha[k]).sum()
+    }
+
     /// Remember the modal accelerations of beam `beam` at the last solve.
     pub(crate) fn remember(&mut self, beam: usize, alpha_dd: &[f64]) {
         let n = alpha_dd.len();

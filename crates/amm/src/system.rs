@@ -443,6 +443,10 @@ pub(crate) struct System {
     /// Full model: the axial acceleration u_i'' of each beam at the last solve, part of the axial
     /// inertia force of Eq. 23 (the whole axially rigid beam accelerates with it).
     udd: [f64; 3],
+    /// Per beam, the lagged accelerations the last [`System::forcing`] used: u_i'' (Eq. 23) and
+    /// the acceleration part `(G2 alpha) . alpha''` of the foreshortening inertia (its u row),
+    /// so that the fixed-point pass changes only those terms ([`System::refresh_lagged_forcing`]).
+    lag_in_forcing: [[f64; 2]; 3],
     /// Full model: the foreshortening inertia of the bent beams in the u rows (`foreshortening`).
     fore: Option<Foreshortening>,
     // per-step buffers
@@ -628,6 +632,7 @@ impl System {
             sleeves,
             geometric,
             udd: [0.0; 3],
+            lag_in_forcing: [[0.0; 2]; 3],
             nm,
             nb,
             bm,
@@ -789,7 +794,7 @@ impl System {
         self.solve_prepared(bp, Some(qhat), qdd);
         self.set_axial_acceleration(qdd);
         if self.iterates_lagged_accelerations() {
-            self.forcing(st, qhat, vhat);
+            self.refresh_lagged_forcing();
             self.solve_prepared(bp, Some(qhat), qdd);
             self.set_axial_acceleration(qdd);
         }
@@ -804,6 +809,47 @@ impl System {
     /// coupling is second order and no pass is taken.
     pub(crate) fn iterates_lagged_accelerations(&self) -> bool {
         self.gravity != [0.0; 2] && self.fore.is_some()
+    }
+
+    /// The fixed-point pass's forcing ([`System::iterates_lagged_accelerations`]): the forcing
+    /// of the last [`System::forcing`] with its two lagged-acceleration terms taken again from
+    /// the accelerations remembered since ([`System::set_axial_acceleration`]): Eq. 23's
+    /// `rho u_i'' G2 alpha` in the alpha rows and the acceleration part `rho (G2 alpha) . alpha''`
+    /// of the u row's foreshortening inertia, each changed by the change of its acceleration. The
+    /// rest of the forcing, the beams' third-order terms included (their own lag, 12.14), is
+    /// unchanged, so the pass costs a few dot products of the kept modes and one substitution.
+    pub(crate) fn refresh_lagged_forcing(&mut self) {
+        let (nm, nb) = (self.nm, self.nb);
+        let Some(geo) = &self.geometric else {
+            return;
+        };
+        for i in 0..3 {
+            let rho = pick(&self.bm, i).rho;
+            let o = i * nb;
+            let [udd_used, acc_used] = self.lag_in_forcing[i];
+            let g2a = geo.g2_alpha(i);
+            let d_udd = self.udd[i] - udd_used;
+            for (k, &j) in geo.kept().iter().enumerate() {
+                self.resid[o + j] += rho * d_udd * g2a[k];
+            }
+            let mut acc = acc_used;
+            if let Some(fore) = self.fore.as_ref() {
+                acc = fore.acceleration_part(i, geo.kept(), g2a);
+                self.resid[o + nm] += rho * (acc - acc_used);
+            }
+            self.lag_in_forcing[i] = [self.udd[i], acc];
+        }
+    }
+
+    /// The forcing of the last [`System::forcing`] (per beam: alpha rows, u row, thp row), for a
+    /// caller that substitutes other right-hand sides before the fixed-point pass.
+    pub(crate) fn forcing_values(&self) -> &[f64] {
+        &self.resid
+    }
+
+    /// Put back a forcing kept with [`System::forcing_values`].
+    pub(crate) fn restore_forcing(&mut self, values: &[f64]) {
+        self.resid.copy_from_slice(values);
     }
 
     /// Remember the axial accelerations u_i'' of `qdd` (the full model's Eq. 23 term of the next
@@ -831,6 +877,8 @@ impl System {
         if let Some(geo) = self.geometric.as_mut() {
             geo.multiply(qhat, nb);
         }
+        let iterates = self.iterates_lagged_accelerations();
+        let mut lagged = [[0.0; 2]; 3];
         for i in 0..3 {
             let bm = pick(&self.bm, i);
             let (rho, l) = (bm.rho, bm.l);
@@ -866,9 +914,13 @@ impl System {
                 // foreshortening inertia of the bent beam in its u row: + rho E''
                 if let Some(fore) = self.fore.as_mut() {
                     r[nm] += rho * fore.second_derivative(i, geo.kept(), g2a, va);
+                    if iterates {
+                        lagged[i] = [self.udd[i], fore.acceleration_part(i, geo.kept(), g2a)];
+                    }
                 }
             }
         }
+        self.lag_in_forcing = lagged;
         if let Some(terms) = self.third_order.as_mut() {
             for (i, t) in terms.iter_mut().enumerate() {
                 let o = i * nb;

@@ -802,8 +802,9 @@ impl System {
     }
 
     /// Whether each step takes one fixed-point pass on the full model's lagged accelerations
-    /// (Eq. 23's u'', the u row's foreshortening inertia): the forcing again with the
-    /// accelerations just solved, the same factors. Under gravity the sag makes their u-alpha
+    /// (Eq. 23's u'', the u row's foreshortening inertia): those two terms again from the
+    /// accelerations just solved ([`System::refresh_lagged_forcing`]), the same factors. Under
+    /// gravity the sag makes their u-alpha
     /// coupling first order, and taken from the last solve alone it diverges at fine steps
     /// (`docs/amm.md` 12.14, "A divergence at fine steps under gravity"). Without gravity the
     /// coupling is second order and no pass is taken.

@@ -69,12 +69,14 @@ pub(crate) struct ThirdOrderTerms {
     curvatures: Vec<f64>,
     /// The kept modal accelerations of the last solve [m^1/2 s^-2].
     acc: Vec<f64>,
-    // per step: the kept coordinates and velocities, and per point w', w'', h, and the two
-    // weights of the back projection
+    // per step: the kept coordinates and velocities, and per point w', w'', w_t', w_tt', h, and
+    // the two weights of the back projection
     alpha: Vec<f64>,
     vel: Vec<f64>,
     slope: Vec<f64>,
     curv: Vec<f64>,
+    slope_rate: Vec<f64>,
+    slope_acc: Vec<f64>,
     h: Vec<f64>,
     on_slope: Vec<f64>,
     on_curv: Vec<f64>,
@@ -120,6 +122,8 @@ impl ThirdOrderTerms {
             slope: vec![0.0; nq],
             curv: vec![0.0; nq],
             h: vec![0.0; nq],
+            slope_rate: vec![0.0; nq],
+            slope_acc: vec![0.0; nq],
             on_slope: vec![0.0; nq],
             on_curv: vec![0.0; nq],
             kept,
@@ -163,8 +167,7 @@ impl ThirdOrderTerms {
     /// w', w'' and h = w_t'^2 + w' w_tt' at every point.
     fn point_values(&mut self) {
         let nq = self.x.len();
-        let wtp = &mut self.on_slope; // workspaces until point_weights fills them
-        let wttp = &mut self.on_curv;
+        let (wtp, wttp) = (&mut self.slope_rate, &mut self.slope_acc);
         for v in [&mut self.slope, &mut self.curv, &mut *wtp, &mut *wttp] {
             v.iter_mut().for_each(|x| *x = 0.0);
         }

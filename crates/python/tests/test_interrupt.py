@@ -9,10 +9,14 @@ import sys
 import textwrap
 import time
 
-# a long FEM run (case 1 on a fine mesh: about 10 s of work), started in a child interpreter
+# a long FEM run (case 1 on a fine mesh: about 10 s of work), started in a child interpreter.
+# The child installs Python's own SIGINT handler first: an interpreter started with SIGINT
+# ignored (a job put in the background by a shell without job control, as `cmd &` in a script
+# does) keeps it ignored, and the test would measure the launcher instead of the binding.
 LONG_RUN = textwrap.dedent(
     """
-    import sys, time, flexstar
+    import signal, sys, time, flexstar
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     exp = flexstar.Experiment.load(sys.argv[1])
     print("started", flush=True)
     try:
@@ -49,7 +53,8 @@ def test_sigint_stops_a_long_fem_run_within_a_second(root):
 # must see the stop too
 LONG_COMPARE = textwrap.dedent(
     """
-    import pathlib, sys, time, flexstar
+    import pathlib, signal, sys, time, flexstar
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     src = pathlib.Path(sys.argv[1]).read_text().replace("elements = 300", "elements = 3000\\ndt = 5e-5")
     cfg = pathlib.Path(sys.argv[2]) / "long.toml"
     cfg.write_text(src)

@@ -1,0 +1,121 @@
+//! The accurate AMM's error estimate on every case of a study, split into its parts, beside the
+//! features its model-error part may be read from (`docs/validation.md` 9):
+//! `cargo run --release -p flexstar-study --example estimate_parts -- STUDY.toml IDS > parts.csv`,
+//! IDS a file of run ids (or unique prefixes), one per line.
+//!
+//! Per case (one CSV row): the automatic choice's N, delivered step h and estimate; the time part
+//! (Eq. T1 of `docs/amm.md` 12.10, the chosen N at 2 h against h), the geometric part (Eq. G1,
+//! 12.9), the truncation part the estimate took (the rest); the direct truncation pair, N
+//! against N + 25 at the estimate's coarse step (the delivered step where the span is too short
+//! for its grid); and per beam the largest elastic tip or junction displacement over its length,
+//! `A_i / L_i`, and its sleeve ratio `Lp_i / L_i`. The true error comes from the study's results.
+use flexstar_amm::adaptive::{
+    estimate_grid, geometric_part, time_check_grid, time_error_estimate, ESTIMATE_STEP_FACTOR,
+};
+use flexstar_metrics::evp::point_evps;
+use flexstar_model::{AmmSettings, Experiment, Response};
+use rayon::prelude::*;
+use std::path::Path;
+
+/// Modes the direct pair adds to the chosen N.
+const PAIR_MODES: usize = 25;
+
+/// Mean EVP (Eq. 45) of `a` against `b`, NaN where it has none.
+fn evp(a: &Response, b: &Response) -> f64 {
+    point_evps(a, b).ok().and_then(|e| e.mean).unwrap_or(f64::NAN)
+}
+
+/// The accurate AMM of `exp` at N = `modes` and step `step` [s], every `every`-th output time.
+fn run(exp: &Experiment, modes: usize, step: f64, every: usize) -> Result<Response, String> {
+    let mut e = exp.clone();
+    e.time.dt_out = every as f64 * exp.time.dt_out;
+    let settings = AmmSettings {
+        modes: Some(modes),
+        dt: Some(step),
+        snapshots: Vec::new(),
+        frames: 0,
+        ..exp.amm.clone()
+    };
+    let problem = e.problem().map_err(|e| e.to_string())?;
+    flexstar_amm::solve(&problem, &settings, flexstar_drive::SolveRequest::motion())
+        .map(|s| s.response)
+        .map_err(|e| e.to_string())
+}
+
+/// One CSV row of `exp` (see the module docs).
+fn parts(id: &str, exp: &Experiment) -> Result<String, String> {
+    let problem = exp.problem().map_err(|e| e.to_string())?;
+    let auto = flexstar_amm::solve(&problem, &exp.amm, flexstar_drive::SolveRequest::motion())
+        .map_err(|e| e.to_string())?
+        .response;
+    let n = auto.info.modes.ok_or("no N")?;
+    let h = auto.info.dt;
+    let estimate = auto.info.error_estimate_percent.ok_or("no estimate")?;
+    let g1 = geometric_part(&problem, &auto);
+    let check = time_check_grid(&problem, h);
+    let delivered = run(exp, n, h, check)?;
+    let time = time_error_estimate(evp(&run(exp, n, 2.0 * h, check)?, &delivered));
+    let (step, every) = match estimate_grid(&problem, h) {
+        Some(every) => (ESTIMATE_STEP_FACTOR * h, every),
+        None => (h, 1),
+    };
+    let direct = evp(&run(exp, n, step, every)?, &run(exp, n + PAIR_MODES, step, every)?);
+    let largest = |h: &Vec<f64>| h.iter().fold(0.0f64, |m, w| m.max(w.abs()));
+    let beams = problem.robot().beams();
+    let per_beam: Vec<String> = (0..3)
+        .map(|i| {
+            let a = largest(&auto.w_tip[i]).max(largest(&auto.w_g[i])) / beams[i].length;
+            format!("{a:.6e},{:.5}", beams[i].sleeve_length / beams[i].length)
+        })
+        .collect();
+    let g = problem.gravity();
+    Ok(format!(
+        "{id},{n},{h:.4e},{estimate:.6e},{time:.6e},{g1:.6e},{:.6e},{direct:.6e},{:.4},{}",
+        estimate - time - g1,
+        g[0].hypot(g[1]),
+        per_beam.join(",")
+    ))
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let [_, study, ids] = args.as_slice() else {
+        eprintln!("usage: estimate_parts STUDY.toml IDS");
+        std::process::exit(2);
+    };
+    let study = flexstar_study::Study::load(Path::new(study)).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(1)
+    });
+    let ids: Vec<String> = std::fs::read_to_string(ids)
+        .unwrap_or_else(|e| {
+            eprintln!("{ids}: {e}");
+            std::process::exit(1)
+        })
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .map(String::from)
+        .collect();
+    let cases: Vec<_> = study
+        .cases()
+        .into_iter()
+        .filter(|c| ids.iter().any(|i| c.run_id.starts_with(i.as_str())))
+        .collect();
+    let base = study.file.parent().unwrap_or(Path::new(".")).join("case.toml");
+    let rows: Vec<String> = cases
+        .par_iter()
+        .map(|case| {
+            let row = study
+                .case_toml(&case.values)
+                .map_err(|e| e.to_string())
+                .and_then(|text| Experiment::from_toml_str(&text, &base).map_err(|e| e.to_string()))
+                .and_then(|exp| parts(&case.run_id, &exp));
+            row.unwrap_or_else(|e| format!("{},error: {}", case.run_id, e.replace(',', ";")))
+        })
+        .collect();
+    println!("id,n,h,estimate,time,g1,truncation,direct,g,a1,r1,a2,r2,a3,r3");
+    for row in rows {
+        println!("{row}");
+    }
+}

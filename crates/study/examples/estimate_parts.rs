@@ -6,9 +6,13 @@
 //! Per case (one CSV row): the automatic choice's N, delivered step h and estimate; the time part
 //! (Eq. T1 of `docs/amm.md` 12.10, the chosen N at 2 h against h), the geometric part (Eq. G1,
 //! 12.9), the truncation part the estimate took (the rest); the direct truncation pair, N
-//! against N + 25 at the estimate's coarse step (the delivered step where the span is too short
-//! for its grid); and per beam the largest elastic tip or junction displacement over its length,
-//! `A_i / L_i`, and its sleeve ratio `Lp_i / L_i`. The true error comes from the study's results.
+//! against N + 25, at the estimate's coarse step (the delivered step where the span is too short
+//! for its grid), at the time check's step 2 h and at h (both on the time check's grid); the
+//! chosen N at h with gravity 1e-9 m/s^2 along X against none (`third`: the beams' third-order
+//! terms, which only a run under gravity carries, on and off; `docs/amm.md` 12.14); and per
+//! beam the largest elastic tip or junction displacement over its length,
+//! `A_i / L_i`, its sleeve ratio `Lp_i / L_i` and its sleeve's inertia over its own about the
+//! junction, `Jp_i / (rho_i L_i^3 / 3)`. The true error comes from the study's results.
 use flexstar_amm::adaptive::{
     estimate_grid, geometric_part, time_check_grid, time_error_estimate, ESTIMATE_STEP_FACTOR,
 };
@@ -54,7 +58,18 @@ fn parts(id: &str, exp: &Experiment) -> Result<String, String> {
     let g1 = geometric_part(&problem, &auto);
     let check = time_check_grid(&problem, h);
     let delivered = run(exp, n, h, check)?;
-    let time = time_error_estimate(evp(&run(exp, n, 2.0 * h, check)?, &delivered));
+    let at_check = run(exp, n, 2.0 * h, check)?;
+    let time = time_error_estimate(evp(&at_check, &delivered));
+    let direct_check = evp(&at_check, &run(exp, n + PAIR_MODES, 2.0 * h, check)?);
+    let direct_h = evp(&delivered, &run(exp, n + PAIR_MODES, h, check)?);
+    let third = {
+        let with_gravity = |g: [f64; 2]| {
+            let mut e = exp.clone();
+            e.gravity = flexstar_model::Gravity::new(g);
+            run(&e, n, h, check)
+        };
+        evp(&with_gravity([1e-9, 0.0])?, &with_gravity([0.0, 0.0])?)
+    };
     let (step, every) = match estimate_grid(&problem, h) {
         Some(every) => (ESTIMATE_STEP_FACTOR * h, every),
         None => (h, 1),
@@ -65,12 +80,18 @@ fn parts(id: &str, exp: &Experiment) -> Result<String, String> {
     let per_beam: Vec<String> = (0..3)
         .map(|i| {
             let a = largest(&auto.w_tip[i]).max(largest(&auto.w_g[i])) / beams[i].length;
-            format!("{a:.6e},{:.5}", beams[i].sleeve_length / beams[i].length)
+            let b = &beams[i];
+            let own_inertia = b.mass_per_length * b.length.powi(3) / 3.0;
+            format!(
+                "{a:.6e},{:.5},{:.5}",
+                b.sleeve_length / b.length,
+                b.sleeve_inertia / own_inertia
+            )
         })
         .collect();
     let g = problem.gravity();
     Ok(format!(
-        "{id},{n},{h:.4e},{estimate:.6e},{time:.6e},{g1:.6e},{:.6e},{direct:.6e},{:.4},{}",
+        "{id},{n},{h:.4e},{estimate:.6e},{time:.6e},{g1:.6e},{:.6e},{direct:.6e},{direct_check:.6e},{direct_h:.6e},{third:.6e},{:.4},{}",
         estimate - time - g1,
         g[0].hypot(g[1]),
         per_beam.join(",")
@@ -114,7 +135,7 @@ fn main() {
             row.unwrap_or_else(|e| format!("{},error: {}", case.run_id, e.replace(',', ";")))
         })
         .collect();
-    println!("id,n,h,estimate,time,g1,truncation,direct,g,a1,r1,a2,r2,a3,r3");
+    println!("id,n,h,estimate,time,g1,truncation,direct,direct_check,direct_h,third,g,a1,r1,j1,a2,r2,j2,a3,r3,j3");
     for row in rows {
         println!("{row}");
     }

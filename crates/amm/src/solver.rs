@@ -813,19 +813,32 @@ mod tests {
             modes: Some(30),
             ..AmmSettings::accurate()
         };
-        let mut worst = [0.0f64; 3];
+        let mut worst = [0.0f64; 5];
+        let mut largest_thp = 0.0f64;
         integrate(&exp, &settings, 30, true, |sys, q| {
             let gaps = sys.sleeve_gaps(q, exp.beams.map(|b| b.lp));
             for (w, g) in worst.iter_mut().zip(gaps) {
                 *w = w.max(g);
             }
+            let nb = q.len() / 3;
+            largest_thp = (0..3).fold(largest_thp, |m, i| m.max(q[i * nb + nb - 1].abs()));
         })
         .unwrap();
-        let [material, unshifted, rigid] = worst;
+        let [material, unshifted, rigid, slope, slope_linear] = worst;
         eprintln!("largest gap at the material points {material:e} m, without the foreshortening {unshifted:e} m, at the rigid points {rigid:e} m");
         assert!(rigid > 1e-7, "the shift must matter in this test: {rigid:e} m");
         assert!(material < 1e-3 * rigid, "{material:e} m against {rigid:e} m");
         assert!(material < 0.05 * unshifted, "{material:e} m against {unshifted:e} m");
+        // the slope row (Eq. S5, docs/amm.md 12.17): sin thp = w'(x_c), where thp = w'(x_c)
+        // (Eq. 43 as printed) is off by about thp^3 / 6
+        let cubic = largest_thp.powi(3) / 6.0;
+        eprintln!("slope row: |sin thp - w'| {slope:e}, |thp - w'| {slope_linear:e}, thp^3 / 6 {cubic:e}");
+        assert!(cubic > 1e-12, "the sleeves must turn in this test: thp {largest_thp:e}");
+        assert!(slope < 0.05 * cubic, "{slope:e} against thp^3 / 6 = {cubic:e}");
+        assert!(
+            slope_linear > 0.5 * cubic,
+            "{slope_linear:e} against thp^3 / 6 = {cubic:e}"
+        );
     }
 
     #[test]

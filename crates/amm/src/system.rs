@@ -1343,9 +1343,9 @@ impl System {
         self.payload_correct(&mut qdd[..nb]);
     }
 
-    /// The sleeve rows evaluated exactly at the state q, for tests ([`Sleeves::gaps`]) [m].
+    /// The sleeve rows evaluated exactly at the state q, for tests ([`Sleeves::gaps`]) [m, -].
     #[cfg(test)]
-    pub(crate) fn sleeve_gaps(&self, q: &[f64], lp: [f64; 3]) -> [f64; 3] {
+    pub(crate) fn sleeve_gaps(&self, q: &[f64], lp: [f64; 3]) -> [f64; 5] {
         let modes: [&ModeSet; 3] = std::array::from_fn(|i| &self.beam(i).modes);
         self.sleeves.gaps(modes, &self.beams, &self.lam, q, lp)
     }

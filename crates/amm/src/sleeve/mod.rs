@@ -253,8 +253,10 @@ impl Sleeves {
     /// every mode, not the table of [`shift`]): largest `|w_i(x_c + e) - sin(thp_i) e|` over
     /// the beams and e in {0, +-Lp/2}, at the material point `x_c = xp - u + f(x_c)` of Eq. S1;
     /// the same at `xp - u` (no foreshortening, as before Eq. S1); and `|w_i(xp_i + e) - e thp_i|`
-    /// (the rigid material points, as the paper takes them) [m]. `beams`, `lam`: the rows and the
-    /// multipliers of the last solve (for the truncation flexibility's deflection).
+    /// (the rigid material points, as the paper takes them) [m]; and the slope row of Eq. S5,
+    /// `|sin(thp_i) - w_i'(x_c)|` [-], then as Eq. 43 writes it, `|thp_i - w_i'(x_c)|`.
+    /// `beams`, `lam`: the rows and the multipliers of the last solve (for the truncation
+    /// flexibility's deflection).
     #[cfg(test)]
     pub(crate) fn gaps(
         &self,
@@ -263,11 +265,11 @@ impl Sleeves {
         lam: &[f64],
         q: &[f64],
         lp: [f64; 3],
-    ) -> [f64; 3] {
+    ) -> [f64; 5] {
         let nm = modes[0].len();
         let nb = nm + 2;
         let mut v = vec![0.0; nm];
-        let mut gaps = [0.0f64; 3];
+        let mut gaps = [0.0f64; 5];
         for (i, beam) in beams.iter().enumerate() {
             let o = i * nb;
             let (alpha, u, thp) = (&q[o..o + nm], q[o + nm], q[o + nm + 1]);
@@ -288,6 +290,12 @@ impl Sleeves {
                     gaps[gap] = gaps[gap].max((dot(&v, alpha) + rr - side).abs());
                 }
             }
+            // the slope at x_c, the truncation flexibility's part being -res[3] (Eq. R4)
+            let mut slope = vec![0.0; nm];
+            modes.values_at(xc, &mut v, Some(&mut slope));
+            let w_slope = dot(&slope, alpha) - res[3];
+            gaps[3] = gaps[3].max((thp.sin() - w_slope).abs());
+            gaps[4] = gaps[4].max((thp - w_slope).abs());
         }
         gaps
     }

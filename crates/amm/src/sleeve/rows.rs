@@ -33,7 +33,8 @@ pub(crate) enum SleeveRow {
     FR,
     /// Eq. 42: `w_i(xp_i - Lp/2) + Lp/2 thp_i = 0`; multiplier `FL_pi` [N] at the left edge.
     FL,
-    /// Eq. 43: `thp_i - w_i'(xp_i) = 0`; multiplier `Mp_i` [N m], the moment of the beam on the sleeve.
+    /// Eq. 43: `thp_i - w_i'(xp_i) = 0` (full model: `sin thp_i - w_i'(x_c) = 0`, Eq. S5 of
+    /// `docs/amm.md` 12.17); multiplier `Mp_i` [N m], the moment of the beam on the sleeve.
     Mp,
 }
 
@@ -74,10 +75,12 @@ pub(super) struct ShiftTerms<'a> {
     pub(super) curvature: f64,
 }
 
-/// Eqs. S3-S4 (`docs/amm.md` 12.11), after the rows' vectors were set at the material point
-/// `x_c`: each sleeve row `r(x_c)` of `beam` gains the alpha gradient `r'(x_c) g` (`w'` at the
-/// pin and the edges, `-w''` for the slope row) and the edges' rows `w(x_c +- hp) -+ hp sin thp`
-/// their exact thp gradient `-+ hp cos thp`; the rows' values stay `r(qhat)` through `gv`.
+/// Eqs. S3-S5 (`docs/amm.md` 12.11, 12.17), after the rows' vectors were set at the material
+/// point `x_c`: each sleeve row `r(x_c)` of `beam` gains the alpha gradient `r'(x_c) g` (`w'` at
+/// the pin and the edges, `-w''` for the slope row); the edges' rows `w(x_c +- hp) -+ hp sin thp`
+/// and the slope row `sin thp - w'(x_c)` (Eq. S5: the beam's tangent turns by `asin w'`, so a
+/// straight beam in the sleeve meets all four rows) take their exact thp gradient (`-+ hp cos
+/// thp`, `cos thp`); the rows' values stay `r(qhat)` through `gv`.
 pub(super) fn shift_rows(beam: &mut BeamRows, rows: &[Row], t: ShiftTerms) {
     let [slope_mid, slope_right, slope_left] = t.slopes;
     let coef = [slope_mid, slope_right, slope_left, -t.curvature];
@@ -91,16 +94,16 @@ pub(super) fn shift_rows(beam: &mut BeamRows, rows: &[Row], t: ShiftTerms) {
         let Row::Sleeve(_, row) = rows[*id] else {
             continue;
         };
-        let (c, edge) = match row {
+        let (c, arm) = match row {
             SleeveRow::Fp => (coef[0], 0.0),
-            SleeveRow::FR => (coef[1], -1.0),
-            SleeveRow::FL => (coef[2], 1.0),
-            SleeveRow::Mp => (coef[3], 0.0),
+            SleeveRow::FR => (coef[1], -t.hp),
+            SleeveRow::FL => (coef[2], t.hp),
+            SleeveRow::Mp => (coef[3], 1.0),
         };
         beam.gv[k] = -beam.sc[k] * c * t.two_f;
-        if edge != 0.0 {
-            beam.ct[k] = edge * t.hp * cos;
-            beam.gv[k] += edge * t.hp * (sin - t.thp * cos);
+        if arm != 0.0 {
+            beam.ct[k] = arm * cos;
+            beam.gv[k] += arm * (sin - t.thp * cos);
         }
     }
 }

@@ -1,6 +1,6 @@
 //! The accurate AMM's error estimate on every case of a study, split into its parts, beside the
 //! features its model-error part may be read from (`docs/validation.md` 9):
-//! `cargo run --release -p flexstar-study --example estimate_parts -- STUDY.toml IDS > parts.csv`,
+//! `cargo run --release -p flexstar-study --example study_estimate_parts -- STUDY.toml IDS > parts.csv`,
 //! IDS a file of run ids (or unique prefixes), one per line.
 //!
 //! Per case (one CSV row): the automatic choice's N, delivered step h and estimate; the time part
@@ -101,7 +101,7 @@ fn parts(id: &str, exp: &Experiment) -> Result<String, String> {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let [_, study, ids] = args.as_slice() else {
-        eprintln!("usage: estimate_parts STUDY.toml IDS");
+        eprintln!("usage: study_estimate_parts STUDY.toml IDS");
         std::process::exit(2);
     };
     let study = flexstar_study::Study::load(Path::new(study)).unwrap_or_else(|e| {

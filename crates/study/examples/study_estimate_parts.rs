@@ -8,6 +8,8 @@
 //! 12.9), the truncation part the estimate took (the rest); the direct truncation pair, N
 //! against N + 25, at the estimate's coarse step (the delivered step where the span is too short
 //! for its grid), at the time check's step 2 h and at h (both on the time check's grid); the
+//! chosen N at 4 h against 2 h and 2 h against h on the 4 h run's grid (`e42`, `e21`: the time
+//! error's observed order), and at h against h / 16 on the time check's grid (`own_time`); the
 //! chosen N at h with gravity 1e-9 m/s^2 along X against none (`third`: the beams' third-order
 //! terms, which only a run under gravity carries, on and off; `docs/amm.md` 12.14); and per
 //! beam the largest elastic tip or junction displacement over its length,
@@ -62,6 +64,16 @@ fn parts(id: &str, exp: &Experiment) -> Result<String, String> {
     let time = time_error_estimate(evp(&at_check, &delivered));
     let direct_check = evp(&at_check, &run(exp, n + PAIR_MODES, 2.0 * h, check)?);
     let direct_h = evp(&delivered, &run(exp, n + PAIR_MODES, h, check)?);
+    // the time error's order: the chosen N at 4 h, 2 h and h on the 4 h run's grid, and the
+    // delivered run against h / 16 (its own time error) on the time check's grid
+    let coarse = ((4.0 * h / exp.time.dt_out) - 1e-9).ceil().max(1.0) as usize;
+    let (at_4h, at_2h, at_h) = (
+        run(exp, n, 4.0 * h, coarse)?,
+        run(exp, n, 2.0 * h, coarse)?,
+        run(exp, n, h, coarse)?,
+    );
+    let (e42, e21) = (evp(&at_4h, &at_2h), evp(&at_2h, &at_h));
+    let own_time = evp(&delivered, &run(exp, n, h / 16.0, check)?);
     let third = {
         let with_gravity = |g: [f64; 2]| {
             let mut e = exp.clone();
@@ -91,7 +103,7 @@ fn parts(id: &str, exp: &Experiment) -> Result<String, String> {
         .collect();
     let g = problem.gravity();
     Ok(format!(
-        "{id},{n},{h:.4e},{estimate:.6e},{time:.6e},{g1:.6e},{:.6e},{direct:.6e},{direct_check:.6e},{direct_h:.6e},{third:.6e},{:.4},{}",
+        "{id},{n},{h:.4e},{estimate:.6e},{time:.6e},{g1:.6e},{:.6e},{direct:.6e},{direct_check:.6e},{direct_h:.6e},{third:.6e},{e42:.6e},{e21:.6e},{own_time:.6e},{:.4},{}",
         estimate - time - g1,
         g[0].hypot(g[1]),
         per_beam.join(",")
@@ -135,7 +147,7 @@ fn main() {
             row.unwrap_or_else(|e| format!("{},error: {}", case.run_id, e.replace(',', ";")))
         })
         .collect();
-    println!("id,n,h,estimate,time,g1,truncation,direct,direct_check,direct_h,third,g,a1,r1,j1,a2,r2,j2,a3,r3,j3");
+    println!("id,n,h,estimate,time,g1,truncation,direct,direct_check,direct_h,third,e42,e21,own_time,g,a1,r1,j1,a2,r2,j2,a3,r3,j3");
     for row in rows {
         println!("{row}");
     }

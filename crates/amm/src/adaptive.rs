@@ -353,8 +353,9 @@ where
         let check = check_every.map(|k| run(n, Pass::TimeCheck { every: k })).transpose()?;
         // the truncation part from the direct pair at the time check's step (docs/amm.md 12.18);
         // Richardson's on the coarse pairs where there is no time check or the pair's run fails
+        // (none at the cap, where N + 25 would be N itself)
         let truncation = match (&check, check_every) {
-            (Some(check), Some(k)) => match run(pair_modes(n), Pass::TimeCheck { every: k }) {
+            (Some(check), Some(k)) if pair_modes(n) > n => match run(pair_modes(n), Pass::TimeCheck { every: k }) {
                 Ok(pair) => {
                     wall += pair.info.wall_s;
                     direct_truncation(check, &pair, n, pair_modes(n)).unwrap_or(estimate)

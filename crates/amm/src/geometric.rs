@@ -145,7 +145,15 @@ mod tests {
         };
         let run = |sys| {
             let started = std::time::Instant::now();
-            integrate_system(&exp, &settings, sys, TOLERANCE_DT, started, |_, _| {}).unwrap()
+            integrate_system(
+                &exp,
+                &settings,
+                sys,
+                TOLERANCE_DT,
+                started,
+                |_: &crate::system::System, _: &[f64]| {},
+            )
+            .unwrap()
         };
         let sys = build_system(&settings, n, &exp).unwrap();
         let kept = run(sys.clone());

@@ -503,13 +503,13 @@ pub(crate) fn shape_times(problem: &Star, settings: &AmmSettings) -> ShapeTimes 
 
 /// [`integrate`] with the system `sys` built (fresh, not yet stepped) and the inputs validated:
 /// steps of at most `dt_max` [s]; the reported wall time counts from `started`.
-pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
+pub(crate) fn integrate_system<O: StepObserver>(
     problem: &Star,
     settings: &AmmSettings,
     mut sys: System,
     dt_max: f64,
     started: std::time::Instant,
-    mut observe: F,
+    mut observe: O,
 ) -> Result<Response, AmmError> {
     let n_modes = sys.nm;
     let (nm, n) = (sys.nm, sys.dim());
@@ -554,6 +554,15 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
         other => other,
     })?;
     acc.copy_from_slice(&qdd);
+    let start = Step {
+        t: 0.0,
+        h: 0.0,
+        bp: 0.0,
+        q: &q,
+        predicted: friction.is_none().then_some((&q[..], &v[..])),
+        qdd: &qdd,
+    };
+    observe.step(&mut sys, &start);
 
     let record = |rec: &mut Recorder,
                   out: Option<&mut FrictionOutput>,
@@ -590,7 +599,15 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
                 events
                     .step(&mut sys, &kin, (&mut st, t), &mut x, out, &rails)
                     .map_err(|e| e.judge_off_beam(h, rigid_sleeve))?;
-                observe(&sys, &q);
+                let step = Step {
+                    t,
+                    h,
+                    bp,
+                    q: &q,
+                    predicted: None,
+                    qdd: &qdd,
+                };
+                observe.step(&mut sys, &step);
                 continue;
             }
             let state = q.iter().zip(&v).zip(acc.iter().zip(&qdd));
@@ -605,7 +622,15 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
             if !accept(&ga, (bp, gp), predicted, &qdd, (&mut q, &mut v, &mut acc)) {
                 return Err(AmmError::NonFinite { t, dt: h });
             }
-            observe(&sys, &q);
+            let step = Step {
+                t,
+                h,
+                bp,
+                q: &q,
+                predicted: Some((&qhat, &vhat)),
+                qdd: &qdd,
+            };
+            observe.step(&mut sys, &step);
         }
         record(&mut rec, friction.as_mut(), &sys, &st, &w[1], (&q, &v, &qdd));
         if flexstar_model::cancel::cancelled() {
@@ -621,6 +646,34 @@ pub(crate) fn integrate_system<F: FnMut(&System, &[f64])>(
     resp.rest_offset = crate::static_start::rest_offset(&mut sys, problem, star_time_scale(problem))?;
     resp.info = run_info("amm", settings, n_modes, dt_max, started);
     Ok(resp)
+}
+
+/// What an observer of [`integrate_system`] sees after a step (and after the consistent start,
+/// `h = 0`): its time [s], length h [s] and `beta'` of the generalized-alpha method, the
+/// coordinates q after it, the predictors `(qhat, vhat)` it was solved about (`None` with
+/// friction, whose events split the step) and its accelerations.
+pub(crate) struct Step<'a> {
+    pub(crate) t: f64,
+    pub(crate) h: f64,
+    pub(crate) bp: f64,
+    pub(crate) q: &'a [f64],
+    pub(crate) predicted: Option<(&'a [f64], &'a [f64])>,
+    pub(crate) qdd: &'a [f64],
+}
+
+/// An observer of [`integrate_system`], called after the consistent start and after every step
+/// with the system as the step left it (its factors, forcing and multipliers).
+pub(crate) trait StepObserver {
+    fn step(&mut self, sys: &mut System, step: &Step);
+}
+
+/// A closure observes the steps only (not the start), with the system and q.
+impl<F: FnMut(&System, &[f64])> StepObserver for F {
+    fn step(&mut self, sys: &mut System, step: &Step) {
+        if step.h > 0.0 {
+            self(sys, step.q)
+        }
+    }
 }
 
 /// Accept a step: `q = q^ + bp q''`, `q' = v^ + gp q''` and the generalized-alpha acceleration
@@ -868,7 +921,15 @@ mod tests {
             );
             let mut sys = sys;
             sys.attach(star.payload, star.damping, star.load, star.gravity);
-            integrate_system(&star, &settings, sys, DEFAULT_DT, std::time::Instant::now(), |_, _| {}).unwrap()
+            integrate_system(
+                &star,
+                &settings,
+                sys,
+                DEFAULT_DT,
+                std::time::Instant::now(),
+                |_: &System, _: &[f64]| {},
+            )
+            .unwrap()
         };
         for _ in 0..2 {
             let kept = integrate(&star, &settings, 24, true, |_, _| {}).unwrap();

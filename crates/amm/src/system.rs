@@ -36,6 +36,8 @@ use crate::sleeve::{SleeveRow, Sleeves, B_MID, B_MSLOPE, SLEEVE_ROWS};
 use crate::third_order::{self, ThirdOrderTerms};
 use flexstar_numerics::vector::dots;
 
+mod kkt;
+
 /// One constraint row and its multiplier (`docs/amm.md` section 1; Eqs. 24-29, 38-43). Beams are
 /// 0-based here. The multiplier is the generalized force on the beam for the row as written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -329,6 +331,9 @@ pub(crate) struct BeamModel {
     w: Vec<f64>,
     p: f64,
     inv_sigma: f64,
+    /// The u diagonal of the step matrix, `rho L (1 + gamma' alpha - beta' th'^2)` plus the
+    /// sleeve's viscous drag (before the border's elimination into `inv_sigma`).
+    suu: f64,
     scaled0: [Vec<f64>; 2],
     /// The junction vectors' Gram entries `[g00, g01, g11]` and `[w0, w1]` of the step.
     jgram: [f64; 3],
@@ -360,6 +365,7 @@ impl BeamModel {
             w: vec![0.0; nm],
             p: 0.0,
             inv_sigma: 0.0,
+            suu: 0.0,
             scaled0: [vec![0.0; nm], vec![0.0; nm]],
             jgram: [0.0; 3],
             jw: [0.0; 2],
@@ -381,6 +387,7 @@ impl BeamModel {
         if self.u_drag != 0.0 {
             sigma += self.u_drag;
         }
+        self.suu = sigma;
         let damped = gp * beta;
         for j in 0..self.lambda_m.len() {
             let d = if beta > 0.0 {
@@ -1129,16 +1136,7 @@ impl System {
     /// so only their 6x6 Gram matrix `B D^-1 B^T` is computed (21 dot products of length N, and
     /// the six `B D^-1 Phi`).
     pub(crate) fn prepare(&mut self, st: &RigidState, bp: f64, gp: f64, qhat: &[f64]) -> Result<(), AmmError> {
-        let thd = st.theta.d1;
-        let thdd = st.theta.d2;
-        self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
-        self.sleeves.on_beams(st.t)?;
-        if self.friction.is_some() {
-            self.friction_terms(qhat);
-        }
-        // each beam's arrowhead and the Gram data of its junction vectors (once for equal beams)
-        self.factor_s(bp, gp, thd, thdd);
-
+        self.prepare_rows(st, bp, gp, qhat)?;
         let m = self.rows.len();
         self.a.iter_mut().for_each(|v| *v = 0.0);
         // disjoint borrows of the fields (no copy of the beams' workspaces)
@@ -1160,6 +1158,20 @@ impl System {
         self.lu
             .factor(&self.a)
             .map_err(|source| AmmError::SingularConstraints { t: st.t, source })
+    }
+
+    /// The first part of [`System::prepare`], what the step's equations need before their
+    /// Schur complement: the sleeve rows at xp(st) (about the predictor `qhat` in the full
+    /// model), the friction terms, and each beam's arrowhead of S with the Gram data of its
+    /// junction vectors (once for equal beams).
+    pub(crate) fn prepare_rows(&mut self, st: &RigidState, bp: f64, gp: f64, qhat: &[f64]) -> Result<(), AmmError> {
+        self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
+        self.sleeves.on_beams(st.t)?;
+        if self.friction.is_some() {
+            self.friction_terms(qhat);
+        }
+        self.factor_s(bp, gp, st.theta.d1, st.theta.d2);
+        Ok(())
     }
 
     /// The payload's Woodbury correction of beam 1's block of the Schur complement (module docs of
@@ -1241,8 +1253,17 @@ impl System {
     /// [`System::forcing_derivative`]): `S qdd - C^T lambda = r`, `C qdd = -C qhat / bp` with
     /// `qhat` given (and `bp > 0`), `C qdd = 0` without. Writes `qdd` and `self.lam`.
     pub(crate) fn solve_prepared(&mut self, bp: f64, qhat: Option<&[f64]>, qdd: &mut [f64]) {
+        self.solve_factored(bp, qhat, None, qdd);
+    }
+
+    /// [`System::solve_prepared`], or with `given` the constraint rows' values (one per row,
+    /// in place of those of the predictor `qhat`): `C S^-1 r + given` on the right side.
+    fn solve_factored(&mut self, bp: f64, qhat: Option<&[f64]>, given: Option<&[f64]>, qdd: &mut [f64]) {
         let (nm, nb) = (self.nm, self.nb);
-        self.rhs.iter_mut().for_each(|v| *v = 0.0);
+        match given {
+            Some(g) => self.rhs.iter_mut().zip(g).for_each(|(v, gk)| *v = -gk),
+            None => self.rhs.iter_mut().for_each(|v| *v = 0.0),
+        }
         // disjoint borrows of the fields (no copy of the beams' workspaces)
         let (beams, resid, dinv_r, rhs) = (&self.beams, &self.resid, &mut self.dinv_r, &mut self.rhs);
         for (i, beam) in beams.iter().enumerate() {

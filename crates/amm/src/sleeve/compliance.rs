@@ -177,6 +177,19 @@ fn kept_products(scaled: &[f64], b: usize, [v0, v1, v2, v3]: [&[f64]; 4]) -> [f6
     }
 }
 
+/// The (global row, sleeve functional, factor) of `beam`'s sleeve rows, and how many.
+fn sleeve_rows(beam: &BeamRows) -> ([(usize, usize, f64); 4], usize) {
+    let mut sleeve = [(0, 0, 0.0); 4];
+    let mut n = 0;
+    for k in 0..beam.ids.len() {
+        if (B_MID..=B_MSLOPE).contains(&beam.basis[k]) && n < 4 {
+            sleeve[n] = (beam.ids[k], beam.basis[k] - B_MID, beam.sc[k]);
+            n += 1;
+        }
+    }
+    (sleeve, n)
+}
+
 impl Sleeves {
     /// Eq. R4 (`docs/amm.md` 12): the truncation flexibility of the sleeve rows of `beams`, `R / bp`
     /// on their block of the Schur complement `a` (m x m, row-major; `C q + R lambda = 0` at
@@ -187,18 +200,27 @@ impl Sleeves {
             return;
         }
         for (beam, res) in beams.iter().zip(&self.res) {
-            // the (global row, sleeve functional, factor) of the beam's four sleeve rows
-            let mut sleeve = [(0, 0, 0.0); 4];
-            let mut n = 0;
-            for k in 0..beam.ids.len() {
-                if (B_MID..=B_MSLOPE).contains(&beam.basis[k]) && n < 4 {
-                    sleeve[n] = (beam.ids[k], beam.basis[k] - B_MID, beam.sc[k]);
-                    n += 1;
-                }
-            }
+            let (sleeve, n) = sleeve_rows(beam);
             for &(gk, fa, sk) in &sleeve[..n] {
                 for &(gs, fb, ss) in &sleeve[..n] {
                     a[gk * m + gs] += sk * ss * res[fa][fb] / bp;
+                }
+            }
+        }
+    }
+
+    /// Eq. R4: the truncation flexibility's part `R lambda / bp` of the sleeve rows of `beams`
+    /// under the multipliers `lam`, added to `rows` (one entry per constraint row); what
+    /// [`Sleeves::add_compliance`] puts in the Schur complement, as a product. No-op without it.
+    pub(crate) fn add_compliance_product(&self, rows: &mut [f64], beams: &[BeamRows; 3], lam: &[f64], bp: f64) {
+        if self.compliance.is_none() || bp <= 0.0 {
+            return;
+        }
+        for (beam, res) in beams.iter().zip(&self.res) {
+            let (sleeve, n) = sleeve_rows(beam);
+            for &(gk, fa, sk) in &sleeve[..n] {
+                for &(gs, fb, ss) in &sleeve[..n] {
+                    rows[gk] += sk * ss * res[fa][fb] / bp * lam[gs];
                 }
             }
         }

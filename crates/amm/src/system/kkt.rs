@@ -1,0 +1,108 @@
+//! The step's equations as a residual, and their solve for a given residual with the step's
+//! factors: what the tangent-linear step of `crate::tangent` needs (`docs/amm.md` 2.2, Eqs.
+//! T-2, T-3).
+//!
+//! A prepared step ([`System::prepare`], [`System::forcing`]) solves, per beam and row,
+//!
+//! ```text
+//! S q'' - C^T lambda = r,      grad c_k . q'' + (c_k(qhat) + sum_s F_ks lambda_s) / bp = 0
+//! ```
+//! with `c_k(qhat)` the row's value at the predictor (its `gu`, `gv` parts included) and `F`
+//! the truncation flexibility of the sleeve rows (Eq. R4) and the axial flexibility of the Fix
+//! rows (Eq. A3); at `bp = 0` (the consistent start) the rows read `grad c_k . q'' = 0`.
+
+use super::{pick, Row, System, NONE};
+
+impl System {
+    /// Whether the step's equations are all in [`System::step_residual`]: not with friction, a
+    /// payload, a load or gravity (their terms, and the fixed-point pass under gravity, are not).
+    pub(crate) fn has_tangent(&self) -> bool {
+        self.friction.is_none() && self.payload.is_none() && self.load.is_none() && self.gravity == [0.0; 2]
+    }
+
+    /// The residual of the prepared step's equations (module docs) at the accelerations `qdd`
+    /// and multipliers `lam`: `primal = S qdd - C^T lam - r` (per beam: alpha rows, u row, thp
+    /// row) and `rows` per constraint row. Zero, to round-off, at the step's own solution.
+    pub(crate) fn step_residual(
+        &self,
+        bp: f64,
+        qhat: &[f64],
+        (qdd, lam): (&[f64], &[f64]),
+        primal: &mut [f64],
+        rows: &mut [f64],
+    ) {
+        let (nm, nb) = (self.nm, self.nb);
+        rows.iter_mut().for_each(|v| *v = 0.0);
+        for (i, beam) in self.beams.iter().enumerate() {
+            let b = pick(&self.bm, i);
+            let o = i * nb;
+            let (qa, qu, qt) = (&qdd[o..o + nm], qdd[o + nm], qdd[o + nm + 1]);
+            let out = &mut primal[o..o + nb];
+            // the arrowhead S: alpha rows d_j a_j + p Phi_j u'', u row -p Phi . a + s_uu u''
+            let mut phi_a = 0.0;
+            for j in 0..nm {
+                out[j] = qa[j] / b.inv_d[j] + b.p * b.phi[j] * qu;
+                phi_a += b.phi[j] * qa[j];
+            }
+            out[nm] = -b.p * phi_a + b.suu * qu;
+            out[nm + 1] = b.jp_step * qt;
+            for (x, r) in out.iter_mut().zip(&self.resid[o..o + nb]) {
+                *x -= r;
+            }
+            // - C^T lambda, and each row's part on this beam
+            for k in 0..beam.ids.len() {
+                let (g, bk, sk) = (beam.ids[k], beam.basis[k], beam.sc[k]);
+                let l = lam[g];
+                out[nm] -= l * beam.cu[k];
+                out[nm + 1] -= l * beam.ct[k];
+                let mut row = beam.cu[k] * qu + beam.ct[k] * qt;
+                let mut value = beam.gu[k] * qhat[o + nm] + beam.ct[k] * qhat[o + nm + 1] + beam.gv[k];
+                if bk != NONE {
+                    let v = self.basis(i, beam, bk);
+                    let (mut vq, mut vh) = (0.0, 0.0);
+                    for j in 0..nm {
+                        out[j] -= l * sk * v[j];
+                        vq += v[j] * qa[j];
+                        vh += v[j] * qhat[o + j];
+                    }
+                    row += sk * vq;
+                    value += sk * vh;
+                }
+                rows[g] += if bp > 0.0 { row + value / bp } else { row };
+            }
+        }
+        if bp > 0.0 {
+            self.sleeves.add_compliance_product(rows, &self.beams, lam, bp);
+            for (k, row) in self.rows.iter().enumerate() {
+                if let Row::Fix(i) = row {
+                    rows[k] += pick(&self.bm, *i).axial_flex / bp * lam[k];
+                }
+            }
+        }
+    }
+
+    /// The correction `(dqdd, dlam)` that solves the prepared step's equations linearised about
+    /// a point whose residual is `(primal, rows)` ([`System::step_residual`]), with the step's
+    /// own factors: `S dqdd - C^T dlam = -primal`, `grad C dqdd + F / bp dlam = -rows`. The
+    /// step's forcing and multipliers are kept. Not with a payload or friction (their rows and
+    /// Woodbury terms are not in [`System::step_residual`]).
+    pub(crate) fn solve_correction(
+        &mut self,
+        bp: f64,
+        (primal, rows): (&[f64], &[f64]),
+        (dqdd, dlam): (&mut [f64], &mut [f64]),
+        keep: (&mut [f64], &mut [f64]),
+    ) {
+        debug_assert!(self.payload.is_none() && self.friction.is_none());
+        let (resid_kept, lam_kept) = keep;
+        resid_kept.copy_from_slice(&self.resid);
+        lam_kept.copy_from_slice(&self.lam);
+        for (r, p) in self.resid.iter_mut().zip(primal) {
+            *r = -p;
+        }
+        self.solve_factored(bp, None, Some(rows), dqdd);
+        dlam.copy_from_slice(&self.lam);
+        self.resid.copy_from_slice(resid_kept);
+        self.lam.copy_from_slice(lam_kept);
+    }
+}

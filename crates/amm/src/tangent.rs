@@ -1,0 +1,360 @@
+//! Forward sensitivities of an AMM run along changes of its motion (`docs/amm.md` 2.2, Eqs.
+//! T-1 to T-4): the tangent-linear model of the generalized-alpha step, solved with each
+//! step's own factors.
+//!
+//! A direction is the same problem with its motion moved by `eps` along it (a via point or a
+//! timing variable of a plan, a coefficient of a polynomial motion). Per step and direction,
+//! the step's equations are evaluated once more on a copy of the system (the probe): at the
+//! direction's rigid state, the predictors and lagged accelerations moved by `eps` times their
+//! tangents, and the step's own solution (`q''`, multipliers). That residual, less the step's own
+//! (zero to round-off), is `eps` times the directional derivative of the equations; one solve
+//! with the step's factors turns it into `eps` times the tangent of `q''` (internal numerical
+//! differentiation: the derivative of the discrete step, not of a second run). The update and
+//! the predictor are linear and act on the tangents as on the state.
+//!
+//! Cost per step and direction: the probe's sleeve rows, arrowhead and forcing, two residual
+//! passes and one substitution with the step's factors; no factorisation.
+
+use flexstar_model::{AmmSettings, ModeCount, Problem, Response};
+use flexstar_numerics::GenAlpha;
+
+use crate::error::AmmError;
+use crate::solver::{build_system, integrate_system, validate, Step, StepObserver, RHO_INF};
+use crate::star::Star;
+use crate::system::System;
+
+/// An AMM run with the derivatives of its elastic outputs along directions of its motion.
+#[derive(Debug, Clone)]
+pub struct Sensitivities {
+    /// The run itself, as [`crate::solve`] gives it at the same fixed N and step.
+    pub response: Response,
+    /// Per direction and beam, `d w_iG / d p` at every output row [m per unit of p]: the
+    /// direction's change of the junction's elastic displacement (the `w_iG` columns of the
+    /// response) over its `eps`.
+    pub w_g: Vec<[Vec<f64>; 3]>,
+    /// Per direction and beam, `d w_i(L) / d p` at every output row, likewise.
+    pub w_tip: Vec<[Vec<f64>; 3]>,
+}
+
+/// The run of `problem` at the fixed N of `settings.modes` and the derivatives of its
+/// junction and tip displacements along each of `moved`: the problem with its motion moved by
+/// `eps` along one direction (the same robot, time span and everything else). The derivative
+/// is that of the discrete run (the tangent-linear model, module docs), so it matches central
+/// differences of whole runs to the order of their own truncation error.
+///
+/// Refused before any work: an automatic N, and friction, a payload, a load or gravity (their
+/// terms are not in the tangent yet: `docs/amm.md` 2.2).
+pub fn solve_with_sensitivities(
+    problem: &Problem,
+    settings: &AmmSettings,
+    moved: &[Problem],
+    eps: f64,
+) -> Result<Sensitivities, AmmError> {
+    let ModeCount::Fixed(n) = settings.mode_count() else {
+        return Err(AmmError::invalid(
+            "amm.modes",
+            "sensitivities need a fixed N (amm.modes)",
+        ));
+    };
+    let star = Star::new(problem);
+    if !(eps.is_finite() && eps != 0.0) {
+        return Err(AmmError::invalid(
+            "eps",
+            format!("need a finite nonzero step, got {eps}"),
+        ));
+    }
+    let stars: Vec<Star> = moved.iter().map(Star::new).collect();
+    if stars.iter().any(|s| s.time.output_times() != star.time.output_times()) {
+        return Err(AmmError::invalid(
+            "time",
+            "every moved problem needs the same output times",
+        ));
+    }
+    let started = std::time::Instant::now();
+    let dt_max = validate(&star, settings, n, true)?;
+    let sys = build_system(settings, n, &star)?;
+    if !sys.has_tangent() {
+        return Err(AmmError::invalid(
+            "amm",
+            "sensitivities are not built for friction, a payload, a load or gravity",
+        ));
+    }
+    let mut tangent = Tangent::new(&sys, &stars, eps, star.time.output_times());
+    let response = integrate_system(&star, settings, sys, dt_max, started, &mut tangent)?;
+    if let Some(e) = tangent.failed.take() {
+        return Err(e);
+    }
+    Ok(Sensitivities {
+        response,
+        w_g: tangent.w_g,
+        w_tip: tangent.w_tip,
+    })
+}
+
+/// One direction's tangent state (per unit of its parameter): coordinates, rates, the
+/// generalized-alpha acceleration variable and the accelerations of the last step.
+#[derive(Debug, Clone)]
+struct Direction {
+    dq: Vec<f64>,
+    dv: Vec<f64>,
+    dacc: Vec<f64>,
+    dqdd: Vec<f64>,
+}
+
+/// The observer of the run that carries the tangents (module docs).
+struct Tangent<'a> {
+    probe: System,
+    moved: &'a [Star<'a>],
+    eps: f64,
+    ga: GenAlpha,
+    dirs: Vec<Direction>,
+    /// The base's accelerations of the previous step (the lagged terms' input).
+    qdd_prev: Vec<f64>,
+    out_times: Vec<f64>,
+    next_out: usize,
+    w_g: Vec<[Vec<f64>; 3]>,
+    w_tip: Vec<[Vec<f64>; 3]>,
+    failed: Option<AmmError>,
+    // workspaces
+    qhat: Vec<f64>,
+    vhat: Vec<f64>,
+    lagged: Vec<f64>,
+    da: Vec<f64>,
+    primal0: Vec<f64>,
+    rows0: Vec<f64>,
+    primal: Vec<f64>,
+    rows: Vec<f64>,
+    corr_q: Vec<f64>,
+    corr_l: Vec<f64>,
+    keep_r: Vec<f64>,
+    keep_l: Vec<f64>,
+}
+
+impl<'a> Tangent<'a> {
+    fn new(sys: &System, moved: &'a [Star<'a>], eps: f64, out_times: Vec<f64>) -> Self {
+        let n = 3 * sys.nb;
+        let m = sys.rows.len();
+        let zero = Direction {
+            dq: vec![0.0; n],
+            dv: vec![0.0; n],
+            dacc: vec![0.0; n],
+            dqdd: vec![0.0; n],
+        };
+        let rows = out_times.len();
+        let column = || [vec![0.0; rows], vec![0.0; rows], vec![0.0; rows]];
+        Tangent {
+            probe: sys.clone(),
+            moved,
+            eps,
+            ga: GenAlpha::new(RHO_INF),
+            dirs: vec![zero; moved.len()],
+            qdd_prev: vec![0.0; n],
+            out_times,
+            next_out: 0,
+            w_g: (0..moved.len()).map(|_| column()).collect(),
+            w_tip: (0..moved.len()).map(|_| column()).collect(),
+            failed: None,
+            qhat: vec![0.0; n],
+            vhat: vec![0.0; n],
+            lagged: vec![0.0; n],
+            da: vec![0.0; n],
+            primal0: vec![0.0; n],
+            rows0: vec![0.0; m],
+            primal: vec![0.0; n],
+            rows: vec![0.0; m],
+            corr_q: vec![0.0; n],
+            corr_l: vec![0.0; m],
+            keep_r: vec![0.0; n],
+            keep_l: vec![0.0; m],
+        }
+    }
+
+    /// Eqs. T-1 to T-4 for one step (or the start, `h = 0`) of every direction.
+    fn advance(&mut self, sys: &mut System, step: &Step) -> Result<(), AmmError> {
+        let Some((qhat, vhat)) = step.predicted else {
+            return Err(AmmError::invalid("amm", "sensitivities are not built for friction"));
+        };
+        let (bp, eps, h) = (step.bp, self.eps, step.h);
+        let gp = if h > 0.0 { self.ga.gamma_prime(h) } else { 0.0 };
+        let apq = self.ga.a_per_qdd();
+        sys.step_residual(bp, qhat, (step.qdd, &sys.lam), &mut self.primal0, &mut self.rows0);
+        for (k, dir) in self.dirs.iter_mut().enumerate() {
+            // the tangent predictor (linear, Eq. T-4), then the moved inputs
+            if h > 0.0 {
+                for j in 0..dir.dq.len() {
+                    let (a, q, v) = self.ga.predict(h, dir.dq[j], dir.dv[j], dir.dacc[j], dir.dqdd[j]);
+                    self.da[j] = a;
+                    self.qhat[j] = qhat[j] + eps * q;
+                    self.vhat[j] = vhat[j] + eps * v;
+                    dir.dq[j] = q;
+                    dir.dv[j] = v;
+                }
+            } else {
+                for j in 0..dir.dq.len() {
+                    self.da[j] = 0.0;
+                    self.qhat[j] = qhat[j] + eps * dir.dq[j];
+                    self.vhat[j] = vhat[j] + eps * dir.dv[j];
+                }
+            }
+            for ((l, p), d) in self.lagged.iter_mut().zip(&self.qdd_prev).zip(&dir.dqdd) {
+                *l = p + eps * d;
+            }
+            // the moved step's equations at the base solution (Eqs. T-2, T-3)
+            let st = self.moved[k].state(step.t)?;
+            self.probe.set_axial_acceleration(&self.lagged);
+            self.probe.prepare_rows(&st, bp, gp, &self.qhat)?;
+            self.probe.forcing(&st, &self.qhat, &self.vhat);
+            self.probe
+                .step_residual(bp, &self.qhat, (step.qdd, &sys.lam), &mut self.primal, &mut self.rows);
+            for (r, r0) in self.primal.iter_mut().zip(&self.primal0) {
+                *r -= r0;
+            }
+            for (r, r0) in self.rows.iter_mut().zip(&self.rows0) {
+                *r -= r0;
+            }
+            sys.solve_correction(
+                bp,
+                (&self.primal, &self.rows),
+                (&mut self.corr_q, &mut self.corr_l),
+                (&mut self.keep_r, &mut self.keep_l),
+            );
+            // the update (linear): q = qhat + bp q'', v = vhat + gp q'', a = a_part + apq q''
+            for j in 0..dir.dq.len() {
+                let d = self.corr_q[j] / eps;
+                dir.dqdd[j] = d;
+                if h > 0.0 {
+                    dir.dq[j] += bp * d;
+                    dir.dv[j] += gp * d;
+                    dir.dacc[j] = self.da[j] + apq * d;
+                } else {
+                    dir.dacc[j] = d;
+                }
+            }
+        }
+        self.qdd_prev.copy_from_slice(step.qdd);
+        self.record(sys, step.t);
+        Ok(())
+    }
+
+    /// The tangents of w_iG and w_i(L) at an output time.
+    fn record(&mut self, sys: &System, t: f64) {
+        let Some(&t_out) = self.out_times.get(self.next_out) else {
+            return;
+        };
+        let tol = 1e-9 * self.out_times.get(1).map_or(1.0, |t1| t1 - self.out_times[0]);
+        if (t - t_out).abs() > tol {
+            return;
+        }
+        let (nm, nb, row) = (sys.nm, sys.nb, self.next_out);
+        for (k, dir) in self.dirs.iter().enumerate() {
+            for i in 0..3 {
+                let b = sys.beam(i);
+                let a = &dir.dq[i * nb..i * nb + nm];
+                self.w_g[k][i][row] = a.iter().zip(&b.phi0).map(|(x, p)| x * p).sum();
+                self.w_tip[k][i][row] = a.iter().zip(&b.phil).map(|(x, p)| x * p).sum();
+            }
+        }
+        self.next_out += 1;
+    }
+}
+
+impl StepObserver for &mut Tangent<'_> {
+    fn step(&mut self, sys: &mut System, step: &Step) {
+        if self.failed.is_some() {
+            return;
+        }
+        if let Err(e) = self.advance(sys, step) {
+            self.failed = Some(e);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flexstar_model::catalogue::paper_case;
+    use flexstar_model::{AmmModel, Experiment, ModeFamily, Trajectory};
+
+    /// Case 3 over 0.2 s, the accurate model's equations at a fixed N, with the coefficient of
+    /// t^2 in s1 (1 m/s^2 on the paper's case) and of t^2 in s3 (0.5) moved by `d1` and `d3`.
+    fn case3(d1: f64, d3: f64) -> Experiment {
+        let mut e = paper_case(3);
+        e.time.t_end = 0.2;
+        e.trajectory = Trajectory::Polynomial {
+            s1: vec![0.0, 0.0, 1.0 + d1],
+            s2: vec![0.0],
+            s3: vec![0.0, 0.0, 0.5 + d3],
+        };
+        e
+    }
+
+    fn settings(model: AmmModel) -> AmmSettings {
+        AmmSettings {
+            family: ModeFamily::Enriched,
+            model,
+            modes: Some(24),
+            tol: None,
+            dt: Some(5e-4),
+            ..AmmSettings::accurate()
+        }
+    }
+
+    /// The largest difference between the tangent of `w` and the central difference of whole
+    /// runs at `+-delta`, over the largest central difference.
+    fn worst(
+        tangent: &[Vec<f64>; 3],
+        plus: &Response,
+        minus: &Response,
+        delta: f64,
+        w: fn(&Response) -> &[Vec<f64>; 3],
+    ) -> f64 {
+        let (mut err, mut scale) = (0.0f64, 0.0f64);
+        for i in 0..3 {
+            for (k, d) in tangent[i].iter().enumerate() {
+                let c = (w(plus)[i][k] - w(minus)[i][k]) / (2.0 * delta);
+                err = err.max((d - c).abs());
+                scale = scale.max(c.abs());
+            }
+        }
+        err / scale
+    }
+
+    /// Eqs. T-1 to T-4 against central differences of whole runs, both models: the derivatives
+    /// of w_iG and w_i(L) along two coefficients of the motion agree to the digits the
+    /// differences allow (their truncation, `delta^2` times the third derivative, and their
+    /// round-off, about `1e-16 / delta` of the outputs).
+    #[test]
+    fn the_tangent_matches_central_differences_of_whole_runs() {
+        for model in [AmmModel::Paper, AmmModel::Full] {
+            let s = settings(model);
+            let base = case3(0.0, 0.0).problem().unwrap();
+            let eps = 1e-6;
+            let moved = [case3(eps, 0.0).problem().unwrap(), case3(0.0, eps).problem().unwrap()];
+            let sens = solve_with_sensitivities(&base, &s, &moved, eps).unwrap();
+            let plain = crate::solve(&base, &s, flexstar_drive::SolveRequest::motion())
+                .unwrap()
+                .response;
+            assert_eq!(
+                plain.w_g, sens.response.w_g,
+                "the run itself is the plain run's, bit for bit"
+            );
+            let delta = 1e-4;
+            for (k, (d1, d3)) in [(delta, 0.0), (0.0, delta)].into_iter().enumerate() {
+                let run = |sign: f64| {
+                    let p = case3(sign * d1, sign * d3).problem().unwrap();
+                    crate::solve(&p, &s, flexstar_drive::SolveRequest::motion())
+                        .unwrap()
+                        .response
+                };
+                let (plus, minus) = (run(1.0), run(-1.0));
+                let eg = worst(&sens.w_g[k], &plus, &minus, delta, |r| &r.w_g);
+                let et = worst(&sens.w_tip[k], &plus, &minus, delta, |r| &r.w_tip);
+                println!("{model:?} direction {k}: w_G {eg:.2e}, tips {et:.2e}");
+                assert!(
+                    eg < 1e-6 && et < 1e-6,
+                    "{model:?} direction {k}: w_G {eg:.2e}, tips {et:.2e}"
+                );
+            }
+        }
+    }
+}

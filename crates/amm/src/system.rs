@@ -327,6 +327,8 @@ pub(crate) struct BeamModel {
     // arrowhead data of the step (Eq. J2), per step
     /// The thp diagonal of the step matrix, `Jp (1 + gamma' alpha)` (Eq. D19).
     jp_step: f64,
+    /// The alpha diagonal `d_j` of the step matrix, and its inverse.
+    d: Vec<f64>,
     inv_d: Vec<f64>,
     w: Vec<f64>,
     p: f64,
@@ -361,6 +363,7 @@ impl BeamModel {
             },
             jp_step: params.jp,
             u_drag: 0.0,
+            d: vec![0.0; nm],
             inv_d: vec![0.0; nm],
             w: vec![0.0; nm],
             p: 0.0,
@@ -396,6 +399,7 @@ impl BeamModel {
             } else {
                 rho * (mass + bp * (self.lambda_m[j] - thd * thd))
             };
+            self.d[j] = d;
             self.inv_d[j] = 1.0 / d;
             self.w[j] = self.phi[j] / d;
             sigma += self.p * self.p * self.phi[j] * self.w[j];

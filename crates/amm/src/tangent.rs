@@ -178,23 +178,40 @@ impl<'a> Tangent<'a> {
         let gp = if h > 0.0 { self.ga.gamma_prime(h) } else { 0.0 };
         let apq = self.ga.a_per_qdd();
         sys.step_residual(bp, qhat, (step.qdd, &sys.lam), &mut self.primal0, &mut self.rows0);
+        // the predictor is linear in (q, v, a, q''): its rows (a_part, qhat, vhat), read off
+        // once per step; at the start the predictors are the state itself
+        let unit = |x: [f64; 4]| self.ga.predict(h, x[0], x[1], x[2], x[3]);
+        let (ca, cq, cv) = if h > 0.0 {
+            let c = [
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+                [0.0, 0.0, 0.0, 1.0],
+            ]
+            .map(unit);
+            (c.map(|x| x.0), c.map(|x| x.1), c.map(|x| x.2))
+        } else {
+            ([0.0; 4], [1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0])
+        };
+        let inv_eps = 1.0 / eps;
         for (k, dir) in self.dirs.iter_mut().enumerate() {
-            // the tangent predictor (linear, Eq. T-4), then the moved inputs
-            if h > 0.0 {
-                for j in 0..dir.dq.len() {
-                    let (a, q, v) = self.ga.predict(h, dir.dq[j], dir.dv[j], dir.dacc[j], dir.dqdd[j]);
-                    self.da[j] = a;
-                    self.qhat[j] = qhat[j] + eps * q;
-                    self.vhat[j] = vhat[j] + eps * v;
-                    dir.dq[j] = q;
-                    dir.dv[j] = v;
-                }
-            } else {
-                for j in 0..dir.dq.len() {
-                    self.da[j] = 0.0;
-                    self.qhat[j] = qhat[j] + eps * dir.dq[j];
-                    self.vhat[j] = vhat[j] + eps * dir.dv[j];
-                }
+            // the tangent predictor (Eq. T-4), then the moved inputs
+            let state = dir
+                .dq
+                .iter_mut()
+                .zip(dir.dv.iter_mut())
+                .zip(dir.dacc.iter().zip(&dir.dqdd));
+            let moved = self.da.iter_mut().zip(self.qhat.iter_mut().zip(self.vhat.iter_mut()));
+            let base = qhat.iter().zip(vhat);
+            for (((q, v), (&a, &d)), ((pa, (mq, mv)), (&bq, &bv))) in state.zip(moved.zip(base)) {
+                let x = [*q, *v, a, d];
+                let comb = |w: [f64; 4]| w[0] * x[0] + w[1] * x[1] + w[2] * x[2] + w[3] * x[3];
+                let (na, nq, nv) = (comb(ca), comb(cq), comb(cv));
+                *pa = na;
+                *mq = bq + eps * nq;
+                *mv = bv + eps * nv;
+                *q = nq;
+                *v = nv;
             }
             for ((l, p), d) in self.lagged.iter_mut().zip(&self.qdd_prev).zip(&dir.dqdd) {
                 *l = p + eps * d;
@@ -220,7 +237,7 @@ impl<'a> Tangent<'a> {
             );
             // the update (linear): q = qhat + bp q'', v = vhat + gp q'', a = a_part + apq q''
             for j in 0..dir.dq.len() {
-                let d = self.corr_q[j] / eps;
+                let d = self.corr_q[j] * inv_eps;
                 dir.dqdd[j] = d;
                 if h > 0.0 {
                     dir.dq[j] += bp * d;
@@ -309,8 +326,8 @@ mod tests {
         w: fn(&Response) -> &[Vec<f64>; 3],
     ) -> f64 {
         let (mut err, mut scale) = (0.0f64, 0.0f64);
-        for i in 0..3 {
-            for (k, d) in tangent[i].iter().enumerate() {
+        for (i, beam) in tangent.iter().enumerate() {
+            for (k, d) in beam.iter().enumerate() {
                 let c = (w(plus)[i][k] - w(minus)[i][k]) / (2.0 * delta);
                 err = err.max((d - c).abs());
                 scale = scale.max(c.abs());

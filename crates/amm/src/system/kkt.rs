@@ -12,6 +12,8 @@
 //! rows (Eq. A3); at `bp = 0` (the consistent start) the rows read `grad c_k . q'' = 0`.
 
 use super::{pick, Row, System, NONE};
+use crate::modes::dot;
+use flexstar_numerics::vector::dots;
 
 impl System {
     /// Whether the step's equations are all in [`System::step_residual`]: not with friction, a
@@ -39,17 +41,24 @@ impl System {
             let (qa, qu, qt) = (&qdd[o..o + nm], qdd[o + nm], qdd[o + nm + 1]);
             let out = &mut primal[o..o + nb];
             // the arrowhead S: alpha rows d_j a_j + p Phi_j u'', u row -p Phi . a + s_uu u''
-            let mut phi_a = 0.0;
-            for j in 0..nm {
-                out[j] = qa[j] / b.inv_d[j] + b.p * b.phi[j] * qu;
-                phi_a += b.phi[j] * qa[j];
+            let rows_a = out[..nm].iter_mut().zip(&self.resid[o..o + nm]);
+            for (((x, r), (&d, &a)), &phi) in rows_a.zip(b.d.iter().zip(qa)).zip(&b.phi) {
+                *x = d * a + b.p * phi * qu - r;
             }
-            out[nm] = -b.p * phi_a + b.suu * qu;
-            out[nm + 1] = b.jp_step * qt;
-            for (x, r) in out.iter_mut().zip(&self.resid[o..o + nb]) {
-                *x -= r;
-            }
-            // - C^T lambda, and each row's part on this beam
+            out[nm] = -b.p * dot(&b.phi, qa) + b.suu * qu - self.resid[o + nm];
+            out[nm + 1] = b.jp_step * qt - self.resid[o + nm + 1];
+            // each basis vector against q'' and qhat (one pass each), then the rows
+            let basis: [&[f64]; 6] = [
+                &b.phi0,
+                &b.dphi0,
+                &beam.sleeve[0],
+                &beam.sleeve[1],
+                &beam.sleeve[2],
+                &beam.sleeve[3],
+            ];
+            let on_qdd = dots(qa, basis);
+            let on_qhat = dots(&qhat[o..o + nm], basis);
+            let mut coef = [0.0; 6];
             for k in 0..beam.ids.len() {
                 let (g, bk, sk) = (beam.ids[k], beam.basis[k], beam.sc[k]);
                 let l = lam[g];
@@ -58,17 +67,19 @@ impl System {
                 let mut row = beam.cu[k] * qu + beam.ct[k] * qt;
                 let mut value = beam.gu[k] * qhat[o + nm] + beam.ct[k] * qhat[o + nm + 1] + beam.gv[k];
                 if bk != NONE {
-                    let v = self.basis(i, beam, bk);
-                    let (mut vq, mut vh) = (0.0, 0.0);
-                    for j in 0..nm {
-                        out[j] -= l * sk * v[j];
-                        vq += v[j] * qa[j];
-                        vh += v[j] * qhat[o + j];
-                    }
-                    row += sk * vq;
-                    value += sk * vh;
+                    coef[bk] += l * sk;
+                    row += sk * on_qdd[bk];
+                    value += sk * on_qhat[bk];
                 }
                 rows[g] += if bp > 0.0 { row + value / bp } else { row };
+            }
+            // - C^T lambda on the alpha rows, one pass per basis vector used
+            for (c, v) in coef.iter().zip(basis) {
+                if *c != 0.0 {
+                    for (x, vj) in out[..nm].iter_mut().zip(v) {
+                        *x -= c * vj;
+                    }
+                }
             }
         }
         if bp > 0.0 {

@@ -70,6 +70,12 @@ pub fn solve_with_sensitivities(
             "every moved problem needs the same output times",
         ));
     }
+    if stars.iter().any(|s| s.robot != star.robot || s.weld != star.weld) {
+        return Err(AmmError::invalid(
+            "robot",
+            "every moved problem needs the same robot (only its motion moves)",
+        ));
+    }
     let started = std::time::Instant::now();
     let dt_max = validate(&star, settings, n, true)?;
     let sys = build_system(settings, n, &star)?;
@@ -334,6 +340,31 @@ mod tests {
             }
         }
         err / scale
+    }
+
+    /// What the tangent does not cover is refused before any work, naming the key.
+    #[test]
+    fn unsupported_runs_are_refused_before_any_work() {
+        let base = case3(0.0, 0.0);
+        let moved = [case3(1e-6, 0.0).problem().unwrap()];
+        let auto = AmmSettings::accurate();
+        let e = solve_with_sensitivities(&base.problem().unwrap(), &auto, &moved, 1e-6).unwrap_err();
+        assert!(e.to_string().contains("amm.modes"), "{e}");
+        let mut heavy = base.clone();
+        heavy.gravity.g = [0.0, -9.81];
+        let e =
+            solve_with_sensitivities(&heavy.problem().unwrap(), &settings(AmmModel::Full), &moved, 1e-6).unwrap_err();
+        assert!(e.to_string().contains("gravity"), "{e}");
+        let mut longer = case3(1e-6, 0.0);
+        longer.robot.l *= 1.01;
+        let e = solve_with_sensitivities(
+            &base.problem().unwrap(),
+            &settings(AmmModel::Full),
+            &[longer.problem().unwrap()],
+            1e-6,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("same robot"), "{e}");
     }
 
     /// Eqs. T-1 to T-4 against central differences of whole runs, both models: the derivatives

@@ -342,6 +342,53 @@ mod tests {
         err / scale
     }
 
+    /// A plan's kind of motion (`docs/motions.md` 1.3, 4.2): the clamped quintic spline from the
+    /// centre towards the edge through two interior points, over 0.5 s and 0.15 s at rest after
+    /// it, on the paper's robot with Rayleigh damping; the interior points' `Gx` and `theta`
+    /// moved by `dx` [m] and `dth` [rad].
+    fn via(dx: f64, dth: f64) -> Experiment {
+        let text = format!(
+            "name = \"via\"\n[time]\nt_end = 0.65\ndt_out = 0.001\n[damping]\nalpha = 0.5\nbeta = 2e-5\n\
+             [trajectory]\nkind = \"via\"\nrest = false\npoints = [\n\
+             {{ t = 0.0, Gx = 0.0, Gy = 0.0, theta = 0.0 }},\n\
+             {{ t = 0.17, Gx = {}, Gy = -0.02, theta = {} }},\n\
+             {{ t = 0.33, Gx = 0.12, Gy = -0.07, theta = 0.0 }},\n\
+             {{ t = 0.5, Gx = 0.2, Gy = -0.11, theta = 0.0 }},\n]\n",
+            0.05 + dx,
+            0.02 + dth
+        );
+        Experiment::from_toml_str(&text, std::path::Path::new("via.toml")).unwrap()
+    }
+
+    /// The tangent along a via point's coordinates against central differences of whole runs:
+    /// the planner's variables (`docs/motions.md` 4.2), with damping in the step matrix. `eps`
+    /// = 1e-7 m, half a millionth of the move (the second-order terms, 8.6e-6 of the derivative
+    /// at `eps` = 1e-6 m and 8.6e-5 at 1e-5 m, grow like `eps`; round-off takes over below,
+    /// 4.2e-6 at 1e-8 m); the differences at +-1e-5 m (theirs fall like `delta^2`: 2.0e-4 of
+    /// the derivative at +-1e-3 m).
+    #[test]
+    fn the_tangent_along_a_via_point_matches_central_differences() {
+        let s = settings(AmmModel::Full);
+        let base = via(0.0, 0.0).problem().unwrap();
+        let eps = 1e-7;
+        let moved = [via(eps, 0.0).problem().unwrap(), via(0.0, eps).problem().unwrap()];
+        let sens = solve_with_sensitivities(&base, &s, &moved, eps).unwrap();
+        let delta = 1e-5;
+        for (k, (dx, dth)) in [(delta, 0.0), (0.0, delta)].into_iter().enumerate() {
+            let run = |sign: f64| {
+                let p = via(sign * dx, sign * dth).problem().unwrap();
+                crate::solve(&p, &s, flexstar_drive::SolveRequest::motion())
+                    .unwrap()
+                    .response
+            };
+            let (plus, minus) = (run(1.0), run(-1.0));
+            let eg = worst(&sens.w_g[k], &plus, &minus, delta, |r| &r.w_g);
+            let et = worst(&sens.w_tip[k], &plus, &minus, delta, |r| &r.w_tip);
+            println!("via direction {k}: w_G {eg:.2e}, tips {et:.2e}");
+            assert!(eg < 2e-6 && et < 2e-6, "via direction {k}: w_G {eg:.2e}, tips {et:.2e}");
+        }
+    }
+
     /// What the tangent does not cover is refused before any work, naming the key.
     #[test]
     fn unsupported_runs_are_refused_before_any_work() {

@@ -347,8 +347,13 @@ mod tests {
     /// it, on the paper's robot with Rayleigh damping; the interior points' `Gx` and `theta`
     /// moved by `dx` [m] and `dth` [rad].
     fn via(dx: f64, dth: f64) -> Experiment {
+        via_on("", dx, dth)
+    }
+
+    /// [`via`] on the robot of the TOML section `robot` (empty: the paper's).
+    fn via_on(robot: &str, dx: f64, dth: f64) -> Experiment {
         let text = format!(
-            "name = \"via\"\n[time]\nt_end = 0.65\ndt_out = 0.001\n[damping]\nalpha = 0.5\nbeta = 2e-5\n\
+            "name = \"via\"\n{robot}[time]\nt_end = 0.65\ndt_out = 0.001\n[damping]\nalpha = 0.5\nbeta = 2e-5\n\
              [trajectory]\nkind = \"via\"\nrest = false\npoints = [\n\
              {{ t = 0.0, Gx = 0.0, Gy = 0.0, theta = 0.0 }},\n\
              {{ t = 0.17, Gx = {}, Gy = -0.02, theta = {} }},\n\
@@ -387,6 +392,30 @@ mod tests {
             println!("via direction {k}: w_G {eg:.2e}, tips {et:.2e}");
             assert!(eg < 2e-6 && et < 2e-6, "via direction {k}: w_G {eg:.2e}, tips {et:.2e}");
         }
+    }
+
+    /// A robot as built (`docs/as-built.md`): unequal beams and weld angles, each beam with
+    /// its own mode set and arrowhead; the tangent along the plan-kind motion's via point
+    /// against central differences, as above.
+    #[test]
+    fn the_tangent_holds_on_a_robot_as_built() {
+        let robot = "[robot]\nL = [0.5, 0.5, 0.47]\nrho = [0.234, 0.25, 0.234]\nweld_deg = [0.0, 121.0, 238.5]\n";
+        let s = settings(AmmModel::Full);
+        let base = via_on(robot, 0.0, 0.0).problem().unwrap();
+        let eps = 1e-7;
+        let sens = solve_with_sensitivities(&base, &s, &[via_on(robot, eps, 0.0).problem().unwrap()], eps).unwrap();
+        let delta = 1e-5;
+        let run = |sign: f64| {
+            let p = via_on(robot, sign * delta, 0.0).problem().unwrap();
+            crate::solve(&p, &s, flexstar_drive::SolveRequest::motion())
+                .unwrap()
+                .response
+        };
+        let (plus, minus) = (run(1.0), run(-1.0));
+        let eg = worst(&sens.w_g[0], &plus, &minus, delta, |r| &r.w_g);
+        let et = worst(&sens.w_tip[0], &plus, &minus, delta, |r| &r.w_tip);
+        println!("as built: w_G {eg:.2e}, tips {et:.2e}");
+        assert!(eg < 2e-6 && et < 2e-6, "as built: w_G {eg:.2e}, tips {et:.2e}");
     }
 
     /// What the tangent does not cover is refused before any work, naming the key.

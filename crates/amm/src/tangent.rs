@@ -342,6 +342,36 @@ mod tests {
         err / scale
     }
 
+    /// Asserts each direction's tangents of `w_iG` and `w_i(L)` within `tol` (relative, [`worst`])
+    /// of the central differences of whole runs, `run(k, d)` being the run with direction k
+    /// moved by `d`, at `+-delta`.
+    fn assert_matches_differences(
+        sens: &Sensitivities,
+        run: impl Fn(usize, f64) -> Response,
+        delta: f64,
+        tol: f64,
+        label: &str,
+    ) {
+        for k in 0..sens.w_g.len() {
+            let (plus, minus) = (run(k, delta), run(k, -delta));
+            let eg = worst(&sens.w_g[k], &plus, &minus, delta, |r| &r.w_g);
+            let et = worst(&sens.w_tip[k], &plus, &minus, delta, |r| &r.w_tip);
+            println!("{label} direction {k}: w_G {eg:.2e}, tips {et:.2e}");
+            assert!(
+                eg < tol && et < tol,
+                "{label} direction {k}: w_G {eg:.2e}, tips {et:.2e}"
+            );
+        }
+    }
+
+    /// The plain run of `exp` at `settings`.
+    fn plain(exp: &Experiment, settings: &AmmSettings) -> Response {
+        let p = exp.problem().unwrap();
+        crate::solve(&p, settings, flexstar_drive::SolveRequest::motion())
+            .unwrap()
+            .response
+    }
+
     /// A plan's kind of motion (`docs/motions.md` 1.3, 4.2): the clamped quintic spline from the
     /// centre towards the edge through two interior points, over 0.5 s and 0.15 s at rest after
     /// it, on the paper's robot with Rayleigh damping; the interior points' `Gx` and `theta`
@@ -378,20 +408,8 @@ mod tests {
         let eps = 1e-7;
         let moved = [via(eps, 0.0).problem().unwrap(), via(0.0, eps).problem().unwrap()];
         let sens = solve_with_sensitivities(&base, &s, &moved, eps).unwrap();
-        let delta = 1e-5;
-        for (k, (dx, dth)) in [(delta, 0.0), (0.0, delta)].into_iter().enumerate() {
-            let run = |sign: f64| {
-                let p = via(sign * dx, sign * dth).problem().unwrap();
-                crate::solve(&p, &s, flexstar_drive::SolveRequest::motion())
-                    .unwrap()
-                    .response
-            };
-            let (plus, minus) = (run(1.0), run(-1.0));
-            let eg = worst(&sens.w_g[k], &plus, &minus, delta, |r| &r.w_g);
-            let et = worst(&sens.w_tip[k], &plus, &minus, delta, |r| &r.w_tip);
-            println!("via direction {k}: w_G {eg:.2e}, tips {et:.2e}");
-            assert!(eg < 2e-6 && et < 2e-6, "via direction {k}: w_G {eg:.2e}, tips {et:.2e}");
-        }
+        let moved = |k: usize, d: f64| if k == 0 { via(d, 0.0) } else { via(0.0, d) };
+        assert_matches_differences(&sens, |k, d| plain(&moved(k, d), &s), 1e-5, 2e-6, "via");
     }
 
     /// A robot as built (`docs/as-built.md`): unequal beams and weld angles, each beam with
@@ -404,18 +422,7 @@ mod tests {
         let base = via_on(robot, 0.0, 0.0).problem().unwrap();
         let eps = 1e-7;
         let sens = solve_with_sensitivities(&base, &s, &[via_on(robot, eps, 0.0).problem().unwrap()], eps).unwrap();
-        let delta = 1e-5;
-        let run = |sign: f64| {
-            let p = via_on(robot, sign * delta, 0.0).problem().unwrap();
-            crate::solve(&p, &s, flexstar_drive::SolveRequest::motion())
-                .unwrap()
-                .response
-        };
-        let (plus, minus) = (run(1.0), run(-1.0));
-        let eg = worst(&sens.w_g[0], &plus, &minus, delta, |r| &r.w_g);
-        let et = worst(&sens.w_tip[0], &plus, &minus, delta, |r| &r.w_tip);
-        println!("as built: w_G {eg:.2e}, tips {et:.2e}");
-        assert!(eg < 2e-6 && et < 2e-6, "as built: w_G {eg:.2e}, tips {et:.2e}");
+        assert_matches_differences(&sens, |_, d| plain(&via_on(robot, d, 0.0), &s), 1e-5, 2e-6, "as built");
     }
 
     /// What the tangent does not cover is refused before any work, naming the key.
@@ -455,30 +462,14 @@ mod tests {
             let eps = 1e-6;
             let moved = [case3(eps, 0.0).problem().unwrap(), case3(0.0, eps).problem().unwrap()];
             let sens = solve_with_sensitivities(&base, &s, &moved, eps).unwrap();
-            let plain = crate::solve(&base, &s, flexstar_drive::SolveRequest::motion())
-                .unwrap()
-                .response;
+            let alone = plain(&case3(0.0, 0.0), &s);
             assert_eq!(
-                plain.w_g, sens.response.w_g,
+                alone.w_g, sens.response.w_g,
                 "the run itself is the plain run's, bit for bit"
             );
-            let delta = 1e-4;
-            for (k, (d1, d3)) in [(delta, 0.0), (0.0, delta)].into_iter().enumerate() {
-                let run = |sign: f64| {
-                    let p = case3(sign * d1, sign * d3).problem().unwrap();
-                    crate::solve(&p, &s, flexstar_drive::SolveRequest::motion())
-                        .unwrap()
-                        .response
-                };
-                let (plus, minus) = (run(1.0), run(-1.0));
-                let eg = worst(&sens.w_g[k], &plus, &minus, delta, |r| &r.w_g);
-                let et = worst(&sens.w_tip[k], &plus, &minus, delta, |r| &r.w_tip);
-                println!("{model:?} direction {k}: w_G {eg:.2e}, tips {et:.2e}");
-                assert!(
-                    eg < 1e-6 && et < 1e-6,
-                    "{model:?} direction {k}: w_G {eg:.2e}, tips {et:.2e}"
-                );
-            }
+            let moved = |k: usize, d: f64| if k == 0 { case3(d, 0.0) } else { case3(0.0, d) };
+            let label = format!("{model:?}");
+            assert_matches_differences(&sens, |k, d| plain(&moved(k, d), &s), 1e-4, 1e-6, &label);
         }
     }
 }

@@ -558,6 +558,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
         t: 0.0,
         h: 0.0,
         bp: 0.0,
+        gp: 0.0,
         q: &q,
         predicted: friction.is_none().then_some((&q[..], &v[..])),
         qdd: &qdd,
@@ -603,6 +604,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
                     t,
                     h,
                     bp,
+                    gp,
                     q: &q,
                     predicted: None,
                     qdd: &qdd,
@@ -626,6 +628,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
                 t,
                 h,
                 bp,
+                gp,
                 q: &q,
                 predicted: Some((&qhat, &vhat)),
                 qdd: &qdd,
@@ -649,13 +652,14 @@ pub(crate) fn integrate_system<O: StepObserver>(
 }
 
 /// What an observer of [`integrate_system`] sees after a step (and after the consistent start,
-/// `h = 0`): its time [s], length h [s] and `beta'` of the generalized-alpha method, the
+/// `h = 0`): its time [s], length h [s], `beta'` and `gamma'` of the generalized-alpha method, the
 /// coordinates q after it, the predictors `(qhat, vhat)` it was solved about (`None` with
 /// friction, whose events split the step) and its accelerations.
 pub(crate) struct Step<'a> {
     pub(crate) t: f64,
     pub(crate) h: f64,
     pub(crate) bp: f64,
+    pub(crate) gp: f64,
     pub(crate) q: &'a [f64],
     pub(crate) predicted: Option<(&'a [f64], &'a [f64])>,
     pub(crate) qdd: &'a [f64],

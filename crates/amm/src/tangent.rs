@@ -19,6 +19,7 @@ use flexstar_model::{AmmSettings, ModeCount, Problem, Response};
 use flexstar_numerics::GenAlpha;
 
 use crate::error::AmmError;
+use crate::modes::dot;
 use crate::solver::{build_system, integrate_system, validate, Step, StepObserver, RHO_INF};
 use crate::star::Star;
 use crate::system::System;
@@ -132,8 +133,6 @@ struct Tangent<'a> {
     rows: Vec<f64>,
     corr_q: Vec<f64>,
     corr_l: Vec<f64>,
-    keep_r: Vec<f64>,
-    keep_l: Vec<f64>,
 }
 
 impl<'a> Tangent<'a> {
@@ -170,8 +169,6 @@ impl<'a> Tangent<'a> {
             rows: vec![0.0; m],
             corr_q: vec![0.0; n],
             corr_l: vec![0.0; m],
-            keep_r: vec![0.0; n],
-            keep_l: vec![0.0; m],
         }
     }
 
@@ -181,7 +178,7 @@ impl<'a> Tangent<'a> {
             return Err(AmmError::invalid("amm", "sensitivities are not built for friction"));
         };
         let (bp, eps, h) = (step.bp, self.eps, step.h);
-        let gp = if h > 0.0 { self.ga.gamma_prime(h) } else { 0.0 };
+        let gp = step.gp;
         let apq = self.ga.a_per_qdd();
         sys.step_residual(bp, qhat, (step.qdd, &sys.lam), &mut self.primal0, &mut self.rows0);
         // the predictor is linear in (q, v, a, q''): its rows (a_part, qhat, vhat), read off
@@ -229,18 +226,14 @@ impl<'a> Tangent<'a> {
             self.probe.forcing(&st, &self.qhat, &self.vhat);
             self.probe
                 .step_residual(bp, &self.qhat, (step.qdd, &sys.lam), &mut self.primal, &mut self.rows);
+            // less the step's own residual: the probe's minus the step's, negated for the solve
             for (r, r0) in self.primal.iter_mut().zip(&self.primal0) {
-                *r -= r0;
+                *r = r0 - *r;
             }
             for (r, r0) in self.rows.iter_mut().zip(&self.rows0) {
                 *r -= r0;
             }
-            sys.solve_correction(
-                bp,
-                (&self.primal, &self.rows),
-                (&mut self.corr_q, &mut self.corr_l),
-                (&mut self.keep_r, &mut self.keep_l),
-            );
+            sys.solve_correction(bp, (&mut self.primal, &self.rows), &mut self.corr_l, &mut self.corr_q);
             // the update (linear): q = qhat + bp q'', v = vhat + gp q'', a = a_part + apq q''
             for j in 0..dir.dq.len() {
                 let d = self.corr_q[j] * inv_eps;
@@ -273,8 +266,8 @@ impl<'a> Tangent<'a> {
             for i in 0..3 {
                 let b = sys.beam(i);
                 let a = &dir.dq[i * nb..i * nb + nm];
-                self.w_g[k][i][row] = a.iter().zip(&b.phi0).map(|(x, p)| x * p).sum();
-                self.w_tip[k][i][row] = a.iter().zip(&b.phil).map(|(x, p)| x * p).sum();
+                self.w_g[k][i][row] = dot(&b.phi0, a);
+                self.w_tip[k][i][row] = dot(&b.phil, a);
             }
         }
         self.next_out += 1;

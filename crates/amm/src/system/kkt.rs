@@ -92,28 +92,25 @@ impl System {
         }
     }
 
-    /// The correction `(dqdd, dlam)` that solves the prepared step's equations linearised about
-    /// a point whose residual is `(primal, rows)` ([`System::step_residual`]), with the step's
-    /// own factors: `S dqdd - C^T dlam = -primal`, `grad C dqdd + F / bp dlam = -rows`. The
-    /// step's forcing and multipliers are kept. Not with a payload or friction (their rows and
-    /// Woodbury terms are not in [`System::step_residual`]).
+    /// The correction `dqdd` that solves the prepared step's equations linearised about a
+    /// point whose residual is `(primal, rows)` ([`System::step_residual`]), with the step's own
+    /// factors: `S dqdd - C^T dlam = -primal`, `grad C dqdd + F / bp dlam = -rows`. Takes
+    /// `minus_primal` (= `-primal`) and a buffer `dlam` of one entry per row (it receives the
+    /// multipliers' correction), swapped in for the step's forcing and multipliers and back, so
+    /// that both are kept. Not with a payload or friction (their rows and Woodbury terms are not
+    /// in [`System::step_residual`]).
     pub(crate) fn solve_correction(
         &mut self,
         bp: f64,
-        (primal, rows): (&[f64], &[f64]),
-        (dqdd, dlam): (&mut [f64], &mut [f64]),
-        keep: (&mut [f64], &mut [f64]),
+        (minus_primal, rows): (&mut Vec<f64>, &[f64]),
+        dlam: &mut Vec<f64>,
+        dqdd: &mut [f64],
     ) {
         debug_assert!(self.payload.is_none() && self.friction.is_none());
-        let (resid_kept, lam_kept) = keep;
-        resid_kept.copy_from_slice(&self.resid);
-        lam_kept.copy_from_slice(&self.lam);
-        for (r, p) in self.resid.iter_mut().zip(primal) {
-            *r = -p;
-        }
+        std::mem::swap(&mut self.resid, minus_primal);
+        std::mem::swap(&mut self.lam, dlam);
         self.solve_factored(bp, None, Some(rows), dqdd);
-        dlam.copy_from_slice(&self.lam);
-        self.resid.copy_from_slice(resid_kept);
-        self.lam.copy_from_slice(lam_kept);
+        std::mem::swap(&mut self.resid, minus_primal);
+        std::mem::swap(&mut self.lam, dlam);
     }
 }

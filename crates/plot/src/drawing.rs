@@ -51,15 +51,29 @@ pub fn write_svg_png<D: Drawing>(d: &D, dir: &Path) -> Result<String, FigureErro
     let svg = svg_string(d)?;
     flexstar_io::output::write_string_atomically(&dir.join(format!("{}.svg", d.name())), &svg)
         .map_err(|e| err(e.to_string()))?;
-    // PNG: drawn into a temporary file beside the target, renamed when complete
-    let png = dir.join(format!("{}.png", d.name()));
-    let tmp = flexstar_io::output::temp_file_in(dir, ".png").map_err(|e| err(e.to_string()))?;
+    // PNG: drawn into a pixel buffer, encoded into a temporary file beside the target, renamed
+    // when complete
+    let (w, h) = d.size();
+    let mut pixels = vec![0u8; 3 * w as usize * h as usize];
     {
-        let root = BitMapBackend::new(tmp.path(), d.size()).into_drawing_area();
+        let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
         d.draw_on(root).map_err(err)?;
     }
+    let png = dir.join(format!("{}.png", d.name()));
+    let mut tmp = flexstar_io::output::temp_file_in(dir, ".png").map_err(|e| err(e.to_string()))?;
+    encode_png(tmp.as_file_mut(), (w, h), &pixels).map_err(|e| err(format!("PNG encoding: {e}")))?;
     tmp.persist(&png).map_err(|e| err(e.to_string()))?;
     Ok(svg)
+}
+
+/// 8-bit RGB pixels, row by row from the top left, as a PNG stream.
+fn encode_png<W: std::io::Write>(out: W, (w, h): (u32, u32), rgb: &[u8]) -> Result<(), png::EncodingError> {
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(out), w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header()?;
+    writer.write_image_data(rgb)?;
+    writer.finish()
 }
 
 static FONT: Once = Once::new();
@@ -74,4 +88,54 @@ pub fn register_font() {
             include_bytes!("../assets/DejaVuSans.ttf"),
         );
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A background of one colour with a rectangle of another in its top-left quarter.
+    struct Blocks;
+
+    impl Drawing for Blocks {
+        fn name(&self) -> &str {
+            "blocks"
+        }
+        fn size(&self) -> (u32, u32) {
+            (40, 30)
+        }
+        fn draw_on<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String> {
+            root.fill(&RGBColor(10, 200, 30)).map_err(|e| e.to_string())?;
+            root.draw(&Rectangle::new([(0, 0), (19, 14)], RGBColor(250, 5, 120).filled()))
+                .map_err(|e| e.to_string())?;
+            root.present().map_err(|e| e.to_string())
+        }
+    }
+
+    #[test]
+    fn the_png_file_holds_the_pixels_drawn() {
+        let dir = tempfile::tempdir().unwrap();
+        write_svg_png(&Blocks, dir.path()).unwrap();
+        let file = std::fs::File::open(dir.path().join("blocks.png")).unwrap();
+        let mut reader = png::Decoder::new(std::io::BufReader::new(file)).read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!((info.width, info.height), (40, 30));
+        assert_eq!(
+            (info.color_type, info.bit_depth),
+            (png::ColorType::Rgb, png::BitDepth::Eight)
+        );
+        let pixel = |x: usize, y: usize| &buf[3 * (y * 40 + x)..3 * (y * 40 + x) + 3];
+        assert_eq!(pixel(3, 3), [250, 5, 120]);
+        assert_eq!(pixel(17, 12), [250, 5, 120]);
+        assert_eq!(pixel(21, 16), [10, 200, 30]);
+        assert_eq!(pixel(39, 29), [10, 200, 30]);
+        // nothing else beside the two files, no temporary left
+        let mut names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["blocks.png", "blocks.svg"]);
+    }
 }

@@ -66,14 +66,18 @@ pub fn write_svg_png<D: Drawing>(d: &D, dir: &Path) -> Result<String, FigureErro
     Ok(svg)
 }
 
-/// 8-bit RGB pixels, row by row from the top left, as a PNG stream.
+/// 8-bit RGB pixels, row by row from the top left, as a PNG stream; the buffer is flushed here
+/// so that a failed write is an error, not a truncated file.
 fn encode_png<W: std::io::Write>(out: W, (w, h): (u32, u32), rgb: &[u8]) -> Result<(), png::EncodingError> {
-    let mut enc = png::Encoder::new(std::io::BufWriter::new(out), w, h);
+    let mut buf = std::io::BufWriter::new(out);
+    let mut enc = png::Encoder::new(&mut buf, w, h);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     let mut writer = enc.write_header()?;
     writer.write_image_data(rgb)?;
-    writer.finish()
+    writer.finish()?;
+    std::io::Write::flush(&mut buf)?;
+    Ok(())
 }
 
 static FONT: Once = Once::new();

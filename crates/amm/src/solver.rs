@@ -562,6 +562,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
         q: &q,
         predicted: friction.is_none().then_some((&q[..], &v[..])),
         qdd: &qdd,
+        output: stops[0].output,
     };
     observe.step(&mut sys, &start);
 
@@ -608,6 +609,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
                     q: &q,
                     predicted: None,
                     qdd: &qdd,
+                    output: if k == nsub { w[1].output } else { None },
                 };
                 observe.step(&mut sys, &step);
                 continue;
@@ -632,6 +634,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
                 q: &q,
                 predicted: Some((&qhat, &vhat)),
                 qdd: &qdd,
+                output: if k == nsub { w[1].output } else { None },
             };
             observe.step(&mut sys, &step);
         }
@@ -654,7 +657,8 @@ pub(crate) fn integrate_system<O: StepObserver>(
 /// What an observer of [`integrate_system`] sees after a step (and after the consistent start,
 /// `h = 0`): its time [s], length h [s], `beta'` and `gamma'` of the generalized-alpha method, the
 /// coordinates q after it, the predictors `(qhat, vhat)` it was solved about (`None` with
-/// friction, whose events split the step) and its accelerations.
+/// friction, whose events split the step), its accelerations, and the response's row it ends on
+/// (the output time the recorder records after it; `None` within an output interval).
 pub(crate) struct Step<'a> {
     pub(crate) t: f64,
     pub(crate) h: f64,
@@ -663,6 +667,7 @@ pub(crate) struct Step<'a> {
     pub(crate) q: &'a [f64],
     pub(crate) predicted: Option<(&'a [f64], &'a [f64])>,
     pub(crate) qdd: &'a [f64],
+    pub(crate) output: Option<usize>,
 }
 
 /// An observer of [`integrate_system`], called after the consistent start and after every step

@@ -430,6 +430,20 @@ impl BeamModel {
     }
 }
 
+/// Eq. A3: each Fix row `k` of `rows` with its beam's axial flexibility over `bp`, the diagonal
+/// entry it adds to the Schur complement (none at `bp = 0` or without the axial flexibility).
+pub(crate) fn axial_flexibilities<'a>(
+    rows: &'a [Row],
+    bm: &'a [BeamModel],
+    bp: f64,
+) -> impl Iterator<Item = (usize, f64)> + 'a {
+    let on = bm[0].axial_flex != 0.0 && bp > 0.0;
+    rows.iter().enumerate().filter_map(move |(k, row)| match row {
+        Row::Fix(i) if on => Some((k, pick(bm, *i).axial_flex / bp)),
+        _ => None,
+    })
+}
+
 /// The element of `v` for beam `i`: `v` holds one (shared by the three beams) or three.
 #[inline]
 pub(crate) fn pick<T>(v: &[T], i: usize) -> &T {
@@ -760,14 +774,9 @@ impl System {
     /// row's diagonal of the Schur complement. No-op in the paper's model and for the consistent
     /// initial accelerations (`bp = 0`).
     fn add_axial_flexibility(&mut self, bp: f64) {
-        if self.bm[0].axial_flex == 0.0 || bp <= 0.0 {
-            return;
-        }
         let m = self.rows.len();
-        for (k, row) in self.rows.iter().enumerate() {
-            if let Row::Fix(i) = row {
-                self.a[k * m + k] += pick(&self.bm, *i).axial_flex / bp;
-            }
+        for (k, f) in axial_flexibilities(&self.rows, &self.bm, bp) {
+            self.a[k * m + k] += f;
         }
     }
 

@@ -86,7 +86,7 @@ pub fn solve_with_sensitivities(
             "sensitivities are not built for friction, a payload, a load or gravity",
         ));
     }
-    let mut tangent = Tangent::new(&sys, &stars, eps, star.time.output_times());
+    let mut tangent = Tangent::new(&sys, &stars, eps, star.time.output_times().len());
     let response = integrate_system(&star, settings, sys, dt_max, started, &mut tangent)?;
     if let Some(e) = tangent.failed.take() {
         return Err(e);
@@ -117,8 +117,6 @@ struct Tangent<'a> {
     dirs: Vec<Direction>,
     /// The base's accelerations of the previous step (the lagged terms' input).
     qdd_prev: Vec<f64>,
-    out_times: Vec<f64>,
-    next_out: usize,
     w_g: Vec<[Vec<f64>; 3]>,
     w_tip: Vec<[Vec<f64>; 3]>,
     failed: Option<AmmError>,
@@ -136,7 +134,8 @@ struct Tangent<'a> {
 }
 
 impl<'a> Tangent<'a> {
-    fn new(sys: &System, moved: &'a [Star<'a>], eps: f64, out_times: Vec<f64>) -> Self {
+    /// The tangents of a run with `rows` output rows, all zero at the start.
+    fn new(sys: &System, moved: &'a [Star<'a>], eps: f64, rows: usize) -> Self {
         let n = 3 * sys.nb;
         let m = sys.rows.len();
         let zero = Direction {
@@ -145,7 +144,6 @@ impl<'a> Tangent<'a> {
             dacc: vec![0.0; n],
             dqdd: vec![0.0; n],
         };
-        let rows = out_times.len();
         let column = || [vec![0.0; rows], vec![0.0; rows], vec![0.0; rows]];
         Tangent {
             probe: sys.clone(),
@@ -154,8 +152,6 @@ impl<'a> Tangent<'a> {
             ga: GenAlpha::new(RHO_INF),
             dirs: vec![zero; moved.len()],
             qdd_prev: vec![0.0; n],
-            out_times,
-            next_out: 0,
             w_g: (0..moved.len()).map(|_| column()).collect(),
             w_tip: (0..moved.len()).map(|_| column()).collect(),
             failed: None,
@@ -248,20 +244,15 @@ impl<'a> Tangent<'a> {
             }
         }
         self.qdd_prev.copy_from_slice(step.qdd);
-        self.record(sys, step.t);
+        if let Some(row) = step.output {
+            self.record(sys, row);
+        }
         Ok(())
     }
 
-    /// The tangents of w_iG and w_i(L) at an output time.
-    fn record(&mut self, sys: &System, t: f64) {
-        let Some(&t_out) = self.out_times.get(self.next_out) else {
-            return;
-        };
-        let tol = 1e-9 * self.out_times.get(1).map_or(1.0, |t1| t1 - self.out_times[0]);
-        if (t - t_out).abs() > tol {
-            return;
-        }
-        let (nm, nb, row) = (sys.nm, sys.nb, self.next_out);
+    /// The tangents of w_iG and w_i(L) at output row `row` (the recorder's row of the step).
+    fn record(&mut self, sys: &System, row: usize) {
+        let (nm, nb) = (sys.nm, sys.nb);
         for (k, dir) in self.dirs.iter().enumerate() {
             for i in 0..3 {
                 let b = sys.beam(i);
@@ -270,7 +261,6 @@ impl<'a> Tangent<'a> {
                 self.w_tip[k][i][row] = dot(&b.phil, a);
             }
         }
-        self.next_out += 1;
     }
 }
 

@@ -11,7 +11,7 @@
 //! the truncation flexibility of the sleeve rows (Eq. R4) and the axial flexibility of the Fix
 //! rows (Eq. A3); at `bp = 0` (the consistent start) the rows read `grad c_k . q'' = 0`.
 
-use super::{pick, Row, System, NONE};
+use super::{axial_flexibilities, pick, System, NONE};
 use crate::modes::dot;
 use flexstar_numerics::vector::dots;
 
@@ -84,10 +84,8 @@ impl System {
         }
         if bp > 0.0 {
             self.sleeves.add_compliance_product(rows, &self.beams, lam, bp);
-            for (k, row) in self.rows.iter().enumerate() {
-                if let Row::Fix(i) = row {
-                    rows[k] += pick(&self.bm, *i).axial_flex / bp * lam[k];
-                }
+            for (k, f) in axial_flexibilities(&self.rows, &self.bm, bp) {
+                rows[k] += f * lam[k];
             }
         }
     }

@@ -53,7 +53,7 @@ fn main() {
             })
             .collect();
         let with = best_of(|| {
-            flexstar_amm::solve_with_sensitivities(&base, &settings, &moved, eps).expect("sensitivities");
+            flexstar_amm::solve_with_sensitivities(&base, &settings, &moved, &vec![eps; k]).expect("sensitivities");
         });
         println!(
             "{k} directions: {:.2} ms, {:.2} plain runs ({:.3} per direction)",

@@ -262,13 +262,13 @@ fn slider_correction(
         // each slider's own sleeve and slider mass (docs/amm.md 13)
         let m = p.star.beam(i).mpp_mpa;
         for (k, dlam) in buf.dlam.iter().enumerate() {
-            row[k] = rec.sleeve_push(i, st, &buf.qnew, dlam, sys.sleeves.axial());
+            row[k] = rec.force.sleeve_push(i, st, &buf.qnew, dlam, sys.sleeves.axial());
         }
         row[i] += m + kp[i] * p.bp + kd[i] * p.gp;
         // Eq. 33 with the weight along the rail (Eq. G2)
-        row[3] = fa[i] + m * rec.gravity_along(i)
+        row[3] = fa[i] + m * rec.force.gravity_along(i)
             - m * p.x_pred[i]
-            - rec.sleeve_push(i, st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
+            - rec.force.sleeve_push(i, st, &buf.qnew, &buf.lam0, sys.sleeves.axial());
         if sys.friction.is_some() || p.rails.is_some() {
             friction_row(
                 sys,
@@ -319,7 +319,7 @@ fn friction_row(
 ) {
     let u = sys.nb * i + sys.nm;
     if sys.friction.is_some() {
-        let along = rec.along_rail(i, st);
+        let along = rec.force.along_rail(i, st);
         for (k, (dlam, dqdd)) in buf.dlam.iter().zip(&buf.dqdd).enumerate() {
             row[k] += along * sys.sleeve_friction_force(i, dlam, dqdd[u], false);
         }
@@ -348,10 +348,10 @@ fn friction_row(
 fn rail_need(sys: &System, rec: &Recorder, fa: [f64; 3], st: &RigidState, q: &[f64], qdd: &[f64]) -> [f64; 3] {
     let ff = stick_slip::sleeve_forces(sys, qdd);
     [0, 1, 2].map(|i| {
-        let m = rec.mass(i);
-        fa[i] + m * rec.gravity_along(i)
-            - rec.sleeve_push(i, st, q, &sys.lam, sys.sleeves.axial())
-            - ff[i] * rec.along_rail(i, st)
+        let m = rec.force.mass(i);
+        fa[i] + m * rec.force.gravity_along(i)
+            - rec.force.sleeve_push(i, st, q, &sys.lam, sys.sleeves.axial())
+            - ff[i] * rec.force.along_rail(i, st)
     })
 }
 

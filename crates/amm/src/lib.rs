@@ -56,7 +56,7 @@ pub use solver::{
     beam_time_scale, parse_family, robot_step_factor, solve, solve_stepwise, tolerance_step, Stats, DEFAULT_DT,
     EXTRA_COLUMNS, RHO_INF, SHAPE_POINTS, TOLERANCE_DT,
 };
-pub use tangent::{solve_with_sensitivities, Sensitivities};
+pub use tangent::{sensitivities_cover, solve_with_sensitivities, Sensitivities};
 
 /// What a mode family with a hidden support at G loses of the experiment's payload and load
 /// (`docs/amm.md` 11.1 and 11.3): pinned-free (`phi(0) = 0`, `u = 0`) the transverse force and the

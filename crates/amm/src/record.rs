@@ -24,11 +24,23 @@ pub(crate) struct Recorder {
     poses: Vec<FramePose>,
     /// The shape times: which are snapshots, which animation frames.
     times: ShapeTimes,
-    /// Multiplier index of each named multiplier column (`None`: row dropped for the family).
-    col_rows: [Option<usize>; 19],
     /// `phi(0)` and `phi(L)` of each beam's modes (one for equal beams).
     phi0: Vec<Vec<f64>>,
     phil: Vec<Vec<f64>>,
+    nm: usize,
+    nb: usize,
+    /// The multipliers' columns and the actuator forces (Eq. 33).
+    pub(crate) force: SliderForce,
+    /// The sensors' readings (`docs/sensors.md`), `None` without sensors.
+    sensors: Option<SensorRecorder>,
+}
+
+/// What Eq. 33 needs beyond the state: each named multiplier column's row, the sliders' masses,
+/// gravity along the rails and the weld (shared by the recorder and the tangent's forces).
+#[derive(Debug, Clone)]
+pub(crate) struct SliderForce {
+    /// Multiplier index of each named multiplier column (`None`: row dropped for the family).
+    col_rows: [Option<usize>; 19],
     nm: usize,
     nb: usize,
     full: bool,
@@ -38,8 +50,81 @@ pub(crate) struct Recorder {
     gravity_along: [f64; 3],
     /// The rails and the weld (Eq. J7).
     weld: Weld,
-    /// The sensors' readings (`docs/sensors.md`), `None` without sensors.
-    sensors: Option<SensorRecorder>,
+}
+
+impl SliderForce {
+    /// The forces of `sys`'s rows in `model`, on the robot of `problem`.
+    pub(crate) fn new(sys: &System, model: AmmModel, problem: &Star) -> Self {
+        let lam_index = |r: Row| sys.rows.iter().position(|x| *x == r);
+        // the junction's multipliers, then the sleeves' in the columns' order Fp1..3, FLp1..3,
+        // FRp1..3, Mp1..3 of EXTRA_COLUMNS
+        let junction = [
+            Some(Row::Fix(0)),
+            Some(Row::Fix(1)),
+            Some(Row::Fix(2)),
+            Some(Row::M1G),
+            None, // M2G = -M1G - M3G (Eq. 25-1)
+            Some(Row::M3G),
+            Some(Row::Fw),
+        ];
+        let sleeves = [SleeveRow::Fp, SleeveRow::FL, SleeveRow::FR, SleeveRow::Mp]
+            .into_iter()
+            .flat_map(|r| (0..3).map(move |i| Some(Row::Sleeve(i, r))));
+        let mut col_rows = [None; 19];
+        for (c, row) in col_rows.iter_mut().zip(junction.into_iter().chain(sleeves)) {
+            *c = row.and_then(lam_index);
+        }
+        SliderForce {
+            col_rows,
+            nm: sys.nm,
+            nb: sys.nb,
+            full: model == AmmModel::Full,
+            mpp_mpa: problem.beams.map(|b| b.mpp_mpa),
+            gravity_along: problem.weld.along_rails(sys.gravity()),
+            weld: problem.weld,
+        }
+    }
+
+    /// `(mpp + mpa)_i` [kg] of slider i (Eq. 33).
+    pub(crate) fn mass(&self, i: usize) -> f64 {
+        self.mpp_mpa[i]
+    }
+
+    /// `g . u_i` [m/s^2] of slider i's rail (Eq. G2).
+    pub(crate) fn gravity_along(&self, i: usize) -> f64 {
+        self.gravity_along[i]
+    }
+
+    /// The multiplier of named column `k` (0 when the row is dropped).
+    pub(crate) fn lam_of(&self, lam: &[f64], k: usize) -> f64 {
+        self.col_rows[k].map_or(0.0, |r| lam[r])
+    }
+
+    /// Eq. 33 without the slider's inertia: the component along `+u_i` of the force of sleeve i on
+    /// beam i [N] ([`sleeve::rows::push`]), linear in the multipliers `lam`, with the sleeve
+    /// rotation of `q` and the u gradients `axial` of the sleeve rows (-w', full model).
+    pub(crate) fn sleeve_push(&self, i: usize, st: &RigidState, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]) -> f64 {
+        let forces = [
+            self.lam_of(lam, 7 + i),
+            self.lam_of(lam, 10 + i),
+            self.lam_of(lam, 13 + i),
+        ];
+        let thp = q[i * self.nb + self.nm + 1];
+        sleeve::rows::push(self.full, i, st, thp, forces, axial[i], &self.weld)
+    }
+
+    /// Eq. 33 with the sleeve and slider's weight along the rail (Eq. G2): the actuator force of
+    /// slider i [N] of a prescribed motion at the rigid state `st`, coordinates `q`, multipliers
+    /// `lam` and the rows' u gradients `axial`.
+    pub(crate) fn eq33(&self, i: usize, st: &RigidState, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]) -> f64 {
+        self.mpp_mpa[i] * (st.s[i].d2 - self.gravity_along[i]) + self.sleeve_push(i, st, q, lam, axial)
+    }
+
+    /// `e_xi . u_i` [-]: beam i's axis at the rigid state `st` along its slider's rail (Eq. F12).
+    pub(crate) fn along_rail(&self, i: usize, st: &RigidState) -> f64 {
+        let (ex, d) = (st.e_x(i), self.weld.rails[i]);
+        ex[0] * d[0] + ex[1] * d[1]
+    }
 }
 
 impl Recorder {
@@ -75,25 +160,6 @@ impl Recorder {
                 }),
             })
             .collect();
-        let lam_index = |r: Row| sys.rows.iter().position(|x| *x == r);
-        // the junction's multipliers, then the sleeves' in the columns' order Fp1..3, FLp1..3,
-        // FRp1..3, Mp1..3 of EXTRA_COLUMNS
-        let junction = [
-            Some(Row::Fix(0)),
-            Some(Row::Fix(1)),
-            Some(Row::Fix(2)),
-            Some(Row::M1G),
-            None, // M2G = -M1G - M3G (Eq. 25-1)
-            Some(Row::M3G),
-            Some(Row::Fw),
-        ];
-        let sleeves = [SleeveRow::Fp, SleeveRow::FL, SleeveRow::FR, SleeveRow::Mp]
-            .into_iter()
-            .flat_map(|r| (0..3).map(move |i| Some(Row::Sleeve(i, r))));
-        let mut col_rows = [None; 19];
-        for (c, row) in col_rows.iter_mut().zip(junction.into_iter().chain(sleeves)) {
-            *c = row.and_then(lam_index);
-        }
         Recorder {
             resp: Response::with_capacity(String::new(), n_out),
             extra,
@@ -102,58 +168,13 @@ impl Recorder {
             poses: vec![FramePose::default(); times.all.len()],
             times,
             shapes,
-            col_rows,
             phi0: sys.bm.iter().map(|b| b.phi0.clone()).collect(),
             phil: sys.bm.iter().map(|b| b.phil.clone()).collect(),
             nm,
             nb,
-            full: settings.model == AmmModel::Full,
-            mpp_mpa: problem.beams.map(|b| b.mpp_mpa),
-            gravity_along: problem.weld.along_rails(sys.gravity()),
-            weld: problem.weld,
+            force: SliderForce::new(sys, settings.model, problem),
             sensors: SensorRecorder::new(problem.sensors, sys, problem.gravity, n_out),
         }
-    }
-
-    /// `(mpp + mpa)_i` [kg] of slider i (Eq. 33).
-    pub(crate) fn mass(&self, i: usize) -> f64 {
-        self.mpp_mpa[i]
-    }
-
-    /// `g . u_i` [m/s^2] of slider i's rail (Eq. G2).
-    pub(crate) fn gravity_along(&self, i: usize) -> f64 {
-        self.gravity_along[i]
-    }
-
-    /// The multiplier of named column `k` (0 when the row is dropped).
-    fn lam_of(&self, lam: &[f64], k: usize) -> f64 {
-        self.col_rows[k].map_or(0.0, |r| lam[r])
-    }
-
-    /// Eq. 33 without the slider's inertia: the component along `+u_i` of the force of sleeve i on
-    /// beam i [N] ([`sleeve::rows::push`]), linear in the multipliers `lam`, with the sleeve
-    /// rotation of `q` and the u gradients `axial` of the sleeve rows (-w', full model).
-    pub(crate) fn sleeve_push(&self, i: usize, st: &RigidState, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]) -> f64 {
-        let forces = [
-            self.lam_of(lam, 7 + i),
-            self.lam_of(lam, 10 + i),
-            self.lam_of(lam, 13 + i),
-        ];
-        let thp = q[i * self.nb + self.nm + 1];
-        sleeve::rows::push(self.full, i, st, thp, forces, axial[i], &self.weld)
-    }
-
-    /// Eq. 33 with the sleeve and slider's weight along the rail (Eq. G2): the actuator force of
-    /// slider i [N] of a prescribed motion at the rigid state `st`, coordinates `q`, multipliers
-    /// `lam` and the rows' u gradients `axial`.
-    pub(crate) fn eq33(&self, i: usize, st: &RigidState, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]) -> f64 {
-        self.mpp_mpa[i] * (st.s[i].d2 - self.gravity_along[i]) + self.sleeve_push(i, st, q, lam, axial)
-    }
-
-    /// `e_xi . u_i` [-]: beam i's axis at the rigid state `st` along its slider's rail (Eq. F12).
-    pub(crate) fn along_rail(&self, i: usize, st: &RigidState) -> f64 {
-        let (ex, d) = (st.e_x(i), self.weld.rails[i]);
-        ex[0] * d[0] + ex[1] * d[1]
     }
 
     /// Record the state at `stop`: a snapshot of the deformed star and/or an output row (with
@@ -198,16 +219,16 @@ impl Recorder {
             use crate::system::pick;
             let w_g = [0, 1, 2].map(|i| beam_val(i, pick::<Vec<f64>>(&self.phi0, i)));
             let w_tip = [0, 1, 2].map(|i| beam_val(i, pick::<Vec<f64>>(&self.phil, i)));
-            let fa = fa.unwrap_or_else(|| [0, 1, 2].map(|i| self.eq33(i, st, q, lam, axial)));
+            let fa = fa.unwrap_or_else(|| [0, 1, 2].map(|i| self.force.eq33(i, st, q, lam, axial)));
             self.resp.push(st.t, w_g, w_tip, fa);
             if let Some(s) = &mut self.sensors {
                 s.record(st, (nm, nb), [q, v, qdd], fa);
             }
-            let dg = self.weld.dg(w_g, [0, 1, 2].map(|i| st.e_w(i)));
+            let dg = self.force.weld.dg(w_g, [0, 1, 2].map(|i| st.e_w(i)));
             for k in 0..self.extra.len() {
                 let val = match k {
-                    4 => -self.lam_of(lam, 3) - self.lam_of(lam, 5),
-                    0..=18 => self.lam_of(lam, k),
+                    4 => -self.force.lam_of(lam, 3) - self.force.lam_of(lam, 5),
+                    0..=18 => self.force.lam_of(lam, k),
                     19..=21 => q[(k - 19) * nb + nm + 1],
                     22..=24 => q[(k - 22) * nb + nm],
                     _ => dg[k - 25],

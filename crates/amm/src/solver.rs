@@ -760,8 +760,8 @@ fn prescribed_rails_power(law: &Friction, st: &RigidState) -> f64 {
 fn friction_fa(rec: &Recorder, sys: &System, st: &RigidState, q: &[f64], qdd: &[f64], law: &Friction) -> [f64; 3] {
     let ff = stick_slip::sleeve_forces(sys, qdd);
     [0, 1, 2].map(|i| {
-        rec.eq33(i, st, q, &sys.lam, sys.sleeves.axial())
-            + ff[i] * rec.along_rail(i, st)
+        rec.force.eq33(i, st, q, &sys.lam, sys.sleeves.axial())
+            + ff[i] * rec.force.along_rail(i, st)
             + stick_slip::rail_force(&law.rail(i), st.s[i].d1)
     })
 }

@@ -32,6 +32,7 @@ use crate::foreshortening::{Foreshortening, KEPT_ANALYTIC};
 use crate::friction::SleeveFriction;
 use crate::geometric::{self, GeometricStiffness};
 use crate::modes::{dot, ModeSet};
+use crate::sleeve::near::SleevesNear;
 use crate::sleeve::{SleeveRow, Sleeves, B_MID, B_MSLOPE, SLEEVE_ROWS};
 use crate::third_order::{self, ThirdOrderTerms};
 use flexstar_numerics::vector::dots;
@@ -1185,6 +1186,34 @@ impl System {
         }
         self.factor_s(bp, gp, st.theta.d1, st.theta.d2);
         Ok(())
+    }
+
+    /// [`System::prepare_rows`] with the sleeve rows to first order about the values a step's
+    /// system kept (`sleeve::near`, [`System::linearise_sleeves`]): the tangent's probe.
+    pub(crate) fn prepare_rows_near(
+        &mut self,
+        st: &RigidState,
+        (bp, gp): (f64, f64),
+        qhat: &[f64],
+        near: &SleevesNear,
+    ) -> Result<(), AmmError> {
+        let xp = [st.xp[0].v, st.xp[1].v, st.xp[2].v];
+        self.sleeves.update_near(&mut self.beams, &self.rows, xp, qhat, near);
+        self.sleeves.on_beams(st.t)?;
+        self.factor_s(bp, gp, st.theta.d1, st.theta.d2);
+        Ok(())
+    }
+
+    /// Keep each step's sleeve values for a tangent's probe (`sleeve::near`).
+    pub(crate) fn keep_sleeve_values(&mut self) {
+        self.sleeves.keep_values(self.nm);
+    }
+
+    /// The derivatives in the material points of the sleeve values `base` kept at its step
+    /// about the predictor `qhat`, evaluated on this system (a probe) as workspace.
+    pub(crate) fn linearise_sleeves(&mut self, base: &mut System, qhat: &[f64]) {
+        let modes: [&ModeSet; 3] = std::array::from_fn(|i| &pick(&self.bm, i).modes);
+        self.sleeves.linearise(&mut self.beams, modes, &mut base.sleeves, qhat);
     }
 
     /// The payload's Woodbury correction of beam 1's block of the Schur complement (module docs of

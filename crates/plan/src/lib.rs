@@ -10,7 +10,8 @@
 //! - [`family`]: the motions searched (a clamped quintic spline through interior via points);
 //! - [`limits`]: slider peaks, the shortest move the limits allow, the refusals of 4.8;
 //! - [`objective`]: one evaluation (an AMM run over the move and a residual window);
-//! - [`lm`]: the Levenberg-Marquardt search;
+//! - [`lm`]: the Levenberg-Marquardt search; [`slopes`]: its Jacobian, from the tangent-linear
+//!   AMM where it applies;
 //! - [`planner`]: the residual objective; [`time`]: the time objective;
 //! - [`cycle`], [`cycle_plan`]: whole cycles (4.12), planned move by move;
 //! - [`uncertainty`], [`robust`], [`minimax`]: `[robust]`, the plan that holds over an
@@ -31,6 +32,7 @@ pub mod planner;
 pub mod qp;
 pub mod robust;
 pub mod section;
+pub mod slopes;
 pub mod time;
 pub mod uncertainty;
 

@@ -1,6 +1,7 @@
 //! Levenberg-Marquardt on the residual vector of an evaluation (`docs/motions.md` 4.5): the
-//! Jacobian by forward differences, its columns evaluated in parallel, optionally on a cheaper
-//! model than the one that judges the iterates (4.9, "The Jacobian's step"). With limits, each damped
+//! Jacobian by forward differences, its columns evaluated in parallel, or given by the caller
+//! (the tangent-linear AMM on a cheaper model than the one that judges the iterates: 4.9, "The
+//! Jacobian's step" and "The Jacobian from the tangent"). With limits, each damped
 //! step is a small quadratic program: the Gauss-Newton model of `|r|^2` minimised within the
 //! limits linearised at the iterate ([`crate::qp`]). A trial step that breaks a limit, leaves the
 //! workspace or does not lower `|r|` is rejected and the damping raised, so that every accepted
@@ -71,8 +72,9 @@ pub struct Solution {
 }
 
 /// Minimise `|r(x)|^2` from `x0` (whose evaluation `e0` must be feasible); `accept` tells a
-/// trial within the limits. `slope`: the model whose runs give the Jacobian (`docs/motions.md`
-/// 4.9, "The Jacobian's step"); `None`, `f` itself. Every iterate and trial is judged by `f`.
+/// trial within the limits. `slope`: the Jacobian at a point and the runs it took
+/// (`docs/motions.md` 4.9, "The Jacobian's step"); `None`, forward differences of `f` itself.
+/// Every iterate and trial is judged by `f`.
 pub fn minimise<F, G, A>(
     f: &F,
     slope: Option<&G>,
@@ -83,7 +85,7 @@ pub fn minimise<F, G, A>(
 ) -> Result<Solution, Rejected>
 where
     F: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
-    G: Fn(&[f64]) -> Result<Eval, Rejected> + Sync,
+    G: Fn(&[f64]) -> Result<(Jacobian, usize), Rejected>,
     A: Fn(&Eval) -> bool,
 {
     let start = Instant::now();
@@ -97,7 +99,7 @@ where
         }
         // a slope model that cannot run a column (a run that fails at its step) gives way to
         // the search's own model
-        let (jac, runs) = match slope.map(|g| jacobian(g, &s.x, None)) {
+        let (jac, runs) = match slope.map(|g| g(&s.x)) {
             Some(Ok(done)) => done,
             _ => jacobian(f, &s.x, Some(&s.eval))?,
         };
@@ -269,6 +271,14 @@ pub struct Jacobian {
     pub progress: Mat<f64>,
 }
 
+/// The forward-difference step of variable `x` (4.5).
+pub(crate) fn difference_step(x: f64) -> f64 {
+    FD_STEP * x.abs().max(1.0)
+}
+
+/// One column's point: the evaluation at `x + sign h e_j`, the sign and `h`.
+pub(crate) type Point = (Eval, f64, f64);
+
 /// The Jacobians of `r` and of the usage at `x` by forward differences of `f` (a backward
 /// difference where the forward point is rejected), the columns in parallel. `base`: `f`'s
 /// evaluation at `x` when known; `None` runs it beside the columns. Returns the Jacobian and the
@@ -280,13 +290,13 @@ where
     let n = x.len();
     let extra = usize::from(base.is_none());
     // item j < n: the column's point and the difference's sign; item n: the base point
-    let points: Vec<Result<(Eval, f64, f64), Rejected>> = (0..n + extra)
+    let points: Vec<Result<Point, Rejected>> = (0..n + extra)
         .into_par_iter()
         .map(|j| {
             if j == n {
                 return f(x).map(|e| (e, 0.0, 0.0));
             }
-            let h = FD_STEP * x[j].abs().max(1.0);
+            let h = difference_step(x[j]);
             let at = |sign: f64| {
                 let mut xp = x.to_vec();
                 xp[j] += sign * h;
@@ -301,6 +311,12 @@ where
     let mut points = points.into_iter().collect::<Result<Vec<_>, _>>()?;
     let own_base = (extra == 1).then(|| points.pop().map(|(e, _, _)| e)).flatten();
     let e0 = own_base.as_ref().or(base).expect("the base evaluation is given or run");
+    Ok((assemble(e0, &points), n + extra))
+}
+
+/// The Jacobian whose column j is the difference of `points[j]` from the base evaluation `e0`
+/// over its signed step.
+pub(crate) fn assemble(e0: &Eval, points: &[Point]) -> Jacobian {
     let rows0: Vec<f64> = e0.r.iter().chain(&e0.usage).chain(&e0.progress).copied().collect();
     let columns: Vec<Vec<f64>> = points
         .iter()
@@ -310,12 +326,11 @@ where
         })
         .collect();
     let (nr, nu) = (e0.r.len(), e0.usage.len());
-    let jac = Jacobian {
-        r: Mat::from_fn(nr, n, |i, j| columns[j][i]),
-        usage: Mat::from_fn(nu, n, |i, j| columns[j][nr + i]),
-        progress: Mat::from_fn(e0.progress.len(), n, |i, j| columns[j][nr + nu + i]),
-    };
-    Ok((jac, n + extra))
+    Jacobian {
+        r: Mat::from_fn(nr, points.len(), |i, j| columns[j][i]),
+        usage: Mat::from_fn(nu, points.len(), |i, j| columns[j][nr + i]),
+        progress: Mat::from_fn(e0.progress.len(), points.len(), |i, j| columns[j][nr + nu + i]),
+    }
 }
 
 /// `J^T J` and `J^T r`.
@@ -354,7 +369,7 @@ mod tests {
             r_floor: 1e-10,
             deadline: Instant::now() + std::time::Duration::from_secs(10),
         };
-        let slope = slope.map(|g| move |x: &[f64]| g(x));
+        let slope = slope.map(|g| move |x: &[f64]| jacobian(&|y: &[f64]| g(y), x, None));
         let s = minimise(&f, slope.as_ref(), &|_: &Eval| true, x0, e0, stop).unwrap();
         assert!(
             (s.x[0] - 1.0).abs() < 1e-6 && (s.x[1] - 1.0).abs() < 1e-6,
@@ -399,7 +414,15 @@ mod tests {
             deadline: Instant::now() + std::time::Duration::from_secs(10),
         };
         let accept = |e: &Eval| e.within(&crate::section::Limits::default());
-        let s = minimise(&f, None::<&fn(&[f64]) -> Result<Eval, Rejected>>, &accept, x0, e0, stop).unwrap();
+        let s = minimise(
+            &f,
+            None::<&fn(&[f64]) -> Result<(Jacobian, usize), Rejected>>,
+            &accept,
+            x0,
+            e0,
+            stop,
+        )
+        .unwrap();
         assert!(
             (s.x[0] - 1.5).abs() < 1e-4 && (s.x[1] - 0.5).abs() < 1e-4,
             "{:?}: {}",
@@ -432,7 +455,7 @@ mod tests {
         };
         let s = minimise(
             &f,
-            None::<&fn(&[f64]) -> Result<Eval, Rejected>>,
+            None::<&fn(&[f64]) -> Result<(Jacobian, usize), Rejected>>,
             &|_: &Eval| true,
             x0,
             e0,

@@ -13,8 +13,9 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
+use flexstar_kinematics::CheckedMotion;
 use flexstar_metrics::residual::dg_magnitude;
-use flexstar_model::{AmmSettings, Experiment, Response, Trajectory};
+use flexstar_model::{AmmSettings, Experiment, Problem, Response, Trajectory};
 
 use crate::family::Family;
 use crate::limits::{slider_samples, KinematicPeaks, Peak};
@@ -221,13 +222,7 @@ impl Evaluator {
 
     /// The AMM run of `traj` up to `t_end` [s] (feasibility checked first over that span).
     pub fn run(&self, traj: &Trajectory, t_end: f64) -> Result<Response, Rejected> {
-        let mut exp = self.exp.clone();
-        exp.trajectory = traj.clone();
-        exp.time.t_end = t_end;
-        let step = flexstar_kinematics::preflight_step(exp.time.dt_out);
-        let checked = flexstar_kinematics::check_motion(&exp.robot, traj, t_end, step)
-            .map_err(|e| Rejected::Infeasible(format!("t = {:.4} s: {}", e.t, e.violation)))?;
-        let problem = exp.problem().map_err(|e| Rejected::Infeasible(e.detail()))?;
+        let (problem, checked) = self.checked(traj, t_end)?;
         self.runs.fetch_add(1, Ordering::Relaxed);
         let r = flexstar_amm::solve(
             &problem,
@@ -236,10 +231,80 @@ impl Evaluator {
         )
         .map(|s| s.response)
         .map_err(|e| Rejected::Solver(e.to_string()))?;
-        if let Some(v) = flexstar_metrics::small_deflection_check(&r, &exp.robot) {
-            return Err(Rejected::Solver(format!("outside the small-deflection range: {v}")));
+        self.small_deflections(r)
+    }
+
+    /// The problem of `traj` up to `t_end` [s] and the proof of its feasibility over that span.
+    fn checked(&self, traj: &Trajectory, t_end: f64) -> Result<(Problem, CheckedMotion), Rejected> {
+        let mut exp = self.exp.clone();
+        exp.trajectory = traj.clone();
+        exp.time.t_end = t_end;
+        let step = flexstar_kinematics::preflight_step(exp.time.dt_out);
+        let checked = flexstar_kinematics::check_motion(&exp.robot, traj, t_end, step)
+            .map_err(|e| Rejected::Infeasible(format!("t = {:.4} s: {}", e.t, e.violation)))?;
+        let problem = exp.problem().map_err(|e| Rejected::Infeasible(e.detail()))?;
+        Ok((problem, checked))
+    }
+
+    /// `r`, refused outside the small-deflection range.
+    fn small_deflections(&self, r: Response) -> Result<Response, Rejected> {
+        match flexstar_metrics::small_deflection_check(&r, &self.exp.robot) {
+            Some(v) => Err(Rejected::Solver(format!("outside the small-deflection range: {v}"))),
+            None => Ok(r),
         }
-        Ok(r)
+    }
+
+    /// Whether [`Evaluator::eval_with_tangents`] covers this evaluator: the tangent-linear AMM
+    /// covers its experiment (`flexstar_amm::sensitivities_cover`: no friction, payload, load
+    /// or gravity).
+    pub fn tangent_covers(&self) -> bool {
+        self.exp
+            .problem()
+            .is_ok_and(|p| flexstar_amm::sensitivities_cover(&p, &self.settings).is_ok())
+    }
+
+    /// [`Evaluator::eval`] of `traj` and of each `moved[k] = (trajectory, h_k)` to first order
+    /// in `h_k` (`docs/motions.md` 4.9, "The Jacobian from the tangent"): one AMM run of `traj`
+    /// with the derivatives of its elastic outputs along each moved motion
+    /// (`flexstar_amm::solve_with_sensitivities`, `docs/amm.md` 2.2), and each moved motion's
+    /// evaluation from that run's outputs moved by `h_k` times their derivatives, its kinematic
+    /// rows (usage, progress, smoothness) from its own trajectory. The moved evaluations' G and
+    /// tips rows are then the base's plus `h_k` times their exact derivatives. Not with a force
+    /// limit ([`Evaluator::tangent_covers`]).
+    pub fn eval_with_tangents(
+        &self,
+        traj: &Trajectory,
+        moved: &[(Trajectory, f64)],
+        t_rest: f64,
+        knots: &[f64],
+    ) -> Result<(Eval, Vec<Eval>), Rejected> {
+        let t_end = t_rest + self.window;
+        let (problem, _) = self.checked(traj, t_end)?;
+        let problems: Vec<Problem> = moved
+            .iter()
+            .map(|(m, _)| self.checked(m, t_end).map(|(p, _)| p))
+            .collect::<Result<_, _>>()?;
+        let steps: Vec<f64> = moved.iter().map(|(_, h)| *h).collect();
+        self.runs.fetch_add(1, Ordering::Relaxed);
+        let sens = flexstar_amm::solve_with_sensitivities(&problem, &self.settings, &problems, &steps)
+            .map_err(|e| Rejected::Solver(e.to_string()))?;
+        let resp = self.small_deflections(sens.response)?;
+        let base = self.assess(&resp, traj, t_rest, knots)?;
+        let evals = moved
+            .iter()
+            .enumerate()
+            .map(|(k, (m, h))| {
+                let mut linear = resp.clone();
+                for i in 0..3 {
+                    let along = |w: &mut Vec<f64>, d: &[f64]| w.iter_mut().zip(d).for_each(|(w, d)| *w += h * d);
+                    along(&mut linear.w_g[i], &sens.w_g[k][i]);
+                    along(&mut linear.w_tip[i], &sens.w_tip[k][i]);
+                    along(&mut linear.fa[i], &sens.fa[k][i]);
+                }
+                self.assess(&linear, m, t_rest, knots)
+            })
+            .collect::<Result<_, _>>()?;
+        Ok((base, evals))
     }
 
     /// Evaluate a motion that rests from `t_rest` [s]: the run over the move and the window,

@@ -14,6 +14,7 @@ use crate::limits::{check_quintic_kinematics, check_t_move, kinematic_peaks, qui
 use crate::lm::{minimise, Stop, TraceRow};
 use crate::objective::{Eval, Evaluator, SmoothRef, Terms};
 use crate::section::{Limits, Objective, PlanConfig};
+use crate::slopes::Slopes;
 use crate::uncertainty::RobustDuration;
 use crate::PlanError;
 
@@ -385,8 +386,8 @@ pub(crate) fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Exper
     let bounds = effective_bounds(&cfg.limits, cfg.plan.peak_factor(), &plain);
     let ev = search_evaluator(cfg, s, bounds, &plain, stop.r_floor);
     let f = |x: &[f64]| evaluate(&ev, &s.family, x, t_move);
-    let slopes = ev.for_slopes();
-    let g = |x: &[f64]| evaluate(slopes.as_ref().unwrap_or(&ev), &s.family, x, t_move);
+    let slopes = Slopes::for_search(&ev, &s.family, t_move);
+    let g = slopes.as_ref().map(|sl| move |x: &[f64]| sl.jacobian(x));
     let accept = |e: &Eval| e.within(&bounds);
     let e0 = ev.assess(&run0, &traj0, t_rest, &knots).map_err(quintic_error)?;
     if !accept(&e0) {
@@ -395,8 +396,7 @@ pub(crate) fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Exper
             e0.broken(&bounds).join(", ")
         )));
     }
-    let sol = minimise(&f, slopes.is_some().then_some(&g), &accept, x0, e0, stop)
-        .map_err(|e| PlanError::Solver(e.to_string()))?;
+    let sol = minimise(&f, g.as_ref(), &accept, x0, e0, stop).map_err(|e| PlanError::Solver(e.to_string()))?;
     let peaks = PeakComparison {
         plain: PeakSet::of(&plain),
         planned: PeakSet::of(&sol.eval),

@@ -18,6 +18,7 @@ use crate::planner::{
     Setup,
 };
 use crate::section::{Objective, PlanConfig};
+use crate::slopes::Slopes;
 use crate::PlanError;
 
 /// Bisection steps of each search (3 % of the bracket).
@@ -189,8 +190,8 @@ fn search_at(cfg: &PlanConfig, s: &Setup, t_move: f64, x0: &[f64], r_max: f64) -
     let deadline = s.started + Duration::from_secs_f64(cfg.plan.budget());
     let stop = Stop { r_floor, deadline };
     let f = |x: &[f64]| evaluate(&ev, &s.family, x, t_move);
-    let slopes = ev.for_slopes();
-    let g = |x: &[f64]| evaluate(slopes.as_ref().unwrap_or(&ev), &s.family, x, t_move);
+    let slopes = Slopes::for_search(&ev, &s.family, t_move);
+    let g = slopes.as_ref().map(|sl| move |x: &[f64]| sl.jacobian(x));
     let accept = |e: &Eval| e.within(&bounds);
     // a warm start that fails at this duration (a run fails, or it is outside this duration's
     // limits) falls back on the plain quintic
@@ -205,7 +206,7 @@ fn search_at(cfg: &PlanConfig, s: &Setup, t_move: f64, x0: &[f64], r_max: f64) -
     if !accept(&e0) {
         return None;
     }
-    let sol = minimise(&f, slopes.is_some().then_some(&g), &accept, x0, e0, stop).ok()?;
+    let sol = minimise(&f, g.as_ref(), &accept, x0, e0, stop).ok()?;
     let traj = s.family.trajectory(&sol.x, t_move);
     let run = s.evaluator.run(&traj, cfg.exp.time.t_end).ok()?;
     let peak = window_peak(&run, cfg.plan.t0 + t_move);

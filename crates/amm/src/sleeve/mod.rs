@@ -29,6 +29,7 @@
 //! F13), and a stuck sleeve a row of its own (`system::Row::Stick`, Eq. F16).
 
 mod compliance;
+pub(crate) mod near;
 pub(crate) mod rows;
 mod shift;
 
@@ -86,6 +87,9 @@ pub(crate) struct Sleeves {
     xc: [f64; 3],
     /// The beams' lengths L_i [m].
     lengths: [f64; 3],
+    /// The mode values of each update kept for the tangent's probe ([`Sleeves::keep_values`]);
+    /// `None` in a plain run.
+    kept: Option<Box<near::SleevesNear>>,
 }
 
 impl Sleeves {
@@ -119,6 +123,7 @@ impl Sleeves {
             axial: [[0.0; 3]; 3],
             xc: [0.0; 3],
             lengths: std::array::from_fn(|i| params[i].l),
+            kept: None,
         }
     }
 
@@ -179,11 +184,32 @@ impl Sleeves {
         qhat: &[f64],
     ) {
         let nm = modes[0].len();
+        let shifts = self.place(xp, qhat, nm);
+        self.evaluate_modes(beams, modes, self.xc, qhat);
+        if let Some(kept) = self.kept.as_mut() {
+            kept.keep(beams, &self.bent, self.xc, qhat, nm);
+        }
+        self.finish(beams, rows, qhat, shifts, None);
+    }
+
+    /// Keep each update's mode values at the material points (`near::SleevesNear`), for the
+    /// tangent's linearised sleeve rows ([`Sleeves::update_near`]).
+    pub(crate) fn keep_values(&mut self, nm: usize) {
+        self.kept = Some(Box::new(near::SleevesNear::new(nm)));
+    }
+
+    /// The values kept at the last update ([`Sleeves::keep_values`]).
+    pub(crate) fn kept(&self) -> Option<&near::SleevesNear> {
+        self.kept.as_deref()
+    }
+
+    /// The material point in each sleeve (Eq. S1) about the predictor `qhat` and its
+    /// foreshortening shift: sets `xp`, `f`, `xc`; returns the shifts [m].
+    fn place(&mut self, xp: [f64; 3], qhat: &[f64], nm: usize) -> [f64; 3] {
         let nb = nm + 2;
         let full = self.full;
         self.xp = xp;
         let alpha = |i: usize| &qhat[i * nb..i * nb + nm];
-        // the material point in each sleeve (Eq. S1) and its foreshortening shift
         let mut shifts = [0.0; 3];
         for (i, (sh, &x)) in shifts.iter_mut().zip(&xp).enumerate() {
             let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
@@ -193,12 +219,27 @@ impl Sleeves {
             });
         }
         self.f = shifts;
-        let xc: [f64; 3] = std::array::from_fn(|i| {
+        self.xc = std::array::from_fn(|i| {
             let u_hat = if full { qhat[i * nb + nm] } else { 0.0 };
             xp[i] - u_hat + shifts[i]
         });
-        self.xc = xc;
-        // the modes at the sleeve points: the three beams at once on a shared set (full model)
+        shifts
+    }
+
+    /// The modes at the sleeve points about the material points `xc` [m]: each beam's vectors
+    /// `[mid, right, left, slope]` (the slope not yet negated) and, in the full model, its
+    /// bending sums with the coordinates of `qhat`; the three beams at once on a shared set.
+    pub(super) fn evaluate_modes(
+        &mut self,
+        beams: &mut [BeamRows; 3],
+        modes: [&ModeSet; 3],
+        xc: [f64; 3],
+        qhat: &[f64],
+    ) {
+        let nm = modes[0].len();
+        let nb = nm + 2;
+        let full = self.full;
+        let alpha = |i: usize| &qhat[i * nb..i * nb + nm];
         let together = full && self.tri.len() == 1;
         if together {
             let out = beams.each_mut().map(|b| {
@@ -208,15 +249,44 @@ impl Sleeves {
             let bent = self.bent.each_mut().map(|bn| &mut *bn);
             let [b0, b1, b2] = bent;
             modes[0].triplets_at3(&self.tri[0], xc, out, [(alpha(0), b0), (alpha(1), b1), (alpha(2), b2)]);
+            return;
         }
         for (i, beam) in beams.iter_mut().enumerate() {
-            let (alpha, shift, xc) = (alpha(i), shifts[i], xc[i]);
             let [mid, right, left, mslope] = &mut beam.sleeve;
             let bent = &mut self.bent[i];
             let tri = pick(&self.tri, i);
-            if !together {
-                modes[i].triplet_at(tri, xc, left, mid, right, mslope, full.then_some((alpha, &mut *bent)));
-            }
+            modes[i].triplet_at(
+                tri,
+                xc[i],
+                left,
+                mid,
+                right,
+                mslope,
+                full.then_some((alpha(i), &mut *bent)),
+            );
+        }
+    }
+
+    /// The rows' coefficients from the modes at the material points ([`Sleeves::evaluate_modes`]):
+    /// the u gradients and the forces' axial directions, the slope row's sign, the truncation
+    /// flexibility block (Eq. R3; `res`: given, linearised, instead of evaluated) and the
+    /// foreshortening's terms (Eqs. S3-S5).
+    pub(super) fn finish(
+        &mut self,
+        beams: &mut [BeamRows; 3],
+        rows: &[Row],
+        qhat: &[f64],
+        shifts: [f64; 3],
+        res: Option<&[[[f64; 4]; 4]; 3]>,
+    ) {
+        let nm = beams[0].sleeve[0].len();
+        let nb = nm + 2;
+        let full = self.full;
+        for (i, beam) in beams.iter_mut().enumerate() {
+            let (alpha, shift, xc) = (&qhat[i * nb..i * nb + nm], shifts[i], self.xc[i]);
+            let [mid, right, left, mslope] = &mut beam.sleeve;
+            let bent = &mut self.bent[i];
+            let tri = pick(&self.tri, i);
             if full {
                 let slope_mid = dot(mslope, alpha);
                 let slopes = [slope_mid, bent.slope_right, bent.slope_left];
@@ -230,7 +300,10 @@ impl Sleeves {
             mslope.iter_mut().for_each(|v| *v = -*v);
             if let Some(c) = self.compliance.as_mut() {
                 let n = c.len();
-                self.res[i] = c[i.min(n - 1)].block(xc, [mid, right, left, mslope]);
+                self.res[i] = match res {
+                    Some(r) => r[i],
+                    None => c[i.min(n - 1)].block(xc, [mid, right, left, mslope]),
+                };
             }
             if let Some(s) = self.shift.as_ref() {
                 let s = pick(s, i);
@@ -246,6 +319,20 @@ impl Sleeves {
                 rows::shift_rows(beam, rows, terms);
             }
         }
+    }
+
+    /// The truncation flexibility block of beam i (Eq. R3) at the material point `xc` [m] with
+    /// the basis vectors `v` (`[mid, right, left, -slope]`); `None` without it.
+    pub(super) fn compliance_block(&mut self, i: usize, xc: f64, v: [&[f64]; 4]) -> Option<[[f64; 4]; 4]> {
+        self.compliance.as_mut().map(|c| {
+            let n = c.len();
+            c[i.min(n - 1)].block(xc, v)
+        })
+    }
+
+    /// Whether the rows carry the full model's bending sums.
+    pub(super) fn is_full(&self) -> bool {
+        self.full
     }
 
     /// The sleeve rows of Eqs. 41-42 evaluated exactly at the state q, for tests, with the

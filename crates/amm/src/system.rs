@@ -341,6 +341,10 @@ pub(crate) struct BeamModel {
     /// The junction vectors' Gram entries `[g00, g01, g11]` and `[w0, w1]` of the step.
     jgram: [f64; 3],
     jw: [f64; 2],
+    /// The inputs of the last [`BeamModel::factor`] (bits of `bp, gp, th', th'', alpha, beta`
+    /// and the drag), on which alone its data depend: a call with the same ones keeps them
+    /// (a rigid rate that stays, as at rest, or every direction of a tangent at one state).
+    factored_for: Option<[u64; 7]>,
 }
 
 impl BeamModel {
@@ -373,6 +377,7 @@ impl BeamModel {
             scaled0: [vec![0.0; nm], vec![0.0; nm]],
             jgram: [0.0; 3],
             jw: [0.0; 2],
+            factored_for: None,
             modes,
         }
     }
@@ -381,6 +386,11 @@ impl BeamModel {
     /// acceleration th'', mass-proportional `alpha` [1/s] and Kelvin-Voigt `beta` [s], and the
     /// junction vectors' Gram entries.
     fn factor(&mut self, bp: f64, gp: f64, thd: f64, thdd: f64, alpha: f64, beta: f64) {
+        let key = [bp, gp, thd, thdd, alpha, beta, self.u_drag].map(f64::to_bits);
+        if self.factored_for == Some(key) {
+            return;
+        }
+        self.factored_for = Some(key);
         let rho = self.rho;
         self.p = rho * (2.0 * gp * thd + bp * thdd);
         // Eq. D19: the mass-proportional damping alpha M scales M in S by 1 + gamma' alpha

@@ -253,23 +253,21 @@ impl<'a> Tangent<'a> {
         for (k, dir) in self.dirs.iter_mut().enumerate() {
             let eps = self.eps[k];
             let inv_eps = 1.0 / eps;
-            // the tangent predictor (Eq. T-4), then the moved inputs
-            let state = dir
-                .dq
-                .iter_mut()
-                .zip(dir.dv.iter_mut())
-                .zip(dir.dacc.iter().zip(&dir.dqdd));
-            let moved = self.da.iter_mut().zip(self.qhat.iter_mut().zip(self.vhat.iter_mut()));
-            let base = qhat.iter().zip(vhat);
-            for (((q, v), (&a, &d)), ((pa, (mq, mv)), (&bq, &bv))) in state.zip(moved.zip(base)) {
-                let x = [*q, *v, a, d];
+            // the tangent predictor (Eq. T-4), then the moved inputs; slices of one length, so
+            // that the loop runs in the processor's lanes
+            let n = dir.dq.len();
+            let (dq, dv, dacc, dqdd) = (&mut dir.dq[..n], &mut dir.dv[..n], &dir.dacc[..n], &dir.dqdd[..n]);
+            let (pa, mq, mv) = (&mut self.da[..n], &mut self.qhat[..n], &mut self.vhat[..n]);
+            let (bq, bv) = (&qhat[..n], &vhat[..n]);
+            for j in 0..n {
+                let x = [dq[j], dv[j], dacc[j], dqdd[j]];
                 let comb = |w: [f64; 4]| w[0] * x[0] + w[1] * x[1] + w[2] * x[2] + w[3] * x[3];
                 let (na, nq, nv) = (comb(ca), comb(cq), comb(cv));
-                *pa = na;
-                *mq = bq + eps * nq;
-                *mv = bv + eps * nv;
-                *q = nq;
-                *v = nv;
+                pa[j] = na;
+                mq[j] = bq[j] + eps * nq;
+                mv[j] = bv[j] + eps * nv;
+                dq[j] = nq;
+                dv[j] = nv;
             }
             for ((l, p), d) in self.lagged.iter_mut().zip(&self.qdd_prev).zip(&dir.dqdd) {
                 *l = p + eps * d;

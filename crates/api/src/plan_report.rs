@@ -165,14 +165,14 @@ fn search_text(p: &flexstar_plan::Planned) -> String {
     let mut s = format!(
         "The accurate AMM (N = {} per beam, frozen) judged each candidate by the RMS of |dG| over a window of {:.3} s \
          (two periods of the first mode at the final pose, {:.3} Hz) after the move: {:.3e} m for the plain quintic, \
-         {:.3e} m planned ({:.1} % of it), after {} evaluations in {:.2} s; stop: {}.\n\n",
+         {:.3e} m planned ({:.1} % of it), after {} in {:.2} s; stop: {}.\n\n",
         p.modes,
         p.window_s,
         p.f1_hz,
         p.plain.norm_g(),
         p.eval.norm_g(),
         100.0 * p.eval.norm_g() / p.plain.norm_g(),
-        p.evaluations,
+        p.evaluations_text(),
         p.wall_s,
         p.reason
     );

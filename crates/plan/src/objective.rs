@@ -165,6 +165,8 @@ pub struct Evaluator {
     terms: Terms,
     /// AMM runs made by this evaluator and its copies (shared).
     runs: Arc<AtomicUsize>,
+    /// The directions the tangent carried in those runs (shared).
+    directions: Arc<AtomicUsize>,
 }
 
 impl Evaluator {
@@ -187,6 +189,7 @@ impl Evaluator {
             limits: Limits::default(),
             terms: Terms::default(),
             runs: Arc::new(AtomicUsize::new(0)),
+            directions: Arc::new(AtomicUsize::new(0)),
         }
     }
 
@@ -218,6 +221,12 @@ impl Evaluator {
     /// AMM runs made so far by this evaluator and every copy of it.
     pub fn runs(&self) -> usize {
         self.runs.load(Ordering::Relaxed)
+    }
+
+    /// The directions carried so far by the tangent in those runs
+    /// ([`Evaluator::eval_with_tangents`]): each costs about 0.7 of a run (`docs/amm.md` 2.2).
+    pub fn tangent_directions(&self) -> usize {
+        self.directions.load(Ordering::Relaxed)
     }
 
     /// The AMM run of `traj` up to `t_end` [s] (feasibility checked first over that span).
@@ -286,6 +295,7 @@ impl Evaluator {
             .collect::<Result<_, _>>()?;
         let steps: Vec<f64> = moved.iter().map(|(_, h)| *h).collect();
         self.runs.fetch_add(1, Ordering::Relaxed);
+        self.directions.fetch_add(moved.len(), Ordering::Relaxed);
         let sens = flexstar_amm::solve_with_sensitivities(&problem, &self.settings, &problems, &steps)
             .map_err(|e| Rejected::Solver(e.to_string()))?;
         let resp = self.small_deflections(sens.response)?;

@@ -72,6 +72,10 @@ pub struct Planned {
     /// quintic, for `objective = "time"` the ZVD baseline's runs and the checks over the span);
     /// not the one run that chose N.
     pub evaluations: usize,
+    /// The directions carried by those of the runs that took the search's Jacobian by the
+    /// tangent-linear AMM (`docs/motions.md` 4.9, "The Jacobian from the tangent"); 0 where the
+    /// Jacobians were forward differences.
+    pub tangent_directions: usize,
     /// Why the search stopped.
     pub reason: String,
     pub wall_s: f64,
@@ -177,6 +181,17 @@ pub struct Setup {
     pub modes: usize,
     pub f1_hz: f64,
     pub started: Instant,
+}
+
+impl Planned {
+    /// "`n` evaluations", with the directions the tangent carried where it took the Jacobians
+    /// (`docs/motions.md` 4.9, "The Jacobian from the tangent").
+    pub fn evaluations_text(&self) -> String {
+        match self.tangent_directions {
+            0 => format!("{} evaluations", self.evaluations),
+            d => format!("{} evaluations ({d} Jacobian columns by the tangent)", self.evaluations),
+        }
+    }
 }
 
 /// Plan the motion of `cfg` (every check of 4.8 first; nothing is written here).
@@ -422,6 +437,7 @@ pub(crate) fn plan_residual(cfg: &PlanConfig, s: &Setup, t_move: f64, zvd: Exper
         r_floor_m: stop.r_floor,
         trace: sol.trace,
         evaluations: s.evaluator.runs(),
+        tangent_directions: s.evaluator.tangent_directions(),
         reason: sol.reason,
         wall_s: s.started.elapsed().as_secs_f64(),
         time_search: None,

@@ -370,6 +370,7 @@ pub fn plan_time(cfg: &PlanConfig, s: &Setup) -> Result<Planned, PlanError> {
         r_floor_m: TIME_FLOOR_SHARE * r_max,
         trace,
         evaluations: s.evaluator.runs(),
+        tangent_directions: s.evaluator.tangent_directions(),
         reason,
         wall_s: s.started.elapsed().as_secs_f64(),
         zvd: zvd_experiment(&cfg.exp, s.family.quintic(zvd_base))?,

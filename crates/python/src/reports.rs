@@ -161,6 +161,7 @@ pub fn plan<'py>(py: Python<'py>, config: PathBuf, out: PathBuf) -> PyResult<Bou
     d.set_item("plan_csv", o.dir.join("plan.csv").display().to_string())?;
     d.set_item("t_move", o.planned.t_move)?;
     d.set_item("evaluations", o.planned.evaluations)?;
+    d.set_item("tangent_columns", o.planned.tangent_directions)?;
     d.set_item("reason", o.planned.reason.clone())?;
     d.set_item("warnings", o.planned.warnings.clone())?;
     d.set_item("residual_G_peak_m", motion_peaks(py, &o.motions)?)?;

@@ -22,12 +22,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let outcome = flexstar_api::plan::plan_to_dir(&args.config, &args.out, |p| {
         eprintln!(
             "plan: move {:.4} s; AMM RMS of |dG| over {:.3} s after the move {:.3e} m (plain quintic {:.3e} m); \
-             {} evaluations in {:.2} s ({})",
+             {} in {:.2} s ({})",
             p.t_move,
             p.window_s,
             p.eval.norm_g(),
             p.plain.norm_g(),
-            p.evaluations,
+            p.evaluations_text(),
             p.wall_s,
             p.reason
         );
@@ -101,13 +101,13 @@ fn run_cycle(args: Args) -> anyhow::Result<()> {
             let p = &m.planned;
             eprintln!(
                 "plan: move {} at {:.4} s for {:.4} s; AMM RMS of |dG| after it {:.3e} m (plain quintic {:.3e} m); \
-                 {} evaluations in {:.2} s ({})",
+                 {} in {:.2} s ({})",
                 k + 1,
                 m.span.t_start,
                 p.t_move,
                 p.eval.norm_g(),
                 p.plain.norm_g(),
-                p.evaluations,
+                p.evaluations_text(),
                 p.wall_s,
                 p.reason
             );

@@ -332,7 +332,8 @@ def plan(config: "os.PathLike[str] | str", out: "os.PathLike[str] | str" = "out"
     ``[plan]`` (and ``[limits]``) give the move; writes ``out/<name>/`` (plan.toml, plan.csv,
     plan.json, plan.md, the plain, ZVD-shaped and planned runs on the AMM and the FEM, figures).
     Returns the folder, the paths of plan.toml and plan.csv, the move time, the search's
-    evaluations and stop reason, and ``residual_G_peak_m``: for ``plain``, ``zvd`` and
+    evaluations (AMM runs), ``tangent_columns`` (the Jacobian columns the tangent-linear AMM
+    carried in them, docs/motions.md 4.9) and stop reason, and ``residual_G_peak_m``: for ``plain``, ``zvd`` and
     ``planned`` the ``(AMM, FEM)`` residual peaks of |dG| after the move [m]. A whole cycle
     (``[plan] points``, docs/motions.md 4.12) is planned as the command plans it: the dict then
     has ``moves`` (per move: ``t_start``, ``t_move``, ``evaluations``, ``reason``, ``warnings``)

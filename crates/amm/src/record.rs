@@ -96,6 +96,7 @@ impl SliderForce {
     }
 
     /// The multiplier of named column `k` (0 when the row is dropped).
+    #[inline]
     pub(crate) fn lam_of(&self, lam: &[f64], k: usize) -> f64 {
         self.col_rows[k].map_or(0.0, |r| lam[r])
     }
@@ -103,6 +104,7 @@ impl SliderForce {
     /// Eq. 33 without the slider's inertia: the component along `+u_i` of the force of sleeve i on
     /// beam i [N] ([`sleeve::rows::push`]), linear in the multipliers `lam`, with the sleeve
     /// rotation of `q` and the u gradients `axial` of the sleeve rows (-w', full model).
+    #[inline]
     pub(crate) fn sleeve_push(&self, i: usize, st: &RigidState, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]) -> f64 {
         let forces = [
             self.lam_of(lam, 7 + i),
@@ -116,6 +118,7 @@ impl SliderForce {
     /// Eq. 33 with the sleeve and slider's weight along the rail (Eq. G2): the actuator force of
     /// slider i [N] of a prescribed motion at the rigid state `st`, coordinates `q`, multipliers
     /// `lam` and the rows' u gradients `axial`.
+    #[inline]
     pub(crate) fn eq33(&self, i: usize, st: &RigidState, q: &[f64], lam: &[f64], axial: &[[f64; 3]; 3]) -> f64 {
         self.mpp_mpa[i] * (st.s[i].d2 - self.gravity_along[i]) + self.sleeve_push(i, st, q, lam, axial)
     }

@@ -168,6 +168,8 @@ struct Tangent<'a> {
     corr_l: Vec<f64>,
     q_moved: Vec<f64>,
     lam_moved: Vec<f64>,
+    nq: Vec<f64>,
+    nv: Vec<f64>,
 }
 
 impl<'a> Tangent<'a> {
@@ -212,6 +214,8 @@ impl<'a> Tangent<'a> {
             corr_l: vec![0.0; m],
             q_moved: vec![0.0; n],
             lam_moved: vec![0.0; m],
+            nq: vec![0.0; n],
+            nv: vec![0.0; n],
         }
     }
 
@@ -253,21 +257,19 @@ impl<'a> Tangent<'a> {
         for (k, dir) in self.dirs.iter_mut().enumerate() {
             let eps = self.eps[k];
             let inv_eps = 1.0 / eps;
-            // the tangent predictor (Eq. T-4), then the moved inputs; slices of one length, so
-            // that the loop runs in the processor's lanes
-            let n = dir.dq.len();
-            let (dq, dv, dacc, dqdd) = (&mut dir.dq[..n], &mut dir.dv[..n], &dir.dacc[..n], &dir.dqdd[..n]);
-            let (pa, mq, mv) = (&mut self.da[..n], &mut self.qhat[..n], &mut self.vhat[..n]);
-            let (bq, bv) = (&qhat[..n], &vhat[..n]);
-            for j in 0..n {
-                let x = [dq[j], dv[j], dacc[j], dqdd[j]];
-                let comb = |w: [f64; 4]| w[0] * x[0] + w[1] * x[1] + w[2] * x[2] + w[3] * x[3];
-                let (na, nq, nv) = (comb(ca), comb(cq), comb(cv));
-                pa[j] = na;
-                mq[j] = bq[j] + eps * nq;
-                mv[j] = bv[j] + eps * nv;
-                dq[j] = nq;
-                dv[j] = nv;
+            // the tangent predictor (Eq. T-4), then the moved inputs: each a combination of the
+            // slices (q, v, a, q'') of one length, in the processor's lanes
+            let x = [&dir.dq[..], &dir.dv[..], &dir.dacc[..], &dir.dqdd[..]];
+            combine(&mut self.da, ca, x);
+            combine(&mut self.nq, cq, x);
+            combine(&mut self.nv, cv, x);
+            dir.dq.copy_from_slice(&self.nq);
+            dir.dv.copy_from_slice(&self.nv);
+            for ((m, b), d) in self.qhat.iter_mut().zip(qhat).zip(&self.nq) {
+                *m = b + eps * d;
+            }
+            for ((m, b), d) in self.vhat.iter_mut().zip(vhat).zip(&self.nv) {
+                *m = b + eps * d;
             }
             for ((l, p), d) in self.lagged.iter_mut().zip(&self.qdd_prev).zip(&dir.dqdd) {
                 *l = p + eps * d;
@@ -289,16 +291,21 @@ impl<'a> Tangent<'a> {
             }
             sys.solve_correction(bp, (&mut self.primal, &self.rows), &mut self.corr_l, &mut self.corr_q);
             // the update (linear): q = qhat + bp q'', v = vhat + gp q'', a = a_part + apq q''
-            for j in 0..dir.dq.len() {
-                let d = self.corr_q[j] * inv_eps;
-                dir.dqdd[j] = d;
-                if h > 0.0 {
-                    dir.dq[j] += bp * d;
-                    dir.dv[j] += gp * d;
-                    dir.dacc[j] = self.da[j] + apq * d;
-                } else {
-                    dir.dacc[j] = d;
+            for (d, c) in dir.dqdd.iter_mut().zip(&self.corr_q) {
+                *d = c * inv_eps;
+            }
+            if h > 0.0 {
+                for (q, d) in dir.dq.iter_mut().zip(&dir.dqdd) {
+                    *q += bp * d;
                 }
+                for (v, d) in dir.dv.iter_mut().zip(&dir.dqdd) {
+                    *v += gp * d;
+                }
+                for ((a, p), d) in dir.dacc.iter_mut().zip(&self.da).zip(&dir.dqdd) {
+                    *a = p + apq * d;
+                }
+            } else {
+                dir.dacc.copy_from_slice(&dir.dqdd);
             }
             // the forces' tangent on an output row: Eq. 33 at the moved state less the step's own
             if let (Some(row), Some(fa0)) = (step.output, fa0) {
@@ -333,6 +340,16 @@ impl<'a> Tangent<'a> {
                 self.w_tip[k][i][row] = dot(&b.phil, a);
             }
         }
+    }
+}
+
+/// `out = w[0] x[0] + w[1] x[1] + w[2] x[2] + w[3] x[3]`, element by element (slices of one
+/// length).
+fn combine(out: &mut [f64], w: [f64; 4], x: [&[f64]; 4]) {
+    let n = out.len();
+    let [a, b, c, d] = x.map(|v| &v[..n]);
+    for j in 0..n {
+        out[j] = w[0] * a[j] + w[1] * b[j] + w[2] * c[j] + w[3] * d[j];
     }
 }
 

@@ -277,9 +277,9 @@ impl Evaluator {
     /// with the derivatives of its elastic outputs along each moved motion
     /// (`flexstar_amm::solve_with_sensitivities`, `docs/amm.md` 2.2), and each moved motion's
     /// evaluation from that run's outputs moved by `h_k` times their derivatives, its kinematic
-    /// rows (usage, progress, smoothness) from its own trajectory. The moved evaluations' G and
-    /// tips rows are then the base's plus `h_k` times their exact derivatives. Not with a force
-    /// limit ([`Evaluator::tangent_covers`]).
+    /// rows (usage, progress, smoothness) from its own trajectory. The moved evaluations' rows of
+    /// G and the tips, and their forces, are then the base's plus `h_k` times their derivatives
+    /// ([`Evaluator::tangent_covers`] says where this applies).
     pub fn eval_with_tangents(
         &self,
         traj: &Trajectory,

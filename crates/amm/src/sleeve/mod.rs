@@ -205,6 +205,7 @@ impl Sleeves {
 
     /// The material point in each sleeve (Eq. S1) about the predictor `qhat` and its
     /// foreshortening shift: sets `xp`, `f`, `xc`; returns the shifts [m].
+    #[inline]
     fn place(&mut self, xp: [f64; 3], qhat: &[f64], nm: usize) -> [f64; 3] {
         let nb = nm + 2;
         let full = self.full;
@@ -229,6 +230,7 @@ impl Sleeves {
     /// The modes at the sleeve points about the material points `xc` [m]: each beam's vectors
     /// `[mid, right, left, slope]` (the slope not yet negated) and, in the full model, its
     /// bending sums with the coordinates of `qhat`; the three beams at once on a shared set.
+    #[inline]
     pub(super) fn evaluate_modes(
         &mut self,
         beams: &mut [BeamRows; 3],
@@ -271,6 +273,7 @@ impl Sleeves {
     /// the u gradients and the forces' axial directions, the slope row's sign, the truncation
     /// flexibility block (Eq. R3; `res`: given, linearised, instead of evaluated) and the
     /// foreshortening's terms (Eqs. S3-S5).
+    #[inline]
     pub(super) fn finish(
         &mut self,
         beams: &mut [BeamRows; 3],

@@ -42,6 +42,9 @@ pub(crate) struct PayloadTerms {
     /// `C_0 S^-1 P^T` of the last prepared step: row k of beam 1's constraint rows against the
     /// three payload rows.
     pub(crate) cross: Vec<[f64; 3]>,
+    /// `S_p` of the last prepared step ([`PayloadTerms::step_matrix`]): the step's residual
+    /// holds `P^T S_p P q''` (`system::kkt`).
+    pub(crate) sp: Mat3,
 }
 
 impl PayloadTerms {
@@ -60,6 +63,7 @@ impl PayloadTerms {
             mass: [[m, 0.0, -m * oy], [0.0, m, m * ox], [-m * oy, m * ox, j_g]],
             w: [[0.0; 3]; 3],
             cross: vec![[0.0; 3]; rows],
+            sp: [[0.0; 3]; 3],
         })
     }
 
@@ -99,8 +103,8 @@ impl PayloadTerms {
     /// and `H = P S^-1 P^T`; `false` when `I + S_p H` is singular (so is beam 1's step matrix).
     /// `c_m = 1 + gp alpha` with mass-proportional damping (Eq. D19), else 1.
     pub(crate) fn set_woodbury(&mut self, x: RigidTerms, (bp, gp, c_m): (f64, f64, f64), h: &Mat3) -> bool {
-        let (d, k, _) = self.rates(x);
-        let sp = nalgebra::Matrix3::from_fn(|a, b| c_m * self.mass[a][b] + gp * d[a][b] + bp * k[a][b]);
+        self.sp = self.step_matrix(x, (bp, gp, c_m));
+        let sp = nalgebra::Matrix3::from_fn(|a, b| self.sp[a][b]);
         let hm = nalgebra::Matrix3::from_fn(|a, b| h[a][b]);
         let lhs = nalgebra::Matrix3::identity() + sp * hm;
         // nalgebra inverts a 3 x 3 in closed form (its determinant tested against zero)
@@ -111,6 +115,13 @@ impl PayloadTerms {
             }
             _ => false,
         }
+    }
+
+    /// The payload's step matrix `S_p = c_m M_p + gp D_p + bp K_p` at the rigid motion `x`
+    /// (Eqs. P2-P6; `c_m = 1 + gp alpha` with mass-proportional damping, Eq. D19, else 1).
+    pub(crate) fn step_matrix(&self, x: RigidTerms, (bp, gp, c_m): (f64, f64, f64)) -> Mat3 {
+        let (d, k, _) = self.rates(x);
+        std::array::from_fn(|a| std::array::from_fn(|b| c_m * self.mass[a][b] + gp * d[a][b] + bp * k[a][b]))
     }
 
     /// Eq. P2, the payload's mass matrix on z.

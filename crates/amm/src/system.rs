@@ -1007,7 +1007,7 @@ impl System {
     }
 
     /// `P q_1` (Eq. P1): `(u_1, phi(0) . alpha_1, phi'(0) . alpha_1)` of beam 1's block of `q`.
-    fn payload_coordinates(&self, q: &[f64]) -> [f64; 3] {
+    pub(crate) fn payload_coordinates(&self, q: &[f64]) -> [f64; 3] {
         let (nm, b) = (self.nm, &self.bm[0]);
         [q[nm], dot(&b.phi0, &q[..nm]), dot(&b.dphi0, &q[..nm])]
     }
@@ -1211,6 +1211,13 @@ impl System {
         self.sleeves.update_near(&mut self.beams, &self.rows, xp, qhat, near);
         self.sleeves.on_beams(st.t)?;
         self.factor_s(bp, gp, st.theta.d1, st.theta.d2);
+        if self.payload.is_some() {
+            let x = self.payload_motion(st);
+            let c_m = 1.0 + gp * self.alpha;
+            if let Some(pl) = self.payload.as_mut() {
+                pl.sp = pl.step_matrix(x, (bp, gp, c_m));
+            }
+        }
         Ok(())
     }
 

@@ -1,7 +1,8 @@
 //! The worst-case (or quantile) search of a robust plan (`docs/motions.md` 4.11): minimise
 //! `max_{k in S_q} |r_k(x)|` over the sample models (Eq. U1) by Gauss-Newton steps on the
-//! epigraph (Eq. U3, [`crate::qp::epigraph_step`]), each model's Jacobian by forward differences
-//! ([`crate::lm::jacobian`], on the model's slope runs of 4.9, "The Jacobian's step"), the damping and the acceptance of 4.9: a trial is accepted when
+//! epigraph (Eq. U3, [`crate::qp::epigraph_step`]), each model's Jacobian on its slope model
+//! ([`crate::slopes`]: the tangent-linear AMM where it covers the model, else forward
+//! differences; 4.9, "The Jacobian's step"), the damping and the acceptance of 4.9: a trial is accepted when
 //! every model's evaluation is within its limits and the objective falls.
 
 use std::time::Instant;
@@ -19,15 +20,12 @@ pub trait Models: Sync {
     fn count(&self) -> usize;
     fn eval(&self, k: usize, x: &[f64]) -> Result<Eval, Rejected>;
     fn accept(&self, k: usize, e: &Eval) -> bool;
-    /// Model `k`'s run for its Jacobian's columns (`docs/motions.md` 4.9, "The Jacobian's
-    /// step"), `None` when that is [`Models::eval`] itself.
-    fn slope_eval(&self, k: usize, x: &[f64]) -> Option<Result<Eval, Rejected>> {
+    /// Model `k`'s Jacobian at `x` and the runs it took, on its slope model (`docs/motions.md`
+    /// 4.9, "The Jacobian's step", "The Jacobian from the tangent"); `None` when it is forward
+    /// differences of [`Models::eval`] itself.
+    fn slope_jacobian(&self, k: usize, x: &[f64]) -> Option<Result<(Jacobian, usize), Rejected>> {
         let _ = (k, x);
         None
-    }
-    /// Whether [`Models::slope_eval`] is a model of its own (its base point then runs too).
-    fn has_slope_model(&self) -> bool {
-        false
     }
 }
 
@@ -121,9 +119,8 @@ fn jacobians<M: Models>(models: &M, x: &[f64], evals: &[Eval]) -> Result<(Vec<Ja
     let mut runs = 0;
     let mut jacs = Vec::with_capacity(models.count());
     for (k, own) in evals.iter().enumerate().take(models.count()) {
-        let slope = |y: &[f64]| models.slope_eval(k, y).unwrap_or_else(|| models.eval(k, y));
         // a slope model that cannot run a column gives way to the model itself
-        let (jac, n) = match models.has_slope_model().then(|| jacobian(&slope, x, None)) {
+        let (jac, n) = match models.slope_jacobian(k, x) {
             Some(Ok(done)) => done,
             _ => jacobian(&|y: &[f64]| models.eval(k, y), x, Some(own))?,
         };

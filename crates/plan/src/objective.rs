@@ -264,8 +264,7 @@ impl Evaluator {
     }
 
     /// Whether [`Evaluator::eval_with_tangents`] covers this evaluator: the tangent-linear AMM
-    /// covers its experiment (`flexstar_amm::sensitivities_cover`: no friction, payload, load
-    /// or gravity).
+    /// covers its experiment (`flexstar_amm::sensitivities_cover`: no friction or gravity).
     pub fn tangent_covers(&self) -> bool {
         self.exp
             .problem()

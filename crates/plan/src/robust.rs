@@ -11,11 +11,13 @@ use serde::Serialize;
 use flexstar_model::{Experiment, ModelError};
 
 use crate::family::Family;
+use crate::lm::Jacobian;
 use crate::minimax::{self, Models};
 use crate::objective::{Eval, Evaluator, Rejected, SmoothRef, Terms};
 use crate::planner::{effective_bounds, evaluate, peak_warnings, PeakComparison, PeakSet, Planned, Setup};
 use crate::planner::{FLOOR_SHARE, WINDOW_PERIODS};
 use crate::section::{Limits, PlanConfig};
+use crate::slopes::Slopes;
 use crate::uncertainty::{RobustDuration, Uncertainty};
 use crate::PlanError;
 
@@ -68,8 +70,9 @@ struct SampleSet<'a> {
     family: &'a Family,
     t_move: f64,
     evaluators: Vec<Evaluator>,
-    /// Each model's evaluator of its Jacobian's runs ([`Evaluator::for_slopes`]).
-    slopes: Vec<Option<Evaluator>>,
+    /// Each model's Jacobians ([`Slopes::for_search`]: its coarse model, by the tangent where it
+    /// covers the model).
+    slopes: Vec<Option<Slopes>>,
     bounds: Vec<Limits>,
 }
 
@@ -86,13 +89,8 @@ impl Models for SampleSet<'_> {
         e.within(&self.bounds[k])
     }
 
-    fn slope_eval(&self, k: usize, x: &[f64]) -> Option<Result<Eval, Rejected>> {
-        let ev = self.slopes[k].as_ref()?;
-        Some(evaluate(ev, self.family, x, self.t_move))
-    }
-
-    fn has_slope_model(&self) -> bool {
-        self.slopes.iter().any(Option::is_some)
+    fn slope_jacobian(&self, k: usize, x: &[f64]) -> Option<Result<(Jacobian, usize), Rejected>> {
+        self.slopes[k].as_ref().map(|s| s.jacobian(x))
     }
 }
 
@@ -146,11 +144,16 @@ pub fn plan_robust(
         None => (score(&e_plain), e_nominal_score(&nominal, &set, unc.quantile)),
         Some((set_plan, plains_plan)) => (score(plains_plan), e_nominal_score(&nominal, set_plan, unc.quantile)),
     };
-    let runs: usize = set.evaluators.iter().map(Evaluator::runs).sum::<usize>()
-        + at_plan
-            .as_ref()
-            .map_or(0, |(p, _)| p.evaluators.iter().map(Evaluator::runs).sum::<usize>())
-        + s.evaluator.runs();
+    // every evaluator's count: the sample models' (at the search's duration and at the plan's),
+    // then the nominal plan's
+    let total = |count: fn(&Evaluator) -> usize| {
+        set.evaluators.iter().map(count).sum::<usize>()
+            + at_plan
+                .as_ref()
+                .map_or(0, |(p, _)| p.evaluators.iter().map(count).sum::<usize>())
+            + count(&s.evaluator)
+    };
+    let (runs, tangent_directions) = (total(Evaluator::runs), total(Evaluator::tangent_directions));
     let info = RobustInfo {
         uncertainty: unc.clone(),
         candidates,
@@ -181,6 +184,7 @@ pub fn plan_robust(
         r_floor_m: stop.floors[k_nom],
         trace: sol.trace,
         evaluations: runs,
+        tangent_directions,
         reason: sol.reason,
         wall_s: s.started.elapsed().as_secs_f64(),
         robust: Some(Box::new(info)),
@@ -348,7 +352,7 @@ fn sample_set<'a>(
             smooth: SmoothRef::new(&plain, cfg.plan.smoothness(), floor),
             monotone: cfg.plan.monotone().then(|| s.family.clone()),
         });
-        set.slopes.push(ev.for_slopes());
+        set.slopes.push(Slopes::for_search(&ev, &s.family, t_move));
         set.evaluators.push(ev);
         set.bounds.push(bounds);
         plains.push(plain);

@@ -7,7 +7,8 @@
 //! ```text
 //! S q'' - C^T lambda = r,      grad c_k . q'' + (c_k(qhat) + sum_s F_ks lambda_s) / bp = 0
 //! ```
-//! with `c_k(qhat)` the row's value at the predictor (its `gu`, `gv` parts included) and `F`
+//! (with a payload, `S` includes beam 1's `P^T S_p P`, `crate::attach`), with `c_k(qhat)` the
+//! row's value at the predictor (its `gu`, `gv` parts included) and `F`
 //! the truncation flexibility of the sleeve rows (Eq. R4) and the axial flexibility of the Fix
 //! rows (Eq. A3); at `bp = 0` (the consistent start) the rows read `grad c_k . q'' = 0`.
 
@@ -16,10 +17,11 @@ use crate::modes::dot;
 use flexstar_numerics::vector::dots;
 
 impl System {
-    /// Whether the step's equations are all in [`System::step_residual`]: not with friction, a
-    /// payload, a load or gravity (their terms, and the fixed-point pass under gravity, are not).
+    /// Whether the step's equations are all in [`System::step_residual`]: not with friction or
+    /// gravity (the stick rows and the fixed-point pass under gravity are not). A payload's
+    /// step matrix is (`P^T S_p P`), and a load is forcing only.
     pub(crate) fn has_tangent(&self) -> bool {
-        self.friction.is_none() && self.payload.is_none() && self.load.is_none() && self.gravity == [0.0; 2]
+        self.friction.is_none() && self.gravity == [0.0; 2]
     }
 
     /// The residual of the prepared step's equations (module docs) at the accelerations `qdd`
@@ -82,6 +84,16 @@ impl System {
                 }
             }
         }
+        if let Some(pl) = &self.payload {
+            // beam 1's P^T S_p P q'' (Eq. P6; `crate::attach`)
+            let z = self.payload_coordinates(qdd);
+            let y: [f64; 3] = std::array::from_fn(|a| (0..3).map(|b| pl.sp[a][b] * z[b]).sum());
+            let (nm, b) = (self.nm, &self.bm[0]);
+            primal[nm] += y[0];
+            for ((x, p0), d0) in primal[..nm].iter_mut().zip(&b.phi0).zip(&b.dphi0) {
+                *x += y[1] * p0 + y[2] * d0;
+            }
+        }
         if bp > 0.0 {
             self.sleeves.add_compliance_product(rows, &self.beams, lam, bp);
             for (k, f) in axial_flexibilities(&self.rows, &self.bm, bp) {
@@ -95,8 +107,8 @@ impl System {
     /// factors: `S dqdd - C^T dlam = -primal`, `grad C dqdd + F / bp dlam = -rows`. Takes
     /// `minus_primal` (= `-primal`) and a buffer `dlam` of one entry per row (it receives the
     /// multipliers' correction), swapped in for the step's forcing and multipliers and back, so
-    /// that both are kept. Not with a payload or friction (their rows and Woodbury terms are not
-    /// in [`System::step_residual`]).
+    /// that both are kept; a payload's Woodbury terms are the step's. Not with friction (its
+    /// stick rows are not in [`System::step_residual`]).
     pub(crate) fn solve_correction(
         &mut self,
         bp: f64,
@@ -104,7 +116,7 @@ impl System {
         dlam: &mut Vec<f64>,
         dqdd: &mut [f64],
     ) {
-        debug_assert!(self.payload.is_none() && self.friction.is_none());
+        debug_assert!(self.friction.is_none());
         std::mem::swap(&mut self.resid, minus_primal);
         std::mem::swap(&mut self.lam, dlam);
         self.solve_factored(bp, None, Some(rows), dqdd);

@@ -50,8 +50,9 @@ impl Slopes {
 
     /// The Jacobian at `x` and the AMM runs it took. By the tangent, column j is that of the
     /// forward difference at the same step `h_j` ([`difference_step`]) with the AMM's outputs
-    /// taken to first order in `h_j` (the derivative itself for the rows of G and the tips, the
-    /// difference of the moved trajectory's own samples for the kinematic rows).
+    /// taken to first order in `h_j` (the derivative itself for the rows of G and the tips and
+    /// the force's usage, the difference of the moved trajectory's own samples for the
+    /// kinematic rows).
     /// Where a moved motion cannot run (it leaves the workspace, or its run fails), the
     /// Jacobian is taken by forward differences on the same model, which step backwards where
     /// the forward point is rejected.

@@ -261,13 +261,16 @@ def test_compare_errors_are_typed(root, tmp_path):
 def test_plan_matches_the_cli_contract(root, tmp_path):
     """flexstar.plan is `flexstar plan`: plan.csv with its header, the planned motion's residual
     peak of G on the FEM at most 1/20 of the plain quintic's (target move 1, docs/motions.md 6),
-    the AMM within 10 % of the FEM on it; a bad plan is a ConfigError naming the key."""
+    the AMM within 10 % of the FEM on it, its Jacobians from the tangent; a bad plan is a
+    ConfigError naming the key."""
     res = flexstar.plan(root / "configs/motions/plan-centre.toml", tmp_path)
     header = pathlib.Path(res["plan_csv"]).read_text().splitlines()[0]
     assert header == "t,Gx,Gy,theta,s1,s2,s3"
     (plain_amm, plain_fem), (amm, fem) = res["residual_G_peak_m"]["plain"], res["residual_G_peak_m"]["planned"]
     assert fem <= plain_fem / 20 and abs(amm - fem) <= 0.1 * fem
     assert abs(res["t_move"] - 0.42) < 1e-12
+    # the bare robot's Jacobians come from the tangent-linear AMM (docs/motions.md 4.9), 12 columns each
+    assert res["tangent_columns"] > 0 and res["tangent_columns"] % 12 == 0
     bad = tmp_path / "bad.toml"
     bad.write_text((root / "configs/motions/plan-centre.toml").read_text().replace("t_move = 0.42", "t_move = 0.42\npoints = 0"))
     with pytest.raises(flexstar.ConfigError) as e:

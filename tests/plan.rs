@@ -175,7 +175,10 @@ fn default_plans_keep_the_quintic_peaks_and_move_forward() {
         // the bare robot's Jacobians come from the tangent-linear AMM (docs/motions.md 4.9, "The
         // Jacobian from the tangent"): every Jacobian of the search, 12 columns each
         let columns = record["planner"]["tangent_directions"].as_u64().unwrap();
-        assert!(columns > 0 && columns.is_multiple_of(12), "{name}: {columns} columns by the tangent");
+        assert!(
+            columns > 0 && columns.is_multiple_of(12),
+            "{name}: {columns} columns by the tangent"
+        );
         assert!(err.contains("Jacobian columns by the tangent"), "{name}: {err}");
         let above = [a_p > a_q * (1.0 + 1e-3), j_p > j_q * 1.02, f_p > f_q * 1.005];
         if above.iter().any(|b| *b) {

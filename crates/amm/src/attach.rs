@@ -99,11 +99,10 @@ impl PayloadTerms {
         std::array::from_fn(|a| f[a] - (0..3).map(|b| d[a][b] * zv[b] + k[a][b] * zq[b]).sum::<f64>())
     }
 
-    /// Set `W = (I + S_p H)^-1 S_p` for the step with `S_p = c_m M_p + gp D_p + bp K_p` at `x`
-    /// and `H = P S^-1 P^T`; `false` when `I + S_p H` is singular (so is beam 1's step matrix).
-    /// `c_m = 1 + gp alpha` with mass-proportional damping (Eq. D19), else 1.
-    pub(crate) fn set_woodbury(&mut self, x: RigidTerms, (bp, gp, c_m): (f64, f64, f64), h: &Mat3) -> bool {
-        self.sp = self.step_matrix(x, (bp, gp, c_m));
+    /// Set `W = (I + S_p H)^-1 S_p` for the step's `S_p` ([`PayloadTerms::sp`], set from
+    /// [`PayloadTerms::step_matrix`]) and `H = P S^-1 P^T`; `false` when `I + S_p H` is singular
+    /// (so is beam 1's step matrix).
+    pub(crate) fn set_woodbury(&mut self, h: &Mat3) -> bool {
         let sp = nalgebra::Matrix3::from_fn(|a, b| self.sp[a][b]);
         let hm = nalgebra::Matrix3::from_fn(|a, b| h[a][b]);
         let lhs = nalgebra::Matrix3::identity() + sp * hm;
@@ -191,7 +190,8 @@ mod tests {
         let s = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(2.0, 3.0, 5.0));
         let s_inv = s.try_inverse().unwrap();
         let h: Mat3 = std::array::from_fn(|a| std::array::from_fn(|b| s_inv[(a, b)]));
-        assert!(p.set_woodbury(x, (bp, gp, 1.0), &h));
+        p.sp = p.step_matrix(x, (bp, gp, 1.0));
+        assert!(p.set_woodbury(&h));
         let (d, k, _) = p.rates(x);
         let sp = nalgebra::Matrix3::from_fn(|a, b| p.mass[a][b] + gp * d[a][b] + bp * k[a][b]);
         let exact = (s + sp).try_inverse().unwrap();

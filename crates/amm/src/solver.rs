@@ -555,7 +555,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
     })?;
     acc.copy_from_slice(&qdd);
     let start = Step {
-        t: 0.0,
+        st: &st,
         h: 0.0,
         bp: 0.0,
         gp: 0.0,
@@ -602,7 +602,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
                     .step(&mut sys, &kin, (&mut st, t), &mut x, out, &rails)
                     .map_err(|e| e.judge_off_beam(h, rigid_sleeve))?;
                 let step = Step {
-                    t,
+                    st: &st,
                     h,
                     bp,
                     gp,
@@ -627,7 +627,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
                 return Err(AmmError::NonFinite { t, dt: h });
             }
             let step = Step {
-                t,
+                st: &st,
                 h,
                 bp,
                 gp,
@@ -655,12 +655,12 @@ pub(crate) fn integrate_system<O: StepObserver>(
 }
 
 /// What an observer of [`integrate_system`] sees after a step (and after the consistent start,
-/// `h = 0`): its time [s], length h [s], `beta'` and `gamma'` of the generalized-alpha method, the
+/// `h = 0`): its rigid state (its time `st.t` [s]), length h [s], `beta'` and `gamma'` of the generalized-alpha method, the
 /// coordinates q after it, the predictors `(qhat, vhat)` it was solved about (`None` with
 /// friction, whose events split the step), its accelerations, and the response's row it ends on
 /// (the output time the recorder records after it; `None` within an output interval).
 pub(crate) struct Step<'a> {
-    pub(crate) t: f64,
+    pub(crate) st: &'a RigidState,
     pub(crate) h: f64,
     pub(crate) bp: f64,
     pub(crate) gp: f64,

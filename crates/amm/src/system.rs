@@ -1160,7 +1160,7 @@ impl System {
     /// so only their 6x6 Gram matrix `B D^-1 B^T` is computed (21 dot products of length N, and
     /// the six `B D^-1 Phi`).
     pub(crate) fn prepare(&mut self, st: &RigidState, bp: f64, gp: f64, qhat: &[f64]) -> Result<(), AmmError> {
-        self.prepare_rows(st, bp, gp, qhat)?;
+        self.prepare_rows(st, (bp, gp), qhat, None)?;
         let m = self.rows.len();
         self.a.iter_mut().for_each(|v| *v = 0.0);
         // disjoint borrows of the fields (no copy of the beams' workspaces)
@@ -1174,7 +1174,7 @@ impl System {
         self.sleeves.add_compliance(&mut self.a, m, &self.beams, bp);
         self.add_axial_flexibility(bp);
         if self.payload.is_some() {
-            self.payload_block(st, self.payload_motion(st), bp, gp)?;
+            self.payload_block(st)?;
         }
         if self.friction.is_some() {
             self.add_friction_to_schur();
@@ -1186,30 +1186,25 @@ impl System {
 
     /// The first part of [`System::prepare`], what the step's equations need before their
     /// Schur complement: the sleeve rows at xp(st) (about the predictor `qhat` in the full
-    /// model), the friction terms, and each beam's arrowhead of S with the Gram data of its
-    /// junction vectors (once for equal beams).
-    pub(crate) fn prepare_rows(&mut self, st: &RigidState, bp: f64, gp: f64, qhat: &[f64]) -> Result<(), AmmError> {
-        self.update_sleeve_rows([st.xp[0].v, st.xp[1].v, st.xp[2].v], qhat);
-        self.sleeves.on_beams(st.t)?;
-        if self.friction.is_some() {
-            self.friction_terms(qhat);
-        }
-        self.factor_s(bp, gp, st.theta.d1, st.theta.d2);
-        Ok(())
-    }
-
-    /// [`System::prepare_rows`] with the sleeve rows to first order about the values a step's
-    /// system kept (`sleeve::near`, [`System::linearise_sleeves`]): the tangent's probe.
-    pub(crate) fn prepare_rows_near(
+    /// model; `near`: to first order about the values a step's system kept, the tangent's
+    /// probe, `sleeve::near`), the friction terms, each beam's arrowhead of S with the Gram data
+    /// of its junction vectors (once for equal beams), and the payload's step matrix `S_p`.
+    pub(crate) fn prepare_rows(
         &mut self,
         st: &RigidState,
         (bp, gp): (f64, f64),
         qhat: &[f64],
-        near: &SleevesNear,
+        near: Option<&SleevesNear>,
     ) -> Result<(), AmmError> {
         let xp = [st.xp[0].v, st.xp[1].v, st.xp[2].v];
-        self.sleeves.update_near(&mut self.beams, &self.rows, xp, qhat, near);
+        match near {
+            Some(near) => self.sleeves.update_near(&mut self.beams, &self.rows, xp, qhat, near),
+            None => self.update_sleeve_rows(xp, qhat),
+        }
         self.sleeves.on_beams(st.t)?;
+        if self.friction.is_some() {
+            self.friction_terms(qhat);
+        }
         self.factor_s(bp, gp, st.theta.d1, st.theta.d2);
         if self.payload.is_some() {
             let x = self.payload_motion(st);
@@ -1235,14 +1230,15 @@ impl System {
 
     /// The payload's Woodbury correction of beam 1's block of the Schur complement (module docs of
     /// `attach`): `A_0 -= (C_0 S^-1 P^T) W (P S^-1 C_0^T)`, every product from the Gram data of
-    /// the step ([`BeamRows::product`]); sets `W` and `C_0 S^-1 P^T` for the substitution.
-    fn payload_block(&mut self, st: &RigidState, x: RigidTerms, bp: f64, gp: f64) -> Result<(), AmmError> {
+    /// the step ([`BeamRows::product`]) and the payload's `S_p` of [`System::prepare_rows`]; sets
+    /// `W` and `C_0 S^-1 P^T` for the substitution.
+    fn payload_block(&mut self, st: &RigidState) -> Result<(), AmmError> {
         let (beam, m) = (&self.beams[0], self.rows.len());
         let Some(pl) = self.payload.as_mut() else {
             return Ok(());
         };
         let (h, cross, back) = beam.payload_products(self.bm[0].p, self.bm[0].inv_sigma);
-        if !pl.set_woodbury(x, (bp, gp, 1.0 + gp * self.alpha), &h) {
+        if !pl.set_woodbury(&h) {
             return Err(AmmError::SingularConstraints {
                 t: st.t,
                 source: RankError::Payload,

@@ -83,7 +83,7 @@ pub fn solve_with_sensitivities(
     covered(&sys)?;
     sys.keep_sleeve_values();
     let force = SliderForce::new(&sys, settings.model, &star);
-    let mut tangent = Tangent::new(&sys, (&star, &stars), (eps, force), star.time.output_times().len());
+    let mut tangent = Tangent::new(&sys, &stars, (eps, force), star.time.output_times().len());
     let response = integrate_system(&star, settings, sys, dt_max, started, &mut tangent)?;
     if let Some(e) = tangent.failed.take() {
         return Err(e);
@@ -140,8 +140,7 @@ struct Direction {
 /// The observer of the run that carries the tangents (module docs).
 struct Tangent<'a> {
     probe: System,
-    /// The run's own problem and the moved ones.
-    base: &'a Star<'a>,
+    /// The moved problems.
     moved: &'a [Star<'a>],
     /// Each direction's step.
     eps: &'a [f64],
@@ -174,12 +173,7 @@ struct Tangent<'a> {
 
 impl<'a> Tangent<'a> {
     /// The tangents of a run with `rows` output rows, all zero at the start.
-    fn new(
-        sys: &System,
-        (base, moved): (&'a Star<'a>, &'a [Star<'a>]),
-        (eps, force): (&'a [f64], SliderForce),
-        rows: usize,
-    ) -> Self {
+    fn new(sys: &System, moved: &'a [Star<'a>], (eps, force): (&'a [f64], SliderForce), rows: usize) -> Self {
         let n = 3 * sys.nb;
         let m = sys.rows.len();
         let zero = Direction {
@@ -191,7 +185,6 @@ impl<'a> Tangent<'a> {
         let column = || [vec![0.0; rows], vec![0.0; rows], vec![0.0; rows]];
         Tangent {
             probe: sys.clone(),
-            base,
             moved,
             eps,
             ga: GenAlpha::new(RHO_INF),
@@ -227,14 +220,10 @@ impl<'a> Tangent<'a> {
         let (bp, h) = (step.bp, step.h);
         let gp = step.gp;
         // Eq. 33 at the step's own state, on an output row (the recorder's forces)
-        let fa0 = match step.output {
-            Some(_) => {
-                let st = self.base.state(step.t)?;
-                let axial = sys.sleeves.axial();
-                Some([0, 1, 2].map(|i| self.force.eq33(i, &st, step.q, &sys.lam, axial)))
-            }
-            None => None,
-        };
+        let fa0 = step.output.map(|_| {
+            let axial = sys.sleeves.axial();
+            [0, 1, 2].map(|i| self.force.eq33(i, step.st, step.q, &sys.lam, axial))
+        });
         let apq = self.ga.a_per_qdd();
         sys.step_residual(bp, qhat, (step.qdd, &sys.lam), &mut self.primal0, &mut self.rows0);
         // the sleeve rows' derivatives in the material points, shared by the directions
@@ -275,10 +264,10 @@ impl<'a> Tangent<'a> {
                 *l = p + eps * d;
             }
             // the moved step's equations at the base solution (Eqs. T-2, T-3)
-            let st = self.moved[k].state(step.t)?;
+            let st = self.moved[k].state(step.st.t)?;
             self.probe.set_axial_acceleration(&self.lagged);
             let near = sys.sleeves.kept().expect("the run keeps its sleeve values");
-            self.probe.prepare_rows_near(&st, (bp, gp), &self.qhat, near)?;
+            self.probe.prepare_rows(&st, (bp, gp), &self.qhat, Some(near))?;
             self.probe.forcing(&st, &self.qhat, &self.vhat);
             self.probe
                 .step_residual(bp, &self.qhat, (step.qdd, &sys.lam), &mut self.primal, &mut self.rows);

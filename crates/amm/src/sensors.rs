@@ -56,6 +56,21 @@ impl SensorRecorder {
     /// accelerations `qdd` (the system's layout: per beam N modes, u, the sleeve rotation) and
     /// the actuator forces `fa` [N].
     pub(crate) fn record(&mut self, st: &RigidState, (nm, nb): (usize, usize), q: [&[f64]; 3], fa: [f64; 3]) {
+        let mut row = Vec::with_capacity(self.raw.columns.len());
+        self.read(st, (nm, nb), q, fa, &mut row);
+        self.raw.push_row(st.t, &row);
+    }
+
+    /// The readings at `st` with `q` = (q, q', q'') and the forces `fa` [N] into `row` (cleared
+    /// first), in the table's column order; nothing recorded.
+    pub(crate) fn read(
+        &self,
+        st: &RigidState,
+        (nm, nb): (usize, usize),
+        q: [&[f64]; 3],
+        fa: [f64; 3],
+        row: &mut Vec<f64>,
+    ) {
         let at = AmmInstant {
             st,
             nm,
@@ -64,9 +79,18 @@ impl SensorRecorder {
             fa,
             points: &self.points,
         };
-        let mut row = Vec::with_capacity(self.raw.columns.len());
-        self.sensors.read(&at, self.gravity, &mut row);
-        self.raw.push_row(st.t, &row);
+        row.clear();
+        self.sensors.read(&at, self.gravity, row);
+    }
+
+    /// An empty table of the readings' columns (names and units), with room for `n_out` rows.
+    pub(crate) fn empty_table(&self, n_out: usize) -> SensorTable {
+        SensorTable::with_columns(&self.sensors.units(), n_out)
+    }
+
+    /// The number of columns a row of [`SensorRecorder::read`] has.
+    pub(crate) fn width(&self) -> usize {
+        self.raw.columns.len()
     }
 
     /// The readings at the output times.

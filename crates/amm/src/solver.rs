@@ -560,6 +560,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
         bp: 0.0,
         gp: 0.0,
         q: &q,
+        v: &v,
         predicted: friction.is_none().then_some((&q[..], &v[..])),
         qdd: &qdd,
         output: stops[0].output,
@@ -607,6 +608,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
                     bp,
                     gp,
                     q: &q,
+                    v: &v,
                     predicted: None,
                     qdd: &qdd,
                     output: if k == nsub { w[1].output } else { None },
@@ -632,6 +634,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
                 bp,
                 gp,
                 q: &q,
+                v: &v,
                 predicted: Some((&qhat, &vhat)),
                 qdd: &qdd,
                 output: if k == nsub { w[1].output } else { None },
@@ -656,7 +659,7 @@ pub(crate) fn integrate_system<O: StepObserver>(
 
 /// What an observer of [`integrate_system`] sees after a step (and after the consistent start,
 /// `h = 0`): its rigid state (its time `st.t` [s]), length h [s], `beta'` and `gamma'` of the generalized-alpha method, the
-/// coordinates q after it, the predictors `(qhat, vhat)` it was solved about (`None` with
+/// coordinates q and rates q' after it, the predictors `(qhat, vhat)` it was solved about (`None` with
 /// friction, whose events split the step), its accelerations, and the response's row it ends on
 /// (the output time the recorder records after it; `None` within an output interval).
 pub(crate) struct Step<'a> {
@@ -665,6 +668,7 @@ pub(crate) struct Step<'a> {
     pub(crate) bp: f64,
     pub(crate) gp: f64,
     pub(crate) q: &'a [f64],
+    pub(crate) v: &'a [f64],
     pub(crate) predicted: Option<(&'a [f64], &'a [f64])>,
     pub(crate) qdd: &'a [f64],
     pub(crate) output: Option<usize>,

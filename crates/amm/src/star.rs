@@ -183,6 +183,28 @@ impl<'a> Star<'a> {
         }
     }
 
+    /// Whether `other` is the same robot in the same setting (payload, damping, load, drive,
+    /// gravity, friction): at most its motion differs.
+    pub(crate) fn same_physics(&self, other: &Star) -> bool {
+        self.robot == other.robot
+            && self.payload == other.payload
+            && self.damping == other.damping
+            && self.load == other.load
+            && self.drive == other.drive
+            && self.gravity == other.gravity
+            && self.friction == other.friction
+    }
+
+    /// Whether `other`'s modes are this problem's: the mode sets depend on the family and N
+    /// (the solver's) and each beam's length alone, the sleeve rows' points on the sleeves'
+    /// lengths (`docs/amm.md` 2.2, "Physical parameters").
+    pub(crate) fn same_basis(&self, other: &Star) -> bool {
+        self.beams
+            .iter()
+            .zip(&other.beams)
+            .all(|(a, b)| a.l == b.l && a.lp == b.lp)
+    }
+
     /// The same problem with a mode set and an arrowhead per beam even where the beams are
     /// equal: the general layout, for the test that it reproduces the shared one.
     #[cfg(test)]

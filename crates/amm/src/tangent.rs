@@ -1,31 +1,36 @@
-//! Forward sensitivities of an AMM run along changes of its motion (`docs/amm.md` 2.2, Eqs.
-//! T-1 to T-4): the tangent-linear model of the generalized-alpha step, solved with each
-//! step's own factors.
+//! Forward sensitivities of an AMM run along changes of its motion or of its physical
+//! parameters (`docs/amm.md` 2.2, Eqs. T-1 to T-4): the tangent-linear model of the
+//! generalized-alpha step, solved with each step's own factors.
 //!
-//! A direction is the same problem with its motion moved by `eps` along it (a via point or a
-//! timing variable of a plan, a coefficient of a polynomial motion). Per step and direction,
-//! the step's equations are evaluated once more on a copy of the system (the probe): at the
-//! direction's rigid state, the predictors and lagged accelerations moved by `eps` times their
-//! tangents, and the step's own solution (`q''`, multipliers). That residual, less the step's own
-//! (zero to round-off), is `eps` times the directional derivative of the equations; one solve
-//! with the step's factors turns it into `eps` times the tangent of `q''` (internal numerical
-//! differentiation: the derivative of the discrete step, not of a second run). The update and
-//! the predictor are linear and act on the tangents as on the state.
+//! A direction is the same problem moved by `eps` along it: its motion (a via point or a timing
+//! variable of a plan, a coefficient of a polynomial motion) or a physical parameter that keeps
+//! the mode basis (a modulus, a density, the payload, the damping, the load: `docs/amm.md` 2.2,
+//! "Physical parameters"). Per step and direction, the step's equations are evaluated once more
+//! on a copy of the system (the probe; one built at the moved parameters where the direction
+//! moves them): at the direction's rigid state, the predictors and lagged accelerations moved by
+//! `eps` times their tangents, and the step's own solution (`q''`, multipliers). That residual,
+//! less the step's own (zero to round-off), is `eps` times the directional derivative of the
+//! equations; one solve with the step's factors turns it into `eps` times the tangent of `q''`
+//! (internal numerical differentiation: the derivative of the discrete step, not of a second
+//! run). The update and the predictor are linear and act on the tangents as on the state. The
+//! outputs' tangents (the junction and tips, Eq. 33's forces, the sensors' readings) are their
+//! values at the moved state less the run's, over `eps`.
 //!
 //! Cost per step and direction: the probe's sleeve rows, arrowhead and forcing, two residual
 //! passes and one substitution with the step's factors; no factorisation.
 
-use flexstar_model::{AmmSettings, ModeCount, Problem, Response};
+use flexstar_model::{AmmSettings, ModeCount, Problem, Response, SensorTable};
 use flexstar_numerics::GenAlpha;
 
 use crate::error::AmmError;
 use crate::modes::dot;
 use crate::record::SliderForce;
+use crate::sensors::SensorRecorder;
 use crate::solver::{build_system, integrate_system, validate, Step, StepObserver, RHO_INF};
 use crate::star::Star;
 use crate::system::System;
 
-/// An AMM run with the derivatives of its elastic outputs along directions of its motion.
+/// An AMM run with the derivatives of its outputs along directions of its motion or parameters.
 #[derive(Debug, Clone)]
 pub struct Sensitivities {
     /// The run itself, as [`crate::solve`] gives it at the same fixed N and step.
@@ -40,16 +45,22 @@ pub struct Sensitivities {
     /// actuator force of Eq. 33 (the `fa` columns of the response), from the tangents of the
     /// multipliers, the sleeve rotation and the rigid state.
     pub fa: Vec<[Vec<f64>; 3]>,
+    /// Per direction, the derivatives of the sensors' readings at the output times (the
+    /// columns of `response.sensors`, before the data acquisition: `docs/sensors.md` section 6)
+    /// [the sensor's unit per unit of p]; `None` without sensors.
+    pub sensors: Option<Vec<SensorTable>>,
 }
 
-/// The run of `problem` at the fixed N of `settings.modes` and the derivatives of its
-/// junction and tip displacements along each of `moved`: direction k is the problem with its
-/// motion moved by `eps[k]` along it (the same robot, time span and everything else). The
-/// derivative is that of the discrete run (the tangent-linear model, module docs), so it matches
-/// central differences of whole runs to the order of their own truncation error.
+/// The run of `problem` at the fixed N of `settings.modes` and the derivatives of its outputs
+/// along each of `moved`: direction k is the problem moved by `eps[k]` along it, in its motion
+/// or in physical parameters that keep the mode basis (every beam's length and sleeve length;
+/// the same output times, sensors and everything else). The derivative is that of the discrete
+/// run (the tangent-linear model, module docs), so it matches central differences of whole runs
+/// to the order of their own truncation error.
 ///
-/// Refused before any work: what [`sensitivities_cover`] refuses, moved problems with other
-/// output times or another robot, and a step `eps[k]` that is zero or not finite.
+/// Refused before any work: what [`sensitivities_cover`] refuses (of the problem or of a moved
+/// one), moved problems with other output times, sensors or mode basis, and a step `eps[k]`
+/// that is zero or not finite.
 pub fn solve_with_sensitivities(
     problem: &Problem,
     settings: &AmmSettings,
@@ -71,19 +82,28 @@ pub fn solve_with_sensitivities(
             "every moved problem needs the same output times",
         ));
     }
-    if stars.iter().any(|s| s.robot != star.robot || s.weld != star.weld) {
+    if stars.iter().any(|s| s.sensors != star.sensors) {
+        return Err(AmmError::invalid(
+            "sensors",
+            "every moved problem needs the same sensors",
+        ));
+    }
+    if stars.iter().any(|s| !s.same_basis(&star)) {
         return Err(AmmError::invalid(
             "robot",
-            "every moved problem needs the same robot (only its motion moves)",
+            "every moved problem needs the same mode basis: the same robot, or one whose beams and \
+             sleeves keep their lengths (L, Lp)",
         ));
     }
     let started = std::time::Instant::now();
     let dt_max = validate(&star, settings, n, true)?;
     let mut sys = build_system(settings, n, &star)?;
     covered(&sys)?;
+    let (probes, probe_of) = probes(&sys, settings, n, (&star, &stars))?;
     sys.keep_sleeve_values();
-    let force = SliderForce::new(&sys, settings.model, &star);
-    let mut tangent = Tangent::new(&sys, &stars, (eps, force), star.time.output_times().len());
+    let n_out = star.time.output_times().len();
+    let sensors = SensorRecorder::new(star.sensors, &sys, star.gravity, n_out);
+    let mut tangent = Tangent::new(&sys, &stars, (eps, probes, probe_of), (sensors, n_out));
     let response = integrate_system(&star, settings, sys, dt_max, started, &mut tangent)?;
     if let Some(e) = tangent.failed.take() {
         return Err(e);
@@ -93,6 +113,7 @@ pub fn solve_with_sensitivities(
         w_g: tangent.w_g,
         w_tip: tangent.w_tip,
         fa: tangent.fa,
+        sensors: tangent.d_sensors,
     })
 }
 
@@ -127,6 +148,49 @@ fn covered(sys: &System) -> Result<(), AmmError> {
     }
 }
 
+/// A copy of the system on which the step's equations are evaluated for some directions, with
+/// Eq. 33's data of its robot.
+struct Probe {
+    sys: System,
+    force: SliderForce,
+}
+
+/// The probes of the directions `stars` about the run's `sys` of `star`, and each direction's
+/// probe: the first a copy of `sys` (every direction that moves the motion only), then one
+/// system built at each other set of physical parameters. Those whose beams differ evaluate
+/// their own sleeves' truncation flexibility (it depends on the beams' stiffness); every probe
+/// takes the rest of the sleeve rows to first order about the run's (the same modes,
+/// `sleeve::near`).
+fn probes(
+    sys: &System,
+    settings: &AmmSettings,
+    n: usize,
+    (star, stars): (&Star, &[Star]),
+) -> Result<(Vec<Probe>, Vec<usize>), AmmError> {
+    let mut probes = vec![Probe {
+        sys: sys.clone(),
+        force: SliderForce::new(sys, settings.model, star),
+    }];
+    let mut owners: Vec<&Star> = vec![star];
+    let mut probe_of = Vec::with_capacity(stars.len());
+    for s in stars {
+        if let Some(j) = owners.iter().position(|o| o.same_physics(s)) {
+            probe_of.push(j);
+            continue;
+        }
+        let mut moved = build_system(settings, n, s)?;
+        covered(&moved)?;
+        if s.beams != star.beams {
+            moved.evaluate_own_flexibility();
+        }
+        let force = SliderForce::new(&moved, settings.model, s);
+        probe_of.push(probes.len());
+        probes.push(Probe { sys: moved, force });
+        owners.push(s);
+    }
+    Ok((probes, probe_of))
+}
+
 /// One direction's tangent state (per unit of its parameter): coordinates, rates, the
 /// generalized-alpha acceleration variable and the accelerations of the last step.
 #[derive(Debug, Clone)]
@@ -137,9 +201,22 @@ struct Direction {
     dqdd: Vec<f64>,
 }
 
+/// The sensors' readings of the run and their tangents (`None` without sensors).
+struct SensorTangents {
+    reader: SensorRecorder,
+    /// The run's readings at the step, and a direction's at its moved state.
+    base: Vec<f64>,
+    row: Vec<f64>,
+    /// The moved rates and accelerations.
+    v_moved: Vec<f64>,
+    qdd_moved: Vec<f64>,
+}
+
 /// The observer of the run that carries the tangents (module docs).
 struct Tangent<'a> {
-    probe: System,
+    probes: Vec<Probe>,
+    /// Each direction's probe.
+    probe_of: Vec<usize>,
     /// The moved problems.
     moved: &'a [Star<'a>],
     /// Each direction's step.
@@ -151,8 +228,8 @@ struct Tangent<'a> {
     w_g: Vec<[Vec<f64>; 3]>,
     w_tip: Vec<[Vec<f64>; 3]>,
     fa: Vec<[Vec<f64>; 3]>,
-    /// Eq. 33's data, for the forces' tangents.
-    force: SliderForce,
+    sensors: Option<SensorTangents>,
+    d_sensors: Option<Vec<SensorTable>>,
     failed: Option<AmmError>,
     // workspaces
     qhat: Vec<f64>,
@@ -172,8 +249,13 @@ struct Tangent<'a> {
 }
 
 impl<'a> Tangent<'a> {
-    /// The tangents of a run with `rows` output rows, all zero at the start.
-    fn new(sys: &System, moved: &'a [Star<'a>], (eps, force): (&'a [f64], SliderForce), rows: usize) -> Self {
+    /// The tangents of a run with `n_out` output rows, all zero at the start.
+    fn new(
+        sys: &System,
+        moved: &'a [Star<'a>],
+        (eps, probes, probe_of): (&'a [f64], Vec<Probe>, Vec<usize>),
+        (sensors, n_out): (Option<SensorRecorder>, usize),
+    ) -> Self {
         let n = 3 * sys.nb;
         let m = sys.rows.len();
         let zero = Direction {
@@ -182,9 +264,20 @@ impl<'a> Tangent<'a> {
             dacc: vec![0.0; n],
             dqdd: vec![0.0; n],
         };
-        let column = || [vec![0.0; rows], vec![0.0; rows], vec![0.0; rows]];
+        let column = || [vec![0.0; n_out], vec![0.0; n_out], vec![0.0; n_out]];
+        let d_sensors = sensors
+            .as_ref()
+            .map(|s| (0..moved.len()).map(|_| s.empty_table(n_out)).collect());
+        let sensors = sensors.map(|reader| SensorTangents {
+            base: Vec::with_capacity(reader.width()),
+            row: Vec::with_capacity(reader.width()),
+            reader,
+            v_moved: vec![0.0; n],
+            qdd_moved: vec![0.0; n],
+        });
         Tangent {
-            probe: sys.clone(),
+            probes,
+            probe_of,
             moved,
             eps,
             ga: GenAlpha::new(RHO_INF),
@@ -193,7 +286,8 @@ impl<'a> Tangent<'a> {
             w_g: (0..moved.len()).map(|_| column()).collect(),
             w_tip: (0..moved.len()).map(|_| column()).collect(),
             fa: (0..moved.len()).map(|_| column()).collect(),
-            force,
+            sensors,
+            d_sensors,
             failed: None,
             qhat: vec![0.0; n],
             vhat: vec![0.0; n],
@@ -219,15 +313,21 @@ impl<'a> Tangent<'a> {
         };
         let (bp, h) = (step.bp, step.h);
         let gp = step.gp;
-        // Eq. 33 at the step's own state, on an output row (the recorder's forces)
+        // Eq. 33 at the step's own state, on an output row (the recorder's forces), and the
+        // sensors' readings there
         let fa0 = step.output.map(|_| {
             let axial = sys.sleeves.axial();
-            [0, 1, 2].map(|i| self.force.eq33(i, step.st, step.q, &sys.lam, axial))
+            [0, 1, 2].map(|i| self.probes[0].force.eq33(i, step.st, step.q, &sys.lam, axial))
         });
+        if let (Some(fa0), Some(s)) = (fa0, self.sensors.as_mut()) {
+            s.reader
+                .read(step.st, (sys.nm, sys.nb), [step.q, step.v, step.qdd], fa0, &mut s.base);
+        }
         let apq = self.ga.a_per_qdd();
         sys.step_residual(bp, qhat, (step.qdd, &sys.lam), &mut self.primal0, &mut self.rows0);
-        // the sleeve rows' derivatives in the material points, shared by the directions
-        self.probe.linearise_sleeves(sys, qhat);
+        // the sleeve rows' derivatives in the material points, shared by the directions and
+        // their probes (the first probe is the workspace)
+        self.probes[0].sys.linearise_sleeves(sys, qhat);
         // the predictor is linear in (q, v, a, q''): its rows (a_part, qhat, vhat), read off
         // once per step; at the start the predictors are the state itself
         let unit = |x: [f64; 4]| self.ga.predict(h, x[0], x[1], x[2], x[3]);
@@ -246,6 +346,7 @@ impl<'a> Tangent<'a> {
         for (k, dir) in self.dirs.iter_mut().enumerate() {
             let eps = self.eps[k];
             let inv_eps = 1.0 / eps;
+            let probe = &mut self.probes[self.probe_of[k]];
             // the tangent predictor (Eq. T-4), then the moved inputs: each a combination of the
             // slices (q, v, a, q'') of one length, in the processor's lanes
             let x = [&dir.dq[..], &dir.dv[..], &dir.dacc[..], &dir.dqdd[..]];
@@ -265,11 +366,12 @@ impl<'a> Tangent<'a> {
             }
             // the moved step's equations at the base solution (Eqs. T-2, T-3)
             let st = self.moved[k].state(step.st.t)?;
-            self.probe.set_axial_acceleration(&self.lagged);
+            probe.sys.set_axial_acceleration(&self.lagged);
             let near = sys.sleeves.kept().expect("the run keeps its sleeve values");
-            self.probe.prepare_rows(&st, (bp, gp), &self.qhat, Some(near))?;
-            self.probe.forcing(&st, &self.qhat, &self.vhat);
-            self.probe
+            probe.sys.prepare_rows(&st, (bp, gp), &self.qhat, Some(near))?;
+            probe.sys.forcing(&st, &self.qhat, &self.vhat);
+            probe
+                .sys
                 .step_residual(bp, &self.qhat, (step.qdd, &sys.lam), &mut self.primal, &mut self.rows);
             // less the step's own residual: the probe's minus the step's, negated for the solve
             for (r, r0) in self.primal.iter_mut().zip(&self.primal0) {
@@ -296,7 +398,8 @@ impl<'a> Tangent<'a> {
             } else {
                 dir.dacc.copy_from_slice(&dir.dqdd);
             }
-            // the forces' tangent on an output row: Eq. 33 at the moved state less the step's own
+            // the outputs' tangents on an output row: Eq. 33 and the sensors' readings at the
+            // moved state less the step's own
             if let (Some(row), Some(fa0)) = (step.output, fa0) {
                 for ((m, q), d) in self.q_moved.iter_mut().zip(step.q).zip(&dir.dq) {
                     *m = q + eps * d;
@@ -304,10 +407,24 @@ impl<'a> Tangent<'a> {
                 for ((m, l), d) in self.lam_moved.iter_mut().zip(&sys.lam).zip(&self.corr_l) {
                     *m = l + d;
                 }
-                let axial = self.probe.sleeves.axial();
-                for (i, f0) in fa0.iter().enumerate() {
-                    let f = self.force.eq33(i, &st, &self.q_moved, &self.lam_moved, axial);
+                let axial = probe.sys.sleeves.axial();
+                let fa = [0, 1, 2].map(|i| probe.force.eq33(i, &st, &self.q_moved, &self.lam_moved, axial));
+                for (i, (f, f0)) in fa.iter().zip(fa0).enumerate() {
                     self.fa[k][i][row] = (f - f0) * inv_eps;
+                }
+                if let (Some(s), Some(tables)) = (self.sensors.as_mut(), self.d_sensors.as_mut()) {
+                    for ((m, v), d) in s.v_moved.iter_mut().zip(step.v).zip(&dir.dv) {
+                        *m = v + eps * d;
+                    }
+                    for ((m, a), d) in s.qdd_moved.iter_mut().zip(step.qdd).zip(&dir.dqdd) {
+                        *m = a + eps * d;
+                    }
+                    let q3 = [&self.q_moved[..], &s.v_moved[..], &s.qdd_moved[..]];
+                    s.reader.read(&st, (sys.nm, sys.nb), q3, fa, &mut s.row);
+                    for (r, b) in s.row.iter_mut().zip(&s.base) {
+                        *r = (*r - b) * inv_eps;
+                    }
+                    tables[k].push_row(step.st.t, &s.row);
                 }
             }
         }
@@ -528,6 +645,108 @@ mod tests {
         );
     }
 
+    /// The plan-kind motion on a robot with a payload, Rayleigh damping and four sensors (an
+    /// accelerometer at G, one on beam 2, a strain gauge near beam 3's root, a force cell), its
+    /// modulus E [Pa], payload mass [kg] and damping `beta` [s] moved by `d`: the fit's kind of
+    /// parameters (`docs/measured.md` 4.5).
+    fn physical(d: [f64; 3]) -> Experiment {
+        let text = format!(
+            "[robot]\nE = {}\n[payload]\nmass = {}\nJ = 2e-4\noffset = [0.01, -0.005]\n\
+             [[sensors]]\nname = \"accG\"\nkind = \"accelerometer\"\nat = \"G\"\n\
+             [[sensors]]\nname = \"accB\"\nkind = \"accelerometer\"\nbeam = 2\nx = 0.45\n\
+             [[sensors]]\nname = \"root\"\nkind = \"strain\"\nbeam = 3\nx = 0.05\nc = 0.001\n\
+             [[sensors]]\nname = \"cell1\"\nkind = \"force\"\nslider = 1\n",
+            200e9 + d[0],
+            0.3 + d[1]
+        );
+        let mut e = via_on(&text, 0.0, 0.0);
+        e.damping.beta = Some(2e-5 + d[2]);
+        e
+    }
+
+    /// The largest difference between a sensor table of derivatives and the central
+    /// differences of two runs' readings at `+-delta`, over the largest central difference, per
+    /// column: the worst column.
+    fn worst_sensor(d: &SensorTable, plus: &Response, minus: &Response, delta: f64) -> f64 {
+        let (sp, sm) = (plus.sensors.as_ref().unwrap(), minus.sensors.as_ref().unwrap());
+        let mut worst = 0.0f64;
+        for (c, col) in d.columns.iter().enumerate() {
+            let (mut err, mut big) = (0.0f64, 0.0f64);
+            for (j, v) in col.values.iter().enumerate() {
+                let central = (sp.columns[c].values[j] - sm.columns[c].values[j]) / (2.0 * delta);
+                err = err.max((v - central).abs());
+                big = big.max(central.abs());
+            }
+            worst = worst.max(err / big);
+        }
+        worst
+    }
+
+    /// The tangent along physical parameters (each direction its own probe, built at the moved
+    /// parameters; `docs/amm.md` 2.2, "Physical parameters") against central differences of
+    /// whole runs at +-1e-4 of each parameter, the sensors' readings included: the largest
+    /// difference 6.5e-5 to 1.6e-4 of the largest derivative (against differences at +-1e-3,
+    /// whose second-order terms are the mean's own, 1.9e-6 to 1.7e-5; at +-1e-5 the damping's
+    /// differences are at their round-off, 2.6e-3).
+    ///
+    /// One-sided, the error of a direction is its second-order terms, which grow like `eps`,
+    /// plus the round-off of the residual's difference, which grows like `1 / eps` and is the
+    /// larger the less the parameter moves the readings (measured, largest relative error of
+    /// the outputs): E 8.8e-4 / 8.8e-5 / 8.8e-6 at `eps` = 1e-4 / 1e-5 / 1e-6 of E (second
+    /// order); the damping's `beta` 3.0e-2 / 2.8e-3 / 4.6e-4 / 1.5e-4 at 1e-6 / 1e-5 / 1e-4 /
+    /// 1e-3 (round-off) and 4.9e-4 at 1e-2. The mean of the directions at `+eps` and `-eps`
+    /// cancels the second-order terms, so that one `eps` (1e-3 of each parameter) serves all:
+    /// how the fit takes its columns (`docs/measured.md` 4.5).
+    #[test]
+    fn the_tangent_along_physical_parameters_matches_central_differences() {
+        let s = settings(AmmModel::Full);
+        let scale = [200e9, 0.3, 2e-5];
+        let unit = |k: usize, d: f64| std::array::from_fn::<f64, 3, _>(|j| if j == k { d } else { 0.0 });
+        let base = physical([0.0; 3]).problem().unwrap();
+        let eps: Vec<f64> = scale.iter().flat_map(|x| [1e-3 * x, -1e-3 * x]).collect();
+        let moved: Vec<_> = (0..6)
+            .map(|j| physical(unit(j / 2, eps[j])).problem().unwrap())
+            .collect();
+        let sens = solve_with_sensitivities(&base, &s, &moved, &eps).unwrap();
+        let alone = plain(&physical([0.0; 3]), &s);
+        assert_eq!(
+            alone.w_g, sens.response.w_g,
+            "the run itself is the plain run's, bit for bit"
+        );
+        let d_sensors = sens.sensors.as_ref().expect("sensor tangents");
+        let mean = |a: &[Vec<f64>; 3], b: &[Vec<f64>; 3]| -> [Vec<f64>; 3] {
+            std::array::from_fn(|i| a[i].iter().zip(&b[i]).map(|(x, y)| 0.5 * (x + y)).collect())
+        };
+        for (k, sc) in scale.iter().enumerate() {
+            let (p, m) = (2 * k, 2 * k + 1);
+            let delta = 1e-4 * sc;
+            let (plus, minus) = (
+                plain(&physical(unit(k, delta)), &s),
+                plain(&physical(unit(k, -delta)), &s),
+            );
+            let eg = worst(&mean(&sens.w_g[p], &sens.w_g[m]), &plus, &minus, delta, |r| &r.w_g);
+            let et = worst(&mean(&sens.w_tip[p], &sens.w_tip[m]), &plus, &minus, delta, |r| {
+                &r.w_tip
+            });
+            let ef = worst(&mean(&sens.fa[p], &sens.fa[m]), &plus, &minus, delta, |r| &r.fa);
+            let mut both = d_sensors[p].clone();
+            for (c, col) in both.columns.iter_mut().enumerate() {
+                for (v, w) in col.values.iter_mut().zip(&d_sensors[m].columns[c].values) {
+                    *v = 0.5 * (*v + w);
+                }
+            }
+            let es = worst_sensor(&both, &plus, &minus, delta);
+            let one_sided = worst_sensor(&d_sensors[p], &plus, &minus, delta);
+            println!(
+                "parameter {k}: w_G {eg:.2e}, tips {et:.2e}, Fa {ef:.2e}, sensors {es:.2e} (one-sided {one_sided:.2e})"
+            );
+            assert!(
+                eg < 1e-4 && et < 1e-4 && ef < 2e-4 && es < 2e-4,
+                "parameter {k}: w_G {eg:.2e}, tips {et:.2e}, Fa {ef:.2e}, sensors {es:.2e}"
+            );
+        }
+    }
+
     /// What the tangent does not cover is refused before any work, naming the key.
     #[test]
     fn unsupported_runs_are_refused_before_any_work() {
@@ -550,7 +769,7 @@ mod tests {
             &[1e-6],
         )
         .unwrap_err();
-        assert!(e.to_string().contains("same robot"), "{e}");
+        assert!(e.to_string().contains("same mode basis"), "{e}");
     }
 
     /// Eqs. T-1 to T-4 against central differences of whole runs, both models: the derivatives

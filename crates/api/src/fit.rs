@@ -180,6 +180,7 @@ impl<'a> Setup<'a> {
             modes: start.modes,
             dt: start.dt,
             window,
+            last: Default::default(),
         };
         let settings = flexstar_fit::Settings {
             max_iterations: self.section.iterations(),

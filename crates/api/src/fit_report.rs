@@ -153,6 +153,7 @@ pub fn fit_json(o: &FitOutcome) -> Value {
         "identifiability": fit.identifiability,
         "iterations": fit.iterations,
         "evaluations": fit.evaluations,
+        "jacobians": { "total": fit.jacobians, "by_tangent": fit.tangent_jacobians },
         "fit_wall_s": fit.wall_s,
         "wall_s": o.wall_s,
         "amm": { "modes": f.modes, "dt": f.dt },
@@ -175,7 +176,7 @@ pub fn fit_markdown(o: &FitOutcome) -> String {
     let fit = &f.fit;
     let mut s = format!(
         "# {}: fit to {}\n\n**{}.** {}\n\nIdentifiability: {}\n\nModel: the accurate AMM at N = {} modes per beam and step {} s (frozen at the start's); \
-         {} iterations, {} model evaluations, {:.2} s for the fit, {:.2} s in all.\n\n",
+         {} iterations, {} model evaluations ({} of {} Jacobians from the tangent-linear AMM), {:.2} s for the fit, {:.2} s in all.\n\n",
         f.input.exp.name,
         f.recording,
         if fit.calibrated() {
@@ -189,6 +190,8 @@ pub fn fit_markdown(o: &FitOutcome) -> String {
         sig(f.dt),
         fit.iterations,
         fit.evaluations,
+        fit.tangent_jacobians,
+        fit.jacobians,
         fit.wall_s,
         o.wall_s,
     );

@@ -127,6 +127,14 @@ fn the_bench_robot_is_calibrated_on_its_fem_recording() {
         f.reason, f.iterations, f.evaluations, f.wall_s, o.wall_s, f.statistics.s2, f.identifiability.message
     );
     assert!(f.calibrated(), "{}", f.reason);
+    // every Jacobian from the tangent-linear AMM (4.5, Eq. LS9b): the bench has no friction or
+    // gravity
+    assert!(
+        f.jacobians > 0 && f.tangent_jacobians == f.jacobians,
+        "{} of {}",
+        f.tangent_jacobians,
+        f.jacobians
+    );
     assert!(o.dir.join("fit.toml").exists() && o.dir.join("report.html").exists());
     // the FEM's check of the calibration (4.9): the FEM of the calibrated robot reads the
     // recording to its noise, as the truth's FEM that made it does

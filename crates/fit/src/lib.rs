@@ -3,8 +3,8 @@
 //! The identification of a model's physical parameters on a recording (`docs/measured.md`
 //! section 4): the weighted least-squares problem on the sensor channels ([`problem`], Eqs.
 //! LS1-LS5, with the channels' noise levels estimated from the recording, [`noise`]), a
-//! Levenberg-Marquardt search within box bounds ([`search`], Eqs. LS6-LS10) on a forward-difference
-//! Jacobian evaluated in parallel ([`jacobian`]), the statistics at the optimum ([`stats`], Eqs.
+//! Levenberg-Marquardt search within box bounds ([`search`], Eqs. LS6-LS10) on a Jacobian from the
+//! model's forward sensitivities or by forward differences evaluated in parallel ([`jacobian`]), the statistics at the optimum ([`stats`], Eqs.
 //! LS11-LS14) and the identifiability check ([`identifiability`], Eqs. LS15-LS16); the white-noise
 //! density a residual spectrum is read against ([`noise::white_psd`], Eq. LS17).
 //!
@@ -36,6 +36,23 @@ use flexstar_model::SensorTable;
 /// not be evaluated there (the search treats a trial step that fails as a rejected one).
 pub trait Model: Sync {
     fn evaluate(&self, theta: &[f64]) -> Result<SensorTable, String>;
+
+    /// The readings at `theta` and their derivatives along each parameter k, from the model's
+    /// forward sensitivities along the step `steps[k]` (the parameter's own unit;
+    /// `docs/measured.md` 4.5, Eq. LS9b). `None`: the model has none, and the Jacobian is taken
+    /// by forward differences; an error: they cannot be taken at `theta` (the same).
+    fn slopes(&self, _theta: &[f64], _steps: &[f64]) -> Option<Result<Slopes, String>> {
+        None
+    }
+}
+
+/// What [`Model::slopes`] gives: the readings, their derivatives per parameter [the channel's
+/// unit per unit of the parameter] on the same times, and the model runs that took.
+#[derive(Debug, Clone)]
+pub struct Slopes {
+    pub readings: SensorTable,
+    pub derivatives: Vec<SensorTable>,
+    pub runs: usize,
 }
 
 impl<F> Model for F

@@ -135,7 +135,12 @@ pub struct Fit {
     /// `stop` in words.
     pub reason: String,
     pub iterations: usize,
+    /// The model runs, a Jacobian's counted as the runs it took.
     pub evaluations: usize,
+    /// The Jacobians taken, and how many of them came from the model's sensitivities
+    /// (`docs/measured.md` 4.5, Eq. LS9b; the rest by forward differences).
+    pub jacobians: usize,
+    pub tangent_jacobians: usize,
     pub wall_s: f64,
     pub trace: Vec<Iteration>,
     /// Every start's search (`docs/measured.md` 4.6): the given start first; the estimates are

@@ -214,6 +214,22 @@ impl Problem {
         Ok(r)
     }
 
+    /// The derivative of Eq. LS1's residual vector along a parameter from the derivatives
+    /// `slopes` of the model's readings along it (a table of [`crate::Model::slopes`]):
+    /// `w_c dy_c / sigma_c`, channel after channel (fitted channels only).
+    pub fn residual_slopes(&self, slopes: &SensorTable) -> Result<Vec<f64>, String> {
+        let mut r = Vec::with_capacity(self.rows());
+        for c in self.channels.iter().filter(|c| c.fitted()) {
+            let dy = self.model_channel(slopes, &c.column)?;
+            let scale = c.weight / c.sigma;
+            r.extend(dy.iter().map(|d| scale * d));
+        }
+        if r.iter().any(|v| !v.is_finite()) {
+            return Err("a derivative of the model's readings is not a number".into());
+        }
+        Ok(r)
+    }
+
     /// The model's error `y_c - m_c` of every channel (fitted or not), in its unit.
     pub fn errors(&self, model: &SensorTable) -> Result<Vec<Vec<f64>>, String> {
         self.channels

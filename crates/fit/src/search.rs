@@ -61,6 +61,9 @@ struct State {
     r: Vec<f64>,
     table: SensorTable,
     j: DMatrix<f64>,
+    /// The model runs of its Jacobian, and whether it came from the model's sensitivities.
+    j_runs: usize,
+    j_tangent: bool,
 }
 
 impl State {
@@ -97,17 +100,19 @@ pub fn fit<M: Model + ?Sized>(
         model,
         settings,
         started,
-        evaluations: 1 + problem.params.len(),
+        evaluations: 0,
+        jacobians: (0, 0),
         trace: Vec::new(),
     };
+    run.count(&start);
     let mut best = run.search_from(start, on_iteration);
     let mut starts = vec![best.outcome(&theta0, settings.offset_tol)];
     let mut chosen = 0;
     for u in crate::starts::halton_starts(problem.params.len(), settings.starts.saturating_sub(1)) {
         let theta = problem.physical(&u);
-        run.evaluations += 1 + problem.params.len();
         match evaluate_state(problem, model, u, theta.clone()) {
             Ok(state) => {
+                run.count(&state);
                 let other = run.search_from(state, on_iteration);
                 starts.push(other.outcome(&theta, settings.offset_tol));
                 if other.better_than(&best) {
@@ -115,15 +120,18 @@ pub fn fit<M: Model + ?Sized>(
                     chosen = starts.len() - 1;
                 }
             }
-            Err(e) => starts.push(StartOutcome {
-                start: theta.clone(),
-                end: theta,
-                cost: f64::NAN,
-                converged: false,
-                iterations: 0,
-                reason: e.to_string(),
-                chosen: false,
-            }),
+            Err(e) => {
+                run.evaluations += 1;
+                starts.push(StartOutcome {
+                    start: theta.clone(),
+                    end: theta,
+                    cost: f64::NAN,
+                    converged: false,
+                    iterations: 0,
+                    reason: e.to_string(),
+                    chosen: false,
+                });
+            }
         }
     }
     starts[chosen].chosen = true;
@@ -179,7 +187,15 @@ fn evaluate_state<M: Model + ?Sized>(
         at: format!("{at} (the step of {})", problem.params[k].key),
         reason,
     })?;
-    Ok(State { u, theta, r, table, j })
+    Ok(State {
+        u,
+        theta,
+        r,
+        table,
+        j: j.j,
+        j_runs: j.runs,
+        j_tangent: j.by_tangent,
+    })
 }
 
 /// `key = value` of every parameter.
@@ -227,6 +243,8 @@ struct Run<'a, M: Model + ?Sized> {
     settings: &'a Settings,
     started: Instant,
     evaluations: usize,
+    /// The Jacobians taken, and how many of them came from the model's sensitivities.
+    jacobians: (usize, usize),
     trace: Vec<Iteration>,
 }
 
@@ -237,6 +255,13 @@ enum Step {
 }
 
 impl<M: Model + ?Sized> Run<'_, M> {
+    /// Count an evaluated state: its run and its Jacobian's.
+    fn count(&mut self, s: &State) {
+        self.evaluations += 1 + s.j_runs;
+        self.jacobians.0 += 1;
+        self.jacobians.1 += usize::from(s.j_tangent);
+    }
+
     /// A search from `s`, its iterations taken out of the bookkeeping.
     fn search_from(&mut self, s: State, on_iteration: &dyn Fn(&Iteration)) -> Searched {
         self.record(&s, 0, 0.0, on_iteration);
@@ -321,11 +346,22 @@ impl<M: Model + ?Sized> Run<'_, M> {
 
     /// The Jacobian at an accepted iterate.
     fn accept(&mut self, u: Vec<f64>, r: Vec<f64>, table: SensorTable, damping: f64) -> Step {
-        self.evaluations += u.len();
         match jacobian(self.problem, self.model, &u, &r) {
             Ok(j) => {
+                self.evaluations += j.runs;
+                self.jacobians.0 += 1;
+                self.jacobians.1 += usize::from(j.by_tangent);
                 let theta = self.problem.physical(&u);
-                Step::Accepted(State { u, theta, r, table, j }, damping)
+                let state = State {
+                    u,
+                    theta,
+                    r,
+                    table,
+                    j: j.j,
+                    j_runs: j.runs,
+                    j_tangent: j.by_tangent,
+                };
+                Step::Accepted(state, damping)
             }
             Err((k, reason)) => Step::Stopped(Stop::EvaluationFailed {
                 reason: format!(
@@ -393,6 +429,8 @@ impl<M: Model + ?Sized> Run<'_, M> {
             reason,
             iterations: self.trace.len().saturating_sub(1),
             evaluations: self.evaluations,
+            jacobians: self.jacobians.0,
+            tangent_jacobians: self.jacobians.1,
             wall_s: self.started.elapsed().as_secs_f64(),
             trace: self.trace,
             starts: Vec::new(),

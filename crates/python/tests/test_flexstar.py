@@ -397,6 +397,8 @@ def test_fit_matches_the_cli_contract(root, tmp_path):
     rec = tmp_path / "rec/truth/fem-sensors.csv"
     res = flexstar.fit(root / "configs/measured/nominal.toml", rec, tmp_path / "out")
     assert res["converged"] and res["calibrated"] and res["identifiability"]["verdict"] == "identifiable"
+    # its Jacobians from the tangent-linear AMM (docs/measured.md 4.5, Eq. LS9b)
+    assert res["jacobians"]["total"] > 0 and res["jacobians"]["by_tangent"] == res["jacobians"]["total"]
     truths = {"payload.mass": (0.4, 0.02), "payload.J": (1.5e-3, 0.02), "damping.zeta": (0.02, 0.05), "robot.E": (190e9, 0.01)}
     for p in res["parameters"]:
         value, target = truths[p["key"]]

@@ -6,6 +6,10 @@
 //! studies, the Python package) solves through [`solve`]; each solver has one entry point of the
 //! shape of `flexstar_drive::SolveRequest` (`docs/architecture.md`, "One way to solve").
 
+mod sensor_slopes;
+
+pub use sensor_slopes::{sensor_slopes, SensorSlopes};
+
 use flexstar_drive::{ActuatorLaw, Drive, Progress, SolveRequest, Solved};
 use flexstar_kinematics::CheckedMotion;
 use flexstar_model::{AmmSettings, DriveKind, Experiment, FemSettings, ModelError, Problem, Response};

@@ -90,6 +90,9 @@ pub(crate) struct Sleeves {
     /// The mode values of each update kept for the tangent's probe ([`Sleeves::keep_values`]);
     /// `None` in a plain run.
     kept: Option<Box<near::SleevesNear>>,
+    /// A tangent's probe at other physical parameters: [`Sleeves::update_near`] evaluates the
+    /// truncation flexibility block on these sleeves instead of taking the run's to first order.
+    own_flexibility: bool,
 }
 
 impl Sleeves {
@@ -124,6 +127,7 @@ impl Sleeves {
             xc: [0.0; 3],
             lengths: std::array::from_fn(|i| params[i].l),
             kept: None,
+            own_flexibility: false,
         }
     }
 
@@ -196,6 +200,11 @@ impl Sleeves {
     /// tangent's linearised sleeve rows ([`Sleeves::update_near`]).
     pub(crate) fn keep_values(&mut self, nm: usize) {
         self.kept = Some(Box::new(near::SleevesNear::new(nm)));
+    }
+
+    /// See the field `own_flexibility`.
+    pub(crate) fn evaluate_own_flexibility(&mut self) {
+        self.own_flexibility = true;
     }
 
     /// The values kept at the last update ([`Sleeves::keep_values`]).

@@ -174,6 +174,7 @@ impl Sleeves {
                 }
             }
         }
-        self.finish(beams, rows, qhat, shifts, Some(&res));
+        let res = (!self.own_flexibility).then_some(&res);
+        self.finish(beams, rows, qhat, shifts, res);
     }
 }

@@ -24,6 +24,13 @@ impl System {
         self.friction.is_none() && self.gravity == [0.0; 2]
     }
 
+    /// A tangent's probe at other physical parameters than the run's: its sleeve rows, taken to
+    /// first order about the run's, evaluate their truncation flexibility on its own beams
+    /// (`sleeve::near`).
+    pub(crate) fn evaluate_own_flexibility(&mut self) {
+        self.sleeves.evaluate_own_flexibility();
+    }
+
     /// The residual of the prepared step's equations (module docs) at the accelerations `qdd`
     /// and multipliers `lam`: `primal = S qdd - C^T lam - r` (per beam: alpha rows, u row, thp
     /// row) and `rows` per constraint row. Zero, to round-off, at the step's own solution.

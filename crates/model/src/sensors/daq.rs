@@ -142,6 +142,18 @@ impl Sensors {
     /// `lowpass_hz`), sampled at `k / rate_hz` up to `t_end` [s] (the output times without a
     /// rate) and its noise added (Eq. S13).
     pub fn acquire(&self, raw: &SensorTable, t_end: f64) -> SensorTable {
+        self.acquire_with(raw, t_end, true)
+    }
+
+    /// The derivative of what the data acquisition records, from the derivatives `raw` of the
+    /// readings at the output times along a parameter: the filter and the sampling are linear,
+    /// the noise does not move with the parameter, so [`Sensors::acquire`] without the noise.
+    pub fn acquire_derivative(&self, raw: &SensorTable, t_end: f64) -> SensorTable {
+        self.acquire_with(raw, t_end, false)
+    }
+
+    /// [`Sensors::acquire`], the noise added when `noise`.
+    fn acquire_with(&self, raw: &SensorTable, t_end: f64, noise: bool) -> SensorTable {
         let t = match self.rate_hz() {
             Some(rate) => sample_times(rate, t_end),
             None => raw.t.clone(),
@@ -160,7 +172,7 @@ impl Sensors {
                     None => filtered,
                 };
                 let sigma = s.daq.noise[axis];
-                if sigma > 0.0 {
+                if noise && sigma > 0.0 {
                     let mut n = Normal::new(s.daq.seed, channel);
                     y.iter_mut().for_each(|v| *v += sigma * n.draw());
                 }

@@ -5,6 +5,8 @@
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 
+use flexstar_model::SensorTable;
+
 use crate::problem::{Param, Problem};
 use crate::Model;
 
@@ -51,7 +53,7 @@ pub fn jacobian<M: Model + ?Sized>(
     u: &[f64],
     r: &[f64],
 ) -> Result<Columns, (usize, String)> {
-    if let Some(Ok(done)) = by_tangent(problem, model, u) {
+    if let Some(Ok((done, _))) = by_tangent(problem, model, u) {
         return Ok(done);
     }
     let j = differences(problem, model, u, r)?;
@@ -62,11 +64,44 @@ pub fn jacobian<M: Model + ?Sized>(
     })
 }
 
+/// An evaluation of the model with its Jacobian ([`evaluate_with_columns`]).
+#[derive(Debug, Clone)]
+pub struct WithColumns {
+    /// The residual vector (Eq. LS1).
+    pub r: Vec<f64>,
+    pub readings: SensorTable,
+    pub columns: Columns,
+}
+
+/// The model at `u` and its Jacobian in one go, from its sensitivities (the run that gives the
+/// readings carries the directions): the residual vector, the readings and the Jacobian. `None`
+/// where the model has none, or they cannot be taken here (the caller then evaluates the model
+/// alone). An evaluation that fails is an error, with the model's reason.
+pub fn evaluate_with_columns<M: Model + ?Sized>(
+    problem: &Problem,
+    model: &M,
+    u: &[f64],
+) -> Option<Result<WithColumns, String>> {
+    let (columns, readings) = match by_tangent(problem, model, u)? {
+        Ok(done) => done,
+        Err(_) => return None,
+    };
+    Some(
+        problem
+            .residuals(&readings)
+            .map(|r| WithColumns { r, readings, columns }),
+    )
+}
+
 /// Eq. LS9b: column j is `dr/dtheta_j (hi_j - lo_j)`, `dr/dtheta_j` from the model's
 /// derivative along `h_j = TANGENT_STEP max(|theta_j|, FD_FLOOR (hi_j - lo_j))`. `None` where
 /// the model has no sensitivities; an error where they cannot be taken here (the caller then
 /// takes differences).
-fn by_tangent<M: Model + ?Sized>(problem: &Problem, model: &M, u: &[f64]) -> Option<Result<Columns, String>> {
+fn by_tangent<M: Model + ?Sized>(
+    problem: &Problem,
+    model: &M,
+    u: &[f64],
+) -> Option<Result<(Columns, SensorTable), String>> {
     let theta = problem.physical(u);
     let steps: Vec<f64> = (problem.params.iter().zip(&theta))
         .map(|(p, t)| TANGENT_STEP * t.abs().max(FD_FLOOR * p.width()))
@@ -84,11 +119,12 @@ fn by_tangent<M: Model + ?Sized>(problem: &Problem, model: &M, u: &[f64]) -> Opt
             .map(|d| problem.residual_slopes(d))
             .collect::<Result<Vec<_>, _>>()?;
         let j = DMatrix::from_fn(problem.rows(), u.len(), |i, k| rows[k][i] * problem.params[k].width());
-        Ok(Columns {
+        let columns = Columns {
             j,
             runs: s.runs,
             by_tangent: true,
-        })
+        };
+        Ok((columns, s.readings))
     }))
 }
 
@@ -116,7 +152,6 @@ fn differences<M: Model + ?Sized>(
 mod tests {
     use super::*;
     use crate::Slopes;
-    use flexstar_model::SensorTable;
 
     /// `y(t) = a sin(b t)` on one channel, with its exact derivatives as the model's slopes
     /// (or an error, or none).
@@ -161,6 +196,26 @@ mod tests {
         };
         let rec = table(|t| 2.0 * (3.0 * t).sin());
         Problem::with_sigmas(vec![p("a", 1.0, 3.0), p("b", 2.0, 6.0)], &rec, &[2.0], &[0.5]).unwrap()
+    }
+
+    /// The search with the model's sensitivities (each trial after an accepted step carrying
+    /// the Jacobian's directions) lands where the search by differences does, every Jacobian
+    /// from the sensitivities, in fewer model runs; the recording `2 sin(3 t)` is fitted
+    /// exactly.
+    #[test]
+    fn a_search_on_the_models_slopes_finds_the_same_minimum() {
+        let p = problem();
+        let settings = crate::Settings::default();
+        let by_slopes = crate::fit(&p, &Sine { slopes: Some(true) }, &settings, &|_| {}).unwrap();
+        let by_differences = crate::fit(&p, &Sine { slopes: None }, &settings, &|_| {}).unwrap();
+        assert!(by_slopes.converged() && by_differences.converged());
+        assert_eq!(by_slopes.tangent_jacobians, by_slopes.jacobians);
+        assert_eq!(by_differences.tangent_jacobians, 0);
+        for (a, b) in by_slopes.theta().iter().zip(by_differences.theta()) {
+            assert!((a - b).abs() < 1e-6 * b.abs(), "{a} vs {b}");
+        }
+        assert!((by_slopes.theta()[0] - 2.0).abs() < 1e-6 && (by_slopes.theta()[1] - 3.0).abs() < 1e-6);
+        assert!(by_slopes.evaluations < by_differences.evaluations);
     }
 
     /// Eq. LS9b: the columns are the model's derivatives weighted (`w / sigma` = 4) and scaled

@@ -5,7 +5,9 @@
 //! the parameters at a bound whose gradient pushes them outwards are held (Eq. LS7); the damped
 //! step of the others solves `(A_F + mu diag A_F) d = -g_F` (Eq. LS8) and is projected onto the
 //! box; it is taken when the cost falls, the damping then lowered by the gain ratio (Nielsen's
-//! rule), else the damping is raised and the step tried again. The search stops on the relative
+//! rule), else the damping is raised and the step tried again. Where the model has
+//! sensitivities, a trial after an accepted step carries the Jacobian's directions (4.5), so
+//! that an accepted trial has its Jacobian without another run. The search stops on the relative
 //! offset (Eq. LS10), a statistical criterion: the distance left to the optimum is below a
 //! thousandth of the estimates' own uncertainty.
 
@@ -16,7 +18,7 @@ use nalgebra::{DMatrix, DVector};
 use flexstar_model::SensorTable;
 
 use crate::identifiability::Verdict;
-use crate::jacobian::jacobian;
+use crate::jacobian::{evaluate_with_columns, jacobian, Columns};
 use crate::outcome::{ChannelFit, Estimate, Fit, Iteration, StartOutcome, Stop};
 use crate::problem::Problem;
 use crate::step::{damped_step, free_set, normal_equations, predicted_decrease, project, relative_offset};
@@ -61,7 +63,8 @@ struct State {
     r: Vec<f64>,
     table: SensorTable,
     j: DMatrix<f64>,
-    /// The model runs of its Jacobian, and whether it came from the model's sensitivities.
+    /// The model runs its Jacobian took beyond the evaluation's own, and whether it came from
+    /// the model's sensitivities.
     j_runs: usize,
     j_tangent: bool,
 }
@@ -102,6 +105,7 @@ pub fn fit<M: Model + ?Sized>(
         started,
         evaluations: 0,
         jacobians: (0, 0),
+        speculate: true,
         trace: Vec::new(),
     };
     run.count(&start);
@@ -181,6 +185,18 @@ fn evaluate_state<M: Model + ?Sized>(
     theta: Vec<f64>,
 ) -> Result<State, FitError> {
     let at = describe(problem, &theta);
+    if let Some(done) = evaluate_with_columns(problem, model, &u) {
+        let done = done.map_err(|reason| FitError::Evaluation { at, reason })?;
+        return Ok(State {
+            u,
+            theta,
+            r: done.r,
+            table: done.readings,
+            j: done.columns.j,
+            j_runs: done.columns.runs - 1,
+            j_tangent: true,
+        });
+    }
     let evaluated = model.evaluate(&theta).and_then(|t| Ok((problem.residuals(&t)?, t)));
     let (r, table) = evaluated.map_err(|reason| FitError::Evaluation { at: at.clone(), reason })?;
     let j = jacobian(problem, model, &u, &r).map_err(|(k, reason)| FitError::Evaluation {
@@ -245,8 +261,14 @@ struct Run<'a, M: Model + ?Sized> {
     evaluations: usize,
     /// The Jacobians taken, and how many of them came from the model's sensitivities.
     jacobians: (usize, usize),
+    /// Whether the next trial carries the Jacobian's directions: after an accepted step (a
+    /// rejected trial then costs the directions too), not after a rejected one.
+    speculate: bool,
     trace: Vec<Iteration>,
 }
+
+/// A trial's residual vector and readings, and its Jacobian where the trial carried it.
+type Evaluated = (Vec<f64>, SensorTable, Option<Columns>);
 
 /// The outcome of one iteration.
 enum Step {
@@ -327,17 +349,36 @@ impl<M: Model + ?Sized> Run<'_, M> {
             let u = project(&s.u, &d);
             let taken: Vec<f64> = u.iter().zip(&s.u).map(|(a, b)| a - b).collect();
             let predicted = predicted_decrease(a, g, &taken);
-            self.evaluations += 1;
-            let trial = self.problem.evaluate(self.model, &u);
+            // after an accepted step the trial carries the Jacobian's directions (the model's
+            // sensitivities, `docs/measured.md` 4.5): an accepted trial then needs no more runs
+            let speculated = (self.speculate)
+                .then(|| evaluate_with_columns(self.problem, self.model, &u))
+                .flatten();
+            let (trial, columns) = match speculated {
+                Some(Ok(done)) => {
+                    self.evaluations += done.columns.runs;
+                    (Ok((done.r, done.readings)), Some(done.columns))
+                }
+                Some(Err(e)) => {
+                    self.evaluations += 1;
+                    (Err(e), None)
+                }
+                None => {
+                    self.evaluations += 1;
+                    (self.problem.evaluate(self.model, &u), None)
+                }
+            };
             if let Ok((r, table)) = trial {
                 let actual = cost0 - cost(&r);
                 if actual > 0.0 && predicted > 0.0 {
                     let rho = actual / predicted;
                     let damping = *mu;
                     *mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
-                    return self.accept(u, r, table, damping);
+                    self.speculate = true;
+                    return self.accept(u, (r, table, columns), damping);
                 }
             }
+            self.speculate = false;
             *mu *= nu;
             nu *= 2.0;
         }
@@ -345,10 +386,13 @@ impl<M: Model + ?Sized> Run<'_, M> {
     }
 
     /// The Jacobian at an accepted iterate.
-    fn accept(&mut self, u: Vec<f64>, r: Vec<f64>, table: SensorTable, damping: f64) -> Step {
-        match jacobian(self.problem, self.model, &u, &r) {
+    fn accept(&mut self, u: Vec<f64>, (r, table, columns): Evaluated, damping: f64) -> Step {
+        let taken = match columns {
+            Some(c) => Ok(c),
+            None => jacobian(self.problem, self.model, &u, &r).inspect(|j| self.evaluations += j.runs),
+        };
+        match taken {
             Ok(j) => {
-                self.evaluations += j.runs;
                 self.jacobians.0 += 1;
                 self.jacobians.1 += usize::from(j.by_tangent);
                 let theta = self.problem.physical(&u);

@@ -72,9 +72,7 @@ impl AmmEvaluation<'_> {
         let doc = flexstar_study::patch::case_document(self.base, &self.keys, &values)?;
         ExperimentDoc::from_table(doc, self.source).map_err(|e| e.to_string())
     }
-}
 
-impl AmmEvaluation<'_> {
     /// The run at `theta` prepared at the frozen N and step, its sensors without noise.
     fn prepared(&self, theta: &[f64]) -> std::result::Result<crate::run::Prepared, String> {
         let exp = noiseless(self.experiment(theta)?.exp);

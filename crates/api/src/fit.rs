@@ -181,6 +181,7 @@ impl<'a> Setup<'a> {
             dt: start.dt,
             window,
             last: Default::default(),
+            refused: Default::default(),
         };
         let settings = flexstar_fit::Settings {
             max_iterations: self.section.iterations(),

@@ -63,6 +63,10 @@ pub(crate) struct AmmEvaluation<'a> {
     /// The last evaluation's prepared run and its parameters' bits: the Jacobian that follows an
     /// accepted step is taken at the same parameters ([`Model::slopes`]).
     pub last: std::sync::Mutex<Option<(Vec<u64>, std::sync::Arc<crate::run::Prepared>)>>,
+    /// Set once the tangent has been refused (a key that moves the mode basis, friction,
+    /// gravity: nothing that changes with the parameters' values) or has failed: the Jacobians
+    /// are then taken by differences without preparing the directions again.
+    pub refused: std::sync::atomic::AtomicBool,
 }
 
 impl AmmEvaluation<'_> {
@@ -132,6 +136,10 @@ impl Model for AmmEvaluation<'_> {
     /// (a prescribed motion, no friction or gravity: `flexstar_amm::sensitivities_cover`): the
     /// directions split into one contiguous group per thread, each group one run.
     fn slopes(&self, theta: &[f64], steps: &[f64]) -> Option<std::result::Result<Slopes, String>> {
+        use std::sync::atomic::Ordering;
+        if self.refused.load(Ordering::Relaxed) {
+            return None;
+        }
         let kept = (self.last.lock().ok())
             .and_then(|last| last.as_ref().filter(|(b, _)| *b == bits(theta)).map(|(_, p)| p.clone()));
         let base = match kept {
@@ -141,6 +149,7 @@ impl Model for AmmEvaluation<'_> {
         let covered =
             flexstar_amm::sensitivities_cover(&base.problem, &base.exp.amm).is_ok() && !base.exp.drive.is_direct();
         if !covered || steps.is_empty() {
+            self.refused.store(true, Ordering::Relaxed);
             return None;
         }
         let groups = rayon::current_num_threads().clamp(1, steps.len());
@@ -154,6 +163,9 @@ impl Model for AmmEvaluation<'_> {
             .into_par_iter()
             .map(|g| self.group_slopes(&base, theta, (steps, g)))
             .collect();
+        if done.is_err() {
+            self.refused.store(true, Ordering::Relaxed);
+        }
         Some(done.map(|groups| {
             let mut groups = groups.into_iter();
             let (readings, mut derivatives) = groups.next().expect("one group at least");
@@ -231,6 +243,7 @@ mod tests {
             dt: start.dt,
             window: 0..start.sensors.t.len(),
             last: Default::default(),
+            refused: Default::default(),
         }
     }
 

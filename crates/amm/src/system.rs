@@ -911,7 +911,7 @@ impl System {
         }
         let iterates = self.iterates_lagged_accelerations();
         let mut lagged = [[0.0; 2]; 3];
-        for i in 0..3 {
+        for (i, lag) in lagged.iter_mut().enumerate() {
             let bm = pick(&self.bm, i);
             let (rho, l) = (bm.rho, bm.l);
             // Eqs. 11-12: e_x = [sin a, -cos a], e_w = [cos a, sin a], one sin/cos pair
@@ -947,7 +947,7 @@ impl System {
                 if let Some(fore) = self.fore.as_mut() {
                     r[nm] += rho * fore.second_derivative(i, geo.kept(), g2a, va);
                     if iterates {
-                        lagged[i] = [self.udd[i], fore.acceleration_part(i, geo.kept(), g2a)];
+                        *lag = [self.udd[i], fore.acceleration_part(i, geo.kept(), g2a)];
                     }
                 }
             }

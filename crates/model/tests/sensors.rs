@@ -259,3 +259,70 @@ fn samples_lie_on_one_clock_and_interpolate_linearly() {
         vec![0.0, 1.0, 4.0, 6.0]
     );
 }
+
+/// The derivative of what the acquisition records (`Sensors::acquire_derivative`, the
+/// acquisition without the noise) against the difference of two noisy acquisitions over their
+/// step: the filter (Eq. S11) and the sampling are linear and the same seed draws the same
+/// noise, so the two agree to round-off.
+#[test]
+fn the_acquisitions_derivative_is_the_difference_of_two_noisy_ones() {
+    let text = r#"
+[time]
+t_end = 0.5
+dt_out = 0.001
+[[sensors]]
+name = "acc"
+kind = "accelerometer"
+at = "G"
+noise = [0.1, 0.4]
+seed = 3
+lowpass_hz = 80.0
+rate_hz = 300.0
+"#;
+    let text = BASE.replace("[time]\nt_end = 0.2\ndt_out = 0.001\n", "") + text;
+    let p = Experiment::from_toml_str(&text, Path::new("d.toml"))
+        .unwrap()
+        .problem()
+        .unwrap();
+    let n = 501;
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+    let wave = |a: f64, f: f64| -> Vec<f64> { t.iter().map(|&s| a * (f * s).sin() + 0.3 * s).collect() };
+    let table = |x: Vec<f64>, y: Vec<f64>| {
+        let mut raw = SensorTable::new(t.clone());
+        raw.push_column("acc_x".into(), "m/s^2", x);
+        raw.push_column("acc_y".into(), "m/s^2", y);
+        raw
+    };
+    let (d_x, d_y) = (wave(0.7, 90.0), wave(-1.3, 400.0));
+    let h = 1e-3;
+    let base = table(wave(2.0, 31.0), wave(1.0, 57.0));
+    let moved = table(
+        base.columns[0]
+            .values
+            .iter()
+            .zip(&d_x)
+            .map(|(b, d)| b + h * d)
+            .collect(),
+        base.columns[1]
+            .values
+            .iter()
+            .zip(&d_y)
+            .map(|(b, d)| b + h * d)
+            .collect(),
+    );
+    let (a0, a1) = (p.sensors().acquire(&base, 0.5), p.sensors().acquire(&moved, 0.5));
+    let d = p.sensors().acquire_derivative(&table(d_x, d_y), 0.5);
+    assert_eq!(d.t, a0.t);
+    for (c, col) in d.columns.iter().enumerate() {
+        let scale = col.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (k, v) in col.values.iter().enumerate() {
+            let diff = (a1.columns[c].values[k] - a0.columns[c].values[k]) / h;
+            assert!(
+                (v - diff).abs() < 1e-9 * scale,
+                "{} at {}: {v} vs {diff}",
+                col.name,
+                d.t[k]
+            );
+        }
+    }
+}

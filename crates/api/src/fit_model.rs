@@ -64,8 +64,8 @@ pub(crate) struct AmmEvaluation<'a> {
     /// accepted step is taken at the same parameters ([`Model::slopes`]).
     pub last: std::sync::Mutex<Option<(Vec<u64>, std::sync::Arc<crate::run::Prepared>)>>,
     /// Set once the tangent has been refused (a key that moves the mode basis, friction,
-    /// gravity: nothing that changes with the parameters' values) or has failed: the Jacobians
-    /// are then taken by differences without preparing the directions again.
+    /// gravity: nothing that changes with the parameters' values): the Jacobians are then taken
+    /// by differences without preparing the directions again.
     pub refused: std::sync::atomic::AtomicBool,
 }
 
@@ -105,8 +105,14 @@ impl AmmEvaluation<'_> {
                 self.prepared(&at).map(|p| p.problem)
             })
             .collect::<std::result::Result<Vec<_>, _>>()?;
-        let s = flexstar_solve::sensor_slopes(&base.problem, &base.exp.amm, &moved, &steps[group])
-            .map_err(|e| e.to_string())?;
+        let s = flexstar_solve::sensor_slopes(&base.problem, &base.exp.amm, &moved, &steps[group]).map_err(|e| {
+            // a refused setting (a direction that moves the mode basis, the sensors, the output
+            // times) holds at every parameter value; a run that fails here may not
+            if let flexstar_solve::SolveError::Amm(flexstar_amm::AmmError::InvalidSetting { .. }) = e {
+                self.refused.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+            e.to_string()
+        })?;
         let table = s
             .response
             .sensors
@@ -163,9 +169,6 @@ impl Model for AmmEvaluation<'_> {
             .into_par_iter()
             .map(|g| self.group_slopes(&base, theta, (steps, g)))
             .collect();
-        if done.is_err() {
-            self.refused.store(true, Ordering::Relaxed);
-        }
         Some(done.map(|groups| {
             let mut groups = groups.into_iter();
             let (readings, mut derivatives) = groups.next().expect("one group at least");

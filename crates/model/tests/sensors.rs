@@ -210,23 +210,25 @@ seed = 11
     assert_eq!(got.units, ["m"]);
 }
 
+/// The problem of [`BASE`] over `t_end` [s] (outputs every ms) with the `[[sensors]]` of
+/// `sensors`.
+fn over(t_end: f64, sensors: &str) -> flexstar_model::Problem {
+    let text = BASE.replace("[time]\nt_end = 0.2\ndt_out = 0.001\n", "")
+        + &format!("[time]\nt_end = {t_end}\ndt_out = 0.001\n")
+        + sensors;
+    Experiment::from_toml_str(&text, Path::new("s.toml"))
+        .unwrap()
+        .problem()
+        .unwrap()
+}
+
 /// `noise = [nx, ny]`: each accelerometer axis gets its own standard deviation (Eq. S13).
 #[test]
 fn an_accelerometer_takes_one_noise_level_per_axis() {
-    let text = r#"
-[time]
-t_end = 20.0
-dt_out = 0.001
-[[sensors]]
-name = "acc"
-kind = "accelerometer"
-at = "G"
-noise = [0.1, 0.4]
-seed = 3
-"#;
-    let text = BASE.replace("[time]\nt_end = 0.2\ndt_out = 0.001\n", "") + text;
-    let exp = Experiment::from_toml_str(&text, Path::new("n.toml")).unwrap();
-    let p = exp.problem().unwrap();
+    let p = over(
+        20.0,
+        "[[sensors]]\nname = \"acc\"\nkind = \"accelerometer\"\nat = \"G\"\nnoise = [0.1, 0.4]\nseed = 3\n",
+    );
     let n = 20_001;
     let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
     let mut raw = SensorTable::new(t);
@@ -266,24 +268,11 @@ fn samples_lie_on_one_clock_and_interpolate_linearly() {
 /// noise, so the two agree to round-off.
 #[test]
 fn the_acquisitions_derivative_is_the_difference_of_two_noisy_ones() {
-    let text = r#"
-[time]
-t_end = 0.5
-dt_out = 0.001
-[[sensors]]
-name = "acc"
-kind = "accelerometer"
-at = "G"
-noise = [0.1, 0.4]
-seed = 3
-lowpass_hz = 80.0
-rate_hz = 300.0
-"#;
-    let text = BASE.replace("[time]\nt_end = 0.2\ndt_out = 0.001\n", "") + text;
-    let p = Experiment::from_toml_str(&text, Path::new("d.toml"))
-        .unwrap()
-        .problem()
-        .unwrap();
+    let p = over(
+        0.5,
+        "[[sensors]]\nname = \"acc\"\nkind = \"accelerometer\"\nat = \"G\"\nnoise = [0.1, 0.4]\nseed = 3\n\
+         lowpass_hz = 80.0\nrate_hz = 300.0\n",
+    );
     let n = 501;
     let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
     let wave = |a: f64, f: f64| -> Vec<f64> { t.iter().map(|&s| a * (f * s).sin() + 0.3 * s).collect() };

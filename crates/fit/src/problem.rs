@@ -199,12 +199,7 @@ impl Problem {
     /// channels only), `w_c (y_c(t_k) - m_ck) / sigma_c`. An error names a channel the model
     /// lacks, other times, or a reading that is not a number.
     pub fn residuals(&self, model: &SensorTable) -> Result<Vec<f64>, String> {
-        let mut r = Vec::with_capacity(self.rows());
-        for c in self.channels.iter().filter(|c| c.fitted()) {
-            let y = self.model_channel(model, &c.column)?;
-            let scale = c.weight / c.sigma;
-            r.extend(y.iter().zip(&c.measured).map(|(y, m)| scale * (y - m)));
-        }
+        let r = self.weighted(model, |y, m| y - m)?;
         if let Some(k) = r.iter().position(|v| !v.is_finite()) {
             return Err(format!(
                 "the model's reading {} is not a number",
@@ -218,14 +213,21 @@ impl Problem {
     /// `slopes` of the model's readings along it (a table of [`crate::Model::slopes`]):
     /// `w_c dy_c / sigma_c`, channel after channel (fitted channels only).
     pub fn residual_slopes(&self, slopes: &SensorTable) -> Result<Vec<f64>, String> {
-        let mut r = Vec::with_capacity(self.rows());
-        for c in self.channels.iter().filter(|c| c.fitted()) {
-            let dy = self.model_channel(slopes, &c.column)?;
-            let scale = c.weight / c.sigma;
-            r.extend(dy.iter().map(|d| scale * d));
-        }
+        let r = self.weighted(slopes, |dy, _| dy)?;
         if r.iter().any(|v| !v.is_finite()) {
             return Err("a derivative of the model's readings is not a number".into());
+        }
+        Ok(r)
+    }
+
+    /// `w_c f(y_ck, m_ck) / sigma_c` of every fitted channel of `table` (its readings `y`
+    /// against the recorded `m`), channel after channel.
+    fn weighted(&self, table: &SensorTable, f: impl Fn(f64, f64) -> f64) -> Result<Vec<f64>, String> {
+        let mut r = Vec::with_capacity(self.rows());
+        for c in self.channels.iter().filter(|c| c.fitted()) {
+            let y = self.model_channel(table, &c.column)?;
+            let scale = c.weight / c.sigma;
+            r.extend(y.iter().zip(&c.measured).map(|(&y, &m)| scale * f(y, m)));
         }
         Ok(r)
     }

@@ -355,19 +355,11 @@ impl<M: Model + ?Sized> Run<'_, M> {
                 .then(|| evaluate_with_columns(self.problem, self.model, &u))
                 .flatten();
             let (trial, columns) = match speculated {
-                Some(Ok(done)) => {
-                    self.evaluations += done.columns.runs;
-                    (Ok((done.r, done.readings)), Some(done.columns))
-                }
-                Some(Err(e)) => {
-                    self.evaluations += 1;
-                    (Err(e), None)
-                }
-                None => {
-                    self.evaluations += 1;
-                    (self.problem.evaluate(self.model, &u), None)
-                }
+                Some(Ok(done)) => (Ok((done.r, done.readings)), Some(done.columns)),
+                Some(Err(e)) => (Err(e), None),
+                None => (self.problem.evaluate(self.model, &u), None),
             };
+            self.evaluations += columns.as_ref().map_or(1, |c| c.runs);
             if let Ok((r, table)) = trial {
                 let actual = cost0 - cost(&r);
                 if actual > 0.0 && predicted > 0.0 {

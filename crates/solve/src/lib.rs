@@ -132,7 +132,7 @@ pub fn solve(
 
 /// The sensors' readings at the output times, which the solver returns, replaced by what the
 /// data acquisition records of them (`docs/sensors.md` section 6: filter, sampling, noise).
-fn acquire_sensors(problem: &Problem, response: &mut Response) {
+pub(crate) fn acquire_sensors(problem: &Problem, response: &mut Response) {
     if let Some(raw) = response.sensors.take() {
         response.sensors = Some(problem.sensors().acquire(&raw, problem.time().t_end));
     }

@@ -40,11 +40,10 @@ pub fn sensor_slopes(
     }
     flexstar_kinematics::check_problem_sensor_mounts(problem)?;
     let sens = flexstar_amm::solve_with_sensitivities(problem, settings, moved, eps)?;
-    let (sensors, t_end) = (problem.sensors(), problem.time().t_end);
     let mut response = sens.response;
-    response.sensors = response.sensors.take().map(|raw| sensors.acquire(&raw, t_end));
+    crate::acquire_sensors(problem, &mut response);
     let slopes = (sens.sensors.unwrap_or_default().iter())
-        .map(|raw| sensors.acquire_derivative(raw, t_end))
+        .map(|raw| problem.sensors().acquire_derivative(raw, problem.time().t_end))
         .collect();
     Ok(SensorSlopes { response, slopes })
 }
